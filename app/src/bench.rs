@@ -1,0 +1,298 @@
+//! `vitreous bench`: the baseline and each requested effect set, alternated frame by frame in
+//! one process on one device, so their ratio is meaningful on a shared, noisy machine.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use serde::Serialize;
+use vitreous_render::renderer::Want;
+use vitreous_render::{ContextOptions, GpuContext, Look, Reflection, Renderer};
+use vitreous_xr::null::{NullBackend, NullConfig};
+use vitreous_xr::{Backend, FrameInput};
+
+use crate::defocus::{DefocusModel, DefocusSetup, LookPlanner};
+use crate::effects::EffectSet;
+use crate::gaze::GazeConfig;
+use crate::gaze::defocus::check_pupil_diameter_m;
+use crate::replay::{Spread, check_size};
+use crate::scene::load_scene;
+use crate::trace_cmd::synth_params_for;
+use crate::views;
+
+/// Frames of each variant rendered before timing starts (shaders compile on first use on
+/// some drivers, lavapipe among them).
+pub const WARM_UP_FRAMES: usize = 5;
+
+/// Options of a benchmark.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// Effect sets compared with the baseline.
+    pub effects: Vec<EffectSet>,
+    /// Eye image size, pixels.
+    pub size: (u32, u32),
+    /// Timed frames per variant.
+    pub frames: usize,
+    /// Reflected image with per-eye refraction.
+    pub reflection: Reflection,
+    /// Turn on validation (slows everything down; for checking, not timing).
+    pub validate: bool,
+    /// Pick the Vulkan device whose name contains this.
+    pub device: Option<String>,
+    /// Pupil diameters to sweep for effect sets with defocus, millimetres (empty: the
+    /// scene's).
+    pub pupils_mm: Vec<f32>,
+}
+
+/// One variant's figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct VariantResult {
+    /// Effect set name (and pupil diameter, for defocus).
+    pub effects: String,
+    /// Texture fetches per covered pixel of the glass, by the shader's structure.
+    pub fetches_per_pixel: u32,
+    /// GPU milliseconds per stereo frame.
+    pub gpu_ms: Option<Spread>,
+    /// CPU milliseconds per stereo frame (recording and submission).
+    pub cpu_ms: Option<Spread>,
+    /// Wall-clock milliseconds per stereo frame, submission to completion.
+    pub wall_ms: Option<Spread>,
+    /// Median GPU time over the baseline's.
+    pub gpu_ratio: Option<f64>,
+    /// Median CPU time over the baseline's.
+    pub cpu_ratio: Option<f64>,
+    /// Median wall time over the baseline's.
+    pub wall_ratio: Option<f64>,
+}
+
+/// A benchmark's result.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    /// The scene file.
+    pub scene: String,
+    /// Vulkan device.
+    pub device: String,
+    /// Vulkan driver.
+    pub driver: String,
+    /// Eye image width, pixels.
+    pub width_px: u32,
+    /// Eye image height, pixels.
+    pub height_px: u32,
+    /// Timed frames per variant.
+    pub frames: usize,
+    /// The baseline first, then each requested set.
+    pub variants: Vec<VariantResult>,
+}
+
+/// Texture fetches per covered pixel of the glass pass for a look (see shaders/glass.wgsl):
+/// blur-stack reads are one trilinear fetch whatever the blur.
+pub fn fetches_per_pixel(look: &Look) -> u32 {
+    let background = look.disparity || look.defocus.is_some();
+    match (background, look.reflection) {
+        (false, _) => 3,
+        (true, Reflection::Phong) => 2,
+        (true, Reflection::EnvironmentFresnel) => 3,
+    }
+}
+
+/// Runs the benchmark.
+pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
+    let scene = load_scene(&options.scene)?;
+    for set in &options.effects {
+        set.ensure_implemented()?;
+    }
+    check_size(options.size.0, options.size.1)?;
+    if options.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let mut sets = vec![EffectSet::NONE];
+    sets.extend(options.effects.iter().copied().filter(|e| *e != EffectSet::NONE));
+    let any_defocus = sets.iter().any(|e| e.defocus);
+    let setup = any_defocus.then(|| DefocusSetup::new(&scene, scene.viewer.pupil_diameter_m));
+    let pupils_m: Vec<f32> = if options.pupils_mm.is_empty() {
+        vec![scene.viewer.pupil_diameter_m]
+    } else {
+        options
+            .pupils_mm
+            .iter()
+            .map(|mm| check_pupil_diameter_m(mm / 1000.0))
+            .collect::<Result<_, _>>()?
+    };
+    // One variant per set, and per pupil diameter for sets with defocus; each with its own
+    // gaze pipeline over the same views.
+    let mut labels = Vec::new();
+    let mut planners = Vec::new();
+    for set in &sets {
+        let base = views::look(set, options.reflection);
+        match (&setup, set.defocus) {
+            (Some(setup), true) => {
+                for &pupil_m in &pupils_m {
+                    let model = DefocusModel {
+                        pupil_m,
+                        ..setup.model
+                    };
+                    labels.push(format!("{set} A_p={:.0}mm", pupil_m * 1000.0));
+                    planners.push(LookPlanner::new(
+                        base,
+                        Some((GazeConfig::new(model.distances), model)),
+                    ));
+                }
+            }
+            _ => {
+                labels.push(set.to_string());
+                planners.push(LookPlanner::new(base, None));
+            }
+        }
+    }
+
+    // The same views for every variant: a synthetic trace looking at the object.
+    let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(&scene))
+        .context("synthesising the benchmark's views")?
+        .samples;
+    let total = WARM_UP_FRAMES + options.frames;
+    let mut backend = NullBackend::new(
+        samples,
+        NullConfig {
+            frame_rate_hz: 60.0,
+            max_frames: None,
+            fov: scene.output.fov,
+            ipd_m: scene.viewer.ipd_m,
+        },
+    )?;
+    let mut inputs: Vec<FrameInput> = Vec::with_capacity(total);
+    while let Some(frame) = backend.wait_frame()? {
+        backend.end_frame(&frame)?;
+        inputs.push(frame);
+    }
+    let inputs: Vec<FrameInput> = inputs.into_iter().cycle().take(total).collect();
+
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: options.validate,
+        device_name: options.device.clone(),
+    })
+    .context("setting up the Vulkan device")?;
+    let (device, driver) = (ctx.device_name.clone(), ctx.driver.clone());
+    let (w, h) = options.size;
+    let mut renderer = Renderer::new(ctx, &views::scene_desc(&scene, setup.as_ref()), w, h)
+        .context("preparing the renderer")?;
+    drop(setup);
+
+    let n = planners.len();
+    let mut gpu = vec![Vec::new(); n];
+    let mut cpu = vec![Vec::new(); n];
+    let mut wall = vec![Vec::new(); n];
+    let mut looks = vec![Look::default(); n];
+    for (k, input) in inputs.iter().enumerate() {
+        for (v, planner) in planners.iter_mut().enumerate() {
+            let started = Instant::now();
+            let (look, _) = planner.plan(input);
+            looks[v] = look;
+            let params = views::frame_params(input, look);
+            renderer.submit(&params, Want::default())?;
+            let result = renderer.flush()?.pop().expect("one frame in flight");
+            let wall_ms = started.elapsed().as_secs_f64() * 1e3;
+            if k >= WARM_UP_FRAMES {
+                if let Some(g) = result.timing.gpu_ms {
+                    gpu[v].push(g);
+                }
+                cpu[v].push(result.timing.cpu_submit_ms);
+                wall[v].push(wall_ms);
+            }
+        }
+    }
+    let v = renderer.context().validation();
+    if v.errors() + v.warnings() > 0 {
+        bail!(
+            "the Vulkan validation layers reported {} errors and {} warnings; first: {}",
+            v.errors(),
+            v.warnings(),
+            v.messages().first().map(String::as_str).unwrap_or("")
+        );
+    }
+    let spreads: Vec<_> = (0..n)
+        .map(|i| {
+            (
+                Spread::of(gpu[i].iter().copied()),
+                Spread::of(cpu[i].iter().copied()),
+                Spread::of(wall[i].iter().copied()),
+            )
+        })
+        .collect();
+    let ratio = |a: Option<Spread>, b: Option<Spread>| match (a, b) {
+        (Some(a), Some(b)) if b.median_ms > 0.0 => Some(a.median_ms / b.median_ms),
+        _ => None,
+    };
+    let base = spreads[0];
+    let results = labels
+        .iter()
+        .zip(&looks)
+        .zip(&spreads)
+        .map(|((label, look), &(g, c, wl))| VariantResult {
+            effects: label.clone(),
+            fetches_per_pixel: fetches_per_pixel(look),
+            gpu_ms: g,
+            cpu_ms: c,
+            wall_ms: wl,
+            gpu_ratio: ratio(g, base.0),
+            cpu_ratio: ratio(c, base.1),
+            wall_ratio: ratio(wl, base.2),
+        })
+        .collect();
+    Ok(BenchReport {
+        scene: options.scene.display().to_string(),
+        device,
+        driver,
+        width_px: w,
+        height_px: h,
+        frames: options.frames,
+        variants: results,
+    })
+}
+
+impl BenchReport {
+    /// The report as a text table.
+    pub fn table(&self) -> String {
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "{} at {}x{} per eye on {} ({}), {} frames per variant, alternated",
+            self.scene, self.width_px, self.height_px, self.device, self.driver, self.frames
+        );
+        let _ = writeln!(
+            out,
+            "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7}",
+            "effects",
+            "fetch",
+            "GPU ms (p10-p90)",
+            "ratio",
+            "CPU ms (p10-p90)",
+            "ratio",
+            "wall ms (p10-p90)",
+            "ratio"
+        );
+        let cell = |s: Option<Spread>| {
+            s.map_or("n/a".to_string(), |s| {
+                format!("{:.2} ({:.2}-{:.2})", s.median_ms, s.p10_ms, s.p90_ms)
+            })
+        };
+        let r = |x: Option<f64>| x.map_or("n/a".to_string(), |x| format!("{x:.3}"));
+        for v in &self.variants {
+            let _ = writeln!(
+                out,
+                "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7}",
+                v.effects,
+                v.fetches_per_pixel,
+                cell(v.gpu_ms),
+                r(v.gpu_ratio),
+                cell(v.cpu_ms),
+                r(v.cpu_ratio),
+                cell(v.wall_ms),
+                r(v.wall_ratio)
+            );
+        }
+        out
+    }
+}

@@ -1,0 +1,110 @@
+//! The one frame loop, driven by any XR backend: wait for a frame, turn its views into the
+//! renderer's parameters, render (into the renderer's own images, or the backend's swapchain
+//! image for the frame), end the frame, and hand finished frames to a sink.
+
+use std::collections::VecDeque;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use vitreous_render::renderer::{FrameResult, Want};
+use vitreous_render::{Look, Renderer};
+use vitreous_xr::{Backend, FrameInput, FrameTarget};
+
+use crate::views;
+
+/// How one frame is drawn and what comes back of it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FramePlan {
+    /// Which layers are drawn, and how.
+    pub look: Look,
+    /// What to read back.
+    pub want: Want,
+}
+
+/// Plans frames and receives them as they finish on the GPU.
+pub trait FrameSink {
+    /// Sees each frame's input as soon as the backend hands it out (e.g. to record it).
+    fn started(&mut self, _input: &FrameInput) -> Result<()> {
+        Ok(())
+    }
+
+    /// How to draw this frame and what to read back of it.
+    fn plan(&mut self, input: &FrameInput) -> FramePlan;
+
+    /// Handles a finished frame (its input and its results), in frame order.
+    fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()>;
+}
+
+/// Timing of one frame, as `summary.json` reports it.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct FrameRecord {
+    /// Frame index.
+    pub index: u64,
+    /// Display time of the frame, nanoseconds on the backend's clock.
+    pub time_ns: i64,
+    /// CPU time the frame itself costs (view set-up, command recording, submission; not the
+    /// wait for an earlier frame's slot), milliseconds.
+    pub cpu_ms: f64,
+    /// GPU time of the frame's rendering, milliseconds (`null` without timestamp support).
+    pub gpu_ms: Option<f64>,
+    /// Defocus kernel width K_g (eq. 13) of the refracted image, background photo pixels
+    /// (`null` without defocus, or while the gaze image is unknown).
+    pub refracted_k_g_px: Option<f32>,
+    /// Defocus kernel width K_g of the surface image, surface texture pixels.
+    pub surface_k_g_px: Option<f32>,
+}
+
+/// Runs frames until the backend ends the session; returns each frame's timing.
+pub fn run<B: Backend>(
+    backend: &mut B,
+    renderer: &mut Renderer,
+    sink: &mut dyn FrameSink,
+) -> Result<Vec<FrameRecord>> {
+    let mut in_flight: VecDeque<(FrameInput, f64, Look)> = VecDeque::new();
+    let mut records = Vec::new();
+    while let Some(input) = backend.wait_frame().context("waiting for the next frame")? {
+        sink.started(&input)?;
+        let started = Instant::now();
+        let plan = sink.plan(&input);
+        let params = views::frame_params(&input, plan.look);
+        let prepare_ms = started.elapsed().as_secs_f64() * 1e3;
+        let done = match backend.frame_target() {
+            FrameTarget::Own => renderer.submit(&params, plan.want),
+            FrameTarget::Swapchain {
+                index,
+                world_behind,
+            } => renderer.submit_external(index as usize, &params, plan.want, world_behind),
+        }
+        .context("rendering a frame")?;
+        backend.end_frame(&input).context("ending a frame")?;
+        in_flight.push_back((input, prepare_ms, plan.look));
+        if let Some(result) = done {
+            finish(&mut in_flight, sink, &mut records, result)?;
+        }
+    }
+    for result in renderer.flush().context("finishing the last frames")? {
+        finish(&mut in_flight, sink, &mut records, result)?;
+    }
+    Ok(records)
+}
+
+/// Hands the oldest frame in flight, now finished, to the sink and records its timing.
+fn finish(
+    in_flight: &mut VecDeque<(FrameInput, f64, Look)>,
+    sink: &mut dyn FrameSink,
+    records: &mut Vec<FrameRecord>,
+    result: FrameResult,
+) -> Result<()> {
+    let (input, prepare_ms, look) = in_flight.pop_front().expect("a frame in flight per result");
+    sink.finished(&input, &result)?;
+    records.push(FrameRecord {
+        index: input.index,
+        time_ns: input.time_ns,
+        cpu_ms: prepare_ms + result.timing.cpu_submit_ms,
+        gpu_ms: result.timing.gpu_ms,
+        refracted_k_g_px: look.defocus.map(|d| d.refracted_k_g_px),
+        surface_k_g_px: look.defocus.map(|d| d.surface_k_g_px),
+    });
+    Ok(())
+}

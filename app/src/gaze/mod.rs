@@ -1,0 +1,118 @@
+//! Gaze: from eye-tracker samples to the gaze image and the focus distance, and the defocus
+//! that follows from them (METHOD.md sections 4 and 5, paper eq. 9-15).
+//!
+//! Per frame, [`GazePipeline::update`] runs:
+//! 1. [`vergence`]: the fixation depth of the newest tracker sample (closest approach of the
+//!    two gaze rays), held through blinks for a bounded time;
+//! 2. [`filter`]: eq. 15's 20-sample moving average (or a lower-latency alternative) over
+//!    tracker samples, each ingested once however many frames see it;
+//! 3. [`image`]: the gaze image (surface or refracted) with hysteresis, or the experimenter's
+//!    override; the focus distance d_f is that image's distance.
+//!
+//! [`defocus`] then turns d_f into the blur of the image not looked at (eq. 10-14).
+//! `docs/gaze.md` maps each equation to its function.
+
+pub mod defocus;
+pub mod filter;
+pub mod image;
+pub mod vergence;
+
+pub use defocus::{DefocusError, GaussianKernel, ImageBlur, blur_reference, image_blur};
+pub use filter::{DepthFilter, FilterKind, FilterParseError, OneEuroParams, SampleFilter};
+pub use image::{GazeImage, GazeOverride, ImageDistances, ImageSelector};
+pub use vergence::{FixationDepth, VergenceConfig, VergenceEstimator};
+
+use vitreous_xr::GazeSample;
+
+/// Everything the gaze pipeline needs to know.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GazeConfig {
+    /// Vergence estimation (depth caps, blink hold time).
+    pub vergence: VergenceConfig,
+    /// Which depth filter runs.
+    pub filter: FilterKind,
+    /// Distances of the surface and refracted images from the head, metres.
+    pub distances: ImageDistances,
+    /// Hysteresis band of the gaze-image decision, fraction of the log gap (see [`image`]).
+    pub band: f32,
+    /// The experimenter's override.
+    pub override_image: GazeOverride,
+}
+
+impl GazeConfig {
+    /// Defaults (eq. 15 filter, 10 m cap, 300 ms hold, band 0.2, auto) for given distances.
+    pub fn new(distances: ImageDistances) -> Self {
+        GazeConfig {
+            vergence: VergenceConfig::default(),
+            filter: FilterKind::default(),
+            distances,
+            band: image::DEFAULT_BAND,
+            override_image: GazeOverride::Auto,
+        }
+    }
+}
+
+/// The gaze pipeline's output for one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GazeState {
+    /// Fixation depth of the newest tracker sample (held through blinks), unfiltered.
+    pub raw_depth: FixationDepth,
+    /// The filtered depth (sample time = newest sample ingested).
+    pub filtered_depth: FixationDepth,
+    /// The gaze image after the override.
+    pub image: GazeImage,
+    /// d_f: the distance of the gaze image from the head, metres; `None` while unknown (no
+    /// defocus then).
+    pub focus_distance_m: Option<f32>,
+}
+
+/// Vergence, filter and gaze-image selection, run once per frame.
+#[derive(Debug)]
+pub struct GazePipeline {
+    /// Settings it was built with.
+    config: GazeConfig,
+    /// Stage 1.
+    vergence: VergenceEstimator,
+    /// Stage 2.
+    filter: SampleFilter,
+    /// Stage 3.
+    selector: ImageSelector,
+}
+
+impl GazePipeline {
+    /// A pipeline with no history.
+    pub fn new(config: GazeConfig) -> Self {
+        GazePipeline {
+            config,
+            vergence: VergenceEstimator::new(config.vergence),
+            filter: SampleFilter::new(config.filter),
+            selector: ImageSelector::new(config.distances, config.band),
+        }
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &GazeConfig {
+        &self.config
+    }
+
+    /// Changes the override (e.g. a live experimenter action); the tracking state is kept.
+    pub fn set_override(&mut self, override_image: GazeOverride) {
+        self.config.override_image = override_image;
+    }
+
+    /// Runs one frame: `gaze` is the newest tracker sample at or before the frame (as in
+    /// `FrameInput::gaze`), `head_time_ns` the frame's time (used for the blink-hold timeout
+    /// only when there is no sample).
+    pub fn update(&mut self, gaze: Option<&GazeSample>, head_time_ns: i64) -> GazeState {
+        let raw_depth = self.vergence.update(gaze, head_time_ns);
+        let filtered_depth = self.filter.feed(&raw_depth);
+        let tracked = self.selector.update(filtered_depth.depth_m());
+        let image = self.config.override_image.apply(tracked);
+        GazeState {
+            raw_depth,
+            filtered_depth,
+            image,
+            focus_distance_m: self.config.distances.of(image),
+        }
+    }
+}

@@ -1,0 +1,346 @@
+//! Fixation depth from the two eyes' gaze rays (METHOD.md section 5: "the intersection
+//! (closest approach) of the calibrated left and right gaze rays").
+//!
+//! # Definition of depth
+//! With eye origins `o_l`, `o_r` and unit directions `d_l`, `d_r` (head frame), the fixation
+//! point `p` is the midpoint of the shortest segment between the two rays. Its depth is
+//! measured from the midpoint between the eyes `m = (o_l + o_r) / 2` along the combined
+//! forward direction `f = normalize(d_l + d_r)` (the bisector of the two gaze directions):
+//! `depth_m = (p - m) . f`. For a fixated point this differs from the Euclidean distance
+//! `|p - m|` by the cosine of the angle between `f` and the direction to `p`, which is below
+//! 1e-4 relative for any fixation a tracker can measure; unlike the Euclidean distance it
+//! stays signed, so a crossing behind the eyes is recognisable.
+//!
+//! # Degenerate cases
+//! - **Near-parallel rays** (vergence angle below what gives [`VergenceConfig::max_depth_m`])
+//!   are a far fixation: the depth is reported as `max_depth_m`.
+//! - **Divergent rays** (the closest approach lies behind either eye): with the tracker's
+//!   angular noise, rays aimed at a far point diverge about as often as they converge far
+//!   away, so by default they are also a far fixation at `max_depth_m`
+//!   ([`DivergentRays::Far`]). [`DivergentRays::Unknown`] treats them as no measurement
+//!   instead (held like a blink).
+//! - **Missing eyes** (blink, glare; either eye invalid): when the sample carries a ready
+//!   fixation point, its distance from the head origin (between the eyes) is used; else when
+//!   it carries a valid combined ray and one eye is valid, the closest approach of those two
+//!   rays is used (half the baseline, same definition of depth); each fallback is logged once
+//!   with `tracing::info!`. A combined ray alone has no depth. Otherwise the last known depth
+//!   is held for [`VergenceConfig::hold_ns`] of sample time, then the depth is
+//!   [`FixationDepth::Unknown`].
+
+use glam::{DVec3, Vec3};
+use vitreous_xr::{GazeRay, GazeSample};
+
+/// Default cap on the reported depth (far fixations and near-parallel rays), metres.
+pub const DEFAULT_MAX_DEPTH_M: f32 = 10.0;
+/// Default floor on the reported depth, metres (closer crossings are tracker error).
+pub const DEFAULT_MIN_DEPTH_M: f32 = 0.05;
+/// Default time a depth is held through invalid samples, nanoseconds (300 ms: longer than a
+/// normal blink, about 100-150 ms, short enough that a lost tracker is noticed).
+pub const DEFAULT_HOLD_NS: i64 = 300_000_000;
+
+/// A fixation depth, or none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FixationDepth {
+    /// A depth measured (or held) from a tracker sample.
+    Known {
+        /// Depth from the midpoint between the eyes along the gaze bisector, metres
+        /// (see the module docs), within `[min_depth_m, max_depth_m]`.
+        depth_m: f32,
+        /// Tracker time of the sample the depth was measured from, nanoseconds. A held depth
+        /// keeps the time of its sample, so filters do not count it twice.
+        sample_time_ns: i64,
+    },
+    /// No depth: no tracker, or no valid measurement for longer than the hold time.
+    Unknown,
+}
+
+impl FixationDepth {
+    /// The depth in metres, if known.
+    pub fn depth_m(&self) -> Option<f32> {
+        match *self {
+            FixationDepth::Known { depth_m, .. } => Some(depth_m),
+            FixationDepth::Unknown => None,
+        }
+    }
+
+    /// The tracker time of the measurement, if known.
+    pub fn sample_time_ns(&self) -> Option<i64> {
+        match *self {
+            FixationDepth::Known { sample_time_ns, .. } => Some(sample_time_ns),
+            FixationDepth::Unknown => None,
+        }
+    }
+}
+
+/// What divergent rays (closest approach behind the eyes) mean.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DivergentRays {
+    /// A far fixation at `max_depth_m` (default: noise around a far target).
+    #[default]
+    Far,
+    /// No measurement: the last depth is held, like during a blink.
+    Unknown,
+}
+
+/// Settings of the vergence estimator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VergenceConfig {
+    /// Cap on the depth; near-parallel rays report this, metres.
+    pub max_depth_m: f32,
+    /// Floor on the depth, metres.
+    pub min_depth_m: f32,
+    /// How long the last depth is held through invalid samples, nanoseconds of sample time.
+    pub hold_ns: i64,
+    /// What divergent rays mean.
+    pub divergent: DivergentRays,
+}
+
+impl Default for VergenceConfig {
+    fn default() -> Self {
+        VergenceConfig {
+            max_depth_m: DEFAULT_MAX_DEPTH_M,
+            min_depth_m: DEFAULT_MIN_DEPTH_M,
+            hold_ns: DEFAULT_HOLD_NS,
+            divergent: DivergentRays::Far,
+        }
+    }
+}
+
+/// How two rays relate: where they cross, or why they do not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RayCrossing {
+    /// The closest approach lies in front of both origins.
+    Converge {
+        /// Depth from the midpoint of the origins along the bisector of the directions,
+        /// metres (may exceed any cap; not clamped).
+        depth_m: f32,
+        /// The fixation point (midpoint of the shortest segment), head frame, metres.
+        point_m: Vec3,
+    },
+    /// The rays are parallel within numerical precision: fixation at infinity.
+    Parallel,
+    /// The closest approach lies behind at least one origin.
+    Divergent,
+}
+
+/// The closest approach of two rays, with depth as defined in the module docs. Directions
+/// need not be normalised (they must be non-zero). Computed in f64: near-parallel rays
+/// make the f32 form cancel badly.
+pub fn closest_approach(a: &GazeRay, b: &GazeRay) -> RayCrossing {
+    let (oa, ob) = (a.origin.as_dvec3(), b.origin.as_dvec3());
+    let (da, db) = (
+        a.direction.as_dvec3().normalize(),
+        b.direction.as_dvec3().normalize(),
+    );
+    let w = oa - ob;
+    let cos = da.dot(db);
+    let (d, e) = (da.dot(w), db.dot(w));
+    let denom = 1.0 - cos * cos;
+    // Below ~1e-7 rad of vergence (sin^2 ~ 1e-14) the depth is beyond 10^5 km for any
+    // eye baseline: call it parallel rather than divide by round-off.
+    if denom < 1e-14 {
+        return RayCrossing::Parallel;
+    }
+    let s = (cos * e - d) / denom;
+    let t = (e - cos * d) / denom;
+    if s <= 0.0 || t <= 0.0 {
+        return RayCrossing::Divergent;
+    }
+    let point = (oa + da * s + ob + db * t) / 2.0;
+    let mid = (oa + ob) / 2.0;
+    let forward = (da + db).try_normalize().unwrap_or(DVec3::NEG_Z);
+    RayCrossing::Converge {
+        depth_m: (point - mid).dot(forward) as f32,
+        point_m: point.as_vec3(),
+    }
+}
+
+/// Which fallback a sample needed; each is logged once per estimator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Fallback {
+    FixationPoint,
+    CombinedRay,
+    CombinedOnly,
+}
+
+/// Turns tracker samples into fixation depths, holding the last depth through blinks.
+#[derive(Clone, Debug)]
+pub struct VergenceEstimator {
+    /// Settings.
+    config: VergenceConfig,
+    /// The last measured depth and its sample time.
+    last_known: Option<(f32, i64)>,
+    /// Fallbacks already logged (indexed by `Fallback as usize`).
+    logged: [bool; 3],
+}
+
+impl VergenceEstimator {
+    /// An estimator with no history.
+    pub fn new(config: VergenceConfig) -> Self {
+        VergenceEstimator {
+            config,
+            last_known: None,
+            logged: [false; 3],
+        }
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &VergenceConfig {
+        &self.config
+    }
+
+    /// The depth for a frame: `gaze` is the newest tracker sample (if any), `now_ns` the
+    /// frame's time, used for the hold timeout only when there is no sample (with a sample,
+    /// the hold is measured in that sample's time).
+    pub fn update(&mut self, gaze: Option<&GazeSample>, now_ns: i64) -> FixationDepth {
+        let (now_ns, measured) = match gaze {
+            Some(g) => (g.sample_time_ns, self.measure(g)),
+            None => (now_ns, None),
+        };
+        if let Some(depth_m) = measured {
+            let depth_m = depth_m.clamp(self.config.min_depth_m, self.config.max_depth_m);
+            self.last_known = Some((depth_m, now_ns));
+            return FixationDepth::Known {
+                depth_m,
+                sample_time_ns: now_ns,
+            };
+        }
+        match self.last_known {
+            Some((depth_m, sample_time_ns))
+                if now_ns.saturating_sub(sample_time_ns) <= self.config.hold_ns =>
+            {
+                FixationDepth::Known {
+                    depth_m,
+                    sample_time_ns,
+                }
+            }
+            _ => {
+                self.last_known = None;
+                FixationDepth::Unknown
+            }
+        }
+    }
+
+    /// The unclamped depth one sample gives, or `None` when it gives none.
+    fn measure(&mut self, g: &GazeSample) -> Option<f32> {
+        let far = self.config.max_depth_m;
+        let from_crossing = |c: RayCrossing, divergent: DivergentRays| match c {
+            RayCrossing::Converge { depth_m, .. } => Some(depth_m.min(far)),
+            RayCrossing::Parallel => Some(far),
+            RayCrossing::Divergent => match divergent {
+                DivergentRays::Far => Some(far),
+                DivergentRays::Unknown => None,
+            },
+        };
+        if g.left.valid && g.right.valid {
+            return from_crossing(closest_approach(&g.left, &g.right), self.config.divergent);
+        }
+        if let Some(p) = g.fixation.filter(|p| p.is_finite()) {
+            self.log_once(Fallback::FixationPoint);
+            return Some(p.length());
+        }
+        let combined = g.combined.filter(|c| c.valid);
+        if let Some(c) = combined {
+            let eye = [g.left, g.right].into_iter().find(|r| r.valid);
+            if let Some(eye) = eye {
+                self.log_once(Fallback::CombinedRay);
+                return from_crossing(closest_approach(&c, &eye), self.config.divergent);
+            }
+            self.log_once(Fallback::CombinedOnly);
+        }
+        None
+    }
+
+    fn log_once(&mut self, which: Fallback) {
+        let seen = &mut self.logged[which as usize];
+        if *seen {
+            return;
+        }
+        *seen = true;
+        match which {
+            Fallback::FixationPoint => tracing::info!(
+                "gaze: a sample without two valid eye rays carries a fixation point; using its \
+                 distance from the head as the fixation depth"
+            ),
+            Fallback::CombinedRay => tracing::info!(
+                "gaze: a sample with one valid eye ray carries a combined ray; using their \
+                 closest approach as the fixation point"
+            ),
+            Fallback::CombinedOnly => tracing::info!(
+                "gaze: a sample carries only a combined gaze ray, which gives no depth; \
+                 holding the last depth"
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ray(origin: Vec3, target: Vec3) -> GazeRay {
+        GazeRay {
+            origin,
+            direction: (target - origin).normalize(),
+            valid: true,
+        }
+    }
+
+    fn sample(t_ns: i64, left: GazeRay, right: GazeRay) -> GazeSample {
+        GazeSample {
+            sample_time_ns: t_ns,
+            left,
+            right,
+            combined: None,
+            fixation: None,
+        }
+    }
+
+    #[test]
+    fn crossing_rays_give_the_target_depth() {
+        let (l, r) = (Vec3::new(-0.032, 0.0, 0.0), Vec3::new(0.032, 0.0, 0.0));
+        let target = Vec3::new(0.0, 0.0, -0.8);
+        match closest_approach(&ray(l, target), &ray(r, target)) {
+            RayCrossing::Converge { depth_m, point_m } => {
+                assert!((depth_m - 0.8).abs() < 1e-4, "{depth_m}");
+                assert!(point_m.distance(target) < 1e-4);
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn combined_ray_with_one_eye_is_used_when_the_other_eye_is_lost() {
+        let target = Vec3::new(0.0, 0.0, -0.5);
+        let left = ray(Vec3::new(-0.032, 0.0, 0.0), target);
+        let combined = ray(Vec3::ZERO, target);
+        let mut g = sample(0, left, GazeRay::INVALID);
+        g.combined = Some(combined);
+        let mut v = VergenceEstimator::new(VergenceConfig::default());
+        let d = v.update(Some(&g), 0).depth_m().unwrap();
+        assert!((d - 0.5).abs() < 1e-3, "{d}");
+        g.left = GazeRay::INVALID;
+        // Combined ray alone: no depth, the last one is held.
+        g.sample_time_ns = 10;
+        assert_eq!(v.update(Some(&g), 10).sample_time_ns(), Some(0));
+    }
+
+    #[test]
+    fn fixation_point_is_used_without_rays() {
+        let mut g = sample(5, GazeRay::INVALID, GazeRay::INVALID);
+        g.fixation = Some(Vec3::new(0.0, 0.3, -0.4));
+        let mut v = VergenceEstimator::new(VergenceConfig::default());
+        let d = v.update(Some(&g), 5).depth_m().unwrap();
+        assert!((d - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn no_sample_at_all_times_out_on_the_frame_clock() {
+        let (l, r) = (Vec3::new(-0.032, 0.0, 0.0), Vec3::new(0.032, 0.0, 0.0));
+        let t = Vec3::new(0.0, 0.0, -1.0);
+        let mut v = VergenceEstimator::new(VergenceConfig::default());
+        v.update(Some(&sample(0, ray(l, t), ray(r, t))), 0);
+        assert!(v.update(None, DEFAULT_HOLD_NS).depth_m().is_some());
+        assert_eq!(v.update(None, DEFAULT_HOLD_NS + 1), FixationDepth::Unknown);
+    }
+}

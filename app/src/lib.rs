@@ -1,0 +1,19 @@
+//! vitreous: perception-based virtual glass for optical see-through head-mounted displays.
+//!
+//! The library behind the `vitreous` command: scene files, the frame loop shared by every XR
+//! backend, trace replay and trace tools. Rendering lives in `vitreous-render`, XR backends and
+//! the trace format in `vitreous-xr`.
+
+pub mod bench;
+pub mod defocus;
+pub mod effects;
+pub mod frame_loop;
+pub mod gaze;
+pub mod output;
+pub mod reference_view;
+pub mod replay;
+pub mod run;
+pub mod scene;
+pub mod trace_analyze;
+pub mod trace_cmd;
+pub mod views;

@@ -1,0 +1,510 @@
+//! The `vitreous` command.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use vitreous::bench::{BenchOptions, bench};
+use vitreous::effects::EffectSet;
+use vitreous::gaze::{FilterKind, GazeOverride};
+use vitreous::replay::{GazeSettings, ReplayOptions, replay};
+use vitreous::trace_analyze::{analyze_trace_file, plot_trace_file};
+use vitreous::trace_cmd::{self, SynthOptions};
+use vitreous_render::Reflection;
+
+/// Perception-based virtual glass for optical see-through headsets.
+#[derive(Parser, Debug)]
+#[command(name = "vitreous", version, about, long_about = None)]
+struct Cli {
+    /// Log verbosity (error, warn, info, debug, trace); RUST_LOG overrides.
+    #[arg(long, global = true, default_value = "info")]
+    log: String,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run a scene on a live OpenXR runtime (a headset, or Monado): Vulkan through
+    /// XR_KHR_vulkan_enable2, additive blend when offered, gaze from the headset or a trace.
+    Run {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// End the session after N frames (default: until the runtime or Ctrl-C ends it).
+        #[arg(long, value_name = "N")]
+        frames: Option<u64>,
+        /// Replay gaze from this trace when the headset has no eye tracker.
+        #[arg(long, value_name = "FILE")]
+        gaze_trace: Option<PathBuf>,
+        /// Record head pose and gaze of every frame into this trace file.
+        #[arg(long, value_name = "FILE")]
+        record: Option<PathBuf>,
+        /// Turn on the Vulkan validation layers and the OpenXR core validation layer; any
+        /// Vulkan message fails the run.
+        #[arg(long)]
+        validate: bool,
+        /// Read back a submitted swapchain image and fail unless the object is in it.
+        #[arg(long)]
+        readback_check: bool,
+        /// Blend mode instead of the automatic choice: additive, alpha-blend, opaque.
+        #[arg(long, value_parser = parse_blend)]
+        blend: Option<vitreous_xr::openxr::Blend>,
+        /// Eye image size instead of the runtime's recommended one, e.g. 640x480.
+        #[arg(long, value_name = "WxH", value_parser = parse_size)]
+        size: Option<(u32, u32)>,
+        /// Effects, overriding the scene's (as for replay).
+        #[arg(long, value_name = "LIST", value_parser = parse_effects)]
+        effects: Option<EffectSet>,
+        /// Folder for summary.json (default: none written).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Replay a head/eye trace through the frame loop on a Vulkan device and write per-eye
+    /// images, see-through previews and summary.json.
+    Replay {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Trace to replay (vitreous trace format v1); default: a synthetic trace for the scene.
+        #[arg(long)]
+        trace: Option<PathBuf>,
+        /// Output folder; default out/<scene name>.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Stop after N frames.
+        #[arg(long, value_name = "N")]
+        frames: Option<u64>,
+        /// Save every K-th frame (0: none).
+        #[arg(long, value_name = "K", default_value_t = 30)]
+        save_every: u64,
+        /// Eye image size overriding the scene's, e.g. 640x480.
+        #[arg(long, value_name = "WxH", value_parser = parse_size)]
+        size: Option<(u32, u32)>,
+        /// Turn on the Vulkan validation layers (with synchronisation validation); any message
+        /// fails the run.
+        #[arg(long)]
+        validate: bool,
+        /// Effects, overriding the scene's: none, disparity, defocus, inducer, caustics, all,
+        /// or a condition (O2..O5, a, b, c); comma-separated.
+        #[arg(long, value_name = "LIST", value_parser = parse_effects)]
+        effects: Option<EffectSet>,
+        /// Use the Vulkan device whose name contains this.
+        #[arg(long)]
+        device: Option<String>,
+        /// Display frame rate of the replay, hertz.
+        #[arg(long, value_name = "HZ", default_value_t = 60.0)]
+        rate: f64,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+        /// Reflected image with per-eye refraction: a Phong highlight of the scene's light
+        /// (the paper's choice) or the environment map with a Fresnel term.
+        #[arg(long, value_enum, default_value_t = ReflectionArg::Phong)]
+        reflection: ReflectionArg,
+        /// Also write each saved eye image beside the CPU ray-traced reference of its
+        /// refraction layer (for sphere scenes: the object's bounding sphere is traced).
+        #[arg(long)]
+        reference: bool,
+        /// Gaze image: auto (from the wearer's fixation depth), or forced to surface or
+        /// refracted, as the paper's experimenter did.
+        #[arg(long, value_name = "IMAGE", default_value = "auto")]
+        gaze_image: GazeOverride,
+        /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, ...
+        #[arg(long, value_name = "FILTER", default_value = "mean20")]
+        filter: FilterKind,
+        /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
+        #[arg(long = "pupil-mm", value_name = "MM")]
+        pupil_mm: Option<f32>,
+    },
+    /// Compare the frame time of the baseline and of effect sets, alternated frame by frame
+    /// in one process on one device; prints medians, spreads and ratios to the baseline.
+    Bench {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// An effect set to compare with the baseline (repeatable), e.g. O4 or disparity.
+        #[arg(long, value_name = "LIST", value_parser = parse_effects, default_value = "O4")]
+        effects: Vec<EffectSet>,
+        /// Eye image size (the Magic Leap One's by default).
+        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "1280x960")]
+        size: (u32, u32),
+        /// Timed frames per variant.
+        #[arg(long, value_name = "N", default_value_t = 60)]
+        frames: usize,
+        /// Reflected image with per-eye refraction.
+        #[arg(long, value_enum, default_value_t = ReflectionArg::Phong)]
+        reflection: ReflectionArg,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Turn on validation (for checking, not timing).
+        #[arg(long)]
+        validate: bool,
+        /// Use the Vulkan device whose name contains this.
+        #[arg(long)]
+        device: Option<String>,
+        /// Pupil diameters to sweep for effect sets with defocus, millimetres, e.g. 2,4,6,8.
+        #[arg(long = "pupil-mm", value_name = "MM", value_delimiter = ',')]
+        pupils_mm: Vec<f32>,
+    },
+    /// Trace tools.
+    Trace {
+        #[command(subcommand)]
+        command: TraceCommand,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum TraceCommand {
+    /// Report, for the default depth filter and each alternative, the gaze-image switch
+    /// latency and the number of switches on a trace (paper eq. 15 and its alternatives).
+    Analyze {
+        /// The trace.
+        trace: PathBuf,
+        /// Scene giving the surface and refracted image distances.
+        #[arg(long)]
+        scene: PathBuf,
+        /// Filters to compare (repeatable): mean20, mean:N, median5, median:N,
+        /// one-euro[:min_cutoff=..,beta=..,d_cutoff=..,pre_median=..]; default all.
+        #[arg(long = "filter", value_name = "FILTER")]
+        filters: Vec<FilterKind>,
+    },
+    /// Plot raw and filtered fixation depth over time with the gaze-image decisions (like
+    /// the paper's Fig. 11).
+    Plot {
+        /// The trace.
+        trace: PathBuf,
+        /// Scene giving the surface and refracted image distances.
+        #[arg(long)]
+        scene: PathBuf,
+        /// Output PNG.
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Filters to draw (repeatable); default all.
+        #[arg(long = "filter", value_name = "FILTER")]
+        filters: Vec<FilterKind>,
+    },
+    /// Import a recording from another tool into the vitreous trace format.
+    Import {
+        /// Recording format: sranipal (HTC Vive Pro Eye SRanipal CSV export).
+        #[arg(long)]
+        from: String,
+        /// The recording.
+        file: PathBuf,
+        /// Output trace file.
+        #[arg(short, long)]
+        out: PathBuf,
+    },
+    /// Synthesise a trace for a scene: the head at the viewer's position, the gaze
+    /// alternating between the object's surface and the refracted background, tracker noise
+    /// and blinks.
+    Synth {
+        /// Scene the trace is for.
+        #[arg(long, default_value = "config/scenes/visual-effects.toml")]
+        scene: PathBuf,
+        /// Output trace file.
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Length, seconds.
+        #[arg(long, default_value_t = 12.0)]
+        duration: f32,
+        /// Tracker sample rate, hertz.
+        #[arg(long, default_value_t = 30.0)]
+        rate: f32,
+        /// Seconds between gaze switches.
+        #[arg(long, default_value_t = 3.0)]
+        switch_period: f32,
+        /// Random seed (the same seed gives the same trace).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+}
+
+/// How the reflected image is drawn.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum ReflectionArg {
+    /// Phong highlight of the scene's point light.
+    Phong,
+    /// Environment map in the mirror direction, weighted by the Fresnel term.
+    Environment,
+}
+
+impl From<ReflectionArg> for Reflection {
+    fn from(r: ReflectionArg) -> Reflection {
+        match r {
+            ReflectionArg::Phong => Reflection::Phong,
+            ReflectionArg::Environment => Reflection::EnvironmentFresnel,
+        }
+    }
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT like 1280x960, got '{s}'"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("expected WIDTHxHEIGHT with whole numbers, got '{s}'"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+fn parse_blend(s: &str) -> Result<vitreous_xr::openxr::Blend, String> {
+    vitreous_xr::openxr::Blend::parse(s)
+        .ok_or_else(|| format!("expected additive, alpha-blend or opaque, got '{s}'"))
+}
+
+fn parse_effects(s: &str) -> Result<EffectSet, String> {
+    EffectSet::parse(s).map_err(|e| e.to_string())
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Run {
+            scene,
+            frames,
+            gaze_trace,
+            record,
+            validate,
+            readback_check,
+            blend,
+            size,
+            effects,
+            out,
+        } => {
+            let s = vitreous::run::run(&vitreous::run::RunOptions {
+                scene,
+                frames,
+                gaze_trace,
+                record,
+                validate,
+                readback_check,
+                blend,
+                size,
+                effects,
+                out,
+                ..Default::default()
+            })?;
+            println!(
+                "session on {} ({}): states {}; {} frames submitted ({} skipped) at {}x{} per \
+                 eye, {:.1} frames/s; blend {}; gaze {}; ended: {}",
+                s.runtime,
+                s.system,
+                s.states.join(" > "),
+                s.frames_submitted,
+                s.frames_skipped,
+                s.width_px,
+                s.height_px,
+                s.frames_per_second,
+                s.blend,
+                s.gaze_source,
+                s.end_reason
+            );
+            println!(
+                "vulkan validation: {} errors, {} warnings (enabled: {})",
+                s.validation.errors, s.validation.warnings, s.validation.enabled
+            );
+            if let Some(c) = &s.readback {
+                println!(
+                    "readback of frame {}: object in {:.1} % of its region ({} of {} px), mean {:.1}",
+                    c.frame,
+                    c.object_fraction * 100.0,
+                    c.object_px,
+                    c.region_px,
+                    c.mean_value
+                );
+            }
+            if let Some(r) = &s.replay_check {
+                println!(
+                    "recording replayed: {} samples, {} frames; max head difference {:.2e} m, \
+                     {:.2e} deg; max eye position difference {:.4} m",
+                    r.samples,
+                    r.frames,
+                    r.max_head_position_m,
+                    r.max_head_angle_deg,
+                    r.max_eye_position_m
+                );
+            }
+            Ok(())
+        }
+        Command::Replay {
+            scene,
+            trace,
+            out,
+            frames,
+            save_every,
+            size,
+            validate,
+            effects,
+            device,
+            rate,
+            quiet,
+            reflection,
+            reference,
+            gaze_image,
+            filter,
+            pupil_mm,
+        } => {
+            let out = match out {
+                Some(out) => out,
+                None => {
+                    let stem = scene
+                        .file_stem()
+                        .context("the scene path has no file name")?;
+                    PathBuf::from("out").join(stem)
+                }
+            };
+            if let Some((w, h)) = size {
+                vitreous::replay::check_size(w, h)?;
+            }
+            let summary = replay(&ReplayOptions {
+                scene,
+                trace,
+                out: out.clone(),
+                frames,
+                save_every,
+                size,
+                validate,
+                effects,
+                device,
+                frame_rate_hz: rate,
+                progress: !quiet,
+                reflection: reflection.into(),
+                reference,
+                gaze: GazeSettings {
+                    filter,
+                    image: gaze_image,
+                    pupil_mm,
+                },
+            })?;
+            println!(
+                "rendered {} frames of {}x{} per eye on {} in {:.1} s ({:.1} frames/s; median \
+                 GPU {} ms, CPU {:.2} ms per stereo frame)",
+                summary.frames,
+                summary.width_px,
+                summary.height_px,
+                summary.device,
+                summary.wall_s,
+                summary.frames_per_second,
+                summary
+                    .gpu_ms
+                    .map_or("n/a".to_string(), |s| format!("{:.2}", s.median_ms)),
+                summary.cpu_ms.map_or(f64::NAN, |s| s.median_ms),
+            );
+            println!(
+                "wrote {} images and {} to {}",
+                summary.saved.len(),
+                "summary.json",
+                out.display()
+            );
+            Ok(())
+        }
+        Command::Bench {
+            scene,
+            effects,
+            size,
+            frames,
+            reflection,
+            json,
+            validate,
+            device,
+            pupils_mm,
+        } => {
+            let report = bench(&BenchOptions {
+                scene,
+                effects,
+                size,
+                frames,
+                reflection: reflection.into(),
+                validate,
+                device,
+                pupils_mm,
+            })?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else {
+                print!("{}", report.table());
+            }
+            Ok(())
+        }
+        Command::Trace { command } => match command {
+            TraceCommand::Analyze {
+                trace,
+                scene,
+                filters,
+            } => {
+                print!("{}", analyze_trace_file(&trace, &scene, &filters)?);
+                Ok(())
+            }
+            TraceCommand::Plot {
+                trace,
+                scene,
+                out,
+                filters,
+            } => {
+                plot_trace_file(&trace, &scene, &filters, &out)?;
+                println!("wrote {}", out.display());
+                Ok(())
+            }
+            TraceCommand::Import { from, file, out } => {
+                println!("{}", trace_cmd::import(&from, &file, &out)?);
+                Ok(())
+            }
+            TraceCommand::Synth {
+                scene,
+                out,
+                duration,
+                rate,
+                switch_period,
+                seed,
+            } => {
+                if !scene.exists() {
+                    bail!(
+                        "scene {} not found; pass --scene SCENE (the trace is made for a scene)",
+                        scene.display()
+                    );
+                }
+                let options = SynthOptions {
+                    duration_s: duration,
+                    rate_hz: rate,
+                    switch_period_s: switch_period,
+                    seed,
+                };
+                println!("{}", trace_cmd::synth(&scene, &options, &out)?);
+                Ok(())
+            }
+        },
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if e.use_stderr() => {
+            // One paragraph, like every other error: clap's own text without its trailer.
+            let text = e.to_string();
+            let first = text.split("\n\n").next().unwrap_or_default().trim();
+            eprintln!("{first} (see --help)");
+            return ExitCode::from(2);
+        }
+        Err(e) => {
+            // --help and --version.
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(format!("{},naga=warn", cli.log)));
+    tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_target(false)
+        .init();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

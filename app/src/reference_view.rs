@@ -1,0 +1,71 @@
+//! The debug output of `vitreous replay --reference`: each saved eye image beside the CPU
+//! reference of its refraction layer (render/src/reference.rs), for scenes whose object is a
+//! sphere (the reference traces the analytic sphere of the object's bounding sphere).
+
+use glam::Vec2;
+use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sample};
+use vitreous_xr::FrameInput;
+
+use crate::scene::{PixelData, Scene};
+use crate::views::eye_params;
+
+/// Grey level shown where the refracted ray misses the background photo (the renderer shows
+/// the environment map there).
+const MISS_GREY: u8 = 40;
+
+/// The analytic sphere of a scene: its object's bounding sphere.
+pub fn sphere_of(scene: &Scene) -> SphereScene {
+    SphereScene {
+        center_m: scene.object.center_m,
+        radius_m: scene.object.radius_m,
+        ior: scene.object.ior,
+        background_from_world: scene.background.world_from_plane().inverse(),
+    }
+}
+
+/// An RGBA8 image twice as wide as an eye image: the GPU's eye image on the left, the CPU
+/// reference of the refraction layer on the right (the background photo's texel at
+/// `(u_c, v_c)`, black off the sphere, grey where the ray misses the photo).
+pub fn side_by_side(
+    scene: &Scene,
+    input: &FrameInput,
+    eye: usize,
+    gpu: &[u8],
+    size: (u32, u32),
+) -> Vec<u8> {
+    let (w, h) = size;
+    let camera = eye_params(&input.views[eye]);
+    let sphere = sphere_of(scene);
+    let dims = Vec2::new(w as f32, h as f32);
+    let photo = &scene.background.photo;
+    let mut out = vec![0u8; (w * 2 * h * 4) as usize];
+    for y in 0..h {
+        let row = (y * w * 2 * 4) as usize;
+        let src = (y * w * 4) as usize;
+        out[row..row + (w * 4) as usize].copy_from_slice(&gpu[src..src + (w * 4) as usize]);
+        for x in 0..w {
+            let pixel = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let rgba = match refraction_sample(&camera, pixel, dims, &sphere) {
+                RefractionSample::Miss => [0, 0, 0, 255],
+                RefractionSample::Hit { uv: None, .. } => [MISS_GREY, MISS_GREY, MISS_GREY, 255],
+                RefractionSample::Hit { uv: Some(uv), .. } => {
+                    texel(&photo.data, photo.width, photo.height, uv)
+                }
+            };
+            let i = row + ((w + x) * 4) as usize;
+            out[i..i + 4].copy_from_slice(&rgba);
+        }
+    }
+    out
+}
+
+/// The nearest texel of an sRGB photo at texture coordinates `uv`.
+fn texel(data: &PixelData, width: u32, height: u32, uv: Vec2) -> [u8; 4] {
+    let x = ((uv.x * width as f32) as u32).min(width - 1);
+    let y = ((uv.y * height as f32) as u32).min(height - 1);
+    let i = ((y * width + x) * 4) as usize;
+    match data {
+        PixelData::Srgb8(bytes) => [bytes[i], bytes[i + 1], bytes[i + 2], 255],
+        PixelData::LinearF32(_) => [255, 0, 255, 255],
+    }
+}

@@ -1,0 +1,377 @@
+//! `vitreous replay`: a recorded (or synthesised) trace through the real frame loop on a real
+//! Vulkan device, writing per-eye images, see-through previews and `summary.json`.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use vitreous_render::renderer::{FrameResult, Want};
+use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
+use vitreous_xr::FrameInput;
+use vitreous_xr::null::{NullBackend, NullConfig};
+use vitreous_xr::trace::{TraceSample, read_trace};
+
+use crate::defocus::{DefocusSetup, LookPlanner};
+use crate::effects::EffectSet;
+use crate::gaze::defocus::check_pupil_diameter_m;
+use crate::gaze::{FilterKind, GazeConfig, GazeOverride};
+use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
+use crate::output::{self, write_atomic};
+use crate::reference_view::side_by_side;
+use crate::scene::{Scene, load_scene};
+use crate::trace_cmd::synth_params_for;
+use crate::views;
+
+/// Options of a replay.
+#[derive(Clone, Debug)]
+pub struct ReplayOptions {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// The trace to replay; `None` synthesises one for the scene.
+    pub trace: Option<PathBuf>,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Stop after this many frames.
+    pub frames: Option<u64>,
+    /// Save every K-th frame (0 saves none); the first frame is always saved when K > 0.
+    pub save_every: u64,
+    /// Eye image size overriding the scene's, pixels.
+    pub size: Option<(u32, u32)>,
+    /// Turn on the Vulkan validation layers; any message fails the replay.
+    pub validate: bool,
+    /// Effects overriding the scene's.
+    pub effects: Option<EffectSet>,
+    /// Pick the Vulkan device whose name contains this.
+    pub device: Option<String>,
+    /// Display frame rate of the replay, hertz.
+    pub frame_rate_hz: f64,
+    /// Show a progress bar.
+    pub progress: bool,
+    /// How the reflected image is drawn when per-eye refraction is on.
+    pub reflection: Reflection,
+    /// Also write each saved eye image beside the CPU reference of its refraction layer.
+    pub reference: bool,
+    /// Depth filter and gaze-image override of the gaze pipeline (used with defocus).
+    pub gaze: GazeSettings,
+}
+
+/// How the gaze pipeline runs (METHOD.md section 5).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GazeSettings {
+    /// Depth filter (eq. 15's 20-sample mean by default).
+    pub filter: FilterKind,
+    /// Experimenter override of the gaze image.
+    pub image: GazeOverride,
+    /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
+    pub pupil_mm: Option<f32>,
+}
+
+/// The per-frame look planner for a scene and effect set, and the defocus stacks to upload
+/// (built when defocus is on).
+pub fn planner_for(
+    scene: &Scene,
+    effects: &EffectSet,
+    reflection: Reflection,
+    gaze: &GazeSettings,
+) -> Result<(LookPlanner, Option<DefocusSetup>)> {
+    let base = views::look(effects, reflection);
+    if !effects.defocus {
+        return Ok((LookPlanner::new(base, None), None));
+    }
+    let pupil_m = match gaze.pupil_mm {
+        Some(mm) => check_pupil_diameter_m(mm / 1000.0)?,
+        None => scene.viewer.pupil_diameter_m,
+    };
+    let setup = DefocusSetup::new(scene, pupil_m);
+    let mut config = GazeConfig::new(setup.model.distances);
+    config.filter = gaze.filter;
+    config.override_image = gaze.image;
+    let planner = LookPlanner::new(base, Some((config, setup.model)));
+    Ok((planner, Some(setup)))
+}
+
+/// Median and spread of a timing.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Spread {
+    /// Median, milliseconds.
+    pub median_ms: f64,
+    /// 10th percentile, milliseconds.
+    pub p10_ms: f64,
+    /// 90th percentile, milliseconds.
+    pub p90_ms: f64,
+}
+
+impl Spread {
+    /// The spread of `values`, or `None` when empty.
+    pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Spread> {
+        let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+        Some(Spread {
+            median_ms: at(0.5),
+            p10_ms: at(0.1),
+            p90_ms: at(0.9),
+        })
+    }
+}
+
+/// Validation layer results.
+#[derive(Clone, Debug, Serialize)]
+pub struct ValidationSummary {
+    /// Whether the layers were on.
+    pub enabled: bool,
+    /// Warning messages.
+    pub warnings: u32,
+    /// Error messages.
+    pub errors: u32,
+    /// The first messages' texts.
+    pub messages: Vec<String>,
+}
+
+/// What `summary.json` holds.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReplaySummary {
+    /// vitreous version.
+    pub vitreous_version: String,
+    /// The scene file.
+    pub scene: String,
+    /// Hex SHA-256 of the scene and its assets.
+    pub scene_hash: String,
+    /// The replayed trace file, or "synthetic".
+    pub trace: String,
+    /// Effect set rendered.
+    pub effects: String,
+    /// Vulkan device name.
+    pub device: String,
+    /// Vulkan driver name and version.
+    pub driver: String,
+    /// Validation results.
+    pub validation: ValidationSummary,
+    /// Eye image width, pixels.
+    pub width_px: u32,
+    /// Eye image height, pixels.
+    pub height_px: u32,
+    /// Display frame rate replayed, hertz.
+    pub frame_rate_hz: f64,
+    /// Frames rendered.
+    pub frames: u64,
+    /// Frames rendered per second of wall-clock time, saving included.
+    pub frames_per_second: f64,
+    /// Wall-clock time of the frame loop, seconds.
+    pub wall_s: f64,
+    /// CPU milliseconds per stereo frame.
+    pub cpu_ms: Option<Spread>,
+    /// GPU milliseconds per stereo frame.
+    pub gpu_ms: Option<Spread>,
+    /// Files written, relative to the output folder.
+    pub saved: Vec<String>,
+    /// Every frame's timing.
+    pub per_frame: Vec<FrameRecord>,
+}
+
+/// The largest eye image side accepted, pixels.
+pub const MAX_SIZE_PX: u32 = 8192;
+
+/// Saves chosen frames while the loop runs.
+struct Saver<'a> {
+    dir: PathBuf,
+    /// Decides each frame's look (gaze-dependent defocus).
+    planner: LookPlanner,
+    /// The scene, when the CPU reference is written beside each saved eye.
+    reference: Option<&'a Scene>,
+    save_every: u64,
+    saved: Vec<String>,
+    progress: ProgressBar,
+}
+
+impl FrameSink for Saver<'_> {
+    fn plan(&mut self, input: &FrameInput) -> FramePlan {
+        let save = self.save_every > 0 && input.index.is_multiple_of(self.save_every);
+        FramePlan {
+            look: self.planner.plan(input).0,
+            want: Want {
+                eyes: save,
+                world: save,
+            },
+        }
+    }
+
+    fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()> {
+        self.progress.inc(1);
+        if let Some(readback) = &result.readback {
+            let names = output::write_frame(&self.dir, input.index, readback)?;
+            self.saved
+                .extend(names.into_iter().map(|n| format!("frames/{n}")));
+            if let Some(scene) = self.reference {
+                let size = (readback.width, readback.height);
+                for (eye, name) in output::EYE_NAMES.iter().enumerate() {
+                    let image = side_by_side(scene, input, eye, &readback.eyes[eye], size);
+                    let png = output::encode_png(&image, size.0 * 2, size.1)?;
+                    let file = format!("{:06}-{name}-reference.png", input.index);
+                    write_atomic(&self.dir.join(&file), &png)?;
+                    self.saved.push(format!("frames/{file}"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Loads the trace or synthesises one for the scene.
+fn load_trace(scene: &Scene, trace: Option<&Path>) -> Result<(Vec<TraceSample>, String)> {
+    match trace {
+        Some(path) => {
+            let samples =
+                read_trace(path).with_context(|| format!("reading trace {}", path.display()))?;
+            if samples.is_empty() {
+                bail!("trace {} has no samples: nothing to replay", path.display());
+            }
+            Ok((samples, path.display().to_string()))
+        }
+        None => {
+            tracing::info!("no --trace given: replaying a synthetic trace for the scene");
+            let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(scene))
+                .context("synthesising a trace for the scene")?
+                .samples;
+            Ok((samples, "synthetic".into()))
+        }
+    }
+}
+
+/// Runs a replay. All input is checked before anything is written.
+pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
+    let scene = load_scene(&options.scene)?;
+    let effects = options.effects.unwrap_or(scene.effects);
+    effects.ensure_implemented()?;
+    let (width, height) = options
+        .size
+        .unwrap_or((scene.output.width_px, scene.output.height_px));
+    check_size(width, height)?;
+    if !(options.frame_rate_hz.is_finite() && (1.0..=1000.0).contains(&options.frame_rate_hz)) {
+        bail!(
+            "--rate must be between 1 and 1000 Hz, got {}",
+            options.frame_rate_hz
+        );
+    }
+    let (samples, trace_name) = load_trace(&scene, options.trace.as_deref())?;
+    let expected_frames = expected_frames(&samples, options.frame_rate_hz, options.frames);
+    let mut backend = NullBackend::new(
+        samples,
+        NullConfig {
+            frame_rate_hz: options.frame_rate_hz,
+            max_frames: options.frames,
+            fov: scene.output.fov,
+            ipd_m: scene.viewer.ipd_m,
+        },
+    )
+    .with_context(|| format!("replaying {trace_name}"))?;
+
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: options.validate,
+        device_name: options.device.clone(),
+    })
+    .context("setting up the Vulkan device")?;
+    let (device, driver) = (ctx.device_name.clone(), ctx.driver.clone());
+    let (planner, defocus) = planner_for(&scene, &effects, options.reflection, &options.gaze)?;
+    let mut renderer = Renderer::new(ctx, &views::scene_desc(&scene, defocus.as_ref()), width, height)
+        .context("preparing the renderer")?;
+    drop(defocus);
+
+    let frames_dir = options.out.join("frames");
+    fs::create_dir_all(&frames_dir)
+        .with_context(|| format!("creating output folder {}", frames_dir.display()))?;
+    let progress = if options.progress {
+        let bar = ProgressBar::new(expected_frames);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} replay [{bar:30}] {pos}/{len} frames {per_sec} {eta}",
+            )
+            .expect("valid template")
+            .progress_chars("=> "),
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let mut saver = Saver {
+        dir: frames_dir,
+        reference: options.reference.then_some(&scene),
+        save_every: options.save_every,
+        planner,
+        saved: Vec::new(),
+        progress,
+    };
+    let started = Instant::now();
+    let records = frame_loop::run(&mut backend, &mut renderer, &mut saver)?;
+    let wall_s = started.elapsed().as_secs_f64();
+    saver.progress.finish_and_clear();
+
+    let v = renderer.context().validation();
+    let validation = ValidationSummary {
+        enabled: renderer.context().validation_enabled(),
+        warnings: v.warnings(),
+        errors: v.errors(),
+        messages: v.messages(),
+    };
+    let summary = ReplaySummary {
+        vitreous_version: env!("CARGO_PKG_VERSION").into(),
+        scene: options.scene.display().to_string(),
+        scene_hash: scene.hash.clone(),
+        trace: trace_name,
+        effects: effects.to_string(),
+        device,
+        driver,
+        validation,
+        width_px: width,
+        height_px: height,
+        frame_rate_hz: options.frame_rate_hz,
+        frames: records.len() as u64,
+        frames_per_second: records.len() as f64 / wall_s.max(1e-9),
+        wall_s,
+        cpu_ms: Spread::of(records.iter().map(|r| r.cpu_ms)),
+        gpu_ms: Spread::of(records.iter().filter_map(|r| r.gpu_ms)),
+        saved: saver.saved,
+        per_frame: records,
+    };
+    let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;
+    write_atomic(&options.out.join("summary.json"), &json)?;
+    if summary.validation.errors + summary.validation.warnings > 0 {
+        bail!(
+            "the Vulkan validation layers reported {} errors and {} warnings (see {}), first: {}",
+            summary.validation.errors,
+            summary.validation.warnings,
+            options.out.join("summary.json").display(),
+            summary
+                .validation
+                .messages
+                .first()
+                .map(String::as_str)
+                .unwrap_or("")
+        );
+    }
+    Ok(summary)
+}
+
+/// Refuses eye image sizes the renderer cannot or should not take.
+pub fn check_size(width: u32, height: u32) -> Result<()> {
+    if !(16..=MAX_SIZE_PX).contains(&width) || !(16..=MAX_SIZE_PX).contains(&height) {
+        bail!("eye image size {width}x{height} is outside 16..={MAX_SIZE_PX} pixels per side");
+    }
+    Ok(())
+}
+
+/// How many frames the null backend will give for `samples` at `rate_hz`.
+fn expected_frames(samples: &[TraceSample], rate_hz: f64, limit: Option<u64>) -> u64 {
+    let span_s = match (samples.first(), samples.last()) {
+        (Some(a), Some(b)) => (b.time_ns - a.time_ns) as f64 * 1e-9,
+        _ => 0.0,
+    };
+    let n = (span_s * rate_hz).floor() as u64 + 1;
+    limit.map_or(n, |l| n.min(l))
+}

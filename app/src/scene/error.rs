@@ -1,0 +1,276 @@
+//! Scene loading errors that point at the scene file's line and column.
+
+use std::fmt;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// A place in a scene file, 1-based like an editor shows it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Location {
+    /// The scene file, as given to [`super::load_scene`].
+    pub file: PathBuf,
+    /// Line number, starting at 1.
+    pub line: usize,
+    /// Column number in characters, starting at 1.
+    pub column: usize,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}", self.file.display(), self.line, self.column)
+    }
+}
+
+/// Why a scene could not be loaded. Every variant but [`SceneError::Read`] names the scene
+/// file, line and column, and the dotted field (`object.diameter_m`) it is about.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The scene file itself could not be read.
+    #[error("{}: cannot read the scene file: {source}", path.display())]
+    Read {
+        /// The scene file.
+        path: PathBuf,
+        /// What the operating system said.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML.
+    #[error("{at}: in `{field}`: TOML syntax error: {message}")]
+    Syntax {
+        /// Where the parser stopped.
+        at: Location,
+        /// The dotted key being parsed, as far as it could be told (`(top level)` if none).
+        field: String,
+        /// What the parser expected.
+        message: String,
+    },
+    /// Valid TOML, but a field is unknown, missing, of the wrong type or out of range.
+    #[error("{at}: `{field}`: {message}")]
+    Invalid {
+        /// Where the field (or its table, for a missing field) is.
+        at: Location,
+        /// The dotted field name.
+        field: String,
+        /// What was expected and what was found.
+        message: String,
+    },
+    /// A file the scene refers to is missing or broken.
+    #[error("{at}: `{field}`: {}: {reason}", asset.display())]
+    Asset {
+        /// Where the field naming the asset is.
+        at: Location,
+        /// The dotted field name.
+        field: String,
+        /// The asset file, resolved against the scene file's folder.
+        asset: PathBuf,
+        /// The underlying reason.
+        reason: String,
+    },
+}
+
+impl SceneError {
+    /// The location in the scene file, when there is one.
+    pub fn location(&self) -> Option<&Location> {
+        match self {
+            SceneError::Read { .. } => None,
+            SceneError::Syntax { at, .. }
+            | SceneError::Invalid { at, .. }
+            | SceneError::Asset { at, .. } => Some(at),
+        }
+    }
+
+    /// The dotted field name, when there is one.
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            SceneError::Read { .. } => None,
+            SceneError::Syntax { field, .. }
+            | SceneError::Invalid { field, .. }
+            | SceneError::Asset { field, .. } => Some(field),
+        }
+    }
+}
+
+/// The scene file's text and name, to turn byte offsets into [`Location`]s.
+pub(crate) struct Source<'a> {
+    /// The scene file path as given.
+    pub file: &'a Path,
+    /// Its text.
+    pub text: &'a str,
+}
+
+impl Source<'_> {
+    /// The location of a byte offset (clamped to the text).
+    pub fn location(&self, offset: usize) -> Location {
+        let mut offset = offset.min(self.text.len());
+        while !self.text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let before = &self.text[..offset];
+        let line = before.matches('\n').count() + 1;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let column = before[line_start..].chars().count() + 1;
+        Location {
+            file: self.file.to_path_buf(),
+            line,
+            column,
+        }
+    }
+
+    /// An [`SceneError::Invalid`] at a span.
+    pub fn invalid(
+        &self,
+        span: Range<usize>,
+        field: &str,
+        message: impl Into<String>,
+    ) -> SceneError {
+        SceneError::Invalid {
+            at: self.location(span.start),
+            field: field.to_owned(),
+            message: message.into(),
+        }
+    }
+
+    /// An [`SceneError::Asset`] at a span.
+    pub fn asset(
+        &self,
+        span: Range<usize>,
+        field: &str,
+        asset: &Path,
+        reason: impl Into<String>,
+    ) -> SceneError {
+        SceneError::Asset {
+            at: self.location(span.start),
+            field: field.to_owned(),
+            asset: asset.to_path_buf(),
+            reason: reason.into(),
+        }
+    }
+
+    /// Converts a `toml` parse or deserialisation error, recovering the dotted field name
+    /// from the error's span.
+    pub fn toml_error(&self, err: &toml::de::Error) -> SceneError {
+        let offset = err.span().map_or(0, |s| s.start);
+        let at = self.location(offset);
+        let message = err.message().trim().to_owned();
+        match toml::de::DeTable::parse(self.text) {
+            Err(_) => SceneError::Syntax {
+                at,
+                field: self.textual_key_path(offset),
+                message,
+            },
+            Ok(root) => {
+                let mut path = Vec::new();
+                key_path_at(root.get_ref(), offset, &mut path);
+                // A missing field is reported at its table: add the field's own name.
+                if let Some(name) = backticked_after(&message, "missing field ") {
+                    path.push(name.to_owned());
+                }
+                let field = if path.is_empty() {
+                    "(top level)".to_owned()
+                } else {
+                    path.join(".")
+                };
+                SceneError::Invalid { at, field, message }
+            }
+        }
+    }
+
+    /// The dotted key on the line of `offset`, found from the text alone (for syntax errors,
+    /// where no parse tree exists): the last `[table]` header before it plus the line's key.
+    fn textual_key_path(&self, offset: usize) -> String {
+        let loc = self.location(offset);
+        let mut table = String::new();
+        let mut key = None;
+        for (i, line) in self.text.lines().enumerate() {
+            let trimmed = line.trim();
+            if i + 1 == loc.line {
+                if let Some(eq) = trimmed.find('=') {
+                    let k = trimmed[..eq].trim().trim_matches('"');
+                    if !k.is_empty() && !k.starts_with('[') {
+                        key = Some(k.to_owned());
+                    }
+                } else if let Some(header) = table_header(trimmed) {
+                    table = header;
+                }
+                break;
+            }
+            if let Some(header) = table_header(trimmed) {
+                table = header;
+            }
+        }
+        match (table.is_empty(), key) {
+            (true, None) => "(top level)".to_owned(),
+            (true, Some(k)) => k,
+            (false, None) => table,
+            (false, Some(k)) => format!("{table}.{k}"),
+        }
+    }
+}
+
+fn table_header(line: &str) -> Option<String> {
+    let inner = line.strip_prefix('[')?;
+    let end = inner.find(']')?;
+    let name = inner[..end].trim_matches(['[', ']', ' ']).trim();
+    (!name.is_empty()).then(|| name.replace([' ', '"'], ""))
+}
+
+fn backticked_after<'m>(message: &'m str, prefix: &str) -> Option<&'m str> {
+    let rest = &message[message.find(prefix)? + prefix.len()..];
+    let rest = rest.strip_prefix('`')?;
+    Some(&rest[..rest.find('`')?])
+}
+
+/// Appends to `path` the keys leading to the deepest entry whose key or value contains
+/// `offset`; returns whether one was found. A `[table]`'s own span covers only its header,
+/// so tables are searched inside before their span is looked at.
+fn key_path_at(table: &toml::de::DeTable<'_>, offset: usize, path: &mut Vec<String>) -> bool {
+    for (key, value) in table {
+        path.push(key.get_ref().to_string());
+        if descend(value.get_ref(), offset, path)
+            || key.span().contains(&offset)
+            || value.span().contains(&offset)
+        {
+            return true;
+        }
+        path.pop();
+    }
+    false
+}
+
+fn descend(value: &toml::de::DeValue<'_>, offset: usize, path: &mut Vec<String>) -> bool {
+    match value {
+        toml::de::DeValue::Table(t) => key_path_at(t, offset, path),
+        toml::de::DeValue::Array(items) => items.iter().any(|item| match item.get_ref() {
+            toml::de::DeValue::Table(t) => key_path_at(t, offset, path),
+            _ => false,
+        }),
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn location_counts_lines_and_characters_from_one() {
+        let src = Source {
+            file: Path::new("s.toml"),
+            text: "a = 1\nbé = 2\n",
+        };
+        assert_eq!(src.location(0).to_string(), "s.toml:1:1");
+        // 'b', 'é' (2 bytes), ' ' -> offset 10 is the space after bé: column 3.
+        assert_eq!(src.location(9).to_string(), "s.toml:2:3");
+        assert_eq!(src.location(1000).line, 3);
+    }
+
+    #[test]
+    fn textual_key_path_uses_last_header() {
+        let src = Source {
+            file: Path::new("s.toml"),
+            text: "[object]\nmodel = \"x\"\n[light]\nposition_m = [1, 2\n",
+        };
+        let offset = src.text.find("[1").unwrap();
+        assert_eq!(src.textual_key_path(offset), "light.position_m");
+    }
+}

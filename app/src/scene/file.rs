@@ -1,0 +1,116 @@
+//! The scene file as written: TOML tables deserialised with every leaf spanned, so that
+//! checks made after parsing can still point at a line. `docs/config.md` documents each
+//! field; [`super::load_scene`] resolves this into a [`super::Scene`]. Fixed-length arrays are
+//! read as `Vec` and their length checked on resolving, because serde's arrays ignore extra
+//! elements.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+/// The whole scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SceneFile {
+    pub object: ObjectToml,
+    pub light: LightToml,
+    pub floor: PlaneToml,
+    pub background: PlaneToml,
+    pub environment: EnvironmentToml,
+    #[serde(default)]
+    pub viewer: ViewerToml,
+    #[serde(default)]
+    pub output: OutputToml,
+    #[serde(default)]
+    pub effects: EffectsToml,
+    #[serde(default)]
+    pub inducer: InducerToml,
+}
+
+/// `[object]`: the virtual transparent object.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ObjectToml {
+    pub model: Spanned<String>,
+    pub diameter_m: Option<Spanned<f32>>,
+    pub scale: Option<Spanned<f32>>,
+    pub position_m: Spanned<Vec<f32>>,
+    pub rotation_deg: Option<Spanned<Vec<f32>>>,
+    pub ior: Option<Spanned<f32>>,
+    pub surface_texture: Option<Spanned<String>>,
+    pub surface_transmittance: Option<Spanned<f32>>,
+}
+
+/// Which frame `[light] position_m` is given in.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub(crate) enum LightFrame {
+    /// World (scene) coordinates.
+    #[default]
+    World,
+    /// Offset from the object's position, world axes.
+    Object,
+}
+
+/// `[light]`: the point light.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct LightToml {
+    pub position_m: Spanned<Vec<f32>>,
+    #[serde(default)]
+    pub frame: LightFrame,
+    pub intensity: Option<Spanned<f32>>,
+    pub color: Option<Spanned<Vec<f32>>>,
+}
+
+/// `[floor]` and `[background]`: a registered real-world plane.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PlaneToml {
+    pub photo: Spanned<String>,
+    pub size_m: Spanned<Vec<f32>>,
+    pub position_m: Spanned<Vec<f32>>,
+    pub rotation_deg: Option<Spanned<Vec<f32>>>,
+}
+
+/// `[environment]`: the environment map of the baseline method.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct EnvironmentToml {
+    pub map: Spanned<String>,
+    pub cube_map: Option<Spanned<String>>,
+}
+
+/// `[viewer]`: the wearer.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ViewerToml {
+    pub ipd_mm: Option<Spanned<f32>>,
+    pub pupil_diameter_mm: Option<Spanned<f32>>,
+    pub head_position_m: Option<Spanned<Vec<f32>>>,
+}
+
+/// `[output]`: per-eye image size and field of view.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct OutputToml {
+    pub width_px: Option<Spanned<i64>>,
+    pub height_px: Option<Spanned<i64>>,
+    pub horizontal_fov_deg: Option<Spanned<f32>>,
+    pub vertical_fov_deg: Option<Spanned<f32>>,
+}
+
+/// `[effects]`: the perception-based effects to render.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct EffectsToml {
+    pub set: Option<Spanned<String>>,
+}
+
+/// `[inducer]`: the shadow inducer's parameters (eq. 2-4).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct InducerToml {
+    pub k: Option<Spanned<f32>>,
+    pub ramp_width_m: Option<Spanned<f32>>,
+    pub resolution_px: Option<Spanned<i64>>,
+}

@@ -1,0 +1,576 @@
+//! glTF 2.0 (`.gltf` + buffers, or `.glb`) to one flat triangle mesh, checking every
+//! accessor against its buffer so that broken files become errors, not panics.
+
+use std::collections::HashSet;
+use std::path::Path;
+
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use gltf::accessor::{DataType, Dimensions};
+
+/// A triangle mesh in model units: every triangle primitive of every mesh node of the
+/// glTF scene, node transforms applied, flattened into one vertex/index list.
+#[derive(Clone, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions, model units (metres by glTF convention before scene scaling).
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals; flat (per-face) where the file has none.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates (`TEXCOORD_0`), zero where the file has none.
+    pub uvs: Vec<Vec2>,
+    /// Triangle list, counter-clockwise front faces, three indices per triangle, each less
+    /// than `positions.len()`.
+    pub indices: Vec<u32>,
+}
+
+impl std::fmt::Debug for Mesh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (lo, hi) = self.bounds();
+        f.debug_struct("Mesh")
+            .field("vertices", &self.positions.len())
+            .field("triangles", &self.triangle_count())
+            .field("bounds", &(lo, hi))
+            .finish()
+    }
+}
+
+impl Mesh {
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the positions (zero for an empty mesh).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        if self.positions.is_empty() {
+            return (Vec3::ZERO, Vec3::ZERO);
+        }
+        self.positions.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        )
+    }
+}
+
+/// A loaded model: the mesh, the first KHR_materials_ior found, and the buffer bytes (for
+/// the scene hash).
+pub(crate) struct LoadedModel {
+    pub mesh: Mesh,
+    pub ior: Option<f32>,
+    pub buffers: Vec<Vec<u8>>,
+}
+
+/// Deepest node hierarchy accepted.
+const MAX_NODE_DEPTH: usize = 64;
+/// Most node visits accepted (a node shared by several parents is visited once per path).
+const MAX_NODE_VISITS: usize = 100_000;
+
+/// Loads a glTF or GLB file's bytes; external buffers are read relative to `base`.
+pub(crate) fn load_gltf(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
+    // Third-party decoders must not take the process down on hostile input; our own checks
+    // below are meant to make this unreachable.
+    std::panic::catch_unwind(|| load_gltf_inner(bytes, base))
+        .unwrap_or_else(|_| Err("the glTF decoder failed on this file (internal panic)".into()))
+}
+
+fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
+    let gltf::Gltf { document, mut blob } = gltf::Gltf::from_slice(bytes).map_err(|e| {
+        let e = e.to_string();
+        if e.starts_with("invalid glTF") {
+            e
+        } else {
+            format!("invalid glTF: {e}")
+        }
+    })?;
+
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let name = match buffer.source() {
+            gltf::buffer::Source::Bin => "GLB binary chunk".to_owned(),
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => "data URI".to_owned(),
+            gltf::buffer::Source::Uri(uri) => uri.to_owned(),
+        };
+        let data = gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(base), &mut blob)
+            .map_err(|e| format!("buffer {} ({name}): {}", buffer.index(), describe(&e)))?;
+        if data.len() < buffer.length() {
+            return Err(format!(
+                "buffer {} ({name}): holds {} bytes, the file declares {}",
+                buffer.index(),
+                data.len(),
+                buffer.length()
+            ));
+        }
+        buffers.push(data.0);
+    }
+
+    let roots: Vec<gltf::Node> = match document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    {
+        Some(scene) => scene.nodes().collect(),
+        None => {
+            let children: HashSet<usize> = document
+                .nodes()
+                .flat_map(|n| n.children().map(|c| c.index()))
+                .collect();
+            document
+                .nodes()
+                .filter(|n| !children.contains(&n.index()))
+                .collect()
+        }
+    };
+
+    let mut out = Builder {
+        buffers: &buffers,
+        mesh: Mesh::default(),
+        ior: None,
+        visits: 0,
+    };
+    let mut ancestors = Vec::new();
+    for root in roots {
+        out.visit(root, Mat4::IDENTITY, &mut ancestors)?;
+    }
+    if out.mesh.indices.is_empty() {
+        return Err("the scene has no triangles (no mesh nodes, or only empty meshes)".into());
+    }
+    Ok(LoadedModel {
+        mesh: out.mesh,
+        ior: out.ior,
+        buffers,
+    })
+}
+
+fn describe(e: &gltf::Error) -> String {
+    match e {
+        gltf::Error::Io(io) if io.kind() == std::io::ErrorKind::NotFound => {
+            "file not found".to_owned()
+        }
+        other => other.to_string(),
+    }
+}
+
+struct Builder<'a> {
+    buffers: &'a [Vec<u8>],
+    mesh: Mesh,
+    ior: Option<f32>,
+    visits: usize,
+}
+
+impl Builder<'_> {
+    fn visit(
+        &mut self,
+        node: gltf::Node,
+        parent: Mat4,
+        ancestors: &mut Vec<usize>,
+    ) -> Result<(), String> {
+        if ancestors.contains(&node.index()) {
+            return Err(format!(
+                "node {} is its own ancestor (recursive node hierarchy)",
+                node.index()
+            ));
+        }
+        if ancestors.len() >= MAX_NODE_DEPTH {
+            return Err(format!(
+                "node hierarchy deeper than {MAX_NODE_DEPTH} levels"
+            ));
+        }
+        self.visits += 1;
+        if self.visits > MAX_NODE_VISITS {
+            return Err(format!("more than {MAX_NODE_VISITS} node visits"));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        let world = parent * local;
+        if !world.is_finite() {
+            return Err(format!("node {}: transform is not finite", node.index()));
+        }
+        if let Some(mesh) = node.mesh() {
+            for primitive in mesh.primitives() {
+                let label = format!(
+                    "mesh {}{} primitive {}",
+                    mesh.index(),
+                    mesh.name().map(|n| format!(" '{n}'")).unwrap_or_default(),
+                    primitive.index()
+                );
+                self.add_primitive(&primitive, world)
+                    .map_err(|e| format!("{label}: {e}"))?;
+            }
+        }
+        ancestors.push(node.index());
+        for child in node.children() {
+            self.visit(child, world, ancestors)?;
+        }
+        ancestors.pop();
+        Ok(())
+    }
+
+    fn add_primitive(&mut self, primitive: &gltf::Primitive, world: Mat4) -> Result<(), String> {
+        if primitive.mode() != gltf::mesh::Mode::Triangles {
+            return Err(format!(
+                "mode {:?} is not supported; only triangle lists (mode 4) are",
+                primitive.mode()
+            ));
+        }
+        if self.ior.is_none() {
+            self.ior = primitive.material().ior();
+        }
+        let position_acc = primitive
+            .get(&gltf::Semantic::Positions)
+            .ok_or("has no POSITION attribute")?;
+        let positions = read_floats::<3>(&position_acc, self.buffers, false)
+            .map_err(|e| format!("POSITION: {e}"))?;
+        let count = positions.len();
+        let normals = match primitive.get(&gltf::Semantic::Normals) {
+            Some(acc) => Some(
+                read_floats::<3>(&acc, self.buffers, false).map_err(|e| format!("NORMAL: {e}"))?,
+            ),
+            None => None,
+        };
+        let uvs = match primitive.get(&gltf::Semantic::TexCoords(0)) {
+            Some(acc) => Some(
+                read_floats::<2>(&acc, self.buffers, true)
+                    .map_err(|e| format!("TEXCOORD_0: {e}"))?,
+            ),
+            None => None,
+        };
+        for (name, len) in [
+            ("NORMAL", normals.as_ref().map(Vec::len)),
+            ("TEXCOORD_0", uvs.as_ref().map(Vec::len)),
+        ] {
+            if let Some(len) = len
+                && len != count
+            {
+                return Err(format!(
+                    "{name} has {len} elements but POSITION has {count}"
+                ));
+            }
+        }
+        let indices: Vec<u32> = match primitive.indices() {
+            Some(acc) => read_indices(&acc, self.buffers).map_err(|e| format!("indices: {e}"))?,
+            None => (0..u32::try_from(count).map_err(|_| "too many vertices")?).collect(),
+        };
+        if !indices.len().is_multiple_of(3) {
+            return Err(format!(
+                "{} indices is not a whole number of triangles",
+                indices.len()
+            ));
+        }
+        if let Some((i, &bad)) = indices
+            .iter()
+            .enumerate()
+            .find(|&(_, &v)| v as usize >= count)
+        {
+            return Err(format!(
+                "index {i} is {bad}, out of range for {count} vertices"
+            ));
+        }
+
+        let normal_matrix = Mat3::from_mat4(world);
+        let det = normal_matrix.determinant();
+        if !det.is_finite() || det.abs() < 1e-12 {
+            return Err("node transform is singular (zero scale)".into());
+        }
+        let normal_matrix = normal_matrix.inverse().transpose();
+        let flip = det < 0.0;
+
+        let base = self.mesh.positions.len();
+        let world_positions: Vec<Vec3> = positions
+            .iter()
+            .map(|p| world.transform_point3(Vec3::from_array(*p)))
+            .collect();
+        if let Some(p) = world_positions.iter().find(|p| !p.is_finite()) {
+            return Err(format!("transformed position {p} is not finite"));
+        }
+        let uv_at = |i: usize| uvs.as_ref().map_or(Vec2::ZERO, |u| Vec2::from_array(u[i]));
+
+        match &normals {
+            Some(normals) => {
+                self.mesh.positions.extend_from_slice(&world_positions);
+                self.mesh.normals.extend(
+                    normals
+                        .iter()
+                        .map(|n| (normal_matrix * Vec3::from_array(*n)).normalize_or_zero()),
+                );
+                self.mesh.uvs.extend((0..count).map(uv_at));
+                for tri in indices.chunks_exact(3) {
+                    let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| i as usize + base);
+                    let (b, c) = if flip { (c, b) } else { (b, c) };
+                    self.mesh.indices.extend(
+                        [a, b, c]
+                            .into_iter()
+                            .map(|i| u32::try_from(i).map_err(|_| "too many vertices"))
+                            .collect::<Result<Vec<_>, _>>()?,
+                    );
+                }
+            }
+            None => {
+                // No normals: one vertex per triangle corner so each face gets its own normal.
+                for tri in indices.chunks_exact(3) {
+                    let mut corners = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+                    if flip {
+                        corners.swap(1, 2);
+                    }
+                    let [pa, pb, pc] = corners.map(|i| world_positions[i]);
+                    let normal = (pb - pa).cross(pc - pa).normalize_or_zero();
+                    for i in corners {
+                        let index = u32::try_from(self.mesh.positions.len())
+                            .map_err(|_| "too many vertices")?;
+                        self.mesh.positions.push(world_positions[i]);
+                        self.mesh.normals.push(normal);
+                        self.mesh.uvs.push(uv_at(i));
+                        self.mesh.indices.push(index);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The bytes of an accessor's elements: `(data, offset of element 0, stride, count)`,
+/// after checking that every element lies inside its buffer view and buffer.
+fn accessor_bytes<'b>(
+    acc: &gltf::Accessor,
+    buffers: &'b [Vec<u8>],
+) -> Result<Option<(&'b [u8], usize)>, String> {
+    if acc.sparse().is_some() {
+        return Err(format!(
+            "accessor {}: sparse accessors are not supported",
+            acc.index()
+        ));
+    }
+    let Some(view) = acc.view() else {
+        return Ok(None);
+    };
+    let data = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| format!("accessor {}: buffer missing", acc.index()))?;
+    let view_end = view
+        .offset()
+        .checked_add(view.length())
+        .filter(|&end| end <= data.len())
+        .ok_or_else(|| {
+            format!(
+                "buffer view {} (bytes {}+{}) lies outside buffer {} ({} bytes)",
+                view.index(),
+                view.offset(),
+                view.length(),
+                view.buffer().index(),
+                data.len()
+            )
+        })?;
+    let view_bytes = &data[view.offset()..view_end];
+    let elem = acc.size();
+    let stride = view.stride().unwrap_or(elem);
+    if stride < elem {
+        return Err(format!(
+            "accessor {}: byte stride {stride} is smaller than its element size {elem}",
+            acc.index()
+        ));
+    }
+    let count = acc.count();
+    if count > 0 {
+        let end = (count - 1)
+            .checked_mul(stride)
+            .and_then(|x| x.checked_add(acc.offset()))
+            .and_then(|x| x.checked_add(elem));
+        if end.is_none_or(|end| end > view_bytes.len()) {
+            return Err(format!(
+                "accessor {}: {count} elements of {elem} bytes (stride {stride}, offset {}) \
+                 do not fit in buffer view {} ({} bytes)",
+                acc.index(),
+                acc.offset(),
+                view.index(),
+                view_bytes.len()
+            ));
+        }
+    }
+    Ok(Some((
+        &view_bytes[acc.offset().min(view_bytes.len())..],
+        stride,
+    )))
+}
+
+fn component(data_type: DataType, bytes: &[u8], normalized: bool) -> Option<f32> {
+    Some(match data_type {
+        DataType::F32 => f32::from_le_bytes(bytes.get(..4)?.try_into().ok()?),
+        DataType::U8 if normalized => f32::from(*bytes.first()?) / 255.0,
+        DataType::U16 if normalized => {
+            f32::from(u16::from_le_bytes(bytes.get(..2)?.try_into().ok()?)) / 65535.0
+        }
+        _ => return None,
+    })
+}
+
+fn read_floats<const N: usize>(
+    acc: &gltf::Accessor,
+    buffers: &[Vec<u8>],
+    allow_normalized: bool,
+) -> Result<Vec<[f32; N]>, String> {
+    let dims_ok = matches!(
+        (acc.dimensions(), N),
+        (Dimensions::Vec2, 2) | (Dimensions::Vec3, 3)
+    );
+    let type_ok = acc.data_type() == DataType::F32
+        || (allow_normalized
+            && acc.normalized()
+            && matches!(acc.data_type(), DataType::U8 | DataType::U16));
+    if !dims_ok || !type_ok {
+        return Err(format!(
+            "accessor {} is {:?} of {:?}{}; expected VEC{N} of float",
+            acc.index(),
+            acc.dimensions(),
+            acc.data_type(),
+            if acc.normalized() {
+                " (normalized)"
+            } else {
+                ""
+            }
+        ));
+    }
+    let count = acc.count();
+    let Some((bytes, stride)) = accessor_bytes(acc, buffers)? else {
+        return Ok(vec![[0.0; N]; count]);
+    };
+    let size = acc.data_type().size();
+    let mut out = Vec::with_capacity(count);
+    for i in 0..count {
+        let mut v = [0.0f32; N];
+        for (c, slot) in v.iter_mut().enumerate() {
+            let at = i * stride + c * size;
+            *slot = bytes
+                .get(at..)
+                .and_then(|b| component(acc.data_type(), b, acc.normalized()))
+                .ok_or_else(|| format!("accessor {}: element {i} out of bounds", acc.index()))?;
+            if !slot.is_finite() {
+                return Err(format!(
+                    "accessor {}: element {i} component {c} is {slot}, not a finite number",
+                    acc.index()
+                ));
+            }
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, String> {
+    if acc.dimensions() != Dimensions::Scalar
+        || !matches!(
+            acc.data_type(),
+            DataType::U8 | DataType::U16 | DataType::U32
+        )
+    {
+        return Err(format!(
+            "accessor {} is {:?} of {:?}; expected SCALAR of unsigned byte, short or int",
+            acc.index(),
+            acc.dimensions(),
+            acc.data_type()
+        ));
+    }
+    let count = acc.count();
+    let Some((bytes, stride)) = accessor_bytes(acc, buffers)? else {
+        return Ok(vec![0; count]);
+    };
+    (0..count)
+        .map(|i| {
+            let at = i * stride;
+            let b = bytes.get(at..).unwrap_or_default();
+            let v = match acc.data_type() {
+                DataType::U8 => b.first().map(|&x| u32::from(x)),
+                DataType::U16 => b
+                    .get(..2)
+                    .map(|x| u32::from(u16::from_le_bytes([x[0], x[1]]))),
+                _ => b
+                    .get(..4)
+                    .map(|x| u32::from_le_bytes([x[0], x[1], x[2], x[3]])),
+            };
+            v.ok_or_else(|| format!("accessor {}: element {i} out of bounds", acc.index()))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A minimal glTF with one triangle in an embedded base64 buffer.
+    fn triangle_gltf(indices: &str, extra_node: &str) -> String {
+        // Three VEC3 float positions (36 bytes) then three u16 indices (6 bytes + 2 pad).
+        let mut bytes = Vec::new();
+        for v in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            for c in v {
+                bytes.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        for i in indices.split(',').map(|s| s.trim().parse::<u16>().unwrap()) {
+            bytes.extend_from_slice(&i.to_le_bytes());
+        }
+        bytes.extend_from_slice(&[0, 0]);
+        let b64 = base64_encode(&bytes);
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0{extra_node}}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+            "buffers":[{{"byteLength":44,"uri":"data:application/octet-stream;base64,{b64}"}}],
+            "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}},
+                           {{"buffer":0,"byteOffset":36,"byteLength":6}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+                           "min":[0,0,0],"max":[1,1,0]}},
+                         {{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}]}}"#
+        )
+    }
+
+    fn base64_encode(bytes: &[u8]) -> String {
+        const T: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut s = String::new();
+        for chunk in bytes.chunks(3) {
+            let b = [
+                chunk[0],
+                *chunk.get(1).unwrap_or(&0),
+                *chunk.get(2).unwrap_or(&0),
+            ];
+            let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+            for k in 0..4 {
+                if k <= chunk.len() {
+                    s.push(T[(n >> (18 - 6 * k) & 63) as usize] as char);
+                } else {
+                    s.push('=');
+                }
+            }
+        }
+        s
+    }
+
+    #[test]
+    fn triangle_without_normals_gets_flat_normal_and_zero_uvs() {
+        let model = load_gltf(triangle_gltf("0,1,2", "").as_bytes(), Path::new(".")).unwrap();
+        assert_eq!(model.mesh.triangle_count(), 1);
+        assert_eq!(model.mesh.normals, vec![Vec3::Z; 3]);
+        assert_eq!(model.mesh.uvs, vec![Vec2::ZERO; 3]);
+        assert_eq!(model.ior, None);
+    }
+
+    #[test]
+    fn node_transform_is_applied_and_mirror_keeps_winding() {
+        let gltf = triangle_gltf("0,1,2", r#","scale":[-2,2,2],"translation":[0,0,-1]"#);
+        let model = load_gltf(gltf.as_bytes(), Path::new(".")).unwrap();
+        let (lo, hi) = model.mesh.bounds();
+        assert_eq!(lo, Vec3::new(-2.0, 0.0, -1.0));
+        assert_eq!(hi, Vec3::new(0.0, 2.0, -1.0));
+        // The mirrored triangle still faces +z after the winding flip.
+        assert!(model.mesh.normals.iter().all(|n| *n == Vec3::Z));
+    }
+
+    #[test]
+    fn out_of_range_index_is_an_error() {
+        let err = load_gltf(triangle_gltf("0,1,7", "").as_bytes(), Path::new("."))
+            .err()
+            .unwrap();
+        assert!(err.contains("out of range for 3 vertices"), "{err}");
+    }
+
+    #[test]
+    fn garbage_is_an_error() {
+        assert!(load_gltf(b"{not json", Path::new(".")).is_err());
+        assert!(load_gltf(b"glTF\x02\0\0\0\xff\xff\xff\xff", Path::new(".")).is_err());
+    }
+}

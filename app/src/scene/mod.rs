@@ -1,0 +1,753 @@
+//! Scene files: TOML describing the virtual glass object, its light, the registered real
+//! floor and background, the environment map, the viewer and the output, resolved into a
+//! [`Scene`] with every asset loaded and checked.
+//!
+//! Frame: OpenXR LOCAL-like, right-handed, +x right, +y up, -z forward, metres, origin at
+//! the viewer's initial head position. The paper's Unity coordinates `(x, y, z)` are
+//! `(x, y, -z)` here. The field reference is `docs/config.md`.
+//!
+//! Every error names the scene file, line, column and dotted field; asset errors also name
+//! the asset file and the decoder's reason. No input makes the loader panic.
+
+mod error;
+mod file;
+mod image;
+mod mesh;
+
+use std::path::{Component, Path, PathBuf};
+
+use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
+use sha2::{Digest, Sha256};
+use toml::Spanned;
+use vitreous_xr::{Fov, Pose};
+
+use crate::effects::EffectSet;
+
+pub use error::{Location, SceneError};
+pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
+pub use mesh::Mesh;
+
+use error::Source;
+use file::{LightFrame, PlaneToml, SceneFile};
+
+/// A fully loaded scene, in the world frame described in the module docs.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The scene file, as given to [`load_scene`].
+    pub path: PathBuf,
+    /// Hex SHA-256 over the scene file's bytes and the bytes of every asset it loads
+    /// (labelled by field, so moving the files elsewhere keeps the hash).
+    pub hash: String,
+    /// The virtual transparent object.
+    pub object: Object,
+    /// The point light.
+    pub light: Light,
+    /// The registered real floor.
+    pub floor: RealPlane,
+    /// The registered real background behind the object.
+    pub background: RealPlane,
+    /// The environment map of the baseline method.
+    pub environment: Environment,
+    /// The wearer.
+    pub viewer: Viewer,
+    /// Per-eye output image and field of view.
+    pub output: Output,
+    /// The effects the scene asks for (parsed, not yet checked against this build).
+    pub effects: EffectSet,
+    /// The shadow inducer's parameters.
+    pub inducer: Inducer,
+}
+
+/// The shadow inducer's parameters (METHOD.md section 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inducer {
+    /// k of eq. 4: gain at the shadow edge relative to the floor's luminance.
+    pub k: f32,
+    /// D of eq. 2: width of the ramp around the shadow, metres.
+    pub ramp_width_m: f32,
+    /// Side of the floor-space shadow mask and distance field, texels.
+    pub resolution_px: u32,
+}
+
+impl Default for Inducer {
+    /// The paper's HoloLens values on a 512 x 512 mask.
+    fn default() -> Inducer {
+        Inducer {
+            k: 0.3,
+            ramp_width_m: 0.14,
+            resolution_px: 512,
+        }
+    }
+}
+
+/// Where the object's refractive index came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IorSource {
+    /// `object.ior` in the scene file.
+    Scene,
+    /// The model's KHR_materials_ior.
+    Gltf,
+    /// Neither: 1.5.
+    Default,
+}
+
+/// The virtual transparent object.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// The triangle mesh in model units.
+    pub mesh: Mesh,
+    /// Model to world: centre the mesh's bounding box on the origin, scale (to the target
+    /// diameter), rotate, translate to `position_m`.
+    pub world_from_model: Mat4,
+    /// World centre of the bounding sphere, metres (the object's `position_m`).
+    pub center_m: Vec3,
+    /// World radius of the bounding sphere about `center_m`, metres.
+    pub radius_m: f32,
+    /// Refractive index relative to air.
+    pub ior: f32,
+    /// Where `ior` came from.
+    pub ior_source: IorSource,
+    /// Surface texture (sRGB), mapped with the mesh's `TEXCOORD_0`, if any.
+    pub surface_texture: Option<Image>,
+    /// Fraction of light the surface texture lets through, 0..1 (1 = no visible surface
+    /// image; the paper's sticker: 0.8).
+    pub surface_transmittance: f32,
+    /// The glTF/GLB file.
+    pub model_path: PathBuf,
+}
+
+/// The point light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// World position, metres.
+    pub position_m: Vec3,
+    /// Dimensionless multiplier on `color`.
+    pub intensity: f32,
+    /// Linear RGB colour.
+    pub color: Vec3,
+}
+
+/// A registered real-world plane: a photo of the real surface, its physical size and pose.
+#[derive(Clone, Debug)]
+pub struct RealPlane {
+    /// The photo (sRGB), top edge towards the plane's local +y.
+    pub photo: Image,
+    /// Width (local x) and height (local y), metres.
+    pub size_m: Vec2,
+    /// Centre and orientation; the visible side faces local +z.
+    pub pose: Pose,
+}
+
+impl RealPlane {
+    /// Maps the unit square `[-0.5, 0.5]^2` at z = 0 (local +y = photo top) onto the plane
+    /// in the world.
+    pub fn world_from_plane(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(
+            self.size_m.extend(1.0),
+            self.pose.orientation,
+            self.pose.position,
+        )
+    }
+
+    /// World unit normal of the visible side.
+    pub fn normal(&self) -> Vec3 {
+        (self.pose.orientation * Vec3::Z).normalize()
+    }
+}
+
+/// The environment map.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    /// Latitude-longitude map, linear RGBA f32, rows as stored in the file (top row = zenith).
+    pub latlong: Image,
+    /// The map's file.
+    pub path: PathBuf,
+    /// `environment.cube_map`: reserved; checked to exist and hashed, not decoded.
+    pub cube_map_path: Option<PathBuf>,
+}
+
+/// The wearer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Viewer {
+    /// Interpupillary distance, metres.
+    pub ipd_m: f32,
+    /// Pupil diameter A_p of eq. 14, metres.
+    pub pupil_diameter_m: f32,
+    /// Head (between the eyes) position used by synthetic traces and when no trace is
+    /// given, metres.
+    pub head_position_m: Vec3,
+}
+
+impl Viewer {
+    /// Left and right eye positions for a head pose: half the IPD along the head's -x / +x.
+    pub fn eye_positions_m(&self, head: &Pose) -> [Vec3; 2] {
+        let half = Vec3::X * (self.ipd_m / 2.0);
+        [head.transform_point(-half), head.transform_point(half)]
+    }
+}
+
+/// Per-eye output.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Output {
+    /// Width of each eye's image, pixels.
+    pub width_px: u32,
+    /// Height of each eye's image, pixels.
+    pub height_px: u32,
+    /// Field of view of each eye, radians.
+    pub fov: Fov,
+}
+
+/// Loads a scene file and every asset it names, checking ranges and decoding everything.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let text = match std::str::from_utf8(&bytes) {
+        Ok(text) => text,
+        Err(e) => {
+            let src = Source {
+                file: path,
+                text: std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default(),
+            };
+            return Err(SceneError::Syntax {
+                at: src.location(e.valid_up_to()),
+                field: "(top level)".into(),
+                message: "the file is not valid UTF-8".into(),
+            });
+        }
+    };
+    let mut loader = Loader {
+        src: Source { file: path, text },
+        dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        hasher: Sha256::new(),
+    };
+    loader.hash_part("scene", &bytes);
+    let raw: SceneFile = toml::from_str(text).map_err(|e| loader.src.toml_error(&e))?;
+    loader.resolve(raw)
+}
+
+struct Loader<'a> {
+    src: Source<'a>,
+    dir: PathBuf,
+    hasher: Sha256,
+}
+
+/// Both bounds of a range included.
+const CLOSED: (bool, bool) = (false, false);
+
+/// Largest accepted coordinate magnitude, metres.
+const MAX_COORD_M: f32 = 1000.0;
+
+impl Loader<'_> {
+    fn hash_part(&mut self, label: &str, bytes: &[u8]) {
+        self.hasher.update((label.len() as u64).to_le_bytes());
+        self.hasher.update(label.as_bytes());
+        self.hasher.update((bytes.len() as u64).to_le_bytes());
+        self.hasher.update(bytes);
+    }
+
+    /// Resolves an asset path against the scene's folder and reads (and hashes) it.
+    fn read_asset(
+        &mut self,
+        field: &str,
+        rel: &Spanned<String>,
+    ) -> Result<(PathBuf, Vec<u8>), SceneError> {
+        if rel.get_ref().trim().is_empty() {
+            return Err(self.src.invalid(
+                rel.span(),
+                field,
+                "expected a file path, found an empty string",
+            ));
+        }
+        let path = normalize(&self.dir.join(rel.get_ref()));
+        let bytes = std::fs::read(&path).map_err(|e| {
+            let reason = match e.kind() {
+                std::io::ErrorKind::NotFound => "file not found".to_owned(),
+                _ => format!("cannot read: {e}"),
+            };
+            self.src.asset(rel.span(), field, &path, reason)
+        })?;
+        self.hash_part(field, &bytes);
+        Ok((path, bytes))
+    }
+
+    fn photo(&mut self, field: &str, rel: &Spanned<String>) -> Result<Image, SceneError> {
+        let (path, bytes) = self.read_asset(field, rel)?;
+        image::decode_photo(&bytes)
+            .map_err(|reason| self.src.asset(rel.span(), field, &path, reason))
+    }
+
+    /// Exactly `N` numbers.
+    fn array<const N: usize>(
+        &self,
+        field: &str,
+        v: &Spanned<Vec<f32>>,
+    ) -> Result<[f32; N], SceneError> {
+        <[f32; N]>::try_from(v.get_ref().as_slice()).map_err(|_| {
+            self.src.invalid(
+                v.span(),
+                field,
+                format!(
+                    "expected an array of {N} numbers, found {}",
+                    v.get_ref().len()
+                ),
+            )
+        })
+    }
+
+    fn vec3(&self, field: &str, v: &Spanned<Vec<f32>>) -> Result<Vec3, SceneError> {
+        let value = Vec3::from_array(self.array(field, v)?);
+        if !value.is_finite() || value.abs().max_element() > MAX_COORD_M {
+            return Err(self.src.invalid(
+                v.span(),
+                field,
+                format!("expected finite coordinates within ±{MAX_COORD_M} m, found {value}"),
+            ));
+        }
+        Ok(value)
+    }
+
+    fn rotation(&self, field: &str, v: Option<&Spanned<Vec<f32>>>) -> Result<Quat, SceneError> {
+        let Some(v) = v else {
+            return Ok(Quat::IDENTITY);
+        };
+        let [x, y, z] = self.array(field, v)?;
+        if ![x, y, z].iter().all(|a| a.is_finite() && a.abs() <= 360.0) {
+            return Err(self.src.invalid(
+                v.span(),
+                field,
+                format!("expected three angles in -360..=360 degrees, found [{x}, {y}, {z}]"),
+            ));
+        }
+        Ok(euler_xyz_deg(Vec3::new(x, y, z)))
+    }
+
+    /// A number within `lo..=hi` (each bound exclusive where `open` says so), `default`
+    /// when absent.
+    fn number(
+        &self,
+        field: &str,
+        v: Option<&Spanned<f32>>,
+        default: f32,
+        (lo, hi): (f32, f32),
+        (lo_open, hi_open): (bool, bool),
+    ) -> Result<f32, SceneError> {
+        let Some(v) = v else {
+            return Ok(default);
+        };
+        let x = *v.get_ref();
+        let above = if lo_open { x > lo } else { x >= lo };
+        let below = if hi_open { x < hi } else { x <= hi };
+        if !(x.is_finite() && above && below) {
+            let lower = if lo_open { ">" } else { ">=" };
+            let upper = if hi_open { "<" } else { "<=" };
+            return Err(self.src.invalid(
+                v.span(),
+                field,
+                format!("expected a number {lower} {lo} and {upper} {hi}, found {x}"),
+            ));
+        }
+        Ok(x)
+    }
+
+    fn resolve(mut self, raw: SceneFile) -> Result<Scene, SceneError> {
+        let object = self.object(&raw.object)?;
+
+        let light_offset = self.vec3("light.position_m", &raw.light.position_m)?;
+        let light = Light {
+            position_m: match raw.light.frame {
+                LightFrame::World => light_offset,
+                LightFrame::Object => object.center_m + light_offset,
+            },
+            intensity: self.number(
+                "light.intensity",
+                raw.light.intensity.as_ref(),
+                1.0,
+                (0.0, 1.0e6),
+                CLOSED,
+            )?,
+            color: match &raw.light.color {
+                None => Vec3::ONE,
+                Some(c) => {
+                    let v = Vec3::from_array(self.array("light.color", c)?);
+                    if !v.is_finite() || v.min_element() < 0.0 || v.max_element() > 1000.0 {
+                        return Err(self.src.invalid(
+                            c.span(),
+                            "light.color",
+                            format!("expected linear RGB components in 0..=1000, found {v}"),
+                        ));
+                    }
+                    v
+                }
+            },
+        };
+
+        let floor = self.plane("floor", &raw.floor)?;
+        let background = self.plane("background", &raw.background)?;
+
+        let (env_path, env_bytes) = self.read_asset("environment.map", &raw.environment.map)?;
+        let latlong = image::decode_hdr(&env_bytes).map_err(|r| {
+            self.src
+                .asset(raw.environment.map.span(), "environment.map", &env_path, r)
+        })?;
+        let cube_map_path = match &raw.environment.cube_map {
+            Some(rel) => Some(self.read_asset("environment.cube_map", rel)?.0),
+            None => None,
+        };
+        let environment = Environment {
+            latlong,
+            path: env_path,
+            cube_map_path,
+        };
+
+        let v = &raw.viewer;
+        let viewer = Viewer {
+            ipd_m: self.number(
+                "viewer.ipd_mm",
+                v.ipd_mm.as_ref(),
+                63.0,
+                (40.0, 90.0),
+                CLOSED,
+            )? / 1000.0,
+            pupil_diameter_m: self.number(
+                "viewer.pupil_diameter_mm",
+                v.pupil_diameter_mm.as_ref(),
+                6.0,
+                (1.0, 9.0),
+                CLOSED,
+            )? / 1000.0,
+            head_position_m: match &v.head_position_m {
+                Some(p) => self.vec3("viewer.head_position_m", p)?,
+                None => Vec3::ZERO,
+            },
+        };
+
+        let o = &raw.output;
+        let pixels = |field: &str, v: Option<&Spanned<i64>>, default: u32| match v {
+            None => Ok(default),
+            Some(v) => match u32::try_from(*v.get_ref()) {
+                Ok(px) if (16..=8192).contains(&px) => Ok(px),
+                _ => Err(self.src.invalid(
+                    v.span(),
+                    field,
+                    format!("expected 16..=8192 pixels, found {}", v.get_ref()),
+                )),
+            },
+        };
+        let width_px = pixels("output.width_px", o.width_px.as_ref(), 1280)?;
+        let height_px = pixels("output.height_px", o.height_px.as_ref(), 960)?;
+        let h_deg = self.number(
+            "output.horizontal_fov_deg",
+            o.horizontal_fov_deg.as_ref(),
+            40.0,
+            (1.0, 170.0),
+            CLOSED,
+        )?;
+        let v_deg = self.number(
+            "output.vertical_fov_deg",
+            o.vertical_fov_deg.as_ref(),
+            30.0,
+            (1.0, 170.0),
+            CLOSED,
+        )?;
+        let output = Output {
+            width_px,
+            height_px,
+            fov: Fov::symmetric(h_deg.to_radians(), v_deg.to_radians()),
+        };
+
+        let effects = match &raw.effects.set {
+            None => EffectSet::NONE,
+            Some(s) => EffectSet::parse(s.get_ref())
+                .map_err(|e| self.src.invalid(s.span(), "effects.set", e.to_string()))?,
+        };
+
+        let inducer = self.inducer(&raw.inducer)?;
+
+        let hash = self
+            .hasher
+            .finalize()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        Ok(Scene {
+            path: self.src.file.to_path_buf(),
+            hash,
+            object,
+            light,
+            floor,
+            background,
+            environment,
+            viewer,
+            output,
+            effects,
+            inducer,
+        })
+    }
+
+    fn inducer(&self, raw: &file::InducerToml) -> Result<Inducer, SceneError> {
+        let default = Inducer::default();
+        let resolution_px = match &raw.resolution_px {
+            None => default.resolution_px,
+            Some(v) => match u32::try_from(*v.get_ref()) {
+                Ok(px) if (16..=4096).contains(&px) => px,
+                _ => {
+                    return Err(self.src.invalid(
+                        v.span(),
+                        "inducer.resolution_px",
+                        format!("expected 16..=4096 texels, found {}", v.get_ref()),
+                    ));
+                }
+            },
+        };
+        Ok(Inducer {
+            k: self.number("inducer.k", raw.k.as_ref(), default.k, (0.0, 10.0), CLOSED)?,
+            ramp_width_m: self.number(
+                "inducer.ramp_width_m",
+                raw.ramp_width_m.as_ref(),
+                default.ramp_width_m,
+                (0.0, 100.0),
+                (true, false),
+            )?,
+            resolution_px,
+        })
+    }
+
+    fn object(&mut self, raw: &file::ObjectToml) -> Result<Object, SceneError> {
+        let (model_path, bytes) = self.read_asset("object.model", &raw.model)?;
+        let base = model_path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        let model = mesh::load_gltf(&bytes, &base).map_err(|r| {
+            self.src
+                .asset(raw.model.span(), "object.model", &model_path, r)
+        })?;
+        for buffer in &model.buffers {
+            self.hash_part("object.model buffer", buffer);
+        }
+
+        let (lo, hi) = model.mesh.bounds();
+        let largest_extent = (hi - lo).max_element();
+        let center_model = (lo + hi) / 2.0;
+        let radius_model = model
+            .mesh
+            .positions
+            .iter()
+            .map(|p| p.distance(center_model))
+            .fold(0.0f32, f32::max);
+        if !(largest_extent > 0.0 && largest_extent.is_finite()) {
+            return Err(self.src.asset(
+                raw.model.span(),
+                "object.model",
+                &model_path,
+                "the mesh has zero size",
+            ));
+        }
+
+        let (scale, scale_field, scale_span) = match (&raw.diameter_m, &raw.scale) {
+            (Some(d), Some(_)) => {
+                return Err(self.src.invalid(
+                    d.span(),
+                    "object.diameter_m",
+                    "give either `diameter_m` or `scale`, not both",
+                ));
+            }
+            (Some(d), None) => {
+                let d_m =
+                    self.number("object.diameter_m", Some(d), 0.0, (0.0, 10.0), (true, true))?;
+                if d_m >= 10.0 {
+                    return Err(self.src.invalid(
+                        d.span(),
+                        "object.diameter_m",
+                        format!("expected a number > 0 and < 10, found {d_m}"),
+                    ));
+                }
+                (d_m / largest_extent, "object.diameter_m", d.span())
+            }
+            (None, Some(s)) => (
+                self.number("object.scale", Some(s), 1.0, (0.0, 1.0e6), (true, false))?,
+                "object.scale",
+                s.span(),
+            ),
+            (None, None) => (1.0, "object.model", raw.model.span()),
+        };
+        let diameter_m = largest_extent * scale;
+        if !(diameter_m > 0.0 && diameter_m < 10.0) {
+            return Err(self.src.invalid(
+                scale_span,
+                scale_field,
+                format!(
+                    "the object would be {diameter_m} m across (model is {largest_extent} units \
+                     across, scale {scale}); expected more than 0 and less than 10 m"
+                ),
+            ));
+        }
+
+        let position = self.vec3("object.position_m", &raw.position_m)?;
+        let rotation = self.rotation("object.rotation_deg", raw.rotation_deg.as_ref())?;
+        let world_from_model =
+            Mat4::from_scale_rotation_translation(Vec3::splat(scale), rotation, position)
+                * Mat4::from_translation(-center_model);
+
+        let (ior, ior_source) = match (&raw.ior, model.ior) {
+            (Some(n), _) => (
+                self.number("object.ior", Some(n), 1.5, (1.0, 4.0), CLOSED)?,
+                IorSource::Scene,
+            ),
+            (None, Some(n)) if (1.0..=4.0).contains(&n) => (n, IorSource::Gltf),
+            (None, Some(n)) => {
+                return Err(self.src.asset(
+                    raw.model.span(),
+                    "object.model",
+                    &model_path,
+                    format!("KHR_materials_ior is {n}; expected 1..=4 (or set `object.ior`)"),
+                ));
+            }
+            (None, None) => (1.5, IorSource::Default),
+        };
+
+        let surface_texture = match &raw.surface_texture {
+            Some(rel) => Some(self.photo("object.surface_texture", rel)?),
+            None => None,
+        };
+        if surface_texture.is_none()
+            && let Some(t) = &raw.surface_transmittance
+        {
+            return Err(self.src.invalid(
+                t.span(),
+                "object.surface_transmittance",
+                "needs `object.surface_texture`",
+            ));
+        }
+        let default_transmittance = if surface_texture.is_some() { 0.8 } else { 1.0 };
+        let surface_transmittance = self.number(
+            "object.surface_transmittance",
+            raw.surface_transmittance.as_ref(),
+            default_transmittance,
+            (0.0, 1.0),
+            CLOSED,
+        )?;
+
+        Ok(Object {
+            mesh: model.mesh,
+            world_from_model,
+            center_m: position,
+            radius_m: radius_model * scale,
+            ior,
+            ior_source,
+            surface_texture,
+            surface_transmittance,
+            model_path,
+        })
+    }
+
+    fn plane(&mut self, table: &str, raw: &PlaneToml) -> Result<RealPlane, SceneError> {
+        let photo = self.photo(&format!("{table}.photo"), &raw.photo)?;
+        let size = Vec2::from_array(self.array(&format!("{table}.size_m"), &raw.size_m)?);
+        if !size.is_finite() || size.min_element() <= 0.0 || size.max_element() > 100.0 {
+            return Err(self.src.invalid(
+                raw.size_m.span(),
+                &format!("{table}.size_m"),
+                format!("expected [width, height] each > 0 and <= 100 m, found {size}"),
+            ));
+        }
+        let position = self.vec3(&format!("{table}.position_m"), &raw.position_m)?;
+        let orientation =
+            self.rotation(&format!("{table}.rotation_deg"), raw.rotation_deg.as_ref())?;
+        Ok(RealPlane {
+            photo,
+            size_m: size,
+            pose: Pose {
+                position,
+                orientation,
+            },
+        })
+    }
+}
+
+/// Rotation from `[x, y, z]` Euler angles in degrees: about world x first, then world y,
+/// then world z (extrinsic XYZ; the matrix is `Rz * Ry * Rx`).
+pub fn euler_xyz_deg(angles_deg: Vec3) -> Quat {
+    let r = angles_deg * (std::f32::consts::PI / 180.0);
+    Quat::from_euler(EulerRot::ZYX, r.z, r.y, r.x)
+}
+
+/// Removes `.` and `name/..` pairs without touching the file system (so that error
+/// messages show `config/models/x.glb`, not `config/scenes/../models/x.glb`).
+fn normalize(path: &Path) -> PathBuf {
+    let mut out: Vec<Component> = Vec::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => match out.last() {
+                Some(Component::Normal(_)) => {
+                    out.pop();
+                }
+                Some(Component::RootDir | Component::Prefix(_)) => {}
+                _ => out.push(c),
+            },
+            other => out.push(other),
+        }
+    }
+    if out.is_empty() {
+        PathBuf::from(".")
+    } else {
+        out.iter().collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn euler_rotates_x_then_y_then_z() {
+        let floor = euler_xyz_deg(Vec3::new(-90.0, 0.0, 0.0));
+        assert!((floor * Vec3::Z).abs_diff_eq(Vec3::Y, 1e-6));
+        assert!((floor * Vec3::Y).abs_diff_eq(Vec3::NEG_Z, 1e-6));
+        let q = euler_xyz_deg(Vec3::new(90.0, 90.0, 0.0));
+        // x first: +y -> +z; then y: +z -> +x.
+        assert!((q * Vec3::Y).abs_diff_eq(Vec3::X, 1e-6));
+    }
+
+    #[test]
+    fn plane_maps_unit_square_and_faces_its_normal() {
+        let plane = RealPlane {
+            photo: Image::new(1, 1, PixelData::Srgb8(vec![0; 4])).unwrap(),
+            size_m: Vec2::new(2.0, 1.0),
+            pose: Pose {
+                position: Vec3::new(0.0, -0.5, -1.0),
+                orientation: euler_xyz_deg(Vec3::new(-90.0, 0.0, 0.0)),
+            },
+        };
+        let m = plane.world_from_plane();
+        assert!(
+            m.transform_point3(Vec3::new(0.5, 0.5, 0.0))
+                .abs_diff_eq(Vec3::new(1.0, -0.5, -1.5), 1e-6)
+        );
+        assert!(plane.normal().abs_diff_eq(Vec3::Y, 1e-6));
+    }
+
+    #[test]
+    fn normalize_folds_parent_components() {
+        assert_eq!(
+            normalize(Path::new("config/scenes/../models/a.glb")),
+            PathBuf::from("config/models/a.glb")
+        );
+        assert_eq!(normalize(Path::new("../x/./y")), PathBuf::from("../x/y"));
+    }
+
+    #[test]
+    fn eyes_are_half_ipd_either_side() {
+        let viewer = Viewer {
+            ipd_m: 0.064,
+            pupil_diameter_m: 0.006,
+            head_position_m: Vec3::ZERO,
+        };
+        let [l, r] = viewer.eye_positions_m(&Pose::IDENTITY);
+        assert_eq!(l, Vec3::new(-0.032, 0.0, 0.0));
+        assert_eq!(r, Vec3::new(0.032, 0.0, 0.0));
+    }
+}

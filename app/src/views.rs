@@ -1,0 +1,112 @@
+//! From what a backend hands out to what the renderer takes: per-eye cameras and the scene's
+//! GPU description.
+
+use vitreous_render::camera::{EyeParams, Fov as RenderFov};
+use vitreous_render::{
+    FrameParams, InducerDesc, LightDesc, Look, MeshRef, PlaneDesc, Reflection, SceneDesc,
+    TexelData, TextureDesc,
+};
+use vitreous_xr::{EyeView, Fov, FrameInput};
+
+use crate::defocus::DefocusSetup;
+use crate::effects::EffectSet;
+use crate::scene::{Image, PixelData, Scene};
+
+/// Scale applied to environment radiance. The shipped HDR maps are in scene-referred units
+/// where 1.0 is a bright diffuse white; they are shown as they are.
+pub const ENVIRONMENT_EXPOSURE: f32 = 1.0;
+
+/// The renderer's field of view for an OpenXR one.
+pub fn render_fov(fov: Fov) -> RenderFov {
+    RenderFov {
+        left_rad: fov.angle_left_rad,
+        right_rad: fov.angle_right_rad,
+        up_rad: fov.angle_up_rad,
+        down_rad: fov.angle_down_rad,
+    }
+}
+
+/// One eye's camera from its view.
+pub fn eye_params(view: &EyeView) -> EyeParams {
+    EyeParams::new(
+        view.pose.position,
+        view.pose.orientation,
+        render_fov(view.fov),
+    )
+}
+
+/// The renderer's parameters for a frame drawn with `look`.
+pub fn frame_params(input: &FrameInput, look: Look) -> FrameParams {
+    FrameParams {
+        eyes: [eye_params(&input.views[0]), eye_params(&input.views[1])],
+        look,
+    }
+}
+
+/// How an effect set is drawn. The baseline is the conventional method (environment map and
+/// Fresnel for both refraction and reflection); with the method's visual effects (disparity,
+/// defocus) the reflected image is drawn as `reflection` says (the paper used a Phong
+/// highlight). Defocus amounts are per frame: this gives none; the frame's gaze sets them.
+pub fn look(effects: &EffectSet, reflection: Reflection) -> Look {
+    let method = effects.disparity || effects.defocus;
+    Look {
+        disparity: effects.disparity,
+        defocus: None,
+        reflection: if method {
+            reflection
+        } else {
+            Reflection::EnvironmentFresnel
+        },
+        inducer: effects.inducer,
+    }
+}
+
+/// The renderer's view of an image.
+pub fn texture(image: &Image) -> TextureDesc<'_> {
+    TextureDesc {
+        width: image.width,
+        height: image.height,
+        data: match &image.data {
+            PixelData::Srgb8(bytes) => TexelData::Srgb8(bytes),
+            PixelData::LinearF32(floats) => TexelData::LinearF32(floats),
+        },
+    }
+}
+
+/// The renderer's view of a scene, with the blur stacks of `defocus` when defocus is used.
+pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> SceneDesc<'a> {
+    let mesh = &scene.object.mesh;
+    SceneDesc {
+        mesh: MeshRef {
+            positions: &mesh.positions,
+            normals: &mesh.normals,
+            uvs: &mesh.uvs,
+            indices: &mesh.indices,
+        },
+        world_from_model: scene.object.world_from_model,
+        ior: scene.object.ior,
+        environment: texture(&scene.environment.latlong),
+        floor: PlaneDesc {
+            world_from_plane: scene.floor.world_from_plane(),
+            photo: texture(&scene.floor.photo),
+        },
+        background: PlaneDesc {
+            world_from_plane: scene.background.world_from_plane(),
+            photo: texture(&scene.background.photo),
+        },
+        exposure: ENVIRONMENT_EXPOSURE,
+        surface: scene.object.surface_texture.as_ref().map(texture),
+        surface_transmittance: scene.object.surface_transmittance,
+        light: LightDesc {
+            position_m: scene.light.position_m,
+            radiance: scene.light.color * scene.light.intensity,
+        },
+        background_stack: defocus.map(|d| d.background.desc()),
+        surface_stack: defocus.and_then(|d| d.surface.as_ref()).map(|s| s.desc()),
+        inducer: InducerDesc {
+            k: scene.inducer.k,
+            ramp_width_m: scene.inducer.ramp_width_m,
+            resolution_px: scene.inducer.resolution_px,
+        },
+    }
+}

@@ -1,0 +1,266 @@
+//! The `vitreous` command on bad input: a non-zero exit, a one-paragraph message naming the
+//! culprit, no panic, and no output files.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn vitreous(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_vitreous"))
+        .args(args)
+        .current_dir(cwd)
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("the vitreous binary runs")
+}
+
+/// Asserts a failed run with one error paragraph that mentions every `needle`.
+fn assert_clean_failure(out: &Output, needles: &[&str]) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "expected failure, stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    assert!(!stderr.contains("RUST_BACKTRACE"), "panic: {stderr}");
+    let message = stderr.trim();
+    assert!(!message.is_empty(), "no message");
+    assert!(
+        !message.contains("\n\n"),
+        "more than one paragraph: {message}"
+    );
+    for needle in needles {
+        assert!(
+            message.contains(needle),
+            "'{needle}' missing from: {message}"
+        );
+    }
+    message.to_owned()
+}
+
+fn scene(name: &str) -> String {
+    workspace()
+        .join("config/scenes")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn malformed_scene_names_file_and_line_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = write(
+        dir.path(),
+        "bad.toml",
+        "[object]\nmodel = \"x.glb\"\ndiameter_m = oops\n",
+    );
+    let out_dir = dir.path().join("out");
+    let out = vitreous(
+        &[
+            "replay",
+            &bad,
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["bad.toml", ":3:"]);
+    assert!(!out_dir.exists(), "output folder created on bad input");
+}
+
+#[test]
+fn missing_trace_is_named_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let out = vitreous(
+        &[
+            "replay",
+            &scene("glass-sphere.toml"),
+            "--trace",
+            "no-such-trace.csv",
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["no-such-trace.csv"]);
+    assert!(!out_dir.exists());
+}
+
+#[test]
+fn trace_with_nan_time_names_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = vitreous_xr::trace::COLUMNS.join(",");
+    let good = "0,0,0,0,0,0,0,1,0,0,,,,,,,0,,,,,,,,,,,,,,,,";
+    let nan = "NaN,0,0,0,0,0,0,1,0,0,,,,,,,0,,,,,,,,,,,,,,,,";
+    let trace = write(
+        dir.path(),
+        "nan.csv",
+        &format!("# vitreous-trace v1\n{header}\n{good}\n{nan}\n"),
+    );
+    let out_dir = dir.path().join("out");
+    let out = vitreous(
+        &[
+            "replay",
+            &scene("glass-sphere.toml"),
+            "--trace",
+            &trace,
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["nan.csv", ":4"]);
+    assert!(!out_dir.exists());
+}
+
+#[test]
+fn truncated_trace_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = vitreous_xr::trace::COLUMNS.join(",");
+    let trace = write(
+        dir.path(),
+        "short.csv",
+        &format!("# vitreous-trace v1\n{header}\n0,0,0,0,0,0\n"),
+    );
+    let out = vitreous(
+        &[
+            "replay",
+            &scene("glass-sphere.toml"),
+            "--trace",
+            &trace,
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["short.csv", ":3"]);
+    assert!(!dir.path().join("out").exists());
+}
+
+#[test]
+fn absurd_sizes_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for size in ["0x0", "100000x10", "12x9"] {
+        let out = vitreous(
+            &[
+                "replay",
+                &scene("glass-sphere.toml"),
+                "--size",
+                size,
+                "--quiet",
+            ],
+            dir.path(),
+        );
+        assert_clean_failure(&out, &["size"]);
+    }
+    let out = vitreous(
+        &[
+            "replay",
+            &scene("glass-sphere.toml"),
+            "--size",
+            "wide",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["WIDTHxHEIGHT"]);
+    assert!(!dir.path().join("out").exists());
+}
+
+#[test]
+fn unknown_and_unimplemented_effects_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = vitreous(
+        &[
+            "replay",
+            &scene("glass-sphere.toml"),
+            "--effects",
+            "sparkle",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["sparkle"]);
+    let out = vitreous(
+        &[
+            "replay",
+            &scene("glass-sphere.toml"),
+            "--effects",
+            "O5",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    let message = assert_clean_failure(&out, &["caustics"]);
+    assert!(message.contains("not implemented"), "{message}");
+    assert!(!dir.path().join("out").exists());
+}
+
+#[test]
+fn import_of_header_only_recording_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let recording = workspace().join("xr/tests/data/sranipal/TESTVA03_2D_Spread9.csv");
+    let target = dir.path().join("t.csv");
+    let out = vitreous(
+        &[
+            "trace",
+            "import",
+            "--from",
+            "sranipal",
+            recording.to_str().unwrap(),
+            "-o",
+            target.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["TESTVA03_2D_Spread9.csv"]);
+    assert!(!target.exists());
+}
+
+#[test]
+fn import_from_unknown_format_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = vitreous(
+        &["trace", "import", "--from", "tobii", "x.csv", "-o", "y.csv"],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["tobii", "sranipal"]);
+    assert!(!dir.path().join("y.csv").exists());
+}
+
+#[test]
+fn imported_real_trace_replays_from_a_fresh_import() {
+    let dir = tempfile::tempdir().unwrap();
+    let recording = workspace().join("xr/tests/data/sranipal/TESTNA10_360VR_Fist3.csv");
+    let target = dir.path().join("t.csv");
+    let out = vitreous(
+        &[
+            "trace",
+            "import",
+            "--from",
+            "sranipal",
+            recording.to_str().unwrap(),
+            "-o",
+            target.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(report.contains("median IPD"), "{report}");
+    let text = std::fs::read_to_string(&target).unwrap();
+    assert!(text.starts_with("# vitreous-trace v1"));
+}

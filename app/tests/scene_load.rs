@@ -1,0 +1,120 @@
+//! A minimal scene resolves with the documented defaults; glTF IOR and transforms are honoured.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+use vitreous::effects::EffectSet;
+use vitreous::scene::{IorSource, load_scene};
+
+fn data(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(rel)
+}
+
+fn repo(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+}
+
+#[test]
+fn minimal_scene_takes_the_documented_defaults() {
+    let scene = load_scene(&data("scenes/minimal.toml")).unwrap();
+    assert_eq!(scene.viewer.ipd_m, 0.063);
+    assert_eq!(scene.viewer.pupil_diameter_m, 0.006);
+    assert_eq!(scene.viewer.head_position_m, Vec3::ZERO);
+    assert_eq!((scene.output.width_px, scene.output.height_px), (1280, 960));
+    let fov = scene.output.fov;
+    assert!((fov.angle_right_rad - 20f32.to_radians()).abs() < 1e-6);
+    assert!((fov.angle_up_rad - 15f32.to_radians()).abs() < 1e-6);
+    assert_eq!(fov.angle_left_rad, -fov.angle_right_rad);
+    assert_eq!(scene.effects, EffectSet::NONE);
+    // Light frame defaults to world.
+    assert_eq!(scene.light.position_m, Vec3::new(0.0, 1.0, 1.0));
+    assert_eq!(scene.light.intensity, 1.0);
+    assert_eq!(scene.light.color, Vec3::ONE);
+    assert_eq!(scene.object.surface_texture, None);
+    assert_eq!(scene.object.surface_transmittance, 1.0);
+    assert_eq!(scene.background.size_m, Vec2::new(2.0, 1.0));
+    assert!(scene.environment.cube_map_path.is_none());
+    // Paths are resolved against the scene file's folder, `..` folded.
+    assert!(
+        scene
+            .object
+            .model_path
+            .ends_with("tests/data/models/TransmissionTest.glb")
+    );
+    assert!(!scene.environment.path.to_string_lossy().contains(".."));
+}
+
+#[test]
+fn diameter_scales_the_largest_extent_and_position_is_the_box_centre() {
+    let scene = load_scene(&data("scenes/minimal.toml")).unwrap();
+    let object = &scene.object;
+    let (lo, hi) = object.mesh.bounds();
+    let a = object.world_from_model.transform_point3(lo);
+    let b = object.world_from_model.transform_point3(hi);
+    assert!(((b - a).abs().max_element() - 0.5).abs() < 1e-4);
+    assert!(((a + b) / 2.0).abs_diff_eq(Vec3::new(0.0, 0.0, -2.0), 1e-4));
+    assert_eq!(object.center_m, Vec3::new(0.0, 0.0, -2.0));
+    assert!(object.radius_m >= 0.25 && object.radius_m <= 0.25 * 3f32.sqrt() + 1e-4);
+    // Every vertex lies inside the bounding sphere.
+    for p in &object.mesh.positions {
+        let w = object.world_from_model.transform_point3(*p);
+        assert!(w.distance(object.center_m) <= object.radius_m + 1e-4);
+    }
+    assert_eq!(object.mesh.normals.len(), object.mesh.positions.len());
+    assert_eq!(object.mesh.uvs.len(), object.mesh.positions.len());
+}
+
+#[test]
+fn gltf_ior_is_used_when_the_scene_gives_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("scenes/minimal.toml"))
+        .unwrap()
+        .replace(
+            "\"../models/TransmissionTest.glb\"",
+            &format!("'{}'", repo("config/models/sphere.glb").display()),
+        )
+        .replace(
+            "\"../../../../config/",
+            &format!("\"{}/", repo("config").display()),
+        );
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, &text).unwrap();
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.object.ior_source, IorSource::Gltf);
+    assert!((scene.object.ior - 1.51).abs() < 1e-6);
+
+    let with_ior = text.replace("diameter_m = 0.5", "diameter_m = 0.5\nior = 1.33");
+    std::fs::write(&path, &with_ior).unwrap();
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.object.ior_source, IorSource::Scene);
+    assert_eq!(scene.object.ior, 1.33);
+}
+
+#[test]
+fn rotation_and_object_frame_light_are_applied() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("scenes/minimal.toml"))
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", data("scenes/..").display()))
+        .replace(
+            "position_m = [0, 1, 1]",
+            "position_m = [0, 1, 1]\nframe = \"object\"\nintensity = 2.5\ncolor = [1, 0.5, 0.25]",
+        )
+        .replace("diameter_m = 0.5", "scale = 0.1\nrotation_deg = [0, 90, 0]");
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, &text).unwrap();
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.light.position_m, Vec3::new(0.0, 1.0, -1.0));
+    assert_eq!(scene.light.intensity, 2.5);
+    assert_eq!(scene.light.color, Vec3::new(1.0, 0.5, 0.25));
+    // A model-space +x direction turns to -z under +90 degrees about y, scaled by 0.1.
+    let m = scene.object.world_from_model;
+    let d = m.transform_vector3(Vec3::X);
+    assert!(d.abs_diff_eq(Vec3::new(0.0, 0.0, -0.1), 1e-6), "{d}");
+    // The hash covers the scene text: a different file, a different hash.
+    let first = scene.hash.clone();
+    std::fs::write(&path, format!("{text}\n# comment\n")).unwrap();
+    assert_ne!(load_scene(&path).unwrap().hash, first);
+}

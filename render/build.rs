@@ -1,0 +1,55 @@
+//! Compiles every WGSL shader in `../shaders` to SPIR-V with naga, validating it on the way.
+//! Nothing is checked in as SPIR-V and no external shader tool is needed.
+
+use std::{env, fs, path::PathBuf};
+
+fn main() {
+    let shader_dir = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap()).join("../shaders");
+    let out_dir = PathBuf::from(env::var("OUT_DIR").unwrap());
+    println!("cargo:rerun-if-changed={}", shader_dir.display());
+
+    let mut entries: Vec<_> = fs::read_dir(&shader_dir)
+        .unwrap_or_else(|e| panic!("reading {}: {e}", shader_dir.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "wgsl"))
+        .collect();
+    entries.sort();
+    for path in entries {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let source = fs::read_to_string(&path).unwrap();
+        let name = path.file_stem().unwrap().to_str().unwrap().to_owned();
+        let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| {
+            panic!(
+                "{}",
+                e.emit_to_string_with_path(&source, path.to_str().unwrap())
+            )
+        });
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::PUSH_CONSTANT,
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| {
+            panic!(
+                "{}",
+                e.emit_to_string_with_path(&source, path.to_str().unwrap())
+            )
+        });
+        for entry in &module.entry_points {
+            let options = naga::back::spv::Options {
+                lang_version: (1, 0),
+                flags: naga::back::spv::WriterFlags::empty(),
+                ..Default::default()
+            };
+            let pipeline_options = naga::back::spv::PipelineOptions {
+                shader_stage: entry.stage,
+                entry_point: entry.name.clone(),
+            };
+            let words =
+                naga::back::spv::write_vec(&module, &info, &options, Some(&pipeline_options))
+                    .unwrap_or_else(|e| panic!("{}: {}: {e}", path.display(), entry.name));
+            let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+            fs::write(out_dir.join(format!("{name}.{}.spv", entry.name)), bytes).unwrap();
+        }
+    }
+}

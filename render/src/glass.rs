@@ -1,0 +1,305 @@
+//! The glass object pass, baseline method: environment-map reflection and refraction blended
+//! by a Fresnel term (METHOD.md section 6; shaders/glass.wgsl).
+
+use ash::vk;
+use glam::Vec4;
+
+use crate::camera::{EyeParams, Look, Reflection};
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::memory::Buffer;
+use crate::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
+use crate::pipeline::{self, PipelineDesc};
+use crate::scene::{GpuScene, SceneDesc, VERTEX_STRIDE};
+use crate::shaders;
+
+/// Phong exponent of the highlight: a sharp highlight, as on polished glass.
+const PHONG_EXPONENT: f32 = 200.0;
+/// Strength of the Phong highlight relative to the light's radiance.
+const PHONG_STRENGTH: f32 = 1.0;
+
+/// `flags` bit: refraction to the background plane.
+const FLAG_BACKGROUND: u32 = 1;
+/// `flags` bit: Phong reflection instead of environment + Fresnel.
+const FLAG_PHONG: u32 = 2;
+
+/// Push constants: one eye.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct EyePush {
+    /// World to clip space of this eye.
+    pub clip_from_world: [f32; 16],
+    /// Eye position (xyz, metres) and eye index (w).
+    pub position: [f32; 4],
+    /// x: FLAG_* bits.
+    pub flags: [u32; 4],
+    /// Where refraction to the background plane is seen from (xyz, metres).
+    pub refraction_origin: [f32; 4],
+    /// Blur-stack coordinates of the refracted (x) and surface (y) images.
+    pub blur: [f32; 4],
+}
+
+impl EyePush {
+    /// The push constants of eye `index` of `eyes` drawn with `look`, sampling blur stacks
+    /// of `slices` (background, surface) with `k_g_steps` (pixels) between slices.
+    pub fn new(
+        eyes: &[EyeParams; 2],
+        index: usize,
+        look: &Look,
+        slices: [u32; 2],
+        k_g_steps: [f32; 2],
+    ) -> EyePush {
+        let eye = &eyes[index];
+        let mut flags = 0;
+        if look.disparity || look.defocus.is_some() {
+            flags |= FLAG_BACKGROUND;
+        }
+        let refraction_origin = if look.disparity {
+            eye.position_m
+        } else {
+            (eyes[0].position_m + eyes[1].position_m) / 2.0
+        };
+        let defocus = look.defocus.unwrap_or_default();
+        let blur = [
+            stack_coordinate(defocus.refracted_k_g_px, k_g_steps[0], slices[0]),
+            stack_coordinate(defocus.surface_k_g_px, k_g_steps[1], slices[1]),
+            0.0,
+            0.0,
+        ];
+        if look.reflection == Reflection::Phong {
+            flags |= FLAG_PHONG;
+        }
+        EyePush {
+            clip_from_world: eye.clip_from_world().to_cols_array(),
+            position: eye.position_m.extend(index as f32).to_array(),
+            flags: [flags, 0, 0, 0],
+            refraction_origin: refraction_origin.extend(1.0).to_array(),
+            blur,
+        }
+    }
+}
+
+/// The texture coordinate along a blur stack of `slices` slices, `step` K_g apart, that blends
+/// the two slices around `k_g` (clamped to the stack): slice centres sit at (i + 0.5) / slices.
+pub fn stack_coordinate(k_g: f32, step: f32, slices: u32) -> f32 {
+    let position = if step > 0.0 {
+        (k_g / step).clamp(0.0, (slices - 1) as f32)
+    } else {
+        0.0
+    };
+    (position + 0.5) / slices as f32
+}
+
+/// Uniform block matching `Globals` in glass.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Globals {
+    world_from_model: [f32; 16],
+    normal_from_model: [f32; 16],
+    background_from_world: [f32; 16],
+    optics: [f32; 4],
+    light: [f32; 4],
+    light_colour: [f32; 4],
+    shading: [f32; 4],
+}
+
+/// The glass pipeline and its descriptors.
+pub struct GlassPass {
+    /// Layout of the single descriptor set.
+    set_layout: vk::DescriptorSetLayout,
+    /// Pipeline layout (set + eye push constants).
+    layout: vk::PipelineLayout,
+    /// The pipeline.
+    pipeline: vk::Pipeline,
+    /// Pool the set lives in.
+    pool: vk::DescriptorPool,
+    /// The descriptor set: globals, environment map, sampler.
+    set: vk::DescriptorSet,
+    /// The uniform buffer behind `Globals`.
+    globals: Buffer,
+}
+
+impl GlassPass {
+    /// Builds the pass for `scene` drawing into `render_pass`.
+    pub fn new(
+        ctx: &GpuContext,
+        render_pass: vk::RenderPass,
+        scene: &GpuScene,
+        desc: &SceneDesc,
+    ) -> Result<GlassPass> {
+        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+        let set_layout = pipeline::set_layout(
+            ctx,
+            &[
+                (0, vk::DescriptorType::UNIFORM_BUFFER, stages),
+                (
+                    1,
+                    vk::DescriptorType::SAMPLED_IMAGE,
+                    vk::ShaderStageFlags::FRAGMENT,
+                ),
+                (
+                    2,
+                    vk::DescriptorType::SAMPLER,
+                    vk::ShaderStageFlags::FRAGMENT,
+                ),
+                (
+                    3,
+                    vk::DescriptorType::SAMPLED_IMAGE,
+                    vk::ShaderStageFlags::FRAGMENT,
+                ),
+                (
+                    4,
+                    vk::DescriptorType::SAMPLER,
+                    vk::ShaderStageFlags::FRAGMENT,
+                ),
+                (
+                    5,
+                    vk::DescriptorType::SAMPLED_IMAGE,
+                    vk::ShaderStageFlags::FRAGMENT,
+                ),
+            ],
+        )?;
+        let layout = pipeline::layout(ctx, set_layout, stages, size_of::<EyePush>() as u32)?;
+        let f = 4;
+        let attributes = [
+            vk::VertexInputAttributeDescription {
+                location: 0,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 0,
+            },
+            vk::VertexInputAttributeDescription {
+                location: 1,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 3 * f,
+            },
+            vk::VertexInputAttributeDescription {
+                location: 2,
+                binding: 0,
+                format: vk::Format::R32G32_SFLOAT,
+                offset: 6 * f,
+            },
+        ];
+        let bindings = [vk::VertexInputBindingDescription {
+            binding: 0,
+            stride: VERTEX_STRIDE,
+            input_rate: vk::VertexInputRate::VERTEX,
+        }];
+        let pipeline = pipeline::create(
+            ctx,
+            render_pass,
+            layout,
+            &PipelineDesc {
+                vertex: shaders::GLASS_VS,
+                fragment: shaders::GLASS_FS,
+                bindings: &bindings,
+                attributes: &attributes,
+                cull: vk::CullModeFlags::BACK,
+            },
+        )?;
+        let pool = pipeline::pool(
+            ctx,
+            1,
+            &[
+                (vk::DescriptorType::UNIFORM_BUFFER, 1),
+                (vk::DescriptorType::SAMPLED_IMAGE, 3),
+                (vk::DescriptorType::SAMPLER, 2),
+            ],
+        )?;
+        let set = pipeline::allocate_set(ctx, pool, set_layout)?;
+        let normal_from_model = desc.world_from_model.inverse().transpose();
+        let surface_opacity = if desc.surface.is_some() {
+            1.0 - desc.surface_transmittance
+        } else {
+            0.0
+        };
+        let globals = Globals {
+            world_from_model: desc.world_from_model.to_cols_array(),
+            normal_from_model: normal_from_model.to_cols_array(),
+            background_from_world: desc.background.world_from_plane.inverse().to_cols_array(),
+            optics: [desc.ior, FRESNEL_BIAS, FRESNEL_SCALE, FRESNEL_POWER],
+            light: desc.light.position_m.extend(1.0).to_array(),
+            light_colour: desc.light.radiance.extend(PHONG_EXPONENT).to_array(),
+            shading: Vec4::new(desc.exposure, surface_opacity, PHONG_STRENGTH, 0.0).to_array(),
+        };
+        let globals = Buffer::with_data(
+            ctx,
+            "glass globals",
+            bytemuck::bytes_of(&globals),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let buffer_info = [vk::DescriptorBufferInfo {
+            buffer: globals.buffer,
+            offset: 0,
+            range: vk::WHOLE_SIZE,
+        }];
+        let write = [vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(0)
+            .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
+            .buffer_info(&buffer_info)];
+        unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
+        pipeline::write_texture(ctx, set, 1, 2, scene.environment.view, scene.env_sampler);
+        pipeline::write_texture(ctx, set, 3, 4, scene.background_stack.view, scene.photo_sampler);
+        pipeline::write_image(ctx, set, 5, scene.surface.view);
+        Ok(GlassPass {
+            set_layout,
+            layout,
+            pipeline,
+            pool,
+            set,
+            globals,
+        })
+    }
+
+    /// Records the draw of the object for one eye, inside that eye's render pass.
+    ///
+    /// # Safety
+    /// `cmd` must be recording inside a render pass compatible with this pass.
+    pub unsafe fn record(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        push: &EyePush,
+    ) {
+        let d = &ctx.device;
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout,
+                0,
+                &[self.set],
+                &[],
+            );
+            d.cmd_push_constants(
+                cmd,
+                self.layout,
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                0,
+                bytemuck::bytes_of(push),
+            );
+            d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
+            d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
+            d.cmd_draw_indexed(cmd, scene.index_count, 1, 0, 0, 0);
+        }
+    }
+
+    /// Frees the pass.
+    ///
+    /// # Safety
+    /// The GPU must no longer use it.
+    pub unsafe fn destroy(&mut self, ctx: &GpuContext) {
+        let d = &ctx.device;
+        unsafe {
+            d.destroy_pipeline(self.pipeline, None);
+            d.destroy_pipeline_layout(self.layout, None);
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+            self.globals.destroy(ctx);
+        }
+    }
+}

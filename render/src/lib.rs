@@ -1,0 +1,41 @@
+//! Vulkan renderer for vitreous.
+//!
+//! Renders the per-eye layers of virtual glass for an additive (optical see-through) display:
+//! linear light on black, each eye into its own layer of a 2-layer array image with the same
+//! pipeline and the eye index in a push constant. Multiview is not used: lavapipe, the CPU
+//! driver CI runs on, gets it wrong.
+//!
+//! # Synchronisation
+//! Work is recorded into one of [`renderer::PIPELINE_DEPTH`] frame slots, each with its own
+//! command buffer, fence and timestamp queries. [`Renderer::render`] first waits for the slot's
+//! previous use to finish, so at most `PIPELINE_DEPTH` frames are in flight. All frames render
+//! into the same target image on one queue; pipeline barriers inside each command buffer order
+//! the accesses across submissions (colour writes, then the transfer to the readback buffer).
+//! Readback results of a slot are valid once its fence has signalled, which
+//! [`Renderer::finish_readback`] waits for.
+//!
+//! Knows nothing about OpenXR: device creation is an injected step ([`context::DeviceCreator`]).
+
+pub mod camera;
+pub mod context;
+pub mod error;
+mod glass;
+pub mod inducer; // shadow inducer (issue 5)
+mod memory;
+pub mod optics;
+mod pipeline;
+pub mod reference;
+pub mod renderer;
+pub mod scene;
+mod shaders;
+mod target;
+mod world;
+
+pub use camera::{Defocus, EyeParams, FrameParams, Look, Reflection};
+pub use context::{ContextOptions, DeviceCreator, GpuContext, PlainVulkan};
+pub use error::{RenderError, Result};
+pub use inducer::InducerFields; // shadow inducer (issue 5)
+pub use renderer::{FrameResult, FrameTiming, Readback, Renderer, Want};
+pub use scene::{
+    BlurStackDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData, TextureDesc,
+};

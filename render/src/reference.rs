@@ -1,0 +1,160 @@
+//! CPU reference of the refraction layer (eq. 7-8) for an analytic sphere: what each pixel of
+//! an eye image samples from the registered background photo. Tests compare the GPU against
+//! it; `vitreous replay --reference` writes it beside the GPU image.
+
+use glam::{Mat4, Vec2, Vec3};
+
+use crate::camera::EyeParams;
+use crate::optics::{fresnel, plane_uv, ray_sphere, refract_heckbert};
+
+/// An analytic glass sphere in front of a registered background plane.
+#[derive(Clone, Copy, Debug)]
+pub struct SphereScene {
+    /// Centre, metres (world).
+    pub center_m: Vec3,
+    /// Radius, metres.
+    pub radius_m: f32,
+    /// Relative index of refraction.
+    pub ior: f32,
+    /// Inverse of the background plane's `world_from_plane`.
+    pub background_from_world: Mat4,
+}
+
+/// What a pixel sees of the sphere's refraction layer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RefractionSample {
+    /// The pixel's ray misses the sphere.
+    Miss,
+    /// The ray enters the sphere.
+    Hit {
+        /// Where the refracted ray meets the background photo, as texture coordinates (u right,
+        /// v down); `None` when it misses it (the environment map is seen instead).
+        uv: Option<Vec2>,
+        /// Fraction of the refracted image that reaches the eye: 1 minus the Fresnel factor.
+        transmission: f32,
+    },
+}
+
+impl EyeParams {
+    /// Unit direction of the view ray through a pixel position (x right, y down, pixel centres
+    /// at half-integers) of an image of `size` pixels.
+    pub fn pixel_ray(&self, pixel: Vec2, size: Vec2) -> Vec3 {
+        let ndc = pixel / size * 2.0 - Vec2::ONE;
+        let world_from_clip = self.clip_from_world().inverse();
+        let near = world_from_clip.project_point3(ndc.extend(0.0));
+        let far = world_from_clip.project_point3(ndc.extend(1.0));
+        (far - near).normalize()
+    }
+}
+
+/// Traces one pixel of one eye: eye ray -> sphere -> first refraction (eq. 7-8) -> background.
+pub fn refraction_sample(
+    eye: &EyeParams,
+    pixel: Vec2,
+    size: Vec2,
+    scene: &SphereScene,
+) -> RefractionSample {
+    let dir = eye.pixel_ray(pixel, size);
+    let origin = eye.position_m;
+    let Some(t) = ray_sphere(origin, dir, scene.center_m, scene.radius_m) else {
+        return RefractionSample::Miss;
+    };
+    let hit = origin + dir * t;
+    let normal = (hit - scene.center_m).normalize();
+    RefractionSample::Hit {
+        uv: refract_heckbert(dir, normal, scene.ior)
+            .and_then(|refracted| plane_uv(hit, refracted, scene.background_from_world)),
+        transmission: 1.0 - fresnel(dir, normal),
+    }
+}
+
+/// Centroid (pixels) of the refracted image of a bright `marker` (a rectangle of photo texture
+/// coordinates: min, max) on a black photo, each pixel weighted by the light it shows
+/// (its transmission), and the number of pixels that see the marker.
+pub fn marker_centroid(
+    eye: &EyeParams,
+    size: (u32, u32),
+    scene: &SphereScene,
+    marker: (Vec2, Vec2),
+) -> Option<(Vec2, usize)> {
+    let dims = Vec2::new(size.0 as f32, size.1 as f32);
+    let mut sum = glam::DVec2::ZERO;
+    let mut weight = 0.0f64;
+    let mut count = 0usize;
+    for y in 0..size.1 {
+        for x in 0..size.0 {
+            let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            if let RefractionSample::Hit {
+                uv: Some(uv),
+                transmission,
+            } = refraction_sample(eye, p, dims, scene)
+                && uv.cmpge(marker.0).all()
+                && uv.cmple(marker.1).all()
+            {
+                sum += p.as_dvec2() * f64::from(transmission);
+                weight += f64::from(transmission);
+                count += 1;
+            }
+        }
+    }
+    (count > 0).then(|| ((sum / weight).as_vec2(), count))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Fov;
+    use glam::Quat;
+
+    #[test]
+    fn pixel_ray_through_the_centre_looks_forward() {
+        let fov = Fov {
+            left_rad: -0.5,
+            right_rad: 0.5,
+            up_rad: 0.4,
+            down_rad: -0.4,
+        };
+        let eye = EyeParams::new(Vec3::ZERO, Quat::IDENTITY, fov);
+        let d = eye.pixel_ray(Vec2::new(50.0, 40.0), Vec2::new(100.0, 80.0));
+        assert!(d.abs_diff_eq(Vec3::NEG_Z, 1e-5), "{d}");
+        // A pixel ray projects back onto its pixel.
+        let p = Vec2::new(13.5, 71.5);
+        let back = eye
+            .project_to_pixel(
+                eye.pixel_ray(p, Vec2::new(100.0, 80.0)),
+                Vec2::new(100.0, 80.0),
+            )
+            .unwrap();
+        assert!(back.abs_diff_eq(p, 1e-3), "{back}");
+    }
+
+    #[test]
+    fn the_centre_ray_refracts_straight_to_the_plane_centre() {
+        let fov = Fov {
+            left_rad: -0.6,
+            right_rad: 0.6,
+            up_rad: 0.45,
+            down_rad: -0.45,
+        };
+        let eye = EyeParams::new(Vec3::ZERO, Quat::IDENTITY, fov);
+        let scene = SphereScene {
+            center_m: Vec3::new(0.0, 0.0, -0.2),
+            radius_m: 0.075,
+            ior: 1.51,
+            background_from_world: Mat4::from_translation(Vec3::new(0.0, 0.0, -0.4)).inverse(),
+        };
+        let s = refraction_sample(&eye, Vec2::new(50.0, 40.0), Vec2::new(100.0, 80.0), &scene);
+        match s {
+            RefractionSample::Hit {
+                uv: Some(uv),
+                transmission,
+            } => {
+                assert!(uv.abs_diff_eq(Vec2::splat(0.5), 1e-3));
+                assert!((transmission - 0.96).abs() < 1e-3);
+            }
+            other => panic!("{other:?}"),
+        }
+        let corner = refraction_sample(&eye, Vec2::new(0.5, 0.5), Vec2::new(100.0, 80.0), &scene);
+        assert_eq!(corner, RefractionSample::Miss);
+    }
+}

@@ -1,0 +1,552 @@
+//! The renderer: owns the GPU context, the scene's resources, the passes and the frame slots.
+
+use std::time::Instant;
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use crate::camera::FrameParams;
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result, VkContext};
+use crate::glass::{EyePush, GlassPass};
+use crate::inducer::{InducerFields, InducerPass}; // shadow inducer (issue 5)
+use crate::memory::Buffer;
+use crate::scene::{GpuScene, SceneDesc};
+use crate::target::{self, StereoTarget};
+use crate::world::WorldPass;
+
+mod external;
+
+/// Frames that may be in flight at once.
+pub const PIPELINE_DEPTH: usize = 2;
+
+/// Largest eye image side the renderer accepts, in pixels.
+pub const MAX_EXTENT: u32 = 8192;
+
+/// What to read back from a frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Want {
+    /// Read back both eye images.
+    pub eyes: bool,
+    /// Also render and read back the real world (floor and background photos) from both eyes,
+    /// for the see-through preview.
+    pub world: bool,
+}
+
+/// Pixels read back from a frame: RGBA8, sRGB-encoded, rows from the top.
+#[derive(Clone, Debug)]
+pub struct Readback {
+    /// Width of each image in pixels.
+    pub width: u32,
+    /// Height of each image in pixels.
+    pub height: u32,
+    /// Left and right eye images (the display's light).
+    pub eyes: [Vec<u8>; 2],
+    /// Left and right views of the real world, when asked for.
+    pub world: Option<[Vec<u8>; 2]>,
+}
+
+/// Timing of one frame.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameTiming {
+    /// GPU time of the frame's rendering (both eyes, without the readback copy), milliseconds;
+    /// `None` when the device cannot write timestamps.
+    pub gpu_ms: Option<f64>,
+    /// CPU time spent recording and submitting the frame, milliseconds.
+    pub cpu_submit_ms: f64,
+}
+
+/// A finished frame.
+#[derive(Clone, Debug)]
+pub struct FrameResult {
+    /// The sequence number [`Renderer::submit`] gave the frame.
+    pub sequence: u64,
+    /// Its timing.
+    pub timing: FrameTiming,
+    /// Its pixels, when asked for.
+    pub readback: Option<Readback>,
+}
+
+/// A frame submitted but not yet collected.
+struct Pending {
+    sequence: u64,
+    want: Want,
+    cpu_submit_ms: f64,
+}
+
+/// Per-frame resources, used round-robin.
+struct FrameSlot {
+    /// Command buffer recorded anew each use.
+    cmd: vk::CommandBuffer,
+    /// Signalled when the slot's last submission finished.
+    fence: vk::Fence,
+    /// Two timestamps (start, end of rendering), when supported.
+    queries: Option<vk::QueryPool>,
+    /// Host-visible copy of both eye layers, then both world layers.
+    readback: Buffer,
+    /// What the slot's in-flight frame is.
+    pending: Option<Pending>,
+}
+
+/// Draws stereo frames of one scene.
+pub struct Renderer {
+    /// Size of each eye image.
+    extent: vk::Extent2D,
+    /// The scene's GPU resources.
+    scene: GpuScene,
+    /// The glass pass.
+    glass: GlassPass,
+    /// The real-world pass for previews.
+    world: WorldPass,
+    /// The shadow inducer's fields and floor overlay (issue 5).
+    inducer: InducerPass,
+    /// The render pass all passes draw in.
+    render_pass: vk::RenderPass,
+    /// Eye images.
+    eye_target: StereoTarget,
+    /// Real-world views.
+    world_target: StereoTarget,
+    /// Command pool of the slots.
+    pool: vk::CommandPool,
+    /// Frame slots.
+    slots: Vec<FrameSlot>,
+    /// Sequence number of the next frame.
+    next_sequence: u64,
+    /// Images owned by someone else (an OpenXR swapchain) that frames may be drawn into
+    /// instead of `eye_target`; see [`Renderer::attach_external`].
+    external: Option<external::External>,
+    /// The GPU context; dropped last.
+    ctx: GpuContext,
+}
+
+impl Renderer {
+    /// Uploads `scene` and prepares to draw eye images of `width` x `height` pixels.
+    pub fn new(ctx: GpuContext, scene: &SceneDesc, width: u32, height: u32) -> Result<Renderer> {
+        if !(1..=MAX_EXTENT).contains(&width) || !(1..=MAX_EXTENT).contains(&height) {
+            return Err(RenderError::InvalidInput(format!(
+                "eye image size {width}x{height} is outside 1..={MAX_EXTENT} pixels per side"
+            )));
+        }
+        let extent = vk::Extent2D { width, height };
+        // Construction is not unwound piece by piece: on error the context is dropped, and
+        // destroying the device frees what was made on it (validation would flag it as a
+        // leak, but tests only construct from valid input).
+        let gpu_scene = GpuScene::new(&ctx, scene)?;
+        let render_pass = target::create_render_pass(&ctx)?;
+        let glass = GlassPass::new(&ctx, render_pass, &gpu_scene, scene)?;
+        let world = WorldPass::new(
+            &ctx,
+            render_pass,
+            &gpu_scene,
+            [
+                scene.floor.world_from_plane,
+                scene.background.world_from_plane,
+            ],
+        )?;
+        let inducer = InducerPass::new(&ctx, render_pass, &gpu_scene, scene)?; // issue 5
+        let eye_target = StereoTarget::new(&ctx, "eye images", render_pass, extent)?;
+        let world_target = StereoTarget::new(&ctx, "world views", render_pass, extent)?;
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(ctx.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
+            .vk("vkCreateCommandPool")?;
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(PIPELINE_DEPTH as u32);
+        let cmds = unsafe { ctx.device.allocate_command_buffers(&alloc) }
+            .vk("vkAllocateCommandBuffers")?;
+        let image_bytes = u64::from(width) * u64::from(height) * 4;
+        let mut slots = Vec::with_capacity(PIPELINE_DEPTH);
+        for cmd in cmds {
+            let fence = unsafe {
+                ctx.device.create_fence(
+                    &vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED),
+                    None,
+                )
+            }
+            .vk("vkCreateFence")?;
+            let queries = match ctx.timestamp_period_ns {
+                Some(_) => {
+                    let info = vk::QueryPoolCreateInfo::default()
+                        .query_type(vk::QueryType::TIMESTAMP)
+                        .query_count(2);
+                    Some(
+                        unsafe { ctx.device.create_query_pool(&info, None) }
+                            .vk("vkCreateQueryPool")?,
+                    )
+                }
+                None => None,
+            };
+            let readback = Buffer::new(
+                &ctx,
+                "readback",
+                image_bytes * 4,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?;
+            slots.push(FrameSlot {
+                cmd,
+                fence,
+                queries,
+                readback,
+                pending: None,
+            });
+        }
+        Ok(Renderer {
+            extent,
+            scene: gpu_scene,
+            glass,
+            world,
+            inducer,
+            render_pass,
+            eye_target,
+            world_target,
+            pool,
+            slots,
+            next_sequence: 0,
+            external: None,
+            ctx,
+        })
+    }
+
+    /// The GPU context.
+    pub fn context(&self) -> &GpuContext {
+        &self.ctx
+    }
+
+    /// Size of each eye image in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.extent.width, self.extent.height)
+    }
+
+    // --- shadow inducer (issue 5) ---
+    /// The shadow inducer's floor-space fields (mask, distance to the shadow edge, gain),
+    /// computed first if no frame has needed them yet. Waits for the GPU; for tests and
+    /// debugging.
+    pub fn inducer_fields(&mut self) -> Result<InducerFields> {
+        self.inducer.read_back(&self.ctx, &self.scene)
+    }
+    // --- end shadow inducer ---
+
+    /// Records and submits a frame. Returns the frame that last used the same slot
+    /// ([`PIPELINE_DEPTH`] frames earlier), once finished, so the caller handles results in
+    /// order while the GPU works on newer frames.
+    pub fn submit(&mut self, params: &FrameParams, want: Want) -> Result<Option<FrameResult>> {
+        self.submit_to(params, want, None)
+    }
+
+    /// [`Renderer::submit`], drawing into an attached external image when `draw` says so.
+    fn submit_to(
+        &mut self,
+        params: &FrameParams,
+        want: Want,
+        draw: Option<external::ExternalDraw>,
+    ) -> Result<Option<FrameResult>> {
+        let sequence = self.next_sequence;
+        let slot_index = (sequence % PIPELINE_DEPTH as u64) as usize;
+        let previous = self.collect(slot_index)?;
+
+        let started = Instant::now();
+        let d = &self.ctx.device;
+        let slot = &self.slots[slot_index];
+        unsafe {
+            d.reset_fences(&[slot.fence]).vk("vkResetFences")?;
+            d.reset_command_buffer(slot.cmd, vk::CommandBufferResetFlags::empty())
+                .vk("vkResetCommandBuffer")?;
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            d.begin_command_buffer(slot.cmd, &begin)
+                .vk("vkBeginCommandBuffer")?;
+            self.record(slot, params, want, draw);
+            d.end_command_buffer(slot.cmd).vk("vkEndCommandBuffer")?;
+            let cmds = [slot.cmd];
+            let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+            d.queue_submit(self.ctx.queue, &submit, slot.fence)
+                .vk("vkQueueSubmit")?;
+        }
+        self.slots[slot_index].pending = Some(Pending {
+            sequence,
+            want,
+            cpu_submit_ms: started.elapsed().as_secs_f64() * 1e3,
+        });
+        self.next_sequence += 1;
+        Ok(previous)
+    }
+
+    /// Waits for every frame in flight and returns them in submission order.
+    pub fn flush(&mut self) -> Result<Vec<FrameResult>> {
+        let mut done = Vec::new();
+        for i in 0..PIPELINE_DEPTH as u64 {
+            let slot = ((self.next_sequence + i) % PIPELINE_DEPTH as u64) as usize;
+            if let Some(result) = self.collect(slot)? {
+                done.push(result);
+            }
+        }
+        Ok(done)
+    }
+
+    /// Waits for the slot's frame, if any, and takes its results.
+    fn collect(&mut self, slot_index: usize) -> Result<Option<FrameResult>> {
+        let d = &self.ctx.device;
+        let slot = &mut self.slots[slot_index];
+        let Some(pending) = slot.pending.take() else {
+            return Ok(None);
+        };
+        unsafe { d.wait_for_fences(&[slot.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        let gpu_ms = match (slot.queries, self.ctx.timestamp_period_ns) {
+            (Some(pool), Some(period)) => {
+                let mut stamps = [0u64; 2];
+                unsafe {
+                    d.get_query_pool_results(
+                        pool,
+                        0,
+                        &mut stamps,
+                        vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                    )
+                }
+                .vk("vkGetQueryPoolResults")?;
+                Some(stamps[1].wrapping_sub(stamps[0]) as f64 * f64::from(period) * 1e-6)
+            }
+            _ => None,
+        };
+        let readback = pending.want.eyes.then(|| {
+            let bytes = slot.readback.mapped();
+            let n = (self.extent.width * self.extent.height * 4) as usize;
+            Readback {
+                width: self.extent.width,
+                height: self.extent.height,
+                eyes: [bytes[..n].to_vec(), bytes[n..2 * n].to_vec()],
+                world: pending
+                    .want
+                    .world
+                    .then(|| [bytes[2 * n..3 * n].to_vec(), bytes[3 * n..4 * n].to_vec()]),
+            }
+        });
+        Ok(Some(FrameResult {
+            sequence: pending.sequence,
+            timing: FrameTiming {
+                gpu_ms,
+                cpu_submit_ms: pending.cpu_submit_ms,
+            },
+            readback,
+        }))
+    }
+
+    /// Records one frame into the slot's command buffer.
+    ///
+    /// # Safety
+    /// The slot's command buffer must be recording and its previous use finished.
+    unsafe fn record(
+        &self,
+        slot: &FrameSlot,
+        params: &FrameParams,
+        want: Want,
+        draw: Option<external::ExternalDraw>,
+    ) {
+        let d = &self.ctx.device;
+        let cmd = slot.cmd;
+        // Where the eyes go: the renderer's own target, or an attached external image (left in
+        // COLOR_ATTACHMENT_OPTIMAL by its render pass), with the real world drawn behind when
+        // the display shows no real world of its own.
+        let (eye_framebuffers, eye_image, eye_pass, world_behind) =
+            match (draw, self.external.as_ref()) {
+                (Some(draw), Some(ext)) => (
+                    ext.framebuffers[draw.image],
+                    ext.images[draw.image],
+                    ext.render_pass,
+                    draw.world_behind,
+                ),
+                _ => (
+                    self.eye_target.framebuffers,
+                    self.eye_target.color.image,
+                    self.render_pass,
+                    false,
+                ),
+            };
+        let external_image = draw.is_some() && self.external.is_some();
+        unsafe {
+            if params.look.inducer {
+                // Once per scene, before the timed part (issue 5).
+                self.inducer.prepare(&self.ctx, cmd, &self.scene);
+            }
+            if let Some(pool) = slot.queries {
+                d.cmd_reset_query_pool(cmd, pool, 0, 2);
+                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 0);
+            }
+            for (index, eye) in params.eyes.iter().enumerate() {
+                self.begin_pass(cmd, eye_pass, eye_framebuffers[index]);
+                if world_behind {
+                    self.world.record(&self.ctx, cmd, eye);
+                }
+                if params.look.inducer {
+                    // Added before the glass, which covers it where the object is (issue 5).
+                    self.inducer.record(&self.ctx, cmd, eye);
+                }
+                self.glass.record(
+                    &self.ctx,
+                    cmd,
+                    &self.scene,
+                    &EyePush::new(
+                        &params.eyes,
+                        index,
+                        &params.look,
+                        self.scene.stack_slices,
+                        self.scene.stack_steps,
+                    ),
+                );
+                d.cmd_end_render_pass(cmd);
+            }
+            if let Some(pool) = slot.queries {
+                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 1);
+            }
+            if want.eyes && want.world {
+                for (index, eye) in params.eyes.iter().enumerate() {
+                    self.begin_pass(cmd, self.render_pass, self.world_target.framebuffers[index]);
+                    self.world.record(&self.ctx, cmd, eye);
+                    d.cmd_end_render_pass(cmd);
+                }
+            }
+            if want.eyes {
+                let layer_bytes = u64::from(self.extent.width) * u64::from(self.extent.height) * 4;
+                if external_image {
+                    external::transition(
+                        d,
+                        cmd,
+                        eye_image,
+                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    );
+                }
+                let mut copies = vec![(eye_image, 0)];
+                if want.world {
+                    copies.push((self.world_target.color.image, 2 * layer_bytes));
+                }
+                for (image, offset) in copies {
+                    let region = vk::BufferImageCopy::default()
+                        .buffer_offset(offset)
+                        .image_subresource(vk::ImageSubresourceLayers {
+                            aspect_mask: vk::ImageAspectFlags::COLOR,
+                            mip_level: 0,
+                            base_array_layer: 0,
+                            layer_count: 2,
+                        })
+                        .image_extent(vk::Extent3D {
+                            width: self.extent.width,
+                            height: self.extent.height,
+                            depth: 1,
+                        });
+                    d.cmd_copy_image_to_buffer(
+                        cmd,
+                        image,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        slot.readback.buffer,
+                        &[region],
+                    );
+                }
+                let to_host = vk::BufferMemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::HOST_READ)
+                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .buffer(slot.readback.buffer)
+                    .offset(0)
+                    .size(vk::WHOLE_SIZE);
+                if external_image {
+                    external::transition(
+                        d,
+                        cmd,
+                        eye_image,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                    );
+                }
+                d.cmd_pipeline_barrier(
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::PipelineStageFlags::HOST,
+                    vk::DependencyFlags::empty(),
+                    &[],
+                    &[to_host],
+                    &[],
+                );
+            }
+        }
+    }
+
+    /// Begins `render_pass` on `framebuffer`, clearing to black (no light) and far depth.
+    unsafe fn begin_pass(
+        &self,
+        cmd: vk::CommandBuffer,
+        render_pass: vk::RenderPass,
+        framebuffer: vk::Framebuffer,
+    ) {
+        let d = &self.ctx.device;
+        let clear = [
+            vk::ClearValue {
+                color: vk::ClearColorValue {
+                    float32: [0.0, 0.0, 0.0, 1.0],
+                },
+            },
+            vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 1.0,
+                    stencil: 0,
+                },
+            },
+        ];
+        let area = vk::Rect2D {
+            offset: vk::Offset2D { x: 0, y: 0 },
+            extent: self.extent,
+        };
+        let begin = vk::RenderPassBeginInfo::default()
+            .render_pass(render_pass)
+            .framebuffer(framebuffer)
+            .render_area(area)
+            .clear_values(&clear);
+        unsafe {
+            d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+            d.cmd_set_viewport(
+                cmd,
+                0,
+                &[vk::Viewport {
+                    x: 0.0,
+                    y: 0.0,
+                    width: self.extent.width as f32,
+                    height: self.extent.height as f32,
+                    min_depth: 0.0,
+                    max_depth: 1.0,
+                }],
+            );
+            d.cmd_set_scissor(cmd, 0, &[area]);
+        }
+    }
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        let ctx = &self.ctx;
+        unsafe {
+            let _ = ctx.device.device_wait_idle();
+            for slot in &mut self.slots {
+                ctx.device.destroy_fence(slot.fence, None);
+                if let Some(pool) = slot.queries {
+                    ctx.device.destroy_query_pool(pool, None);
+                }
+                slot.readback.destroy(ctx);
+            }
+            ctx.device.destroy_command_pool(self.pool, None);
+            if let Some(mut external) = self.external.take() {
+                external.destroy(ctx);
+            }
+            self.eye_target.destroy(ctx);
+            self.world_target.destroy(ctx);
+            self.glass.destroy(ctx);
+            self.world.destroy(ctx);
+            self.inducer.destroy(ctx);
+            ctx.device.destroy_render_pass(self.render_pass, None);
+            self.scene.destroy(ctx);
+        }
+    }
+}

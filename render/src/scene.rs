@@ -1,0 +1,407 @@
+//! The scene as the renderer sees it: plain data in, GPU resources out.
+
+use ash::vk;
+use glam::{Mat4, Vec2, Vec3};
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result, VkContext};
+use crate::memory::{Buffer, Image, upload_texture, upload_volume};
+
+/// Texels of a texture, RGBA, row-major from the top-left.
+#[derive(Clone, Copy, Debug)]
+pub enum TexelData<'a> {
+    /// 8-bit sRGB-encoded RGBA (photos, surface textures).
+    Srgb8(&'a [u8]),
+    /// Linear RGBA floats (HDR environment maps).
+    LinearF32(&'a [f32]),
+}
+
+/// A texture to upload.
+#[derive(Clone, Copy, Debug)]
+pub struct TextureDesc<'a> {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// The texels.
+    pub data: TexelData<'a>,
+}
+
+/// A triangle mesh in model units.
+#[derive(Clone, Copy, Debug)]
+pub struct MeshRef<'a> {
+    /// Vertex positions.
+    pub positions: &'a [Vec3],
+    /// Vertex normals (outward).
+    pub normals: &'a [Vec3],
+    /// Texture coordinates.
+    pub uvs: &'a [Vec2],
+    /// Triangle list indices.
+    pub indices: &'a [u32],
+}
+
+/// A registered real-world plane with its photo.
+#[derive(Clone, Copy, Debug)]
+pub struct PlaneDesc<'a> {
+    /// Maps the unit square [-0.5, 0.5]^2 at z = 0 onto the plane (photo top towards +y).
+    pub world_from_plane: Mat4,
+    /// The photo of the real surface.
+    pub photo: TextureDesc<'a>,
+}
+
+/// Everything static the renderer draws.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneDesc<'a> {
+    /// The glass object's mesh.
+    pub mesh: MeshRef<'a>,
+    /// Model to world transform of the object.
+    pub world_from_model: Mat4,
+    /// Relative index of refraction of the object.
+    pub ior: f32,
+    /// Latitude-longitude environment map (radiance).
+    pub environment: TextureDesc<'a>,
+    /// The real floor.
+    pub floor: PlaneDesc<'a>,
+    /// The real background.
+    pub background: PlaneDesc<'a>,
+    /// Scale applied to environment radiance before display.
+    pub exposure: f32,
+    /// The object's surface texture (mapped with the mesh's uvs), if any.
+    pub surface: Option<TextureDesc<'a>>,
+    /// Fraction of light the surface texture lets through, 0..1 (eq. 9's alpha is 1 minus
+    /// this, times the texel's alpha).
+    pub surface_transmittance: f32,
+    /// The point light.
+    pub light: LightDesc,
+    /// Blur stack of the background photo for defocus (eq. 10-14); `None`: the photo only.
+    pub background_stack: Option<BlurStackDesc<'a>>,
+    /// Blur stack of the surface texture for defocus; `None`: the texture only.
+    pub surface_stack: Option<BlurStackDesc<'a>>,
+    // --- shadow inducer (issue 5; render/src/inducer.rs) ---
+    /// Shadow inducer parameters (eq. 2-4).
+    pub inducer: InducerDesc,
+    // --- end shadow inducer ---
+}
+
+// --- shadow inducer (issue 5; render/src/inducer.rs) ---
+/// Parameters of the shadow inducer (METHOD.md section 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InducerDesc {
+    /// k of eq. 4: the inducer's gain at the shadow edge, relative to the floor's luminance.
+    pub k: f32,
+    /// D of eq. 2: width of the ramp around the shadow, metres.
+    pub ramp_width_m: f32,
+    /// Side of the floor-space shadow mask and distance field, texels (over the floor
+    /// photo's area).
+    pub resolution_px: u32,
+}
+
+impl InducerDesc {
+    /// The paper's HoloLens values: k = 0.3, D = 140 mm, on a 512 x 512 mask.
+    pub const PAPER: InducerDesc = InducerDesc {
+        k: 0.3,
+        ramp_width_m: 0.14,
+        resolution_px: 512,
+    };
+}
+
+impl Default for InducerDesc {
+    fn default() -> InducerDesc {
+        InducerDesc::PAPER
+    }
+}
+// --- end shadow inducer ---
+
+/// An image blurred by increasing amounts: slice i is the image convolved with the Gaussian
+/// of eq. 10-12 for kernel width K_g = i * `k_g_step_px`. Sampled with trilinear filtering,
+/// a fractional slice position blends two neighbours, which has exactly the interpolated
+/// variance (eq. 11: the variance grows linearly with K_g): one fetch whatever the blur.
+#[derive(Clone, Copy, Debug)]
+pub struct BlurStackDesc<'a> {
+    /// Width of each slice, texels.
+    pub width: u32,
+    /// Height of each slice, texels.
+    pub height: u32,
+    /// Number of slices (at least 2).
+    pub slices: u32,
+    /// K_g between consecutive slices, pixels of the image.
+    pub k_g_step_px: f32,
+    /// sRGB-encoded RGBA8 texels, slice after slice.
+    pub srgb8: &'a [u8],
+}
+
+/// A point light.
+#[derive(Clone, Copy, Debug)]
+pub struct LightDesc {
+    /// World position, metres.
+    pub position_m: Vec3,
+    /// Linear RGB colour times intensity.
+    pub radiance: Vec3,
+}
+
+/// Bytes per interleaved vertex: position, normal, uv.
+pub(crate) const VERTEX_STRIDE: u32 = 8 * 4;
+
+/// The scene's GPU resources.
+pub(crate) struct GpuScene {
+    /// Interleaved vertices.
+    pub vertices: Buffer,
+    /// Triangle indices.
+    pub indices: Buffer,
+    /// Number of indices.
+    pub index_count: u32,
+    /// Environment map (RGBA16F).
+    pub environment: Image,
+    /// Floor photo then background photo (sRGB).
+    pub photos: [Image; 2],
+    /// The surface texture's blur stack (3-D, sRGB); a white texel when the scene has none.
+    pub surface: Image,
+    /// The background photo's blur stack (3-D, sRGB), sampled by the glass pass.
+    pub background_stack: Image,
+    /// Slices of the background and surface stacks.
+    pub stack_slices: [u32; 2],
+    /// K_g between slices of the background and surface stacks, pixels.
+    pub stack_steps: [f32; 2],
+    /// Repeating in u, clamped in v: latitude-longitude maps.
+    pub env_sampler: vk::Sampler,
+    /// Clamped: photos.
+    pub photo_sampler: vk::Sampler,
+}
+
+impl GpuScene {
+    /// Validates `desc` and uploads it. On an error part way, what was created is left to
+    /// the device's destruction (the renderer drops its context on any construction error).
+    pub fn new(ctx: &GpuContext, desc: &SceneDesc) -> Result<GpuScene> {
+        validate(ctx, desc)?;
+        let m = desc.mesh;
+        let mut interleaved = Vec::with_capacity(m.positions.len() * 8);
+        for i in 0..m.positions.len() {
+            interleaved.extend_from_slice(&m.positions[i].to_array());
+            interleaved.extend_from_slice(&m.normals[i].to_array());
+            interleaved.extend_from_slice(&m.uvs[i].to_array());
+        }
+        let vertices = Buffer::with_data(
+            ctx,
+            "vertices",
+            bytemuck::cast_slice(&interleaved),
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+        )?;
+        let indices = Buffer::with_data(
+            ctx,
+            "indices",
+            bytemuck::cast_slice(m.indices),
+            vk::BufferUsageFlags::INDEX_BUFFER,
+        )?;
+        let environment = upload(ctx, "environment map", &desc.environment)?;
+        let floor = upload(ctx, "floor photo", &desc.floor.photo)?;
+        let background = upload(ctx, "background photo", &desc.background.photo)?;
+        let white = [255u8; 4];
+        let surface_photo = desc.surface.unwrap_or(TextureDesc {
+            width: 1,
+            height: 1,
+            data: TexelData::Srgb8(&white),
+        });
+        let (background_stack, background_slices, background_step) =
+            upload_stack(ctx, "background blur stack", &desc.background.photo, desc.background_stack)?;
+        let (surface, surface_slices, surface_step) =
+            upload_stack(ctx, "surface blur stack", &surface_photo, desc.surface_stack)?;
+        Ok(GpuScene {
+            vertices,
+            indices,
+            index_count: m.indices.len() as u32,
+            environment,
+            photos: [floor, background],
+            surface,
+            background_stack,
+            stack_slices: [background_slices, surface_slices],
+            stack_steps: [background_step, surface_step],
+            env_sampler: sampler(ctx, vk::SamplerAddressMode::REPEAT)?,
+            photo_sampler: sampler(ctx, vk::SamplerAddressMode::CLAMP_TO_EDGE)?,
+        })
+    }
+
+    /// Frees everything.
+    ///
+    /// # Safety
+    /// The GPU must no longer use the scene.
+    pub unsafe fn destroy(&mut self, ctx: &GpuContext) {
+        unsafe {
+            self.vertices.destroy(ctx);
+            self.indices.destroy(ctx);
+            self.environment.destroy(ctx);
+            for p in &mut self.photos {
+                p.destroy(ctx);
+            }
+            self.surface.destroy(ctx);
+            self.background_stack.destroy(ctx);
+            ctx.device.destroy_sampler(self.env_sampler, None);
+            ctx.device.destroy_sampler(self.photo_sampler, None);
+        }
+    }
+}
+
+fn validate(ctx: &GpuContext, desc: &SceneDesc) -> Result<()> {
+    let m = desc.mesh;
+    let n = m.positions.len();
+    if n == 0 || m.indices.is_empty() || !m.indices.len().is_multiple_of(3) {
+        return Err(RenderError::InvalidInput(format!(
+            "the mesh needs vertices and a whole number of triangles (has {n} vertices, {} indices)",
+            m.indices.len()
+        )));
+    }
+    if m.normals.len() != n || m.uvs.len() != n {
+        return Err(RenderError::InvalidInput(format!(
+            "mesh attribute counts differ: {n} positions, {} normals, {} uvs",
+            m.normals.len(),
+            m.uvs.len()
+        )));
+    }
+    if let Some(bad) = m.indices.iter().find(|&&i| i as usize >= n) {
+        return Err(RenderError::InvalidInput(format!(
+            "mesh index {bad} is out of range for {n} vertices"
+        )));
+    }
+    if !(desc.ior.is_finite() && desc.ior >= 1.0) {
+        return Err(RenderError::InvalidInput(format!(
+            "index of refraction must be finite and >= 1, got {}",
+            desc.ior
+        )));
+    }
+    let limit = unsafe { ctx.instance.get_physical_device_properties(ctx.physical) }
+        .limits
+        .max_image_dimension2_d;
+    crate::inducer::validate(&desc.inducer, limit)?; // shadow inducer (issue 5)
+    if !(0.0..=1.0).contains(&desc.surface_transmittance) {
+        return Err(RenderError::InvalidInput(format!(
+            "surface transmittance must be within 0..1, got {}",
+            desc.surface_transmittance
+        )));
+    }
+    for (name, stack, plain) in [
+        ("background blur stack", &desc.background_stack, Some(&desc.background.photo)),
+        ("surface blur stack", &desc.surface_stack, desc.surface.as_ref()),
+    ] {
+        if let Some(st) = stack {
+            let expected = st.width as usize * st.height as usize * 4 * st.slices as usize;
+            if st.slices < 2 || st.srgb8.len() != expected || !(st.k_g_step_px > 0.0) {
+                return Err(RenderError::InvalidInput(format!(
+                    "{name}: needs at least 2 slices of {}x{} RGBA8 texels ({expected} bytes) and \
+                     a positive K_g step; got {} slices, {} bytes, step {}",
+                    st.width,
+                    st.height,
+                    st.srgb8.len(),
+                    st.slices,
+                    st.k_g_step_px
+                )));
+            }
+            if plain.is_none() {
+                return Err(RenderError::InvalidInput(format!(
+                    "{name} given without its image"
+                )));
+            }
+        }
+    }
+    let mut textures = vec![
+        ("environment map", &desc.environment),
+        ("floor photo", &desc.floor.photo),
+        ("background photo", &desc.background.photo),
+    ];
+    if let Some(surface) = &desc.surface {
+        textures.push(("surface texture", surface));
+    }
+    for (name, t) in textures {
+        if t.width == 0 || t.height == 0 || t.width > limit || t.height > limit {
+            return Err(RenderError::InvalidInput(format!(
+                "{name} is {}x{} texels; this device takes 1..={limit} per side",
+                t.width, t.height
+            )));
+        }
+        let expected = t.width as usize * t.height as usize * 4;
+        let got = match t.data {
+            TexelData::Srgb8(d) => d.len(),
+            TexelData::LinearF32(d) => d.len(),
+        };
+        if got != expected {
+            return Err(RenderError::InvalidInput(format!(
+                "{name}: expected {expected} RGBA components for {}x{}, got {got}",
+                t.width, t.height
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn upload(ctx: &GpuContext, name: &str, t: &TextureDesc) -> Result<Image> {
+    let extent = vk::Extent2D {
+        width: t.width,
+        height: t.height,
+    };
+    match t.data {
+        TexelData::Srgb8(bytes) => {
+            upload_texture(ctx, name, vk::Format::R8G8B8A8_SRGB, extent, bytes)
+        }
+        TexelData::LinearF32(floats) => {
+            // Half floats filter linearly on every device; 32-bit floats do not.
+            let halves: Vec<half::f16> = floats.iter().map(|&f| half::f16::from_f32(f)).collect();
+            let bytes: Vec<u8> = halves.iter().flat_map(|h| h.to_le_bytes()).collect();
+            upload_texture(ctx, name, vk::Format::R16G16B16A16_SFLOAT, extent, &bytes)
+        }
+    }
+}
+
+/// Uploads a blur stack as a 3-D texture; without one, the plain image twice (a 3-D texture
+/// needs two slices to be one), which samples as the unblurred image at any slice position.
+fn upload_stack(
+    ctx: &GpuContext,
+    name: &str,
+    plain: &TextureDesc,
+    stack: Option<BlurStackDesc>,
+) -> Result<(Image, u32, f32)> {
+    let extent = |w, h| vk::Extent2D {
+        width: w,
+        height: h,
+    };
+    match stack {
+        Some(s) => Ok((
+            upload_volume(
+                ctx,
+                name,
+                vk::Format::R8G8B8A8_SRGB,
+                extent(s.width, s.height),
+                s.slices,
+                s.srgb8,
+            )?,
+            s.slices,
+            s.k_g_step_px,
+        )),
+        None => {
+            let TexelData::Srgb8(bytes) = plain.data else {
+                return Err(RenderError::InvalidInput(format!(
+                    "{name}: an 8-bit sRGB image is needed"
+                )));
+            };
+            let twice = [bytes, bytes].concat();
+            let image = upload_volume(
+                ctx,
+                name,
+                vk::Format::R8G8B8A8_SRGB,
+                extent(plain.width, plain.height),
+                2,
+                &twice,
+            )?;
+            Ok((image, 2, 1.0))
+        }
+    }
+}
+
+fn sampler(ctx: &GpuContext, u_mode: vk::SamplerAddressMode) -> Result<vk::Sampler> {
+    let info = vk::SamplerCreateInfo::default()
+        .mag_filter(vk::Filter::LINEAR)
+        .min_filter(vk::Filter::LINEAR)
+        .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+        .address_mode_u(u_mode)
+        .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .max_lod(0.0);
+    unsafe { ctx.device.create_sampler(&info, None) }.vk("vkCreateSampler")
+}

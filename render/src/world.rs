@@ -1,0 +1,141 @@
+//! The real world (floor and background photos on their registered planes), drawn only for the
+//! see-through preview, never into an eye image (shaders/world.wgsl).
+
+use ash::vk;
+use glam::Mat4;
+
+use crate::camera::EyeParams;
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::pipeline::{self, PipelineDesc};
+use crate::scene::GpuScene;
+use crate::shaders;
+
+/// Push constants: one plane seen by one eye.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct PlanePush {
+    clip_from_world: [f32; 16],
+    world_from_plane: [f32; 16],
+}
+
+/// The real-world pipeline and one descriptor set per plane.
+pub struct WorldPass {
+    /// Layout of a plane's descriptor set.
+    set_layout: vk::DescriptorSetLayout,
+    /// Pipeline layout.
+    layout: vk::PipelineLayout,
+    /// The pipeline.
+    pipeline: vk::Pipeline,
+    /// Pool of the sets.
+    pool: vk::DescriptorPool,
+    /// Floor then background.
+    sets: [vk::DescriptorSet; 2],
+    /// Floor then background plane transforms.
+    planes: [Mat4; 2],
+}
+
+impl WorldPass {
+    /// Builds the pass for the scene's two planes.
+    pub fn new(
+        ctx: &GpuContext,
+        render_pass: vk::RenderPass,
+        scene: &GpuScene,
+        planes: [Mat4; 2],
+    ) -> Result<WorldPass> {
+        let fs = vk::ShaderStageFlags::FRAGMENT;
+        let set_layout = pipeline::set_layout(
+            ctx,
+            &[
+                (0, vk::DescriptorType::SAMPLED_IMAGE, fs),
+                (1, vk::DescriptorType::SAMPLER, fs),
+            ],
+        )?;
+        let layout = pipeline::layout(
+            ctx,
+            set_layout,
+            vk::ShaderStageFlags::VERTEX,
+            size_of::<PlanePush>() as u32,
+        )?;
+        let pipeline = pipeline::create(
+            ctx,
+            render_pass,
+            layout,
+            &PipelineDesc {
+                vertex: shaders::WORLD_VS,
+                fragment: shaders::WORLD_FS,
+                bindings: &[],
+                attributes: &[],
+                cull: vk::CullModeFlags::NONE,
+            },
+        )?;
+        let pool = pipeline::pool(
+            ctx,
+            2,
+            &[
+                (vk::DescriptorType::SAMPLED_IMAGE, 2),
+                (vk::DescriptorType::SAMPLER, 2),
+            ],
+        )?;
+        let mut sets = [vk::DescriptorSet::null(); 2];
+        for (set, photo) in sets.iter_mut().zip(&scene.photos) {
+            *set = pipeline::allocate_set(ctx, pool, set_layout)?;
+            pipeline::write_texture(ctx, *set, 0, 1, photo.view, scene.photo_sampler);
+        }
+        Ok(WorldPass {
+            set_layout,
+            layout,
+            pipeline,
+            pool,
+            sets,
+            planes,
+        })
+    }
+
+    /// Records both planes for one eye, inside that eye's render pass.
+    ///
+    /// # Safety
+    /// `cmd` must be recording inside a render pass compatible with this pass.
+    pub unsafe fn record(&self, ctx: &GpuContext, cmd: vk::CommandBuffer, eye: &EyeParams) {
+        let d = &ctx.device;
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            for (set, plane) in self.sets.iter().zip(&self.planes) {
+                let push = PlanePush {
+                    clip_from_world: eye.clip_from_world().to_cols_array(),
+                    world_from_plane: plane.to_cols_array(),
+                };
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    self.layout,
+                    0,
+                    &[*set],
+                    &[],
+                );
+                d.cmd_push_constants(
+                    cmd,
+                    self.layout,
+                    vk::ShaderStageFlags::VERTEX,
+                    0,
+                    bytemuck::bytes_of(&push),
+                );
+                d.cmd_draw(cmd, 6, 1, 0, 0);
+            }
+        }
+    }
+
+    /// Frees the pass.
+    ///
+    /// # Safety
+    /// The GPU must no longer use it.
+    pub unsafe fn destroy(&mut self, ctx: &GpuContext) {
+        let d = &ctx.device;
+        unsafe {
+            d.destroy_pipeline(self.pipeline, None);
+            d.destroy_pipeline_layout(self.layout, None);
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}

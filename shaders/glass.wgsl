@@ -1,0 +1,188 @@
+// The glass object: the surface image, the refracted image and the reflected image of one
+// eye, added together as linear light on black (on an additive display black adds nothing).
+//
+// Baseline ("conventional method", METHOD.md section 6, The Cg Tutorial ch. 7): reflection and
+// refraction looked up in a latitude-longitude environment map at infinity, blended by an
+// empirical Fresnel term. The refracted image then has the disparity of infinity.
+//
+// Disparity (METHOD.md section 3, eq. 7-8 in Heckbert's form): each eye refracts its own view
+// ray at the surface and follows T to the registered background plane, where the photo of the
+// real background is sampled at (u_c, v_c). The refracted image gets the disparity of the real
+// background seen through the glass. Where T misses the plane, the environment map is used.
+//
+// The surface image (texture with its transmittance) is blended by eq. 9.
+//
+// Gaze-dependent defocus (eq. 9-14): the refracted and surface images are read from blur stacks
+// at the blur the frame asks for; one (trilinear) fetch each, whatever the blur.
+//
+// Texture fetches per covered pixel: baseline 3 (refracted and reflected environment, surface);
+// with background refraction (disparity and/or defocus) and Phong reflection 2 (background
+// stack or environment, surface stack); with environment reflection 3.
+
+struct Eye {
+    clip_from_world: mat4x4<f32>,
+    // xyz: the eye's position in the world (metres); w: eye index (0 left, 1 right).
+    position: vec4<f32>,
+    // x: FLAG_* bits.
+    flags: vec4<u32>,
+    // xyz: where refraction to the background plane is seen from: this eye (disparity), or
+    // the point between the eyes (defocus without disparity).
+    refraction_origin: vec4<f32>,
+    // Blur-stack coordinates (0..1 along the stack's depth) of x: the refracted image
+    // (background photo), y: the surface image (surface texture).
+    blur: vec4<f32>,
+};
+
+// Refract to the registered background plane (disparity or defocus on).
+const FLAG_BACKGROUND: u32 = 1u;
+const FLAG_PHONG: u32 = 2u;
+
+struct Globals {
+    world_from_model: mat4x4<f32>,
+    // Inverse-transpose of world_from_model, for normals.
+    normal_from_model: mat4x4<f32>,
+    // Maps the world into the background plane's frame, where its photo covers the unit
+    // square [-0.5, 0.5]^2 at z = 0 (top edge towards +y).
+    background_from_world: mat4x4<f32>,
+    // x: relative index of refraction n; y, z, w: Fresnel bias, scale and power.
+    optics: vec4<f32>,
+    // xyz: point light position in the world (metres); w: intensity.
+    light: vec4<f32>,
+    // rgb: light colour (linear); w: Phong exponent.
+    light_colour: vec4<f32>,
+    // x: exposure of environment radiance; y: surface opacity (1 - transmittance, 0 without a
+    // surface texture); z: Phong specular strength.
+    shading: vec4<f32>,
+};
+
+var<push_constant> eye: Eye;
+@group(0) @binding(0) var<uniform> g: Globals;
+@group(0) @binding(1) var env_map: texture_2d<f32>;
+@group(0) @binding(2) var wrap_sampler: sampler;
+// Blur stacks (eq. 10-14): slice i holds the image blurred with K_g = i * step; trilinear
+// filtering between slices gives any K_g in one fetch.
+@group(0) @binding(3) var background: texture_3d<f32>;
+@group(0) @binding(4) var clamp_sampler: sampler;
+@group(0) @binding(5) var surface: texture_3d<f32>;
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world_pos: vec3<f32>,
+    @location(1) world_normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+};
+
+@vertex
+fn vs_main(
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+) -> VertexOut {
+    var out: VertexOut;
+    let world = g.world_from_model * vec4<f32>(position, 1.0);
+    out.world_pos = world.xyz;
+    out.world_normal = (g.normal_from_model * vec4<f32>(normal, 0.0)).xyz;
+    out.uv = uv;
+    out.clip = eye.clip_from_world * world;
+    return out;
+}
+
+const PI: f32 = 3.14159265358979;
+
+// Direction -> latitude-longitude texture coordinate. u = 0.5 looks down -z (forward),
+// u grows towards +x; v = 0 is straight up (+y).
+fn latlong_uv(d: vec3<f32>) -> vec2<f32> {
+    let u = atan2(d.x, -d.z) / (2.0 * PI) + 0.5;
+    let v = acos(clamp(d.y / max(length(d), 1e-20), -1.0, 1.0)) / PI;
+    return vec2<f32>(u, v);
+}
+
+fn environment(d: vec3<f32>) -> vec3<f32> {
+    // Explicit LOD: the atan2 seam would otherwise make screen derivatives explode.
+    return textureSampleLevel(env_map, wrap_sampler, latlong_uv(d), 0.0).rgb * g.shading.x;
+}
+
+// eq. 7-8, Heckbert's form (twin of render/src/optics.rs refract_heckbert): incident I unit
+// from the eye, normal N unit facing the eye, n relative index. xyz: T (not normalised);
+// w: 1, or 0 for total internal reflection (non-positive radicand).
+fn refract_heckbert(incident: vec3<f32>, normal: vec3<f32>, n: f32) -> vec4<f32> {
+    let v = incident / abs(dot(incident, normal));
+    let w = v + normal;
+    let radicand = n * n * dot(v, v) - dot(w, w);
+    if radicand <= 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let k_f = inverseSqrt(radicand);
+    return vec4<f32>(k_f * (normal + v) - normal, 1.0);
+}
+
+// Where the ray origin + t * dir (t > 0) meets the background plane: xy photo coordinates,
+// z: 1 on the photo, 0 on a miss (twin of render/src/optics.rs plane_uv).
+fn background_uv(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    let o = (g.background_from_world * vec4<f32>(origin, 1.0)).xyz;
+    let d = (g.background_from_world * vec4<f32>(dir, 0.0)).xyz;
+    if abs(d.z) < 1e-12 {
+        return vec3<f32>(0.0);
+    }
+    let t = -o.z / d.z;
+    let hit = o + d * t;
+    if t <= 0.0 || abs(hit.x) > 0.5 || abs(hit.y) > 0.5 {
+        return vec3<f32>(0.0);
+    }
+    return vec3<f32>(hit.x + 0.5, 0.5 - hit.y, 1.0);
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    let incident = normalize(in.world_pos - eye.position.xyz);
+    var n = normalize(in.world_normal);
+    if dot(n, incident) > 0.0 {
+        n = -n;
+    }
+    let ior = g.optics.x;
+    let reflected = reflect(incident, n);
+    let fresnel = clamp(g.optics.y + g.optics.z * pow(1.0 + dot(incident, n), g.optics.w), 0.0, 1.0);
+    let flags = eye.flags.x;
+
+    // The refracted image C_b.
+    var refracted_image: vec3<f32>;
+    if (flags & FLAG_BACKGROUND) != 0u {
+        let from_origin = normalize(in.world_pos - eye.refraction_origin.xyz);
+        let t = refract_heckbert(from_origin, n, ior);
+        if t.w == 0.0 {
+            refracted_image = environment(reflected);
+        } else {
+            let uv = background_uv(in.world_pos, t.xyz);
+            if uv.z > 0.0 {
+                refracted_image = textureSampleLevel(
+                    background, clamp_sampler, vec3<f32>(uv.xy, eye.blur.x), 0.0).rgb;
+            } else {
+                refracted_image = environment(t.xyz);
+            }
+        }
+    } else {
+        var t = refract(incident, n, 1.0 / ior);
+        if dot(t, t) == 0.0 {
+            t = reflected;
+        }
+        refracted_image = environment(t);
+    }
+
+    // The reflected image.
+    var reflected_image: vec3<f32>;
+    if (flags & FLAG_PHONG) != 0u {
+        let to_light = normalize(g.light.xyz - in.world_pos);
+        let mirror = reflect(-to_light, n);
+        let specular = pow(max(dot(mirror, -incident), 0.0), g.light_colour.w);
+        reflected_image = g.light_colour.rgb * g.light.w * g.shading.z * specular;
+    } else {
+        reflected_image = fresnel * environment(reflected);
+    }
+
+    // eq. 9: C_o = alpha C_s + (1 - alpha) C_b, alpha the surface's opacity.
+    let surface_texel = textureSample(surface, wrap_sampler, vec3<f32>(in.uv, eye.blur.y));
+    let alpha = g.shading.y * surface_texel.a;
+    let colour = alpha * surface_texel.rgb + (1.0 - alpha) * (1.0 - fresnel) * refracted_image
+        + reflected_image;
+    return vec4<f32>(colour, 1.0);
+}

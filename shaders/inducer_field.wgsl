@@ -1,0 +1,119 @@
+// Distance to the shadow edge and the inducer's gain, in floor space (METHOD.md section 1,
+// eq. 2-4; render/src/inducer.rs). Full-screen passes over the floor-space textures:
+//
+// 1. fs_seed: every shadow texel is its own nearest shadow texel; lit texels have none yet.
+// 2. fs_jump (jump flooding, log2(N) passes with halving steps, then one more of step 1):
+//    each texel keeps, of the seeds stored at itself and at its 8 neighbours `step` texels
+//    away, the one nearest in metres.
+// 3. fs_distance: d, the distance from a lit texel to the shadow edge in metres; -1 inside
+//    the shadow.
+// 4. fs_ramp: k alpha(d) (eq. 2 and 4), what the floor overlay multiplies the floor photo by.
+//
+// Every fetch is a textureLoad of one texel: no filtering, no sampler.
+
+struct Field {
+    // Floor metres per texel along the texture's x (u) and y (v).
+    texel_m: vec2<f32>,
+    // fs_jump: the jump of this pass, texels.
+    step: i32,
+    // Side of the floor-space textures, texels.
+    size: i32,
+    // D of eq. 2, metres.
+    ramp_width_m: f32,
+    // k of eq. 4.
+    k: f32,
+    pad: vec2<f32>,
+};
+
+var<push_constant> field: Field;
+// The pass's input: the mask (fs_seed), seeds (fs_jump, fs_distance) or distances (fs_ramp).
+@group(0) @binding(0) var source: texture_2d<f32>;
+// The shadow mask, for fs_distance.
+@group(0) @binding(1) var shadow_mask: texture_2d<f32>;
+
+// Coordinate of "no seed found yet": far from every texel, so any real seed is nearer.
+const NO_SEED: f32 = -1.0e7;
+// Distance written where the floor has no shadow at all, metres.
+const FAR_M: f32 = 1.0e9;
+
+@vertex
+fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
+    // One triangle covering the whole target.
+    let corner = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
+    return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+
+@fragment
+fn fs_seed(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let p = vec2<i32>(frag.xy);
+    if textureLoad(source, p, 0).r > 0.5 {
+        return vec4<f32>(vec2<f32>(p), 0.0, 0.0);
+    }
+    return vec4<f32>(NO_SEED, NO_SEED, 0.0, 0.0);
+}
+
+// Squared distance in metres between texel centres.
+fn distance2_m(seed: vec2<f32>, p: vec2<f32>) -> f32 {
+    let v = (seed - p) * field.texel_m;
+    return dot(v, v);
+}
+
+@fragment
+fn fs_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let p = vec2<i32>(frag.xy);
+    let pf = vec2<f32>(p);
+    var best = textureLoad(source, p, 0).xy;
+    var best_d = distance2_m(best, pf);
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = p + vec2<i32>(dx, dy) * field.step;
+            let inside = all(q >= vec2<i32>(0)) && all(q < vec2<i32>(field.size));
+            if (dx != 0 || dy != 0) && inside {
+                let seed = textureLoad(source, q, 0).xy;
+                let d = distance2_m(seed, pf);
+                if d < best_d {
+                    best = seed;
+                    best_d = d;
+                }
+            }
+        }
+    }
+    return vec4<f32>(best, 0.0, 0.0);
+}
+
+// Distance from a lit texel to the shadow edge, metres, given the offset (texels) to its
+// nearest shadow texel: the edge is taken halfway between that texel's centre and its lit
+// neighbour's, i.e. half a texel short of the shadow texel's centre along the offset.
+// Same formula as inducer::edge_distance_m on the CPU.
+fn edge_distance_m(offset: vec2<f32>) -> f32 {
+    let texels = length(offset);
+    return length(offset * field.texel_m) * (1.0 - 0.5 / texels);
+}
+
+@fragment
+fn fs_distance(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let p = vec2<i32>(frag.xy);
+    if textureLoad(shadow_mask, p, 0).r > 0.5 {
+        return vec4<f32>(-1.0, 0.0, 0.0, 0.0);
+    }
+    let seed = textureLoad(source, p, 0).xy;
+    if seed.x < 0.5 * NO_SEED {
+        return vec4<f32>(FAR_M, 0.0, 0.0, 0.0);
+    }
+    return vec4<f32>(edge_distance_m(seed - vec2<f32>(p)), 0.0, 0.0, 0.0);
+}
+
+// eq. 2: alpha(d) = (D - d) / D for 0 <= d < D, 0 beyond D and inside the shadow (d < 0).
+fn ramp(d_m: f32, width_m: f32) -> f32 {
+    if d_m < 0.0 || d_m >= width_m {
+        return 0.0;
+    }
+    return (width_m - d_m) / width_m;
+}
+
+@fragment
+fn fs_ramp(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let d_m = textureLoad(source, vec2<i32>(frag.xy), 0).r;
+    // eq. 4: alpha'(d) = k alpha(d).
+    return vec4<f32>(field.k * ramp(d_m, field.ramp_width_m), 0.0, 0.0, 0.0);
+}

@@ -1,0 +1,312 @@
+//! Per-eye refraction (eq. 7-8) on the machine's Vulkan device with validation on, against
+//! the CPU reference: the paper's visual-effect geometry (150 mm glass sphere 0.2 m in front
+//! of the eyes, background photo 0.4 m in front).
+
+use glam::{Mat4, Quat, Vec2, Vec3};
+use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_render::reference::{SphereScene, marker_centroid};
+use vitreous_render::renderer::Want;
+use vitreous_render::{
+    ContextOptions, FrameParams, GpuContext, LightDesc, Look, MeshRef, PlaneDesc, Reflection,
+    Renderer, SceneDesc, TexelData, TextureDesc,
+};
+use vitreous_tests::uv_sphere;
+
+const W: u32 = 640;
+const H: u32 = 480;
+const CENTER: Vec3 = Vec3::new(0.0, 0.0, -0.2);
+const RADIUS: f32 = 0.075;
+const IOR: f32 = 1.51;
+const IPD: f32 = 0.063;
+/// Side of the background plane, metres.
+const PLANE_M: f32 = 0.6;
+/// Photo resolution and the marker's texel range (a small bright square at the centre).
+const PHOTO: u32 = 512;
+const MARKER: (u32, u32) = (244, 268);
+
+fn fov() -> Fov {
+    Fov {
+        left_rad: -0.55,
+        right_rad: 0.55,
+        up_rad: 0.42,
+        down_rad: -0.42,
+    }
+}
+
+fn eyes() -> [EyeParams; 2] {
+    [-IPD / 2.0, IPD / 2.0].map(|x| EyeParams::new(Vec3::new(x, 0.0, 0.0), Quat::IDENTITY, fov()))
+}
+
+fn background_plane() -> Mat4 {
+    Mat4::from_scale_rotation_translation(
+        Vec3::new(PLANE_M, PLANE_M, 1.0),
+        Quat::IDENTITY,
+        Vec3::new(0.0, 0.0, -0.4),
+    )
+}
+
+/// RGBA8 black image with a white square of texels [lo, hi) in both axes.
+fn marker_photo(size: u32, lo: u32, hi: u32) -> Vec<u8> {
+    let mut px = vec![0u8; (size * size * 4) as usize];
+    for y in 0..size {
+        for x in 0..size {
+            let i = ((y * size + x) * 4) as usize;
+            px[i + 3] = 255;
+            if (lo..hi).contains(&x) && (lo..hi).contains(&y) {
+                px[i..i + 3].copy_from_slice(&[255, 255, 255]);
+            }
+        }
+    }
+    px
+}
+
+/// Linear RGBA float environment, black, optionally with a bright square straight ahead.
+fn environment(marker: bool) -> (u32, u32, Vec<f32>) {
+    let (w, h) = (256u32, 128u32);
+    let mut env = vec![0.0f32; (w * h * 4) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            let i = ((y * w + x) * 4) as usize;
+            env[i + 3] = 1.0;
+            if marker && (124..132).contains(&x) && (60..68).contains(&y) {
+                env[i..i + 3].copy_from_slice(&[4.0, 4.0, 4.0]);
+            }
+        }
+    }
+    (w, h, env)
+}
+
+/// Renders both eyes of the sphere with `look` and returns the eye images.
+fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: true,
+        device_name: None,
+    })
+    .expect("Vulkan device with validation");
+    let (positions, normals, uvs, indices) = uv_sphere(128, 64);
+    let (ew, eh, env) = environment(env_marker);
+    let photo = if surface_dot {
+        marker_photo(PHOTO, 0, 0)
+    } else {
+        marker_photo(PHOTO, MARKER.0, MARKER.1)
+    };
+    // A black surface texture with a white dot at uv (0.5, 0.5), opaque (transmittance 0).
+    let dot = {
+        let (w, h) = (256u32, 128u32);
+        let mut px = vec![0u8; (w * h * 4) as usize];
+        for y in 0..h {
+            for x in 0..w {
+                let i = ((y * w + x) * 4) as usize;
+                px[i + 3] = 255;
+                if (126..130).contains(&x) && (62..66).contains(&y) {
+                    px[i..i + 3].copy_from_slice(&[255, 255, 255]);
+                }
+            }
+        }
+        px
+    };
+    let floor_photo = marker_photo(4, 0, 0);
+    let scene = SceneDesc {
+        mesh: MeshRef {
+            positions: &positions,
+            normals: &normals,
+            uvs: &uvs,
+            indices: &indices,
+        },
+        // Half a turn about y puts the texture's u = 0.5 towards the viewer.
+        world_from_model: Mat4::from_scale_rotation_translation(
+            Vec3::splat(RADIUS),
+            Quat::from_rotation_y(std::f32::consts::PI),
+            CENTER,
+        ),
+        ior: IOR,
+        environment: TextureDesc {
+            width: ew,
+            height: eh,
+            data: TexelData::LinearF32(&env),
+        },
+        floor: PlaneDesc {
+            world_from_plane: Mat4::from_translation(Vec3::new(0.0, -1.0, 0.0)),
+            photo: TextureDesc {
+                width: 4,
+                height: 4,
+                data: TexelData::Srgb8(&floor_photo),
+            },
+        },
+        background: PlaneDesc {
+            world_from_plane: background_plane(),
+            photo: TextureDesc {
+                width: PHOTO,
+                height: PHOTO,
+                data: TexelData::Srgb8(&photo),
+            },
+        },
+        exposure: 1.0,
+        surface: surface_dot.then_some(TextureDesc {
+            width: 256,
+            height: 128,
+            data: TexelData::Srgb8(&dot),
+        }),
+        surface_transmittance: 0.0,
+        light: LightDesc {
+            position_m: Vec3::new(1.0, 1.0, 1.0),
+            radiance: Vec3::ONE,
+        },
+        background_stack: None,
+        surface_stack: None,
+        inducer: vitreous_render::InducerDesc::PAPER,
+    };
+    let mut renderer = Renderer::new(ctx, &scene, W, H).expect("renderer");
+    let params = FrameParams { eyes: eyes(), look };
+    let want = Want {
+        eyes: true,
+        world: false,
+    };
+    let mut results: Vec<_> = renderer
+        .submit(&params, want)
+        .unwrap()
+        .into_iter()
+        .collect();
+    results.extend(renderer.flush().unwrap());
+    let v = renderer.context().validation();
+    assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
+    results.pop().unwrap().readback.unwrap().eyes
+}
+
+/// Centroid of the image weighted by its linear light (the images are sRGB-encoded), which is
+/// what the CPU reference computes for a white marker on black.
+fn bright_centroid(rgba: &[u8]) -> Vec2 {
+    let max = rgba.chunks_exact(4).map(|p| p[0]).max().unwrap();
+    assert!(max > 100, "nothing bright in the image (max {max})");
+    let to_linear = |b: u8| ((b as f64 / 255.0 + 0.055) / 1.055).powf(2.4);
+    let mut sum = glam::DVec2::ZERO;
+    let mut weight = 0.0;
+    for (i, px) in rgba.chunks_exact(4).enumerate() {
+        let l = to_linear(px[0]);
+        if l > 0.01 {
+            let p = glam::DVec2::new((i as u32 % W) as f64 + 0.5, (i as u32 / W) as f64 + 0.5);
+            sum += p * l;
+            weight += l;
+        }
+    }
+    (sum / weight).as_vec2()
+}
+
+/// CPU reference of the surface dot: the centroid of the pixels whose ray meets the sphere
+/// where the texture's dot is (texels 126..130 x 62..66 of 256 x 128, the sphere turned half a
+/// turn about y as in `render`).
+fn reference_dot(eye: &EyeParams, size: Vec2) -> Vec2 {
+    let mut sum = Vec2::ZERO;
+    let mut count = 0.0;
+    for y in 0..H {
+        for x in 0..W {
+            let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let dir = eye.pixel_ray(p, size);
+            let Some(t) = vitreous_render::optics::ray_sphere(eye.position_m, dir, CENTER, RADIUS)
+            else {
+                continue;
+            };
+            // Back into the mesh's frame: undo the half turn.
+            let local = Quat::from_rotation_y(-std::f32::consts::PI)
+                * ((eye.position_m + dir * t - CENTER) / RADIUS);
+            let phi = local.x.atan2(local.z).rem_euclid(std::f32::consts::TAU);
+            let u = phi / std::f32::consts::TAU * 256.0;
+            let v = local.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI * 128.0;
+            if (126.0..130.0).contains(&u) && (62.0..66.0).contains(&v) {
+                sum += p;
+                count += 1.0;
+            }
+        }
+    }
+    assert!(count > 0.0, "the reference does not see the dot");
+    sum / count
+}
+
+fn reference_scene() -> SphereScene {
+    SphereScene {
+        center_m: CENTER,
+        radius_m: RADIUS,
+        ior: IOR,
+        background_from_world: background_plane().inverse(),
+    }
+}
+
+fn reference_marker(eye: &EyeParams) -> Vec2 {
+    let lo = MARKER.0 as f32 / PHOTO as f32;
+    let hi = MARKER.1 as f32 / PHOTO as f32;
+    marker_centroid(
+        eye,
+        (W, H),
+        &reference_scene(),
+        (Vec2::splat(lo), Vec2::splat(hi)),
+    )
+    .expect("the reference sees the marker")
+    .0
+}
+
+const DISPARITY: Look = Look {
+    disparity: true,
+    defocus: None,
+    reflection: Reflection::EnvironmentFresnel,
+    inducer: false,
+};
+const BASELINE: Look = Look {
+    disparity: false,
+    defocus: None,
+    reflection: Reflection::EnvironmentFresnel,
+    inducer: false,
+};
+
+#[test]
+fn refracted_marker_matches_the_cpu_reference_in_each_eye() {
+    let images = render(DISPARITY, false, false);
+    for (i, eye) in eyes().iter().enumerate() {
+        let gpu = bright_centroid(&images[i]);
+        let reference = reference_marker(eye);
+        assert!(
+            (gpu - reference).length() < 1.0,
+            "eye {i}: GPU marker at {gpu}, reference at {reference}"
+        );
+    }
+}
+
+#[test]
+fn refracted_image_has_its_own_disparity_only_with_the_effect() {
+    let size = Vec2::new(W as f32, H as f32);
+    // The surface pattern: a dot on the sphere's front, at the front point's projection.
+    let surface = render(DISPARITY, true, false);
+    let surface_gpu: Vec<Vec2> = surface.iter().map(|img| bright_centroid(img)).collect();
+    let [l, r] = eyes();
+    let surface_offset = surface_gpu[0].x - surface_gpu[1].x;
+    let surface_predicted = reference_dot(&l, size).x - reference_dot(&r, size).x;
+    assert!(
+        (surface_offset - surface_predicted).abs() < 1.0,
+        "surface offset {surface_offset} vs reference {surface_predicted}"
+    );
+
+    let reference_offset = reference_marker(&l).x - reference_marker(&r).x;
+    let refracted = render(DISPARITY, false, false);
+    let refracted_offset = bright_centroid(&refracted[0]).x - bright_centroid(&refracted[1]).x;
+    let predicted = reference_offset - surface_predicted;
+    let measured = refracted_offset - surface_offset;
+    assert!(
+        (measured - predicted).abs() < 1.0,
+        "refracted minus surface offset: measured {measured} px, reference {predicted} px"
+    );
+    assert!(
+        predicted.abs() > 5.0,
+        "the geometry should give the refracted image a clearly different disparity \
+         ({predicted} px)"
+    );
+
+    // The conventional method refracts into the environment at infinity: its refracted
+    // image does not follow the background's disparity.
+    let baseline = render(BASELINE, false, true);
+    let baseline_offset = bright_centroid(&baseline[0]).x - bright_centroid(&baseline[1]).x;
+    let baseline_relative = baseline_offset - surface_offset;
+    assert!(
+        (baseline_relative - predicted).abs() > 3.0,
+        "baseline refracted offset {baseline_relative} px should not match the reference \
+         {predicted} px"
+    );
+}

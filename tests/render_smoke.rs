@@ -1,0 +1,140 @@
+//! The renderer on the machine's Vulkan device with validation on: the sphere lands where the
+//! CPU projection says, in both eyes, and validation stays silent.
+
+use glam::{Quat, Vec2, Vec3};
+use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_render::renderer::Want;
+use vitreous_render::{
+    ContextOptions, FrameParams, GpuContext, LightDesc, Look, MeshRef, PlaneDesc, Renderer,
+    SceneDesc, TexelData, TextureDesc,
+};
+use vitreous_tests::{flat_environment, grey_photo, lit_centroid, place, uv_sphere};
+
+#[test]
+fn sphere_centroid_matches_projection_in_both_eyes_with_validation_silent() {
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: true,
+        device_name: None,
+    })
+    .expect("Vulkan device with validation");
+    let (positions, normals, uvs, indices) = uv_sphere(64, 32);
+    let env = flat_environment(64, 32, 0.8);
+    let photo = grey_photo(8, 8, 128);
+    let center = Vec3::new(0.01, -0.02, -0.45);
+    let radius = 0.04;
+    let photo_desc = TextureDesc {
+        width: 8,
+        height: 8,
+        data: TexelData::Srgb8(&photo),
+    };
+    let scene = SceneDesc {
+        mesh: MeshRef {
+            positions: &positions,
+            normals: &normals,
+            uvs: &uvs,
+            indices: &indices,
+        },
+        world_from_model: place(center, radius),
+        ior: 1.51,
+        environment: TextureDesc {
+            width: 64,
+            height: 32,
+            data: TexelData::LinearF32(&env),
+        },
+        floor: PlaneDesc {
+            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -0.5, -0.5)),
+            photo: photo_desc,
+        },
+        background: PlaneDesc {
+            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
+            photo: photo_desc,
+        },
+        exposure: 1.0,
+        surface: None,
+        surface_transmittance: 1.0,
+        light: LightDesc {
+            position_m: Vec3::new(0.0, 1.0, 0.0),
+            radiance: Vec3::ONE,
+        },
+        background_stack: None,
+        surface_stack: None,
+        inducer: vitreous_render::InducerDesc::PAPER,
+    };
+    let (w, h) = (320u32, 240u32);
+    let mut renderer = Renderer::new(ctx, &scene, w, h).expect("renderer");
+    let fov = Fov {
+        left_rad: -0.35,
+        right_rad: 0.35,
+        up_rad: 0.27,
+        down_rad: -0.27,
+    };
+    let ipd = 0.063;
+    let eyes = [-ipd / 2.0, ipd / 2.0]
+        .map(|x| EyeParams::new(Vec3::new(x, 0.0, 0.0), Quat::IDENTITY, fov));
+    let params = FrameParams {
+        eyes,
+        look: Look::default(),
+    };
+    let want = Want {
+        eyes: true,
+        world: true,
+    };
+    let mut results = Vec::new();
+    for _ in 0..3 {
+        results.extend(renderer.submit(&params, want).unwrap());
+    }
+    results.extend(renderer.flush().unwrap());
+    assert_eq!(results.len(), 3);
+    let last = results.last().unwrap().readback.as_ref().unwrap();
+    let size = Vec2::new(w as f32, h as f32);
+    let mut xs = Vec::new();
+    for (i, eye) in eyes.iter().enumerate() {
+        let (centroid, count) = lit_centroid(&last.eyes[i], w, 10).expect("sphere visible");
+        let expected = eye.project_to_pixel(center, size).unwrap();
+        assert!(count > 100, "eye {i}: only {count} lit pixels");
+        assert!(
+            (centroid - expected).length() < 2.0,
+            "eye {i}: centroid {centroid} vs projection {expected}"
+        );
+        xs.push(centroid.x);
+    }
+    let disparity = xs[0] - xs[1];
+    let expected = eyes[0].project_to_pixel(center, size).unwrap().x
+        - eyes[1].project_to_pixel(center, size).unwrap().x;
+    assert!(
+        (disparity - expected).abs() < 1.0,
+        "{disparity} vs {expected}"
+    );
+    let world = last.world.as_ref().unwrap();
+    assert!(world[0].chunks_exact(4).all(|p| p[3] == 255));
+    let v = renderer.context().validation();
+    assert_eq!(
+        v.errors() + v.warnings(),
+        0,
+        "validation messages: {:#?}",
+        v.messages()
+    );
+}
+
+/// The zero-message assertions above can fail: a deliberate misuse is counted.
+#[test]
+fn validation_messages_are_counted() {
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: true,
+        device_name: None,
+    })
+    .expect("Vulkan device with validation");
+    assert_eq!(ctx.validation().errors(), 0);
+    let info = ash::vk::BufferCreateInfo::default()
+        .size(0)
+        .usage(ash::vk::BufferUsageFlags::VERTEX_BUFFER);
+    // A zero-sized buffer violates VUID-VkBufferCreateInfo-size-00912.
+    if let Ok(buffer) = unsafe { ctx.device.create_buffer(&info, None) } {
+        unsafe { ctx.device.destroy_buffer(buffer, None) };
+    }
+    assert!(
+        ctx.validation().errors() > 0,
+        "validation error not counted"
+    );
+    assert!(!ctx.validation().messages().is_empty());
+}

@@ -1,0 +1,70 @@
+//! Shared helpers for the end-to-end tests: small procedural scenes and image measurements.
+
+use glam::{Mat4, Vec2, Vec3};
+
+/// A UV sphere of unit radius: positions, normals, uvs, indices.
+pub fn uv_sphere(segments: u32, rings: u32) -> (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<u32>) {
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    for r in 0..=rings {
+        let v = r as f32 / rings as f32;
+        let theta = v * std::f32::consts::PI;
+        for s in 0..=segments {
+            let u = s as f32 / segments as f32;
+            let phi = u * std::f32::consts::TAU;
+            positions.push(Vec3::new(
+                theta.sin() * phi.sin(),
+                theta.cos(),
+                theta.sin() * phi.cos(),
+            ));
+            uvs.push(Vec2::new(u, v));
+        }
+    }
+    let mut indices = Vec::new();
+    let row = segments + 1;
+    for r in 0..rings {
+        for s in 0..segments {
+            let a = r * row + s;
+            let b = a + row;
+            // Counter-clockwise seen from outside.
+            indices.extend_from_slice(&[a, b, a + 1, a + 1, b, b + 1]);
+        }
+    }
+    let normals = positions.clone();
+    (positions, normals, uvs, indices)
+}
+
+/// Linear RGBA floats of a smooth, bright environment (for tests that need light everywhere).
+pub fn flat_environment(width: u32, height: u32, value: f32) -> Vec<f32> {
+    (0..width * height)
+        .flat_map(|_| [value, value, value, 1.0])
+        .collect()
+}
+
+/// A grey sRGB photo.
+pub fn grey_photo(width: u32, height: u32, level: u8) -> Vec<u8> {
+    (0..width * height)
+        .flat_map(|_| [level, level, level, 255])
+        .collect()
+}
+
+/// Centroid (x, y in pixels, pixel centres at half-integers) and count of the pixels of an
+/// RGBA8 image whose brightest channel exceeds `threshold`.
+pub fn lit_centroid(rgba: &[u8], width: u32, threshold: u8) -> Option<(Vec2, usize)> {
+    let mut sum = glam::DVec2::ZERO;
+    let mut count = 0usize;
+    for (i, px) in rgba.chunks_exact(4).enumerate() {
+        if px[0].max(px[1]).max(px[2]) > threshold {
+            let x = (i as u32 % width) as f64 + 0.5;
+            let y = (i as u32 / width) as f64 + 0.5;
+            sum += glam::DVec2::new(x, y);
+            count += 1;
+        }
+    }
+    (count > 0).then(|| ((sum / count as f64).as_vec2(), count))
+}
+
+/// A model matrix placing a unit-radius mesh as a sphere of `radius_m` at `center_m`.
+pub fn place(center_m: Vec3, radius_m: f32) -> Mat4 {
+    Mat4::from_scale_rotation_translation(Vec3::splat(radius_m), glam::Quat::IDENTITY, center_m)
+}

@@ -1,0 +1,154 @@
+//! Plain data handed from an XR backend to the frame loop, and the backend trait.
+
+use glam::{Quat, Vec3};
+
+/// A rigid transform: where something is and which way it faces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose {
+    /// Position in metres.
+    pub position: Vec3,
+    /// Orientation as a unit quaternion.
+    pub orientation: Quat,
+}
+
+impl Pose {
+    /// The pose at the origin looking down -z.
+    pub const IDENTITY: Pose = Pose {
+        position: Vec3::ZERO,
+        orientation: Quat::IDENTITY,
+    };
+
+    /// Maps a point from this pose's local frame into the parent frame.
+    pub fn transform_point(&self, p: Vec3) -> Vec3 {
+        self.position + self.orientation * p
+    }
+
+    /// Maps a direction from this pose's local frame into the parent frame.
+    pub fn transform_vector(&self, v: Vec3) -> Vec3 {
+        self.orientation * v
+    }
+}
+
+/// A field of view as OpenXR gives it: four signed half-angles in radians
+/// (left and down are negative for a symmetric view).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fov {
+    /// Angle of the left edge, radians (negative to the left).
+    pub angle_left_rad: f32,
+    /// Angle of the right edge, radians.
+    pub angle_right_rad: f32,
+    /// Angle of the top edge, radians.
+    pub angle_up_rad: f32,
+    /// Angle of the bottom edge, radians (negative downwards).
+    pub angle_down_rad: f32,
+}
+
+impl Fov {
+    /// A symmetric field of view from full horizontal and vertical angles in radians.
+    pub fn symmetric(horizontal_rad: f32, vertical_rad: f32) -> Fov {
+        Fov {
+            angle_left_rad: -horizontal_rad / 2.0,
+            angle_right_rad: horizontal_rad / 2.0,
+            angle_up_rad: vertical_rad / 2.0,
+            angle_down_rad: -vertical_rad / 2.0,
+        }
+    }
+}
+
+/// One eye's view for a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EyeView {
+    /// The eye's pose in the world (scene) frame: position of the eye, orientation of the view.
+    pub pose: Pose,
+    /// The eye's field of view.
+    pub fov: Fov,
+}
+
+/// A gaze ray in the head frame (OpenXR axes, metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GazeRay {
+    /// Ray origin in the head frame, metres.
+    pub origin: Vec3,
+    /// Unit direction in the head frame.
+    pub direction: Vec3,
+    /// False while the tracker lost the eye (blink, glare): origin and direction are then
+    /// meaningless.
+    pub valid: bool,
+}
+
+impl GazeRay {
+    /// An invalid ray (no measurement).
+    pub const INVALID: GazeRay = GazeRay {
+        origin: Vec3::ZERO,
+        direction: Vec3::NEG_Z,
+        valid: false,
+    };
+}
+
+/// One eye-tracker sample, in the head frame of the same instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GazeSample {
+    /// The tracker's own time for this sample, nanoseconds on the trace/runtime clock.
+    /// Filters must use this, not the render frame time: one tracker sample may be seen by
+    /// several render frames.
+    pub sample_time_ns: i64,
+    /// Left eye gaze ray.
+    pub left: GazeRay,
+    /// Right eye gaze ray.
+    pub right: GazeRay,
+    /// A combined (cyclopean) ray, when the source gives one.
+    pub combined: Option<GazeRay>,
+    /// A fixation point in the head frame (metres), when the source computed one.
+    pub fixation: Option<Vec3>,
+}
+
+/// What a backend hands the frame loop for one frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameInput {
+    /// Index of the frame since the session started.
+    pub index: u64,
+    /// Predicted display time of the frame, nanoseconds.
+    pub time_ns: i64,
+    /// Head pose in the world (scene) frame.
+    pub head: Pose,
+    /// Left and right eye views, in that order.
+    pub views: [EyeView; 2],
+    /// The newest gaze sample at or before `time_ns`, if the source has any.
+    pub gaze: Option<GazeSample>,
+}
+
+/// A source of frames: an OpenXR session or a replayed trace.
+///
+/// The frame loop calls [`Backend::wait_frame`] then, after rendering, [`Backend::end_frame`],
+/// once each per frame and in that order.
+pub trait Backend {
+    /// The error type of this backend.
+    type Error: std::error::Error + Send + Sync + 'static;
+
+    /// Blocks until the next frame should be rendered. `Ok(None)` ends the session.
+    fn wait_frame(&mut self) -> Result<Option<FrameInput>, Self::Error>;
+
+    /// Tells the backend the frame handed out by the last `wait_frame` has been rendered.
+    fn end_frame(&mut self, frame: &FrameInput) -> Result<(), Self::Error>;
+
+    /// Where the frame handed out by the last `wait_frame` is to be drawn. Backends that
+    /// own no display images (the null backend) keep the default, [`FrameTarget::Own`].
+    fn frame_target(&self) -> FrameTarget {
+        FrameTarget::Own
+    }
+}
+
+/// Where a frame is drawn (see [`Backend::frame_target`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameTarget {
+    /// The renderer's own images (replay, previews, readback).
+    Own,
+    /// Image `index` of the backend's swapchain, handed to the renderer before the loop; with
+    /// `world_behind`, the real world is drawn behind the glass (an opaque display).
+    Swapchain {
+        /// Index of the swapchain image acquired for this frame.
+        index: u32,
+        /// Draw the scene's real-world photos behind the glass.
+        world_behind: bool,
+    },
+}

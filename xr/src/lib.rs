@@ -1,0 +1,18 @@
+//! XR backends for vitreous.
+//!
+//! The frame loop in the `vitreous` crate talks to a [`Backend`]: the OpenXR runtime on a
+//! headset, or the [`null`] backend that replays a recorded [`trace`] on any Vulkan device.
+//! This crate knows nothing about the rendering method; it hands out plain [`FrameInput`]s.
+//!
+//! Axes everywhere are OpenXR's: right-handed, +x right, +y up, -z forward, metres.
+
+pub mod frame;
+pub mod null;
+pub mod openxr;
+pub mod sranipal;
+pub mod synth;
+pub mod trace;
+
+pub use frame::{Backend, EyeView, Fov, FrameInput, FrameTarget, GazeRay, GazeSample, Pose};
+pub use null::{NullBackend, NullConfig, NullError};
+pub use trace::{TraceError, TraceReader, TraceSample, TraceWriter, read_trace};

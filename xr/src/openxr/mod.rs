@@ -1,0 +1,579 @@
+//! The OpenXR backend: a live session on a headset runtime (Magic Leap 2, Monado, ...).
+//!
+//! Set-up happens in three steps because OpenXR's XR_KHR_vulkan_enable2 must create the Vulkan
+//! instance and device itself, while the renderer owns them afterwards:
+//! 1. [`Runtime::new`]: OpenXR instance (HMD form factor; XR_KHR_vulkan_enable2 required,
+//!    eye-gaze and depth-layer extensions when offered), system, stereo view configuration,
+//!    blend-mode choice. Its `create_vulkan_*` methods are what the renderer's device creator
+//!    calls (the app adapts them to `vitreous_render::DeviceCreator`).
+//! 2. [`Runtime::start`]: session on the renderer's device, reference space (STAGE when offered,
+//!    else LOCAL), one 2-layer array swapchain, gaze source. Gives the [`Session`] backend and
+//!    the swapchain's `VkImage`s for the renderer to draw into.
+//! 3. The frame loop drives the [`Session`] through [`crate::Backend`]: `wait_frame`
+//!    (xrWaitFrame, xrBeginFrame, acquire and wait a swapchain image, locate views at the
+//!    predicted display time), rendering into [`crate::Backend::frame_target`], `end_frame`
+//!    (release, xrEndFrame with a projection layer).
+//!
+//! Teardown order: [`Session`] (swapchain, spaces, session) before the Vulkan device, the
+//! [`Runtime`] (instance) after it; see the app's `run` module.
+//!
+//! Every way out of a session (frame limit, Ctrl-C, the runtime stopping it, session or
+//! instance loss) goes through xrRequestExitSession / xrEndSession where the state allows and
+//! ends with a [`state::EndReason`] instead of an error.
+
+pub mod actions;
+pub mod choose;
+mod gaze;
+mod session;
+pub mod state;
+
+use std::fmt::Write as _;
+
+use ash::vk;
+use ash::vk::Handle;
+use openxr as xr;
+use thiserror::Error;
+
+/// The `ash` crate these APIs use, for callers without their own dependency on it.
+pub use ash;
+pub use choose::{Blend, ColorFormat, GazeSource};
+pub use session::{Session, SessionReport};
+pub use state::{EndReason, State};
+
+use crate::frame::Pose;
+
+/// The OpenXR core validation layer's name.
+pub const CORE_VALIDATION_LAYER: &str = "XR_APILAYER_LUNARG_core_validation";
+
+/// Errors of the OpenXR backend. Messages say what was expected and what to do.
+#[derive(Debug, Error)]
+pub enum OpenXrError {
+    /// The OpenXR loader library could not be loaded.
+    #[error(
+        "no OpenXR loader: {0}. Install one (Debian trixie: libopenxr-loader1) or run through \
+         tools/monado/run-ci, which provisions Monado"
+    )]
+    NoLoader(String),
+    /// No runtime is installed or active, or it failed to start.
+    #[error(
+        "no usable OpenXR runtime: {0}. Install and start one (Monado: monado-service), or \
+         point XR_RUNTIME_JSON at its manifest"
+    )]
+    NoRuntime(String),
+    /// The runtime lacks XR_KHR_vulkan_enable2.
+    #[error(
+        "the OpenXR runtime does not offer XR_KHR_vulkan_enable2, which vitreous needs to render \
+         with Vulkan (offered: {0})"
+    )]
+    NoVulkan(String),
+    /// No head-mounted display is connected.
+    #[error("no head-mounted display: {0}")]
+    NoHmd(String),
+    /// Something the runtime offers does not fit vitreous.
+    #[error("{0}")]
+    Unsupported(String),
+    /// A failed OpenXR call.
+    #[error("OpenXR call {call} failed: {result}")]
+    Call {
+        /// Which call.
+        call: &'static str,
+        /// What it returned.
+        result: xr::sys::Result,
+    },
+    /// A Vulkan call made through the runtime failed.
+    #[error("{call} (through the OpenXR runtime) failed: {result}")]
+    Vulkan {
+        /// Which call.
+        call: &'static str,
+        /// What it returned.
+        result: vk::Result,
+    },
+    /// The gaze trace could not be read.
+    #[error(transparent)]
+    Trace(#[from] crate::trace::TraceError),
+    /// Frame calls came in the wrong order.
+    #[error("frame order: {0}")]
+    FrameOrder(String),
+}
+
+/// Shorthand for results of this module.
+pub type Result<T, E = OpenXrError> = std::result::Result<T, E>;
+
+/// Names the failed call on an OpenXR result.
+pub(crate) trait XrContext<T> {
+    /// Converts the error, naming the call.
+    fn xr(self, call: &'static str) -> Result<T>;
+}
+
+impl<T> XrContext<T> for std::result::Result<T, xr::sys::Result> {
+    fn xr(self, call: &'static str) -> Result<T> {
+        self.map_err(|result| OpenXrError::Call { call, result })
+    }
+}
+
+/// How to set up the OpenXR side.
+#[derive(Clone, Debug, Default)]
+pub struct OpenXrOptions {
+    /// Blend mode to use instead of the automatic choice (must be offered).
+    pub blend: Option<Blend>,
+    /// Enable the OpenXR core validation layer (XR_APILAYER_LUNARG_core_validation) when it is
+    /// installed; it can also be enabled with `XR_ENABLE_API_LAYERS`.
+    pub validation: bool,
+    /// Eye image size instead of the runtime's recommended one, pixels.
+    pub size: Option<(u32, u32)>,
+}
+
+/// What the runtime offers, for logs and summaries.
+#[derive(Clone, Debug)]
+pub struct RuntimeInfo {
+    /// Runtime name and version.
+    pub runtime: String,
+    /// System (headset) name.
+    pub system: String,
+    /// Extensions vitreous enabled.
+    pub extensions: Vec<String>,
+    /// Blend modes offered, in the runtime's order.
+    pub blend_modes_offered: Vec<Blend>,
+    /// The blend mode used.
+    pub blend: Blend,
+    /// Recommended eye image size, pixels.
+    pub recommended_size: (u32, u32),
+    /// Largest eye image size, pixels.
+    pub max_size: (u32, u32),
+    /// The eye image size used, pixels.
+    pub size: (u32, u32),
+    /// The system supports XR_EXT_eye_gaze_interaction (`supportsEyeGazeInteraction`).
+    pub eye_gaze_supported: bool,
+    /// The system supports XR_FB_eye_tracking_social.
+    pub fb_eye_tracking_supported: bool,
+    /// Vulkan versions the runtime accepts (min, max) as "major.minor".
+    pub vulkan_versions: (String, String),
+}
+
+/// An OpenXR instance and system: everything before there is a Vulkan device.
+pub struct Runtime {
+    /// The instance (also kept alive by sessions made from it).
+    instance: xr::Instance,
+    /// The HMD system.
+    system: xr::SystemId,
+    /// What was found and chosen.
+    info: RuntimeInfo,
+    /// XR_KHR_composition_layer_depth is enabled.
+    depth_layer: bool,
+    /// XR_EXT_eye_gaze_interaction is enabled.
+    ext_gaze: bool,
+    /// XR_FB_eye_tracking_social is enabled.
+    fb_gaze: bool,
+    /// The Vulkan instance made through the runtime, for the device steps.
+    vk_instance: Option<vk::Instance>,
+}
+
+impl Runtime {
+    /// Loads the OpenXR loader, creates the instance and finds the headset.
+    pub fn new(options: &OpenXrOptions) -> Result<Runtime> {
+        let entry =
+            unsafe { xr::Entry::load(&()) }.map_err(|e| OpenXrError::NoLoader(e.to_string()))?;
+        let available = entry
+            .enumerate_extensions()
+            .map_err(|e| OpenXrError::NoRuntime(format!("listing extensions: {e}")))?;
+        if !available.khr_vulkan_enable2 {
+            return Err(OpenXrError::NoVulkan(extension_list(&available)));
+        }
+        let mut wanted = xr::ExtensionSet::default();
+        wanted.khr_vulkan_enable2 = true;
+        wanted.ext_eye_gaze_interaction = available.ext_eye_gaze_interaction;
+        wanted.fb_eye_tracking_social = available.fb_eye_tracking_social;
+        wanted.khr_composition_layer_depth = available.khr_composition_layer_depth;
+        let mut layers = Vec::new();
+        if options.validation {
+            let installed = entry
+                .enumerate_layers()
+                .map_err(|e| OpenXrError::NoRuntime(format!("listing API layers: {e}")))?;
+            let already = std::env::var("XR_ENABLE_API_LAYERS")
+                .is_ok_and(|v| v.split([':', ';', ',']).any(|l| l == CORE_VALIDATION_LAYER));
+            if installed
+                .iter()
+                .any(|l| l.layer_name == CORE_VALIDATION_LAYER)
+                && !already
+            {
+                layers.push(CORE_VALIDATION_LAYER);
+            } else if !already {
+                tracing::warn!(
+                    "OpenXR validation asked for, but {CORE_VALIDATION_LAYER} is not installed"
+                );
+            }
+        }
+        let app = xr::ApplicationInfo {
+            application_name: "vitreous",
+            application_version: 1,
+            engine_name: "vitreous",
+            engine_version: 1,
+            api_version: xr::Version::new(1, 0, 0),
+        };
+        let instance = entry
+            .create_instance(&app, &wanted, &layers, &())
+            .map_err(|e| OpenXrError::NoRuntime(format!("xrCreateInstance: {e}")))?;
+        let props = instance.properties().xr("xrGetInstanceProperties")?;
+        let system = instance
+            .system(xr::FormFactor::HEAD_MOUNTED_DISPLAY)
+            .map_err(|e| OpenXrError::NoHmd(format!("xrGetSystem: {e}")))?;
+        let sys_props = instance
+            .system_properties(system)
+            .xr("xrGetSystemProperties")?;
+        let (eye_gaze_supported, fb_eye_tracking_supported) = gaze_support(
+            &instance,
+            system,
+            wanted.ext_eye_gaze_interaction,
+            wanted.fb_eye_tracking_social,
+        );
+
+        let stereo = xr::ViewConfigurationType::PRIMARY_STEREO;
+        let blend_modes_offered: Vec<Blend> = instance
+            .enumerate_environment_blend_modes(system, stereo)
+            .xr("xrEnumerateEnvironmentBlendModes")?
+            .into_iter()
+            .filter_map(|m| match m {
+                xr::EnvironmentBlendMode::ADDITIVE => Some(Blend::Additive),
+                xr::EnvironmentBlendMode::ALPHA_BLEND => Some(Blend::AlphaBlend),
+                xr::EnvironmentBlendMode::OPAQUE => Some(Blend::Opaque),
+                _ => None,
+            })
+            .collect();
+        let blend = choose::choose_blend(&blend_modes_offered, options.blend)
+            .map_err(OpenXrError::Unsupported)?;
+        let views = instance
+            .enumerate_view_configuration_views(system, stereo)
+            .xr("xrEnumerateViewConfigurationViews")?;
+        if views.len() != 2 {
+            return Err(OpenXrError::Unsupported(format!(
+                "the stereo view configuration has {} views; expected 2",
+                views.len()
+            )));
+        }
+        let recommended_size = (
+            views[0].recommended_image_rect_width,
+            views[0].recommended_image_rect_height,
+        );
+        let max_size = (
+            views[0].max_image_rect_width,
+            views[0].max_image_rect_height,
+        );
+        let size = choose::choose_size(recommended_size, max_size, options.size);
+        let reqs = instance
+            .graphics_requirements::<xr::Vulkan>(system)
+            .xr("xrGetVulkanGraphicsRequirements2KHR")?;
+        let version = |v: xr::Version| format!("{}.{}", v.major(), v.minor());
+        let info = RuntimeInfo {
+            runtime: format!("{} {}", props.runtime_name, props.runtime_version),
+            system: sys_props.system_name.clone(),
+            extensions: enabled_names(&wanted),
+            blend_modes_offered,
+            blend,
+            recommended_size,
+            max_size,
+            size,
+            eye_gaze_supported,
+            fb_eye_tracking_supported,
+            vulkan_versions: (
+                version(reqs.min_api_version_supported),
+                version(reqs.max_api_version_supported),
+            ),
+        };
+        tracing::info!(
+            runtime = %info.runtime,
+            system = %info.system,
+            extensions = %info.extensions.join(" "),
+            "OpenXR runtime ready"
+        );
+        let offered: Vec<String> = info
+            .blend_modes_offered
+            .iter()
+            .map(ToString::to_string)
+            .collect();
+        tracing::info!(
+            "blend mode {} ({}; offered: {})",
+            info.blend,
+            if options.blend.is_some() {
+                "asked for"
+            } else {
+                "automatic choice"
+            },
+            offered.join(", ")
+        );
+        if info.blend != Blend::Additive {
+            tracing::warn!(
+                "the runtime offers no ADDITIVE blend mode: this is not an optical see-through \
+                 display{}",
+                if info.blend.needs_world_behind() {
+                    "; the scene's real-world photos are drawn behind the glass"
+                } else {
+                    ""
+                }
+            );
+        }
+        Ok(Runtime {
+            instance,
+            system,
+            info,
+            depth_layer: wanted.khr_composition_layer_depth,
+            ext_gaze: wanted.ext_eye_gaze_interaction,
+            fb_gaze: wanted.fb_eye_tracking_social,
+            vk_instance: None,
+        })
+    }
+
+    /// What the runtime offers and what was chosen.
+    pub fn info(&self) -> &RuntimeInfo {
+        &self.info
+    }
+
+    /// Whether XR_KHR_composition_layer_depth is enabled. Depth is not submitted yet: the
+    /// renderer's depth image is its own, not a swapchain (see docs/headsets.md).
+    pub fn depth_layer_enabled(&self) -> bool {
+        self.depth_layer
+    }
+
+    /// Checks that the renderer's Vulkan API version is one the runtime accepts.
+    pub fn check_vulkan_version(&self, api_version: u32) -> Result<()> {
+        let reqs = self
+            .instance
+            .graphics_requirements::<xr::Vulkan>(self.system)
+            .xr("xrGetVulkanGraphicsRequirements2KHR")?;
+        let ours = xr::Version::new(
+            vk::api_version_major(api_version) as u16,
+            vk::api_version_minor(api_version) as u16,
+            0,
+        );
+        let min = reqs.min_api_version_supported;
+        let max = reqs.max_api_version_supported;
+        let key = |v: xr::Version| (v.major(), v.minor());
+        if key(ours) < key(min) || key(ours) > key(max) {
+            return Err(OpenXrError::Unsupported(format!(
+                "the runtime accepts Vulkan {}.{} to {}.{}; vitreous uses {}.{}",
+                min.major(),
+                min.minor(),
+                max.major(),
+                max.minor(),
+                ours.major(),
+                ours.minor()
+            )));
+        }
+        Ok(())
+    }
+
+    /// Creates the Vulkan instance through the runtime (xrCreateVulkanInstanceKHR).
+    ///
+    /// # Safety
+    /// `info` must be a valid instance create info; the caller owns and destroys the instance
+    /// after every session made from this runtime is gone.
+    pub unsafe fn create_vulkan_instance(
+        &mut self,
+        entry: &ash::Entry,
+        info: &vk::InstanceCreateInfo,
+    ) -> Result<ash::Instance> {
+        let gipa = entry.static_fn().get_instance_proc_addr;
+        let raw = unsafe {
+            self.instance.create_vulkan_instance(
+                self.system,
+                std::mem::transmute::<
+                    vk::PFN_vkGetInstanceProcAddr,
+                    xr::sys::platform::VkGetInstanceProcAddr,
+                >(gipa),
+                info as *const vk::InstanceCreateInfo as *const _,
+            )
+        }
+        .xr("xrCreateVulkanInstanceKHR")?
+        .map_err(|result| OpenXrError::Vulkan {
+            call: "vkCreateInstance",
+            result: vk::Result::from_raw(result),
+        })?;
+        let handle = vk::Instance::from_raw(raw as u64);
+        self.vk_instance = Some(handle);
+        Ok(unsafe { ash::Instance::load(entry.static_fn(), handle) })
+    }
+
+    /// The physical device the runtime's headset is driven by (xrGetVulkanGraphicsDevice2KHR).
+    pub fn vulkan_physical_device(&self, instance: &ash::Instance) -> Result<vk::PhysicalDevice> {
+        let raw = unsafe {
+            self.instance
+                .vulkan_graphics_device(self.system, instance.handle().as_raw() as _)
+        }
+        .xr("xrGetVulkanGraphicsDevice2KHR")?;
+        Ok(vk::PhysicalDevice::from_raw(raw as u64))
+    }
+
+    /// Creates the logical device through the runtime (xrCreateVulkanDeviceKHR).
+    ///
+    /// # Safety
+    /// `physical` must come from [`Runtime::vulkan_physical_device`]; `info` must be valid.
+    pub unsafe fn create_vulkan_device(
+        &mut self,
+        entry: &ash::Entry,
+        instance: &ash::Instance,
+        physical: vk::PhysicalDevice,
+        info: &vk::DeviceCreateInfo,
+    ) -> Result<ash::Device> {
+        let gipa = entry.static_fn().get_instance_proc_addr;
+        let raw = unsafe {
+            self.instance.create_vulkan_device(
+                self.system,
+                std::mem::transmute::<
+                    vk::PFN_vkGetInstanceProcAddr,
+                    xr::sys::platform::VkGetInstanceProcAddr,
+                >(gipa),
+                physical.as_raw() as _,
+                info as *const vk::DeviceCreateInfo as *const _,
+            )
+        }
+        .xr("xrCreateVulkanDeviceKHR")?
+        .map_err(|result| OpenXrError::Vulkan {
+            call: "vkCreateDevice",
+            result: vk::Result::from_raw(result),
+        })?;
+        Ok(unsafe { ash::Device::load(instance.fp_v1_0(), vk::Device::from_raw(raw as u64)) })
+    }
+}
+
+/// The renderer's Vulkan objects a session is created on.
+#[derive(Clone, Copy, Debug)]
+pub struct VulkanHandles {
+    /// The instance made by [`Runtime::create_vulkan_instance`].
+    pub instance: vk::Instance,
+    /// The physical device from [`Runtime::vulkan_physical_device`].
+    pub physical: vk::PhysicalDevice,
+    /// The device made by [`Runtime::create_vulkan_device`].
+    pub device: vk::Device,
+    /// Queue family of the queue frames are submitted on.
+    pub queue_family: u32,
+    /// Index of that queue in its family.
+    pub queue_index: u32,
+}
+
+/// How a session runs.
+#[derive(Clone, Debug, Default)]
+pub struct SessionOptions {
+    /// End after this many rendered frames (None: until stopped).
+    pub max_frames: Option<u64>,
+    /// Replay gaze from this trace (by time since the first frame) when no eye tracker is
+    /// available.
+    pub gaze_trace: Option<std::path::PathBuf>,
+    /// Where the scene's origin (the viewer's head at start) is put relative to the first
+    /// located head pose; `None` puts it exactly there (yaw only).
+    pub scene_origin: Option<Pose>,
+    /// Position of the viewer's head in the scene frame, metres (the scene's
+    /// `viewer.head_position_m`).
+    pub viewer_position_m: glam::Vec3,
+    /// Install a Ctrl-C handler that ends the session cleanly.
+    pub handle_ctrl_c: bool,
+}
+
+/// The swapchain's images and format, for the renderer.
+#[derive(Clone, Debug)]
+pub struct SwapchainImages {
+    /// The `VkImage`s, 2 layers each.
+    pub images: Vec<vk::Image>,
+    /// Their format.
+    pub format: vk::Format,
+    /// Whether the format encodes sRGB itself.
+    pub srgb: bool,
+    /// Size of each layer, pixels.
+    pub size: (u32, u32),
+}
+
+impl Runtime {
+    /// Creates the session on the renderer's device, its spaces, swapchain and gaze source.
+    ///
+    /// # Safety
+    /// `vulkan` must hold the handles made through this runtime; they must outlive the
+    /// returned session.
+    pub unsafe fn start(
+        &self,
+        vulkan: VulkanHandles,
+        options: &SessionOptions,
+    ) -> Result<(Session, SwapchainImages)> {
+        unsafe { session::start(self, vulkan, options) }
+    }
+}
+
+/// Which of the eye-gaze features the system supports (EXT interaction, FB social).
+fn gaze_support(
+    instance: &xr::Instance,
+    system: xr::SystemId,
+    ext: bool,
+    fb: bool,
+) -> (bool, bool) {
+    let mut ext_props = xr::sys::SystemEyeGazeInteractionPropertiesEXT {
+        ty: xr::sys::SystemEyeGazeInteractionPropertiesEXT::TYPE,
+        next: std::ptr::null_mut(),
+        supports_eye_gaze_interaction: xr::sys::FALSE,
+    };
+    let mut fb_props = xr::sys::SystemEyeTrackingPropertiesFB {
+        ty: xr::sys::SystemEyeTrackingPropertiesFB::TYPE,
+        next: std::ptr::null_mut(),
+        supports_eye_tracking: xr::sys::FALSE,
+    };
+    let mut next: *mut std::ffi::c_void = std::ptr::null_mut();
+    if ext {
+        ext_props.next = next;
+        next = &mut ext_props as *mut _ as *mut _;
+    }
+    if fb {
+        fb_props.next = next;
+        next = &mut fb_props as *mut _ as *mut _;
+    }
+    if next.is_null() {
+        return (false, false);
+    }
+    // SAFETY: a zeroed XrSystemProperties with a valid chain of output structs that live
+    // across the call.
+    let ok = unsafe {
+        let mut props: xr::sys::SystemProperties = std::mem::zeroed();
+        props.ty = xr::sys::SystemProperties::TYPE;
+        props.next = next;
+        (instance.fp().get_system_properties)(instance.as_raw(), system, &mut props)
+    };
+    if ok != xr::sys::Result::SUCCESS {
+        tracing::warn!("xrGetSystemProperties with eye-tracking properties failed: {ok}");
+        return (false, false);
+    }
+    (
+        ext && ext_props.supports_eye_gaze_interaction == xr::sys::TRUE,
+        fb && fb_props.supports_eye_tracking == xr::sys::TRUE,
+    )
+}
+
+/// The names of the extensions vitreous enables, for logs.
+fn enabled_names(set: &xr::ExtensionSet) -> Vec<String> {
+    let mut names = Vec::new();
+    for (on, name) in [
+        (set.khr_vulkan_enable2, "XR_KHR_vulkan_enable2"),
+        (set.ext_eye_gaze_interaction, "XR_EXT_eye_gaze_interaction"),
+        (set.fb_eye_tracking_social, "XR_FB_eye_tracking_social"),
+        (
+            set.khr_composition_layer_depth,
+            "XR_KHR_composition_layer_depth",
+        ),
+    ] {
+        if on {
+            names.push(name.to_owned());
+        }
+    }
+    names
+}
+
+/// A short list of the graphics extensions a runtime offers, for the no-Vulkan message.
+fn extension_list(set: &xr::ExtensionSet) -> String {
+    let mut s = String::new();
+    for (on, name) in [
+        (set.khr_vulkan_enable, "XR_KHR_vulkan_enable"),
+        (set.khr_opengl_enable, "XR_KHR_opengl_enable"),
+    ] {
+        if on {
+            let _ = write!(s, "{}{name}", if s.is_empty() { "" } else { ", " });
+        }
+    }
+    if s.is_empty() {
+        s.push_str("no graphics API extension");
+    }
+    s
+}

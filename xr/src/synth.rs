@@ -1,0 +1,622 @@
+//! Synthetic traces: a viewer looking at a glass surface who switches gaze between a point on
+//! the surface and a point seen through it, with known ground truth.
+//!
+//! The head stands at [`SynthParams::head_position`] facing the surface point (with +y up),
+//! plus a slow, small sway (a few millimetres, a fraction of a degree) that is deterministic
+//! for a seed. Gaze alternates between the surface point (first) and the refracted point every
+//! [`SynthParams::switch_period_s`]. Both eye rays start at `∓ipd/2` along head x and point at
+//! the current target, plus Gaussian angular noise; during blinks both eyes are invalid.
+//!
+//! `fixation` and `combined` are `None` in every sample: the consumer computes vergence from
+//! the two rays, as with a real tracker. The true target of each moment is in
+//! [`SynthTrace::phases`].
+
+use glam::{Mat3, Quat, Vec3};
+use thiserror::Error;
+
+use crate::frame::{GazeRay, GazeSample, Pose};
+use crate::trace::TraceSample;
+
+/// Amplitude of the head's positional sway along each world axis, metres.
+const SWAY_POSITION_M: f32 = 0.003;
+/// Amplitude of the head's rotational sway about each head axis, degrees.
+const SWAY_ANGLE_DEG: f32 = 0.3;
+/// Most samples a synthetic trace may have (about 38 days at 30 Hz).
+const MAX_SAMPLES: f64 = 1e8;
+
+/// What to synthesise. Points are in the world frame (OpenXR axes, metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SynthParams {
+    /// Where the head (between the eyes) stands, metres.
+    pub head_position: Vec3,
+    /// The fixated point on the glass surface, metres; the head faces it.
+    pub surface_point: Vec3,
+    /// The fixated point seen through the glass (the refracted image), metres.
+    pub refracted_point: Vec3,
+    /// Distance between the eyes' ray origins, metres.
+    pub ipd_m: f32,
+    /// Length of the trace, seconds (samples at 0 .. duration inclusive).
+    pub duration_s: f32,
+    /// Tracker sample rate, hertz.
+    pub rate_hz: f32,
+    /// Time between gaze switches, seconds; 0 (or less) never switches.
+    pub switch_period_s: f32,
+    /// Standard deviation of the angular gaze noise per axis, degrees; 0 for exact rays.
+    pub noise_deg: f32,
+    /// Time between blink starts, seconds; the first blink starts at this time. 0 (or less)
+    /// for no blinks.
+    pub blink_every_s: f32,
+    /// How long each blink lasts, seconds.
+    pub blink_duration_s: f32,
+    /// Seed of the sway and noise; the same parameters give the same trace.
+    pub seed: u64,
+}
+
+impl Default for SynthParams {
+    fn default() -> Self {
+        SynthParams {
+            head_position: Vec3::ZERO,
+            surface_point: Vec3::new(0.0, 0.0, -0.6),
+            refracted_point: Vec3::new(0.0, -0.05, -1.5),
+            ipd_m: 0.063,
+            duration_s: 10.0,
+            rate_hz: 30.0,
+            switch_period_s: 3.0,
+            noise_deg: 0.5,
+            blink_every_s: 4.0,
+            blink_duration_s: 0.15,
+            seed: 1,
+        }
+    }
+}
+
+/// Parameters that cannot give a trace.
+#[derive(Debug, Error, PartialEq)]
+pub enum SynthError {
+    /// A parameter is NaN, infinite or out of its range.
+    #[error("synthetic trace parameter `{field}` is {value}; expected {expected}")]
+    BadParam {
+        /// The field of [`SynthParams`].
+        field: &'static str,
+        /// Its value, printed.
+        value: String,
+        /// What it should be.
+        expected: &'static str,
+    },
+}
+
+impl SynthParams {
+    /// Checks that the parameters describe a trace.
+    pub fn validate(&self) -> Result<(), SynthError> {
+        let bad = |field: &'static str, value: String, expected: &'static str| {
+            Err(SynthError::BadParam {
+                field,
+                value,
+                expected,
+            })
+        };
+        for (field, v) in [
+            ("head_position", self.head_position),
+            ("surface_point", self.surface_point),
+            ("refracted_point", self.refracted_point),
+        ] {
+            if !v.is_finite() {
+                return bad(field, format!("{v}"), "finite coordinates");
+            }
+        }
+        for (field, v) in [
+            ("surface_point", self.surface_point),
+            ("refracted_point", self.refracted_point),
+        ] {
+            if v.distance(self.head_position) < 0.01 {
+                return bad(
+                    field,
+                    format!("{v}"),
+                    "a point at least 1 cm from head_position",
+                );
+            }
+        }
+        let non_negative = [
+            ("ipd_m", self.ipd_m),
+            ("duration_s", self.duration_s),
+            ("noise_deg", self.noise_deg),
+            ("blink_duration_s", self.blink_duration_s),
+        ];
+        for (field, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(field, format!("{v}"), "a finite number >= 0");
+            }
+        }
+        for (field, v) in [
+            ("switch_period_s", self.switch_period_s),
+            ("blink_every_s", self.blink_every_s),
+        ] {
+            if !v.is_finite() {
+                return bad(field, format!("{v}"), "a finite number (<= 0 to disable)");
+            }
+        }
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0 && self.rate_hz <= 1e6) {
+            return bad(
+                "rate_hz",
+                format!("{}", self.rate_hz),
+                "a rate in (0, 1e6] Hz",
+            );
+        }
+        if f64::from(self.duration_s) * f64::from(self.rate_hz) > MAX_SAMPLES {
+            return bad(
+                "duration_s",
+                format!("{}", self.duration_s),
+                "at most 1e8 samples (duration_s * rate_hz)",
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Which point the eyes are on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GazeTarget {
+    /// The point on the glass surface.
+    Surface,
+    /// The point seen through the glass.
+    Refracted,
+}
+
+/// A stretch of time with one gaze target: the ground truth for switch-latency tests.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GazePhase {
+    /// First nanosecond of the phase (trace clock).
+    pub start_ns: i64,
+    /// End of the phase, nanoseconds, exclusive; the last phase ends after the last sample.
+    pub end_ns: i64,
+    /// Which point is fixated.
+    pub target: GazeTarget,
+    /// That point in the world frame, metres.
+    pub point_world: Vec3,
+}
+
+/// A blink: both eyes invalid from `start_ns` (inclusive) to `end_ns` (exclusive).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Blink {
+    /// Start, nanoseconds.
+    pub start_ns: i64,
+    /// End, nanoseconds, exclusive.
+    pub end_ns: i64,
+}
+
+/// A synthetic trace and what is true about it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SynthTrace {
+    /// The samples, times from 0 at `rate_hz`.
+    pub samples: Vec<TraceSample>,
+    /// The gaze phases in time order, covering the whole trace.
+    pub phases: Vec<GazePhase>,
+    /// The blinks that start within the trace.
+    pub blinks: Vec<Blink>,
+}
+
+impl SynthTrace {
+    /// The phase at a time, if the time is within the trace.
+    pub fn phase_at(&self, time_ns: i64) -> Option<&GazePhase> {
+        self.phases
+            .iter()
+            .find(|p| p.start_ns <= time_ns && time_ns < p.end_ns)
+    }
+}
+
+/// Synthesises a trace; empty (with a warning logged) if the parameters are invalid — use
+/// [`synthesize_with_truth`] to get the reason.
+pub fn synthesize(params: &SynthParams) -> Vec<TraceSample> {
+    match synthesize_with_truth(params) {
+        Ok(trace) => trace.samples,
+        Err(e) => {
+            tracing::warn!("{e}");
+            Vec::new()
+        }
+    }
+}
+
+/// Synthesises a trace with its ground truth (gaze phases, blinks).
+pub fn synthesize_with_truth(params: &SynthParams) -> Result<SynthTrace, SynthError> {
+    params.validate()?;
+    let p = params;
+    let seconds_to_ns = |s: f64| (s * 1e9).round() as i64;
+    let n = (f64::from(p.duration_s) * f64::from(p.rate_hz)).floor() as u64 + 1;
+    let time_of = |k: u64| seconds_to_ns(k as f64 / f64::from(p.rate_hz));
+    let end_ns = time_of(n - 1) + 1;
+
+    let mut rng = SplitMix64(p.seed);
+    let sway = Sway::new(&mut rng);
+    let base = look_at(p.head_position, p.surface_point);
+    let target_of = |t: GazeTarget| match t {
+        GazeTarget::Surface => p.surface_point,
+        GazeTarget::Refracted => p.refracted_point,
+    };
+
+    let phases = phases(p, end_ns, seconds_to_ns, &target_of);
+    let blinks = blinks(p, end_ns, seconds_to_ns);
+    let mut noise = SplitMix64(p.seed ^ 0x9e37_79b9_7f4a_7c15);
+    let noise_rad = p.noise_deg.to_radians();
+
+    let mut samples = Vec::with_capacity(n as usize);
+    let mut phase = 0;
+    for k in 0..n {
+        let time_ns = time_of(k);
+        let t_s = k as f32 / p.rate_hz;
+        while phase + 1 < phases.len() && phases[phase].end_ns <= time_ns {
+            phase += 1;
+        }
+        let (offset_m, rotation) = sway.at(t_s);
+        let head = Pose {
+            position: p.head_position + offset_m,
+            orientation: (base * rotation).normalize(),
+        };
+        let blinking = blinks
+            .iter()
+            .any(|b| b.start_ns <= time_ns && time_ns < b.end_ns);
+        // Draw noise even during blinks so a blink does not shift later noise.
+        let mut eye = |side: f32| {
+            let origin = Vec3::new(side * p.ipd_m / 2.0, 0.0, 0.0);
+            let target_head = head
+                .orientation
+                .inverse()
+                .mul_vec3(phases[phase].point_world - head.position);
+            let direction = add_noise(
+                (target_head - origin).normalize(),
+                noise.gaussian() as f32 * noise_rad,
+                noise.gaussian() as f32 * noise_rad,
+            );
+            if blinking {
+                GazeRay::INVALID
+            } else {
+                GazeRay {
+                    origin,
+                    direction,
+                    valid: true,
+                }
+            }
+        };
+        let left = eye(-1.0);
+        let right = eye(1.0);
+        samples.push(TraceSample {
+            time_ns,
+            head,
+            gaze: GazeSample {
+                sample_time_ns: time_ns,
+                left,
+                right,
+                combined: None,
+                fixation: None,
+            },
+        });
+    }
+    Ok(SynthTrace {
+        samples,
+        phases,
+        blinks,
+    })
+}
+
+/// The gaze phases: surface first, then alternating every `switch_period_s`.
+fn phases(
+    p: &SynthParams,
+    end_ns: i64,
+    seconds_to_ns: impl Fn(f64) -> i64,
+    target_of: &impl Fn(GazeTarget) -> Vec3,
+) -> Vec<GazePhase> {
+    let mut phases = Vec::new();
+    let period = f64::from(p.switch_period_s);
+    let mut i = 0u64;
+    loop {
+        let target = if i.is_multiple_of(2) {
+            GazeTarget::Surface
+        } else {
+            GazeTarget::Refracted
+        };
+        let start_ns = seconds_to_ns(i as f64 * period);
+        let phase_end = if period > 0.0 {
+            seconds_to_ns((i + 1) as f64 * period).min(end_ns)
+        } else {
+            end_ns
+        };
+        phases.push(GazePhase {
+            start_ns,
+            end_ns: phase_end,
+            target,
+            point_world: target_of(target),
+        });
+        if phase_end >= end_ns {
+            return phases;
+        }
+        i += 1;
+    }
+}
+
+/// The blinks that start before `end_ns`.
+fn blinks(p: &SynthParams, end_ns: i64, seconds_to_ns: impl Fn(f64) -> i64) -> Vec<Blink> {
+    let mut blinks = Vec::new();
+    if p.blink_every_s <= 0.0 || p.blink_duration_s <= 0.0 {
+        return blinks;
+    }
+    for k in 1u64.. {
+        let start_s = k as f64 * f64::from(p.blink_every_s);
+        let start_ns = seconds_to_ns(start_s);
+        if start_ns >= end_ns {
+            break;
+        }
+        blinks.push(Blink {
+            start_ns,
+            end_ns: seconds_to_ns(start_s + f64::from(p.blink_duration_s)),
+        });
+    }
+    blinks
+}
+
+/// The orientation whose -z looks from `eye` at `target` with +y as close to up as possible.
+fn look_at(eye: Vec3, target: Vec3) -> Quat {
+    let forward = (target - eye).normalize();
+    let up = if forward.cross(Vec3::Y).length_squared() > 1e-6 {
+        Vec3::Y
+    } else {
+        Vec3::Z
+    };
+    let right = forward.cross(up).normalize();
+    let up = right.cross(forward);
+    Quat::from_mat3(&Mat3::from_cols(right, up, -forward)).normalize()
+}
+
+/// Tilts a unit direction by two small angles about axes perpendicular to it.
+fn add_noise(direction: Vec3, a_rad: f32, b_rad: f32) -> Vec3 {
+    if a_rad == 0.0 && b_rad == 0.0 {
+        return direction;
+    }
+    let (u, v) = direction.any_orthonormal_pair();
+    (direction + u * a_rad.tan() + v * b_rad.tan()).normalize()
+}
+
+/// A slow head sway: a sum of sinusoids per axis with seeded phases and frequencies.
+struct Sway {
+    /// Per axis (position x, y, z, rotation about x, y, z): frequency in Hz and phase in rad.
+    terms: [(f32, f32); 6],
+}
+
+impl Sway {
+    fn new(rng: &mut SplitMix64) -> Sway {
+        let mut terms = [(0.0, 0.0); 6];
+        for t in &mut terms {
+            let frequency_hz = 0.05 + 0.25 * rng.unit() as f32;
+            let phase_rad = std::f32::consts::TAU * rng.unit() as f32;
+            *t = (frequency_hz, phase_rad);
+        }
+        Sway { terms }
+    }
+
+    /// Position offset (world, metres) and rotation (head frame) at time `t_s`.
+    fn at(&self, t_s: f32) -> (Vec3, Quat) {
+        let w = |i: usize| {
+            let (f, ph) = self.terms[i];
+            (std::f32::consts::TAU * f * t_s + ph).sin()
+        };
+        let offset = Vec3::new(w(0), w(1), w(2)) * SWAY_POSITION_M;
+        let a = SWAY_ANGLE_DEG.to_radians();
+        let rotation = Quat::from_rotation_y(w(4) * a)
+            * Quat::from_rotation_x(w(3) * a)
+            * Quat::from_rotation_z(w(5) * a);
+        (offset, rotation)
+    }
+}
+
+/// A small, well-mixed deterministic PRNG (SplitMix64); enough for noise and sway.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Standard normal (Box-Muller).
+    fn gaussian(&mut self) -> f64 {
+        let u1 = 1.0 - self.unit(); // (0, 1]: ln is finite
+        let u2 = self.unit();
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Closest point between two rays (midpoint of the shortest segment); `None` if parallel.
+    fn closest_approach(a: &GazeRay, b: &GazeRay) -> Option<Vec3> {
+        let w = a.origin - b.origin;
+        let (d1, d2) = (a.direction, b.direction);
+        let (bb, d, e) = (d1.dot(d2), d1.dot(w), d2.dot(w));
+        let denom = 1.0 - bb * bb;
+        if denom < 1e-12 {
+            return None;
+        }
+        let s = (bb * e - d) / denom;
+        let t = (e - bb * d) / denom;
+        Some((a.origin + d1 * s + b.origin + d2 * t) / 2.0)
+    }
+
+    fn params() -> SynthParams {
+        SynthParams {
+            head_position: Vec3::new(0.2, 1.6, 0.5),
+            surface_point: Vec3::new(0.0, 1.2, -0.3),
+            refracted_point: Vec3::new(0.1, 1.1, -1.4),
+            noise_deg: 0.0,
+            ..SynthParams::default()
+        }
+    }
+
+    #[test]
+    fn vergence_of_exact_rays_is_on_the_target() {
+        let trace = synthesize_with_truth(&params()).unwrap();
+        let mut checked = [0, 0];
+        for s in &trace.samples {
+            if !s.gaze.left.valid {
+                continue;
+            }
+            let p = closest_approach(&s.gaze.left, &s.gaze.right).unwrap();
+            let world = s.head.transform_point(p);
+            let phase = trace.phase_at(s.time_ns).unwrap();
+            assert!(
+                world.distance(phase.point_world) < 1e-3,
+                "t={} {world} vs {}",
+                s.time_ns,
+                phase.point_world
+            );
+            checked[(phase.target == GazeTarget::Refracted) as usize] += 1;
+            assert!((s.gaze.left.origin.distance(s.gaze.right.origin) - 0.063).abs() < 1e-6);
+        }
+        assert!(checked[0] > 100 && checked[1] > 50, "{checked:?}");
+    }
+
+    #[test]
+    fn head_faces_the_surface_point_and_sways_a_little() {
+        let p = params();
+        let trace = synthesize_with_truth(&p).unwrap();
+        let mut max_offset: f32 = 0.0;
+        for s in &trace.samples {
+            let forward = s.head.transform_vector(Vec3::NEG_Z);
+            let to_surface = (p.surface_point - s.head.position).normalize();
+            assert!(forward.angle_between(to_surface).to_degrees() < 1.0);
+            max_offset = max_offset.max(s.head.position.distance(p.head_position));
+            assert!((s.head.orientation.length() - 1.0).abs() < 1e-5);
+        }
+        assert!(max_offset > 1e-4 && max_offset < 0.01, "{max_offset}");
+    }
+
+    #[test]
+    fn phases_alternate_every_switch_period() {
+        let trace = synthesize_with_truth(&params()).unwrap();
+        let targets: Vec<_> = trace.phases.iter().map(|p| p.target).collect();
+        use GazeTarget::*;
+        assert_eq!(targets, [Surface, Refracted, Surface, Refracted]);
+        assert_eq!(trace.phases[1].start_ns, 3_000_000_000);
+        assert_eq!(trace.phases[0].end_ns, 3_000_000_000);
+        assert_eq!(
+            trace.phases[3].end_ns,
+            trace.samples.last().unwrap().time_ns + 1
+        );
+    }
+
+    #[test]
+    fn blinks_make_both_eyes_invalid() {
+        let trace = synthesize_with_truth(&params()).unwrap();
+        assert_eq!(trace.blinks.len(), 2);
+        let mut blinked = 0;
+        for s in &trace.samples {
+            let in_blink = trace
+                .blinks
+                .iter()
+                .any(|b| b.start_ns <= s.time_ns && s.time_ns < b.end_ns);
+            assert_eq!(!s.gaze.left.valid, in_blink);
+            assert_eq!(!s.gaze.right.valid, in_blink);
+            blinked += in_blink as usize;
+        }
+        // 150 ms at 30 Hz: 4 or 5 samples per blink.
+        assert!((8..=10).contains(&blinked), "{blinked}");
+    }
+
+    #[test]
+    fn same_seed_same_trace_other_seed_other_trace() {
+        let p = SynthParams {
+            noise_deg: 1.0,
+            ..params()
+        };
+        assert_eq!(synthesize(&p), synthesize(&p));
+        assert_ne!(synthesize(&p), synthesize(&SynthParams { seed: 2, ..p }));
+    }
+
+    #[test]
+    fn noise_has_about_the_requested_spread() {
+        let noisy = SynthParams {
+            noise_deg: 1.0,
+            blink_every_s: 0.0,
+            duration_s: 60.0,
+            ..params()
+        };
+        let exact = SynthParams {
+            noise_deg: 0.0,
+            ..noisy
+        };
+        let (a, b) = (synthesize(&noisy), synthesize(&exact));
+        let sq: f32 = a
+            .iter()
+            .zip(&b)
+            .map(|(a, b)| {
+                a.gaze
+                    .left
+                    .direction
+                    .angle_between(b.gaze.left.direction)
+                    .to_degrees()
+                    .powi(2)
+            })
+            .sum();
+        // Two independent axes of 1 degree each: mean squared angle about 2.
+        let mean_sq = sq / a.len() as f32;
+        assert!((1.6..2.4).contains(&mean_sq), "{mean_sq}");
+    }
+
+    #[test]
+    fn times_strictly_increase_and_trace_round_trips() {
+        let samples = synthesize(&SynthParams {
+            rate_hz: 90.0,
+            ..SynthParams::default()
+        });
+        assert_eq!(samples.len(), 901);
+        assert!(samples.windows(2).all(|w| w[0].time_ns < w[1].time_ns));
+        let mut w = crate::trace::TraceWriter::new(Vec::new()).unwrap();
+        for s in &samples {
+            w.write(s).unwrap();
+        }
+        let text = w.finish().unwrap();
+        let back: Vec<TraceSample> = crate::trace::TraceReader::new(&text[..], "synth")
+            .unwrap()
+            .collect::<Result<_, _>>()
+            .unwrap();
+        assert_eq!(back, samples);
+    }
+
+    #[test]
+    fn bad_params_are_reported_not_panicked_on() {
+        let bad = [
+            SynthParams {
+                rate_hz: 0.0,
+                ..params()
+            },
+            SynthParams {
+                duration_s: f32::NAN,
+                ..params()
+            },
+            SynthParams {
+                surface_point: params().head_position,
+                ..params()
+            },
+            SynthParams {
+                duration_s: 1e12,
+                ..params()
+            },
+        ];
+        for p in bad {
+            assert!(synthesize_with_truth(&p).is_err());
+            assert!(synthesize(&p).is_empty());
+        }
+        let zero = synthesize(&SynthParams {
+            duration_s: 0.0,
+            ..params()
+        });
+        assert_eq!(zero.len(), 1);
+    }
+}

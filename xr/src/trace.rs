@@ -1,0 +1,1285 @@
+//! The vitreous trace format, version 1: head poses and eye-tracker samples as UTF-8 text.
+//!
+//! One sample per line, comma-separated, after a version line and a column header line. The
+//! full description (every column, its unit and axes) is in `docs/trace-format.md`; the short
+//! version:
+//!
+//! ```text
+//! # vitreous-trace v1
+//! time_ns,head_x_m,head_y_m,head_z_m,head_qx,head_qy,head_qz,head_qw,gaze_time_ns,left_valid,...
+//! 0,0,0,0,0,0,0,1,0,1,-0.032,0,0,0,0,-1,1,0.032,0,0,0,0,-1,,,,,,,,,,
+//! ```
+//!
+//! The reader is strict about what the replay depends on (times, head pose) and lenient about
+//! what trackers really produce: a gaze ray with a NaN/infinite value or a zero direction is
+//! read as an invalid ray of that eye instead of failing the whole trace.
+//!
+//! The writer runs the same checks before writing, so it never produces a file the reader
+//! refuses, and flushes after every sample so a crash loses at most the sample being written.
+
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, BufWriter, Write};
+use std::path::Path;
+
+use glam::{Quat, Vec3};
+use thiserror::Error;
+
+use crate::frame::{GazeRay, GazeSample, Pose};
+
+/// The first line of every version-1 trace.
+pub const VERSION_LINE: &str = "# vitreous-trace v1";
+
+/// What the version line starts with, whatever the version.
+const VERSION_PREFIX: &str = "# vitreous-trace ";
+
+/// The column names of version 1, in file order (the second non-comment line of a trace).
+pub const COLUMNS: [&str; 33] = [
+    "time_ns",
+    "head_x_m",
+    "head_y_m",
+    "head_z_m",
+    "head_qx",
+    "head_qy",
+    "head_qz",
+    "head_qw",
+    "gaze_time_ns",
+    "left_valid",
+    "left_origin_x_m",
+    "left_origin_y_m",
+    "left_origin_z_m",
+    "left_dir_x",
+    "left_dir_y",
+    "left_dir_z",
+    "right_valid",
+    "right_origin_x_m",
+    "right_origin_y_m",
+    "right_origin_z_m",
+    "right_dir_x",
+    "right_dir_y",
+    "right_dir_z",
+    "combined_valid",
+    "combined_origin_x_m",
+    "combined_origin_y_m",
+    "combined_origin_z_m",
+    "combined_dir_x",
+    "combined_dir_y",
+    "combined_dir_z",
+    "fixation_x_m",
+    "fixation_y_m",
+    "fixation_z_m",
+];
+
+/// Index of the first column of each group in [`COLUMNS`].
+const LEFT: usize = 9;
+const RIGHT: usize = 16;
+const COMBINED: usize = 23;
+const FIXATION: usize = 30;
+
+/// How far the head quaternion's norm may be from 1 before the sample is refused; within it
+/// the quaternion is normalised (text round-off, other tools' rounding).
+pub const QUAT_NORM_TOLERANCE: f32 = 1e-3;
+
+/// Below this length a gaze direction counts as zero (the ray is then invalid).
+const MIN_DIRECTION_LENGTH: f32 = 1e-6;
+
+/// Vectors whose squared length is within this of 1 are kept bit-exact instead of being
+/// normalised again, so that writing then reading a sample gives the same numbers.
+const UNIT_EPSILON: f32 = 1e-6;
+
+/// One line of a trace: a head pose and the newest eye-tracker sample at that time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TraceSample {
+    /// Time of the head pose, nanoseconds on the trace clock. Strictly increasing in a trace.
+    pub time_ns: i64,
+    /// Head pose in the world frame (OpenXR LOCAL-like axes, metres).
+    pub head: Pose,
+    /// The eye-tracker sample, rays in the head frame. `gaze.sample_time_ns <= time_ns`.
+    pub gaze: GazeSample,
+}
+
+/// Everything that can go wrong reading or writing a trace. Messages name the file, the line
+/// (1-based) and the column where they can.
+#[derive(Debug, Error)]
+pub enum TraceError {
+    /// The file could not be opened, read or written.
+    #[error("{file}: {context}: {source}")]
+    Io {
+        /// File name (or a description of the stream).
+        file: String,
+        /// What was being done, with the line number when known.
+        context: String,
+        /// The underlying error.
+        #[source]
+        source: io::Error,
+    },
+    /// The file has no lines at all.
+    #[error("{file}: empty file; expected first line `{VERSION_LINE}`")]
+    Empty {
+        /// File name.
+        file: String,
+    },
+    /// The first line is not a vitreous trace version line.
+    #[error("{file}:{line}: not a vitreous trace: expected `{VERSION_LINE}`, found `{found}`")]
+    BadVersionLine {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// The line as found (shortened).
+        found: String,
+    },
+    /// The version line names a version this reader does not know.
+    #[error(
+        "{file}:{line}: unsupported trace version `{version}`; this reader understands only v1"
+    )]
+    UnsupportedVersion {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// The version text after `# vitreous-trace `.
+        version: String,
+    },
+    /// The file ends after the version line, without the column header line.
+    #[error("{file}: missing column header line after `{VERSION_LINE}`")]
+    MissingColumnHeader {
+        /// File name.
+        file: String,
+    },
+    /// The column header line does not list the version-1 columns in order.
+    #[error("{file}:{line}: column {column} of the header is `{found}`, expected `{expected}`")]
+    BadColumnHeader {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// Column number (1-based).
+        column: usize,
+        /// The name found (empty when the header is too short).
+        found: String,
+        /// The name expected (empty when the header is too long).
+        expected: &'static str,
+    },
+    /// A sample line has the wrong number of fields.
+    #[error("{file}:{line}: {found} fields, expected {expected} (one per column)")]
+    FieldCount {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// Number of comma-separated fields found.
+        found: usize,
+        /// Number of columns of the format.
+        expected: usize,
+    },
+    /// A field could not be parsed.
+    #[error("{file}:{line}: column `{column}`: expected {expected}, found `{found}`")]
+    BadField {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// Column name.
+        column: &'static str,
+        /// The text found.
+        found: String,
+        /// What the column holds.
+        expected: &'static str,
+    },
+    /// A time or head-pose value is NaN or infinite.
+    #[error("{file}:{line}: column `{column}`: expected a finite number, found {value}")]
+    NonFinite {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// Column name.
+        column: &'static str,
+        /// The value found.
+        value: f32,
+    },
+    /// The head orientation quaternion is too far from unit length.
+    #[error(
+        "{file}:{line}: head quaternion (head_qx..head_qw) has norm {norm}, expected a unit quaternion (within {QUAT_NORM_TOLERANCE})"
+    )]
+    NonUnitQuaternion {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// The norm found.
+        norm: f32,
+    },
+    /// `time_ns` does not increase.
+    #[error(
+        "{file}:{line}: column `time_ns`: {time_ns} is not after the previous sample's {previous_ns}; times must strictly increase"
+    )]
+    TimeNotIncreasing {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// This sample's time.
+        time_ns: i64,
+        /// The previous sample's time.
+        previous_ns: i64,
+    },
+    /// `gaze_time_ns` is later than the head pose time of the same line.
+    #[error(
+        "{file}:{line}: column `gaze_time_ns`: {gaze_time_ns} is after time_ns {time_ns}; a line pairs a head pose with the newest gaze sample at or before it"
+    )]
+    GazeAfterPose {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// The gaze sample time.
+        gaze_time_ns: i64,
+        /// The head pose time.
+        time_ns: i64,
+    },
+    /// `gaze_time_ns` goes backwards.
+    #[error(
+        "{file}:{line}: column `gaze_time_ns`: {gaze_time_ns} is before the previous sample's {previous_ns}; gaze times must not decrease"
+    )]
+    GazeTimeBackwards {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// This sample's gaze time.
+        gaze_time_ns: i64,
+        /// The previous sample's gaze time.
+        previous_ns: i64,
+    },
+    /// An optional group (combined ray, fixation) is only partly filled.
+    #[error(
+        "{file}:{line}: the {group} columns must be either all empty or all filled; column `{column}` is empty"
+    )]
+    PartialGroup {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// `combined` or `fixation`.
+        group: &'static str,
+        /// The first empty column of the group.
+        column: &'static str,
+    },
+}
+
+/// Builds a `BadField` error without repeating the struct each time.
+fn bad_field(
+    file: &str,
+    line: usize,
+    col: usize,
+    found: &str,
+    expected: &'static str,
+) -> TraceError {
+    TraceError::BadField {
+        file: file.to_owned(),
+        line,
+        column: COLUMNS[col],
+        found: shorten(found),
+        expected,
+    }
+}
+
+/// Keeps error messages readable when a line is garbage.
+fn shorten(s: &str) -> String {
+    const MAX: usize = 60;
+    if s.chars().count() <= MAX {
+        s.to_owned()
+    } else {
+        let head: String = s.chars().take(MAX).collect();
+        format!("{head}...")
+    }
+}
+
+/// Checks a head pose and its times; normalises small quaternion drift. Shared by the reader
+/// and the writer so that what one accepts the other does too.
+fn check_sample(
+    file: &str,
+    line: usize,
+    sample: &TraceSample,
+    previous: Option<(i64, i64)>,
+) -> Result<TraceSample, TraceError> {
+    let p = sample.head.position;
+    let q = sample.head.orientation;
+    let values = [p.x, p.y, p.z, q.x, q.y, q.z, q.w];
+    for (i, &value) in values.iter().enumerate() {
+        if !value.is_finite() {
+            return Err(TraceError::NonFinite {
+                file: file.to_owned(),
+                line,
+                column: COLUMNS[1 + i],
+                value,
+            });
+        }
+    }
+    let norm = q.length();
+    if !norm.is_finite() || (norm - 1.0).abs() > QUAT_NORM_TOLERANCE {
+        return Err(TraceError::NonUnitQuaternion {
+            file: file.to_owned(),
+            line,
+            norm,
+        });
+    }
+    let gaze_time_ns = sample.gaze.sample_time_ns;
+    if let Some((previous_ns, previous_gaze_ns)) = previous {
+        if sample.time_ns <= previous_ns {
+            return Err(TraceError::TimeNotIncreasing {
+                file: file.to_owned(),
+                line,
+                time_ns: sample.time_ns,
+                previous_ns,
+            });
+        }
+        if gaze_time_ns < previous_gaze_ns {
+            return Err(TraceError::GazeTimeBackwards {
+                file: file.to_owned(),
+                line,
+                gaze_time_ns,
+                previous_ns: previous_gaze_ns,
+            });
+        }
+    }
+    if gaze_time_ns > sample.time_ns {
+        return Err(TraceError::GazeAfterPose {
+            file: file.to_owned(),
+            line,
+            gaze_time_ns,
+            time_ns: sample.time_ns,
+        });
+    }
+    let mut out = *sample;
+    out.head.orientation = unit_quat(q);
+    out.gaze.left = clean_ray(sample.gaze.left);
+    out.gaze.right = clean_ray(sample.gaze.right);
+    out.gaze.combined = sample.gaze.combined.map(clean_ray);
+    out.gaze.fixation = sample.gaze.fixation.filter(|f| f.is_finite());
+    Ok(out)
+}
+
+/// Normalises a quaternion unless it already is unit to f32 precision (keeps round trips exact).
+fn unit_quat(q: Quat) -> Quat {
+    if (q.length_squared() - 1.0).abs() <= UNIT_EPSILON {
+        q
+    } else {
+        q.normalize()
+    }
+}
+
+/// The canonical form of a gaze ray: invalid rays (flagged, non-finite, zero direction) become
+/// [`GazeRay::INVALID`]; valid directions are unit length.
+pub fn clean_ray(ray: GazeRay) -> GazeRay {
+    if !ray.valid || !ray.origin.is_finite() || !ray.direction.is_finite() {
+        return GazeRay::INVALID;
+    }
+    // Scaled by the largest component first so huge finite values do not overflow.
+    let largest = ray.direction.abs().max_element();
+    if largest < MIN_DIRECTION_LENGTH {
+        return GazeRay::INVALID;
+    }
+    let direction = if (ray.direction.length_squared() - 1.0).abs() <= UNIT_EPSILON {
+        ray.direction
+    } else {
+        (ray.direction / largest).normalize()
+    };
+    GazeRay {
+        origin: ray.origin,
+        direction,
+        valid: true,
+    }
+}
+
+/// Parses a required float field (any finite or non-finite value; callers check finiteness).
+fn parse_f32(file: &str, line: usize, fields: &[&str], col: usize) -> Result<f32, TraceError> {
+    let text = fields[col];
+    text.parse::<f32>()
+        .map_err(|_| bad_field(file, line, col, text, "a decimal number"))
+}
+
+/// Parses a required integer time field.
+fn parse_i64(file: &str, line: usize, fields: &[&str], col: usize) -> Result<i64, TraceError> {
+    let text = fields[col];
+    text.parse::<i64>()
+        .map_err(|_| bad_field(file, line, col, text, "an integer number of nanoseconds"))
+}
+
+/// Parses three consecutive float fields.
+fn parse_vec3(file: &str, line: usize, fields: &[&str], col: usize) -> Result<Vec3, TraceError> {
+    Ok(Vec3::new(
+        parse_f32(file, line, fields, col)?,
+        parse_f32(file, line, fields, col + 1)?,
+        parse_f32(file, line, fields, col + 2)?,
+    ))
+}
+
+/// Parses a ray group: `valid, origin xyz, dir xyz` starting at `col`. The caller has checked
+/// that the valid flag is present.
+fn parse_ray(file: &str, line: usize, fields: &[&str], col: usize) -> Result<GazeRay, TraceError> {
+    let valid = match fields[col] {
+        "1" => true,
+        "0" => false,
+        other => return Err(bad_field(file, line, col, other, "0 or 1")),
+    };
+    if !valid {
+        // An invalid ray's numbers are meaningless: they may be empty and are not read.
+        return Ok(GazeRay::INVALID);
+    }
+    let origin = parse_vec3(file, line, fields, col + 1)?;
+    let direction = parse_vec3(file, line, fields, col + 4)?;
+    Ok(clean_ray(GazeRay {
+        origin,
+        direction,
+        valid,
+    }))
+}
+
+/// Parses one sample line (already split into trimmed fields) without the time-order checks.
+fn parse_fields(file: &str, line: usize, fields: &[&str]) -> Result<TraceSample, TraceError> {
+    if fields.len() != COLUMNS.len() {
+        return Err(TraceError::FieldCount {
+            file: file.to_owned(),
+            line,
+            found: fields.len(),
+            expected: COLUMNS.len(),
+        });
+    }
+    let time_ns = parse_i64(file, line, fields, 0)?;
+    let position = parse_vec3(file, line, fields, 1)?;
+    let orientation = Quat::from_xyzw(
+        parse_f32(file, line, fields, 4)?,
+        parse_f32(file, line, fields, 5)?,
+        parse_f32(file, line, fields, 6)?,
+        parse_f32(file, line, fields, 7)?,
+    );
+    let gaze_time_ns = parse_i64(file, line, fields, 8)?;
+    let left = parse_ray(file, line, fields, LEFT)?;
+    let right = parse_ray(file, line, fields, RIGHT)?;
+
+    let combined = match optional_group(file, line, fields, COMBINED, 7, "combined")? {
+        false => None,
+        true => Some(parse_ray(file, line, fields, COMBINED)?),
+    };
+    let fixation = match optional_group(file, line, fields, FIXATION, 3, "fixation")? {
+        false => None,
+        true => Some(parse_vec3(file, line, fields, FIXATION)?),
+    };
+    Ok(TraceSample {
+        time_ns,
+        head: Pose {
+            position,
+            orientation,
+        },
+        gaze: GazeSample {
+            sample_time_ns: gaze_time_ns,
+            left,
+            right,
+            combined,
+            fixation,
+        },
+    })
+}
+
+/// Whether an optional group is present. All empty: absent. For the combined ray, a `0` flag
+/// with empty numbers is allowed (present but invalid); otherwise every field must be filled.
+fn optional_group(
+    file: &str,
+    line: usize,
+    fields: &[&str],
+    col: usize,
+    len: usize,
+    group: &'static str,
+) -> Result<bool, TraceError> {
+    let group_fields = &fields[col..col + len];
+    if group_fields.iter().all(|f| f.is_empty()) {
+        return Ok(false);
+    }
+    let flag_only_invalid = group == "combined" && group_fields[0] == "0";
+    let needed = if flag_only_invalid { 1 } else { len };
+    if let Some(i) = group_fields[..needed].iter().position(|f| f.is_empty()) {
+        return Err(TraceError::PartialGroup {
+            file: file.to_owned(),
+            line,
+            group,
+            column: COLUMNS[col + i],
+        });
+    }
+    Ok(true)
+}
+
+/// Streams [`TraceSample`]s out of a version-1 trace.
+///
+/// The version and column header lines are checked by the constructor; samples are parsed
+/// and checked one line at a time as the iterator is advanced. After the first error the
+/// iterator ends.
+pub struct TraceReader<R> {
+    /// The text being read.
+    reader: R,
+    /// File name used in error messages.
+    name: String,
+    /// Number of the last line read (1-based).
+    line: usize,
+    /// Time and gaze time of the previous sample, for the ordering checks.
+    previous: Option<(i64, i64)>,
+    /// Set after an error or the end of the input: the iterator is fused.
+    done: bool,
+    /// Reused line buffer.
+    buf: String,
+}
+
+impl TraceReader<BufReader<File>> {
+    /// Opens a trace file and checks its version and column header lines.
+    pub fn open(path: impl AsRef<Path>) -> Result<Self, TraceError> {
+        let path = path.as_ref();
+        let name = path.display().to_string();
+        let file = File::open(path).map_err(|source| TraceError::Io {
+            file: name.clone(),
+            context: "opening trace".to_owned(),
+            source,
+        })?;
+        TraceReader::new(BufReader::new(file), name)
+    }
+}
+
+impl<R: BufRead> TraceReader<R> {
+    /// Reads a trace from any buffered reader; `name` is used in error messages. Checks the
+    /// version and column header lines.
+    pub fn new(reader: R, name: impl Into<String>) -> Result<Self, TraceError> {
+        let mut this = TraceReader {
+            reader,
+            name: name.into(),
+            line: 0,
+            previous: None,
+            done: false,
+            buf: String::new(),
+        };
+        this.read_headers()?;
+        Ok(this)
+    }
+
+    /// The file name used in error messages.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Reads the next physical line into `self.buf` without its line ending; `false` at EOF.
+    fn next_line(&mut self) -> Result<bool, TraceError> {
+        self.buf.clear();
+        let n = self
+            .reader
+            .read_line(&mut self.buf)
+            .map_err(|source| TraceError::Io {
+                file: self.name.clone(),
+                context: format!("reading line {}", self.line + 1),
+                source,
+            })?;
+        if n == 0 {
+            return Ok(false);
+        }
+        self.line += 1;
+        let trimmed = self.buf.trim_end_matches(['\n', '\r']).len();
+        self.buf.truncate(trimmed);
+        Ok(true)
+    }
+
+    /// Reads the next line that is neither blank nor a `#` comment; `false` at EOF.
+    fn next_content_line(&mut self) -> Result<bool, TraceError> {
+        loop {
+            if !self.next_line()? {
+                return Ok(false);
+            }
+            let t = self.buf.trim();
+            if !t.is_empty() && !t.starts_with('#') {
+                return Ok(true);
+            }
+        }
+    }
+
+    /// Checks the version line and the column header line.
+    fn read_headers(&mut self) -> Result<(), TraceError> {
+        if !self.next_line()? {
+            return Err(TraceError::Empty {
+                file: self.name.clone(),
+            });
+        }
+        let first = self.buf.trim_start_matches('\u{feff}').trim();
+        match first.strip_prefix(VERSION_PREFIX) {
+            Some("v1") => {}
+            Some(version) => {
+                return Err(TraceError::UnsupportedVersion {
+                    file: self.name.clone(),
+                    line: self.line,
+                    version: shorten(version.trim()),
+                });
+            }
+            None => {
+                return Err(TraceError::BadVersionLine {
+                    file: self.name.clone(),
+                    line: self.line,
+                    found: shorten(first),
+                });
+            }
+        }
+        if !self.next_content_line()? {
+            return Err(TraceError::MissingColumnHeader {
+                file: self.name.clone(),
+            });
+        }
+        let names: Vec<&str> = self.buf.split(',').map(str::trim).collect();
+        for i in 0..names.len().max(COLUMNS.len()) {
+            let found = names.get(i).copied().unwrap_or("");
+            let expected = COLUMNS.get(i).copied().unwrap_or("");
+            if found != expected {
+                return Err(TraceError::BadColumnHeader {
+                    file: self.name.clone(),
+                    line: self.line,
+                    column: i + 1,
+                    found: shorten(found),
+                    expected,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads, parses and checks the next sample.
+    fn next_sample(&mut self) -> Result<Option<TraceSample>, TraceError> {
+        if !self.next_content_line()? {
+            return Ok(None);
+        }
+        let fields: Vec<&str> = self.buf.split(',').map(str::trim).collect();
+        let raw = parse_fields(&self.name, self.line, &fields)?;
+        let sample = check_sample(&self.name, self.line, &raw, self.previous)?;
+        self.previous = Some((sample.time_ns, sample.gaze.sample_time_ns));
+        Ok(Some(sample))
+    }
+}
+
+impl<R: BufRead> Iterator for TraceReader<R> {
+    type Item = Result<TraceSample, TraceError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        match self.next_sample() {
+            Ok(Some(sample)) => Some(Ok(sample)),
+            Ok(None) => {
+                self.done = true;
+                None
+            }
+            Err(e) => {
+                self.done = true;
+                Some(Err(e))
+            }
+        }
+    }
+}
+
+impl<R: BufRead> std::iter::FusedIterator for TraceReader<R> {}
+
+/// Reads a whole trace file into memory.
+pub fn read_trace(path: impl AsRef<Path>) -> Result<Vec<TraceSample>, TraceError> {
+    TraceReader::open(path)?.collect()
+}
+
+/// Writes [`TraceSample`]s as a version-1 trace.
+///
+/// Every sample is checked like the reader checks it (finite head pose, unit quaternion,
+/// increasing times, gaze time not after the pose time) and flushed once written.
+pub struct TraceWriter<W: Write> {
+    /// Where the text goes.
+    writer: W,
+    /// File name used in error messages.
+    name: String,
+    /// Line number the next sample will have (1-based).
+    line: usize,
+    /// Time and gaze time of the previous sample, for the ordering checks.
+    previous: Option<(i64, i64)>,
+    /// Reused line buffer.
+    buf: String,
+}
+
+impl TraceWriter<BufWriter<File>> {
+    /// Creates (or truncates) a trace file and writes its header lines.
+    pub fn create(path: impl AsRef<Path>) -> Result<Self, TraceError> {
+        let path = path.as_ref();
+        let name = path.display().to_string();
+        let file = File::create(path).map_err(|source| TraceError::Io {
+            file: name.clone(),
+            context: "creating trace".to_owned(),
+            source,
+        })?;
+        TraceWriter::with_name(BufWriter::new(file), name)
+    }
+}
+
+impl<W: Write> TraceWriter<W> {
+    /// Writes a trace into any writer (named `<output>` in error messages) and writes its
+    /// header lines.
+    pub fn new(writer: W) -> Result<Self, TraceError> {
+        TraceWriter::with_name(writer, "<output>")
+    }
+
+    /// Like [`TraceWriter::new`], with the name to use in error messages.
+    pub fn with_name(writer: W, name: impl Into<String>) -> Result<Self, TraceError> {
+        let mut this = TraceWriter {
+            writer,
+            name: name.into(),
+            line: 3,
+            previous: None,
+            buf: String::new(),
+        };
+        this.buf = format!("{VERSION_LINE}\n{}\n", COLUMNS.join(","));
+        this.flush_buf("writing header")?;
+        Ok(this)
+    }
+
+    /// Checks and writes one sample, then flushes. Invalid gaze rays (flagged, non-finite,
+    /// zero direction) are written as `0` with empty numbers; a non-finite fixation point is
+    /// written as absent.
+    pub fn write(&mut self, sample: &TraceSample) -> Result<(), TraceError> {
+        use std::fmt::Write as _;
+
+        let s = check_sample(&self.name, self.line, sample, self.previous)?;
+        let p = s.head.position;
+        let q = s.head.orientation;
+        let b = &mut self.buf;
+        b.clear();
+        // Writing into a String cannot fail.
+        let _ = write!(
+            b,
+            "{},{},{},{},{},{},{},{},{}",
+            s.time_ns, p.x, p.y, p.z, q.x, q.y, q.z, q.w, s.gaze.sample_time_ns
+        );
+        write_ray(b, Some(s.gaze.left));
+        write_ray(b, Some(s.gaze.right));
+        write_ray(b, s.gaze.combined);
+        match s.gaze.fixation {
+            Some(f) => {
+                let _ = write!(b, ",{},{},{}", f.x, f.y, f.z);
+            }
+            None => b.push_str(",,,"),
+        }
+        b.push('\n');
+        self.flush_buf("writing sample")?;
+        self.previous = Some((s.time_ns, s.gaze.sample_time_ns));
+        self.line += 1;
+        Ok(())
+    }
+
+    /// Flushes and returns the underlying writer.
+    pub fn finish(mut self) -> Result<W, TraceError> {
+        self.writer.flush().map_err(|source| TraceError::Io {
+            file: self.name.clone(),
+            context: "flushing trace".to_owned(),
+            source,
+        })?;
+        Ok(self.writer)
+    }
+
+    /// Writes `self.buf` and flushes, so a crash loses at most the line being written.
+    fn flush_buf(&mut self, what: &str) -> Result<(), TraceError> {
+        let result = self
+            .writer
+            .write_all(self.buf.as_bytes())
+            .and_then(|()| self.writer.flush());
+        result.map_err(|source| TraceError::Io {
+            file: self.name.clone(),
+            context: format!("{what} (line {})", self.line),
+            source,
+        })
+    }
+}
+
+/// Appends one ray group (with its leading comma); `None` writes all-empty fields.
+fn write_ray(b: &mut String, ray: Option<GazeRay>) {
+    use std::fmt::Write as _;
+    match ray {
+        None => b.push_str(",,,,,,,"),
+        Some(r) if !r.valid => b.push_str(",0,,,,,,"),
+        Some(r) => {
+            let (o, d) = (r.origin, r.direction);
+            let _ = write!(b, ",1,{},{},{},{},{},{}", o.x, o.y, o.z, d.x, d.y, d.z);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn ray(origin: Vec3, direction: Vec3) -> GazeRay {
+        GazeRay {
+            origin,
+            direction: direction.normalize(),
+            valid: true,
+        }
+    }
+
+    fn sample(time_ns: i64) -> TraceSample {
+        TraceSample {
+            time_ns,
+            head: Pose {
+                position: Vec3::new(0.1, 1.6, -0.2),
+                orientation: Quat::from_rotation_y(0.3),
+            },
+            gaze: GazeSample {
+                sample_time_ns: time_ns - 5,
+                left: ray(Vec3::new(-0.032, 0.0, 0.01), Vec3::new(0.1, 0.0, -1.0)),
+                right: ray(Vec3::new(0.032, 0.0, 0.01), Vec3::new(-0.1, 0.0, -1.0)),
+                combined: None,
+                fixation: None,
+            },
+        }
+    }
+
+    fn to_text(samples: &[TraceSample]) -> String {
+        let mut w = TraceWriter::new(Vec::new()).unwrap();
+        for s in samples {
+            w.write(s).unwrap();
+        }
+        String::from_utf8(w.finish().unwrap()).unwrap()
+    }
+
+    fn read_str(text: &str) -> Result<Vec<TraceSample>, TraceError> {
+        TraceReader::new(text.as_bytes(), "test.trace")?.collect()
+    }
+
+    /// A valid trace text with `n` samples, for corrupting one line in the tests.
+    fn good_text(n: i64) -> String {
+        to_text(&(1..=n).map(|i| sample(i * 1000)).collect::<Vec<_>>())
+    }
+
+    /// Replaces field `col` of physical line `line` (1-based).
+    fn with_field(text: &str, line: usize, col: usize, value: &str) -> String {
+        text.lines()
+            .enumerate()
+            .map(|(i, l)| {
+                if i + 1 == line {
+                    let mut f: Vec<&str> = l.split(',').collect();
+                    f[col] = value;
+                    f.join(",")
+                } else {
+                    l.to_owned()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
+    fn line_of(e: &TraceError) -> Option<usize> {
+        use TraceError::*;
+        match e {
+            BadVersionLine { line, .. }
+            | UnsupportedVersion { line, .. }
+            | BadColumnHeader { line, .. }
+            | FieldCount { line, .. }
+            | BadField { line, .. }
+            | NonFinite { line, .. }
+            | NonUnitQuaternion { line, .. }
+            | TimeNotIncreasing { line, .. }
+            | GazeAfterPose { line, .. }
+            | GazeTimeBackwards { line, .. }
+            | PartialGroup { line, .. } => Some(*line),
+            _ => None,
+        }
+    }
+
+    #[test]
+    fn round_trip_keeps_samples_exactly() {
+        let mut samples: Vec<_> = (1..=5).map(|i| sample(i * 1_000_000)).collect();
+        samples[1].gaze.left = GazeRay::INVALID;
+        samples[2].gaze.combined = Some(ray(Vec3::ZERO, Vec3::new(0.0, 0.1, -1.0)));
+        samples[3].gaze.combined = Some(GazeRay::INVALID);
+        samples[4].gaze.fixation = Some(Vec3::new(0.01, -0.02, -0.75));
+        let text = to_text(&samples);
+        assert_eq!(read_str(&text).unwrap(), samples);
+    }
+
+    #[test]
+    fn file_round_trip_and_read_trace() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.trace");
+        let samples: Vec<_> = (1..=3).map(|i| sample(i * 10)).collect();
+        let mut w = TraceWriter::create(&path).unwrap();
+        for s in &samples {
+            w.write(s).unwrap();
+        }
+        // Flushed per sample: readable before finish().
+        assert_eq!(read_trace(&path).unwrap(), samples);
+        w.finish().unwrap();
+        assert_eq!(read_trace(&path).unwrap(), samples);
+    }
+
+    #[test]
+    fn missing_file_names_the_file() {
+        let e = read_trace("/nonexistent/dir/x.trace").unwrap_err();
+        assert!(e.to_string().contains("/nonexistent/dir/x.trace"), "{e}");
+    }
+
+    #[test]
+    fn empty_file_is_refused() {
+        let e = read_str("").unwrap_err();
+        assert!(matches!(e, TraceError::Empty { .. }), "{e}");
+        assert!(e.to_string().contains("test.trace"));
+    }
+
+    #[test]
+    fn header_only_file_is_an_empty_trace() {
+        let text = format!("{VERSION_LINE}\n{}\n", COLUMNS.join(","));
+        assert_eq!(read_str(&text).unwrap(), vec![]);
+        let e = read_str(&format!("{VERSION_LINE}\n")).unwrap_err();
+        assert!(matches!(e, TraceError::MissingColumnHeader { .. }), "{e}");
+    }
+
+    #[test]
+    fn comments_blank_lines_and_crlf_are_accepted() {
+        let text = good_text(3).replace('\n', "\r\n");
+        let mut lines: Vec<&str> = text.split("\r\n").collect();
+        lines.insert(1, "# recorded by hand");
+        lines.insert(4, "");
+        lines.insert(5, "  # another comment");
+        let text = lines.join("\r\n");
+        assert_eq!(read_str(&text).unwrap().len(), 3);
+    }
+
+    #[test]
+    fn wrong_or_missing_version_line_is_refused() {
+        let text = good_text(1);
+        let e = read_str(&text.replacen("v1", "v2", 1)).unwrap_err();
+        assert!(
+            matches!(e, TraceError::UnsupportedVersion { line: 1, .. }),
+            "{e}"
+        );
+        assert!(e.to_string().contains("v2"));
+        let no_version: String = text.lines().skip(1).collect::<Vec<_>>().join("\n");
+        let e = read_str(&no_version).unwrap_err();
+        assert!(
+            matches!(e, TraceError::BadVersionLine { line: 1, .. }),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn wrong_column_header_names_the_column() {
+        let text = good_text(1).replacen("head_qw", "head_w", 1);
+        let e = read_str(&text).unwrap_err();
+        match &e {
+            TraceError::BadColumnHeader {
+                line: 2,
+                column: 8,
+                expected: "head_qw",
+                ..
+            } => {}
+            _ => panic!("unexpected {e}"),
+        }
+        let short = good_text(1).replacen(",fixation_z_m", "", 1);
+        let e = read_str(&short).unwrap_err();
+        assert!(
+            matches!(e, TraceError::BadColumnHeader { column: 33, .. }),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn wrong_field_count_gives_line() {
+        let mut text = good_text(3);
+        text = text.replacen("\n3000,", "\n3000,1,", 1);
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::FieldCount {
+                    line: 5,
+                    found: 34,
+                    expected: 33,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn unparseable_numbers_give_line_and_column() {
+        let text = with_field(&good_text(3), 4, 2, "1.6m");
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::BadField {
+                    line: 4,
+                    column: "head_y_m",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("test.trace:4"), "{e}");
+        let text = with_field(&good_text(3), 3, 0, "1.5");
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::BadField {
+                    line: 3,
+                    column: "time_ns",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        let text = with_field(&good_text(3), 5, LEFT, "yes");
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::BadField {
+                    line: 5,
+                    column: "left_valid",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn non_finite_head_pose_is_refused() {
+        for (col, v) in [(1, "NaN"), (3, "inf"), (7, "-inf")] {
+            let text = with_field(&good_text(3), 4, col, v);
+            let e = read_str(&text).unwrap_err();
+            assert!(matches!(e, TraceError::NonFinite { line: 4, .. }), "{e}");
+            assert_eq!(line_of(&e), Some(4));
+        }
+    }
+
+    #[test]
+    fn non_unit_quaternion_is_refused_and_drift_normalised() {
+        let text = with_field(&good_text(2), 3, 7, "2");
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(e, TraceError::NonUnitQuaternion { line: 3, .. }),
+            "{e}"
+        );
+        // (0,0,0,1.0004): small drift, normalised.
+        let text = with_field(&with_field(&good_text(2), 3, 5, "0"), 3, 7, "1.0004");
+        let samples = read_str(&text).unwrap();
+        assert!(
+            samples[0]
+                .head
+                .orientation
+                .abs_diff_eq(Quat::IDENTITY, 1e-6)
+        );
+    }
+
+    #[test]
+    fn times_must_increase() {
+        let text = with_field(&good_text(3), 5, 0, "2000");
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::TimeNotIncreasing {
+                    line: 5,
+                    time_ns: 2000,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        let text = with_field(&good_text(3), 4, 8, "2001");
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(e, TraceError::GazeAfterPose { line: 4, .. }),
+            "{e}"
+        );
+        let text = with_field(&good_text(3), 4, 8, "900");
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(e, TraceError::GazeTimeBackwards { line: 4, .. }),
+            "{e}"
+        );
+        // Equal gaze times are fine: a faster head tracker repeats the gaze sample.
+        let text = with_field(&good_text(3), 4, 8, "995");
+        assert!(read_str(&text).is_ok());
+    }
+
+    #[test]
+    fn bad_gaze_values_make_the_eye_invalid() {
+        let text = with_field(&good_text(2), 3, LEFT + 4, "NaN");
+        let s = read_str(&text).unwrap();
+        assert_eq!(s[0].gaze.left, GazeRay::INVALID);
+        assert!(s[0].gaze.right.valid);
+        let zero = with_field(
+            &with_field(
+                &with_field(&good_text(2), 3, RIGHT + 4, "0"),
+                3,
+                RIGHT + 5,
+                "0",
+            ),
+            3,
+            RIGHT + 6,
+            "0",
+        );
+        let s = read_str(&zero).unwrap();
+        assert_eq!(s[0].gaze.right, GazeRay::INVALID);
+        assert!(s[0].gaze.left.valid);
+    }
+
+    #[test]
+    fn example_in_the_format_doc_reads() {
+        let doc = include_str!("../../docs/trace-format.md");
+        let start = doc.find("```text\n").unwrap() + "```text\n".len();
+        let end = start + doc[start..].find("```").unwrap();
+        let samples = read_str(&doc[start..end]).unwrap();
+        assert_eq!(samples.len(), 3);
+        assert_eq!(samples[1].gaze.left, GazeRay::INVALID);
+        assert_eq!(
+            samples[2].gaze.sample_time_ns,
+            samples[1].gaze.sample_time_ns
+        );
+        assert_eq!(samples[2].gaze.fixation, Some(Vec3::new(0.0, 0.0, -0.6)));
+    }
+
+    #[test]
+    fn huge_finite_directions_are_normalised_not_invalid() {
+        let text = with_field(&good_text(1), 3, LEFT + 6, "-3e38");
+        let s = read_str(&text).unwrap();
+        assert!(s[0].gaze.left.valid);
+        assert!(s[0].gaze.left.direction.abs_diff_eq(Vec3::NEG_Z, 1e-6));
+    }
+
+    #[test]
+    fn directions_are_normalised_on_read() {
+        let text = with_field(&good_text(1), 3, LEFT + 6, "-10");
+        let s = read_str(&text).unwrap();
+        assert!((s[0].gaze.left.direction.length() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn partial_optional_group_is_refused() {
+        let text = with_field(&good_text(2), 4, FIXATION, "0.5");
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::PartialGroup {
+                    line: 4,
+                    group: "fixation",
+                    column: "fixation_y_m",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        let text = with_field(&good_text(2), 4, COMBINED + 1, "0.5");
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::PartialGroup {
+                    line: 4,
+                    group: "combined",
+                    column: "combined_valid",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn reader_stops_after_first_error() {
+        let text = with_field(&good_text(3), 4, 1, "x");
+        let mut r = TraceReader::new(text.as_bytes(), "t").unwrap();
+        assert!(r.next().unwrap().is_ok());
+        assert!(r.next().unwrap().is_err());
+        assert!(r.next().is_none());
+    }
+
+    #[test]
+    fn writer_refuses_what_reader_would() {
+        let mut w = TraceWriter::new(Vec::new()).unwrap();
+        w.write(&sample(100)).unwrap();
+        let e = w.write(&sample(100)).unwrap_err();
+        assert!(
+            matches!(e, TraceError::TimeNotIncreasing { line: 4, .. }),
+            "{e}"
+        );
+        let mut bad = sample(200);
+        bad.head.position.x = f32::NAN;
+        assert!(matches!(w.write(&bad), Err(TraceError::NonFinite { .. })));
+        w.write(&sample(200)).unwrap();
+    }
+
+    fn arb_vec3(range: f32) -> impl Strategy<Value = Vec3> {
+        (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+    }
+
+    fn arb_ray() -> impl Strategy<Value = GazeRay> {
+        (any::<bool>(), arb_vec3(0.1), arb_vec3(1.0)).prop_map(|(valid, o, d)| {
+            clean_ray(GazeRay {
+                origin: o,
+                direction: d,
+                valid,
+            })
+        })
+    }
+
+    fn arb_sample() -> impl Strategy<Value = (i64, i64, TraceSample)> {
+        (
+            1i64..1_000_000_000,
+            0i64..1_000_000,
+            arb_vec3(100.0),
+            arb_vec3(1.0),
+            -3.0f32..3.0,
+            (arb_ray(), arb_ray(), proptest::option::of(arb_ray())),
+            proptest::option::of(arb_vec3(10.0)),
+        )
+            .prop_map(
+                |(dt, lag, position, axis, angle, (left, right, combined), fixation)| {
+                    let axis = axis.try_normalize().unwrap_or(Vec3::Y);
+                    let sample = TraceSample {
+                        time_ns: 0,
+                        head: Pose {
+                            position,
+                            orientation: Quat::from_axis_angle(axis, angle),
+                        },
+                        gaze: GazeSample {
+                            sample_time_ns: 0,
+                            left,
+                            right,
+                            combined,
+                            fixation,
+                        },
+                    };
+                    (dt, lag, sample)
+                },
+            )
+    }
+
+    proptest! {
+        #[test]
+        fn random_traces_round_trip(raw in proptest::collection::vec(arb_sample(), 0..20)) {
+            let mut time_ns = -5_000_000_000i64;
+            let mut gaze_ns = i64::MIN;
+            let mut samples = Vec::new();
+            for (dt, lag, mut s) in raw {
+                time_ns += dt;
+                gaze_ns = gaze_ns.max(time_ns - lag);
+                s.time_ns = time_ns;
+                s.gaze.sample_time_ns = gaze_ns;
+                s.head.orientation = unit_quat(s.head.orientation);
+                samples.push(s);
+            }
+            let text = to_text(&samples);
+            prop_assert_eq!(read_str(&text).unwrap(), samples);
+        }
+    }
+}

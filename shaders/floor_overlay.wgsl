@@ -3,7 +3,7 @@
 // carries the shadow inducer's light L_s = k alpha(d) L_r. What the wearer then sees on the
 // floor is L_o = L_r + L_s = (1 + k alpha(d)) L_r (eq. 5); the shadow keeps L_r.
 //
-// Only the rectangle around the shadow plus the ramp's width is drawn (computed on the CPU),
+// Only the rectangle around the shadow plus the ramp's width (and the caustics' extent) is drawn (computed on the CPU),
 // and texels with no inducer light are discarded before the photo is read: at most two
 // texture fetches per covered pixel (the precomputed gain, the floor photo).
 
@@ -14,7 +14,8 @@ struct Overlay {
 };
 
 var<push_constant> overlay: Overlay;
-// k alpha(d) over the floor's unit square (fs_ramp of inducer_field.wgsl).
+// k alpha(d) + G over the floor's unit square, each term as switched on (fs_combine of
+// inducer_field.wgsl).
 @group(0) @binding(0) var gain: texture_2d<f32>;
 // The registered photo of the real floor: L_r, decoded to linear light by the sRGB format.
 @group(0) @binding(1) var floor_photo: texture_2d<f32>;
@@ -42,11 +43,11 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VertexOut {
 
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    let k_alpha = textureSampleLevel(gain, clamp_sampler, in.uv, 0.0).r;
-    if k_alpha <= 0.0 {
+    let overlay_gain = textureSampleLevel(gain, clamp_sampler, in.uv, 0.0).r;
+    if overlay_gain <= 0.0 {
         discard;
     }
     let l_r = textureSampleLevel(floor_photo, clamp_sampler, in.uv, 0.0).rgb;
-    // eq. 3: L_s = alpha'(d) L_r.
-    return vec4<f32>(k_alpha * l_r, 0.0);
+    // eq. 3 and 6: L_s + L'_c = (alpha'(d) + G) L_r.
+    return vec4<f32>(overlay_gain * l_r, 0.0);
 }

@@ -7,7 +7,10 @@
 //    away, the one nearest in metres.
 // 3. fs_distance: d, the distance from a lit texel to the shadow edge in metres; -1 inside
 //    the shadow.
-// 4. fs_ramp: k alpha(d) (eq. 2 and 4), what the floor overlay multiplies the floor photo by.
+// 4. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain.
+// 5. fs_combine (caustics, eq. 6): the floor overlay's gain at the caustic map's resolution,
+//    k alpha(d) (if the inducer is on) + G (if the caustics are on), what the floor overlay
+//    multiplies the floor photo by. Rerun when those switches change.
 //
 // Every fetch is a textureLoad of one texel: no filtering, no sampler.
 
@@ -22,13 +25,14 @@ struct Field {
     ramp_width_m: f32,
     // k of eq. 4.
     k: f32,
-    pad: vec2<f32>,
+    // fs_combine: weights of the inducer's gain and of the caustic gain G (1 on, 0 off).
+    switches: vec2<f32>,
 };
 
 var<push_constant> field: Field;
 // The pass's input: the mask (fs_seed), seeds (fs_jump, fs_distance) or distances (fs_ramp).
 @group(0) @binding(0) var source: texture_2d<f32>;
-// The shadow mask, for fs_distance.
+// The shadow mask, for fs_distance; the caustic gain G (R32F), for fs_combine.
 @group(0) @binding(1) var shadow_mask: texture_2d<f32>;
 
 // Coordinate of "no seed found yet": far from every texel, so any real seed is nearer.
@@ -116,4 +120,36 @@ fn fs_ramp(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let d_m = textureLoad(source, vec2<i32>(frag.xy), 0).r;
     // eq. 4: alpha'(d) = k alpha(d).
     return vec4<f32>(field.k * ramp(d_m, field.ramp_width_m), 0.0, 0.0, 0.0);
+}
+
+// k alpha(d) at floor uv (0..1, v down), bilinear between texel centres and clamped at the
+// edges like the overlay's sampler (four loads: this pass runs once per switch change).
+fn inducer_gain_bilinear(uv: vec2<f32>) -> f32 {
+    let n = field.size;
+    let t = uv * f32(n) - 0.5;
+    let base = floor(t);
+    let f = t - base;
+    let b = vec2<i32>(base);
+    let hi = vec2<i32>(n - 1);
+    let g00 = textureLoad(source, clamp(b, vec2<i32>(0), hi), 0).r;
+    let g10 = textureLoad(source, clamp(b + vec2<i32>(1, 0), vec2<i32>(0), hi), 0).r;
+    let g01 = textureLoad(source, clamp(b + vec2<i32>(0, 1), vec2<i32>(0), hi), 0).r;
+    let g11 = textureLoad(source, clamp(b + vec2<i32>(1, 1), vec2<i32>(0), hi), 0).r;
+    return mix(mix(g00, g10, f.x), mix(g01, g11, f.x), f.y);
+}
+
+@fragment
+fn fs_combine(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    // The target has the caustic map's size, texel for texel.
+    let p = vec2<i32>(frag.xy);
+    let uv = frag.xy / vec2<f32>(textureDimensions(shadow_mask));
+    var gain = 0.0;
+    if field.switches.x > 0.0 {
+        gain += field.switches.x * inducer_gain_bilinear(uv);
+    }
+    if field.switches.y > 0.0 {
+        // eq. 6: L'_c = max(0, L_c - L_r) = G L_r; G >= 0 is checked on loading.
+        gain += field.switches.y * textureLoad(shadow_mask, p, 0).r;
+    }
+    return vec4<f32>(gain, 0.0, 0.0, 0.0);
 }

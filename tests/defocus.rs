@@ -16,9 +16,9 @@ use vitreous::views;
 use vitreous_render::reference::{RefractionSample, refraction_sample};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, Defocus, GpuContext, Look, Reflection, Renderer};
+use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::synth::{GazeTarget, synthesize_with_truth};
-use vitreous_xr::FrameInput;
 
 const W: u32 = 320;
 const H: u32 = 240;
@@ -40,7 +40,11 @@ fn black(width: u32, height: u32, linear: bool) -> Image {
 
 fn srgb_to_linear(b: u8) -> f32 {
     let c = b as f32 / 255.0;
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// Renders one stereo frame of `scene` with `look`; returns the eye images.
@@ -68,7 +72,9 @@ fn render(scene: &Scene, setup: &DefocusSetup, input: &FrameInput, look: Look) -
 
 /// The first frame of the scene's synthetic trace at the test's size.
 fn first_frame(scene: &Scene) -> FrameInput {
-    let samples = synthesize_with_truth(&synth_params_for(scene)).unwrap().samples;
+    let samples = synthesize_with_truth(&synth_params_for(scene))
+        .unwrap()
+        .samples;
     let mut backend = NullBackend::new(
         samples,
         NullConfig {
@@ -112,10 +118,15 @@ fn refracted_blur_matches_the_literal_convolution() {
             }),
             reflection: Reflection::EnvironmentFresnel,
             inducer: false,
+            caustics: false,
         };
         let gpu = render(&scene, &setup, &input, look);
         let blurred = blur_reference(&grey, pw, ph, k_g);
-        let sharp_vs_blurred: f32 = grey.iter().zip(&blurred).map(|(a, b)| (a - b).abs()).sum::<f32>()
+        let sharp_vs_blurred: f32 = grey
+            .iter()
+            .zip(&blurred)
+            .map(|(a, b)| (a - b).abs())
+            .sum::<f32>()
             / grey.len() as f32;
         let sphere = vitreous::reference_view::sphere_of(&scene);
         let size = Vec2::new(W as f32, H as f32);
@@ -124,8 +135,10 @@ fn refracted_blur_matches_the_literal_convolution() {
         for y in 0..H {
             for x in 0..W {
                 let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                let RefractionSample::Hit { uv: Some(uv), transmission } =
-                    refraction_sample(&camera, p, size, &sphere)
+                let RefractionSample::Hit {
+                    uv: Some(uv),
+                    transmission,
+                } = refraction_sample(&camera, p, size, &sphere)
                 else {
                     continue;
                 };
@@ -259,7 +272,11 @@ fn sharpness_by_gaze(scene: &Scene) -> Vec<(GazeImage, f64)> {
 }
 
 fn mean_of(values: &[(GazeImage, f64)], image: GazeImage) -> f64 {
-    let v: Vec<f64> = values.iter().filter(|(i, _)| *i == image).map(|(_, s)| *s).collect();
+    let v: Vec<f64> = values
+        .iter()
+        .filter(|(i, _)| *i == image)
+        .map(|(_, s)| *s)
+        .collect();
     assert!(!v.is_empty(), "no frame with the gaze on {image:?}");
     v.iter().sum::<f64>() / v.len() as f64
 }
@@ -271,16 +288,31 @@ fn blur_follows_the_gaze_on_the_synthetic_trace() {
     refracted_only.object.surface_texture = None;
     refracted_only.environment.latlong = black(8, 4, true);
     let s = sharpness_by_gaze(&refracted_only);
-    let (on, off) = (mean_of(&s, GazeImage::Refracted), mean_of(&s, GazeImage::Surface));
-    assert!(on > 1.5 * off, "refracted image: sharpness {on} looked at vs {off} not");
+    let (on, off) = (
+        mean_of(&s, GazeImage::Refracted),
+        mean_of(&s, GazeImage::Surface),
+    );
+    assert!(
+        on > 1.5 * off,
+        "refracted image: sharpness {on} looked at vs {off} not"
+    );
 
     // The surface image alone (black background and environment): sharper while looked at.
     let mut surface_only = scene();
-    let (bw, bh) = (surface_only.background.photo.width, surface_only.background.photo.height);
+    let (bw, bh) = (
+        surface_only.background.photo.width,
+        surface_only.background.photo.height,
+    );
     surface_only.background.photo = black(bw, bh, false);
     surface_only.environment.latlong = black(8, 4, true);
     surface_only.object.surface_transmittance = 0.0;
     let s = sharpness_by_gaze(&surface_only);
-    let (on, off) = (mean_of(&s, GazeImage::Surface), mean_of(&s, GazeImage::Refracted));
-    assert!(on > 1.5 * off, "surface image: sharpness {on} looked at vs {off} not");
+    let (on, off) = (
+        mean_of(&s, GazeImage::Surface),
+        mean_of(&s, GazeImage::Refracted),
+    );
+    assert!(
+        on > 1.5 * off,
+        "surface image: sharpness {on} looked at vs {off} not"
+    );
 }

@@ -155,6 +155,7 @@ fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
         background_stack: None,
         surface_stack: None,
         inducer: vitreous_render::InducerDesc::PAPER,
+        caustics: None,
     };
     let mut renderer = Renderer::new(ctx, &scene, W, H).expect("renderer");
     let params = FrameParams { eyes: eyes(), look };
@@ -249,12 +250,14 @@ const DISPARITY: Look = Look {
     defocus: None,
     reflection: Reflection::EnvironmentFresnel,
     inducer: false,
+    caustics: false,
 };
 const BASELINE: Look = Look {
     disparity: false,
     defocus: None,
     reflection: Reflection::EnvironmentFresnel,
     inducer: false,
+    caustics: false,
 };
 
 #[test]

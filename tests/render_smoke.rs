@@ -59,6 +59,7 @@ fn sphere_centroid_matches_projection_in_both_eyes_with_validation_silent() {
         background_stack: None,
         surface_stack: None,
         inducer: vitreous_render::InducerDesc::PAPER,
+        caustics: None,
     };
     let (w, h) = (320u32, 240u32);
     let mut renderer = Renderer::new(ctx, &scene, w, h).expect("renderer");

@@ -100,16 +100,25 @@ pub fn fetches_per_pixel(look: &Look) -> u32 {
 
 /// Runs the benchmark.
 pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
-    let scene = load_scene(&options.scene)?;
+    let mut scene = load_scene(&options.scene)?;
     for set in &options.effects {
         set.ensure_implemented()?;
+    }
+    if options.effects.iter().any(|set| set.caustics) {
+        scene.load_caustics()?;
     }
     check_size(options.size.0, options.size.1)?;
     if options.frames == 0 {
         bail!("--frames must be at least 1");
     }
     let mut sets = vec![EffectSet::NONE];
-    sets.extend(options.effects.iter().copied().filter(|e| *e != EffectSet::NONE));
+    sets.extend(
+        options
+            .effects
+            .iter()
+            .copied()
+            .filter(|e| *e != EffectSet::NONE),
+    );
     let any_defocus = sets.iter().any(|e| e.defocus);
     let setup = any_defocus.then(|| DefocusSetup::new(&scene, scene.viewer.pupil_diameter_m));
     let pupils_m: Vec<f32> = if options.pupils_mm.is_empty() {

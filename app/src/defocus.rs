@@ -11,7 +11,8 @@ use vitreous_render::{Defocus, Look};
 use vitreous_xr::FrameInput;
 
 use crate::gaze::defocus::{PUPIL_MAX_MM, blur_circle_diameter_m, gaussian_kernel, image_blur};
-use crate::gaze::{GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances};
+use crate::gaze::{GazeConfig, GazeImage, GazeOverride, GazePipeline, GazeState, ImageDistances};
+use crate::output::{linear_to_srgb, srgb_to_linear};
 use crate::scene::{Image, PixelData, Scene};
 
 /// Slices of each blur stack (K_g = 0 included).
@@ -153,6 +154,21 @@ impl LookPlanner {
         }
     }
 
+    /// Forces the gaze image (or lets the tracker choose again) from now on; no effect
+    /// without defocus. The gaze pipeline keeps its tracking state.
+    pub fn set_gaze_override(&mut self, image: GazeOverride) {
+        if let Some((pipeline, _)) = &mut self.defocus {
+            pipeline.set_override(image);
+        }
+    }
+
+    /// The forced gaze image; `None` without defocus.
+    pub fn gaze_override(&self) -> Option<GazeOverride> {
+        self.defocus
+            .as_ref()
+            .map(|(pipeline, _)| pipeline.config().override_image)
+    }
+
     /// The look of a frame, and the gaze state behind its defocus (when defocus is on).
     pub fn plan(&mut self, input: &FrameInput) -> (Look, Option<GazeState>) {
         match &mut self.defocus {
@@ -202,24 +218,26 @@ pub fn blur_separable(rgba: &[f32], width: usize, height: usize, k_g_px: f32) ->
     let w1 = &kernel.weights_1d;
     let pass = |src: &[f32], horizontal: bool| -> Vec<f32> {
         let mut out = vec![0.0f32; src.len()];
-        out.par_chunks_mut(width * 4).enumerate().for_each(|(y, row)| {
-            for x in 0..width {
-                let mut acc = [0.0f32; 4];
-                for (k, wk) in w1.iter().enumerate() {
-                    let o = k as isize - r;
-                    let (sx, sy) = if horizontal {
-                        ((x as isize + o).clamp(0, width as isize - 1) as usize, y)
-                    } else {
-                        (x, (y as isize + o).clamp(0, height as isize - 1) as usize)
-                    };
-                    let i = (sy * width + sx) * 4;
-                    for c in 0..4 {
-                        acc[c] += wk * src[i + c];
+        out.par_chunks_mut(width * 4)
+            .enumerate()
+            .for_each(|(y, row)| {
+                for x in 0..width {
+                    let mut acc = [0.0f32; 4];
+                    for (k, wk) in w1.iter().enumerate() {
+                        let o = k as isize - r;
+                        let (sx, sy) = if horizontal {
+                            ((x as isize + o).clamp(0, width as isize - 1) as usize, y)
+                        } else {
+                            (x, (y as isize + o).clamp(0, height as isize - 1) as usize)
+                        };
+                        let i = (sy * width + sx) * 4;
+                        for c in 0..4 {
+                            acc[c] += wk * src[i + c];
+                        }
                     }
+                    row[x * 4..x * 4 + 4].copy_from_slice(&acc);
                 }
-                row[x * 4..x * 4 + 4].copy_from_slice(&acc);
-            }
-        });
+            });
         out
     };
     let horizontal = pass(rgba, true);
@@ -244,28 +262,6 @@ pub fn to_linear(image: &Image) -> Vec<f32> {
     }
 }
 
-fn srgb_to_linear(v: u8) -> f32 {
-    let c = f32::from(v) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Linear light (clamped to 0..1) to an sRGB byte; alpha passes through this too, which is
-/// harmless for the opaque textures used.
-fn linear_to_srgb(l: f32) -> u8 {
-    let l = l.clamp(0.0, 1.0);
-    let c = if l <= 0.003_130_8 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (c * 255.0 + 0.5) as u8
-}
-
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -274,7 +270,9 @@ mod tests {
     #[test]
     fn separable_blur_equals_the_literal_convolution() {
         let (w, h) = (23usize, 17usize);
-        let gray: Vec<f32> = (0..w * h).map(|i| ((i * 7919) % 97) as f32 / 97.0).collect();
+        let gray: Vec<f32> = (0..w * h)
+            .map(|i| ((i * 7919) % 97) as f32 / 97.0)
+            .collect();
         let rgba: Vec<f32> = gray.iter().flat_map(|&g| [g, g, g, 1.0]).collect();
         for k_g in [0.0, 1.5, 3.0, 7.2] {
             let fast = blur_separable(&rgba, w, h, k_g);

@@ -95,7 +95,7 @@ impl EffectSet {
         disparity: true,
         defocus: true,
         inducer: true,
-        caustics: false,
+        caustics: true,
     };
 
     /// Parses a comma-separated, case-insensitive list of names: `none`, `disparity`,

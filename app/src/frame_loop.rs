@@ -73,8 +73,15 @@ pub fn run<B: Backend>(
             FrameTarget::Own => renderer.submit(&params, plan.want),
             FrameTarget::Swapchain {
                 index,
+                depth_index,
                 world_behind,
-            } => renderer.submit_external(index as usize, &params, plan.want, world_behind),
+            } => renderer.submit_external_with_depth(
+                index as usize,
+                depth_index.map(|d| d as usize),
+                &params,
+                plan.want,
+                world_behind,
+            ),
         }
         .context("rendering a frame")?;
         backend.end_frame(&input).context("ending a frame")?;

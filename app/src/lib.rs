@@ -5,6 +5,7 @@
 //! the trace format in `vitreous-xr`.
 
 pub mod bench;
+pub mod caustics;
 pub mod defocus;
 pub mod effects;
 pub mod frame_loop;

@@ -106,12 +106,13 @@ enum Command {
         #[arg(long)]
         reference: bool,
         /// Gaze image: auto (from the wearer's fixation depth), or forced to surface or
-        /// refracted, as the paper's experimenter did.
-        #[arg(long, value_name = "IMAGE", default_value = "auto")]
-        gaze_image: GazeOverride,
-        /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, ...
-        #[arg(long, value_name = "FILTER", default_value = "mean20")]
-        filter: FilterKind,
+        /// refracted, as the paper's experimenter did; default: the scene's `[gaze] image`.
+        #[arg(long, value_name = "IMAGE")]
+        gaze_image: Option<GazeOverride>,
+        /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, ...; default: the
+        /// scene's `[gaze] filter`.
+        #[arg(long, value_name = "FILTER")]
+        filter: Option<FilterKind>,
         /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
         #[arg(long = "pupil-mm", value_name = "MM")]
         pupil_mm: Option<f32>,
@@ -392,9 +393,8 @@ fn run(cli: Cli) -> Result<()> {
                 summary.cpu_ms.map_or(f64::NAN, |s| s.median_ms),
             );
             println!(
-                "wrote {} images and {} to {}",
+                "wrote {} images and summary.json to {}",
                 summary.saved.len(),
-                "summary.json",
                 out.display()
             );
             Ok(())

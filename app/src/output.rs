@@ -47,7 +47,7 @@ pub fn encode_png(rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
 }
 
 /// sRGB-encoded byte to linear light.
-fn srgb_to_linear(v: u8) -> f32 {
+pub fn srgb_to_linear(v: u8) -> f32 {
     let c = f32::from(v) / 255.0;
     if c <= 0.04045 {
         c / 12.92
@@ -57,7 +57,7 @@ fn srgb_to_linear(v: u8) -> f32 {
 }
 
 /// Linear light (clamped to 0..1) to an sRGB-encoded byte.
-fn linear_to_srgb(l: f32) -> u8 {
+pub fn linear_to_srgb(l: f32) -> u8 {
     let l = l.clamp(0.0, 1.0);
     let c = if l <= 0.003_130_8 {
         l * 12.92

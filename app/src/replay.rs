@@ -16,9 +16,9 @@ use vitreous_xr::trace::{TraceSample, read_trace};
 
 use crate::defocus::{DefocusSetup, LookPlanner};
 use crate::effects::EffectSet;
+use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
 use crate::gaze::defocus::check_pupil_diameter_m;
 use crate::gaze::{FilterKind, GazeConfig, GazeOverride};
-use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
 use crate::output::{self, write_atomic};
 use crate::reference_view::side_by_side;
 use crate::scene::{Scene, load_scene};
@@ -58,13 +58,13 @@ pub struct ReplayOptions {
     pub gaze: GazeSettings,
 }
 
-/// How the gaze pipeline runs (METHOD.md section 5).
+/// How the gaze pipeline runs (METHOD.md section 5); `None` keeps the scene's choice.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct GazeSettings {
-    /// Depth filter (eq. 15's 20-sample mean by default).
-    pub filter: FilterKind,
-    /// Experimenter override of the gaze image.
-    pub image: GazeOverride,
+    /// Depth filter overriding the scene's `[gaze] filter`.
+    pub filter: Option<FilterKind>,
+    /// Experimenter override of the gaze image, overriding the scene's `[gaze] image`.
+    pub image: Option<GazeOverride>,
     /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
     pub pupil_mm: Option<f32>,
 }
@@ -77,20 +77,44 @@ pub fn planner_for(
     reflection: Reflection,
     gaze: &GazeSettings,
 ) -> Result<(LookPlanner, Option<DefocusSetup>)> {
-    let base = views::look(effects, reflection);
-    if !effects.defocus {
-        return Ok((LookPlanner::new(base, None), None));
-    }
-    let pupil_m = match gaze.pupil_mm {
-        Some(mm) => check_pupil_diameter_m(mm / 1000.0)?,
-        None => scene.viewer.pupil_diameter_m,
+    let (mut planners, setup) = planners_for(scene, &[*effects], reflection, gaze)?;
+    Ok((planners.remove(0), setup))
+}
+
+/// One look planner per effect set in `sets` (in that order), sharing one defocus setup (blur
+/// stacks), built when any of the sets has defocus on.
+pub fn planners_for(
+    scene: &Scene,
+    sets: &[EffectSet],
+    reflection: Reflection,
+    gaze: &GazeSettings,
+) -> Result<(Vec<LookPlanner>, Option<DefocusSetup>)> {
+    let setup = if sets.iter().any(|e| e.defocus) {
+        let pupil_m = match gaze.pupil_mm {
+            Some(mm) => check_pupil_diameter_m(mm / 1000.0)?,
+            None => scene.viewer.pupil_diameter_m,
+        };
+        Some(DefocusSetup::new(scene, pupil_m))
+    } else {
+        None
     };
-    let setup = DefocusSetup::new(scene, pupil_m);
-    let mut config = GazeConfig::new(setup.model.distances);
-    config.filter = gaze.filter;
-    config.override_image = gaze.image;
-    let planner = LookPlanner::new(base, Some((config, setup.model)));
-    Ok((planner, Some(setup)))
+    let planners = sets
+        .iter()
+        .map(|effects| {
+            let base = views::look(effects, reflection);
+            let defocus = match (&setup, effects.defocus) {
+                (Some(setup), true) => {
+                    let mut config = GazeConfig::new(setup.model.distances);
+                    config.filter = gaze.filter.unwrap_or(scene.gaze.filter);
+                    config.override_image = gaze.image.unwrap_or(scene.gaze.image);
+                    Some((config, setup.model))
+                }
+                _ => None,
+            };
+            LookPlanner::new(base, defocus)
+        })
+        .collect();
+    Ok((planners, setup))
 }
 
 /// Median and spread of a timing.
@@ -246,9 +270,12 @@ fn load_trace(scene: &Scene, trace: Option<&Path>) -> Result<(Vec<TraceSample>, 
 
 /// Runs a replay. All input is checked before anything is written.
 pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
-    let scene = load_scene(&options.scene)?;
+    let mut scene = load_scene(&options.scene)?;
     let effects = options.effects.unwrap_or(scene.effects);
     effects.ensure_implemented()?;
+    if effects.caustics {
+        scene.load_caustics()?;
+    }
     let (width, height) = options
         .size
         .unwrap_or((scene.output.width_px, scene.output.height_px));
@@ -279,8 +306,13 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     .context("setting up the Vulkan device")?;
     let (device, driver) = (ctx.device_name.clone(), ctx.driver.clone());
     let (planner, defocus) = planner_for(&scene, &effects, options.reflection, &options.gaze)?;
-    let mut renderer = Renderer::new(ctx, &views::scene_desc(&scene, defocus.as_ref()), width, height)
-        .context("preparing the renderer")?;
+    let mut renderer = Renderer::new(
+        ctx,
+        &views::scene_desc(&scene, defocus.as_ref()),
+        width,
+        height,
+    )
+    .context("preparing the renderer")?;
     drop(defocus);
 
     let frames_dir = options.out.join("frames");

@@ -28,11 +28,11 @@ use vitreous_xr::openxr::{
 use vitreous_xr::trace::{TraceSample, TraceWriter, read_trace};
 use vitreous_xr::{Backend, FrameInput, GazeRay, GazeSample, Pose};
 
-use crate::effects::EffectSet;
 use crate::defocus::LookPlanner;
+use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
-use crate::replay::{GazeSettings, planner_for};
 use crate::output::write_atomic;
+use crate::replay::{GazeSettings, planner_for};
 use crate::replay::{Spread, ValidationSummary};
 use crate::scene::{Scene, load_scene};
 use crate::views;
@@ -361,9 +361,12 @@ fn trace_sample(input: &FrameInput) -> TraceSample {
 /// Runs the scene on the OpenXR runtime. Fails with a clear message when there is no runtime,
 /// no Vulkan support, a validation message, or a failed readback check.
 pub fn run(options: &RunOptions) -> Result<RunSummary> {
-    let scene = load_scene(&options.scene)?;
+    let mut scene = load_scene(&options.scene)?;
     let effects = options.effects.unwrap_or(scene.effects);
     effects.ensure_implemented()?;
+    if effects.caustics {
+        scene.load_caustics()?;
+    }
     let mut runtime = Runtime::new(&OpenXrOptions {
         blend: options.blend,
         validation: options.validate,
@@ -405,8 +408,13 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         options.reflection,
         &GazeSettings::default(),
     )?;
-    let mut renderer = Renderer::new(ctx, &views::scene_desc(&scene, defocus.as_ref()), width, height)
-        .context("preparing the renderer")?;
+    let mut renderer = Renderer::new(
+        ctx,
+        &views::scene_desc(&scene, defocus.as_ref()),
+        width,
+        height,
+    )
+    .context("preparing the renderer")?;
     drop(defocus);
     let (mut session, images) = unsafe {
         runtime.start(

@@ -3,8 +3,8 @@
 
 use vitreous_render::camera::{EyeParams, Fov as RenderFov};
 use vitreous_render::{
-    FrameParams, InducerDesc, LightDesc, Look, MeshRef, PlaneDesc, Reflection, SceneDesc,
-    TexelData, TextureDesc,
+    CausticsDesc, FrameParams, InducerDesc, LightDesc, Look, MeshRef, PlaneDesc, Reflection,
+    SceneDesc, TexelData, TextureDesc,
 };
 use vitreous_xr::{EyeView, Fov, FrameInput};
 
@@ -58,6 +58,7 @@ pub fn look(effects: &EffectSet, reflection: Reflection) -> Look {
             Reflection::EnvironmentFresnel
         },
         inducer: effects.inducer,
+        caustics: effects.caustics,
     }
 }
 
@@ -108,5 +109,11 @@ pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> Sc
             ramp_width_m: scene.inducer.ramp_width_m,
             resolution_px: scene.inducer.resolution_px,
         },
+        // Present once `Scene::load_caustics` has read the bake.
+        caustics: scene.caustics.gain.as_ref().map(|bake| CausticsDesc {
+            width: bake.width_px,
+            height: bake.height_px,
+            gain: &bake.gain,
+        }),
     }
 }

@@ -190,18 +190,31 @@ fn unknown_and_unimplemented_effects_are_refused() {
         dir.path(),
     );
     assert_clean_failure(&out, &["sparkle"]);
+    // Every effect is implemented; the caustics need the scene's bake. A scene naming none
+    // (torus.toml) and one naming a missing file are refused with the file named, and
+    // nothing is written.
     let out = vitreous(
         &[
             "replay",
-            &scene("glass-sphere.toml"),
+            &scene("torus.toml"),
             "--effects",
-            "O5",
+            "caustics",
             "--quiet",
         ],
         dir.path(),
     );
-    let message = assert_clean_failure(&out, &["caustics"]);
-    assert!(message.contains("not implemented"), "{message}");
+    assert_clean_failure(&out, &["torus.toml", "caustics bake"]);
+    let config = workspace().join("config").display().to_string();
+    let text = std::fs::read_to_string(scene("glass-sphere.toml"))
+        .unwrap()
+        .replace("\"../", &format!("\"{config}/"))
+        .replace("bakes/glass-sphere.exr", "bakes/no-such-bake.exr");
+    let missing = write(dir.path(), "sphere.toml", &text);
+    let out = vitreous(
+        &["replay", &missing, "--effects", "b", "--quiet"],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["no-such-bake.exr", "vitreous-caustics -- bake"]);
     assert!(!dir.path().join("out").exists());
 }
 

@@ -108,6 +108,9 @@ pub struct Look {
     pub reflection: Reflection,
     /// Add the shadow inducer's floor overlay (eq. 1-5, render/src/inducer.rs).
     pub inducer: bool,
+    /// Add the corrected caustics G L_r (eq. 6) to the floor overlay; needs the scene's
+    /// caustic gain map ([`crate::SceneDesc::caustics`]), draws nothing without one.
+    pub caustics: bool,
 }
 
 /// Everything the renderer needs to draw one stereo frame.

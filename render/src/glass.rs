@@ -241,7 +241,14 @@ impl GlassPass {
             .buffer_info(&buffer_info)];
         unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
         pipeline::write_texture(ctx, set, 1, 2, scene.environment.view, scene.env_sampler);
-        pipeline::write_texture(ctx, set, 3, 4, scene.background_stack.view, scene.photo_sampler);
+        pipeline::write_texture(
+            ctx,
+            set,
+            3,
+            4,
+            scene.background_stack.view,
+            scene.photo_sampler,
+        );
         pipeline::write_image(ctx, set, 5, scene.surface.view);
         Ok(GlassPass {
             set_layout,

@@ -38,7 +38,7 @@
 //! frames' overlay reads.
 
 use std::ffi::CStr;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3, Vec4};
@@ -47,8 +47,8 @@ use gpu_allocator::MemoryLocation;
 use crate::camera::EyeParams;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
-use crate::memory::{Buffer, Image, subresource_range};
-use crate::scene::{GpuScene, InducerDesc, SceneDesc, VERTEX_STRIDE};
+use crate::memory::{Buffer, Image, subresource_range, upload_texture};
+use crate::scene::{CausticsDesc, GpuScene, InducerDesc, SceneDesc, VERTEX_STRIDE};
 use crate::shaders;
 
 /// SPIR-V of one entry point of a shader in `shaders/`, compiled by build.rs.
@@ -65,6 +65,7 @@ const SEED_FS: &[u8] = spirv!("inducer_field.fs_seed");
 const JUMP_FS: &[u8] = spirv!("inducer_field.fs_jump");
 const DISTANCE_FS: &[u8] = spirv!("inducer_field.fs_distance");
 const RAMP_FS: &[u8] = spirv!("inducer_field.fs_ramp");
+const COMBINE_FS: &[u8] = spirv!("inducer_field.fs_combine"); // caustics (issue 6)
 const OVERLAY_VS: &[u8] = spirv!("floor_overlay.vs_main");
 const OVERLAY_FS: &[u8] = spirv!("floor_overlay.fs_main");
 
@@ -328,7 +329,8 @@ struct FieldPush {
     size: i32,
     ramp_width_m: f32,
     k: f32,
-    pad: [f32; 2],
+    /// fs_combine: weights of k alpha(d) and of the caustic gain G (1 on, 0 off).
+    switches: [f32; 2],
 }
 
 /// Push constants of the overlay, as `Overlay` in shaders/floor_overlay.wgsl.
@@ -345,14 +347,18 @@ const SEEDS_A: usize = 1;
 const SEEDS_B: usize = 2;
 const DISTANCE: usize = 3;
 const GAIN: usize = 4;
+/// The overlay's gain, k alpha(d) + G as switched on, at the caustic map's resolution
+/// (caustics, issue 6).
+const OVERLAY: usize = 5;
 
 /// Format of each floor-space image, in the order of the indices above.
-const FORMATS: [vk::Format; 5] = [
+const FORMATS: [vk::Format; 6] = [
     vk::Format::R8_UNORM,
     vk::Format::R32G32_SFLOAT,
     vk::Format::R32G32_SFLOAT,
     vk::Format::R32_SFLOAT,
     // Half floats filter linearly on every device: the overlay samples it bilinearly.
+    vk::Format::R16_SFLOAT,
     vk::Format::R16_SFLOAT,
 ];
 
@@ -361,6 +367,82 @@ const SEED: usize = 0;
 const JUMP: usize = 1;
 const DIST: usize = 2;
 const RAMP: usize = 3;
+const COMBINE: usize = 4;
+
+/// Largest caustic gain accepted (the overlay's gain is stored as a half float).
+pub const MAX_CAUSTIC_GAIN: f32 = 60000.0;
+
+/// Checks a caustic gain map; `max_image_px` is the device's largest 2-D image side.
+pub fn validate_caustics(desc: &CausticsDesc, max_image_px: u32) -> Result<()> {
+    let (w, h) = (desc.width, desc.height);
+    if w == 0 || h == 0 || w > max_image_px || h > max_image_px {
+        return Err(RenderError::InvalidInput(format!(
+            "the caustic gain map is {w}x{h} texels; this device takes 1..={max_image_px} per side"
+        )));
+    }
+    if desc.gain.len() != w as usize * h as usize {
+        return Err(RenderError::InvalidInput(format!(
+            "the caustic gain map has {} values for {w}x{h} texels",
+            desc.gain.len()
+        )));
+    }
+    if let Some(bad) = desc
+        .gain
+        .iter()
+        .find(|g| !(g.is_finite() && (0.0..=MAX_CAUSTIC_GAIN).contains(*g)))
+    {
+        return Err(RenderError::InvalidInput(format!(
+            "caustic gains must be finite and within 0..={MAX_CAUSTIC_GAIN}, found {bad}"
+        )));
+    }
+    Ok(())
+}
+
+/// The plane-local rectangle (min x, min y, max x, max y) holding every non-zero texel of a
+/// `width` x `height` caustic gain map (row 0 at plane-local +y), grown by one texel for the
+/// bilinear footprint and clamped to the unit square; `None` when every gain is 0.
+pub fn caustic_rect(width: u32, height: u32, gain: &[f32]) -> Option<[f32; 4]> {
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for (i, &g) in gain.iter().enumerate() {
+        if g > 0.0 {
+            let (x, y) = (i as u32 % width, i as u32 / width);
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    if x0 == u32::MAX {
+        return None;
+    }
+    let u_lo = (x0 as f32 - 1.0) / width as f32;
+    let u_hi = (x1 as f32 + 2.0) / width as f32;
+    let v_lo = (y0 as f32 - 1.0) / height as f32;
+    let v_hi = (y1 as f32 + 2.0) / height as f32;
+    Some([
+        (u_lo - 0.5).max(-0.5),
+        (0.5 - v_hi).max(-0.5),
+        (u_hi - 0.5).min(0.5),
+        (0.5 - v_lo).min(0.5),
+    ])
+}
+
+/// The smallest rectangle holding both (either may be absent).
+fn union_rect(a: Option<[f32; 4]>, b: Option<[f32; 4]>) -> Option<[f32; 4]> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some([
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ]),
+        (a, None) => a,
+        (None, b) => b,
+    }
+}
+
+/// Sentinel of [`InducerPass::combined_for`]: the overlay gain has not been combined yet.
+const NOT_COMBINED: u8 = u8::MAX;
 
 /// The shadow inducer's floor-space fields, the passes that compute them and the overlay.
 pub(crate) struct InducerPass {
@@ -372,11 +454,25 @@ pub(crate) struct InducerPass {
     world_from_plane: Mat4,
     /// Model space to the mask's clip space; `None` when the light is not above the floor.
     mask_clip_from_model: Option<Mat4>,
-    /// Plane-local rectangle the overlay covers; `None` when nothing can be lit.
+    /// Plane-local rectangle the inducer's light covers; `None` when nothing can be lit.
     rect: Option<[f32; 4]>,
+    /// The caustic gain map's size (the overlay gain's), and its G values (empty without a
+    /// map).
+    caustic_extent: vk::Extent2D,
+    caustic_gain: Vec<f32>,
+    /// Plane-local rectangle of the caustics' non-zero extent; `None` without caustics.
+    caustic_rect: Option<[f32; 4]>,
+    /// The caustic gain G (R32F, read texel for texel by fs_combine; zeros without a map).
+    caustic: Option<Image>,
+    /// Extent of each image in [`InducerPass::images`].
+    extents: Vec<vk::Extent2D>,
+    /// Switches (bit 0 inducer, bit 1 caustics) the overlay gain was last combined for, or
+    /// [`NOT_COMBINED`].
+    combined_for: AtomicU8,
     /// Triangle indices of the mesh.
     index_count: u32,
-    /// Mask, seeds (two), distance and gain, in that order ([`MASK`] ..= [`GAIN`]).
+    /// Mask, seeds (two), distance, gain and overlay gain, in that order ([`MASK`] ..=
+    /// [`OVERLAY`]).
     images: Vec<Image>,
     /// One single-attachment render pass per image, ending in SHADER_READ_ONLY_OPTIMAL.
     render_passes: Vec<vk::RenderPass>,
@@ -390,7 +486,7 @@ pub(crate) struct InducerPass {
     field_set_layout: vk::DescriptorSetLayout,
     /// Their pipeline layout.
     field_layout: vk::PipelineLayout,
-    /// Seed, jump, distance and ramp pipelines ([`SEED`] ..= [`RAMP`]).
+    /// Seed, jump, distance, ramp and combine pipelines ([`SEED`] ..= [`COMBINE`]).
     field_pipelines: Vec<vk::Pipeline>,
     /// Set layout of the overlay: gain, floor photo, sampler.
     overlay_set_layout: vk::DescriptorSetLayout,
@@ -401,7 +497,7 @@ pub(crate) struct InducerPass {
     /// Pool of every set below.
     pool: vk::DescriptorPool,
     /// Sets reading: the mask (seed pass), seeds A, seeds B (jumps), the final seeds
-    /// (distance pass), the distances (ramp pass).
+    /// (distance pass), the distances (ramp pass), the gain and G (combine pass).
     field_sets: Vec<vk::DescriptorSet>,
     /// The overlay's set.
     overlay_set: vk::DescriptorSet,
@@ -433,6 +529,24 @@ impl InducerPass {
                 .map(|p| desc.world_from_model.transform_point3(*p));
             overlay_rect(world, shadow, floor.plane_from_world, margin)
         });
+        let (caustic_extent, caustic_gain, caustic_rect) = match &desc.caustics {
+            Some(c) => (
+                vk::Extent2D {
+                    width: c.width,
+                    height: c.height,
+                },
+                c.gain.to_vec(),
+                caustic_rect(c.width, c.height, c.gain),
+            ),
+            None => (
+                vk::Extent2D {
+                    width: n,
+                    height: n,
+                },
+                Vec::new(),
+                None,
+            ),
+        };
         let mut pass = InducerPass {
             desc: params,
             texel_m,
@@ -440,6 +554,12 @@ impl InducerPass {
             mask_clip_from_model: shadow
                 .map(|s| mask_clip_from_model(&floor, s, desc.world_from_model)),
             rect,
+            caustic_extent,
+            caustic_gain,
+            caustic_rect,
+            caustic: None,
+            extents: Vec::new(),
+            combined_for: AtomicU8::new(NOT_COMBINED),
             index_count: scene.index_count,
             images: Vec::new(),
             render_passes: Vec::new(),
@@ -485,8 +605,15 @@ impl InducerPass {
             "jump flood B",
             "edge distance",
             "gain",
+            "overlay gain",
         ];
-        for (name, format) in names.into_iter().zip(FORMATS) {
+        for (index, (name, format)) in names.into_iter().zip(FORMATS).enumerate() {
+            let extent = if index == OVERLAY {
+                self.caustic_extent
+            } else {
+                extent
+            };
+            self.extents.push(extent);
             self.images.push(Image::new(
                 ctx,
                 &format!("inducer {name}"),
@@ -503,8 +630,8 @@ impl InducerPass {
             let info = vk::FramebufferCreateInfo::default()
                 .render_pass(render_pass)
                 .attachments(&attachments)
-                .width(n)
-                .height(n)
+                .width(extent.width)
+                .height(extent.height)
                 .layers(1);
             self.framebuffers
                 .push(unsafe { d.create_framebuffer(&info, None) }.vk("vkCreateFramebuffer")?);
@@ -543,6 +670,7 @@ impl InducerPass {
             (JUMP_FS, c"fs_jump", SEEDS_A),
             (DISTANCE_FS, c"fs_distance", DISTANCE),
             (RAMP_FS, c"fs_ramp", GAIN),
+            (COMBINE_FS, c"fs_combine", OVERLAY),
         ];
         for (spirv, entry, target) in field_stages {
             let pipeline = create_pipeline(
@@ -585,11 +713,27 @@ impl InducerPass {
             },
         )?;
 
+        // The caustic gain G; zeros when the scene has no map, so that fs_combine always
+        // reads a valid image of the overlay gain's size.
+        let zeros;
+        let gain: &[f32] = if self.caustic_gain.is_empty() {
+            zeros = vec![0.0f32; (n * n) as usize];
+            &zeros
+        } else {
+            &self.caustic_gain
+        };
+        self.caustic = Some(upload_texture(
+            ctx,
+            "caustic gain",
+            vk::Format::R32_SFLOAT,
+            self.caustic_extent,
+            bytemuck::cast_slice(gain),
+        )?);
         self.pool = crate::pipeline::pool(
             ctx,
-            6,
+            7,
             &[
-                (vk::DescriptorType::SAMPLED_IMAGE, 12),
+                (vk::DescriptorType::SAMPLED_IMAGE, 14),
                 (vk::DescriptorType::SAMPLER, 1),
             ],
         )?;
@@ -600,8 +744,13 @@ impl InducerPass {
             crate::pipeline::write_image(ctx, set, 1, self.images[MASK].view);
             self.field_sets.push(set);
         }
+        let set = crate::pipeline::allocate_set(ctx, self.pool, self.field_set_layout)?;
+        crate::pipeline::write_image(ctx, set, 0, self.images[GAIN].view);
+        let caustic_view = self.caustic.as_ref().expect("just uploaded").view;
+        crate::pipeline::write_image(ctx, set, 1, caustic_view);
+        self.field_sets.push(set);
         self.overlay_set = crate::pipeline::allocate_set(ctx, self.pool, self.overlay_set_layout)?;
-        crate::pipeline::write_image(ctx, self.overlay_set, 0, self.images[GAIN].view);
+        crate::pipeline::write_image(ctx, self.overlay_set, 0, self.images[OVERLAY].view);
         crate::pipeline::write_texture(
             ctx,
             self.overlay_set,
@@ -634,16 +783,44 @@ impl InducerPass {
             .collect()
     }
 
-    /// Records the fields' computation the first time it is called; later calls record
-    /// nothing (the scene is static).
+    /// Records the fields' computation the first time it is called, and the overlay gain's
+    /// combination (k alpha(d) if `inducer`, + G if `caustics`) whenever those switches
+    /// differ from the last combination's; otherwise nothing (the scene is static).
     ///
     /// # Safety
     /// `cmd` must be recording outside any render pass, and be submitted before any command
     /// buffer recorded later that draws the overlay.
-    pub unsafe fn prepare(&self, ctx: &GpuContext, cmd: vk::CommandBuffer, scene: &GpuScene) {
+    pub unsafe fn prepare(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        inducer: bool,
+        caustics: bool,
+    ) {
         if !self.computed.swap(true, Ordering::AcqRel) {
             unsafe { self.record_fields(ctx, cmd, scene) };
         }
+        let switches = u8::from(inducer) | (u8::from(caustics) << 1);
+        if self.combined_for.swap(switches, Ordering::AcqRel) != switches {
+            let push = FieldPush {
+                texel_m: self.texel_m.to_array(),
+                step: 0,
+                size: self.desc.resolution_px as i32,
+                ramp_width_m: self.desc.ramp_width_m,
+                k: self.desc.k,
+                switches: [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
+            };
+            unsafe { self.full_screen(ctx, cmd, OVERLAY, COMBINE, self.field_sets[5], &push) };
+        }
+    }
+
+    /// The plane-local rectangle the overlay draws for these switches, if any.
+    pub fn overlay_rect(&self, inducer: bool, caustics: bool) -> Option<[f32; 4]> {
+        union_rect(
+            self.rect.filter(|_| inducer),
+            self.caustic_rect.filter(|_| caustics),
+        )
     }
 
     /// Records the mask, jump-flooding, distance and ramp passes.
@@ -658,7 +835,7 @@ impl InducerPass {
             size: self.desc.resolution_px as i32,
             ramp_width_m: self.desc.ramp_width_m,
             k: self.desc.k,
-            pad: [0.0; 2],
+            switches: [0.0; 2],
         };
         unsafe {
             self.begin(ctx, cmd, MASK);
@@ -692,13 +869,10 @@ impl InducerPass {
 
     /// Begins the render pass writing image `target`, with a viewport covering it.
     unsafe fn begin(&self, ctx: &GpuContext, cmd: vk::CommandBuffer, target: usize) {
-        let n = self.desc.resolution_px;
+        let extent = self.extents[target];
         let area = vk::Rect2D {
             offset: vk::Offset2D { x: 0, y: 0 },
-            extent: vk::Extent2D {
-                width: n,
-                height: n,
-            },
+            extent,
         };
         let clear = [vk::ClearValue {
             color: vk::ClearColorValue { float32: [0.0; 4] },
@@ -717,8 +891,8 @@ impl InducerPass {
                 &[vk::Viewport {
                     x: 0.0,
                     y: 0.0,
-                    width: n as f32,
-                    height: n as f32,
+                    width: extent.width as f32,
+                    height: extent.height as f32,
                     min_depth: 0.0,
                     max_depth: 1.0,
                 }],
@@ -765,15 +939,23 @@ impl InducerPass {
         }
     }
 
-    /// Records the floor overlay for one eye, inside that eye's render pass. Draws nothing
-    /// when no floor texel can receive inducer light.
+    /// Records the floor overlay for one eye, inside that eye's render pass: the inducer's
+    /// light if `inducer`, the corrected caustics if `caustics` (as last given to
+    /// [`InducerPass::prepare`]). Draws nothing when no floor texel can receive either.
     ///
     /// # Safety
     /// `cmd` must be recording inside a render pass compatible with the one given to
     /// [`InducerPass::new`], after [`InducerPass::prepare`] was recorded into it or into a
     /// command buffer submitted earlier.
-    pub unsafe fn record(&self, ctx: &GpuContext, cmd: vk::CommandBuffer, eye: &EyeParams) {
-        let Some(rect) = self.rect else {
+    pub unsafe fn record(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        eye: &EyeParams,
+        inducer: bool,
+        caustics: bool,
+    ) {
+        let Some(rect) = self.overlay_rect(inducer, caustics) else {
             return;
         };
         let d = &ctx.device;
@@ -955,6 +1137,9 @@ impl InducerPass {
                 d.destroy_render_pass(render_pass, None);
             }
             for mut image in self.images.drain(..) {
+                image.destroy(ctx);
+            }
+            if let Some(mut image) = self.caustic.take() {
                 image.destroy(ctx);
             }
         }

@@ -37,5 +37,6 @@ pub use error::{RenderError, Result};
 pub use inducer::InducerFields; // shadow inducer (issue 5)
 pub use renderer::{FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
-    BlurStackDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData, TextureDesc,
+    BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData,
+    TextureDesc,
 };

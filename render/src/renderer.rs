@@ -367,9 +367,12 @@ impl Renderer {
             };
         let external_image = draw.is_some() && self.external.is_some();
         unsafe {
-            if params.look.inducer {
-                // Once per scene, before the timed part (issue 5).
-                self.inducer.prepare(&self.ctx, cmd, &self.scene);
+            let (inducer, caustics) = (params.look.inducer, params.look.caustics);
+            if inducer || caustics {
+                // Once per scene (and per change of these switches), before the timed part
+                // (issues 5 and 6).
+                self.inducer
+                    .prepare(&self.ctx, cmd, &self.scene, inducer, caustics);
             }
             if let Some(pool) = slot.queries {
                 d.cmd_reset_query_pool(cmd, pool, 0, 2);
@@ -380,9 +383,10 @@ impl Renderer {
                 if world_behind {
                     self.world.record(&self.ctx, cmd, eye);
                 }
-                if params.look.inducer {
-                    // Added before the glass, which covers it where the object is (issue 5).
-                    self.inducer.record(&self.ctx, cmd, eye);
+                if inducer || caustics {
+                    // Added before the glass, which covers it where the object is (issues 5
+                    // and 6).
+                    self.inducer.record(&self.ctx, cmd, eye, inducer, caustics);
                 }
                 self.glass.record(
                     &self.ctx,

@@ -81,7 +81,27 @@ pub struct SceneDesc<'a> {
     /// Shadow inducer parameters (eq. 2-4).
     pub inducer: InducerDesc,
     // --- end shadow inducer ---
+    // --- caustics (issue 6; render/src/inducer.rs) ---
+    /// The caustic gain map G (eq. 6), if the scene has a bake; the overlay adds G L_r when
+    /// [`crate::Look::caustics`] is on (nothing without a map).
+    pub caustics: Option<CausticsDesc<'a>>,
+    // --- end caustics ---
 }
+
+// --- caustics (issue 6; render/src/inducer.rs) ---
+/// A caustic gain map over the floor photo's area: `width` x `height` linear gains G >= 0,
+/// row-major, row 0 at the photo's top edge (the same orientation and uvs as the photo). The
+/// corrected caustics of eq. 6 are L'_c = G L_r (docs/caustics.md).
+#[derive(Clone, Copy, Debug)]
+pub struct CausticsDesc<'a> {
+    /// Texels per row.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// The gains, `width * height` of them.
+    pub gain: &'a [f32],
+}
+// --- end caustics ---
 
 // --- shadow inducer (issue 5; render/src/inducer.rs) ---
 /// Parameters of the shadow inducer (METHOD.md section 1).
@@ -201,10 +221,18 @@ impl GpuScene {
             height: 1,
             data: TexelData::Srgb8(&white),
         });
-        let (background_stack, background_slices, background_step) =
-            upload_stack(ctx, "background blur stack", &desc.background.photo, desc.background_stack)?;
-        let (surface, surface_slices, surface_step) =
-            upload_stack(ctx, "surface blur stack", &surface_photo, desc.surface_stack)?;
+        let (background_stack, background_slices, background_step) = upload_stack(
+            ctx,
+            "background blur stack",
+            &desc.background.photo,
+            desc.background_stack,
+        )?;
+        let (surface, surface_slices, surface_step) = upload_stack(
+            ctx,
+            "surface blur stack",
+            &surface_photo,
+            desc.surface_stack,
+        )?;
         Ok(GpuScene {
             vertices,
             indices,
@@ -271,6 +299,9 @@ fn validate(ctx: &GpuContext, desc: &SceneDesc) -> Result<()> {
         .limits
         .max_image_dimension2_d;
     crate::inducer::validate(&desc.inducer, limit)?; // shadow inducer (issue 5)
+    if let Some(caustics) = &desc.caustics {
+        crate::inducer::validate_caustics(caustics, limit)?; // caustics (issue 6)
+    }
     if !(0.0..=1.0).contains(&desc.surface_transmittance) {
         return Err(RenderError::InvalidInput(format!(
             "surface transmittance must be within 0..1, got {}",
@@ -278,12 +309,24 @@ fn validate(ctx: &GpuContext, desc: &SceneDesc) -> Result<()> {
         )));
     }
     for (name, stack, plain) in [
-        ("background blur stack", &desc.background_stack, Some(&desc.background.photo)),
-        ("surface blur stack", &desc.surface_stack, desc.surface.as_ref()),
+        (
+            "background blur stack",
+            &desc.background_stack,
+            Some(&desc.background.photo),
+        ),
+        (
+            "surface blur stack",
+            &desc.surface_stack,
+            desc.surface.as_ref(),
+        ),
     ] {
         if let Some(st) = stack {
             let expected = st.width as usize * st.height as usize * 4 * st.slices as usize;
-            if st.slices < 2 || st.srgb8.len() != expected || !(st.k_g_step_px > 0.0) {
+            if st.slices < 2
+                || st.srgb8.len() != expected
+                || st.k_g_step_px.is_nan()
+                || st.k_g_step_px <= 0.0
+            {
                 return Err(RenderError::InvalidInput(format!(
                     "{name}: needs at least 2 slices of {}x{} RGBA8 texels ({expected} bytes) and \
                      a positive K_g step; got {} slices, {} bytes, step {}",

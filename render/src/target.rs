@@ -27,6 +27,18 @@ pub fn create_render_pass_for(
     color_format: vk::Format,
     final_layout: vk::ImageLayout,
 ) -> Result<vk::RenderPass> {
+    create_render_pass_storing_depth(ctx, color_format, final_layout, false)
+}
+
+/// Like [`create_render_pass_for`]; with `store_depth` the depth attachment is stored (for a
+/// depth image someone else reads afterwards: an OpenXR depth swapchain). Load/store ops do
+/// not affect render-pass compatibility, so the same pipelines draw in both.
+pub fn create_render_pass_storing_depth(
+    ctx: &GpuContext,
+    color_format: vk::Format,
+    final_layout: vk::ImageLayout,
+    store_depth: bool,
+) -> Result<vk::RenderPass> {
     let attachments = [
         vk::AttachmentDescription::default()
             .format(color_format)
@@ -41,7 +53,11 @@ pub fn create_render_pass_for(
             .format(DEPTH_FORMAT)
             .samples(vk::SampleCountFlags::TYPE_1)
             .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .store_op(if store_depth {
+                vk::AttachmentStoreOp::STORE
+            } else {
+                vk::AttachmentStoreOp::DONT_CARE
+            })
             .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
             .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
             .initial_layout(vk::ImageLayout::UNDEFINED)

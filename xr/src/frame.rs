@@ -148,6 +148,9 @@ pub enum FrameTarget {
     Swapchain {
         /// Index of the swapchain image acquired for this frame.
         index: u32,
+        /// Index of the depth swapchain image acquired for this frame, when depth is
+        /// submitted (XR_KHR_composition_layer_depth); the renderer writes its depth there.
+        depth_index: Option<u32>,
         /// Draw the scene's real-world photos behind the glass.
         world_behind: bool,
     },

@@ -24,6 +24,25 @@ pub(crate) struct SceneFile {
     pub effects: EffectsToml,
     #[serde(default)]
     pub inducer: InducerToml,
+    #[serde(default)]
+    pub gaze: GazeToml,
+    #[serde(default)]
+    pub caustics: CausticsToml,
+}
+
+/// `[caustics]`: the scene's caustic bake (eq. 6).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct CausticsToml {
+    pub bake: Option<Spanned<String>>,
+}
+
+/// `[gaze]`: how the gaze image is chosen for defocus.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct GazeToml {
+    pub filter: Option<Spanned<String>>,
+    pub image: Option<Spanned<String>>,
 }
 
 /// `[object]`: the virtual transparent object.

@@ -22,6 +22,7 @@ use toml::Spanned;
 use vitreous_xr::{Fov, Pose};
 
 use crate::effects::EffectSet;
+use crate::gaze::{FilterKind, FilterParseError, GazeOverride};
 
 pub use error::{Location, SceneError};
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
@@ -54,8 +55,40 @@ pub struct Scene {
     pub output: Output,
     /// The effects the scene asks for (parsed, not yet checked against this build).
     pub effects: EffectSet,
+    /// How the gaze image is chosen for defocus.
+    pub gaze: GazeChoice,
     /// The shadow inducer's parameters.
     pub inducer: Inducer,
+    /// The caustic bake (eq. 6): where it is and, once [`Scene::load_caustics`] ran, its
+    /// gain map.
+    pub caustics: Caustics,
+}
+
+/// `[caustics]`: the scene's caustic gain bake (docs/caustics.md).
+#[derive(Clone, Debug, Default)]
+pub struct Caustics {
+    /// The bake file, resolved against the scene's folder; `None` when the scene names none.
+    /// Not read (nor hashed) when the scene loads: only when the caustics are asked for.
+    pub bake: Option<PathBuf>,
+    /// The gain map, after [`Scene::load_caustics`].
+    pub gain: Option<crate::caustics::Bake>,
+}
+
+impl Scene {
+    /// Reads the scene's caustic bake into [`Caustics::gain`], checking that it was baked
+    /// for this scene (its stored hash equals [`Scene::hash`]). Errors name the file: no bake
+    /// named, missing, corrupt, or made for another scene.
+    pub fn load_caustics(&mut self) -> Result<(), crate::caustics::BakeError> {
+        let path =
+            self.caustics
+                .bake
+                .as_ref()
+                .ok_or_else(|| crate::caustics::BakeError::NotNamed {
+                    scene: self.path.clone(),
+                })?;
+        self.caustics.gain = Some(crate::caustics::read_bake(path, &self.hash)?);
+        Ok(())
+    }
 }
 
 /// The shadow inducer's parameters (METHOD.md section 1).
@@ -78,6 +111,15 @@ impl Default for Inducer {
             resolution_px: 512,
         }
     }
+}
+
+/// `[gaze]`: the fixation-depth filter and the experimenter's gaze-image override.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GazeChoice {
+    /// Depth filter (default: eq. 15's 20-sample mean).
+    pub filter: FilterKind,
+    /// Gaze image: auto, or forced to the surface or the refracted image.
+    pub image: GazeOverride,
 }
 
 /// Where the object's refractive index came from.
@@ -464,6 +506,41 @@ impl Loader<'_> {
         };
 
         let inducer = self.inducer(&raw.inducer)?;
+        let caustics = Caustics {
+            bake: match &raw.caustics.bake {
+                None => None,
+                Some(rel) if rel.get_ref().trim().is_empty() => {
+                    return Err(self.src.invalid(
+                        rel.span(),
+                        "caustics.bake",
+                        "expected a file path, found an empty string",
+                    ));
+                }
+                Some(rel) => Some(normalize(&self.dir.join(rel.get_ref()))),
+            },
+            gain: None,
+        };
+        let gaze = GazeChoice {
+            filter: match &raw.gaze.filter {
+                None => FilterKind::default(),
+                Some(f) => f.get_ref().parse().map_err(|e: FilterParseError| {
+                    self.src.invalid(f.span(), "gaze.filter", e.to_string())
+                })?,
+            },
+            image: match &raw.gaze.image {
+                None => GazeOverride::Auto,
+                Some(i) => i.get_ref().parse().map_err(|_| {
+                    self.src.invalid(
+                        i.span(),
+                        "gaze.image",
+                        format!(
+                            "expected auto, surface or refracted, found '{}'",
+                            i.get_ref()
+                        ),
+                    )
+                })?,
+            },
+        };
 
         let hash = self
             .hasher
@@ -483,6 +560,8 @@ impl Loader<'_> {
             output,
             effects,
             inducer,
+            gaze,
+            caustics,
         })
     }
 

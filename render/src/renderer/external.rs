@@ -3,10 +3,16 @@
 //! An OpenXR runtime hands out a few 2-layer colour images (its swapchain) and says, frame by
 //! frame, which one to draw. [`Renderer::attach_external`] makes a framebuffer per image and
 //! layer once; [`Renderer::submit_external`] then records the same passes as
-//! [`Renderer::submit`] into the chosen image. The eye images keep their own depth buffer (the
-//! renderer's), and the colour image is left in `COLOR_ATTACHMENT_OPTIMAL`, the layout OpenXR
+//! [`Renderer::submit`] into the chosen image. Depth goes to the renderer's own depth buffer
+//! (but see below), and the colour image is left in `COLOR_ATTACHMENT_OPTIMAL`, the layout OpenXR
 //! expects back on release. A readback of such a frame copies the external image, so tests can
 //! check what was really handed to the runtime.
+//!
+//! With [`Renderer::attach_external_with_depth`], the eye passes write their depth into
+//! external 2-layer depth images too (an OpenXR depth swapchain for
+//! XR_KHR_composition_layer_depth): the depth attachment is stored and left in
+//! `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`. The colour and depth swapchains hand out their images
+//! independently, so there is a framebuffer per (colour image, depth image, layer).
 
 use ash::vk;
 
@@ -20,20 +26,33 @@ use crate::target;
 pub(super) struct External {
     /// Render pass leaving colour in `COLOR_ATTACHMENT_OPTIMAL`.
     pub(super) render_pass: vk::RenderPass,
-    /// The external images, 2 layers each; not owned.
+    /// The colour image of each slot (slot = colour index * depth slots + depth index), 2
+    /// layers each; not owned.
     pub(super) images: Vec<vk::Image>,
+    /// Number of external colour images.
+    color_count: usize,
+    /// Number of external depth images (0: the renderer's own depth image is used).
+    depth_count: usize,
     /// Per-layer colour views of the images, owned.
     views: Vec<vk::ImageView>,
-    /// Per-layer views of the renderer's own depth image, owned.
+    /// Per-layer views of the depth images (the renderer's own, or each external one's), owned.
     depth_views: Vec<vk::ImageView>,
-    /// Framebuffer of each image's left and right layer.
+    /// Framebuffer of each slot's left and right layer.
     pub(super) framebuffers: Vec<[vk::Framebuffer; 2]>,
+}
+
+impl External {
+    /// The slot of colour image `color` and depth image `depth` (ignored without external
+    /// depth images).
+    fn slot(&self, color: usize, depth: usize) -> usize {
+        color * self.depth_count.max(1) + if self.depth_count == 0 { 0 } else { depth }
+    }
 }
 
 /// Which external image a frame is drawn into, and how.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct ExternalDraw {
-    /// Index into [`External::images`].
+    /// Slot: index into [`External::images`] and [`External::framebuffers`].
     pub(super) image: usize,
     /// Draw the real world (floor and background photos) behind the glass.
     pub(super) world_behind: bool,
@@ -108,10 +127,13 @@ pub(super) unsafe fn transition(
 }
 
 impl Renderer {
+    /// The depth format the renderer draws, which external depth images must have.
+    pub const DEPTH_FORMAT: vk::Format = target::DEPTH_FORMAT;
+
     /// Lets later frames be drawn into `images`: 2-layer colour images of `format` and the
     /// renderer's [size](Renderer::size), one layer per eye, created with colour-attachment
     /// (and, for readbacks, transfer-source) usage, such as an OpenXR swapchain's. Replaces
-    /// images attached before.
+    /// images attached before. Depth goes to the renderer's own depth image.
     ///
     /// `format` must be the renderer's colour format, `R8G8B8A8_SRGB` (shaders write linear
     /// light and the image encodes it); other formats are refused with a clear error.
@@ -123,6 +145,22 @@ impl Renderer {
         &mut self,
         images: &[vk::Image],
         format: vk::Format,
+    ) -> Result<()> {
+        unsafe { self.attach_external_with_depth(images, format, &[]) }
+    }
+
+    /// Like [`Renderer::attach_external`], and the eye passes' depth is written into (and
+    /// kept in) `depth_images`: 2-layer [`Renderer::DEPTH_FORMAT`] images of the renderer's
+    /// size with depth-attachment usage, such as an OpenXR depth swapchain's, left in
+    /// `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`. Empty `depth_images`: the renderer's own depth.
+    ///
+    /// # Safety
+    /// As [`Renderer::attach_external`], for the depth images too.
+    pub unsafe fn attach_external_with_depth(
+        &mut self,
+        images: &[vk::Image],
+        format: vk::Format,
+        depth_images: &[vk::Image],
     ) -> Result<()> {
         if format != target::COLOR_FORMAT {
             return Err(RenderError::InvalidInput(format!(
@@ -137,49 +175,84 @@ impl Renderer {
         }
         self.detach_external()?;
         let ctx = &self.ctx;
-        let render_pass =
-            target::create_render_pass_for(ctx, format, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)?;
+        let render_pass = target::create_render_pass_storing_depth(
+            ctx,
+            format,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            !depth_images.is_empty(),
+        )?;
+        let depth_slots = depth_images.len().max(1);
         let mut external = External {
             render_pass,
-            images: images.to_vec(),
+            images: Vec::with_capacity(images.len() * depth_slots),
+            color_count: images.len(),
+            depth_count: depth_images.len(),
             views: Vec::new(),
             depth_views: Vec::new(),
             framebuffers: Vec::new(),
         };
+        let layer_view = |image: vk::Image,
+                          format: vk::Format,
+                          aspect: vk::ImageAspectFlags,
+                          layer: u32|
+         -> Result<vk::ImageView> {
+            let info = vk::ImageViewCreateInfo::default()
+                .image(image)
+                .view_type(vk::ImageViewType::TYPE_2D)
+                .format(format)
+                .subresource_range(vk::ImageSubresourceRange {
+                    aspect_mask: aspect,
+                    base_mip_level: 0,
+                    level_count: 1,
+                    base_array_layer: layer,
+                    layer_count: 1,
+                });
+            unsafe { ctx.device.create_image_view(&info, None) }.vk("vkCreateImageView")
+        };
         let built = (|| {
-            for layer in 0..2 {
-                external
-                    .depth_views
-                    .push(self.eye_target.depth.layer_view(ctx, layer)?);
+            // Depth views: [depth image][layer], flattened.
+            if depth_images.is_empty() {
+                for layer in 0..2 {
+                    external
+                        .depth_views
+                        .push(self.eye_target.depth.layer_view(ctx, layer)?);
+                }
+            } else {
+                for &depth in depth_images {
+                    for layer in 0..2 {
+                        external.depth_views.push(layer_view(
+                            depth,
+                            target::DEPTH_FORMAT,
+                            vk::ImageAspectFlags::DEPTH,
+                            layer,
+                        )?);
+                    }
+                }
             }
             for &image in images {
-                let mut fbs = [vk::Framebuffer::null(); 2];
+                let mut color_views = [vk::ImageView::null(); 2];
                 for layer in 0..2u32 {
-                    let info = vk::ImageViewCreateInfo::default()
-                        .image(image)
-                        .view_type(vk::ImageViewType::TYPE_2D)
-                        .format(format)
-                        .subresource_range(vk::ImageSubresourceRange {
-                            aspect_mask: vk::ImageAspectFlags::COLOR,
-                            base_mip_level: 0,
-                            level_count: 1,
-                            base_array_layer: layer,
-                            layer_count: 1,
-                        });
-                    let view = unsafe { ctx.device.create_image_view(&info, None) }
-                        .vk("vkCreateImageView")?;
+                    let view = layer_view(image, format, vk::ImageAspectFlags::COLOR, layer)?;
                     external.views.push(view);
-                    let attachments = [view, external.depth_views[layer as usize]];
-                    let fb_info = vk::FramebufferCreateInfo::default()
-                        .render_pass(render_pass)
-                        .attachments(&attachments)
-                        .width(self.extent.width)
-                        .height(self.extent.height)
-                        .layers(1);
-                    fbs[layer as usize] = unsafe { ctx.device.create_framebuffer(&fb_info, None) }
-                        .vk("vkCreateFramebuffer")?;
+                    color_views[layer as usize] = view;
                 }
-                external.framebuffers.push(fbs);
+                for depth in 0..depth_slots {
+                    let mut fbs = [vk::Framebuffer::null(); 2];
+                    for layer in 0..2usize {
+                        let attachments =
+                            [color_views[layer], external.depth_views[depth * 2 + layer]];
+                        let fb_info = vk::FramebufferCreateInfo::default()
+                            .render_pass(render_pass)
+                            .attachments(&attachments)
+                            .width(self.extent.width)
+                            .height(self.extent.height)
+                            .layers(1);
+                        fbs[layer] = unsafe { ctx.device.create_framebuffer(&fb_info, None) }
+                            .vk("vkCreateFramebuffer")?;
+                    }
+                    external.images.push(image);
+                    external.framebuffers.push(fbs);
+                }
             }
             Ok(())
         })();
@@ -205,9 +278,15 @@ impl Renderer {
         Ok(())
     }
 
-    /// Number of attached external images (0 when none).
+    /// Number of attached external colour images (0 when none).
     pub fn external_count(&self) -> usize {
-        self.external.as_ref().map_or(0, |e| e.images.len())
+        self.external.as_ref().map_or(0, |e| e.color_count)
+    }
+
+    /// Number of attached external depth images (0 when none, or when the renderer's own
+    /// depth image is used).
+    pub fn external_depth_count(&self) -> usize {
+        self.external.as_ref().map_or(0, |e| e.depth_count)
     }
 
     /// Like [`Renderer::submit`], drawing into attached external image `image` (its index in
@@ -226,17 +305,43 @@ impl Renderer {
         want: Want,
         world_behind: bool,
     ) -> Result<Option<FrameResult>> {
+        self.submit_external_with_depth(image, None, params, want, world_behind)
+    }
+
+    /// Like [`Renderer::submit_external`], writing depth into attached external depth image
+    /// `depth` (its index in the depth slice given to
+    /// [`Renderer::attach_external_with_depth`]); needed exactly when depth images are
+    /// attached.
+    pub fn submit_external_with_depth(
+        &mut self,
+        image: usize,
+        depth: Option<usize>,
+        params: &FrameParams,
+        want: Want,
+        world_behind: bool,
+    ) -> Result<Option<FrameResult>> {
         let count = self.external_count();
         if image >= count {
             return Err(RenderError::InvalidInput(format!(
                 "external image {image} does not exist ({count} attached)"
             )));
         }
+        let depth_count = self.external_depth_count();
+        let depth = match (depth, depth_count) {
+            (None, 0) => 0,
+            (Some(d), n) if d < n => d,
+            (d, n) => {
+                return Err(RenderError::InvalidInput(format!(
+                    "external depth image {d:?} with {n} depth images attached"
+                )));
+            }
+        };
+        let slot = self.external.as_ref().map_or(0, |e| e.slot(image, depth));
         self.submit_to(
             params,
             want,
             Some(ExternalDraw {
-                image,
+                image: slot,
                 world_behind,
             }),
         )

@@ -61,7 +61,6 @@ pub struct CausticScene {
 
 impl CausticScene {
     /// Takes the object (mesh placed in the world), light and floor from a loaded scene.
-    #[cfg(feature = "scene")]
     pub fn from_scene(scene: &vitreous::scene::Scene) -> Self {
         let m = scene.object.world_from_model;
         let normal_matrix = glam::Mat3::from_mat4(m).inverse().transpose();

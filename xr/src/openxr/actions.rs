@@ -1,23 +1,82 @@
 //! Live actions: what the wearer (or experimenter) can do during a session, bound through an
 //! OpenXR action set to whatever the runtime maps (simple controller select/menu, ...), and the
 //! pure mapping from input edges to [`Command`]s.
+//!
+//! Two boolean actions, `select` and `menu`, each with the subaction paths `/user/hand/left`
+//! and `/user/hand/right`, are suggested for these interaction profiles ([`BINDINGS`]):
+//!
+//! | profile | select | menu |
+//! | --- | --- | --- |
+//! | `/interaction_profiles/khr/simple_controller` | `select/click` | `menu/click` |
+//! | `/interaction_profiles/htc/vive_controller` | `trigger/click` | `menu/click` |
+//! | `/interaction_profiles/oculus/touch_controller` | left `x/click`, right `a/click` | left `y/click`, right `b/click` |
+//! | `/interaction_profiles/valve/index_controller` | `a/click` | `b/click` |
+//!
+//! [`commands_for`] turns one hand's presses into commands: the right hand drives the
+//! experiment (select: next gaze image, menu: next effect condition, menu pressed while select
+//! is held or the other way round: nudge the scene away), the left hand the registration
+//! (select: turn the scene left, menu: turn it right, a chord: nudge it closer).
 
 use glam::Vec3;
+use openxr as xr;
+
+use super::{Result, XrContext};
 
 /// The scene nudge per press, metres.
 pub const NUDGE_STEP_M: f32 = 0.01;
 
+/// The scene turn per press, radians (2 degrees).
+pub const ROTATE_STEP_RAD: f32 = std::f32::consts::PI / 90.0;
+
 /// Something a live action asks for.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Command {
-    /// Move the scene by this offset in the world frame, metres.
+    /// Move the scene by this offset in the scene frame, metres.
     Nudge(Vec3),
-    /// Rotate the scene about the vertical axis through the viewer, radians.
+    /// Rotate the scene about the vertical axis through the viewer, radians (positive: counter-
+    /// clockwise seen from above, i.e. to the viewer's left).
     Rotate(f32),
     /// Switch to the next effect condition.
     NextCondition,
     /// Force the gaze image: cycles surface, refracted, automatic.
     NextGazeImage,
+}
+
+impl std::fmt::Display for Command {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Command::Nudge(d) => write!(
+                f,
+                "nudge the scene by ({:+.3}, {:+.3}, {:+.3}) m",
+                d.x, d.y, d.z
+            ),
+            Command::Rotate(a) => write!(f, "turn the scene by {:+.1} deg", a.to_degrees()),
+            Command::NextCondition => f.write_str("next effect condition"),
+            Command::NextGazeImage => f.write_str("next gaze image (surface, refracted, auto)"),
+        }
+    }
+}
+
+/// Which hand an input is on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hand {
+    /// `/user/hand/left`.
+    Left,
+    /// `/user/hand/right`.
+    Right,
+}
+
+impl Hand {
+    /// Both hands, left first.
+    pub const BOTH: [Hand; 2] = [Hand::Left, Hand::Right];
+
+    /// The user path.
+    pub fn path(self) -> &'static str {
+        match self {
+            Hand::Left => "/user/hand/left",
+            Hand::Right => "/user/hand/right",
+        }
+    }
 }
 
 /// Which inputs changed to pressed this frame.
@@ -31,20 +90,199 @@ pub struct Presses {
     pub chord: bool,
 }
 
-/// The commands for this frame's presses: select cycles the gaze image, menu the effect
-/// condition, both together nudge the scene away from the viewer by [`NUDGE_STEP_M`].
+/// One input's state after an xrSyncActions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ButtonState {
+    /// Bound and active.
+    pub active: bool,
+    /// Down now.
+    pub down: bool,
+    /// Changed since the previous sync.
+    pub changed: bool,
+}
+
+impl ButtonState {
+    /// Went down at this sync.
+    pub fn pressed(self) -> bool {
+        self.active && self.down && self.changed
+    }
+
+    /// Held (down and active).
+    pub fn held(self) -> bool {
+        self.active && self.down
+    }
+}
+
+/// One hand's presses from its two buttons' states: a chord is a press of one button while
+/// the other is held (or both pressed at the same sync).
+pub fn presses(select: ButtonState, menu: ButtonState) -> Presses {
+    let (s, m) = (select.pressed(), menu.pressed());
+    Presses {
+        select: s,
+        menu: m,
+        chord: (s && menu.held()) || (m && select.held()),
+    }
+}
+
+/// The commands for this frame's presses on the right hand (the experimenter's): select cycles
+/// the gaze image, menu the effect condition, both together nudge the scene away from the
+/// viewer by [`NUDGE_STEP_M`].
 pub fn commands(p: Presses) -> Vec<Command> {
+    commands_for(Hand::Right, p)
+}
+
+/// The commands for this frame's presses on `hand`: the right hand as [`commands`]; on the
+/// left, select turns the scene left and menu right by [`ROTATE_STEP_RAD`], both together
+/// nudge it closer by [`NUDGE_STEP_M`].
+pub fn commands_for(hand: Hand, p: Presses) -> Vec<Command> {
     if p.chord {
-        return vec![Command::Nudge(Vec3::new(0.0, 0.0, -NUDGE_STEP_M))];
+        let z = match hand {
+            Hand::Right => -NUDGE_STEP_M,
+            Hand::Left => NUDGE_STEP_M,
+        };
+        return vec![Command::Nudge(Vec3::new(0.0, 0.0, z))];
     }
     let mut out = Vec::new();
-    if p.select {
-        out.push(Command::NextGazeImage);
-    }
-    if p.menu {
-        out.push(Command::NextCondition);
+    match hand {
+        Hand::Right => {
+            if p.select {
+                out.push(Command::NextGazeImage);
+            }
+            if p.menu {
+                out.push(Command::NextCondition);
+            }
+        }
+        Hand::Left => {
+            if p.select {
+                out.push(Command::Rotate(ROTATE_STEP_RAD));
+            }
+            if p.menu {
+                out.push(Command::Rotate(-ROTATE_STEP_RAD));
+            }
+        }
     }
     out
+}
+
+/// Suggested bindings: interaction profile, then (hand, select input, menu input) paths
+/// relative to the hand's user path.
+pub const BINDINGS: &[(&str, [(Hand, &str, &str); 2])] = &[
+    (
+        "/interaction_profiles/khr/simple_controller",
+        [
+            (Hand::Left, "input/select/click", "input/menu/click"),
+            (Hand::Right, "input/select/click", "input/menu/click"),
+        ],
+    ),
+    (
+        "/interaction_profiles/htc/vive_controller",
+        [
+            (Hand::Left, "input/trigger/click", "input/menu/click"),
+            (Hand::Right, "input/trigger/click", "input/menu/click"),
+        ],
+    ),
+    (
+        "/interaction_profiles/oculus/touch_controller",
+        [
+            (Hand::Left, "input/x/click", "input/y/click"),
+            (Hand::Right, "input/a/click", "input/b/click"),
+        ],
+    ),
+    (
+        "/interaction_profiles/valve/index_controller",
+        [
+            (Hand::Left, "input/a/click", "input/b/click"),
+            (Hand::Right, "input/a/click", "input/b/click"),
+        ],
+    ),
+];
+
+/// The controller action set: `select` and `menu` on each hand.
+pub(super) struct Controls {
+    /// The action set (attached by the session with its other sets).
+    pub(super) set: xr::ActionSet,
+    /// The select action.
+    select: xr::Action<bool>,
+    /// The menu action.
+    menu: xr::Action<bool>,
+    /// `/user/hand/left`, `/user/hand/right`.
+    hands: [xr::Path; 2],
+    /// Profiles whose suggested bindings the runtime accepted.
+    pub(super) profiles: Vec<&'static str>,
+}
+
+impl Controls {
+    /// Creates the set and its actions and suggests [`BINDINGS`]. A profile the runtime
+    /// refuses is skipped with a warning; the caller attaches [`Controls::set`].
+    pub(super) fn new(instance: &xr::Instance) -> Result<Controls> {
+        let hands = [
+            instance
+                .string_to_path(Hand::Left.path())
+                .xr("xrStringToPath")?,
+            instance
+                .string_to_path(Hand::Right.path())
+                .xr("xrStringToPath")?,
+        ];
+        let set = instance
+            .create_action_set("vitreous_controls", "vitreous controls", 0)
+            .xr("xrCreateActionSet")?;
+        let select = set
+            .create_action::<bool>("select", "Select", &hands)
+            .xr("xrCreateAction(select)")?;
+        let menu = set
+            .create_action::<bool>("menu", "Menu", &hands)
+            .xr("xrCreateAction(menu)")?;
+        let mut profiles = Vec::new();
+        for (profile, hand_bindings) in BINDINGS {
+            let made = (|| -> Result<()> {
+                let profile_path = instance.string_to_path(profile).xr("xrStringToPath")?;
+                let mut bindings = Vec::new();
+                for (hand, s, m) in hand_bindings {
+                    let s = instance
+                        .string_to_path(&format!("{}/{s}", hand.path()))
+                        .xr("xrStringToPath")?;
+                    let m = instance
+                        .string_to_path(&format!("{}/{m}", hand.path()))
+                        .xr("xrStringToPath")?;
+                    bindings.push(xr::Binding::new(&select, s));
+                    bindings.push(xr::Binding::new(&menu, m));
+                }
+                instance
+                    .suggest_interaction_profile_bindings(profile_path, &bindings)
+                    .xr("xrSuggestInteractionProfileBindings")
+            })();
+            match made {
+                Ok(()) => profiles.push(*profile),
+                Err(e) => tracing::warn!("controller bindings for {profile} refused: {e}"),
+            }
+        }
+        Ok(Controls {
+            set,
+            select,
+            menu,
+            hands,
+            profiles,
+        })
+    }
+
+    /// The commands of both hands' presses since the previous sync; call right after
+    /// xrSyncActions with [`Controls::set`] active.
+    pub(super) fn commands(&self, session: &xr::Session<xr::Vulkan>) -> Result<Vec<Command>> {
+        let state = |action: &xr::Action<bool>, hand: xr::Path| -> Result<ButtonState> {
+            let s = action.state(session, hand).xr("xrGetActionStateBoolean")?;
+            Ok(ButtonState {
+                active: s.is_active,
+                down: s.current_state,
+                changed: s.changed_since_last_sync,
+            })
+        };
+        let mut out = Vec::new();
+        for (hand, path) in Hand::BOTH.into_iter().zip(self.hands) {
+            let p = presses(state(&self.select, path)?, state(&self.menu, path)?);
+            out.extend(commands_for(hand, p));
+        }
+        Ok(out)
+    }
 }
 
 #[cfg(test)]
@@ -77,5 +315,93 @@ mod tests {
             commands(chord),
             [Command::Nudge(Vec3::new(0.0, 0.0, -NUDGE_STEP_M))]
         );
+        assert_eq!(
+            commands_for(Hand::Left, chord),
+            [Command::Nudge(Vec3::new(0.0, 0.0, NUDGE_STEP_M))]
+        );
+    }
+
+    #[test]
+    fn the_left_hand_turns_the_scene_both_ways() {
+        let select = Presses {
+            select: true,
+            ..Default::default()
+        };
+        let menu = Presses {
+            menu: true,
+            ..Default::default()
+        };
+        assert_eq!(
+            commands_for(Hand::Left, select),
+            [Command::Rotate(ROTATE_STEP_RAD)]
+        );
+        assert_eq!(
+            commands_for(Hand::Left, menu),
+            [Command::Rotate(-ROTATE_STEP_RAD)]
+        );
+    }
+
+    #[test]
+    fn presses_are_edges_and_chords_need_the_other_button_held() {
+        let up = ButtonState {
+            active: true,
+            ..Default::default()
+        };
+        let pressed = ButtonState {
+            active: true,
+            down: true,
+            changed: true,
+        };
+        let held = ButtonState {
+            active: true,
+            down: true,
+            changed: false,
+        };
+        let released = ButtonState {
+            active: true,
+            down: false,
+            changed: true,
+        };
+        assert_eq!(presses(up, up), Presses::default());
+        assert_eq!(presses(held, held), Presses::default());
+        assert_eq!(presses(released, up), Presses::default());
+        assert_eq!(
+            presses(pressed, up),
+            Presses {
+                select: true,
+                ..Default::default()
+            }
+        );
+        assert_eq!(
+            presses(held, pressed),
+            Presses {
+                menu: true,
+                chord: true,
+                ..Default::default()
+            }
+        );
+        assert_eq!(
+            presses(pressed, pressed),
+            Presses {
+                select: true,
+                menu: true,
+                chord: true,
+            }
+        );
+        // An unbound (inactive) input never presses.
+        let inactive = ButtonState {
+            active: false,
+            ..pressed
+        };
+        assert_eq!(presses(inactive, up), Presses::default());
+    }
+
+    #[test]
+    fn every_profile_binds_both_hands() {
+        for (profile, hands) in BINDINGS {
+            assert!(profile.starts_with("/interaction_profiles/"));
+            assert_eq!(hands[0].0, Hand::Left, "{profile}");
+            assert_eq!(hands[1].0, Hand::Right, "{profile}");
+        }
     }
 }

@@ -7,12 +7,15 @@
 //!    blend-mode choice. Its `create_vulkan_*` methods are what the renderer's device creator
 //!    calls (the app adapts them to `vitreous_render::DeviceCreator`).
 //! 2. [`Runtime::start`]: session on the renderer's device, reference space (STAGE when offered,
-//!    else LOCAL), one 2-layer array swapchain, gaze source. Gives the [`Session`] backend and
-//!    the swapchain's `VkImage`s for the renderer to draw into.
+//!    else LOCAL), one 2-layer array swapchain (and a 2-layer depth swapchain when depth is
+//!    submitted with XR_KHR_composition_layer_depth), gaze source, the controller action set
+//!    ([`actions`]). Gives the [`Session`] backend and the swapchains' `VkImage`s for the
+//!    renderer to draw into.
 //! 3. The frame loop drives the [`Session`] through [`crate::Backend`]: `wait_frame`
 //!    (xrWaitFrame, xrBeginFrame, acquire and wait a swapchain image, locate views at the
-//!    predicted display time), rendering into [`crate::Backend::frame_target`], `end_frame`
-//!    (release, xrEndFrame with a projection layer).
+//!    predicted display time, xrSyncActions once FOCUSED), rendering into
+//!    [`crate::Backend::frame_target`], `end_frame` (release, xrEndFrame with a projection
+//!    layer, each view chaining its `XrCompositionLayerDepthInfoKHR` when depth is submitted).
 //!
 //! Teardown order: [`Session`] (swapchain, spaces, session) before the Vulkan device, the
 //! [`Runtime`] (instance) after it; see the app's `run` module.
@@ -34,6 +37,7 @@ use ash::vk::Handle;
 use openxr as xr;
 use thiserror::Error;
 
+pub use actions::Command;
 /// The `ash` crate these APIs use, for callers without their own dependency on it.
 pub use ash;
 pub use choose::{Blend, ColorFormat, GazeSource};
@@ -327,8 +331,8 @@ impl Runtime {
         &self.info
     }
 
-    /// Whether XR_KHR_composition_layer_depth is enabled. Depth is not submitted yet: the
-    /// renderer's depth image is its own, not a swapchain (see docs/headsets.md).
+    /// Whether XR_KHR_composition_layer_depth is enabled (depth is then submitted when the
+    /// session is asked to, see [`SessionOptions::depth`]).
     pub fn depth_layer_enabled(&self) -> bool {
         self.depth_layer
     }
@@ -465,6 +469,20 @@ pub struct SessionOptions {
     pub viewer_position_m: glam::Vec3,
     /// Install a Ctrl-C handler that ends the session cleanly.
     pub handle_ctrl_c: bool,
+    /// Submit depth with XR_KHR_composition_layer_depth in this format and range, when the
+    /// runtime offers the extension and the format (None: no depth submission).
+    pub depth: Option<DepthOptions>,
+}
+
+/// How depth is submitted (XR_KHR_composition_layer_depth).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthOptions {
+    /// The depth format the renderer writes (the depth swapchain's format).
+    pub format: vk::Format,
+    /// Distance of depth 0 (the projection's near plane), metres.
+    pub near_m: f32,
+    /// Distance of depth 1 (the projection's far plane), metres.
+    pub far_m: f32,
 }
 
 /// The swapchain's images and format, for the renderer.
@@ -478,6 +496,9 @@ pub struct SwapchainImages {
     pub srgb: bool,
     /// Size of each layer, pixels.
     pub size: (u32, u32),
+    /// The depth swapchain's `VkImage`s (2 layers each, [`DepthOptions::format`]), when depth
+    /// is submitted; empty otherwise.
+    pub depth_images: Vec<vk::Image>,
 }
 
 impl Runtime {

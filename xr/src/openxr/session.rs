@@ -2,6 +2,7 @@
 
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use ash::vk;
@@ -9,11 +10,13 @@ use ash::vk::Handle;
 use glam::{Quat, Vec3};
 use openxr as xr;
 
+use super::actions::{Command, Controls};
 use super::choose::{self, Blend, GazeOffer, GazeSource, SpaceChoice};
 use super::gaze::{ExtGaze, FbTracker, Gaze, TraceGaze};
 use super::state::{self, Action, EndReason, State};
 use super::{
-    OpenXrError, Result, Runtime, SessionOptions, SwapchainImages, VulkanHandles, XrContext,
+    DepthOptions, OpenXrError, Result, Runtime, SessionOptions, SwapchainImages, VulkanHandles,
+    XrContext,
 };
 use crate::frame::{Backend, EyeView, Fov, FrameInput, FrameTarget, Pose};
 
@@ -53,6 +56,18 @@ pub struct SessionReport {
     pub blend: Option<Blend>,
     /// Frames whose views the runtime could not locate fully (pose not valid).
     pub frames_untracked: u64,
+    /// The controller action set was created and attached to the session.
+    pub actions_attached: bool,
+    /// Interaction profiles whose suggested bindings the runtime accepted.
+    pub action_profiles: Vec<String>,
+    /// Successful xrSyncActions calls (one per FOCUSED frame).
+    pub action_syncs: u64,
+    /// Commands the live actions gave.
+    pub commands: u64,
+    /// Frames submitted with depth (XR_KHR_composition_layer_depth).
+    pub frames_with_depth: u64,
+    /// The depth swapchain's format (VkFormat code) when depth is submitted.
+    pub depth_format: Option<i32>,
 }
 
 impl SessionReport {
@@ -70,6 +85,8 @@ struct Pending {
     views: Vec<xr::View>,
     /// Its index.
     index: u64,
+    /// The depth swapchain image acquired for it, when depth is submitted.
+    depth_image: Option<u32>,
 }
 
 /// A live OpenXR session; the [`Backend`] of `vitreous run`.
@@ -80,6 +97,16 @@ pub struct Session {
     waiter: xr::FrameWaiter,
     /// The one 2-layer swapchain.
     swapchain: xr::Swapchain<xr::Vulkan>,
+    /// The 2-layer depth swapchain, when depth is submitted, and its near/far planes.
+    depth: Option<(xr::Swapchain<xr::Vulkan>, DepthOptions)>,
+    /// The controller actions, when their set could be made.
+    controls: Option<Controls>,
+    /// Every action set attached to the session (synced together each FOCUSED frame).
+    action_sets: Vec<xr::ActionSet>,
+    /// Where commands go for the app (see [`Session::take_commands`]).
+    commands_tx: mpsc::Sender<Command>,
+    /// The app's end, until taken.
+    commands_rx: Option<mpsc::Receiver<Command>>,
     /// The gaze source (holds spaces/trackers of the session).
     gaze: Gaze,
     /// The app space the scene is placed in (STAGE or LOCAL).
@@ -197,6 +224,28 @@ pub(super) unsafe fn start(
         .into_iter()
         .map(vk::Image::from_raw)
         .collect();
+    let depth = match (rt.depth_layer, options.depth) {
+        (true, Some(d)) => depth_swapchain(&session, &formats, d, (w, h)),
+        (false, Some(_)) => {
+            tracing::info!(
+                "depth not submitted: the runtime does not offer XR_KHR_composition_layer_depth"
+            );
+            None
+        }
+        (_, None) => None,
+    };
+    let depth_images = match &depth {
+        Some((chain, _)) => match chain.enumerate_images() {
+            Ok(raw) => raw.into_iter().map(vk::Image::from_raw).collect(),
+            Err(e) => {
+                return Err(OpenXrError::Call {
+                    call: "xrEnumerateSwapchainImages(depth)",
+                    result: e,
+                });
+            }
+        },
+        None => Vec::new(),
+    };
 
     let offer = GazeOffer {
         fb_social: rt.fb_gaze && rt.info.fb_eye_tracking_supported,
@@ -238,10 +287,37 @@ pub(super) unsafe fn start(
             }
         }
     };
+    // Controller actions: a failure here costs the live actions only, never the session.
+    let controls = match Controls::new(&rt.instance) {
+        Ok(c) => Some(c),
+        Err(e) => {
+            tracing::warn!("no live controller actions: {e}");
+            None
+        }
+    };
+    // xrAttachSessionActionSets may be called once per session: every set goes in together.
+    let mut action_sets: Vec<xr::ActionSet> = Vec::new();
     if let Gaze::ExtGaze(g) = &gaze {
+        action_sets.push(g.set.clone());
+    }
+    if let Some(c) = &controls {
+        action_sets.push(c.set.clone());
+    }
+    if !action_sets.is_empty() {
+        let refs: Vec<&xr::ActionSet> = action_sets.iter().collect();
         session
-            .attach_action_sets(&[&g.set])
+            .attach_action_sets(&refs)
             .xr("xrAttachSessionActionSets")?;
+    }
+    let action_profiles: Vec<String> = controls
+        .as_ref()
+        .map(|c| c.profiles.iter().map(|p| (*p).to_owned()).collect())
+        .unwrap_or_default();
+    if controls.is_some() {
+        tracing::info!(
+            "controller actions attached (select, menu on each hand; profiles: {})",
+            action_profiles.join(", ")
+        );
     }
     tracing::info!("gaze source: {}", gaze.source());
     if gaze.source() == GazeSource::Manual {
@@ -261,6 +337,9 @@ pub(super) unsafe fn start(
         gaze_source: Some(gaze.source()),
         space: Some(space_choice),
         blend: Some(rt.info.blend),
+        actions_attached: controls.is_some(),
+        action_profiles,
+        depth_format: depth.as_ref().map(|(_, d)| d.format.as_raw()),
         ..SessionReport::default()
     };
     let out = SwapchainImages {
@@ -268,12 +347,19 @@ pub(super) unsafe fn start(
         format: vk::Format::from_raw(format.vk_format as i32),
         srgb: format.srgb,
         size: (w, h),
+        depth_images,
     };
+    let (commands_tx, commands_rx) = mpsc::channel();
     Ok((
         Session {
             stream,
             waiter,
             swapchain,
+            depth,
+            controls,
+            action_sets,
+            commands_tx,
+            commands_rx: Some(commands_rx),
             gaze,
             space,
             view_space,
@@ -296,6 +382,113 @@ pub(super) unsafe fn start(
         },
         out,
     ))
+}
+
+/// Makes the 2-layer depth swapchain, or says why not and returns `None` (no depth is then
+/// submitted; nothing else changes).
+fn depth_swapchain(
+    session: &xr::Session<xr::Vulkan>,
+    formats: &[i64],
+    depth: DepthOptions,
+    (w, h): (u32, u32),
+) -> Option<(xr::Swapchain<xr::Vulkan>, DepthOptions)> {
+    let code = i64::from(depth.format.as_raw());
+    if !formats.contains(&code) {
+        tracing::warn!(
+            "depth not submitted: the runtime offers no {:?} swapchain (VkFormat codes \
+             offered: {formats:?})",
+            depth.format
+        );
+        return None;
+    }
+    let made = session.create_swapchain(&xr::SwapchainCreateInfo {
+        create_flags: xr::SwapchainCreateFlags::EMPTY,
+        usage_flags: xr::SwapchainUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        format: code as u32,
+        sample_count: 1,
+        width: w,
+        height: h,
+        face_count: 1,
+        array_size: 2,
+        mip_count: 1,
+    });
+    match made {
+        Ok(chain) => {
+            tracing::info!(
+                "depth submitted with XR_KHR_composition_layer_depth: {:?} swapchain, depth 0..1 \
+                 = {} m..{} m",
+                depth.format,
+                depth.near_m,
+                depth.far_m
+            );
+            Some((chain, depth))
+        }
+        Err(e) => {
+            tracing::warn!("depth not submitted: xrCreateSwapchain(depth) failed: {e}");
+            None
+        }
+    }
+}
+
+/// The depth info of one eye's layer: image `layer` of `swapchain` over `rect`, depth 0..1
+/// from `near_m` to `far_m` (a standard, not reversed, projection).
+pub(crate) fn depth_info(
+    swapchain: xr::sys::Swapchain,
+    layer: u32,
+    rect: xr::Rect2Di,
+    depth: &DepthOptions,
+) -> xr::sys::CompositionLayerDepthInfoKHR {
+    xr::sys::CompositionLayerDepthInfoKHR {
+        ty: xr::sys::CompositionLayerDepthInfoKHR::TYPE,
+        next: std::ptr::null(),
+        sub_image: xr::sys::SwapchainSubImage {
+            swapchain,
+            image_rect: rect,
+            image_array_index: layer,
+        },
+        min_depth: 0.0,
+        max_depth: 1.0,
+        near_z: depth.near_m,
+        far_z: depth.far_m,
+    }
+}
+
+/// Chains each view's depth info into its `next` (keeping whatever was chained before behind
+/// it).
+///
+/// # Safety
+/// `infos` must outlive every use of `views` (xrEndFrame), and must not move.
+pub(crate) unsafe fn chain_depth(
+    views: &mut [xr::sys::CompositionLayerProjectionView],
+    infos: &mut [xr::sys::CompositionLayerDepthInfoKHR],
+) {
+    for (view, info) in views.iter_mut().zip(infos.iter_mut()) {
+        info.next = view.next;
+        view.next = info as *const xr::sys::CompositionLayerDepthInfoKHR as *const _;
+    }
+}
+
+/// The scene frame from app space after a re-registration command: the scene moves by `d`
+/// (Nudge), or turns by `a` about the vertical axis through the head at `head_m` (Rotate),
+/// both in the scene frame. Other commands leave it as is.
+pub(crate) fn re_register(world_from_space: &Pose, command: Command, head_m: Vec3) -> Pose {
+    let change = match command {
+        // The scene moving by d is everything else moving by -d in scene coordinates.
+        Command::Nudge(d) => Pose {
+            position: -d,
+            orientation: Quat::IDENTITY,
+        },
+        // p' = R(-a) (p - h) + h.
+        Command::Rotate(a) => {
+            let r = Quat::from_rotation_y(-a);
+            Pose {
+                position: head_m - r * head_m,
+                orientation: r,
+            }
+        }
+        Command::NextCondition | Command::NextGazeImage => return *world_from_space,
+    };
+    compose(&change, world_from_space)
 }
 
 /// vitreous' state for an OpenXR one.
@@ -382,16 +575,47 @@ impl Session {
         self.size
     }
 
-    /// Moves the scene by `offset` (scene frame, metres) and turns it by `yaw_rad` about +y:
-    /// live re-registration.
-    pub fn nudge_scene(&mut self, offset_m: Vec3, yaw_rad: f32) {
+    /// The commands of the live actions, as they come (each is also logged, and Nudge and
+    /// Rotate are applied to the scene's placement by the session itself). `None` after the
+    /// first call.
+    pub fn take_commands(&mut self) -> Option<mpsc::Receiver<Command>> {
+        self.commands_rx.take()
+    }
+
+    /// Applies a command as if a live action gave it (Nudge and Rotate re-register the scene;
+    /// every command is passed on to [`Session::take_commands`]'s receiver). `head_m` is the
+    /// head's position in the scene frame.
+    pub fn command(&mut self, command: Command, head_m: Vec3) {
+        tracing::info!("live action: {command}");
+        self.report.commands += 1;
         if let Some(w) = &mut self.world_from_space {
-            let turn = Pose {
-                position: offset_m,
-                orientation: Quat::from_rotation_y(yaw_rad),
-            };
-            *w = compose(&turn, w);
+            *w = re_register(w, command, head_m);
         }
+        // The app may have dropped its receiver: then nobody wants the rest.
+        let _ = self.commands_tx.send(command);
+    }
+
+    /// xrSyncActions with every attached set, then the controller commands; only while
+    /// FOCUSED (input goes to the focused session only).
+    fn sync_actions(&mut self, head_m: Vec3) -> Result<()> {
+        if self.state != State::Focused || self.action_sets.is_empty() {
+            return Ok(());
+        }
+        let active: Vec<xr::ActiveActionSet<'_>> = self
+            .action_sets
+            .iter()
+            .map(xr::ActiveActionSet::new)
+            .collect();
+        self.session.sync_actions(&active).xr("xrSyncActions")?;
+        self.report.action_syncs += 1;
+        let commands = match &self.controls {
+            Some(c) => c.commands(&self.session)?,
+            None => Vec::new(),
+        };
+        for command in commands {
+            self.command(command, head_m);
+        }
+        Ok(())
     }
 
     fn set_state(&mut self, s: State) {
@@ -586,19 +810,33 @@ impl Backend for Session {
             self.swapchain
                 .wait_image(xr::Duration::INFINITE)
                 .xr("xrWaitSwapchainImage")?;
+            let depth_image = match &mut self.depth {
+                Some((chain, _)) => {
+                    let i = chain.acquire_image().xr("xrAcquireSwapchainImage(depth)")?;
+                    chain
+                        .wait_image(xr::Duration::INFINITE)
+                        .xr("xrWaitSwapchainImage(depth)")?;
+                    Some(i)
+                }
+                None => None,
+            };
             // Views are located after the wait for the image, as late as this loop allows.
             let (head_space, views, tracked) = self.locate(display)?;
             if !tracked {
                 self.report.frames_untracked += 1;
             }
             let first_display = *self.first_display.get_or_insert(display);
-            let world_from_space = *self.world_from_space.get_or_insert_with(|| {
+            let placed = *self.world_from_space.get_or_insert_with(|| {
                 place_scene(
                     &head_space,
                     self.options.viewer_position_m,
                     self.options.scene_origin,
                 )
             });
+            // Live actions (and the eye-gaze action) are synced before the gaze is sampled and
+            // before the placement is used, so a nudge shows in this very frame.
+            self.sync_actions(compose(&placed, &head_space).position)?;
+            let world_from_space = self.world_from_space.unwrap_or(placed);
             let gaze = self
                 .gaze
                 .sample(&self.session, &self.view_space, display, first_display);
@@ -623,6 +861,7 @@ impl Backend for Session {
                     display,
                     views,
                     index: self.next_index,
+                    depth_image,
                 },
                 image,
             ));
@@ -633,8 +872,9 @@ impl Backend for Session {
 
     fn frame_target(&self) -> FrameTarget {
         match &self.pending {
-            Some((_, image)) => FrameTarget::Swapchain {
+            Some((pending, image)) => FrameTarget::Swapchain {
                 index: *image,
+                depth_index: pending.depth_image,
                 world_behind: self.world_behind,
             },
             None => FrameTarget::Own,
@@ -656,6 +896,9 @@ impl Backend for Session {
         self.swapchain
             .release_image()
             .xr("xrReleaseSwapchainImage")?;
+        if let (Some((chain, _)), Some(_)) = (&mut self.depth, pending.depth_image) {
+            chain.release_image().xr("xrReleaseSwapchainImage(depth)")?;
+        }
         let (w, h) = self.size;
         let rect = xr::Rect2Di {
             offset: xr::Offset2Di { x: 0, y: 0 },
@@ -664,7 +907,7 @@ impl Backend for Session {
                 height: h as i32,
             },
         };
-        let views: Vec<_> = pending
+        let mut views: Vec<_> = pending
             .views
             .iter()
             .enumerate()
@@ -680,13 +923,37 @@ impl Backend for Session {
                     )
             })
             .collect();
+        // Depth: the safe API cannot chain XrCompositionLayerDepthInfoKHR, so each view is
+        // rebuilt from its raw struct with the depth info behind `next`. `depth_infos` lives
+        // (unmoved) until xrEndFrame has returned.
+        let mut depth_infos: Vec<xr::sys::CompositionLayerDepthInfoKHR> = Vec::new();
+        if let (Some((chain, options)), Some(_)) = (&self.depth, pending.depth_image) {
+            depth_infos = (0..views.len() as u32)
+                .map(|eye| depth_info(chain.as_raw(), eye, rect, options))
+                .collect();
+            let mut raw: Vec<xr::sys::CompositionLayerProjectionView> =
+                views.iter().map(|v| *v.as_raw()).collect();
+            // SAFETY: `depth_infos` is not touched again before xrEndFrame returns; the
+            // rebuilt views keep the colour swapchain they referenced (still alive in self).
+            unsafe {
+                chain_depth(&mut raw, &mut depth_infos);
+                views = raw
+                    .into_iter()
+                    .map(|r| xr::CompositionLayerProjectionView::from_raw(r))
+                    .collect();
+            }
+        }
         let layer = xr::CompositionLayerProjection::new()
             .space(&self.space)
             .views(&views);
         self.stream
             .end(pending.display, self.blend, &[&layer])
             .xr("xrEndFrame")?;
+        drop(depth_infos);
         self.report.frames_submitted += 1;
+        if pending.depth_image.is_some() {
+            self.report.frames_with_depth += 1;
+        }
         Ok(())
     }
 }
@@ -697,6 +964,9 @@ impl Drop for Session {
         // runtime is not left waiting.
         if let Some((pending, _)) = self.pending.take() {
             let _ = self.swapchain.release_image();
+            if let (Some((chain, _)), Some(_)) = (&mut self.depth, pending.depth_image) {
+                let _ = chain.release_image();
+            }
             let _ = self.stream.end(pending.display, self.blend, &[]);
         }
         if self.running {
@@ -724,5 +994,67 @@ mod tests {
         // Round trip of the helpers.
         let back = compose(&inverse(&w), &head_world);
         assert!((back.position - head0.position).length() < 1e-5);
+    }
+    #[test]
+    fn a_nudge_moves_the_scene_and_a_turn_keeps_the_head_in_place() {
+        let head0 = Pose {
+            position: Vec3::new(0.3, 1.6, 0.2),
+            orientation: Quat::from_rotation_y(0.4),
+        };
+        let w = place_scene(&head0, Vec3::ZERO, None);
+        let head_m = compose(&w, &head0).position;
+        // The scene moves 1 cm away (-z): the head's scene coordinates move 1 cm the other way.
+        let d = Vec3::new(0.0, 0.0, -0.01);
+        let nudged = re_register(&w, Command::Nudge(d), head_m);
+        let moved = compose(&nudged, &head0).position - head_m;
+        assert!((moved + d).length() < 1e-6, "{moved}");
+        // A turn about the head: the head stays, its view turns the other way in the scene,
+        // so the scene appears turned by +a (to the left).
+        let a = 0.1;
+        let turned = re_register(&w, Command::Rotate(a), head_m);
+        let head = compose(&turned, &head0);
+        assert!((head.position - head_m).length() < 1e-5);
+        let f = head.orientation * Vec3::NEG_Z;
+        let f0 = compose(&w, &head0).orientation * Vec3::NEG_Z;
+        let yaw = |v: Vec3| (-v.x).atan2(-v.z);
+        assert!((yaw(f) - yaw(f0) + a).abs() < 1e-5, "{f} {f0}");
+        // Other commands leave the placement alone.
+        assert_eq!(re_register(&w, Command::NextCondition, head_m), w);
+    }
+
+    #[test]
+    fn each_view_chains_its_depth_info() {
+        let rect = xr::Rect2Di {
+            offset: xr::Offset2Di { x: 0, y: 0 },
+            extent: xr::Extent2Di {
+                width: 320,
+                height: 240,
+            },
+        };
+        let options = DepthOptions {
+            format: vk::Format::D32_SFLOAT,
+            near_m: 0.02,
+            far_m: 100.0,
+        };
+        let chain = <xr::sys::Swapchain as xr::sys::Handle>::from_raw(7);
+        let mut infos: Vec<_> = (0..2)
+            .map(|l| depth_info(chain, l, rect, &options))
+            .collect();
+        let view = *xr::CompositionLayerProjectionView::<xr::Vulkan>::new().as_raw();
+        let mut views = [view, view];
+        unsafe { chain_depth(&mut views, &mut infos) };
+        for (eye, v) in views.iter().enumerate() {
+            let info = unsafe { &*(v.next as *const xr::sys::CompositionLayerDepthInfoKHR) };
+            assert_eq!(
+                info.ty,
+                xr::sys::StructureType::COMPOSITION_LAYER_DEPTH_INFO_KHR
+            );
+            assert!(info.next.is_null());
+            assert_eq!(info.sub_image.swapchain, chain);
+            assert_eq!(info.sub_image.image_array_index, eye as u32);
+            assert_eq!(info.sub_image.image_rect.extent.width, 320);
+            assert_eq!((info.min_depth, info.max_depth), (0.0, 1.0));
+            assert_eq!((info.near_z, info.far_z), (0.02, 100.0));
+        }
     }
 }

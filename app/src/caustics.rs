@@ -1,0 +1,298 @@
+//! The caustics bake file (paper Sec. 3.1.2, eq. 6; docs/caustics.md): a single-channel linear
+//! f32 OpenEXR image of the caustic gain G, ZIP compressed, row 0 = the floor photo's top edge,
+//! with the scene hash and the bake parameters as text attributes. Written by the baker
+//! (`vitreous-caustics`, which re-exports this module) and read by the renderer's app.
+
+use std::path::{Path, PathBuf};
+
+use exr::prelude::*;
+use thiserror::Error;
+
+/// Name of the header attribute holding the scene hash.
+pub const SCENE_HASH_ATTRIBUTE: &str = "vitreous_scene_hash";
+/// Name of the header attribute holding the bake parameters (`key=value; ...`).
+pub const PARAMS_ATTRIBUTE: &str = "vitreous_caustics_params";
+/// Name of the single channel holding the gain.
+pub const GAIN_CHANNEL: &str = "Y";
+
+/// A caustic gain map for one scene's floor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bake {
+    /// Width, texels (floor local x, left to right).
+    pub width_px: u32,
+    /// Height, texels (row 0 = the floor photo's top edge, floor local +y).
+    pub height_px: u32,
+    /// Relative caustic gain G >= 0 per texel, row-major: the corrected caustic overlay is
+    /// `G * L_r` (eq. 6) where `L_r` is the floor photo's linear luminance at that texel.
+    pub gain: Vec<f32>,
+    /// [`crate::scene::Scene::hash`] of the scene it was baked for.
+    pub scene_hash: String,
+    /// The bake parameters, `key=value; ...` text.
+    pub params: String,
+}
+
+impl Bake {
+    /// Gain at texel `(x, y)` (y = 0 at the photo top), 0 outside the map.
+    pub fn gain_at(&self, x_px: u32, y_px: u32) -> f32 {
+        if x_px >= self.width_px || y_px >= self.height_px {
+            return 0.0;
+        }
+        self.gain[y_px as usize * self.width_px as usize + x_px as usize]
+    }
+
+    /// Bilinear gain at floor texture coordinates (u right, v down, both 0..1, v = 0 at the
+    /// photo top; plane-local `(x, y)` = `(u - 0.5, 0.5 - v)`), clamped to the edge.
+    pub fn sample(&self, u: f32, v: f32) -> f32 {
+        let x = (u * self.width_px as f32 - 0.5).clamp(0.0, (self.width_px - 1) as f32);
+        let y = (v * self.height_px as f32 - 0.5).clamp(0.0, (self.height_px - 1) as f32);
+        let (x0, y0) = (x.floor() as u32, y.floor() as u32);
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let g = |dx: u32, dy: u32| {
+            self.gain_at(
+                (x0 + dx).min(self.width_px - 1),
+                (y0 + dy).min(self.height_px - 1),
+            )
+        };
+        (g(0, 0) * (1.0 - fx) + g(1, 0) * fx) * (1.0 - fy)
+            + (g(0, 1) * (1.0 - fx) + g(1, 1) * fx) * fy
+    }
+}
+
+/// Why a bake file cannot be used.
+#[derive(Debug, Error)]
+pub enum BakeError {
+    /// No file at the path.
+    #[error(
+        "no caustics bake at {path}; bake it with \
+         `cargo run --release -p vitreous-caustics -- bake <scene.toml> -o {path}`"
+    )]
+    Missing {
+        /// The path looked for.
+        path: PathBuf,
+    },
+    /// The file exists but cannot be read.
+    #[error("cannot read the caustics bake {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// The file is not a valid gain EXR.
+    #[error("the caustics bake {path} is corrupt or not a caustics bake: {reason}")]
+    Corrupt {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// Baked for another scene (or the scene or its assets changed since).
+    #[error(
+        "the caustics bake {path} was made for a different scene (hash {found}, the scene's \
+         is {expected}); the scene or one of its assets changed since: re-bake with \
+         `cargo run --release -p vitreous-caustics -- bake <scene.toml> -o {path}`"
+    )]
+    WrongScene {
+        /// The file.
+        path: PathBuf,
+        /// The hash of the scene being rendered.
+        expected: String,
+        /// The hash stored in the file.
+        found: String,
+    },
+    /// The scene names no bake (`[caustics] bake`) but the caustics were asked for.
+    #[error(
+        "the scene {scene} names no caustics bake: add `[caustics] bake = \"../bakes/<name>.exr\"` \
+         and bake it with `cargo run --release -p vitreous-caustics -- bake {scene}`"
+    )]
+    NotNamed {
+        /// The scene file.
+        scene: PathBuf,
+    },
+    /// Writing failed.
+    #[error("cannot write the caustics bake {path}: {reason}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The encoder's or operating system's reason.
+        reason: String,
+    },
+}
+
+/// Writes `bake` to `path` (single channel `Y`, f32, ZIP, deterministic byte for byte).
+pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError> {
+    let write_err = |reason: String| BakeError::Write {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let text = |s: &str| {
+        Text::new_or_none(s)
+            .ok_or_else(|| write_err(format!("attribute text {s:?} is not Latin-1")))
+    };
+    let size = (bake.width_px as usize, bake.height_px as usize);
+    if bake.gain.len() != size.0 * size.1 {
+        return Err(write_err(format!(
+            "{} gain values for {} x {} texels",
+            bake.gain.len(),
+            size.0,
+            size.1
+        )));
+    }
+    let channel = AnyChannel::new(GAIN_CHANNEL, FlatSamples::F32(bake.gain.clone()));
+    // One custom attribute per attribute map: exr keeps them in hash maps, and a single
+    // entry per map keeps the header's byte order fixed.
+    let mut layer_attributes = LayerAttributes::default();
+    layer_attributes.other.insert(
+        text(PARAMS_ATTRIBUTE)?,
+        AttributeValue::Text(text(&bake.params)?),
+    );
+    let layer = Layer::new(
+        size,
+        layer_attributes,
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(vec![channel].into()),
+    );
+    let mut image = Image::from_layer(layer);
+    image.attributes.other.insert(
+        text(SCENE_HASH_ATTRIBUTE)?,
+        AttributeValue::Text(text(&bake.scene_hash)?),
+    );
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| write_err(e.to_string()))?;
+    }
+    image
+        .write()
+        .non_parallel()
+        .to_file(path)
+        .map_err(|e| write_err(e.to_string()))
+}
+
+/// Reads a bake and checks it belongs to the scene with hash `expected_scene_hash`.
+pub fn read_bake(path: &Path, expected_scene_hash: &str) -> std::result::Result<Bake, BakeError> {
+    let bake = read_bake_unchecked(path)?;
+    if bake.scene_hash != expected_scene_hash {
+        return Err(BakeError::WrongScene {
+            path: path.to_path_buf(),
+            expected: expected_scene_hash.to_owned(),
+            found: bake.scene_hash,
+        });
+    }
+    Ok(bake)
+}
+
+/// Reads a bake without checking which scene it belongs to (for comparisons).
+pub fn read_bake_unchecked(path: &Path) -> std::result::Result<Bake, BakeError> {
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(BakeError::Missing {
+                path: path.to_path_buf(),
+            });
+        }
+        Err(source) => {
+            return Err(BakeError::Io {
+                path: path.to_path_buf(),
+                source,
+            });
+        }
+        Ok(_) => {}
+    }
+    let corrupt = |reason: String| BakeError::Corrupt {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| corrupt(e.to_string()))?;
+    let attr_text = |map: &std::collections::HashMap<Text, AttributeValue>, name: &str| {
+        map.iter().find_map(|(k, v)| match v {
+            AttributeValue::Text(t) if k.eq(name) => Some(t.to_string()),
+            _ => None,
+        })
+    };
+    let layer = &image.layer_data;
+    let scene_hash = attr_text(&image.attributes.other, SCENE_HASH_ATTRIBUTE)
+        .or_else(|| attr_text(&layer.attributes.other, SCENE_HASH_ATTRIBUTE))
+        .ok_or_else(|| corrupt(format!("it has no `{SCENE_HASH_ATTRIBUTE}` attribute")))?;
+    let params = attr_text(&layer.attributes.other, PARAMS_ATTRIBUTE)
+        .or_else(|| attr_text(&image.attributes.other, PARAMS_ATTRIBUTE))
+        .unwrap_or_default();
+    let channel = layer
+        .channel_data
+        .list
+        .iter()
+        .find(|c| c.name.to_string() == GAIN_CHANNEL)
+        .ok_or_else(|| corrupt(format!("it has no `{GAIN_CHANNEL}` channel")))?;
+    let gain: Vec<f32> = match &channel.sample_data {
+        FlatSamples::F32(v) => v.clone(),
+        FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
+        FlatSamples::U32(_) => return Err(corrupt("the gain channel holds integers".into())),
+    };
+    let (w, h) = (layer.size.width(), layer.size.height());
+    if gain.len() != w * h || w == 0 || h == 0 {
+        return Err(corrupt(format!(
+            "{} samples for {w} x {h} texels",
+            gain.len()
+        )));
+    }
+    if let Some(bad) = gain.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
+        return Err(corrupt(format!(
+            "it holds a gain of {bad}; gains are finite and >= 0"
+        )));
+    }
+    Ok(Bake {
+        width_px: w as u32,
+        height_px: h as u32,
+        gain,
+        scene_hash,
+        params,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Bake {
+        Bake {
+            width_px: 5,
+            height_px: 3,
+            gain: (0..15).map(|i| i as f32 * 0.5).collect(),
+            scene_hash: "abc123".into(),
+            params: "method=test".into(),
+        }
+    }
+
+    #[test]
+    fn bake_round_trips_with_hash_and_orientation() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("b.exr");
+        write_bake(&path, &sample()).unwrap();
+        let back = read_bake(&path, "abc123").unwrap();
+        assert_eq!(back, sample());
+        assert_eq!(back.gain_at(4, 0), 2.0);
+        assert!((back.sample(0.1, 1.0 / 6.0) - 0.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn missing_corrupt_and_foreign_bakes_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("b.exr");
+        let err = read_bake(&path, "x").unwrap_err();
+        assert!(matches!(err, BakeError::Missing { .. }), "{err}");
+        assert!(err.to_string().contains("vitreous-caustics -- bake"));
+
+        std::fs::write(&path, b"not an exr").unwrap();
+        let err = read_bake(&path, "x").unwrap_err();
+        assert!(matches!(err, BakeError::Corrupt { .. }), "{err}");
+
+        write_bake(&path, &sample()).unwrap();
+        let err = read_bake(&path, "other").unwrap_err();
+        assert!(matches!(err, BakeError::WrongScene { .. }), "{err}");
+        assert!(err.to_string().contains("abc123") && err.to_string().contains("other"));
+    }
+}

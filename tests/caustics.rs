@@ -1,0 +1,246 @@
+//! The corrected caustics overlay (METHOD.md section 2, eq. 6) on the machine's Vulkan device
+//! with validation on: with a uniform floor photo and a known caustic gain map G, every floor
+//! pixel of the eye image carries (k alpha(d) + G) L_r for the study's condition c (inducer +
+//! caustics), G L_r for b (caustics only) and nothing for a; plus the shipped bakes' scene
+//! check and the errors for missing and foreign bakes.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Quat, Vec2, Vec3, Vec4Swizzles};
+use vitreous::caustics::{Bake, BakeError};
+use vitreous::effects::EffectSet;
+use vitreous::scene::{Image, PixelData, Scene, load_scene};
+use vitreous::views;
+use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_render::renderer::Want;
+use vitreous_render::{ContextOptions, FrameParams, GpuContext, Readback, Reflection, Renderer};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn scene(name: &str) -> Scene {
+    let path = workspace().join("config/scenes").join(name);
+    load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn srgb_to_linear(v: u8) -> f32 {
+    let c = f32::from(v) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The photo coordinate of a world point on the floor.
+fn floor_uv(scene: &Scene, world: Vec3) -> Vec2 {
+    let local = scene
+        .floor
+        .world_from_plane()
+        .inverse()
+        .transform_point3(world);
+    Vec2::new(local.x + 0.5, 0.5 - local.y)
+}
+
+/// Where the centre of pixel (x, y) sees the floor plane.
+fn pixel_on_floor(eye: &EyeParams, size: (u32, u32), x: u32, y: u32, floor_y: f32) -> Vec3 {
+    let ndc = Vec2::new(
+        (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
+        (y as f32 + 0.5) / size.1 as f32 * 2.0 - 1.0,
+    );
+    let world_from_clip: Mat4 = eye.clip_from_world().inverse();
+    let far = world_from_clip * ndc.extend(0.5).extend(1.0);
+    let dir = far.xyz() / far.w - eye.position_m;
+    eye.position_m + dir * ((floor_y - eye.position_m.y) / dir.y)
+}
+
+/// Where the straight ray from the light through the object's centre meets the floor: the
+/// middle of the shadow.
+fn shadow_centre(scene: &Scene) -> Vec3 {
+    let light = scene.light.position_m;
+    let dir = scene.object.center_m - light;
+    let floor_y = scene.floor.pose.position.y;
+    light + dir * ((floor_y - light.y) / dir.y)
+}
+
+/// Two eyes 0.6 m above the shadow's middle looking straight down.
+fn top_down_eyes(scene: &Scene) -> [EyeParams; 2] {
+    let above = shadow_centre(scene) + Vec3::Y * 0.6;
+    let fov = Fov {
+        left_rad: -0.4,
+        right_rad: 0.4,
+        up_rad: 0.3,
+        down_rad: -0.3,
+    };
+    let down = Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2);
+    [-0.0315f32, 0.0315].map(|x| EyeParams::new(above + Vec3::X * x, down, fov))
+}
+
+/// A caustic gain map at `n` x `n`: a Gaussian spot of peak `peak` and sigma 12 texels at
+/// floor uv `centre`, 0 where it falls below 1 % of the peak (so the map has a small
+/// non-zero extent).
+fn spot_bake(n: u32, centre: Vec2, peak: f32, hash: &str) -> Bake {
+    let sigma = 12.0f32;
+    let gain = (0..n * n)
+        .map(|i| {
+            let p = Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5);
+            let r2 = (p - centre * n as f32).length_squared();
+            let g = peak * (-r2 / (2.0 * sigma * sigma)).exp();
+            if g < 0.01 * peak { 0.0 } else { g }
+        })
+        .collect();
+    Bake {
+        width_px: n,
+        height_px: n,
+        gain,
+        scene_hash: hash.to_owned(),
+        params: "method=test".into(),
+    }
+}
+
+fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], effects: &str) -> Readback {
+    let effects = EffectSet::parse(effects).unwrap();
+    let params = FrameParams {
+        eyes,
+        look: views::look(&effects, Reflection::EnvironmentFresnel),
+    };
+    let want = Want {
+        eyes: true,
+        world: false,
+    };
+    let mut results = Vec::new();
+    results.extend(renderer.submit(&params, want).unwrap());
+    results.extend(renderer.flush().unwrap());
+    results.pop().unwrap().readback.unwrap()
+}
+
+#[test]
+fn eye_image_adds_inducer_and_caustic_gain_times_a_uniform_floor() {
+    const GREY: u8 = 120;
+    let mut s = scene("glass-sphere.toml");
+    s.floor.photo = Image::new(8, 8, PixelData::Srgb8([GREY, GREY, GREY, 255].repeat(64))).unwrap();
+    let l_r = srgb_to_linear(GREY);
+    // The spot straddles the shadow's edge towards the viewer (shadow, ramp and open floor).
+    let centre = floor_uv(&s, shadow_centre(&s) + Vec3::new(0.02, 0.0, 0.06));
+    let n = s.inducer.resolution_px;
+    let bake = spot_bake(n, centre, 0.8, &s.hash);
+    s.caustics.gain = Some(bake.clone());
+    let (w, h) = (320u32, 240u32);
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: true,
+        device_name: None,
+    })
+    .expect("Vulkan device with validation");
+    let mut r = Renderer::new(ctx, &views::scene_desc(&s, None), w, h).expect("renderer");
+    let eyes = top_down_eyes(&s);
+    let none = render(&mut r, eyes, "a");
+    // c, then b, then c again: the combined gain is recomputed on every switch change.
+    let frames = [
+        ("c", render(&mut r, eyes, "c")),
+        ("b", render(&mut r, eyes, "b")),
+        ("inducer", render(&mut r, eyes, "inducer")),
+        ("c", render(&mut r, eyes, "c")),
+    ];
+    let fields = r.inducer_fields().unwrap();
+    let floor_y = s.floor.pose.position.y;
+    for (name, frame) in &frames {
+        let (inducer_on, caustics_on) = match *name {
+            "c" => (true, true),
+            "b" => (false, true),
+            _ => (true, false),
+        };
+        let (mut worst, mut caustic_px, mut both_px, mut dark_px) = (0.0f32, 0, 0, 0);
+        for (e, eye) in eyes.iter().enumerate() {
+            for y in 0..h {
+                for x in 0..w {
+                    let i = ((y * w + x) * 4) as usize;
+                    if none.eyes[e][i..i + 3].iter().any(|&c| c != 0) {
+                        continue; // the glass covers the floor here
+                    }
+                    let uv = floor_uv(&s, pixel_on_floor(eye, (w, h), x, y, floor_y));
+                    let k_alpha = if inducer_on {
+                        fields.gain_bilinear(uv)
+                    } else {
+                        0.0
+                    };
+                    let g = if caustics_on {
+                        bake.sample(uv.x, uv.y)
+                    } else {
+                        0.0
+                    };
+                    let expected = (k_alpha + g) * l_r;
+                    let got = srgb_to_linear(frame.eyes[e][i]);
+                    let err = (got - expected).abs() / l_r;
+                    assert!(
+                        err <= 0.02,
+                        "{name}: eye {e} pixel ({x}, {y}): {got} vs {expected} (k alpha {k_alpha}, G {g})"
+                    );
+                    worst = worst.max(err);
+                    if g > 0.05 {
+                        caustic_px += 1;
+                        if k_alpha > 0.05 {
+                            both_px += 1;
+                        }
+                    }
+                    if k_alpha == 0.0 && g == 0.0 && bake.sample(uv.x, uv.y) == 0.0 {
+                        dark_px += 1;
+                    }
+                }
+            }
+        }
+        eprintln!(
+            "{name}: {caustic_px} caustic pixels ({both_px} also in the ramp), {dark_px} \
+             without overlay, worst error {worst:.4} of L_r"
+        );
+        if caustics_on {
+            assert!(caustic_px > 1000, "{name}: {caustic_px}");
+        }
+        if inducer_on && caustics_on {
+            assert!(both_px > 100, "{name}: {both_px}");
+        }
+    }
+    // Condition a adds nothing: the eye image is black wherever the glass is not.
+    let lit = none.eyes[0]
+        .chunks_exact(4)
+        .filter(|p| p[..3].iter().any(|&c| c != 0))
+        .count();
+    assert!(lit < (w * h / 4) as usize, "{lit} lit pixels with a");
+    let v = r.context().validation();
+    assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
+}
+
+#[test]
+fn shipped_bakes_belong_to_their_scenes() {
+    for name in ["glass-sphere.toml", "diamond.toml"] {
+        let mut s = scene(name);
+        s.load_caustics().unwrap_or_else(|e| panic!("{name}: {e}"));
+        let bake = s.caustics.gain.as_ref().unwrap();
+        let peak = bake.gain.iter().cloned().fold(0.0f32, f32::max);
+        eprintln!(
+            "{name}: {}x{} texels, peak G {peak}",
+            bake.width_px, bake.height_px
+        );
+        assert!(peak > 0.5, "{name}: peak G {peak}");
+    }
+}
+
+#[test]
+fn missing_unnamed_and_foreign_bakes_are_named() {
+    let mut s = scene("glass-sphere.toml");
+    s.hash = "0000".into();
+    let err = s.load_caustics().unwrap_err();
+    assert!(matches!(err, BakeError::WrongScene { .. }), "{err}");
+    assert!(err.to_string().contains("glass-sphere.exr"), "{err}");
+
+    let dir = tempfile::tempdir().unwrap();
+    s.caustics.bake = Some(dir.path().join("nowhere.exr"));
+    let err = s.load_caustics().unwrap_err();
+    assert!(matches!(err, BakeError::Missing { .. }), "{err}");
+    assert!(err.to_string().contains("nowhere.exr"), "{err}");
+
+    let mut t = scene("torus.toml");
+    let err = t.load_caustics().unwrap_err();
+    assert!(matches!(err, BakeError::NotNamed { .. }), "{err}");
+    assert!(err.to_string().contains("torus.toml"), "{err}");
+}

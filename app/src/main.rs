@@ -305,6 +305,24 @@ fn run(cli: Cli) -> Result<()> {
                 "vulkan validation: {} errors, {} warnings (enabled: {})",
                 s.validation.errors, s.validation.warnings, s.validation.enabled
             );
+            println!(
+                "actions attached: {}, syncs: {}, commands: {} (profiles: {}; conditions: {}; \
+                 final condition {}, gaze image {})",
+                s.actions_attached,
+                s.action_syncs,
+                s.commands,
+                s.action_profiles.join(", "),
+                s.conditions.join(" > "),
+                s.final_condition,
+                s.final_gaze_image
+            );
+            println!(
+                "depth submitted: {} ({}), {} of {} frames with depth",
+                s.depth_submitted,
+                s.depth_format.as_deref().unwrap_or("no depth swapchain"),
+                s.frames_with_depth,
+                s.frames_submitted
+            );
             if let Some(c) = &s.readback {
                 println!(
                     "readback of frame {}: object in {:.1} % of its region ({} of {} px), mean {:.1}",

@@ -7,7 +7,14 @@
 //! then the OpenXR instance.
 //!
 //! The loop is the shared one ([`crate::frame_loop`]) plus one hook: each frame is drawn where
-//! [`Backend::frame_target`] says (the renderer's own images or swapchain image `i`).
+//! [`Backend::frame_target`] says (the renderer's own images or swapchain image `i`, and depth
+//! swapchain image `j` when depth is submitted).
+//!
+//! Live actions (controller buttons, see `vitreous_xr::openxr::actions`) re-register the scene
+//! in the session itself; the commands that change the look reach the sink through
+//! [`Session::take_commands`](vitreous_xr::openxr::Session::take_commands) and are applied
+//! by [`LiveLooks`]: the next effect condition among those this build implements, and the
+//! forced gaze image (surface, refracted, auto).
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -23,7 +30,8 @@ use vitreous_render::{
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::openxr::ash::{self, vk};
 use vitreous_xr::openxr::{
-    Blend, OpenXrOptions, Runtime, SessionOptions, SessionReport, State, VulkanHandles,
+    Blend, Command, DepthOptions, OpenXrOptions, Runtime, SessionOptions, SessionReport, State,
+    VulkanHandles,
 };
 use vitreous_xr::trace::{TraceSample, TraceWriter, read_trace};
 use vitreous_xr::{Backend, FrameInput, GazeRay, GazeSample, Pose};
@@ -31,8 +39,9 @@ use vitreous_xr::{Backend, FrameInput, GazeRay, GazeSample, Pose};
 use crate::defocus::LookPlanner;
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
+use crate::gaze::GazeOverride;
 use crate::output::write_atomic;
-use crate::replay::{GazeSettings, planner_for};
+use crate::replay::{GazeSettings, planners_for};
 use crate::replay::{Spread, ValidationSummary};
 use crate::scene::{Scene, load_scene};
 use crate::views;
@@ -165,6 +174,135 @@ pub struct RunSummary {
     pub recorded_samples: u64,
     /// Replay of the recording against the session's views, when recorded.
     pub replay_check: Option<ReplayCheck>,
+    /// The controller action set was created and attached.
+    pub actions_attached: bool,
+    /// Interaction profiles whose bindings the runtime accepted.
+    pub action_profiles: Vec<String>,
+    /// xrSyncActions calls (one per FOCUSED frame).
+    pub action_syncs: u64,
+    /// Commands the live actions gave.
+    pub commands: u64,
+    /// The effect conditions the live actions cycle through, the first one the start.
+    pub conditions: Vec<String>,
+    /// The effect condition at the end.
+    pub final_condition: String,
+    /// The forced gaze image at the end (`auto`: the tracker decides).
+    pub final_gaze_image: String,
+    /// Whether depth was submitted (XR_KHR_composition_layer_depth).
+    pub depth_submitted: bool,
+    /// The depth swapchain's format, when depth was submitted.
+    pub depth_format: Option<String>,
+    /// Frames submitted with depth.
+    pub frames_with_depth: u64,
+}
+
+/// The paper's study conditions, in the order the live action cycles through them (after the
+/// run's own effect set): O2 (none), O3 (defocus), O4 (disparity), O5 (disparity + defocus),
+/// b (caustics), c (inducer + caustics).
+pub const STUDY_CONDITIONS: [&str; 6] = ["O2", "O3", "O4", "O5", "b", "c"];
+
+/// The effect conditions `vitreous run` cycles through: `start` first, then the study
+/// conditions, each once, keeping only those this build implements and (for caustics) those
+/// whose bake is loaded.
+pub fn live_conditions(start: EffectSet, caustics_loaded: bool) -> Vec<EffectSet> {
+    let mut out = vec![start];
+    for name in STUDY_CONDITIONS {
+        let set = EffectSet::parse(name).expect("study condition names parse");
+        if !out.contains(&set)
+            && set.ensure_implemented().is_ok()
+            && (!set.caustics || caustics_loaded)
+        {
+            out.push(set);
+        }
+    }
+    out
+}
+
+/// The looks the live actions switch between: a look planner per effect condition (all fed
+/// every frame, so switching keeps the gaze filters warm) and the forced gaze image.
+pub struct LiveLooks {
+    /// Each condition and its planner.
+    conditions: Vec<(EffectSet, LookPlanner)>,
+    /// Index of the condition shown.
+    current: usize,
+    /// The forced gaze image.
+    gaze: GazeOverride,
+}
+
+impl LiveLooks {
+    /// Starts at the first condition with gaze image `gaze`, applied to every planner.
+    pub fn new(conditions: Vec<(EffectSet, LookPlanner)>, gaze: GazeOverride) -> LiveLooks {
+        assert!(!conditions.is_empty(), "at least one condition");
+        let mut looks = LiveLooks {
+            conditions,
+            current: 0,
+            gaze,
+        };
+        looks.set_gaze(gaze);
+        looks
+    }
+
+    /// The condition shown.
+    pub fn condition(&self) -> EffectSet {
+        self.conditions[self.current].0
+    }
+
+    /// The forced gaze image.
+    pub fn gaze(&self) -> GazeOverride {
+        self.gaze
+    }
+
+    fn set_gaze(&mut self, gaze: GazeOverride) {
+        self.gaze = gaze;
+        for (_, planner) in &mut self.conditions {
+            planner.set_gaze_override(gaze);
+        }
+    }
+
+    /// Applies a live command; says what changed (None for commands the session handles:
+    /// Nudge and Rotate).
+    pub fn apply(&mut self, command: Command) -> Option<String> {
+        match command {
+            Command::NextCondition => {
+                self.current = (self.current + 1) % self.conditions.len();
+                Some(format!(
+                    "effect condition now {} ({} of {})",
+                    self.condition(),
+                    self.current + 1,
+                    self.conditions.len()
+                ))
+            }
+            Command::NextGazeImage => {
+                let next = match self.gaze {
+                    GazeOverride::Auto => GazeOverride::Surface,
+                    GazeOverride::Surface => GazeOverride::Refracted,
+                    GazeOverride::Refracted => GazeOverride::Auto,
+                };
+                self.set_gaze(next);
+                Some(format!(
+                    "gaze image now {next}{}",
+                    if self.condition().defocus {
+                        ""
+                    } else {
+                        " (shown once a condition with defocus is on)"
+                    }
+                ))
+            }
+            Command::Nudge(_) | Command::Rotate(_) => None,
+        }
+    }
+
+    /// This frame's look: every planner sees the frame, the current one's look is used.
+    pub fn plan(&mut self, input: &FrameInput) -> vitreous_render::Look {
+        let mut look = None;
+        for (i, (_, planner)) in self.conditions.iter_mut().enumerate() {
+            let l = planner.plan(input).0;
+            if i == self.current {
+                look = Some(l);
+            }
+        }
+        look.expect("current condition exists")
+    }
 }
 
 /// Creates the renderer's Vulkan instance and device through the OpenXR runtime.
@@ -217,8 +355,10 @@ impl DeviceCreator for XrDeviceCreator<'_> {
 
 /// Records frames and checks a readback.
 struct RunSink {
-    /// Decides each frame's look (gaze-dependent defocus).
-    planner: LookPlanner,
+    /// Decides each frame's look (effect condition, gaze-dependent defocus).
+    looks: LiveLooks,
+    /// Live commands from the session.
+    commands: Option<std::sync::mpsc::Receiver<Command>>,
     /// Frame to read back, if any.
     readback_frame: Option<u64>,
     /// The scene's object, for the region check.
@@ -247,8 +387,15 @@ impl FrameSink for RunSink {
 
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         let read = self.readback_frame == Some(input.index);
+        if let Some(rx) = &self.commands {
+            for command in rx.try_iter() {
+                if let Some(change) = self.looks.apply(command) {
+                    tracing::info!("frame {}: {change}", input.index);
+                }
+            }
+        }
         FramePlan {
-            look: self.planner.plan(input).0,
+            look: self.looks.plan(input),
             want: Want {
                 eyes: read,
                 world: read,
@@ -367,6 +514,23 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
     if effects.caustics {
         scene.load_caustics()?;
     }
+    // The caustic conditions are offered live only with the scene's bake loaded.
+    let caustics_loaded = effects.caustics
+        || (scene.caustics.bake.is_some()
+            && EffectSet::IMPLEMENTED.caustics
+            && scene
+                .load_caustics()
+                .map_err(|e| tracing::warn!("caustic conditions not offered live: {e}"))
+                .is_ok());
+    let conditions = live_conditions(effects, caustics_loaded);
+    tracing::info!(
+        "effect conditions (menu on the right controller): {}",
+        conditions
+            .iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join(" > ")
+    );
     let mut runtime = Runtime::new(&OpenXrOptions {
         blend: options.blend,
         validation: options.validate,
@@ -402,9 +566,9 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         queue_family: ctx.queue_family,
         queue_index: 0,
     };
-    let (planner, defocus) = planner_for(
+    let (planners, defocus) = planners_for(
         &scene,
-        &effects,
+        &conditions,
         options.reflection,
         &GazeSettings::default(),
     )?;
@@ -425,6 +589,11 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
                 scene_origin: None,
                 viewer_position_m: scene.viewer.head_position_m,
                 handle_ctrl_c: true,
+                depth: Some(DepthOptions {
+                    format: Renderer::DEPTH_FORMAT,
+                    near_m: vitreous_render::camera::NEAR_M,
+                    far_m: vitreous_render::camera::FAR_M,
+                }),
             },
         )
     }
@@ -436,8 +605,10 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
             images.format
         );
     }
-    unsafe { renderer.attach_external(&images.images, images.format) }
-        .context("using the swapchain images")?;
+    unsafe {
+        renderer.attach_external_with_depth(&images.images, images.format, &images.depth_images)
+    }
+    .context("using the swapchain images")?;
 
     let writer = match &options.record {
         Some(path) => Some(
@@ -447,7 +618,11 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
     };
     let world_behind = info.blend.needs_world_behind();
     let mut sink = RunSink {
-        planner,
+        looks: LiveLooks::new(
+            conditions.iter().copied().zip(planners).collect(),
+            scene.gaze.image,
+        ),
+        commands: session.take_commands(),
         // Late enough for the pipelines to be warm and the head to have moved.
         readback_frame: options
             .readback_check
@@ -531,6 +706,18 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
             0
         },
         replay_check,
+        actions_attached: report.actions_attached,
+        action_profiles: report.action_profiles.clone(),
+        action_syncs: report.action_syncs,
+        commands: report.commands,
+        conditions: conditions.iter().map(ToString::to_string).collect(),
+        final_condition: sink.looks.condition().to_string(),
+        final_gaze_image: sink.looks.gaze().to_string(),
+        depth_submitted: report.depth_format.is_some(),
+        depth_format: report
+            .depth_format
+            .map(|f| format!("{:?}", vk::Format::from_raw(f))),
+        frames_with_depth: report.frames_with_depth,
     };
     if let Some(out) = &options.out {
         fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -689,5 +876,55 @@ mod tests {
             false,
         );
         assert!(!c.passed && c.region_px == 0);
+    }
+    #[test]
+    fn live_conditions_start_with_the_runs_own_and_skip_unloaded_caustics() {
+        let defocus = EffectSet::parse("defocus").unwrap();
+        let c = live_conditions(defocus, false);
+        assert_eq!(c[0], defocus);
+        assert_eq!(c.iter().filter(|&&e| e == defocus).count(), 1);
+        assert!(
+            c.iter()
+                .all(|e| !e.caustics && e.ensure_implemented().is_ok())
+        );
+        assert!(c.contains(&EffectSet::NONE));
+        assert!(c.contains(&EffectSet::parse("O5").unwrap()));
+        let with = live_conditions(EffectSet::NONE, true);
+        assert!(with.contains(&EffectSet::parse("c").unwrap()));
+    }
+
+    #[test]
+    fn live_commands_cycle_the_condition_and_the_gaze_image() {
+        let sets = [EffectSet::NONE, EffectSet::parse("disparity").unwrap()];
+        let planners = sets
+            .iter()
+            .map(|e| LookPlanner::new(views::look(e, Reflection::default()), None))
+            .collect::<Vec<_>>();
+        let mut looks = LiveLooks::new(
+            sets.iter().copied().zip(planners).collect(),
+            GazeOverride::Auto,
+        );
+        assert!(!looks.plan(&frame()).disparity);
+        assert!(looks.apply(Command::NextCondition).is_some());
+        assert_eq!(looks.condition(), sets[1]);
+        assert!(looks.plan(&frame()).disparity);
+        looks.apply(Command::NextCondition);
+        assert_eq!(looks.condition(), sets[0], "wraps round");
+        let mut seen = Vec::new();
+        for _ in 0..3 {
+            looks.apply(Command::NextGazeImage);
+            seen.push(looks.gaze());
+        }
+        assert_eq!(
+            seen,
+            [
+                GazeOverride::Surface,
+                GazeOverride::Refracted,
+                GazeOverride::Auto
+            ]
+        );
+        // Re-registration is the session's: nothing changes here.
+        assert!(looks.apply(Command::Rotate(0.1)).is_none());
+        assert_eq!(looks.condition(), sets[0]);
     }
 }

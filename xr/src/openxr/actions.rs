@@ -164,9 +164,12 @@ pub fn commands_for(hand: Hand, p: Presses) -> Vec<Command> {
     out
 }
 
-/// Suggested bindings: interaction profile, then (hand, select input, menu input) paths
-/// relative to the hand's user path.
-pub const BINDINGS: &[(&str, [(Hand, &str, &str); 2])] = &[
+/// One hand's suggested bindings: the hand, then its select and menu input paths relative to
+/// the hand's user path.
+pub type HandBinding = (Hand, &'static str, &'static str);
+
+/// Suggested bindings: interaction profile, then each hand's (left first).
+pub const BINDINGS: &[(&str, [HandBinding; 2])] = &[
     (
         "/interaction_profiles/khr/simple_controller",
         [

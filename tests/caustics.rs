@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{Mat4, Quat, Vec2, Vec3, Vec4Swizzles};
+use glam::{Quat, Vec2, Vec3};
 use vitreous::caustics::{Bake, BakeError};
 use vitreous::effects::EffectSet;
 use vitreous::scene::{Image, PixelData, Scene, load_scene};
@@ -14,6 +14,7 @@ use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::renderer::Want;
 use vitreous_render::{ContextOptions, FrameParams, GpuContext, Readback, Reflection, Renderer};
+use vitreous_tests::pixel_on_floor;
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -41,18 +42,6 @@ fn floor_uv(scene: &Scene, world: Vec3) -> Vec2 {
         .inverse()
         .transform_point3(world);
     Vec2::new(local.x + 0.5, 0.5 - local.y)
-}
-
-/// Where the centre of pixel (x, y) sees the floor plane.
-fn pixel_on_floor(eye: &EyeParams, size: (u32, u32), x: u32, y: u32, floor_y: f32) -> Vec3 {
-    let ndc = Vec2::new(
-        (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
-        (y as f32 + 0.5) / size.1 as f32 * 2.0 - 1.0,
-    );
-    let world_from_clip: Mat4 = eye.clip_from_world().inverse();
-    let far = world_from_clip * ndc.extend(0.5).extend(1.0);
-    let dir = far.xyz() / far.w - eye.position_m;
-    eye.position_m + dir * ((floor_y - eye.position_m.y) / dir.y)
 }
 
 /// Where the straight ray from the light through the object's centre meets the floor: the

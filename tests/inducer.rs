@@ -10,7 +10,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{Mat4, Quat, Vec2, Vec3, Vec4Swizzles};
+use glam::{Quat, Vec2, Vec3};
 use vitreous::output::see_through;
 use vitreous::scene::{Image, PixelData, Scene, load_scene};
 use vitreous::views;
@@ -18,6 +18,7 @@ use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::inducer::{self, InducerFields};
 use vitreous_render::renderer::Want;
 use vitreous_render::{ContextOptions, FrameParams, GpuContext, Look, Readback, Renderer};
+use vitreous_tests::pixel_on_floor;
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -280,18 +281,6 @@ fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], inducer: bool, world: b
     results.extend(renderer.submit(&params, want).unwrap());
     results.extend(renderer.flush().unwrap());
     results.pop().unwrap().readback.unwrap()
-}
-
-/// Where the centre of pixel (x, y) sees the floor plane.
-fn pixel_on_floor(eye: &EyeParams, size: (u32, u32), x: u32, y: u32, floor_y: f32) -> Vec3 {
-    let ndc = Vec2::new(
-        (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
-        (y as f32 + 0.5) / size.1 as f32 * 2.0 - 1.0,
-    );
-    let world_from_clip: Mat4 = eye.clip_from_world().inverse();
-    let far = world_from_clip * ndc.extend(0.5).extend(1.0);
-    let dir = far.xyz() / far.w - eye.position_m;
-    eye.position_m + dir * ((floor_y - eye.position_m.y) / dir.y)
 }
 
 #[test]

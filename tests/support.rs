@@ -68,3 +68,19 @@ pub fn lit_centroid(rgba: &[u8], width: u32, threshold: u8) -> Option<(Vec2, usi
 pub fn place(center_m: Vec3, radius_m: f32) -> Mat4 {
     Mat4::from_scale_rotation_translation(Vec3::splat(radius_m), glam::Quat::IDENTITY, center_m)
 }
+
+/// Where the centre of pixel (x, y) of an image of `size` pixels sees the horizontal floor
+/// plane at height `floor_y`.
+pub fn pixel_on_floor(
+    eye: &vitreous_render::EyeParams,
+    size: (u32, u32),
+    x: u32,
+    y: u32,
+    floor_y: f32,
+) -> Vec3 {
+    let dir = eye.pixel_ray(
+        Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
+        Vec2::new(size.0 as f32, size.1 as f32),
+    );
+    eye.position_m + dir * ((floor_y - eye.position_m.y) / dir.y)
+}

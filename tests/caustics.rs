@@ -14,7 +14,7 @@ use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::renderer::Want;
 use vitreous_render::{ContextOptions, FrameParams, GpuContext, Readback, Reflection, Renderer};
-use vitreous_tests::pixel_on_floor;
+use vitreous_tests::{pixel_on_floor, render_once};
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -98,10 +98,7 @@ fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], effects: &str) -> Readb
         eyes: true,
         world: false,
     };
-    let mut results = Vec::new();
-    results.extend(renderer.submit(&params, want).unwrap());
-    results.extend(renderer.flush().unwrap());
-    results.pop().unwrap().readback.unwrap()
+    render_once(renderer, &params, want)
 }
 
 #[test]

@@ -16,6 +16,7 @@ use vitreous::views;
 use vitreous_render::reference::{RefractionSample, refraction_sample};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, Defocus, GpuContext, Look, Reflection, Renderer};
+use vitreous_tests::render_once;
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::synth::{GazeTarget, synthesize_with_truth};
@@ -59,15 +60,10 @@ fn render(scene: &Scene, setup: &DefocusSetup, input: &FrameInput, look: Look) -
         eyes: true,
         world: false,
     };
-    let mut done: Vec<_> = renderer
-        .submit(&views::frame_params(input, look), want)
-        .unwrap()
-        .into_iter()
-        .collect();
-    done.extend(renderer.flush().unwrap());
+    let readback = render_once(&mut renderer, &views::frame_params(input, look), want);
     let v = renderer.context().validation();
     assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
-    done.pop().unwrap().readback.unwrap().eyes
+    readback.eyes
 }
 
 /// The first frame of the scene's synthetic trace at the test's size.

@@ -18,7 +18,7 @@ use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::inducer::{self, InducerFields};
 use vitreous_render::renderer::Want;
 use vitreous_render::{ContextOptions, FrameParams, GpuContext, Look, Readback, Renderer};
-use vitreous_tests::pixel_on_floor;
+use vitreous_tests::{pixel_on_floor, render_once};
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -277,10 +277,7 @@ fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], inducer: bool, world: b
         },
     };
     let want = Want { eyes: true, world };
-    let mut results = Vec::new();
-    results.extend(renderer.submit(&params, want).unwrap());
-    results.extend(renderer.flush().unwrap());
-    results.pop().unwrap().readback.unwrap()
+    render_once(renderer, &params, want)
 }
 
 #[test]

@@ -10,7 +10,7 @@ use vitreous_render::{
     ContextOptions, FrameParams, GpuContext, LightDesc, Look, MeshRef, PlaneDesc, Reflection,
     Renderer, SceneDesc, TexelData, TextureDesc,
 };
-use vitreous_tests::uv_sphere;
+use vitreous_tests::{render_once, uv_sphere};
 
 const W: u32 = 640;
 const H: u32 = 480;
@@ -163,15 +163,10 @@ fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
         eyes: true,
         world: false,
     };
-    let mut results: Vec<_> = renderer
-        .submit(&params, want)
-        .unwrap()
-        .into_iter()
-        .collect();
-    results.extend(renderer.flush().unwrap());
+    let readback = render_once(&mut renderer, &params, want);
     let v = renderer.context().validation();
     assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
-    results.pop().unwrap().readback.unwrap().eyes
+    readback.eyes
 }
 
 /// Centroid of the image weighted by its linear light (the images are sRGB-encoded), which is

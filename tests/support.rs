@@ -84,3 +84,16 @@ pub fn pixel_on_floor(
     );
     eye.position_m + dir * ((floor_y - eye.position_m.y) / dir.y)
 }
+
+/// Renders one frame, waits for it, and returns its pixels.
+pub fn render_once(
+    renderer: &mut vitreous_render::Renderer,
+    params: &vitreous_render::FrameParams,
+    want: vitreous_render::Want,
+) -> vitreous_render::Readback {
+    let mut done: Vec<_> = renderer.submit(params, want).unwrap().into_iter().collect();
+    done.extend(renderer.flush().unwrap());
+    done.pop()
+        .and_then(|frame| frame.readback)
+        .expect("the frame was read back")
+}

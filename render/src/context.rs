@@ -8,16 +8,24 @@
 use std::ffi::{CStr, c_char, c_void};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use crate::error::{RenderError, Result, VkContext};
+pub use crate::validation::ValidationLog;
+use crate::validation::debug_callback;
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 /// The Vulkan API version the renderer asks for.
 pub const API_VERSION: u32 = vk::API_VERSION_1_2;
+
+/// How long any fence wait may take before it is reported as [`RenderError::Timeout`]. The
+/// slowest legitimate wait is a first frame computing a 4096^2 floor field on a CPU device
+/// under validation (a few seconds on two cores); a GPU that is silent for this long is hung.
+pub const FENCE_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// How to set up the GPU context.
 #[derive(Clone, Debug, Default)]
@@ -69,11 +77,15 @@ pub trait DeviceCreator {
 pub struct PlainVulkan;
 
 impl DeviceCreator for PlainVulkan {
+    /// # Safety
+    /// As [`DeviceCreator::create_instance`].
     unsafe fn create_instance(
         &mut self,
         entry: &ash::Entry,
         info: &vk::InstanceCreateInfo,
     ) -> Result<ash::Instance> {
+        // SAFETY: the trait's contract: `info` is a valid create info; the caller owns the
+        // instance.
         unsafe { entry.create_instance(info, None) }.vk("vkCreateInstance")
     }
 
@@ -82,6 +94,7 @@ impl DeviceCreator for PlainVulkan {
         instance: &ash::Instance,
         options: &ContextOptions,
     ) -> Result<vk::PhysicalDevice> {
+        // SAFETY: `instance` is a live instance.
         let devices =
             unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
         let usable: Vec<_> = devices
@@ -114,6 +127,7 @@ impl DeviceCreator for PlainVulkan {
                     ))
                 });
         }
+        // SAFETY: in the closure, `pd` was enumerated from the live `instance`.
         let rank =
             |pd: vk::PhysicalDevice| match unsafe { instance.get_physical_device_properties(pd) }
                 .device_type
@@ -130,79 +144,18 @@ impl DeviceCreator for PlainVulkan {
             .expect("non-empty"))
     }
 
+    /// # Safety
+    /// As [`DeviceCreator::create_device`].
     unsafe fn create_device(
         &mut self,
         instance: &ash::Instance,
         physical: vk::PhysicalDevice,
         info: &vk::DeviceCreateInfo,
     ) -> Result<ash::Device> {
+        // SAFETY: the trait's contract: `physical` comes from `instance` and `info` is valid
+        // for it.
         unsafe { instance.create_device(physical, info, None) }.vk("vkCreateDevice")
     }
-}
-
-/// Counts and keeps the validation layer's messages.
-#[derive(Debug, Default)]
-pub struct ValidationLog {
-    /// Messages of warning severity seen so far.
-    warnings: AtomicU32,
-    /// Messages of error severity seen so far.
-    errors: AtomicU32,
-    /// The first few messages' texts, for test failures and logs.
-    first: Mutex<Vec<String>>,
-}
-
-impl ValidationLog {
-    /// Number of warning messages so far.
-    pub fn warnings(&self) -> u32 {
-        self.warnings.load(Ordering::Relaxed)
-    }
-
-    /// Number of error messages so far.
-    pub fn errors(&self) -> u32 {
-        self.errors.load(Ordering::Relaxed)
-    }
-
-    /// The first (up to 20) warning and error messages.
-    pub fn messages(&self) -> Vec<String> {
-        self.first.lock().map(|m| m.clone()).unwrap_or_default()
-    }
-
-    fn record(&self, severity: vk::DebugUtilsMessageSeverityFlagsEXT, text: String) {
-        if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
-            self.errors.fetch_add(1, Ordering::Relaxed);
-            tracing::error!(target: "vulkan", "{text}");
-        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
-            self.warnings.fetch_add(1, Ordering::Relaxed);
-            tracing::warn!(target: "vulkan", "{text}");
-        } else {
-            tracing::debug!(target: "vulkan", "{text}");
-            return;
-        }
-        if let Ok(mut first) = self.first.lock()
-            && first.len() < 20
-        {
-            first.push(text);
-        }
-    }
-}
-
-unsafe extern "system" fn debug_callback(
-    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
-    _types: vk::DebugUtilsMessageTypeFlagsEXT,
-    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
-    user: *mut c_void,
-) -> vk::Bool32 {
-    // SAFETY: `user` is the ValidationLog kept alive by the GpuContext for the messenger's
-    // lifetime; `data` is valid for the duration of the callback per the Vulkan spec.
-    let log = unsafe { &*(user as *const ValidationLog) };
-    let text = unsafe {
-        data.as_ref()
-            .filter(|d| !d.p_message.is_null())
-            .map(|d| CStr::from_ptr(d.p_message).to_string_lossy().into_owned())
-            .unwrap_or_default()
-    };
-    log.record(severity, text);
-    vk::FALSE
 }
 
 /// The Vulkan objects every pass borrows.
@@ -225,8 +178,12 @@ pub struct GpuContext {
     pub queue_family: u32,
     /// The graphics queue all work is submitted to.
     pub queue: vk::Queue,
-    /// Device memory allocator; `None` only during drop.
-    allocator: Option<Mutex<Allocator>>,
+    /// Device memory allocator, shared with every buffer's and image's memory; `None` only
+    /// during drop.
+    allocator: Option<Arc<Mutex<Allocator>>>,
+    /// Allocations left before [`GpuContext::fail_allocation_after`]'s injected failure
+    /// (`u32::MAX`: never).
+    allocations_before_failure: AtomicU32,
     /// Command pool for one-shot uploads.
     upload_pool: vk::CommandPool,
     /// Human-readable device name.
@@ -251,6 +208,8 @@ impl GpuContext {
         extra_instance_extensions: &[&CStr],
         extra_device_extensions: &[&CStr],
     ) -> Result<GpuContext> {
+        // SAFETY: loading the system's Vulkan loader runs its initialisation; the loader is
+        // trusted like any linked library, and `entry` keeps it loaded as long as the context.
         let entry = unsafe { ash::Entry::load() }?;
 
         let mut layers: Vec<*const c_char> = Vec::new();
@@ -259,6 +218,7 @@ impl GpuContext {
             .map(|e| e.as_ptr())
             .collect();
         if options.validation {
+            // SAFETY: `entry` is a loaded Vulkan entry point.
             let available = unsafe { entry.enumerate_instance_layer_properties() }
                 .vk("vkEnumerateInstanceLayerProperties")?;
             let found = available
@@ -287,6 +247,9 @@ impl GpuContext {
         if options.validation {
             instance_info = instance_info.push_next(&mut validation_features);
         }
+        // SAFETY: `instance_info` and everything it points to (names, layers, extensions,
+        // validation features) live until the call returns; the instance is owned by the
+        // guard below until the context takes it.
         let instance = unsafe { creator.create_instance(&entry, &instance_info) }?;
         let mut guard = InstanceGuard(Some(instance.clone()), None);
 
@@ -306,6 +269,9 @@ impl GpuContext {
                 )
                 .pfn_user_callback(Some(debug_callback))
                 .user_data(Arc::as_ptr(&validation) as *mut c_void);
+            // SAFETY: the callback's user data is the `ValidationLog` in `validation`, an `Arc`
+            // the context keeps until after it destroys the messenger; the guard destroys
+            // the messenger if construction fails.
             let messenger = unsafe { loader.create_debug_utils_messenger(&info, None) }
                 .vk("vkCreateDebugUtilsMessengerEXT")?;
             Some((loader, messenger))
@@ -327,7 +293,11 @@ impl GpuContext {
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&device_exts);
+        // SAFETY: `physical` was picked from `instance`, and `device_info` names one queue of
+        // a family it has; the device is destroyed below on any later failure, or by the
+        // context's drop.
         let device = unsafe { creator.create_device(&instance, physical, &device_info) }?;
+        // SAFETY: queue 0 of `queue_family` was requested in `device_info`.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
 
         let allocator = Allocator::new(&AllocatorCreateDesc {
@@ -339,6 +309,7 @@ impl GpuContext {
             allocation_sizes: Default::default(),
         })
         .map_err(|source| {
+            // SAFETY: nothing has been made on the device yet.
             unsafe { device.destroy_device(None) };
             RenderError::Allocation {
                 what: "the allocator".into(),
@@ -348,18 +319,24 @@ impl GpuContext {
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(queue_family)
             .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+        // SAFETY: a valid create info for a family of this device.
         let upload_pool = match unsafe { device.create_command_pool(&pool_info, None) } {
             Ok(pool) => pool,
             Err(e) => {
                 drop(allocator);
+                // SAFETY: the allocator (which owned the only device memory) is gone and
+                // nothing else was made on the device.
                 unsafe { device.destroy_device(None) };
                 return Err(e).vk("vkCreateCommandPool");
             }
         };
 
+        // SAFETY: `physical` belongs to the live `instance`,
+        // and `props2`'s chain points to `driver_props`, alive for the call.
         let props = unsafe { instance.get_physical_device_properties(physical) };
         let mut driver_props = vk::PhysicalDeviceDriverProperties::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver_props);
+        // SAFETY: as above.
         unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
         let driver = format!(
             "{} {}",
@@ -374,6 +351,7 @@ impl GpuContext {
         )
         .trim()
         .to_owned();
+        // SAFETY: as above.
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let timestamp_period_ns = (families[queue_family as usize].timestamp_valid_bits > 0
             && props.limits.timestamp_compute_and_graphics == vk::TRUE)
@@ -392,7 +370,8 @@ impl GpuContext {
             device,
             queue_family,
             queue,
-            allocator: Some(Mutex::new(allocator)),
+            allocator: Some(Arc::new(Mutex::new(allocator))),
+            allocations_before_failure: AtomicU32::new(u32::MAX),
             upload_pool,
             driver,
             timestamp_period_ns,
@@ -416,54 +395,127 @@ impl GpuContext {
         self.validation_enabled
     }
 
-    /// The device memory allocator.
-    pub(crate) fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
-        self.allocator
-            .as_ref()
-            .expect("allocator lives until drop")
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    /// The validation log itself, which outlives the context (to check, after a failed
+    /// construction dropped the context, that the device's destruction found no leaks).
+    pub fn validation_log(&self) -> Arc<ValidationLog> {
+        Arc::clone(&self.validation)
     }
 
-    /// Records commands with `record`, submits them and waits until they finished.
+    /// Makes the allocation after the next `count` ones fail with [`RenderError::Injected`]
+    /// (once; later ones succeed again). For tests that construction unwinds cleanly
+    /// whichever step fails.
+    #[doc(hidden)]
+    pub fn fail_allocation_after(&self, count: u32) {
+        self.allocations_before_failure
+            .store(count, Ordering::Relaxed);
+    }
+
+    /// Counts one allocation towards an injected failure; the error when it is due.
+    pub(crate) fn check_injected_failure(&self, what: &str) -> Result<()> {
+        let left = self.allocations_before_failure.load(Ordering::Relaxed);
+        match left {
+            u32::MAX => Ok(()),
+            0 => {
+                self.allocations_before_failure
+                    .store(u32::MAX, Ordering::Relaxed);
+                Err(RenderError::Injected(what.to_owned()))
+            }
+            n => {
+                self.allocations_before_failure
+                    .store(n - 1, Ordering::Relaxed);
+                Ok(())
+            }
+        }
+    }
+
+    /// A shared handle to the device memory allocator, for memory that frees itself.
+    pub(crate) fn shared_allocator(&self) -> Arc<Mutex<Allocator>> {
+        Arc::clone(self.allocator.as_ref().expect("allocator lives until drop"))
+    }
+
+    /// Waits for `fence` for at most [`FENCE_TIMEOUT`]; `what` names the work in the timeout
+    /// error. A lost device is [`RenderError::DeviceLost`].
+    pub(crate) fn wait_fence(&self, fence: vk::Fence, what: &'static str) -> Result<()> {
+        let nanos = FENCE_TIMEOUT.as_nanos() as u64;
+        // SAFETY: `fence` is a live fence of this device (the callers own it) and no other
+        // thread resets it while we wait (they hold `&mut` or own it outright).
+        match unsafe { self.device.wait_for_fences(&[fence], true, nanos) } {
+            Err(vk::Result::TIMEOUT) => Err(RenderError::Timeout {
+                what,
+                seconds: FENCE_TIMEOUT.as_secs(),
+            }),
+            other => other.vk("vkWaitForFences"),
+        }
+    }
+
+    /// Records commands with `record`, submits them and waits (at most [`FENCE_TIMEOUT`])
+    /// until they finished. On a timeout the command buffer and fence are leaked, not freed
+    /// under the GPU, and the caller must leak what the commands use too
+    /// ([`RenderError::gpu_may_still_run`]).
+    ///
+    /// `record` gets a command buffer in the recording state, outside any render pass; the
+    /// objects it records must live until this returns.
     pub(crate) fn one_shot(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
         let device = &self.device;
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(self.upload_pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
+        // SAFETY: the upload pool is live and only used from here, with `&self` (the pool is
+        // transient and one_shot is not re-entered: recording closures do not call it).
         let cmd =
             unsafe { device.allocate_command_buffers(&info) }.vk("vkAllocateCommandBuffers")?[0];
+        let mut fence = vk::Fence::null();
         let result = (|| {
             let begin = vk::CommandBufferBeginInfo::default()
                 .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            // SAFETY: `cmd` was just allocated and is in the initial state.
             unsafe { device.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
             record(cmd);
+            // SAFETY: `cmd` is recording and `record` left no render pass open.
             unsafe { device.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")?;
-            let fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }
+            // SAFETY: a plain fence; destroyed below unless the wait times out.
+            fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }
                 .vk("vkCreateFence")?;
             let cmds = [cmd];
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
-            let waited = unsafe { device.queue_submit(self.queue, &submit, fence) }
-                .vk("vkQueueSubmit")
-                .and_then(|_| {
-                    unsafe { device.wait_for_fences(&[fence], true, u64::MAX) }
-                        .vk("vkWaitForFences")
-                });
-            unsafe { device.destroy_fence(fence, None) };
-            waited
+            // SAFETY: `cmd` is executable, the fence unsignalled, and the queue is only used
+            // from the thread that owns the context's users.
+            unsafe { device.queue_submit(self.queue, &submit, fence) }.vk("vkQueueSubmit")?;
+            self.wait_fence(fence, "a one-shot upload or readback")
         })();
-        unsafe { device.free_command_buffers(self.upload_pool, &[cmd]) };
+        if result.as_ref().is_err_and(RenderError::gpu_may_still_run) {
+            return result;
+        }
+        // SAFETY: the submission (if any) finished, or the device is lost (when objects may
+        // be destroyed regardless); the fence may be null when it was never created.
+        unsafe {
+            device.destroy_fence(fence, None);
+            device.free_command_buffers(self.upload_pool, &[cmd]);
+        }
         result
     }
 }
 
 impl Drop for GpuContext {
     fn drop(&mut self) {
+        // Every buffer and image should be gone by now (their owners drop before the
+        // context); one still alive would free its memory into an allocator without a device.
+        if let Some(allocator) = &self.allocator
+            && Arc::strong_count(allocator) > 1
+        {
+            tracing::error!(
+                alive = Arc::strong_count(allocator) - 1,
+                "GPU memory outlives its context; destroying the device anyway"
+            );
+        }
+        // SAFETY: the context is the last owner of the device: the objects made on it were
+        // dropped before it (they are held by the context's users, declared before it), so
+        // after the idle wait nothing uses them; the allocator frees its memory blocks, so it
+        // goes before the device, and the messenger and instance go last.
         unsafe {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.upload_pool, None);
-            // The allocator frees its memory blocks, so it must go before the device.
             self.allocator.take();
             self.device.destroy_device(None);
             if let Some((loader, messenger)) = self.debug.take() {
@@ -483,6 +535,8 @@ struct InstanceGuard(
 impl Drop for InstanceGuard {
     fn drop(&mut self) {
         if let Some(instance) = self.0.take() {
+            // SAFETY: construction failed before a device was made (or after it was
+            // destroyed), so the messenger and instance have no children left.
             unsafe {
                 if let Some((loader, messenger)) = self.1.take() {
                     loader.destroy_debug_utils_messenger(messenger, None);
@@ -494,6 +548,7 @@ impl Drop for InstanceGuard {
 }
 
 fn graphics_queue_family(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Option<u32> {
+    // SAFETY: `pd` was enumerated from the live `instance`.
     unsafe { instance.get_physical_device_queue_family_properties(pd) }
         .iter()
         .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS))
@@ -501,6 +556,7 @@ fn graphics_queue_family(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Op
 }
 
 fn device_name(instance: &ash::Instance, pd: vk::PhysicalDevice) -> String {
+    // SAFETY: `pd` was enumerated from the live `instance`.
     let props = unsafe { instance.get_physical_device_properties(pd) };
     props
         .device_name_as_c_str()

@@ -20,9 +20,21 @@ pub enum RenderError {
          (Debian: apt-get install vulkan-validationlayers)"
     )]
     ValidationLayerMissing,
-    /// The device was lost (driver crash, GPU reset).
-    #[error("the Vulkan device was lost")]
+    /// The device was lost (driver crash, GPU reset): from a submit, a fence wait or any
+    /// other call. Nothing more can be rendered with this context.
+    #[error("the Vulkan device was lost (driver crash or GPU reset); restart to render again")]
     DeviceLost,
+    /// The GPU did not finish submitted work within the allowed time.
+    #[error(
+        "the GPU did not finish {what} within {seconds} s; the device may be hung or far too \
+         slow for this load"
+    )]
+    Timeout {
+        /// What was waited for.
+        what: &'static str,
+        /// How long, seconds.
+        seconds: u64,
+    },
     /// Any other failed Vulkan call.
     #[error("Vulkan call {call} failed: {result}")]
     Vulkan {
@@ -45,6 +57,17 @@ pub enum RenderError {
     /// A device creation step injected by the caller (e.g. an OpenXR runtime) failed.
     #[error("device creation failed: {0}")]
     Creation(String),
+    /// A failure forced by [`crate::GpuContext::fail_allocation_after`], to test unwinding.
+    #[error("injected failure while allocating memory for {0}")]
+    Injected(String),
+}
+
+impl RenderError {
+    /// Whether work submitted before this error may still be running on the GPU, so that
+    /// what it uses must not be freed (a fence wait timed out).
+    pub fn gpu_may_still_run(&self) -> bool {
+        matches!(self, RenderError::Timeout { .. })
+    }
 }
 
 /// Shorthand for results of this crate.

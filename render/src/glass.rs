@@ -9,7 +9,8 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::Buffer;
 use crate::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
-use crate::pipeline::{self, PipelineDesc};
+use crate::owned::Owned;
+use crate::pipeline::{self, Blend, PipelineSpec};
 use crate::scene::{GpuScene, SceneDesc, VERTEX_STRIDE};
 use crate::shaders;
 
@@ -103,20 +104,20 @@ struct Globals {
     shading: [f32; 4],
 }
 
-/// The glass pipeline and its descriptors.
+/// The glass pipeline and its descriptors, freed on drop.
 pub struct GlassPass {
-    /// Layout of the single descriptor set.
-    set_layout: vk::DescriptorSetLayout,
-    /// Pipeline layout (set + eye push constants).
-    layout: vk::PipelineLayout,
     /// The pipeline.
-    pipeline: vk::Pipeline,
+    pipeline: Owned<vk::Pipeline>,
+    /// Pipeline layout (set + eye push constants).
+    layout: Owned<vk::PipelineLayout>,
     /// Pool the set lives in.
-    pool: vk::DescriptorPool,
+    _pool: Owned<vk::DescriptorPool>,
+    /// Layout of the single descriptor set.
+    _set_layout: Owned<vk::DescriptorSetLayout>,
     /// The descriptor set: globals, environment map, sampler.
     set: vk::DescriptorSet,
     /// The uniform buffer behind `Globals`.
-    globals: Buffer,
+    _globals: Buffer,
 }
 
 impl GlassPass {
@@ -159,7 +160,12 @@ impl GlassPass {
                 ),
             ],
         )?;
-        let layout = pipeline::layout(ctx, set_layout, stages, size_of::<EyePush>() as u32)?;
+        let layout = pipeline::layout(
+            ctx,
+            Some(set_layout.raw()),
+            stages,
+            size_of::<EyePush>() as u32,
+        )?;
         let f = 4;
         let attributes = [
             vk::VertexInputAttributeDescription {
@@ -188,14 +194,16 @@ impl GlassPass {
         }];
         let pipeline = pipeline::create(
             ctx,
-            render_pass,
-            layout,
-            &PipelineDesc {
-                vertex: shaders::GLASS_VS,
-                fragment: shaders::GLASS_FS,
+            &PipelineSpec {
+                render_pass,
+                layout: layout.raw(),
+                vertex: (shaders::GLASS_VS, c"vs_main"),
+                fragment: (shaders::GLASS_FS, c"fs_main"),
                 bindings: &bindings,
                 attributes: &attributes,
                 cull: vk::CullModeFlags::BACK,
+                depth: true,
+                blend: Blend::Replace,
             },
         )?;
         let pool = pipeline::pool(
@@ -207,7 +215,7 @@ impl GlassPass {
                 (vk::DescriptorType::SAMPLER, 2),
             ],
         )?;
-        let set = pipeline::allocate_set(ctx, pool, set_layout)?;
+        let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let normal_from_model = desc.world_from_model.inverse().transpose();
         let surface_opacity = if desc.surface.is_some() {
             1.0 - desc.surface_transmittance
@@ -239,24 +247,25 @@ impl GlassPass {
             .dst_binding(0)
             .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
             .buffer_info(&buffer_info)];
+        // SAFETY: the set was just allocated and no GPU work uses it; the buffer is live.
         unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
-        pipeline::write_texture(ctx, set, 1, 2, scene.environment.view, scene.env_sampler);
+        pipeline::write_texture(ctx, set, 1, 2, scene.environment.view, scene.env_sampler());
         pipeline::write_texture(
             ctx,
             set,
             3,
             4,
             scene.background_stack.view,
-            scene.photo_sampler,
+            scene.photo_sampler(),
         );
         pipeline::write_image(ctx, set, 5, scene.surface.view);
         Ok(GlassPass {
-            set_layout,
-            layout,
             pipeline,
-            pool,
+            layout,
+            _pool: pool,
+            _set_layout: set_layout,
             set,
-            globals,
+            _globals: globals,
         })
     }
 
@@ -272,19 +281,22 @@ impl GlassPass {
         push: &EyePush,
     ) {
         let d = &ctx.device;
+        // SAFETY: the caller's contract (recording inside a compatible render pass); the
+        // pipeline, set and scene buffers are live for as long as the renderer that records
+        // them, which waits for its frames before dropping them.
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw());
             d.cmd_bind_descriptor_sets(
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,
-                self.layout,
+                self.layout.raw(),
                 0,
                 &[self.set],
                 &[],
             );
             d.cmd_push_constants(
                 cmd,
-                self.layout,
+                self.layout.raw(),
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                 0,
                 bytemuck::bytes_of(push),
@@ -292,21 +304,6 @@ impl GlassPass {
             d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
             d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
             d.cmd_draw_indexed(cmd, scene.index_count, 1, 0, 0, 0);
-        }
-    }
-
-    /// Frees the pass.
-    ///
-    /// # Safety
-    /// The GPU must no longer use it.
-    pub unsafe fn destroy(&mut self, ctx: &GpuContext) {
-        let d = &ctx.device;
-        unsafe {
-            d.destroy_pipeline(self.pipeline, None);
-            d.destroy_pipeline_layout(self.layout, None);
-            d.destroy_descriptor_pool(self.pool, None);
-            d.destroy_descriptor_set_layout(self.set_layout, None);
-            self.globals.destroy(ctx);
         }
     }
 }

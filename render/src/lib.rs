@@ -19,22 +19,26 @@
 pub mod camera;
 pub mod context;
 pub mod error;
+pub mod floor;
 mod glass;
-pub mod inducer; // shadow inducer (issue 5)
 mod memory;
 pub mod optics;
+mod owned;
 mod pipeline;
 pub mod reference;
 pub mod renderer;
 pub mod scene;
 mod shaders;
 mod target;
+mod validation;
 mod world;
 
 pub use camera::{Defocus, EyeParams, FrameParams, Look, Reflection};
 pub use context::{ContextOptions, DeviceCreator, GpuContext, PlainVulkan};
 pub use error::{RenderError, Result};
-pub use inducer::InducerFields; // shadow inducer (issue 5)
+/// The floor passes under their earlier name.
+pub use floor as inducer;
+pub use floor::InducerFields;
 pub use renderer::{FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
     BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData,

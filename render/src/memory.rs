@@ -1,18 +1,99 @@
 //! Buffers and images backed by the context's allocator, and texture uploads.
+//!
+//! A [`Buffer`] or [`Image`] owns its Vulkan object and its memory and frees both on drop,
+//! so a constructor that fails part way gives back what it made by returning early. The
+//! memory keeps a shared handle to the allocator; the context drops its own handle (and with
+//! it, normally, the allocator) just before the device.
+
+use std::sync::{Arc, Mutex};
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
+use crate::owned::Owned;
 
-/// A buffer and its memory. Free it with [`Buffer::destroy`].
+/// Memory of a buffer or image, handed back to the context's allocator on drop.
+struct Memory {
+    /// The allocator it came from (shared with the context, which frees it before the
+    /// device).
+    allocator: Arc<Mutex<Allocator>>,
+    /// The allocation; `None` only during drop.
+    allocation: Option<Allocation>,
+}
+
+impl Memory {
+    /// Allocates memory for `requirements` in `location`.
+    fn new(
+        ctx: &GpuContext,
+        name: &str,
+        requirements: vk::MemoryRequirements,
+        location: MemoryLocation,
+        linear: bool,
+    ) -> Result<Memory> {
+        ctx.check_injected_failure(name)?;
+        let allocator = ctx.shared_allocator();
+        let allocation = lock(&allocator)
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .map_err(|source| RenderError::Allocation {
+                what: name.to_owned(),
+                source,
+            })?;
+        Ok(Memory {
+            allocator,
+            allocation: Some(allocation),
+        })
+    }
+
+    /// The allocation.
+    fn get(&self) -> &Allocation {
+        self.allocation
+            .as_ref()
+            .expect("allocation lives until drop")
+    }
+
+    /// The allocation, writable.
+    fn get_mut(&mut self) -> &mut Allocation {
+        self.allocation
+            .as_mut()
+            .expect("allocation lives until drop")
+    }
+}
+
+impl Drop for Memory {
+    fn drop(&mut self) {
+        if let Some(allocation) = self.allocation.take() {
+            // Freeing only fails for an allocation the allocator does not know, which cannot
+            // happen for one it handed out; nothing useful to do about it in a drop.
+            let _ = lock(&self.allocator).free(allocation);
+        }
+    }
+}
+
+/// Locks the allocator, recovering from a poisoned lock (the allocator's state stays
+/// consistent: a panic inside it would already have aborted the allocation).
+fn lock(allocator: &Mutex<Allocator>) -> std::sync::MutexGuard<'_, Allocator> {
+    allocator
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// A buffer and its memory, both freed on drop.
 pub struct Buffer {
     /// The Vulkan buffer.
     pub buffer: vk::Buffer,
-    /// Its memory; `None` once destroyed.
-    allocation: Option<Allocation>,
+    /// Its memory, freed right after the buffer is destroyed; `None` until bound.
+    memory: Option<Memory>,
+    /// The device the buffer was made on.
+    device: ash::Device,
 }
 
 impl Buffer {
@@ -29,35 +110,24 @@ impl Buffer {
             .size(size.max(4))
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: `info` is a valid create info; the buffer is owned by the `Buffer` below
+        // from the next statement on, whose drop destroys it.
         let buffer = unsafe { device.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
-        let requirements = unsafe { device.get_buffer_memory_requirements(buffer) };
-        let allocation = ctx
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|source| {
-                unsafe { device.destroy_buffer(buffer, None) };
-                RenderError::Allocation {
-                    what: name.to_owned(),
-                    source,
-                }
-            })?;
-        if let Err(e) =
-            unsafe { device.bind_buffer_memory(buffer, allocation.memory(), allocation.offset()) }
-        {
-            let _ = ctx.allocator().free(allocation);
-            unsafe { device.destroy_buffer(buffer, None) };
-            return Err(e).vk("vkBindBufferMemory");
-        }
-        Ok(Buffer {
+        let mut owned = Buffer {
             buffer,
-            allocation: Some(allocation),
-        })
+            memory: None,
+            device: device.clone(),
+        };
+        // SAFETY: `buffer` is a live buffer of `device`.
+        let requirements = unsafe { device.get_buffer_memory_requirements(buffer) };
+        let memory = Memory::new(ctx, name, requirements, location, true)?;
+        let a = memory.get();
+        // SAFETY: the memory was allocated for this buffer's requirements and is not bound
+        // to anything else; the buffer has no memory bound yet.
+        unsafe { device.bind_buffer_memory(buffer, a.memory(), a.offset()) }
+            .vk("vkBindBufferMemory")?;
+        owned.memory = Some(memory);
+        Ok(owned)
     }
 
     /// A host-visible buffer filled with `bytes`.
@@ -74,48 +144,57 @@ impl Buffer {
             usage,
             MemoryLocation::CpuToGpu,
         )?;
-        buffer.mapped_mut()[..bytes.len()].copy_from_slice(bytes);
+        buffer.mapped_mut()?[..bytes.len()].copy_from_slice(bytes);
         Ok(buffer)
     }
 
     /// The mapped bytes of a host-visible buffer.
-    pub fn mapped(&self) -> &[u8] {
-        self.allocation
+    pub fn mapped(&self) -> Result<&[u8]> {
+        self.memory
             .as_ref()
-            .and_then(|a| a.mapped_slice())
-            .expect("buffer is host visible")
+            .and_then(|m| m.get().mapped_slice())
+            .ok_or_else(|| not_mapped("read"))
     }
 
     /// The mapped bytes of a host-visible buffer, writable.
-    pub fn mapped_mut(&mut self) -> &mut [u8] {
-        self.allocation
+    pub fn mapped_mut(&mut self) -> Result<&mut [u8]> {
+        self.memory
             .as_mut()
-            .and_then(|a| a.mapped_slice_mut())
-            .expect("buffer is host visible")
-    }
-
-    /// Frees the buffer.
-    ///
-    /// # Safety
-    /// The GPU must no longer use it.
-    pub unsafe fn destroy(&mut self, ctx: &GpuContext) {
-        if let Some(allocation) = self.allocation.take() {
-            unsafe { ctx.device.destroy_buffer(self.buffer, None) };
-            let _ = ctx.allocator().free(allocation);
-        }
+            .and_then(|m| m.get_mut().mapped_slice_mut())
+            .ok_or_else(|| not_mapped("written"))
     }
 }
 
-/// An image, its memory and a view of all its layers.
+/// The error for a buffer that is not host visible (an internal mistake, reported rather
+/// than panicking).
+fn not_mapped(how: &str) -> RenderError {
+    RenderError::InvalidInput(format!(
+        "a GPU-only buffer was {how} from the CPU; it must be host visible"
+    ))
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        // SAFETY: the buffer was made on `device`; its owner drops it only when no GPU work
+        // uses it any more (see crate::owned), and before the context's device. The memory is
+        // freed afterwards, when `memory` drops.
+        unsafe { self.device.destroy_buffer(self.buffer, None) };
+        self.memory.take();
+    }
+}
+
+/// An image, its memory and a view of all its layers, all freed on drop.
 pub struct Image {
     /// The Vulkan image.
     pub image: vk::Image,
     /// A view of the whole image (2-D, or 2-D array when it has several layers).
     pub view: vk::ImageView,
-    /// Its memory; `None` once destroyed.
-    allocation: Option<Allocation>,
+    /// Its memory; `None` until bound.
+    memory: Option<Memory>,
     /// Texel format.
     pub format: vk::Format,
+    /// The device the image was made on.
+    device: ash::Device,
 }
 
 impl Image {
@@ -163,84 +242,68 @@ impl Image {
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: `info` is a valid create info; the image is owned by the `Image` below from
+        // the next statement on, whose drop destroys it.
         let image = unsafe { device.create_image(&info, None) }.vk("vkCreateImage")?;
-        let requirements = unsafe { device.get_image_memory_requirements(image) };
-        let allocation = ctx
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|source| {
-                unsafe { device.destroy_image(image, None) };
-                RenderError::Allocation {
-                    what: name.to_owned(),
-                    source,
-                }
-            })?;
-        let mut img = Image {
+        let mut owned = Image {
             image,
             view: vk::ImageView::null(),
-            allocation: Some(allocation),
+            memory: None,
             format,
+            device: device.clone(),
         };
-        let bound = {
-            let a = img.allocation.as_ref().expect("just allocated");
-            unsafe { device.bind_image_memory(image, a.memory(), a.offset()) }
-        };
-        let view = bound.and_then(|_| {
-            let view_info = vk::ImageViewCreateInfo::default()
-                .image(image)
-                .view_type(if volume {
-                    vk::ImageViewType::TYPE_3D
-                } else if layers > 1 {
-                    vk::ImageViewType::TYPE_2D_ARRAY
-                } else {
-                    vk::ImageViewType::TYPE_2D
-                })
-                .format(format)
-                .subresource_range(subresource_range(aspect, 0, layers));
-            unsafe { device.create_image_view(&view_info, None) }
-        });
-        match view {
-            Ok(view) => {
-                img.view = view;
-                Ok(img)
-            }
-            Err(e) => {
-                unsafe { img.destroy(ctx) };
-                Err(e).vk("vkCreateImageView")
-            }
-        }
+        // SAFETY: `image` is a live image of `device`.
+        let requirements = unsafe { device.get_image_memory_requirements(image) };
+        let memory = Memory::new(ctx, name, requirements, MemoryLocation::GpuOnly, false)?;
+        let a = memory.get();
+        // SAFETY: the memory was allocated for this image's requirements and is bound to
+        // nothing else; the image has no memory bound yet.
+        unsafe { device.bind_image_memory(image, a.memory(), a.offset()) }
+            .vk("vkBindImageMemory")?;
+        owned.memory = Some(memory);
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(image)
+            .view_type(if volume {
+                vk::ImageViewType::TYPE_3D
+            } else if layers > 1 {
+                vk::ImageViewType::TYPE_2D_ARRAY
+            } else {
+                vk::ImageViewType::TYPE_2D
+            })
+            .format(format)
+            .subresource_range(subresource_range(aspect, 0, layers));
+        // SAFETY: the image is live and bound to memory; the view covers its layers and is
+        // destroyed by the image's drop.
+        owned.view =
+            unsafe { device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
+        Ok(owned)
     }
 
-    /// A view of one layer of this image.
-    pub fn layer_view(&self, ctx: &GpuContext, layer: u32) -> Result<vk::ImageView> {
+    /// A view of one layer of this image, owned by the caller (it must drop before the
+    /// image).
+    pub fn layer_view(&self, ctx: &GpuContext, layer: u32) -> Result<Owned<vk::ImageView>> {
         let info = vk::ImageViewCreateInfo::default()
             .image(self.image)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(self.format)
             .subresource_range(subresource_range(aspect_of(self.format), layer, 1));
-        unsafe { ctx.device.create_image_view(&info, None) }.vk("vkCreateImageView")
+        // SAFETY: the image is live and bound to memory; `layer` is checked by validation
+        // against its layer count; the view is owned (and destroyed) by the returned value.
+        let view = unsafe { ctx.device.create_image_view(&info, None) }.vk("vkCreateImageView")?;
+        Ok(Owned::new(ctx, view))
     }
+}
 
-    /// Frees the image and its view.
-    ///
-    /// # Safety
-    /// The GPU must no longer use it.
-    pub unsafe fn destroy(&mut self, ctx: &GpuContext) {
-        if let Some(allocation) = self.allocation.take() {
-            unsafe {
-                if self.view != vk::ImageView::null() {
-                    ctx.device.destroy_image_view(self.view, None);
-                }
-                ctx.device.destroy_image(self.image, None);
-            }
-            let _ = ctx.allocator().free(allocation);
+impl Drop for Image {
+    fn drop(&mut self) {
+        // SAFETY: the view and image were made on `device`; the owner drops the image only
+        // when no GPU work uses it any more (see crate::owned), and before the context's
+        // device. Null views (a failed construction) are ignored by Vulkan.
+        unsafe {
+            self.device.destroy_image_view(self.view, None);
+            self.device.destroy_image(self.image, None);
         }
+        self.memory.take();
     }
 }
 
@@ -266,7 +329,7 @@ pub fn upload_volume(
     depth: u32,
     bytes: &[u8],
 ) -> Result<Image> {
-    let mut staging = Buffer::with_data(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_SRC)?;
+    let staging = Buffer::with_data(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_SRC)?;
     let image = Image::with_depth(
         ctx,
         name,
@@ -275,15 +338,12 @@ pub fn upload_volume(
         depth,
         1,
         vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
-    );
-    let mut image = match image {
-        Ok(image) => image,
-        Err(e) => {
-            unsafe { staging.destroy(ctx) };
-            return Err(e);
-        }
-    };
+    )?;
     let device = &ctx.device;
+    // SAFETY: `cmd` is recording outside a render pass (one_shot's contract); the staging
+    // buffer and the image are live and outlive the submission (one_shot waits for it, and
+    // on a timeout both are leaked below rather than freed under the GPU); the image is in
+    // UNDEFINED layout, as the first barrier says.
     let result = ctx.one_shot(|cmd| unsafe {
         let range = subresource_range(vk::ImageAspectFlags::COLOR, 0, 1);
         let to_dst = vk::ImageMemoryBarrier::default()
@@ -342,12 +402,17 @@ pub fn upload_volume(
             &[to_read],
         );
     });
-    unsafe { staging.destroy(ctx) };
-    if let Err(e) = result {
-        unsafe { image.destroy(ctx) };
-        return Err(e);
+    match result {
+        Ok(()) => Ok(image),
+        Err(e) => {
+            if e.gpu_may_still_run() {
+                // The copy may still be running: leaking is the only sound choice.
+                std::mem::forget(staging);
+                std::mem::forget(image);
+            }
+            Err(e)
+        }
     }
-    Ok(image)
 }
 
 /// The aspect of a format: depth for depth formats, colour otherwise.

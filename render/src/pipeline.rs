@@ -1,55 +1,87 @@
-//! Shared pieces of graphics pipeline creation.
+//! The one place render builds pipelines, render passes, framebuffers and descriptors.
+//!
+//! Every pass (glass, world, the floor passes) describes its pipeline with a
+//! [`PipelineSpec`] and gets it from [`create`]; render passes come from
+//! [`eye_render_pass`] (colour + depth, one eye layer) and [`field_render_pass`] (one
+//! floor-space colour image); [`begin_render_pass`] starts either with a viewport and scissor
+//! covering the target. Everything returned is an [`Owned`] handle that destroys itself.
+
+use std::ffi::CStr;
 
 use ash::vk;
 
 use crate::context::GpuContext;
 use crate::error::{Result, VkContext};
+use crate::owned::Owned;
+use crate::scene::VERTEX_STRIDE;
 use crate::shaders;
 
-/// How a pipeline draws.
-pub struct PipelineDesc<'a> {
-    /// Vertex shader SPIR-V.
-    pub vertex: &'a [u8],
-    /// Fragment shader SPIR-V.
-    pub fragment: &'a [u8],
-    /// Vertex buffer bindings.
+/// How a pipeline's colour output meets the target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blend {
+    /// Overwrite (each layer owns its pixels).
+    Replace,
+    /// Add to the target's colour (ONE, ONE) without touching alpha: light added on top.
+    Add,
+}
+
+/// How a triangle-list pipeline with dynamic viewport and scissor draws.
+pub struct PipelineSpec<'a> {
+    /// The render pass (subpass 0) it draws in.
+    pub render_pass: vk::RenderPass,
+    /// Its layout.
+    pub layout: vk::PipelineLayout,
+    /// Vertex shader SPIR-V and entry point.
+    pub vertex: (&'a [u8], &'a CStr),
+    /// Fragment shader SPIR-V and entry point.
+    pub fragment: (&'a [u8], &'a CStr),
+    /// Vertex buffer bindings (empty: the shader makes its vertices).
     pub bindings: &'a [vk::VertexInputBindingDescription],
     /// Vertex attributes.
     pub attributes: &'a [vk::VertexInputAttributeDescription],
     /// Which faces to cull.
     pub cull: vk::CullModeFlags,
+    /// Test and write depth (LESS); otherwise neither.
+    pub depth: bool,
+    /// Colour blending.
+    pub blend: Blend,
 }
 
-/// Creates a pipeline for subpass 0 of `render_pass` with depth test and write, no blending
-/// (each layer owns its pixels), and dynamic viewport and scissor.
-pub fn create(
-    ctx: &GpuContext,
-    render_pass: vk::RenderPass,
-    layout: vk::PipelineLayout,
-    desc: &PipelineDesc,
-) -> Result<vk::Pipeline> {
-    let device = &ctx.device;
-    let vs = module(ctx, desc.vertex)?;
-    let fs = match module(ctx, desc.fragment) {
-        Ok(fs) => fs,
-        Err(e) => {
-            unsafe { device.destroy_shader_module(vs, None) };
-            return Err(e);
-        }
+/// The vertex input reading only positions from the scene's interleaved vertex buffer.
+pub const MESH_POSITION_BINDING: vk::VertexInputBindingDescription =
+    vk::VertexInputBindingDescription {
+        binding: 0,
+        stride: VERTEX_STRIDE,
+        input_rate: vk::VertexInputRate::VERTEX,
     };
+
+/// Location 0: the position (three floats at the vertex's start).
+pub const MESH_POSITION_ATTRIBUTE: vk::VertexInputAttributeDescription =
+    vk::VertexInputAttributeDescription {
+        location: 0,
+        binding: 0,
+        format: vk::Format::R32G32B32_SFLOAT,
+        offset: 0,
+    };
+
+/// Creates the pipeline `spec` describes.
+pub fn create(ctx: &GpuContext, spec: &PipelineSpec) -> Result<Owned<vk::Pipeline>> {
+    // Dropped (destroyed) on return: a pipeline does not need its modules afterwards.
+    let vs = module(ctx, spec.vertex.0)?;
+    let fs = module(ctx, spec.fragment.0)?;
     let stages = [
         vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::VERTEX)
-            .module(vs)
-            .name(c"vs_main"),
+            .module(vs.raw())
+            .name(spec.vertex.1),
         vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::FRAGMENT)
-            .module(fs)
-            .name(c"fs_main"),
+            .module(fs.raw())
+            .name(spec.fragment.1),
     ];
     let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
-        .vertex_binding_descriptions(desc.bindings)
-        .vertex_attribute_descriptions(desc.attributes);
+        .vertex_binding_descriptions(spec.bindings)
+        .vertex_attribute_descriptions(spec.attributes);
     let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
         .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
     let viewport = vk::PipelineViewportStateCreateInfo::default()
@@ -60,18 +92,33 @@ pub fn create(
     // (the sign of the framebuffer-space area, negated) then sees them counter-clockwise.
     let raster = vk::PipelineRasterizationStateCreateInfo::default()
         .polygon_mode(vk::PolygonMode::FILL)
-        .cull_mode(desc.cull)
+        .cull_mode(spec.cull)
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0);
     let multisample = vk::PipelineMultisampleStateCreateInfo::default()
         .rasterization_samples(vk::SampleCountFlags::TYPE_1);
     let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(true)
-        .depth_write_enable(true)
+        .depth_test_enable(spec.depth)
+        .depth_write_enable(spec.depth)
         .depth_compare_op(vk::CompareOp::LESS);
-    let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
-        .blend_enable(false)
-        .color_write_mask(vk::ColorComponentFlags::RGBA)];
+    let blend_attachments = [match spec.blend {
+        Blend::Add => vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ZERO)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+            .alpha_blend_op(vk::BlendOp::ADD)
+            .color_write_mask(
+                vk::ColorComponentFlags::R
+                    | vk::ColorComponentFlags::G
+                    | vk::ColorComponentFlags::B,
+            ),
+        Blend::Replace => vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(false)
+            .color_write_mask(vk::ColorComponentFlags::RGBA),
+    }];
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
     let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
     let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
@@ -85,32 +132,234 @@ pub fn create(
         .depth_stencil_state(&depth)
         .color_blend_state(&blend)
         .dynamic_state(&dynamic)
-        .layout(layout)
-        .render_pass(render_pass)
+        .layout(spec.layout)
+        .render_pass(spec.render_pass)
         .subpass(0);
-    let result =
-        unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
-    unsafe {
-        device.destroy_shader_module(vs, None);
-        device.destroy_shader_module(fs, None);
+    // SAFETY: every handle in `info` (modules, layout, render pass) is live for the call, and
+    // the state structs it points to live until it returns.
+    let pipelines = unsafe {
+        ctx.device
+            .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
     }
-    result
-        .map(|p| p[0])
-        .map_err(|(_, e)| e)
-        .vk("vkCreateGraphicsPipelines")
+    .map_err(|(_, e)| e)
+    .vk("vkCreateGraphicsPipelines")?;
+    Ok(Owned::new(ctx, pipelines[0]))
 }
 
-fn module(ctx: &GpuContext, spirv: &[u8]) -> Result<vk::ShaderModule> {
+/// A shader module of SPIR-V compiled by build.rs.
+fn module(ctx: &GpuContext, spirv: &[u8]) -> Result<Owned<vk::ShaderModule>> {
     let words = shaders::words(spirv);
     let info = vk::ShaderModuleCreateInfo::default().code(&words);
-    unsafe { ctx.device.create_shader_module(&info, None) }.vk("vkCreateShaderModule")
+    // SAFETY: `words` is SPIR-V that naga wrote and validated at build time.
+    let module =
+        unsafe { ctx.device.create_shader_module(&info, None) }.vk("vkCreateShaderModule")?;
+    Ok(Owned::new(ctx, module))
+}
+
+/// The render pass of the eye images: a colour attachment of `color_format`, cleared and
+/// stored, left in `final_layout`, and a depth attachment, cleared and stored only with
+/// `store_depth` (for a depth image someone else reads: an OpenXR depth swapchain). Load and
+/// store ops and layouts do not affect render-pass compatibility, so the same pipelines draw
+/// in every variant of the same colour format.
+pub fn eye_render_pass(
+    ctx: &GpuContext,
+    color_format: vk::Format,
+    depth_format: vk::Format,
+    final_layout: vk::ImageLayout,
+    store_depth: bool,
+) -> Result<Owned<vk::RenderPass>> {
+    let attachments = [
+        vk::AttachmentDescription::default()
+            .format(color_format)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+            .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .initial_layout(vk::ImageLayout::UNDEFINED)
+            .final_layout(final_layout),
+        vk::AttachmentDescription::default()
+            .format(depth_format)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(if store_depth {
+                vk::AttachmentStoreOp::STORE
+            } else {
+                vk::AttachmentStoreOp::DONT_CARE
+            })
+            .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+            .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .initial_layout(vk::ImageLayout::UNDEFINED)
+            .final_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
+    ];
+    let color_ref = [vk::AttachmentReference {
+        attachment: 0,
+        layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+    }];
+    let depth_ref = vk::AttachmentReference {
+        attachment: 1,
+        layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+    };
+    let subpasses = [vk::SubpassDescription::default()
+        .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
+        .color_attachments(&color_ref)
+        .depth_stencil_attachment(&depth_ref)];
+    let attachment_stages = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
+        | vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS
+        | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
+    let attachment_writes =
+        vk::AccessFlags::COLOR_ATTACHMENT_WRITE | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE;
+    let dependencies = [
+        // The previous frame's use of the same images (attachment writes, the readback copy)
+        // must finish before this pass writes them again.
+        vk::SubpassDependency::default()
+            .src_subpass(vk::SUBPASS_EXTERNAL)
+            .dst_subpass(0)
+            .src_stage_mask(attachment_stages | vk::PipelineStageFlags::TRANSFER)
+            .src_access_mask(attachment_writes)
+            .dst_stage_mask(attachment_stages)
+            .dst_access_mask(attachment_writes | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ),
+        // The colour written here is read by the readback copy.
+        vk::SubpassDependency::default()
+            .src_subpass(0)
+            .dst_subpass(vk::SUBPASS_EXTERNAL)
+            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
+            .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags::TRANSFER)
+            .dst_access_mask(vk::AccessFlags::TRANSFER_READ),
+    ];
+    render_pass(ctx, &attachments, &subpasses, &dependencies)
+}
+
+/// A render pass with one colour attachment of `format`, cleared, left for fragment shaders
+/// to read (a floor-space field). Its dependencies order it after earlier reads and writes of
+/// the image (by fragment shaders, attachments or transfers) and make its writes visible to
+/// later fragment shaders and transfers.
+pub fn field_render_pass(ctx: &GpuContext, format: vk::Format) -> Result<Owned<vk::RenderPass>> {
+    let attachments = [vk::AttachmentDescription::default()
+        .format(format)
+        .samples(vk::SampleCountFlags::TYPE_1)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+        .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+        .initial_layout(vk::ImageLayout::UNDEFINED)
+        .final_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)];
+    let color_ref = [vk::AttachmentReference {
+        attachment: 0,
+        layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+    }];
+    let subpasses = [vk::SubpassDescription::default()
+        .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
+        .color_attachments(&color_ref)];
+    let dependencies = [
+        vk::SubpassDependency::default()
+            .src_subpass(vk::SUBPASS_EXTERNAL)
+            .dst_subpass(0)
+            .src_stage_mask(
+                vk::PipelineStageFlags::FRAGMENT_SHADER
+                    | vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
+                    | vk::PipelineStageFlags::TRANSFER,
+            )
+            .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
+            .dst_access_mask(
+                vk::AccessFlags::COLOR_ATTACHMENT_WRITE | vk::AccessFlags::COLOR_ATTACHMENT_READ,
+            ),
+        vk::SubpassDependency::default()
+            .src_subpass(0)
+            .dst_subpass(vk::SUBPASS_EXTERNAL)
+            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
+            .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
+            .dst_stage_mask(
+                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER,
+            )
+            .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::TRANSFER_READ),
+    ];
+    render_pass(ctx, &attachments, &subpasses, &dependencies)
+}
+
+fn render_pass(
+    ctx: &GpuContext,
+    attachments: &[vk::AttachmentDescription],
+    subpasses: &[vk::SubpassDescription],
+    dependencies: &[vk::SubpassDependency],
+) -> Result<Owned<vk::RenderPass>> {
+    let info = vk::RenderPassCreateInfo::default()
+        .attachments(attachments)
+        .subpasses(subpasses)
+        .dependencies(dependencies);
+    // SAFETY: `info` and the arrays it points to are valid for the call.
+    let render_pass =
+        unsafe { ctx.device.create_render_pass(&info, None) }.vk("vkCreateRenderPass")?;
+    Ok(Owned::new(ctx, render_pass))
+}
+
+/// A framebuffer of `attachments` (one layer) for `render_pass`.
+pub fn framebuffer(
+    ctx: &GpuContext,
+    render_pass: vk::RenderPass,
+    attachments: &[vk::ImageView],
+    extent: vk::Extent2D,
+) -> Result<Owned<vk::Framebuffer>> {
+    let info = vk::FramebufferCreateInfo::default()
+        .render_pass(render_pass)
+        .attachments(attachments)
+        .width(extent.width)
+        .height(extent.height)
+        .layers(1);
+    // SAFETY: the render pass and views are live; the caller keeps the views alive as long
+    // as the framebuffer (it owns both).
+    let framebuffer =
+        unsafe { ctx.device.create_framebuffer(&info, None) }.vk("vkCreateFramebuffer")?;
+    Ok(Owned::new(ctx, framebuffer))
+}
+
+/// Begins `render_pass` on `framebuffer` over all of `extent`, clearing to `clear`, with a
+/// viewport and scissor covering it.
+///
+/// # Safety
+/// `cmd` must be recording outside any render pass; the render pass and framebuffer must be
+/// live, compatible, and outlive the command buffer's execution.
+pub unsafe fn begin_render_pass(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    render_pass: vk::RenderPass,
+    framebuffer: vk::Framebuffer,
+    extent: vk::Extent2D,
+    clear: &[vk::ClearValue],
+) {
+    let area = vk::Rect2D {
+        offset: vk::Offset2D { x: 0, y: 0 },
+        extent,
+    };
+    let begin = vk::RenderPassBeginInfo::default()
+        .render_pass(render_pass)
+        .framebuffer(framebuffer)
+        .render_area(area)
+        .clear_values(clear);
+    let viewport = vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: extent.width as f32,
+        height: extent.height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    // SAFETY: the caller's contract: `cmd` records outside a render pass, the handles are
+    // live; the pipelines bound inside set viewport and scissor dynamically.
+    unsafe {
+        device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+        device.cmd_set_viewport(cmd, 0, &[viewport]);
+        device.cmd_set_scissor(cmd, 0, &[area]);
+    }
 }
 
 /// A descriptor set layout from (binding, type, stages) triples.
 pub fn set_layout(
     ctx: &GpuContext,
     bindings: &[(u32, vk::DescriptorType, vk::ShaderStageFlags)],
-) -> Result<vk::DescriptorSetLayout> {
+) -> Result<Owned<vk::DescriptorSetLayout>> {
     let bindings: Vec<_> = bindings
         .iter()
         .map(|&(binding, ty, stages)| {
@@ -122,18 +371,20 @@ pub fn set_layout(
         })
         .collect();
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
-    unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
-        .vk("vkCreateDescriptorSetLayout")
+    // SAFETY: `info` and its bindings are valid for the call.
+    let layout = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
+        .vk("vkCreateDescriptorSetLayout")?;
+    Ok(Owned::new(ctx, layout))
 }
 
-/// A pipeline layout with one set layout and push constants of `push_size` bytes.
+/// A pipeline layout with at most one set layout and push constants of `push_size` bytes.
 pub fn layout(
     ctx: &GpuContext,
-    set_layout: vk::DescriptorSetLayout,
+    set_layout: Option<vk::DescriptorSetLayout>,
     push_stages: vk::ShaderStageFlags,
     push_size: u32,
-) -> Result<vk::PipelineLayout> {
-    let set_layouts = [set_layout];
+) -> Result<Owned<vk::PipelineLayout>> {
+    let set_layouts: Vec<_> = set_layout.into_iter().collect();
     let ranges = [vk::PushConstantRange {
         stage_flags: push_stages,
         offset: 0,
@@ -142,7 +393,10 @@ pub fn layout(
     let info = vk::PipelineLayoutCreateInfo::default()
         .set_layouts(&set_layouts)
         .push_constant_ranges(&ranges);
-    unsafe { ctx.device.create_pipeline_layout(&info, None) }.vk("vkCreatePipelineLayout")
+    // SAFETY: `info` and the set layouts it names are valid for the call.
+    let layout =
+        unsafe { ctx.device.create_pipeline_layout(&info, None) }.vk("vkCreatePipelineLayout")?;
+    Ok(Owned::new(ctx, layout))
 }
 
 /// A descriptor pool for `sets` sets with the given descriptor counts.
@@ -150,7 +404,7 @@ pub fn pool(
     ctx: &GpuContext,
     sets: u32,
     sizes: &[(vk::DescriptorType, u32)],
-) -> Result<vk::DescriptorPool> {
+) -> Result<Owned<vk::DescriptorPool>> {
     let sizes: Vec<_> = sizes
         .iter()
         .map(|&(ty, descriptor_count)| vk::DescriptorPoolSize {
@@ -161,10 +415,13 @@ pub fn pool(
     let info = vk::DescriptorPoolCreateInfo::default()
         .max_sets(sets)
         .pool_sizes(&sizes);
-    unsafe { ctx.device.create_descriptor_pool(&info, None) }.vk("vkCreateDescriptorPool")
+    // SAFETY: `info` and its sizes are valid for the call.
+    let pool =
+        unsafe { ctx.device.create_descriptor_pool(&info, None) }.vk("vkCreateDescriptorPool")?;
+    Ok(Owned::new(ctx, pool))
 }
 
-/// Allocates one set of `layout` from `pool`.
+/// Allocates one set of `layout` from `pool` (freed with the pool).
 pub fn allocate_set(
     ctx: &GpuContext,
     pool: vk::DescriptorPool,
@@ -174,6 +431,8 @@ pub fn allocate_set(
     let info = vk::DescriptorSetAllocateInfo::default()
         .descriptor_pool(pool)
         .set_layouts(&layouts);
+    // SAFETY: the pool and layout are live; the pool is only used from the thread building
+    // the pass that owns it.
     Ok(unsafe { ctx.device.allocate_descriptor_sets(&info) }.vk("vkAllocateDescriptorSets")?[0])
 }
 
@@ -208,6 +467,8 @@ pub fn write_texture(
             .descriptor_type(vk::DescriptorType::SAMPLER)
             .image_info(&sampler_info),
     ];
+    // SAFETY: the set is not in use by pending GPU work (it is written while its pass is
+    // built), and the view and sampler are live.
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
 
@@ -223,5 +484,6 @@ pub fn write_image(ctx: &GpuContext, set: vk::DescriptorSet, binding: u32, view:
         .dst_binding(binding)
         .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
         .image_info(&image_info)];
+    // SAFETY: as in `write_texture`: the set is idle and the view live.
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }

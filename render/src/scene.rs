@@ -6,6 +6,7 @@ use glam::{Mat4, Vec2, Vec3};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
 use crate::memory::{Buffer, Image, upload_texture, upload_volume};
+use crate::owned::Owned;
 
 /// Texels of a texture, RGBA, row-major from the top-left.
 #[derive(Clone, Copy, Debug)]
@@ -77,18 +78,18 @@ pub struct SceneDesc<'a> {
     pub background_stack: Option<BlurStackDesc<'a>>,
     /// Blur stack of the surface texture for defocus; `None`: the texture only.
     pub surface_stack: Option<BlurStackDesc<'a>>,
-    // --- shadow inducer (issue 5; render/src/inducer.rs) ---
+    // --- shadow inducer (issue 5; render/src/floor/) ---
     /// Shadow inducer parameters (eq. 2-4).
     pub inducer: InducerDesc,
     // --- end shadow inducer ---
-    // --- caustics (issue 6; render/src/inducer.rs) ---
+    // --- caustics (issue 6; render/src/floor/) ---
     /// The caustic gain map G (eq. 6), if the scene has a bake; the overlay adds G L_r when
     /// [`crate::Look::caustics`] is on (nothing without a map).
     pub caustics: Option<CausticsDesc<'a>>,
     // --- end caustics ---
 }
 
-// --- caustics (issue 6; render/src/inducer.rs) ---
+// --- caustics (issue 6; render/src/floor/) ---
 /// A caustic gain map over the floor photo's area: `width` x `height` linear gains G >= 0,
 /// row-major, row 0 at the photo's top edge (the same orientation and uvs as the photo). The
 /// corrected caustics of eq. 6 are L'_c = G L_r (docs/caustics.md).
@@ -103,7 +104,7 @@ pub struct CausticsDesc<'a> {
 }
 // --- end caustics ---
 
-// --- shadow inducer (issue 5; render/src/inducer.rs) ---
+// --- shadow inducer (issue 5; render/src/floor/) ---
 /// Parameters of the shadow inducer (METHOD.md section 1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InducerDesc {
@@ -183,14 +184,14 @@ pub(crate) struct GpuScene {
     /// K_g between slices of the background and surface stacks, pixels.
     pub stack_steps: [f32; 2],
     /// Repeating in u, clamped in v: latitude-longitude maps.
-    pub env_sampler: vk::Sampler,
+    env_sampler: Owned<vk::Sampler>,
     /// Clamped: photos.
-    pub photo_sampler: vk::Sampler,
+    photo_sampler: Owned<vk::Sampler>,
 }
 
 impl GpuScene {
-    /// Validates `desc` and uploads it. On an error part way, what was created is left to
-    /// the device's destruction (the renderer drops its context on any construction error).
+    /// Validates `desc` and uploads it. On an error part way, what was created is freed (every
+    /// piece frees itself on drop).
     pub fn new(ctx: &GpuContext, desc: &SceneDesc) -> Result<GpuScene> {
         validate(ctx, desc)?;
         let m = desc.mesh;
@@ -248,24 +249,80 @@ impl GpuScene {
         })
     }
 
-    /// Frees everything.
-    ///
-    /// # Safety
-    /// The GPU must no longer use the scene.
-    pub unsafe fn destroy(&mut self, ctx: &GpuContext) {
-        unsafe {
-            self.vertices.destroy(ctx);
-            self.indices.destroy(ctx);
-            self.environment.destroy(ctx);
-            for p in &mut self.photos {
-                p.destroy(ctx);
-            }
-            self.surface.destroy(ctx);
-            self.background_stack.destroy(ctx);
-            ctx.device.destroy_sampler(self.env_sampler, None);
-            ctx.device.destroy_sampler(self.photo_sampler, None);
-        }
+    /// The sampler of latitude-longitude maps (repeating in u).
+    pub fn env_sampler(&self) -> vk::Sampler {
+        self.env_sampler.raw()
     }
+
+    /// The sampler of photos (clamped).
+    pub fn photo_sampler(&self) -> vk::Sampler {
+        self.photo_sampler.raw()
+    }
+}
+
+/// Smallest accepted inducer mask side, texels.
+pub const MIN_RESOLUTION_PX: u32 = 16;
+/// Largest accepted inducer mask side, texels (a 4096^2 jump flood costs seconds on
+/// lavapipe).
+pub const MAX_RESOLUTION_PX: u32 = 4096;
+/// Largest accepted inducer k.
+pub const MAX_K: f32 = 10.0;
+/// Largest accepted ramp width D, metres.
+pub const MAX_RAMP_WIDTH_M: f32 = 100.0;
+/// Largest caustic gain accepted (the overlay's gain is stored as a half float).
+pub const MAX_CAUSTIC_GAIN: f32 = 60000.0;
+
+/// Checks the inducer's parameters; `max_image_px` is the device's largest 2-D image side.
+pub fn validate_inducer(desc: &InducerDesc, max_image_px: u32) -> Result<()> {
+    if !(desc.k.is_finite() && (0.0..=MAX_K).contains(&desc.k)) {
+        return Err(RenderError::InvalidInput(format!(
+            "inducer k must be within 0..={MAX_K}, got {}",
+            desc.k
+        )));
+    }
+    if !(desc.ramp_width_m.is_finite()
+        && desc.ramp_width_m > 0.0
+        && desc.ramp_width_m <= MAX_RAMP_WIDTH_M)
+    {
+        return Err(RenderError::InvalidInput(format!(
+            "inducer ramp width D must be > 0 and <= {MAX_RAMP_WIDTH_M} m, got {}",
+            desc.ramp_width_m
+        )));
+    }
+    let max = MAX_RESOLUTION_PX.min(max_image_px);
+    if !(MIN_RESOLUTION_PX..=max).contains(&desc.resolution_px) {
+        return Err(RenderError::InvalidInput(format!(
+            "inducer resolution must be within {MIN_RESOLUTION_PX}..={max} texels, got {}",
+            desc.resolution_px
+        )));
+    }
+    Ok(())
+}
+
+/// Checks a caustic gain map; `max_image_px` is the device's largest 2-D image side.
+pub fn validate_caustics(desc: &CausticsDesc, max_image_px: u32) -> Result<()> {
+    let (w, h) = (desc.width, desc.height);
+    if w == 0 || h == 0 || w > max_image_px || h > max_image_px {
+        return Err(RenderError::InvalidInput(format!(
+            "the caustic gain map is {w}x{h} texels; this device takes 1..={max_image_px} per side"
+        )));
+    }
+    if desc.gain.len() != w as usize * h as usize {
+        return Err(RenderError::InvalidInput(format!(
+            "the caustic gain map has {} values for {w}x{h} texels",
+            desc.gain.len()
+        )));
+    }
+    if let Some(bad) = desc
+        .gain
+        .iter()
+        .find(|g| !(g.is_finite() && (0.0..=MAX_CAUSTIC_GAIN).contains(*g)))
+    {
+        return Err(RenderError::InvalidInput(format!(
+            "caustic gains must be finite and within 0..={MAX_CAUSTIC_GAIN}, found {bad}"
+        )));
+    }
+    Ok(())
 }
 
 fn validate(ctx: &GpuContext, desc: &SceneDesc) -> Result<()> {
@@ -295,12 +352,13 @@ fn validate(ctx: &GpuContext, desc: &SceneDesc) -> Result<()> {
             desc.ior
         )));
     }
+    // SAFETY: `physical` was enumerated from `instance`, which the context keeps alive.
     let limit = unsafe { ctx.instance.get_physical_device_properties(ctx.physical) }
         .limits
         .max_image_dimension2_d;
-    crate::inducer::validate(&desc.inducer, limit)?; // shadow inducer (issue 5)
+    validate_inducer(&desc.inducer, limit)?;
     if let Some(caustics) = &desc.caustics {
-        crate::inducer::validate_caustics(caustics, limit)?; // caustics (issue 6)
+        validate_caustics(caustics, limit)?;
     }
     if !(0.0..=1.0).contains(&desc.surface_transmittance) {
         return Err(RenderError::InvalidInput(format!(
@@ -437,7 +495,7 @@ fn upload_stack(
     }
 }
 
-fn sampler(ctx: &GpuContext, u_mode: vk::SamplerAddressMode) -> Result<vk::Sampler> {
+fn sampler(ctx: &GpuContext, u_mode: vk::SamplerAddressMode) -> Result<Owned<vk::Sampler>> {
     let info = vk::SamplerCreateInfo::default()
         .mag_filter(vk::Filter::LINEAR)
         .min_filter(vk::Filter::LINEAR)
@@ -446,5 +504,7 @@ fn sampler(ctx: &GpuContext, u_mode: vk::SamplerAddressMode) -> Result<vk::Sampl
         .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
         .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
         .max_lod(0.0);
-    unsafe { ctx.device.create_sampler(&info, None) }.vk("vkCreateSampler")
+    // SAFETY: `info` is a valid create info; the sampler is owned by the returned value.
+    let sampler = unsafe { ctx.device.create_sampler(&info, None) }.vk("vkCreateSampler")?;
+    Ok(Owned::new(ctx, sampler))
 }

@@ -7,7 +7,8 @@ use glam::Mat4;
 use crate::camera::EyeParams;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::pipeline::{self, PipelineDesc};
+use crate::owned::Owned;
+use crate::pipeline::{self, Blend, PipelineSpec};
 use crate::scene::GpuScene;
 use crate::shaders;
 
@@ -19,16 +20,16 @@ struct PlanePush {
     world_from_plane: [f32; 16],
 }
 
-/// The real-world pipeline and one descriptor set per plane.
+/// The real-world pipeline and one descriptor set per plane, freed on drop.
 pub struct WorldPass {
-    /// Layout of a plane's descriptor set.
-    set_layout: vk::DescriptorSetLayout,
-    /// Pipeline layout.
-    layout: vk::PipelineLayout,
     /// The pipeline.
-    pipeline: vk::Pipeline,
+    pipeline: Owned<vk::Pipeline>,
+    /// Pipeline layout.
+    layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets.
-    pool: vk::DescriptorPool,
+    _pool: Owned<vk::DescriptorPool>,
+    /// Layout of a plane's descriptor set.
+    _set_layout: Owned<vk::DescriptorSetLayout>,
     /// Floor then background.
     sets: [vk::DescriptorSet; 2],
     /// Floor then background plane transforms.
@@ -53,20 +54,22 @@ impl WorldPass {
         )?;
         let layout = pipeline::layout(
             ctx,
-            set_layout,
+            Some(set_layout.raw()),
             vk::ShaderStageFlags::VERTEX,
             size_of::<PlanePush>() as u32,
         )?;
         let pipeline = pipeline::create(
             ctx,
-            render_pass,
-            layout,
-            &PipelineDesc {
-                vertex: shaders::WORLD_VS,
-                fragment: shaders::WORLD_FS,
+            &PipelineSpec {
+                render_pass,
+                layout: layout.raw(),
+                vertex: (shaders::WORLD_VS, c"vs_main"),
+                fragment: (shaders::WORLD_FS, c"fs_main"),
                 bindings: &[],
                 attributes: &[],
                 cull: vk::CullModeFlags::NONE,
+                depth: true,
+                blend: Blend::Replace,
             },
         )?;
         let pool = pipeline::pool(
@@ -79,14 +82,14 @@ impl WorldPass {
         )?;
         let mut sets = [vk::DescriptorSet::null(); 2];
         for (set, photo) in sets.iter_mut().zip(&scene.photos) {
-            *set = pipeline::allocate_set(ctx, pool, set_layout)?;
-            pipeline::write_texture(ctx, *set, 0, 1, photo.view, scene.photo_sampler);
+            *set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+            pipeline::write_texture(ctx, *set, 0, 1, photo.view, scene.photo_sampler());
         }
         Ok(WorldPass {
-            set_layout,
-            layout,
             pipeline,
-            pool,
+            layout,
+            _pool: pool,
+            _set_layout: set_layout,
             sets,
             planes,
         })
@@ -98,8 +101,11 @@ impl WorldPass {
     /// `cmd` must be recording inside a render pass compatible with this pass.
     pub unsafe fn record(&self, ctx: &GpuContext, cmd: vk::CommandBuffer, eye: &EyeParams) {
         let d = &ctx.device;
+        // SAFETY: the caller's contract (recording inside a compatible render pass); the
+        // pipeline and sets are live for as long as the renderer that records them, which
+        // waits for its frames before dropping them.
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw());
             for (set, plane) in self.sets.iter().zip(&self.planes) {
                 let push = PlanePush {
                     clip_from_world: eye.clip_from_world().to_cols_array(),
@@ -108,34 +114,20 @@ impl WorldPass {
                 d.cmd_bind_descriptor_sets(
                     cmd,
                     vk::PipelineBindPoint::GRAPHICS,
-                    self.layout,
+                    self.layout.raw(),
                     0,
                     &[*set],
                     &[],
                 );
                 d.cmd_push_constants(
                     cmd,
-                    self.layout,
+                    self.layout.raw(),
                     vk::ShaderStageFlags::VERTEX,
                     0,
                     bytemuck::bytes_of(&push),
                 );
                 d.cmd_draw(cmd, 6, 1, 0, 0);
             }
-        }
-    }
-
-    /// Frees the pass.
-    ///
-    /// # Safety
-    /// The GPU must no longer use it.
-    pub unsafe fn destroy(&mut self, ctx: &GpuContext) {
-        let d = &ctx.device;
-        unsafe {
-            d.destroy_pipeline(self.pipeline, None);
-            d.destroy_pipeline_layout(self.layout, None);
-            d.destroy_descriptor_pool(self.pool, None);
-            d.destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
 }

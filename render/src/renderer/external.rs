@@ -18,27 +18,28 @@ use ash::vk;
 
 use super::{FrameResult, Renderer, Want};
 use crate::camera::FrameParams;
-use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
-use crate::target;
+use crate::owned::Owned;
+use crate::{pipeline, target};
 
-/// Framebuffers over external images.
+/// Framebuffers over external images; the views, framebuffers and render pass are freed on
+/// drop (the images are not).
 pub(super) struct External {
+    /// Framebuffer of each slot's left and right layer (slot = colour index * depth slots +
+    /// depth index).
+    framebuffers: Vec<[Owned<vk::Framebuffer>; 2]>,
+    /// Per-layer colour views of the images.
+    _views: Vec<Owned<vk::ImageView>>,
+    /// Per-layer views of the depth images (the renderer's own, or each external one's).
+    _depth_views: Vec<Owned<vk::ImageView>>,
     /// Render pass leaving colour in `COLOR_ATTACHMENT_OPTIMAL`.
-    pub(super) render_pass: vk::RenderPass,
-    /// The colour image of each slot (slot = colour index * depth slots + depth index), 2
-    /// layers each; not owned.
+    render_pass: Owned<vk::RenderPass>,
+    /// The colour image of each slot, 2 layers each; not owned.
     pub(super) images: Vec<vk::Image>,
     /// Number of external colour images.
     color_count: usize,
     /// Number of external depth images (0: the renderer's own depth image is used).
     depth_count: usize,
-    /// Per-layer colour views of the images, owned.
-    views: Vec<vk::ImageView>,
-    /// Per-layer views of the depth images (the renderer's own, or each external one's), owned.
-    depth_views: Vec<vk::ImageView>,
-    /// Framebuffer of each slot's left and right layer.
-    pub(super) framebuffers: Vec<[vk::Framebuffer; 2]>,
 }
 
 impl External {
@@ -59,26 +60,15 @@ pub(super) struct ExternalDraw {
 }
 
 impl External {
-    /// Frees the views, framebuffers and render pass (not the images).
-    ///
-    /// # Safety
-    /// The GPU must no longer use them.
-    pub(super) unsafe fn destroy(&mut self, ctx: &GpuContext) {
-        let d = &ctx.device;
-        unsafe {
-            for fb in self.framebuffers.drain(..).flatten() {
-                if fb != vk::Framebuffer::null() {
-                    d.destroy_framebuffer(fb, None);
-                }
-            }
-            for view in self.views.drain(..).chain(self.depth_views.drain(..)) {
-                d.destroy_image_view(view, None);
-            }
-            if self.render_pass != vk::RenderPass::null() {
-                d.destroy_render_pass(self.render_pass, None);
-                self.render_pass = vk::RenderPass::null();
-            }
-        }
+    /// The render pass the external framebuffers belong to.
+    pub(super) fn render_pass(&self) -> vk::RenderPass {
+        self.render_pass.raw()
+    }
+
+    /// The left and right framebuffers of slot `slot`.
+    pub(super) fn framebuffers(&self, slot: usize) -> [vk::Framebuffer; 2] {
+        let [left, right] = &self.framebuffers[slot];
+        [left.raw(), right.raw()]
     }
 }
 
@@ -113,6 +103,8 @@ pub(super) unsafe fn transition(
             base_array_layer: 0,
             layer_count: 2,
         });
+    // SAFETY: the caller's contract: `cmd` records outside a render pass and `image` is in
+    // layout `from`.
     unsafe {
         d.cmd_pipeline_barrier(
             cmd,
@@ -146,6 +138,7 @@ impl Renderer {
         images: &[vk::Image],
         format: vk::Format,
     ) -> Result<()> {
+        // SAFETY: the caller's contract is this function's, for no depth images.
         unsafe { self.attach_external_with_depth(images, format, &[]) }
     }
 
@@ -181,21 +174,11 @@ impl Renderer {
             vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
             !depth_images.is_empty(),
         )?;
-        let depth_slots = depth_images.len().max(1);
-        let mut external = External {
-            render_pass,
-            images: Vec::with_capacity(images.len() * depth_slots),
-            color_count: images.len(),
-            depth_count: depth_images.len(),
-            views: Vec::new(),
-            depth_views: Vec::new(),
-            framebuffers: Vec::new(),
-        };
         let layer_view = |image: vk::Image,
                           format: vk::Format,
                           aspect: vk::ImageAspectFlags,
                           layer: u32|
-         -> Result<vk::ImageView> {
+         -> Result<Owned<vk::ImageView>> {
             let info = vk::ImageViewCreateInfo::default()
                 .image(image)
                 .view_type(vk::ImageViewType::TYPE_2D)
@@ -207,73 +190,75 @@ impl Renderer {
                     base_array_layer: layer,
                     layer_count: 1,
                 });
-            unsafe { ctx.device.create_image_view(&info, None) }.vk("vkCreateImageView")
+            // SAFETY: the caller of `attach_external_with_depth` guarantees the image is a
+            // live 2-layer image of this device; the view is owned right away.
+            let view =
+                unsafe { ctx.device.create_image_view(&info, None) }.vk("vkCreateImageView")?;
+            Ok(Owned::new(ctx, view))
         };
-        let built = (|| {
-            // Depth views: [depth image][layer], flattened.
-            if depth_images.is_empty() {
+        // Depth views: [depth image][layer], flattened. Everything made here is owned, so an
+        // error part way frees it on the way out.
+        let mut depth_views = Vec::new();
+        if depth_images.is_empty() {
+            for layer in 0..2 {
+                depth_views.push(self.eye_target.depth.layer_view(ctx, layer)?);
+            }
+        } else {
+            for &depth in depth_images {
                 for layer in 0..2 {
-                    external
-                        .depth_views
-                        .push(self.eye_target.depth.layer_view(ctx, layer)?);
+                    depth_views.push(layer_view(
+                        depth,
+                        target::DEPTH_FORMAT,
+                        vk::ImageAspectFlags::DEPTH,
+                        layer,
+                    )?);
                 }
-            } else {
-                for &depth in depth_images {
-                    for layer in 0..2 {
-                        external.depth_views.push(layer_view(
-                            depth,
-                            target::DEPTH_FORMAT,
-                            vk::ImageAspectFlags::DEPTH,
-                            layer,
-                        )?);
-                    }
-                }
-            }
-            for &image in images {
-                let mut color_views = [vk::ImageView::null(); 2];
-                for layer in 0..2u32 {
-                    let view = layer_view(image, format, vk::ImageAspectFlags::COLOR, layer)?;
-                    external.views.push(view);
-                    color_views[layer as usize] = view;
-                }
-                for depth in 0..depth_slots {
-                    let mut fbs = [vk::Framebuffer::null(); 2];
-                    for layer in 0..2usize {
-                        let attachments =
-                            [color_views[layer], external.depth_views[depth * 2 + layer]];
-                        let fb_info = vk::FramebufferCreateInfo::default()
-                            .render_pass(render_pass)
-                            .attachments(&attachments)
-                            .width(self.extent.width)
-                            .height(self.extent.height)
-                            .layers(1);
-                        fbs[layer] = unsafe { ctx.device.create_framebuffer(&fb_info, None) }
-                            .vk("vkCreateFramebuffer")?;
-                    }
-                    external.images.push(image);
-                    external.framebuffers.push(fbs);
-                }
-            }
-            Ok(())
-        })();
-        match built {
-            Ok(()) => {
-                self.external = Some(external);
-                Ok(())
-            }
-            Err(e) => {
-                unsafe { external.destroy(ctx) };
-                Err(e)
             }
         }
+        let depth_slots = depth_images.len().max(1);
+        let mut views = Vec::with_capacity(images.len() * 2);
+        let mut slot_images = Vec::with_capacity(images.len() * depth_slots);
+        let mut framebuffers = Vec::with_capacity(images.len() * depth_slots);
+        for &image in images {
+            let left = layer_view(image, format, vk::ImageAspectFlags::COLOR, 0)?;
+            let right = layer_view(image, format, vk::ImageAspectFlags::COLOR, 1)?;
+            let color_views = [left.raw(), right.raw()];
+            views.push(left);
+            views.push(right);
+            for depth in 0..depth_slots {
+                let framebuffer = |layer: usize| {
+                    pipeline::framebuffer(
+                        ctx,
+                        render_pass.raw(),
+                        &[color_views[layer], depth_views[depth * 2 + layer].raw()],
+                        self.extent,
+                    )
+                };
+                framebuffers.push([framebuffer(0)?, framebuffer(1)?]);
+                slot_images.push(image);
+            }
+        }
+        self.external = Some(External {
+            framebuffers,
+            _views: views,
+            _depth_views: depth_views,
+            render_pass,
+            images: slot_images,
+            color_count: images.len(),
+            depth_count: depth_images.len(),
+        });
+        Ok(())
     }
 
     /// Waits for every frame in flight and forgets the external images (they may then be
     /// destroyed). Frames still in flight are lost: call [`Renderer::flush`] first to keep them.
     pub fn detach_external(&mut self) -> Result<()> {
-        if let Some(mut external) = self.external.take() {
-            unsafe { self.ctx.device.device_wait_idle() }.vk("vkDeviceWaitIdle")?;
-            unsafe { external.destroy(&self.ctx) };
+        if let Some(external) = self.external.take() {
+            // SAFETY: waiting for idle has no preconditions. On a failed wait (a lost device)
+            // the objects may still be destroyed.
+            let waited = unsafe { self.ctx.device.device_wait_idle() }.vk("vkDeviceWaitIdle");
+            drop(external);
+            waited?;
         }
         Ok(())
     }

@@ -1,0 +1,188 @@
+//! The floor-space fields: the images the floor passes render into (one render pass and
+//! framebuffer each), their push constants, and the fields as read back to the CPU.
+
+use ash::vk;
+use glam::Vec2;
+
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::memory::Image;
+use crate::owned::Owned;
+use crate::pipeline;
+
+/// Indices into the pass's field targets.
+pub(crate) const MASK: usize = 0;
+pub(crate) const SEEDS_A: usize = 1;
+pub(crate) const SEEDS_B: usize = 2;
+pub(crate) const DISTANCE: usize = 3;
+pub(crate) const GAIN: usize = 4;
+/// The overlay's gain, k alpha(d) + G as switched on, at the caustic map's resolution.
+pub(crate) const OVERLAY: usize = 5;
+
+/// Name and format of each floor-space image, in the order of the indices above.
+pub(crate) const FIELDS: [(&str, vk::Format); 6] = [
+    ("shadow mask", vk::Format::R8_UNORM),
+    ("jump flood A", vk::Format::R32G32_SFLOAT),
+    ("jump flood B", vk::Format::R32G32_SFLOAT),
+    ("edge distance", vk::Format::R32_SFLOAT),
+    // Half floats filter linearly on every device: the overlay samples it bilinearly.
+    ("gain", vk::Format::R16_SFLOAT),
+    ("overlay gain", vk::Format::R16_SFLOAT),
+];
+
+/// One floor-space image with the render pass and framebuffer that write it (dropped in
+/// that order: framebuffer, render pass, image).
+pub(crate) struct FieldTarget {
+    /// The framebuffer over the image.
+    pub framebuffer: Owned<vk::Framebuffer>,
+    /// A single-attachment render pass ending in SHADER_READ_ONLY_OPTIMAL.
+    pub render_pass: Owned<vk::RenderPass>,
+    /// The image.
+    pub image: Image,
+    /// Its size.
+    pub extent: vk::Extent2D,
+}
+
+impl FieldTarget {
+    /// Creates the image `name` of `format` and `extent` with its render pass and framebuffer.
+    pub fn new(
+        ctx: &GpuContext,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+    ) -> Result<FieldTarget> {
+        let image = Image::new(
+            ctx,
+            &format!("inducer {name}"),
+            format,
+            extent,
+            1,
+            vk::ImageUsageFlags::COLOR_ATTACHMENT
+                | vk::ImageUsageFlags::SAMPLED
+                | vk::ImageUsageFlags::TRANSFER_SRC,
+        )?;
+        let render_pass = pipeline::field_render_pass(ctx, format)?;
+        let framebuffer = pipeline::framebuffer(ctx, render_pass.raw(), &[image.view], extent)?;
+        Ok(FieldTarget {
+            framebuffer,
+            render_pass,
+            image,
+            extent,
+        })
+    }
+
+    /// Begins this target's render pass, cleared to zero, with a viewport covering it.
+    ///
+    /// # Safety
+    /// `cmd` must be recording outside any render pass, and execute while `self` lives.
+    pub unsafe fn begin(&self, device: &ash::Device, cmd: vk::CommandBuffer) {
+        let clear = [vk::ClearValue {
+            color: vk::ClearColorValue { float32: [0.0; 4] },
+        }];
+        // SAFETY: the caller's contract; the render pass and framebuffer are this target's.
+        unsafe {
+            pipeline::begin_render_pass(
+                device,
+                cmd,
+                self.render_pass.raw(),
+                self.framebuffer.raw(),
+                self.extent,
+                &clear,
+            );
+        }
+    }
+}
+
+/// Push constants of the floor-space passes, as `Field` in shaders/inducer_field.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct FieldPush {
+    /// Floor metres per texel along x and y.
+    pub texel_m: [f32; 2],
+    /// The jump of a jump-flooding pass, texels.
+    pub step: i32,
+    /// Side of the fields, texels.
+    pub size: i32,
+    /// D of eq. 2, metres.
+    pub ramp_width_m: f32,
+    /// k of eq. 4.
+    pub k: f32,
+    /// fs_combine: weights of k alpha(d) and of the caustic gain G (1 on, 0 off).
+    pub switches: [f32; 2],
+}
+
+/// The floor-space fields read back from the GPU, row-major from the photo's top-left.
+#[derive(Clone, Debug)]
+pub struct InducerFields {
+    /// Side of every field, texels.
+    pub resolution_px: u32,
+    /// Floor metres per texel along x (u) and y (v).
+    pub texel_m: Vec2,
+    /// 1 where the floor is in the object's shadow, 0 where lit.
+    pub mask: Vec<u8>,
+    /// Distance to the shadow edge, metres; -1 inside the shadow, [`super::FAR_M`] without shadow.
+    pub distance_m: Vec<f32>,
+    /// k alpha(d) (eq. 2, 4): the overlay multiplies the floor photo by this.
+    pub gain: Vec<f32>,
+    /// The plane-local rectangle the overlay draws (see [`super::overlay_rect`]), if any.
+    pub rect: Option<[f32; 4]>,
+}
+
+impl InducerFields {
+    /// Index of texel (x, y).
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        (y * self.resolution_px + x) as usize
+    }
+
+    /// The texel holding photo coordinate `uv` (0..1, v down).
+    pub fn texel_at(&self, uv: Vec2) -> (u32, u32) {
+        let n = self.resolution_px;
+        let t = (uv * n as f32).floor();
+        (
+            (t.x.max(0.0) as u32).min(n - 1),
+            (t.y.max(0.0) as u32).min(n - 1),
+        )
+    }
+
+    /// The gain at `uv` filtered bilinearly between texel centres, as the overlay's sampler
+    /// does (clamped at the edges).
+    pub fn gain_bilinear(&self, uv: Vec2) -> f32 {
+        let n = self.resolution_px as i32;
+        let t = uv * n as f32 - Vec2::splat(0.5);
+        let base = t.floor();
+        let f = t - base;
+        let get = |dx: i32, dy: i32| {
+            let x = (base.x as i32 + dx).clamp(0, n - 1);
+            let y = (base.y as i32 + dy).clamp(0, n - 1);
+            self.gain[(y * n + x) as usize]
+        };
+        let top = get(0, 0) * (1.0 - f.x) + get(1, 0) * f.x;
+        let bottom = get(0, 1) * (1.0 - f.x) + get(1, 1) * f.x;
+        top * (1.0 - f.y) + bottom * f.y
+    }
+}
+
+/// Bytes per texel of the readback of the mask (R8), the distance (R32F) and the gain (R16F),
+/// stored one after another.
+pub(crate) const READBACK_BYTES_PER_TEXEL: u64 = 7;
+
+impl InducerFields {
+    /// Decodes a readback of `n` x `n` texels: the mask, then the distances, then the gains.
+    pub(crate) fn decode(bytes: &[u8], n: u32, texel_m: Vec2, rect: Option<[f32; 4]>) -> Self {
+        let t = n as usize * n as usize;
+        InducerFields {
+            resolution_px: n,
+            texel_m,
+            mask: bytes[..t].iter().map(|&b| u8::from(b > 127)).collect(),
+            distance_m: bytes[t..5 * t]
+                .chunks_exact(4)
+                .map(|f| f32::from_le_bytes([f[0], f[1], f[2], f[3]]))
+                .collect(),
+            gain: bytes[5 * t..7 * t]
+                .chunks_exact(2)
+                .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
+                .collect(),
+            rect,
+        }
+    }
+}

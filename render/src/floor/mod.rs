@@ -1,0 +1,74 @@
+//! The shadow inducer (METHOD.md section 1, paper Sec. 3.1.1, eq. 1-5).
+//!
+//! An additive display cannot darken the real floor where the virtual object's shadow falls,
+//! so the floor AROUND the shadow is brightened by a ramp that fades out over a width D; the
+//! eye then reads the untouched shadow region as darker than its surround.
+//!
+//! Everything below lives in floor space: square textures of `resolution_px` texels over the
+//! floor photo's area (the unit square of [`crate::PlaneDesc::world_from_plane`], texel (0, 0) at the
+//! photo's top-left, so texture uv equals photo uv). Once per scene (on the first frame that
+//! asks for the inducer, or on [`crate::Renderer::inducer_fields`]) four kinds of fragment passes run
+//! (no compute: lavapipe's timestamps do not see compute work, and these passes are cheap):
+//!
+//! 1. **Shadow mask** (eq. 1, shaders/inducer_mask.wgsl): the mesh projected from the point
+//!    light onto the floor plane by a homogeneous planar projection ([`planar_shadow`],
+//!    geometry.rs) and
+//!    rasterised straight into floor space; covered texels are in shadow. For an opaque
+//!    occluder this equals a conventional shadow-map lookup at each floor texel, without the
+//!    map's resolution and depth-bias artefacts.
+//! 2. **Jump flooding** (jump_flood.rs; shaders/inducer_field.wgsl `fs_seed`, `fs_jump`): ceil(log2 N)
+//!    passes with halving jumps plus one of jump 1, ping-ponging two RG32F textures of
+//!    nearest-shadow-texel coordinates, nearest in metres.
+//! 3. **Distance to the edge** (`fs_distance`, [`edge_distance_m`]): d in metres for every
+//!    lit texel, -1 inside the shadow.
+//! 4. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the precombined
+//!    overlay texture.
+//!
+//! Per eye, the floor overlay (overlay.rs; shaders/floor_overlay.wgsl) is a world-anchored rectangle on
+//! the floor plane covering only the shadow plus the ramp (bounded on the CPU from the mesh's
+//! projected vertices, [`overlay_rect`]); it adds L_s = k alpha(d) L_r (eq. 3) with blend
+//! (ONE, ONE), discarding texels without inducer light before it reads the photo: at most two
+//! texture fetches per covered pixel. The see-through preview then shows
+//! L_o = (1 + k alpha(d)) L_r (eq. 5).
+//!
+//! # Synchronisation
+//! Each floor-space pass is its own render pass whose subpass dependencies order it after the
+//! previous pass's colour writes and fragment reads and make its writes visible to fragment
+//! shaders and transfers; its image ends in SHADER_READ_ONLY_OPTIMAL. A recomputation (a
+//! moving light, later) recorded in a frame's command buffer therefore also waits for earlier
+//! frames' overlay reads.
+//!
+//! # Modules
+//! - `geometry`: the floor's frame, the shadow projection (eq. 1) and the overlay's rectangles;
+//! - `reference`: eq. 2-5 and the exact distance field on the CPU;
+//! - `fields`: the floor-space images, the push constants and the fields read back;
+//! - `jump_flood`: the schedule of the distance-field passes;
+//! - `overlay`: the per-eye overlay pipeline;
+//! - `pass`: the pass that builds all of it and records it once per scene;
+//! - `progress`: whether that computation has really run (set only after its fence);
+//! - `readback`: copying the fields back to the CPU.
+//!
+//! The scene limits checked before any of this is built (`validate_inducer`,
+//! `validate_caustics`) live with the descriptions they check, in [`crate::scene`].
+
+mod fields;
+mod geometry;
+mod jump_flood;
+mod overlay;
+mod pass;
+mod progress;
+mod readback;
+mod reference;
+
+pub use crate::scene::{
+    MAX_CAUSTIC_GAIN, MAX_K, MAX_RAMP_WIDTH_M, MAX_RESOLUTION_PX, MIN_RESOLUTION_PX,
+    validate_caustics, validate_inducer as validate,
+};
+pub use fields::InducerFields;
+pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
+pub(crate) use pass::InducerPass;
+pub(crate) use progress::Prepared;
+pub use reference::{
+    FAR_M, edge_distance_m, exact_edge_distances, inducer_gain, inducer_light, perceived_floor,
+    ramp,
+};

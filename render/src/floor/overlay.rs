@@ -1,0 +1,142 @@
+//! The floor overlay (shaders/floor_overlay.wgsl): per eye, a world-anchored rectangle on the
+//! floor plane that adds the precombined gain times the floor photo, L_s = k alpha(d) L_r
+//! (eq. 3) plus the corrected caustics G L_r, with blend (ONE, ONE).
+
+use ash::vk;
+use glam::Mat4;
+
+use crate::camera::EyeParams;
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::owned::Owned;
+use crate::pipeline::{self, Blend, PipelineSpec};
+use crate::scene::GpuScene;
+use crate::shaders::{OVERLAY_FS, OVERLAY_VS};
+
+/// Push constants of the overlay, as `Overlay` in shaders/floor_overlay.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct OverlayPush {
+    /// Floor plane (unit square) to this eye's clip space.
+    clip_from_plane: [f32; 16],
+    /// The plane-local rectangle to draw (min x, min y, max x, max y).
+    rect: [f32; 4],
+}
+
+/// The overlay's pipeline and descriptors, freed on drop.
+pub(crate) struct OverlayPass {
+    /// The pipeline (additive, in the eye render pass).
+    pipeline: Owned<vk::Pipeline>,
+    /// Its layout.
+    layout: Owned<vk::PipelineLayout>,
+    /// Pool of the set.
+    _pool: Owned<vk::DescriptorPool>,
+    /// Layout of the set: gain, floor photo, sampler.
+    _set_layout: Owned<vk::DescriptorSetLayout>,
+    /// The set.
+    set: vk::DescriptorSet,
+}
+
+impl OverlayPass {
+    /// The overlay drawing in `eye_render_pass`, reading the gain `gain_view` and the scene's
+    /// floor photo.
+    pub fn new(
+        ctx: &GpuContext,
+        eye_render_pass: vk::RenderPass,
+        scene: &GpuScene,
+        gain_view: vk::ImageView,
+    ) -> Result<OverlayPass> {
+        let fragment = vk::ShaderStageFlags::FRAGMENT;
+        let set_layout = pipeline::set_layout(
+            ctx,
+            &[
+                (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+                (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+                (2, vk::DescriptorType::SAMPLER, fragment),
+            ],
+        )?;
+        let layout = pipeline::layout(
+            ctx,
+            Some(set_layout.raw()),
+            vk::ShaderStageFlags::VERTEX,
+            size_of::<OverlayPush>() as u32,
+        )?;
+        // The overlay neither tests nor writes depth: it is drawn before the glass, which then
+        // covers it where the object is in front (on a see-through display the real floor
+        // behind the glass is seen through the glass's own layer).
+        let pipeline = pipeline::create(
+            ctx,
+            &PipelineSpec {
+                render_pass: eye_render_pass,
+                layout: layout.raw(),
+                vertex: (OVERLAY_VS, c"vs_main"),
+                fragment: (OVERLAY_FS, c"fs_main"),
+                bindings: &[],
+                attributes: &[],
+                cull: vk::CullModeFlags::NONE,
+                depth: false,
+                blend: Blend::Add,
+            },
+        )?;
+        let pool = pipeline::pool(
+            ctx,
+            1,
+            &[
+                (vk::DescriptorType::SAMPLED_IMAGE, 2),
+                (vk::DescriptorType::SAMPLER, 1),
+            ],
+        )?;
+        let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+        pipeline::write_image(ctx, set, 0, gain_view);
+        pipeline::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
+        Ok(OverlayPass {
+            pipeline,
+            layout,
+            _pool: pool,
+            _set_layout: set_layout,
+            set,
+        })
+    }
+
+    /// Records the overlay's rectangle `rect` (plane-local) for one eye.
+    ///
+    /// # Safety
+    /// `cmd` must be recording inside a render pass compatible with the one given to
+    /// [`OverlayPass::new`], and the gain image must have been written by commands submitted
+    /// before (or recorded earlier into) `cmd`, and still be alive when it executes.
+    pub unsafe fn record(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        eye: &EyeParams,
+        world_from_plane: Mat4,
+        rect: [f32; 4],
+    ) {
+        let d = &ctx.device;
+        let push = OverlayPush {
+            clip_from_plane: (eye.clip_from_world() * world_from_plane).to_cols_array(),
+            rect,
+        };
+        // SAFETY: the caller's contract; the pipeline, layout and set are this pass's and
+        // live until the renderer has waited for its frames.
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw());
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout.raw(),
+                0,
+                &[self.set],
+                &[],
+            );
+            d.cmd_push_constants(
+                cmd,
+                self.layout.raw(),
+                vk::ShaderStageFlags::VERTEX,
+                0,
+                bytemuck::bytes_of(&push),
+            );
+            d.cmd_draw(cmd, 6, 1, 0, 0);
+        }
+    }
+}

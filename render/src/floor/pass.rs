@@ -1,0 +1,422 @@
+//! The floor pass: builds the floor-space fields' pipelines once per scene and records their
+//! computation (mask, jump flooding, distance, ramp, combination) when a frame first needs
+//! them (progress.rs tracks whether it has really run; readback.rs copies the fields back).
+
+use ash::vk;
+use glam::{Mat4, Vec2};
+
+use super::fields::{DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY};
+use super::geometry::{
+    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, union_rect,
+};
+use super::jump_flood::{COMBINE, FieldDraw, RAMP, distance_passes};
+use super::overlay::OverlayPass;
+use super::progress::{Prepared, Progress};
+use crate::camera::EyeParams;
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::memory::{Image, upload_texture};
+use crate::owned::Owned;
+use crate::pipeline::{self, Blend, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec};
+use crate::scene::{GpuScene, InducerDesc, SceneDesc};
+use crate::shaders;
+
+/// The shadow inducer's floor-space fields, the passes that compute them and the overlay; all
+/// GPU objects are freed on drop.
+pub(crate) struct InducerPass {
+    /// k, D and the resolution.
+    pub(super) desc: InducerDesc,
+    /// Floor metres per texel along x and y.
+    pub(super) texel_m: Vec2,
+    /// The floor plane's transform (unit square to world).
+    world_from_plane: Mat4,
+    /// Model space to the mask's clip space; `None` when the light is not above the floor.
+    mask_clip_from_model: Option<Mat4>,
+    /// Plane-local rectangle the inducer's light covers; `None` when nothing can be lit.
+    pub(super) rect: Option<[f32; 4]>,
+    /// Plane-local rectangle of the caustics' non-zero extent; `None` without caustics.
+    caustic_rect: Option<[f32; 4]>,
+    /// Triangle indices of the mesh.
+    index_count: u32,
+    /// What has really been computed.
+    pub(super) progress: Progress,
+    /// The overlay drawn in the eye passes.
+    overlay: OverlayPass,
+    /// The mask pipeline.
+    mask_pipeline: Owned<vk::Pipeline>,
+    /// Layout of the mask pass (push constants only).
+    mask_layout: Owned<vk::PipelineLayout>,
+    /// Seed, jump, distance, ramp and combine pipelines (`SEED` ..= `COMBINE`).
+    field_pipelines: Vec<Owned<vk::Pipeline>>,
+    /// Their pipeline layout.
+    field_layout: Owned<vk::PipelineLayout>,
+    /// Pool of the sets below.
+    _pool: Owned<vk::DescriptorPool>,
+    /// Set layout of the full-screen passes: source and mask (or gain and G) textures.
+    _field_set_layout: Owned<vk::DescriptorSetLayout>,
+    /// The set reading each field image as the source (null for images never read so).
+    source_sets: [vk::DescriptorSet; FIELDS.len()],
+    /// The combine pass's set: the gain and G.
+    combine_set: vk::DescriptorSet,
+    /// The caustic gain G (R32F, read texel for texel by fs_combine; zeros without a map).
+    _caustic: Image,
+    /// Mask, seeds (two), distance, gain and overlay gain, in the order of [`FIELDS`].
+    pub(super) targets: Vec<FieldTarget>,
+}
+
+impl InducerPass {
+    /// Prepares the passes for the scene's object, light and floor; the overlay pipeline draws
+    /// in `eye_render_pass`. Nothing is computed yet. On an error part way, what was made is
+    /// freed.
+    pub fn new(
+        ctx: &GpuContext,
+        eye_render_pass: vk::RenderPass,
+        scene: &GpuScene,
+        desc: &SceneDesc,
+    ) -> Result<InducerPass> {
+        let params = desc.inducer;
+        let n = params.resolution_px;
+        let floor = Floor::new(desc.floor.world_from_plane);
+        let shadow = planar_shadow(floor.center_m, floor.normal, desc.light.position_m);
+        let rect = shadow.and_then(|shadow| {
+            // Ramp width plus two texels (rasterisation and the overlay's bilinear footprint).
+            let margin = Vec2::splat(params.ramp_width_m) / floor.size_m + 2.0 / n as f32;
+            let world = desc
+                .mesh
+                .positions
+                .iter()
+                .map(|p| desc.world_from_model.transform_point3(*p));
+            overlay_rect(world, shadow, floor.plane_from_world, margin)
+        });
+        let field_extent = vk::Extent2D {
+            width: n,
+            height: n,
+        };
+        // The overlay gain has the caustic map's size; G is zeros when the scene has no map,
+        // so that fs_combine always reads a valid image of the overlay gain's size.
+        let zeros;
+        let (caustic_extent, caustic_gain, caustic_rect) = match &desc.caustics {
+            Some(c) => (
+                vk::Extent2D {
+                    width: c.width,
+                    height: c.height,
+                },
+                c.gain,
+                caustic_rect(c.width, c.height, c.gain),
+            ),
+            None => {
+                zeros = vec![0.0f32; (n * n) as usize];
+                (field_extent, &zeros[..], None)
+            }
+        };
+
+        let mut targets = Vec::with_capacity(FIELDS.len());
+        for (index, (name, format)) in FIELDS.into_iter().enumerate() {
+            let extent = if index == OVERLAY {
+                caustic_extent
+            } else {
+                field_extent
+            };
+            targets.push(FieldTarget::new(ctx, name, format, extent)?);
+        }
+
+        let vertex = vk::ShaderStageFlags::VERTEX;
+        let fragment = vk::ShaderStageFlags::FRAGMENT;
+        let mask_layout = pipeline::layout(ctx, None, vertex, size_of::<[f32; 16]>() as u32)?;
+        let mask_pipeline = pipeline::create(
+            ctx,
+            &PipelineSpec {
+                render_pass: targets[MASK].render_pass.raw(),
+                layout: mask_layout.raw(),
+                vertex: (shaders::MASK_VS, c"vs_main"),
+                fragment: (shaders::MASK_FS, c"fs_main"),
+                bindings: &[MESH_POSITION_BINDING],
+                attributes: &[MESH_POSITION_ATTRIBUTE],
+                cull: vk::CullModeFlags::NONE,
+                depth: false,
+                blend: Blend::Replace,
+            },
+        )?;
+
+        let field_set_layout = pipeline::set_layout(
+            ctx,
+            &[
+                (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+                (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+            ],
+        )?;
+        let field_layout = pipeline::layout(
+            ctx,
+            Some(field_set_layout.raw()),
+            fragment,
+            size_of::<FieldPush>() as u32,
+        )?;
+        // In the order SEED, JUMP, DIST, RAMP, COMBINE, with the field each writes.
+        let field_stages = [
+            (shaders::SEED_FS, c"fs_seed", super::fields::SEEDS_A),
+            (shaders::JUMP_FS, c"fs_jump", super::fields::SEEDS_A),
+            (shaders::DISTANCE_FS, c"fs_distance", DISTANCE),
+            (shaders::RAMP_FS, c"fs_ramp", GAIN),
+            (shaders::COMBINE_FS, c"fs_combine", OVERLAY),
+        ];
+        let mut field_pipelines = Vec::with_capacity(field_stages.len());
+        for (spirv, entry, target) in field_stages {
+            field_pipelines.push(pipeline::create(
+                ctx,
+                &PipelineSpec {
+                    render_pass: targets[target].render_pass.raw(),
+                    layout: field_layout.raw(),
+                    vertex: (shaders::FIELD_VS, c"vs_main"),
+                    fragment: (spirv, entry),
+                    bindings: &[],
+                    attributes: &[],
+                    cull: vk::CullModeFlags::NONE,
+                    depth: false,
+                    blend: Blend::Replace,
+                },
+            )?);
+        }
+
+        let caustic = upload_texture(
+            ctx,
+            "caustic gain",
+            vk::Format::R32_SFLOAT,
+            caustic_extent,
+            bytemuck::cast_slice(caustic_gain),
+        )?;
+        let sources = [
+            MASK,
+            super::fields::SEEDS_A,
+            super::fields::SEEDS_B,
+            DISTANCE,
+        ];
+        let pool = pipeline::pool(
+            ctx,
+            sources.len() as u32 + 1,
+            &[(
+                vk::DescriptorType::SAMPLED_IMAGE,
+                2 * (sources.len() as u32 + 1),
+            )],
+        )?;
+        let mut source_sets = [vk::DescriptorSet::null(); FIELDS.len()];
+        for source in sources {
+            let set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
+            pipeline::write_image(ctx, set, 0, targets[source].image.view);
+            pipeline::write_image(ctx, set, 1, targets[MASK].image.view);
+            source_sets[source] = set;
+        }
+        let combine_set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
+        pipeline::write_image(ctx, combine_set, 0, targets[GAIN].image.view);
+        pipeline::write_image(ctx, combine_set, 1, caustic.view);
+        let overlay = OverlayPass::new(ctx, eye_render_pass, scene, targets[OVERLAY].image.view)?;
+
+        Ok(InducerPass {
+            desc: params,
+            texel_m: floor.size_m / n as f32,
+            world_from_plane: floor.world_from_plane,
+            mask_clip_from_model: shadow
+                .map(|s| mask_clip_from_model(&floor, s, desc.world_from_model)),
+            rect,
+            caustic_rect,
+            index_count: scene.index_count,
+            progress: Progress::default(),
+            overlay,
+            mask_pipeline,
+            mask_layout,
+            field_pipelines,
+            field_layout,
+            _pool: pool,
+            _field_set_layout: field_set_layout,
+            source_sets,
+            combine_set,
+            _caustic: caustic,
+            targets,
+        })
+    }
+
+    /// The push constants shared by the full-screen passes.
+    fn push(&self, step: i32, switches: [f32; 2]) -> FieldPush {
+        FieldPush {
+            texel_m: self.texel_m.to_array(),
+            step,
+            size: self.desc.resolution_px as i32,
+            ramp_width_m: self.desc.ramp_width_m,
+            k: self.desc.k,
+            switches,
+        }
+    }
+
+    /// Records what a frame drawing the overlay with these switches still needs: the fields'
+    /// computation when no submitted work holds it, and the overlay gain's combination
+    /// (k alpha(d) if `inducer`, + G if `caustics`) when the last one submitted was for
+    /// other switches. Returns what was recorded, for [`InducerPass::submitted`] and
+    /// [`InducerPass::finished`]; records nothing (the scene is static) otherwise.
+    ///
+    /// # Safety
+    /// `cmd` must be recording outside any render pass, and be submitted before any command
+    /// buffer recorded later that draws the overlay; `scene` must be the scene the pass was
+    /// made for, and `self` and `scene` must outlive the command buffer's execution.
+    pub unsafe fn prepare(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        inducer: bool,
+        caustics: bool,
+    ) -> Prepared {
+        let switches = u8::from(inducer) | (u8::from(caustics) << 1);
+        let prepared = self.progress.plan(Some(switches));
+        // SAFETY: the caller's contract covers both recordings (outside a render pass, the
+        // objects outlive the execution).
+        unsafe {
+            if prepared.fields {
+                self.record_fields(ctx, cmd, scene);
+            }
+            if prepared.combined.is_some() {
+                let push = self.push(
+                    0,
+                    [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
+                );
+                self.full_screen(ctx, cmd, OVERLAY, COMBINE, self.combine_set, &push);
+            }
+        }
+        prepared
+    }
+
+    /// The command buffer `prepared` was recorded into has been submitted.
+    pub fn submitted(&mut self, prepared: Prepared) {
+        self.progress.submitted(prepared);
+    }
+
+    /// The command buffer `prepared` was recorded into has finished (`ok`: its fence
+    /// signalled) or failed to (its wait failed), so its results cannot be relied on.
+    pub fn finished(&mut self, prepared: Prepared, ok: bool) {
+        self.progress.finished(prepared, ok);
+    }
+
+    /// The plane-local rectangle the overlay draws for these switches, if any.
+    pub fn overlay_rect(&self, inducer: bool, caustics: bool) -> Option<[f32; 4]> {
+        union_rect(
+            self.rect.filter(|_| inducer),
+            self.caustic_rect.filter(|_| caustics),
+        )
+    }
+
+    /// Records the mask, jump-flooding, distance and ramp passes.
+    ///
+    /// # Safety
+    /// As [`InducerPass::prepare`].
+    pub(super) unsafe fn record_fields(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+    ) {
+        let d = &ctx.device;
+        // SAFETY: the caller's contract: `cmd` records outside a render pass and everything
+        // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it.
+        unsafe {
+            self.targets[MASK].begin(d, cmd);
+            if let Some(clip_from_model) = self.mask_clip_from_model {
+                d.cmd_bind_pipeline(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    self.mask_pipeline.raw(),
+                );
+                d.cmd_push_constants(
+                    cmd,
+                    self.mask_layout.raw(),
+                    vk::ShaderStageFlags::VERTEX,
+                    0,
+                    bytemuck::bytes_of(&clip_from_model.to_cols_array()),
+                );
+                d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
+                d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
+                d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+            }
+            d.cmd_end_render_pass(cmd);
+            let ramp = FieldDraw {
+                target: GAIN,
+                pipeline: RAMP,
+                source: DISTANCE,
+                step: 0,
+            };
+            for draw in distance_passes(self.desc.resolution_px)
+                .into_iter()
+                .chain([ramp])
+            {
+                let push = self.push(draw.step, [0.0; 2]);
+                let set = self.source_sets[draw.source];
+                self.full_screen(ctx, cmd, draw.target, draw.pipeline, set, &push);
+            }
+        }
+    }
+
+    /// One full-screen pass of `pipeline` into field `target`.
+    ///
+    /// # Safety
+    /// As [`InducerPass::prepare`]; `set` must be one of this pass's sets.
+    unsafe fn full_screen(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        target: usize,
+        pipeline: usize,
+        set: vk::DescriptorSet,
+        push: &FieldPush,
+    ) {
+        let d = &ctx.device;
+        // SAFETY: the caller's contract; the pipeline, layout, set and target are this
+        // pass's.
+        unsafe {
+            self.targets[target].begin(d, cmd);
+            d.cmd_bind_pipeline(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.field_pipelines[pipeline].raw(),
+            );
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.field_layout.raw(),
+                0,
+                &[set],
+                &[],
+            );
+            d.cmd_push_constants(
+                cmd,
+                self.field_layout.raw(),
+                vk::ShaderStageFlags::FRAGMENT,
+                0,
+                bytemuck::bytes_of(push),
+            );
+            d.cmd_draw(cmd, 3, 1, 0, 0);
+            d.cmd_end_render_pass(cmd);
+        }
+    }
+
+    /// Records the floor overlay for one eye, inside that eye's render pass: the inducer's
+    /// light if `inducer`, the corrected caustics if `caustics` (as last given to
+    /// [`InducerPass::prepare`]). Draws nothing when no floor texel can receive either.
+    ///
+    /// # Safety
+    /// `cmd` must be recording inside a render pass compatible with the one given to
+    /// [`InducerPass::new`], after [`InducerPass::prepare`] was recorded into it or into a
+    /// command buffer submitted earlier; `self` must outlive its execution.
+    pub unsafe fn record(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        eye: &EyeParams,
+        inducer: bool,
+        caustics: bool,
+    ) {
+        if let Some(rect) = self.overlay_rect(inducer, caustics) {
+            // SAFETY: the caller's contract, which is the overlay's.
+            unsafe {
+                self.overlay
+                    .record(ctx, cmd, eye, self.world_from_plane, rect)
+            };
+        }
+    }
+}

@@ -1,0 +1,117 @@
+//! Whether the floor fields have really been computed. The state changes only when the
+//! renderer reports what happened to submitted work (submitted, then finished or failed),
+//! never while commands are being recorded, so a failed submit or a lost frame leaves the
+//! computation due again.
+
+/// Where a one-time computation stands.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) enum Computation {
+    /// Not recorded into any submitted work (or that work failed).
+    #[default]
+    Missing,
+    /// Recorded into work that was submitted and has not been waited for; later work on the
+    /// same queue is ordered after it, so it is not recorded again.
+    Submitted,
+    /// Waited for: the results are in the images.
+    Done,
+}
+
+/// What [`InducerPass::prepare`] recorded into a command buffer; handed back to
+/// [`InducerPass::submitted`] once the command buffer was submitted and to
+/// [`InducerPass::finished`] once its fence signalled (or the wait failed).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Prepared {
+    /// The fields (mask, distance, gain) were recorded.
+    pub(super) fields: bool,
+    /// The overlay gain's combination for these switches was recorded.
+    pub(super) combined: Option<u8>,
+}
+
+/// Progress of the floor fields' computation: changes only when the renderer reports what
+/// happened to submitted work, never while recording.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Progress {
+    /// The mask, distance and gain fields.
+    pub fields: Computation,
+    /// The switches (bit 0 inducer, bit 1 caustics) of the last overlay gain combination
+    /// submitted, while it is submitted or done.
+    combined_for: Option<u8>,
+}
+
+impl Progress {
+    /// What must be recorded for a frame drawing with `switches`.
+    pub fn plan(&self, switches: Option<u8>) -> Prepared {
+        Prepared {
+            fields: self.fields == Computation::Missing,
+            combined: switches.filter(|&s| self.combined_for != Some(s)),
+        }
+    }
+
+    /// The work `prepared` was recorded into has been submitted.
+    pub fn submitted(&mut self, prepared: Prepared) {
+        if prepared.fields {
+            self.fields = Computation::Submitted;
+        }
+        if prepared.combined.is_some() {
+            self.combined_for = prepared.combined;
+        }
+    }
+
+    /// The work `prepared` was recorded into has finished (`ok`) or can no longer be relied
+    /// on (its fence wait failed).
+    pub fn finished(&mut self, prepared: Prepared, ok: bool) {
+        if prepared.fields && self.fields == Computation::Submitted {
+            self.fields = if ok {
+                Computation::Done
+            } else {
+                Computation::Missing
+            };
+        }
+        if !ok && prepared.combined.is_some() && self.combined_for == prepared.combined {
+            self.combined_for = None;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fields_count_as_computed_only_after_their_work_finished() {
+        let mut progress = Progress::default();
+        let first = progress.plan(Some(1));
+        assert_eq!(
+            first,
+            Prepared {
+                fields: true,
+                combined: Some(1)
+            }
+        );
+        // Recording alone changes nothing: a failed submit leaves everything to redo.
+        assert_eq!(progress.plan(Some(1)), first);
+        progress.submitted(first);
+        assert_eq!(progress.fields, Computation::Submitted);
+        // Work submitted later is ordered after it: nothing to record again.
+        assert_eq!(progress.plan(Some(1)), Prepared::default());
+        progress.finished(first, true);
+        assert_eq!(progress.fields, Computation::Done);
+        // Other switches need only a new combination.
+        assert_eq!(
+            progress.plan(Some(3)),
+            Prepared {
+                fields: false,
+                combined: Some(3)
+            }
+        );
+    }
+
+    #[test]
+    fn a_failed_wait_makes_the_fields_due_again() {
+        let mut progress = Progress::default();
+        let first = progress.plan(Some(2));
+        progress.submitted(first);
+        progress.finished(first, false);
+        assert_eq!(progress.plan(Some(2)), first);
+    }
+}

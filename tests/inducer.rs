@@ -15,7 +15,7 @@ use vitreous::output::see_through;
 use vitreous::scene::{Image, PixelData, Scene, load_scene};
 use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
-use vitreous_render::inducer::{self, InducerFields};
+use vitreous_render::floor::{self, InducerFields};
 use vitreous_render::renderer::Want;
 use vitreous_render::{ContextOptions, FrameParams, GpuContext, Look, Readback, Renderer};
 use vitreous_tests::{pixel_on_floor, render_once};
@@ -108,7 +108,7 @@ fn shadow_ends_z(scene: &Scene) -> (f32, f32) {
 /// largest error in texels.
 fn check_distance_field(fields: &InducerFields, ramp_width_m: f32) -> f32 {
     let n = fields.resolution_px;
-    let exact = inducer::exact_edge_distances(&fields.mask, n, fields.texel_m);
+    let exact = floor::exact_edge_distances(&fields.mask, n, fields.texel_m);
     let texel = fields.texel_m.max_element();
     let mut worst = 0.0f32;
     let mut checked = 0;
@@ -144,7 +144,7 @@ fn check_gain_follows_distance(fields: &InducerFields, k: f32, d_m: f32) {
         if fields.mask[i] == 1 || d >= d_m {
             assert_eq!(g, 0.0, "texel {i}: d = {d}, gain {g} where it must be zero");
         } else {
-            let expected = k * inducer::ramp(d, d_m);
+            let expected = floor::inducer_gain(k, floor::ramp(d, d_m));
             assert!((g - expected).abs() <= 1e-3, "texel {i}: {g} vs {expected}");
         }
     }
@@ -194,7 +194,7 @@ fn check_profile(
             continue;
         }
         // The floor photo's maximum bounds L_r: |gain error| * L_r <= |gain error| * max.
-        let expected = k * inducer::ramp(s.max(0.0), d_m);
+        let expected = floor::inducer_gain(k, floor::ramp(s.max(0.0), d_m));
         let err = (gain - expected).abs();
         assert!(
             err <= 0.02,
@@ -378,9 +378,12 @@ fn glass_sphere_preview_shows_a_shadow_on_the_real_floor() {
         );
         assert!((shadow - shadow_world).abs() <= 0.01 * shadow_world.max(0.01));
         assert!((beyond - beyond_world).abs() <= 0.01 * beyond_world.max(0.01));
-        // The first half of the ramp averages k * 3/4 above the floor.
-        let gain = ring / ring_world - 1.0;
-        assert!((gain - 0.75 * k).abs() < 0.04, "ramp gain {gain}");
+        // The first half of the ramp averages alpha = 3/4: eq. 5 with that alpha.
+        let expected = floor::perceived_floor(k, 0.75, ring_world);
+        assert!(
+            (ring - expected).abs() < 0.04 * ring_world,
+            "ramp luminance {ring}, eq. 5 gives {expected}"
+        );
     }
     assert_silent(&r);
 }

@@ -5,8 +5,8 @@ use glam::{Quat, Vec2, Vec3};
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::renderer::Want;
 use vitreous_render::{
-    ContextOptions, FrameParams, GpuContext, LightDesc, Look, MeshRef, PlaneDesc, Renderer,
-    SceneDesc, TexelData, TextureDesc,
+    CausticsDesc, ContextOptions, FrameParams, GpuContext, LightDesc, Look, MeshRef, PlaneDesc,
+    RenderError, Renderer, SceneDesc, TexelData, TextureDesc,
 };
 use vitreous_tests::{flat_environment, grey_photo, lit_centroid, place, uv_sphere};
 
@@ -138,4 +138,106 @@ fn validation_messages_are_counted() {
         "validation error not counted"
     );
     assert!(!ctx.validation().messages().is_empty());
+}
+
+/// A construction that fails part way frees what it made before the device goes: with an
+/// allocation failure injected at every step in turn, each attempt reports that failure, and
+/// validation (which names every object still alive when the device is destroyed) stays
+/// silent; the attempt after the last step builds a working renderer.
+#[test]
+fn failed_construction_unwinds_without_leaks_at_every_step() {
+    let (positions, normals, uvs, indices) = uv_sphere(8, 4);
+    let env = flat_environment(8, 4, 0.5);
+    let photo = grey_photo(4, 4, 128);
+    let gain = vec![0.5f32; 8 * 8];
+    let photo_desc = TextureDesc {
+        width: 4,
+        height: 4,
+        data: TexelData::Srgb8(&photo),
+    };
+    let scene = SceneDesc {
+        mesh: MeshRef {
+            positions: &positions,
+            normals: &normals,
+            uvs: &uvs,
+            indices: &indices,
+        },
+        world_from_model: place(Vec3::new(0.0, -0.2, -0.5), 0.05),
+        ior: 1.5,
+        environment: TextureDesc {
+            width: 8,
+            height: 4,
+            data: TexelData::LinearF32(&env),
+        },
+        floor: PlaneDesc {
+            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -0.5, -0.5)),
+            photo: photo_desc,
+        },
+        background: PlaneDesc {
+            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
+            photo: photo_desc,
+        },
+        exposure: 1.0,
+        surface: None,
+        surface_transmittance: 1.0,
+        light: LightDesc {
+            position_m: Vec3::new(0.0, 1.0, 0.0),
+            radiance: Vec3::ONE,
+        },
+        background_stack: None,
+        surface_stack: None,
+        inducer: vitreous_render::InducerDesc {
+            resolution_px: 32,
+            ..vitreous_render::InducerDesc::PAPER
+        },
+        caustics: Some(CausticsDesc {
+            width: 8,
+            height: 8,
+            gain: &gain,
+        }),
+    };
+    let mut failed_steps = 0;
+    for step in 0..200 {
+        let ctx = GpuContext::headless(&ContextOptions {
+            validation: true,
+            device_name: None,
+        })
+        .expect("Vulkan device with validation");
+        let log = ctx.validation_log();
+        ctx.fail_allocation_after(step);
+        let built = Renderer::new(ctx, &scene, 16, 12);
+        let done = match built {
+            Err(RenderError::Injected(what)) => {
+                failed_steps += 1;
+                eprintln!("step {step}: failed allocating {what}");
+                false
+            }
+            Err(e) => panic!("step {step}: not the injected failure: {e}"),
+            Ok(mut renderer) => {
+                // Past the last allocation of construction: the renderer works. The armed
+                // failure, if still pending, hits the fields' readback buffer, which must
+                // unwind too and leave the fields computable.
+                let fields = match renderer.inducer_fields() {
+                    Err(RenderError::Injected(_)) => renderer.inducer_fields(),
+                    other => other,
+                }
+                .expect("fields");
+                assert!(fields.mask.contains(&1), "no shadow in the mask");
+                drop(renderer);
+                true
+            }
+        };
+        // The context (and its device) is gone now, in both cases.
+        assert_eq!(
+            log.errors() + log.warnings(),
+            0,
+            "step {step}: validation messages: {:#?}",
+            log.messages()
+        );
+        if done {
+            assert!(failed_steps > 20, "only {failed_steps} steps allocate");
+            return;
+        }
+    }
+    panic!("construction still failing after 200 injected failures");
 }

@@ -316,9 +316,17 @@ impl Renderer {
         let Some(pending) = slot.pending.take() else {
             return Ok(None);
         };
-        let waited = self.ctx.wait_fence(slot.fence.raw(), "a frame");
-        self.inducer.finished(pending.prepared, waited.is_ok());
-        waited?;
+        if let Err(e) = self.ctx.wait_fence(slot.fence.raw(), "a frame") {
+            if e.gpu_may_still_run() {
+                // Still in flight: kept, so that the slot is not reset and re-recorded under
+                // the GPU; a later call waits for it again.
+                slot.pending = Some(pending);
+            } else {
+                self.inducer.finished(pending.prepared, false);
+            }
+            return Err(e);
+        }
+        self.inducer.finished(pending.prepared, true);
         let gpu_ms = match (&slot.queries, self.ctx.timestamp_period_ns) {
             (Some(pool), Some(period)) => {
                 let mut stamps = [0u64; 2];
@@ -337,11 +345,12 @@ impl Renderer {
             }
             _ => None,
         };
-        let readback = match pending.want.eyes {
-            false => None,
-            true => Some(slot.readback.mapped()?),
+        let bytes = if pending.want.eyes {
+            Some(slot.readback.mapped()?)
+        } else {
+            None
         };
-        let readback = readback.map(|bytes| {
+        let readback = bytes.map(|bytes| {
             let n = (self.extent.width * self.extent.height * 4) as usize;
             Readback {
                 width: self.extent.width,

@@ -7,12 +7,19 @@
 //!
 //! # Synchronisation
 //! Work is recorded into one of [`renderer::PIPELINE_DEPTH`] frame slots, each with its own
-//! command buffer, fence and timestamp queries. [`Renderer::render`] first waits for the slot's
+//! command buffer, fence and timestamp queries. [`Renderer::submit`] first waits for the slot's
 //! previous use to finish, so at most `PIPELINE_DEPTH` frames are in flight. All frames render
 //! into the same target image on one queue; pipeline barriers inside each command buffer order
 //! the accesses across submissions (colour writes, then the transfer to the readback buffer).
 //! Readback results of a slot are valid once its fence has signalled, which
-//! [`Renderer::finish_readback`] waits for.
+//! [`Renderer::submit`] (for the frame `PIPELINE_DEPTH` earlier) and [`Renderer::flush`] wait
+//! for. Every fence wait gives up after [`context::FENCE_TIMEOUT`] with
+//! [`RenderError::Timeout`]; a lost device is [`RenderError::DeviceLost`] wherever it shows.
+//!
+//! # Resources
+//! Every GPU object is owned by a value that frees it on drop (`owned.rs`, `memory.rs`), so
+//! a failed constructor gives back what it made by returning early; the context, which owns
+//! the device, is dropped after all of them.
 //!
 //! Knows nothing about OpenXR: device creation is an injected step ([`context::DeviceCreator`]).
 

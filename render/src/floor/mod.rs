@@ -5,28 +5,28 @@
 //! eye then reads the untouched shadow region as darker than its surround.
 //!
 //! Everything below lives in floor space: square textures of `resolution_px` texels over the
-//! floor photo's area (the unit square of [`crate::PlaneDesc::world_from_plane`], texel (0, 0) at the
-//! photo's top-left, so texture uv equals photo uv). Once per scene (on the first frame that
-//! asks for the inducer, or on [`crate::Renderer::inducer_fields`]) four kinds of fragment passes run
-//! (no compute: lavapipe's timestamps do not see compute work, and these passes are cheap):
+//! floor photo's area (the unit square of [`crate::PlaneDesc::world_from_plane`], texel
+//! (0, 0) at the photo's top-left, so texture uv equals photo uv). Once per scene (on the
+//! first frame that asks for the inducer, or on [`crate::Renderer::inducer_fields`]) four
+//! kinds of fragment passes run (no compute: lavapipe's timestamps do not see compute work,
+//! and these passes are cheap):
 //!
 //! 1. **Shadow mask** (eq. 1, shaders/inducer_mask.wgsl): the mesh projected from the point
-//!    light onto the floor plane by a homogeneous planar projection ([`planar_shadow`],
-//!    geometry.rs) and
-//!    rasterised straight into floor space; covered texels are in shadow. For an opaque
-//!    occluder this equals a conventional shadow-map lookup at each floor texel, without the
-//!    map's resolution and depth-bias artefacts.
-//! 2. **Jump flooding** (jump_flood.rs; shaders/inducer_field.wgsl `fs_seed`, `fs_jump`): ceil(log2 N)
-//!    passes with halving jumps plus one of jump 1, ping-ponging two RG32F textures of
-//!    nearest-shadow-texel coordinates, nearest in metres.
+//!    light onto the floor plane by a homogeneous planar projection ([`planar_shadow`] in
+//!    geometry.rs) and rasterised straight into floor space; covered texels are in shadow.
+//!    For an opaque occluder this equals a conventional shadow-map lookup at each floor
+//!    texel, without the map's resolution and depth-bias artefacts.
+//! 2. **Jump flooding** (jump_flood.rs; shaders/inducer_field.wgsl `fs_seed`, `fs_jump`):
+//!    ceil(log2 N) passes with halving jumps plus one of jump 1, ping-ponging two RG32F
+//!    textures of nearest-shadow-texel coordinates, nearest in metres.
 //! 3. **Distance to the edge** (`fs_distance`, [`edge_distance_m`]): d in metres for every
 //!    lit texel, -1 inside the shadow.
 //! 4. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the precombined
 //!    overlay texture.
 //!
-//! Per eye, the floor overlay (overlay.rs; shaders/floor_overlay.wgsl) is a world-anchored rectangle on
-//! the floor plane covering only the shadow plus the ramp (bounded on the CPU from the mesh's
-//! projected vertices, [`overlay_rect`]); it adds L_s = k alpha(d) L_r (eq. 3) with blend
+//! Per eye, the floor overlay (overlay.rs; shaders/floor_overlay.wgsl) is a world-anchored
+//! rectangle on the floor plane covering only the shadow plus the ramp (bounded on the CPU
+//! from the mesh's projected vertices, [`overlay_rect`]); it adds L_s = k alpha(d) L_r (eq. 3) with blend
 //! (ONE, ONE), discarding texels without inducer light before it reads the photo: at most two
 //! texture fetches per covered pixel. The see-through preview then shows
 //! L_o = (1 + k alpha(d)) L_r (eq. 5).

@@ -16,9 +16,9 @@ pub(super) enum Computation {
     Done,
 }
 
-/// What [`InducerPass::prepare`] recorded into a command buffer; handed back to
-/// [`InducerPass::submitted`] once the command buffer was submitted and to
-/// [`InducerPass::finished`] once its fence signalled (or the wait failed).
+/// What [`super::InducerPass::prepare`] recorded into a command buffer; handed back to
+/// [`super::InducerPass::submitted`] once the command buffer was submitted and to
+/// [`super::InducerPass::finished`] once its fence signalled (or the wait failed).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Prepared {
     /// The fields (mask, distance, gain) were recorded.

@@ -17,8 +17,7 @@ use crate::effects::EffectSet;
 use crate::gaze::GazeConfig;
 use crate::gaze::defocus::check_pupil_diameter_m;
 use crate::replay::{Spread, check_size};
-use crate::scene::load_scene;
-use crate::trace_cmd::synth_params_for;
+use crate::scene::{load_scene, synth_params_for};
 use crate::views;
 
 /// Frames of each variant rendered before timing starts (shaders compile on first use on

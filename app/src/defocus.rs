@@ -67,7 +67,7 @@ impl DefocusModel {
     /// The model of `scene` with pupil diameter `pupil_m`.
     pub fn new(scene: &Scene, pupil_m: f32) -> DefocusModel {
         DefocusModel {
-            distances: ImageDistances::for_scene(scene),
+            distances: scene.image_distances(),
             pupil_m,
             background_px_per_m: scene.background.photo.width as f32 / scene.background.size_m.x,
             // u runs once around the object: texels per metre of its circumference.

@@ -449,7 +449,7 @@ impl fmt::Display for AnalyzeReport {
 }
 
 /// `vitreous trace analyze TRACE --scene SCENE`: the image distances come from the scene
-/// ([`ImageDistances::for_scene`]); gaze changes are derived from the raw depth (a trace
+/// ([`Scene::image_distances`](crate::scene::Scene::image_distances)); gaze changes are derived from the raw depth (a trace
 /// file carries no ground truth). `filters` empty means the default and every alternative.
 pub fn analyze_trace_file(
     trace: &Path,
@@ -479,7 +479,7 @@ fn load_inputs(
     let scene = load_scene(scene).with_context(|| format!("loading scene {}", scene.display()))?;
     let samples = vitreous_xr::read_trace(trace)
         .with_context(|| format!("reading trace {}", trace.display()))?;
-    let mut config = AnalyzeConfig::new(ImageDistances::for_scene(&scene));
+    let mut config = AnalyzeConfig::new(scene.image_distances());
     if !filters.is_empty() {
         config.filters = filters.to_vec();
     }

@@ -11,6 +11,7 @@
 
 mod error;
 mod file;
+mod fixation;
 mod image;
 mod mesh;
 
@@ -25,6 +26,7 @@ use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, FilterParseError, GazeOverride};
 
 pub use error::{Location, SceneError};
+pub use fixation::{FixationPoints, synth_params_for};
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
 pub use mesh::Mesh;
 

@@ -6,10 +6,11 @@
 use std::path::Path;
 
 use glam::Vec2;
-use vitreous::defocus::{DefocusSetup, LookPlanner};
+use vitreous::blur_stack::DefocusSetup;
 use vitreous::frame_loop::{self, FramePlan, FrameSink};
-use vitreous::gaze::defocus::blur_reference;
+use vitreous::gaze::blur::blur_reference;
 use vitreous::gaze::{GazeConfig, GazeImage};
+use vitreous::look::LookPlanner;
 use vitreous::scene::{Image, PixelData, Scene, load_scene};
 use vitreous::trace_cmd::synth_params_for;
 use vitreous::views;

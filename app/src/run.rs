@@ -36,10 +36,10 @@ use vitreous_xr::openxr::{
 use vitreous_xr::trace::{TraceSample, TraceWriter, read_trace};
 use vitreous_xr::{Backend, FrameInput, GazeRay, GazeSample, Pose};
 
-use crate::defocus::LookPlanner;
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::gaze::GazeOverride;
+use crate::look::LookPlanner;
 use crate::output::write_atomic;
 use crate::replay::{GazeSettings, planners_for};
 use crate::replay::{Spread, ValidationSummary};

@@ -4,7 +4,8 @@
 
 use rayon::prelude::*;
 
-use crate::gaze::blur::{PUPIL_MAX_MM, blur_circle_diameter_m, gaussian_kernel};
+use crate::gaze::GazeImage;
+use crate::gaze::blur::{PUPIL_MAX_MM, gaussian_kernel};
 use crate::look::DefocusModel;
 use crate::output::{linear_to_srgb, srgb_to_linear};
 use crate::scene::{Image, PixelData, Scene};
@@ -59,11 +60,17 @@ impl DefocusSetup {
     /// pupil can change without rebuilding them.
     pub fn new(scene: &Scene, pupil_m: f32) -> DefocusSetup {
         let model = DefocusModel::new(scene, pupil_m);
-        let (s, r) = (model.distances.surface_m, model.distances.refracted_m);
-        let max_pupil_m = PUPIL_MAX_MM / 1000.0;
-        let max_background_k =
-            model.background_px_per_m * blur_circle_diameter_m(max_pupil_m, r, s);
-        let max_surface_k = model.surface_px_per_m * blur_circle_diameter_m(max_pupil_m, s, r);
+        // The deepest blur of each image: the other image in focus, at the largest pupil.
+        let deepest = DefocusModel {
+            pupil_m: PUPIL_MAX_MM / 1000.0,
+            ..model
+        };
+        let max_background_k = deepest
+            .defocus(GazeImage::Surface)
+            .map_or(0.0, |d| d.refracted_k_g_px);
+        let max_surface_k = deepest
+            .defocus(GazeImage::Refracted)
+            .map_or(0.0, |d| d.surface_k_g_px);
         let (background, surface) = rayon::join(
             || build_stack(&scene.background.photo, max_background_k),
             || {

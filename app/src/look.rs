@@ -7,7 +7,7 @@
 use vitreous_render::{Defocus, Look};
 use vitreous_xr::FrameInput;
 
-use crate::gaze::blur::image_blur;
+use crate::gaze::blur::{image_blur, px_per_m};
 use crate::gaze::{GazeConfig, GazeImage, GazeOverride, GazePipeline, GazeState, ImageDistances};
 use crate::scene::Scene;
 
@@ -31,10 +31,16 @@ impl DefocusModel {
         DefocusModel {
             distances: scene.image_distances(),
             pupil_m,
-            background_px_per_m: scene.background.photo.width as f32 / scene.background.size_m.x,
+            background_px_per_m: px_per_m(
+                scene.background.photo.width as f32,
+                scene.background.size_m.x,
+            ),
             // u runs once around the object: texels per metre of its circumference.
             surface_px_per_m: scene.object.surface_texture.as_ref().map_or(1.0, |t| {
-                t.width as f32 / (std::f32::consts::PI * 2.0 * scene.object.radius_m)
+                px_per_m(
+                    t.width as f32,
+                    std::f32::consts::PI * 2.0 * scene.object.radius_m,
+                )
             }),
         }
     }

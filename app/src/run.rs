@@ -30,8 +30,8 @@ use vitreous_render::{
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::openxr::ash::{self, vk};
 use vitreous_xr::openxr::{
-    Blend, Command, DepthOptions, OpenXrOptions, Runtime, SessionOptions, SessionReport, State,
-    VulkanHandles,
+    Blend, Command, Cycle, DepthOptions, OpenXrOptions, Runtime, SessionOptions, SessionReport,
+    State, VulkanHandles,
 };
 use vitreous_xr::trace::{TraceSample, TraceWriter, read_trace};
 use vitreous_xr::{Backend, FrameInput, GazeRay, GazeSample, Pose};
@@ -260,10 +260,11 @@ impl LiveLooks {
     }
 
     /// Applies a live command; says what changed (None for commands the session handles:
-    /// Nudge and Rotate).
+    /// Nudge and Rotate). [`GAZE_IMAGE_CYCLE`] steps the forced gaze image,
+    /// [`CONDITION_CYCLE`] the effect condition.
     pub fn apply(&mut self, command: Command) -> Option<String> {
         match command {
-            Command::NextCondition => {
+            Command::Cycle(CONDITION_CYCLE) => {
                 self.current = (self.current + 1) % self.conditions.len();
                 Some(format!(
                     "effect condition now {} ({} of {})",
@@ -272,7 +273,7 @@ impl LiveLooks {
                     self.conditions.len()
                 ))
             }
-            Command::NextGazeImage => {
+            Command::Cycle(GAZE_IMAGE_CYCLE) => {
                 let next = match self.gaze {
                     GazeOverride::Auto => GazeOverride::Surface,
                     GazeOverride::Surface => GazeOverride::Refracted,
@@ -304,6 +305,12 @@ impl LiveLooks {
         look.expect("current condition exists")
     }
 }
+
+/// The live cycle (right-hand select) that forces the gaze image: surface, refracted, auto.
+pub const GAZE_IMAGE_CYCLE: Cycle = Cycle::Primary;
+
+/// The live cycle (right-hand menu) that steps through the effect conditions.
+pub const CONDITION_CYCLE: Cycle = Cycle::Secondary;
 
 /// Creates the renderer's Vulkan instance and device through the OpenXR runtime.
 pub struct XrDeviceCreator<'a> {
@@ -905,14 +912,14 @@ mod tests {
             GazeOverride::Auto,
         );
         assert!(!looks.plan(&frame()).disparity);
-        assert!(looks.apply(Command::NextCondition).is_some());
+        assert!(looks.apply(Command::Cycle(CONDITION_CYCLE)).is_some());
         assert_eq!(looks.condition(), sets[1]);
         assert!(looks.plan(&frame()).disparity);
-        looks.apply(Command::NextCondition);
+        looks.apply(Command::Cycle(CONDITION_CYCLE));
         assert_eq!(looks.condition(), sets[0], "wraps round");
         let mut seen = Vec::new();
         for _ in 0..3 {
-            looks.apply(Command::NextGazeImage);
+            looks.apply(Command::Cycle(GAZE_IMAGE_CYCLE));
             seen.push(looks.gaze());
         }
         assert_eq!(

@@ -30,11 +30,11 @@ use std::sync::Once;
 use anyhow::{Context, Result, anyhow};
 use plotters::prelude::*;
 use vitreous_xr::TraceSample;
-use vitreous_xr::synth::{GazePhase, GazeTarget};
+use vitreous_xr::synth::GazePhase;
 
 use crate::gaze::vergence::{FixationDepth, VergenceConfig, VergenceEstimator};
 use crate::gaze::{FilterKind, GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances};
-use crate::scene::load_scene;
+use crate::scene::{gaze_image_of_target, load_scene};
 
 /// Default persistence of a raw-depth crossing that counts as a gaze change, nanoseconds.
 pub const DEFAULT_PERSIST_NS: i64 = 200_000_000;
@@ -164,12 +164,10 @@ pub fn raw_depths(samples: &[TraceSample], vergence: VergenceConfig) -> Vec<(i64
     out
 }
 
-/// The truth timeline of ground-truth phases.
+/// The truth timeline of ground-truth phases of a trace whose targets are laid out as
+/// [`crate::scene::synth_params_for`] does (surface, then refracted).
 pub fn timeline_from_phases(phases: &[GazePhase]) -> TruthTimeline {
-    let image = |p: &GazePhase| match p.target {
-        GazeTarget::Surface => GazeImage::Surface,
-        GazeTarget::Refracted => GazeImage::Refracted,
-    };
+    let image = |p: &GazePhase| gaze_image_of_target(p.target);
     let mut changes = Vec::new();
     for w in phases.windows(2) {
         if image(&w[0]) != image(&w[1]) {

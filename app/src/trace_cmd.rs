@@ -9,7 +9,7 @@ use vitreous_xr::synth::{SynthParams, synthesize_with_truth};
 use vitreous_xr::trace::{TraceSample, TraceWriter};
 
 use crate::output::write_atomic;
-use crate::scene::load_scene;
+use crate::scene::{REFRACTED_TARGET, SURFACE_TARGET, load_scene};
 
 pub use crate::scene::synth_params_for;
 
@@ -79,8 +79,8 @@ pub fn synth(scene_path: &Path, options: &SynthOptions, out: &Path) -> Result<St
         params.duration_s,
         params.rate_hz,
         params.switch_period_s,
-        params.surface_point.to_array(),
-        params.refracted_point.to_array(),
+        params.targets[SURFACE_TARGET].point_m.to_array(),
+        params.targets[REFRACTED_TARGET].point_m.to_array(),
         trace.blinks.len()
     ))
 }

@@ -26,7 +26,9 @@ use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, FilterParseError, GazeOverride};
 
 pub use error::{Location, SceneError};
-pub use fixation::{FixationPoints, synth_params_for};
+pub use fixation::{
+    FixationPoints, REFRACTED_TARGET, SURFACE_TARGET, gaze_image_of_target, synth_params_for,
+};
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
 pub use mesh::Mesh;
 

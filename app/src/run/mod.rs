@@ -1,0 +1,499 @@
+//! `vitreous run`: the frame loop on a live OpenXR runtime (a headset, or Monado in CI).
+//!
+//! Set-up order is dictated by XR_KHR_vulkan_enable2: the OpenXR runtime first, then the
+//! renderer's Vulkan instance and device created *through* it ([`XrDeviceCreator`]), then the
+//! session on that device, whose swapchain images the renderer draws into. Teardown is the
+//! reverse: the renderer lets go of the swapchain images, the session goes, then the device,
+//! then the OpenXR instance.
+//!
+//! The loop is the shared one ([`crate::frame_loop`]) plus one hook: each frame is drawn where
+//! [`Backend::frame_target`](vitreous_xr::Backend::frame_target) says (the renderer's own
+//! images or swapchain image `i`, and depth swapchain image `j` when depth is submitted).
+//!
+//! Live actions (controller buttons, see `vitreous_xr::openxr::actions`) re-register the scene
+//! in the session itself; the commands that change the look reach the sink through
+//! [`Session::take_commands`](vitreous_xr::openxr::Session::take_commands) and are applied
+//! by [`LiveLooks`]: the next effect condition among those this build implements, and the
+//! forced gaze image (surface, refracted, auto).
+//!
+//! Parts: `device.rs` (Vulkan through the runtime), `live.rs` (conditions and live
+//! commands), `readback.rs` (the readback check), `recording.rs` (the recorded trace and its
+//! replay check); this file sets the session up, runs it and writes the summary.
+
+mod device;
+mod live;
+mod readback;
+mod recording;
+
+use std::fs;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use serde::Serialize;
+use vitreous_render::renderer::{FrameResult, Want};
+use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
+use vitreous_xr::FrameInput;
+use vitreous_xr::openxr::ash::vk;
+use vitreous_xr::openxr::{
+    Blend, Command, DepthOptions, OpenXrOptions, Runtime, SessionOptions, SessionReport, State,
+    VulkanHandles,
+};
+use vitreous_xr::trace::TraceWriter;
+
+pub use device::XrDeviceCreator;
+pub use live::{CONDITION_CYCLE, GAZE_IMAGE_CYCLE, LiveLooks, STUDY_CONDITIONS, live_conditions};
+pub use readback::{LIT_THRESHOLD, MIN_OBJECT_FRACTION, ReadbackCheck};
+pub use recording::ReplayCheck;
+
+use crate::effects::EffectSet;
+use crate::frame_loop::{self, FramePlan, FrameSink};
+use crate::output::write_atomic;
+use crate::replay::{GazeSettings, planners_for};
+use crate::replay::{Spread, ValidationSummary};
+use crate::scene::load_scene;
+use crate::views;
+use readback::check_readback;
+use recording::{replay_check, trace_sample};
+
+/// Options of `vitreous run`.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// End the session after this many frames (None: until the runtime or Ctrl-C ends it).
+    pub frames: Option<u64>,
+    /// Gaze replayed from this trace when the headset has no eye tracker.
+    pub gaze_trace: Option<PathBuf>,
+    /// Record head pose and gaze of every frame into this trace file.
+    pub record: Option<PathBuf>,
+    /// Turn on the Vulkan validation layers and the OpenXR core validation layer; any Vulkan
+    /// message fails the run.
+    pub validate: bool,
+    /// Read back a submitted swapchain image and check the object is in it.
+    pub readback_check: bool,
+    /// Blend mode instead of the automatic choice.
+    pub blend: Option<Blend>,
+    /// Eye image size instead of the runtime's recommended one.
+    pub size: Option<(u32, u32)>,
+    /// Effects overriding the scene's.
+    pub effects: Option<EffectSet>,
+    /// How the reflected image is drawn.
+    pub reflection: Reflection,
+    /// Where summary.json goes (None: not written).
+    pub out: Option<PathBuf>,
+}
+
+/// What `vitreous run` reports (and writes to summary.json).
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    /// vitreous version.
+    pub vitreous_version: String,
+    /// The scene file.
+    pub scene: String,
+    /// OpenXR runtime name and version.
+    pub runtime: String,
+    /// The headset's name.
+    pub system: String,
+    /// Enabled OpenXR extensions.
+    pub extensions: Vec<String>,
+    /// Blend modes offered.
+    pub blend_modes_offered: Vec<String>,
+    /// The blend mode used.
+    pub blend: String,
+    /// Whether the real world was drawn behind the glass (opaque displays).
+    pub world_behind: bool,
+    /// The reference space.
+    pub space: String,
+    /// The gaze source.
+    pub gaze_source: String,
+    /// Swapchain format and whether it encodes sRGB.
+    pub swapchain_format: String,
+    /// Session states reached, in order.
+    pub states: Vec<String>,
+    /// Whether FOCUSED was reached.
+    pub reached_focused: bool,
+    /// Why the session ended.
+    pub end_reason: String,
+    /// Frames submitted with a projection layer.
+    pub frames_submitted: u64,
+    /// Frames the runtime said not to render.
+    pub frames_skipped: u64,
+    /// Frames whose head pose was not fully tracked.
+    pub frames_untracked: u64,
+    /// Vulkan device and driver.
+    pub device: String,
+    /// Eye image size, pixels.
+    pub width_px: u32,
+    /// Eye image size, pixels.
+    pub height_px: u32,
+    /// Vulkan validation results.
+    pub validation: ValidationSummary,
+    /// Wall-clock time of the session's frame loop, seconds.
+    pub wall_s: f64,
+    /// Frames per second.
+    pub frames_per_second: f64,
+    /// CPU milliseconds per frame.
+    pub cpu_ms: Option<Spread>,
+    /// GPU milliseconds per frame.
+    pub gpu_ms: Option<Spread>,
+    /// The readback check, when asked for.
+    pub readback: Option<ReadbackCheck>,
+    /// The recording, when asked for.
+    pub recorded: Option<String>,
+    /// Samples recorded.
+    pub recorded_samples: u64,
+    /// Replay of the recording against the session's views, when recorded.
+    pub replay_check: Option<ReplayCheck>,
+    /// The controller action set was created and attached.
+    pub actions_attached: bool,
+    /// Interaction profiles whose bindings the runtime accepted.
+    pub action_profiles: Vec<String>,
+    /// xrSyncActions calls (one per FOCUSED frame).
+    pub action_syncs: u64,
+    /// Commands the live actions gave.
+    pub commands: u64,
+    /// The effect conditions the live actions cycle through, the first one the start.
+    pub conditions: Vec<String>,
+    /// The effect condition at the end.
+    pub final_condition: String,
+    /// The forced gaze image at the end (`auto`: the tracker decides).
+    pub final_gaze_image: String,
+    /// Whether depth was submitted (XR_KHR_composition_layer_depth).
+    pub depth_submitted: bool,
+    /// The depth swapchain's format, when depth was submitted.
+    pub depth_format: Option<String>,
+    /// Frames submitted with depth.
+    pub frames_with_depth: u64,
+}
+
+/// Records frames and checks a readback.
+struct RunSink {
+    /// Decides each frame's look (effect condition, gaze-dependent defocus).
+    looks: LiveLooks,
+    /// Live commands from the session.
+    commands: Option<std::sync::mpsc::Receiver<Command>>,
+    /// Frame to read back, if any.
+    readback_frame: Option<u64>,
+    /// The scene's object, for the region check.
+    object_center_m: glam::Vec3,
+    /// The object's radius.
+    object_radius_m: f32,
+    /// Whether the world is drawn behind.
+    world_behind: bool,
+    /// The readback result.
+    readback: Option<ReadbackCheck>,
+    /// Where head pose and gaze are recorded, if asked.
+    writer: Option<TraceWriter<std::io::BufWriter<std::fs::File>>>,
+    /// Every frame's input, for the replay check.
+    recorded: Vec<FrameInput>,
+}
+
+impl FrameSink for RunSink {
+    fn started(&mut self, input: &FrameInput) -> Result<()> {
+        if let Some(w) = &mut self.writer {
+            w.write(&trace_sample(input))
+                .context("recording the trace")?;
+        }
+        self.recorded.push(input.clone());
+        Ok(())
+    }
+
+    fn plan(&mut self, input: &FrameInput) -> FramePlan {
+        let read = self.readback_frame == Some(input.index);
+        if let Some(rx) = &self.commands {
+            for command in rx.try_iter() {
+                if let Some(change) = self.looks.apply(command) {
+                    tracing::info!("frame {}: {change}", input.index);
+                }
+            }
+        }
+        FramePlan {
+            look: self.looks.plan(input),
+            want: Want {
+                eyes: read,
+                world: read,
+            },
+        }
+    }
+
+    fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()> {
+        if let Some(rb) = &result.readback {
+            self.readback = Some(check_readback(
+                input,
+                rb,
+                self.object_center_m,
+                self.object_radius_m,
+                self.world_behind,
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Runs the scene on the OpenXR runtime. Fails with a clear message when there is no runtime,
+/// no Vulkan support, a validation message, or a failed readback check.
+pub fn run(options: &RunOptions) -> Result<RunSummary> {
+    let mut scene = load_scene(&options.scene)?;
+    let effects = options.effects.unwrap_or(scene.effects);
+    effects.ensure_implemented()?;
+    if effects.caustics {
+        scene.load_caustics()?;
+    }
+    // The caustic conditions are offered live only with the scene's bake loaded.
+    let caustics_loaded = effects.caustics
+        || (scene.caustics.bake.is_some()
+            && EffectSet::IMPLEMENTED.caustics
+            && scene
+                .load_caustics()
+                .map_err(|e| tracing::warn!("caustic conditions not offered live: {e}"))
+                .is_ok());
+    let conditions = live_conditions(effects, caustics_loaded);
+    tracing::info!(
+        "effect conditions (menu on the right controller): {}",
+        conditions
+            .iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join(" > ")
+    );
+    let mut runtime = Runtime::new(&OpenXrOptions {
+        blend: options.blend,
+        validation: options.validate,
+        size: options.size,
+    })
+    .context("starting OpenXR")?;
+    let info = runtime.info().clone();
+    let (width, height) = info.size;
+    tracing::info!(
+        "eye images {width}x{height} (recommended {}x{}, max {}x{})",
+        info.recommended_size.0,
+        info.recommended_size.1,
+        info.max_size.0,
+        info.max_size.1
+    );
+    let ctx = GpuContext::new(
+        &ContextOptions {
+            validation: options.validate,
+            device_name: None,
+        },
+        &mut XrDeviceCreator {
+            runtime: &mut runtime,
+        },
+        &[],
+        &[],
+    )
+    .context("setting up the Vulkan device through the OpenXR runtime")?;
+    let device = format!("{} ({})", ctx.device_name, ctx.driver);
+    let handles = VulkanHandles {
+        instance: ctx.instance.handle(),
+        physical: ctx.physical,
+        device: ctx.device.handle(),
+        queue_family: ctx.queue_family,
+        queue_index: 0,
+    };
+    let (planners, defocus) = planners_for(
+        &scene,
+        &conditions,
+        options.reflection,
+        &GazeSettings::default(),
+    )?;
+    let mut renderer = Renderer::new(
+        ctx,
+        &views::scene_desc(&scene, defocus.as_ref()),
+        width,
+        height,
+    )
+    .context("preparing the renderer")?;
+    drop(defocus);
+    let (mut session, images) = unsafe {
+        runtime.start(
+            handles,
+            &SessionOptions {
+                max_frames: options.frames,
+                gaze_trace: options.gaze_trace.clone(),
+                scene_origin: None,
+                viewer_position_m: scene.viewer.head_position_m,
+                handle_ctrl_c: true,
+                depth: Some(DepthOptions {
+                    format: Renderer::DEPTH_FORMAT,
+                    near_m: vitreous_render::camera::NEAR_M,
+                    far_m: vitreous_render::camera::FAR_M,
+                }),
+            },
+        )
+    }
+    .context("starting the OpenXR session")?;
+    if !images.srgb {
+        bail!(
+            "the runtime offers only UNORM swapchain formats; vitreous renders into sRGB images \
+             only for now (VkFormat {:?})",
+            images.format
+        );
+    }
+    unsafe {
+        renderer.attach_external_with_depth(&images.images, images.format, &images.depth_images)
+    }
+    .context("using the swapchain images")?;
+
+    let writer = match &options.record {
+        Some(path) => Some(
+            TraceWriter::create(path).with_context(|| format!("creating {}", path.display()))?,
+        ),
+        None => None,
+    };
+    let world_behind = info.blend.needs_world_behind();
+    let mut sink = RunSink {
+        looks: LiveLooks::new(
+            conditions.iter().copied().zip(planners).collect(),
+            scene.gaze.image,
+        ),
+        commands: session.take_commands(),
+        // Late enough for the pipelines to be warm and the head to have moved.
+        readback_frame: options
+            .readback_check
+            .then(|| options.frames.map_or(10, |n| (n / 2).min(10)).max(1) - 1),
+        object_center_m: scene.object.center_m,
+        object_radius_m: scene.object.radius_m,
+        world_behind,
+        readback: None,
+        writer,
+        recorded: Vec::new(),
+    };
+    let started = Instant::now();
+    let result = frame_loop::run(&mut session, &mut renderer, &mut sink);
+    let wall_s = started.elapsed().as_secs_f64();
+    // Teardown order: images out of the renderer, then the session, then (at the end) the
+    // device with the renderer, then the OpenXR instance.
+    renderer
+        .detach_external()
+        .context("releasing the swapchain images")?;
+    let report: SessionReport = session.report().clone();
+    drop(session);
+    if let Some(w) = sink.writer.take() {
+        w.finish().context("closing the recording")?;
+    }
+    let records = result?;
+
+    let v = renderer.context().validation();
+    let validation = ValidationSummary {
+        enabled: renderer.context().validation_enabled(),
+        warnings: v.warnings(),
+        errors: v.errors(),
+        messages: v.messages(),
+    };
+    drop(renderer);
+    drop(runtime);
+
+    let replay_check = match &options.record {
+        Some(path) => Some(replay_check(path, &sink.recorded, &scene)?),
+        None => None,
+    };
+    let summary = RunSummary {
+        vitreous_version: env!("CARGO_PKG_VERSION").into(),
+        scene: options.scene.display().to_string(),
+        runtime: info.runtime.clone(),
+        system: info.system.clone(),
+        extensions: info.extensions.clone(),
+        blend_modes_offered: info
+            .blend_modes_offered
+            .iter()
+            .map(ToString::to_string)
+            .collect(),
+        blend: info.blend.to_string(),
+        world_behind,
+        space: report.space.map(|s| format!("{s:?}")).unwrap_or_default(),
+        gaze_source: report
+            .gaze_source
+            .map(|g| g.to_string())
+            .unwrap_or_default(),
+        swapchain_format: format!("{:?} (sRGB: {})", images.format, images.srgb),
+        states: report.states.iter().map(ToString::to_string).collect(),
+        reached_focused: report.reached(State::Focused),
+        end_reason: report
+            .end_reason
+            .map_or("unknown".into(), |r| r.to_string()),
+        frames_submitted: report.frames_submitted,
+        frames_skipped: report.frames_skipped,
+        frames_untracked: report.frames_untracked,
+        device,
+        width_px: width,
+        height_px: height,
+        validation,
+        wall_s,
+        frames_per_second: records.len() as f64 / wall_s.max(1e-9),
+        cpu_ms: Spread::of(records.iter().map(|r| r.cpu_ms)),
+        gpu_ms: Spread::of(records.iter().filter_map(|r| r.gpu_ms)),
+        readback: sink.readback.clone(),
+        recorded: options.record.as_ref().map(|p| p.display().to_string()),
+        recorded_samples: if options.record.is_some() {
+            sink.recorded.len() as u64
+        } else {
+            0
+        },
+        replay_check,
+        actions_attached: report.actions_attached,
+        action_profiles: report.action_profiles.clone(),
+        action_syncs: report.action_syncs,
+        commands: report.commands,
+        conditions: conditions.iter().map(ToString::to_string).collect(),
+        final_condition: sink.looks.condition().to_string(),
+        final_gaze_image: sink.looks.gaze().to_string(),
+        depth_submitted: report.depth_format.is_some(),
+        depth_format: report
+            .depth_format
+            .map(|f| format!("{:?}", vk::Format::from_raw(f))),
+        frames_with_depth: report.frames_with_depth,
+    };
+    if let Some(out) = &options.out {
+        fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+        let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;
+        write_atomic(&out.join("summary.json"), &json)?;
+    }
+    if summary.validation.errors + summary.validation.warnings > 0 {
+        bail!(
+            "the Vulkan validation layers reported {} errors and {} warnings, first: {}",
+            summary.validation.errors,
+            summary.validation.warnings,
+            summary
+                .validation
+                .messages
+                .first()
+                .map(String::as_str)
+                .unwrap_or("")
+        );
+    }
+    if options.readback_check {
+        match &summary.readback {
+            Some(c) if c.passed => {}
+            Some(c) => bail!(
+                "readback check failed: frame {} shows the object in {:.1} % of its region \
+                 ({} of {} px); expected at least {:.0} %",
+                c.frame,
+                c.object_fraction * 100.0,
+                c.object_px,
+                c.region_px,
+                MIN_OBJECT_FRACTION * 100.0
+            ),
+            None => bail!("readback check: no frame was read back (the session ended first)"),
+        }
+    }
+    Ok(summary)
+}
+
+/// A frame at time 5 ns with identity poses and no gaze, for the tests of this module's parts.
+#[cfg(test)]
+pub(crate) fn test_frame() -> FrameInput {
+    use vitreous_xr::{EyeView, Fov, Pose};
+    let view = EyeView {
+        pose: Pose::IDENTITY,
+        fov: Fov::symmetric(1.0, 1.0),
+    };
+    FrameInput {
+        index: 0,
+        time_ns: 5,
+        head: Pose::IDENTITY,
+        views: [view, view],
+        gaze: None,
+    }
+}

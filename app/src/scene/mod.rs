@@ -1,0 +1,297 @@
+//! Scene files: TOML describing the virtual glass object, its light, the registered real
+//! floor and background, the environment map, the viewer and the output, resolved into a
+//! [`Scene`] with every asset loaded and checked.
+//!
+//! Frame: OpenXR LOCAL-like, right-handed, +x right, +y up, -z forward, metres, origin at
+//! the viewer's initial head position. The paper's Unity coordinates `(x, y, z)` are
+//! `(x, y, -z)` here. The field reference is `docs/config.md`.
+//!
+//! Every error names the scene file, line, column and dotted field; asset errors also name
+//! the asset file and the decoder's reason. No input makes the loader panic.
+//!
+//! This file holds what a loaded scene is; `load.rs` reads and checks a file into one,
+//! `file.rs` is the file's raw TOML shape, `error.rs` its errors, `image.rs` and `mesh.rs`
+//! the assets, `fixation.rs` where a viewer of the scene looks.
+
+mod error;
+mod file;
+mod fixation;
+mod image;
+mod load;
+mod mesh;
+
+use std::path::PathBuf;
+
+use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
+use vitreous_xr::{Fov, Pose};
+
+use crate::effects::EffectSet;
+use crate::gaze::{FilterKind, GazeOverride};
+
+pub use error::{Location, SceneError};
+pub use fixation::{
+    FixationPoints, REFRACTED_TARGET, SURFACE_TARGET, gaze_image_of_target, synth_params_for,
+};
+pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
+pub use load::load_scene;
+pub use mesh::Mesh;
+
+/// A fully loaded scene, in the world frame described in the module docs.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The scene file, as given to [`load_scene`].
+    pub path: PathBuf,
+    /// Hex SHA-256 over the scene file's bytes and the bytes of every asset it loads
+    /// (labelled by field, so moving the files elsewhere keeps the hash).
+    pub hash: String,
+    /// The virtual transparent object.
+    pub object: Object,
+    /// The point light.
+    pub light: Light,
+    /// The registered real floor.
+    pub floor: RealPlane,
+    /// The registered real background behind the object.
+    pub background: RealPlane,
+    /// The environment map of the baseline method.
+    pub environment: Environment,
+    /// The wearer.
+    pub viewer: Viewer,
+    /// Per-eye output image and field of view.
+    pub output: Output,
+    /// The effects the scene asks for (parsed, not yet checked against this build).
+    pub effects: EffectSet,
+    /// How the gaze image is chosen for defocus.
+    pub gaze: GazeChoice,
+    /// The shadow inducer's parameters.
+    pub inducer: Inducer,
+    /// The caustic bake (eq. 6): where it is and, once [`Scene::load_caustics`] ran, its
+    /// gain map.
+    pub caustics: Caustics,
+}
+
+/// `[caustics]`: the scene's caustic gain bake (docs/caustics.md).
+#[derive(Clone, Debug, Default)]
+pub struct Caustics {
+    /// The bake file, resolved against the scene's folder; `None` when the scene names none.
+    /// Not read (nor hashed) when the scene loads: only when the caustics are asked for.
+    pub bake: Option<PathBuf>,
+    /// The gain map, after [`Scene::load_caustics`].
+    pub gain: Option<crate::caustics::Bake>,
+}
+
+impl Scene {
+    /// Reads the scene's caustic bake into [`Caustics::gain`], checking that it was baked
+    /// for this scene (its stored hash equals [`Scene::hash`]). Errors name the file: no bake
+    /// named, missing, corrupt, or made for another scene.
+    pub fn load_caustics(&mut self) -> Result<(), crate::caustics::BakeError> {
+        let path =
+            self.caustics
+                .bake
+                .as_ref()
+                .ok_or_else(|| crate::caustics::BakeError::NotNamed {
+                    scene: self.path.clone(),
+                })?;
+        self.caustics.gain = Some(crate::caustics::read_bake(path, &self.hash)?);
+        Ok(())
+    }
+}
+
+/// The shadow inducer's parameters (METHOD.md section 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inducer {
+    /// k of eq. 4: gain at the shadow edge relative to the floor's luminance.
+    pub k: f32,
+    /// D of eq. 2: width of the ramp around the shadow, metres.
+    pub ramp_width_m: f32,
+    /// Side of the floor-space shadow mask and distance field, texels.
+    pub resolution_px: u32,
+}
+
+impl Default for Inducer {
+    /// The paper's HoloLens values on a 512 x 512 mask.
+    fn default() -> Inducer {
+        Inducer {
+            k: 0.3,
+            ramp_width_m: 0.14,
+            resolution_px: 512,
+        }
+    }
+}
+
+/// `[gaze]`: the fixation-depth filter and the experimenter's gaze-image override.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GazeChoice {
+    /// Depth filter (default: eq. 15's 20-sample mean).
+    pub filter: FilterKind,
+    /// Gaze image: auto, or forced to the surface or the refracted image.
+    pub image: GazeOverride,
+}
+
+/// Where the object's refractive index came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IorSource {
+    /// `object.ior` in the scene file.
+    Scene,
+    /// The model's KHR_materials_ior.
+    Gltf,
+    /// Neither: 1.5.
+    Default,
+}
+
+/// The virtual transparent object.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// The triangle mesh in model units.
+    pub mesh: Mesh,
+    /// Model to world: centre the mesh's bounding box on the origin, scale (to the target
+    /// diameter), rotate, translate to `position_m`.
+    pub world_from_model: Mat4,
+    /// World centre of the bounding sphere, metres (the object's `position_m`).
+    pub center_m: Vec3,
+    /// World radius of the bounding sphere about `center_m`, metres.
+    pub radius_m: f32,
+    /// Refractive index relative to air.
+    pub ior: f32,
+    /// Where `ior` came from.
+    pub ior_source: IorSource,
+    /// Surface texture (sRGB), mapped with the mesh's `TEXCOORD_0`, if any.
+    pub surface_texture: Option<Image>,
+    /// Fraction of light the surface texture lets through, 0..1 (1 = no visible surface
+    /// image; the paper's sticker: 0.8).
+    pub surface_transmittance: f32,
+    /// The glTF/GLB file.
+    pub model_path: PathBuf,
+}
+
+/// The point light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// World position, metres.
+    pub position_m: Vec3,
+    /// Dimensionless multiplier on `color`.
+    pub intensity: f32,
+    /// Linear RGB colour.
+    pub color: Vec3,
+}
+
+/// A registered real-world plane: a photo of the real surface, its physical size and pose.
+#[derive(Clone, Debug)]
+pub struct RealPlane {
+    /// The photo (sRGB), top edge towards the plane's local +y.
+    pub photo: Image,
+    /// Width (local x) and height (local y), metres.
+    pub size_m: Vec2,
+    /// Centre and orientation; the visible side faces local +z.
+    pub pose: Pose,
+}
+
+impl RealPlane {
+    /// Maps the unit square `[-0.5, 0.5]^2` at z = 0 (local +y = photo top) onto the plane
+    /// in the world.
+    pub fn world_from_plane(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(
+            self.size_m.extend(1.0),
+            self.pose.orientation,
+            self.pose.position,
+        )
+    }
+
+    /// World unit normal of the visible side.
+    pub fn normal(&self) -> Vec3 {
+        (self.pose.orientation * Vec3::Z).normalize()
+    }
+}
+
+/// The environment map.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    /// Latitude-longitude map, linear RGBA f32, rows as stored in the file (top row = zenith).
+    pub latlong: Image,
+    /// The map's file.
+    pub path: PathBuf,
+    /// `environment.cube_map`: reserved; checked to exist and hashed, not decoded.
+    pub cube_map_path: Option<PathBuf>,
+}
+
+/// The wearer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Viewer {
+    /// Interpupillary distance, metres.
+    pub ipd_m: f32,
+    /// Pupil diameter A_p of eq. 14, metres.
+    pub pupil_diameter_m: f32,
+    /// Head (between the eyes) position used by synthetic traces and when no trace is
+    /// given, metres.
+    pub head_position_m: Vec3,
+}
+
+impl Viewer {
+    /// Left and right eye positions for a head pose: half the IPD along the head's -x / +x.
+    pub fn eye_positions_m(&self, head: &Pose) -> [Vec3; 2] {
+        let half = Vec3::X * (self.ipd_m / 2.0);
+        [head.transform_point(-half), head.transform_point(half)]
+    }
+}
+
+/// Per-eye output.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Output {
+    /// Width of each eye's image, pixels.
+    pub width_px: u32,
+    /// Height of each eye's image, pixels.
+    pub height_px: u32,
+    /// Field of view of each eye, radians.
+    pub fov: Fov,
+}
+
+/// Rotation from `[x, y, z]` Euler angles in degrees: about world x first, then world y,
+/// then world z (extrinsic XYZ; the matrix is `Rz * Ry * Rx`).
+pub fn euler_xyz_deg(angles_deg: Vec3) -> Quat {
+    let r = angles_deg * (std::f32::consts::PI / 180.0);
+    Quat::from_euler(EulerRot::ZYX, r.z, r.y, r.x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn euler_rotates_x_then_y_then_z() {
+        let floor = euler_xyz_deg(Vec3::new(-90.0, 0.0, 0.0));
+        assert!((floor * Vec3::Z).abs_diff_eq(Vec3::Y, 1e-6));
+        assert!((floor * Vec3::Y).abs_diff_eq(Vec3::NEG_Z, 1e-6));
+        let q = euler_xyz_deg(Vec3::new(90.0, 90.0, 0.0));
+        // x first: +y -> +z; then y: +z -> +x.
+        assert!((q * Vec3::Y).abs_diff_eq(Vec3::X, 1e-6));
+    }
+
+    #[test]
+    fn plane_maps_unit_square_and_faces_its_normal() {
+        let plane = RealPlane {
+            photo: Image::new(1, 1, PixelData::Srgb8(vec![0; 4])).unwrap(),
+            size_m: Vec2::new(2.0, 1.0),
+            pose: Pose {
+                position: Vec3::new(0.0, -0.5, -1.0),
+                orientation: euler_xyz_deg(Vec3::new(-90.0, 0.0, 0.0)),
+            },
+        };
+        let m = plane.world_from_plane();
+        assert!(
+            m.transform_point3(Vec3::new(0.5, 0.5, 0.0))
+                .abs_diff_eq(Vec3::new(1.0, -0.5, -1.5), 1e-6)
+        );
+        assert!(plane.normal().abs_diff_eq(Vec3::Y, 1e-6));
+    }
+
+    #[test]
+    fn eyes_are_half_ipd_either_side() {
+        let viewer = Viewer {
+            ipd_m: 0.064,
+            pupil_diameter_m: 0.006,
+            head_position_m: Vec3::ZERO,
+        };
+        let [l, r] = viewer.eye_positions_m(&Pose::IDENTITY);
+        assert_eq!(l, Vec3::new(-0.032, 0.0, 0.0));
+        assert_eq!(r, Vec3::new(0.032, 0.0, 0.0));
+    }
+}

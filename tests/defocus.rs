@@ -6,11 +6,12 @@
 use std::path::Path;
 
 use glam::Vec2;
-use vitreous::defocus::{DefocusSetup, LookPlanner};
+use vitreous::blur_stack::DefocusSetup;
 use vitreous::frame_loop::{self, FramePlan, FrameSink};
-use vitreous::gaze::defocus::blur_reference;
+use vitreous::gaze::blur::blur_reference;
 use vitreous::gaze::{GazeConfig, GazeImage};
-use vitreous::scene::{Image, PixelData, Scene, load_scene};
+use vitreous::look::LookPlanner;
+use vitreous::scene::{Image, PixelData, Scene, gaze_image_of_target, load_scene};
 use vitreous::trace_cmd::synth_params_for;
 use vitreous::views;
 use vitreous_render::reference::{RefractionSample, refraction_sample};
@@ -19,7 +20,7 @@ use vitreous_render::{ContextOptions, Defocus, GpuContext, Look, Reflection, Ren
 use vitreous_tests::render_once;
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::synth::{GazeTarget, synthesize_with_truth};
+use vitreous_xr::synth::synthesize_with_truth;
 
 const W: u32 = 320;
 const H: u32 = 240;
@@ -230,8 +231,12 @@ fn sharpness_by_gaze(scene: &Scene) -> Vec<(GazeImage, f64)> {
         .map(|p| ((p.start_ns as f64 * 1e-9 + 2.5) * 60.0) as u64)
         .filter(|f| *f < 600)
         .collect();
-    let targets: Vec<GazeTarget> = truth.phases.iter().map(|p| p.target).collect();
-    assert!(targets.contains(&GazeTarget::Surface) && targets.contains(&GazeTarget::Refracted));
+    let images: Vec<GazeImage> = truth
+        .phases
+        .iter()
+        .map(|p| gaze_image_of_target(p.target))
+        .collect();
+    assert!(images.contains(&GazeImage::Surface) && images.contains(&GazeImage::Refracted));
     let effects = vitreous::effects::EffectSet::parse("O5").unwrap();
     let mut look = views::look(&effects, Reflection::EnvironmentFresnel);
     look.reflection = Reflection::EnvironmentFresnel;

@@ -12,13 +12,13 @@ use vitreous_render::{ContextOptions, GpuContext, Look, Reflection, Renderer};
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::{Backend, FrameInput};
 
-use crate::defocus::{DefocusModel, DefocusSetup, LookPlanner};
+use crate::blur_stack::DefocusSetup;
 use crate::effects::EffectSet;
 use crate::gaze::GazeConfig;
-use crate::gaze::defocus::check_pupil_diameter_m;
+use crate::gaze::blur::check_pupil_diameter_m;
+use crate::look::{DefocusModel, LookPlanner};
 use crate::replay::{Spread, check_size};
-use crate::scene::load_scene;
-use crate::trace_cmd::synth_params_for;
+use crate::scene::{load_scene, synth_params_for};
 use crate::views;
 
 /// Frames of each variant rendered before timing starts (shaders compile on first use on

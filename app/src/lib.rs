@@ -5,11 +5,12 @@
 //! the trace format in `vitreous-xr`.
 
 pub mod bench;
+pub mod blur_stack;
 pub mod caustics;
-pub mod defocus;
 pub mod effects;
 pub mod frame_loop;
 pub mod gaze;
+pub mod look;
 pub mod output;
 pub mod reference_view;
 pub mod replay;

@@ -14,11 +14,12 @@ use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{TraceSample, read_trace};
 
-use crate::defocus::{DefocusSetup, LookPlanner};
+use crate::blur_stack::DefocusSetup;
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
-use crate::gaze::defocus::check_pupil_diameter_m;
+use crate::gaze::blur::check_pupil_diameter_m;
 use crate::gaze::{FilterKind, GazeConfig, GazeOverride};
+use crate::look::LookPlanner;
 use crate::output::{self, write_atomic};
 use crate::reference_view::side_by_side;
 use crate::scene::{Scene, load_scene};

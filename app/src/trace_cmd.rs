@@ -9,42 +9,9 @@ use vitreous_xr::synth::{SynthParams, synthesize_with_truth};
 use vitreous_xr::trace::{TraceSample, TraceWriter};
 
 use crate::output::write_atomic;
-use crate::scene::{Scene, load_scene};
+use crate::scene::{REFRACTED_TARGET, SURFACE_TARGET, load_scene};
 
-/// Distance behind the object's centre where the refracted image is assumed to lie when the
-/// scene's background plane is not in line with the object, metres.
-const FALLBACK_REFRACTED_DEPTH_M: f32 = 0.2;
-
-/// Synthetic-trace parameters for a scene: the head at the viewer's position looking at the
-/// object; the gaze alternates between the front of the object's surface and the point of the
-/// background plane seen through the object's centre (where the refracted image lies).
-pub fn synth_params_for(scene: &Scene) -> SynthParams {
-    let head = scene.viewer.head_position_m;
-    let center = scene.object.center_m;
-    let to_object = (center - head).normalize_or(glam::Vec3::NEG_Z);
-    let surface_point = center - to_object * scene.object.radius_m;
-    let plane_point = scene.background.pose.position;
-    let normal = scene.background.normal();
-    let denom = to_object.dot(normal);
-    let behind = center + to_object * FALLBACK_REFRACTED_DEPTH_M;
-    let refracted_point = if denom.abs() > 1e-3 {
-        let t = (plane_point - head).dot(normal) / denom;
-        if t > (center - head).length() {
-            head + to_object * t
-        } else {
-            behind
-        }
-    } else {
-        behind
-    };
-    SynthParams {
-        head_position: head,
-        surface_point,
-        refracted_point,
-        ipd_m: scene.viewer.ipd_m,
-        ..SynthParams::default()
-    }
-}
+pub use crate::scene::synth_params_for;
 
 /// Writes `samples` as a trace file at `out` (atomically).
 pub fn write_trace_file(samples: &[TraceSample], out: &Path) -> Result<()> {
@@ -112,8 +79,8 @@ pub fn synth(scene_path: &Path, options: &SynthOptions, out: &Path) -> Result<St
         params.duration_s,
         params.rate_hz,
         params.switch_period_s,
-        params.surface_point.to_array(),
-        params.refracted_point.to_array(),
+        params.targets[SURFACE_TARGET].point_m.to_array(),
+        params.targets[REFRACTED_TARGET].point_m.to_array(),
         trace.blinks.len()
     ))
 }

@@ -8,7 +8,7 @@ use vitreous_render::{
 };
 use vitreous_xr::{EyeView, Fov, FrameInput};
 
-use crate::defocus::DefocusSetup;
+use crate::blur_stack::DefocusSetup;
 use crate::effects::EffectSet;
 use crate::scene::{Image, PixelData, Scene};
 

@@ -1,9 +1,9 @@
 //! Defocus maths (eq. 10-14) through the public API.
 
 use proptest::prelude::*;
-use vitreous::gaze::defocus::{
+use vitreous::gaze::blur::{
     DefocusError, blur_circle_diameter_m, blur_reference, check_pupil_diameter_m, gaussian_kernel,
-    gaussian_variance_px2, kernel_radius_px, kernel_width_px,
+    gaussian_variance_px2, kernel_radius_px, kernel_width_px, px_per_m,
 };
 
 proptest! {
@@ -28,7 +28,7 @@ fn eq14_against_hand_computed_values() {
     // The paper's layout (6 mm; surface 0.125 m, background 0.4 m).
     assert!((blur_circle_diameter_m(0.006, 0.4, 0.125) - 0.0132).abs() < 1e-7);
     // eq. 13 on a 1024 px photo 0.5 m wide: 2048 px/m * 3 mm = 6.144 px; eq. 11 and 12.
-    let k = kernel_width_px(1024.0, 0.5, 0.003);
+    let k = kernel_width_px(px_per_m(1024.0, 0.5), 0.003);
     assert!((k - 6.144).abs() < 1e-4);
     assert!((gaussian_variance_px2(k) - 3.072).abs() < 1e-4);
     assert_eq!(kernel_radius_px(k), 3);

@@ -4,10 +4,11 @@
 use glam::Vec3;
 use vitreous::gaze::{FilterKind, GazeConfig, GazeImage, GazeOverride, ImageDistances};
 use vitreous::trace_analyze::{AnalyzeConfig, Truth, analyze, plot, replay};
-use vitreous_xr::synth::{SynthParams, SynthTrace, synthesize_with_truth};
+use vitreous_xr::synth::{FixationTarget, SynthParams, SynthTrace, synthesize_with_truth};
 
 /// The synthetic trace the alternative is tuned on: 30 Hz, 0.5 degree noise, blinks every
-/// 4 s, gaze switching every 3 s between 0.6 m and 1.5 m, one minute long.
+/// 4 s, gaze switching every 3 s between 0.6 m (the surface, target 0) and 1.5 m (the
+/// refracted image, target 1), one minute long.
 fn alternating(seed: u64) -> (SynthTrace, ImageDistances) {
     let p = SynthParams {
         duration_s: 60.0,
@@ -15,7 +16,11 @@ fn alternating(seed: u64) -> (SynthTrace, ImageDistances) {
         ..SynthParams::default()
     };
     let trace = synthesize_with_truth(&p).unwrap();
-    let d = ImageDistances::from_points(p.head_position, p.surface_point, p.refracted_point);
+    let d = ImageDistances::from_points(
+        p.head_position,
+        p.targets[vitreous::scene::SURFACE_TARGET].point_m,
+        p.targets[vitreous::scene::REFRACTED_TARGET].point_m,
+    );
     (trace, d)
 }
 
@@ -68,7 +73,7 @@ fn one_euro_meets_the_latency_target_at_30_hz() {
 fn blinks_produce_no_spurious_switch() {
     for target in [Vec3::new(0.0, 0.0, -0.6), Vec3::new(0.0, -0.05, -1.5)] {
         let p = SynthParams {
-            surface_point: target,
+            targets: vec![FixationTarget::new("still", target)],
             switch_period_s: 0.0,
             duration_s: 60.0,
             blink_every_s: 1.5,

@@ -18,8 +18,6 @@ use std::str::FromStr;
 use glam::Vec3;
 use thiserror::Error;
 
-use crate::scene::Scene;
-
 /// Default hysteresis band, as a fraction of the log gap between threshold and image.
 pub const DEFAULT_BAND: f32 = 0.2;
 
@@ -60,14 +58,6 @@ impl ImageDistances {
             surface_m: head_m.distance(surface_point_m),
             refracted_m: head_m.distance(refracted_point_m),
         }
-    }
-
-    /// The distances for a scene, from the viewer's head position to the points that
-    /// synthetic traces fixate ([`crate::trace_cmd::synth_params_for`]): the front of the
-    /// object and the background seen through the object's centre.
-    pub fn for_scene(scene: &Scene) -> Self {
-        let p = crate::trace_cmd::synth_params_for(scene);
-        Self::from_points(p.head_position, p.surface_point, p.refracted_point)
     }
 
     /// The decision threshold: the geometric mean of the two distances, metres.

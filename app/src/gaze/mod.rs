@@ -9,15 +9,15 @@
 //! 3. [`image`]: the gaze image (surface or refracted) with hysteresis, or the experimenter's
 //!    override; the focus distance d_f is that image's distance.
 //!
-//! [`defocus`] then turns d_f into the blur of the image not looked at (eq. 10-14).
+//! [`blur`] then turns d_f into the blur of the image not looked at (eq. 10-14).
 //! `docs/gaze.md` maps each equation to its function.
 
-pub mod defocus;
+pub mod blur;
 pub mod filter;
 pub mod image;
 pub mod vergence;
 
-pub use defocus::{DefocusError, GaussianKernel, ImageBlur, blur_reference, image_blur};
+pub use blur::{DefocusError, GaussianKernel, ImageBlur, blur_reference, image_blur};
 pub use filter::{DepthFilter, FilterKind, FilterParseError, OneEuroParams, SampleFilter};
 pub use image::{GazeImage, GazeOverride, ImageDistances, ImageSelector};
 pub use vergence::{FixationDepth, VergenceConfig, VergenceEstimator};

@@ -12,10 +12,11 @@
 //! | `/interaction_profiles/oculus/touch_controller` | left `x/click`, right `a/click` | left `y/click`, right `b/click` |
 //! | `/interaction_profiles/valve/index_controller` | `a/click` | `b/click` |
 //!
-//! [`commands_for`] turns one hand's presses into commands: the right hand drives the
-//! experiment (select: next gaze image, menu: next effect condition, menu pressed while select
-//! is held or the other way round: nudge the scene away), the left hand the registration
-//! (select: turn the scene left, menu: turn it right, a chord: nudge it closer).
+//! [`commands_for`] turns one hand's presses into commands: the right hand steps the
+//! application's two cycles (select: [`Cycle::Primary`], menu: [`Cycle::Secondary`]; what
+//! they cycle through is the application's choice), menu pressed while select is held or the
+//! other way round nudges the scene away; the left hand drives the registration (select: turn
+//! the scene left, menu: turn it right, a chord: nudge it closer).
 
 use glam::Vec3;
 use openxr as xr;
@@ -36,10 +37,17 @@ pub enum Command {
     /// Rotate the scene about the vertical axis through the viewer, radians (positive: counter-
     /// clockwise seen from above, i.e. to the viewer's left).
     Rotate(f32),
-    /// Switch to the next effect condition.
-    NextCondition,
-    /// Force the gaze image: cycles surface, refracted, automatic.
-    NextGazeImage,
+    /// Step one of the application's cycles to its next value.
+    Cycle(Cycle),
+}
+
+/// The two cycles the right hand steps; the application decides what each goes through.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Cycle {
+    /// Stepped by the right hand's select (trigger).
+    Primary,
+    /// Stepped by the right hand's menu button.
+    Secondary,
 }
 
 impl std::fmt::Display for Command {
@@ -51,8 +59,8 @@ impl std::fmt::Display for Command {
                 d.x, d.y, d.z
             ),
             Command::Rotate(a) => write!(f, "turn the scene by {:+.1} deg", a.to_degrees()),
-            Command::NextCondition => f.write_str("next effect condition"),
-            Command::NextGazeImage => f.write_str("next gaze image (surface, refracted, auto)"),
+            Command::Cycle(Cycle::Primary) => f.write_str("step the primary cycle"),
+            Command::Cycle(Cycle::Secondary) => f.write_str("step the secondary cycle"),
         }
     }
 }
@@ -124,9 +132,9 @@ pub fn presses(select: ButtonState, menu: ButtonState) -> Presses {
     }
 }
 
-/// The commands for this frame's presses on the right hand (the experimenter's): select cycles
-/// the gaze image, menu the effect condition, both together nudge the scene away from the
-/// viewer by [`NUDGE_STEP_M`].
+/// The commands for this frame's presses on the right hand (the experimenter's): select steps
+/// the primary cycle, menu the secondary, both together nudge the scene away from the viewer
+/// by [`NUDGE_STEP_M`].
 pub fn commands(p: Presses) -> Vec<Command> {
     commands_for(Hand::Right, p)
 }
@@ -146,10 +154,10 @@ pub fn commands_for(hand: Hand, p: Presses) -> Vec<Command> {
     match hand {
         Hand::Right => {
             if p.select {
-                out.push(Command::NextGazeImage);
+                out.push(Command::Cycle(Cycle::Primary));
             }
             if p.menu {
-                out.push(Command::NextCondition);
+                out.push(Command::Cycle(Cycle::Secondary));
             }
         }
         Hand::Left => {
@@ -293,17 +301,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn select_cycles_gaze_and_menu_cycles_condition() {
+    fn select_steps_the_primary_cycle_and_menu_the_secondary() {
         let select = Presses {
             select: true,
             ..Default::default()
         };
-        assert_eq!(commands(select), [Command::NextGazeImage]);
+        assert_eq!(commands(select), [Command::Cycle(Cycle::Primary)]);
         let menu = Presses {
             menu: true,
             ..Default::default()
         };
-        assert_eq!(commands(menu), [Command::NextCondition]);
+        assert_eq!(commands(menu), [Command::Cycle(Cycle::Secondary)]);
         assert!(commands(Presses::default()).is_empty());
     }
 

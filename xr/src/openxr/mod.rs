@@ -37,7 +37,7 @@ use ash::vk::Handle;
 use openxr as xr;
 use thiserror::Error;
 
-pub use actions::Command;
+pub use actions::{Command, Cycle};
 /// The `ash` crate these APIs use, for callers without their own dependency on it.
 pub use ash;
 pub use choose::{Blend, ColorFormat, GazeSource};

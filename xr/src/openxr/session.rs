@@ -486,7 +486,7 @@ pub(crate) fn re_register(world_from_space: &Pose, command: Command, head_m: Vec
                 orientation: r,
             }
         }
-        Command::NextCondition | Command::NextGazeImage => return *world_from_space,
+        Command::Cycle(_) => return *world_from_space,
     };
     compose(&change, world_from_space)
 }
@@ -1019,7 +1019,10 @@ mod tests {
         let yaw = |v: Vec3| (-v.x).atan2(-v.z);
         assert!((yaw(f) - yaw(f0) + a).abs() < 1e-5, "{f} {f0}");
         // Other commands leave the placement alone.
-        assert_eq!(re_register(&w, Command::NextCondition, head_m), w);
+        assert_eq!(
+            re_register(&w, Command::Cycle(crate::openxr::Cycle::Secondary), head_m),
+            w
+        );
     }
 
     #[test]

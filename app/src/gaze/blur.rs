@@ -65,10 +65,17 @@ pub fn blur_circle_diameter_m(
     pupil_diameter_m * (image_distance_m - focus_distance_m).abs() / focus_distance_m
 }
 
-/// eq. 13: kernel width in the photo's pixels, `K_g = (W_p / W_l) * D_b`, where the photo is
+/// eq. 13: kernel width in the photo's pixels, `K_g = (W_p / W_l) * D_b`, where
+/// `px_per_m` is W_p / W_l: the photo is W_p pixels across W_l metres of its image
+/// ([`px_per_m`]). The only place eq. 13 is evaluated.
+pub fn kernel_width_px(px_per_m: f32, blur_circle_m: f32) -> f32 {
+    px_per_m * blur_circle_m
+}
+
+/// eq. 13's W_p / W_l: pixels of a photo per metre of the image it is laid on, for a photo
 /// `photo_width_px` (W_p) pixels across `photo_width_m` (W_l) metres.
-pub fn kernel_width_px(photo_width_px: f32, photo_width_m: f32, blur_circle_m: f32) -> f32 {
-    photo_width_px / photo_width_m * blur_circle_m
+pub fn px_per_m(photo_width_px: f32, photo_width_m: f32) -> f32 {
+    photo_width_px / photo_width_m
 }
 
 /// eq. 11: variance of the Gaussian, `sigma^2 = K_g / 2` (pixels^2).
@@ -200,8 +207,8 @@ pub fn image_blur(
     ImageBlur {
         surface_blur_circle_m,
         refracted_blur_circle_m,
-        surface_k_g_px: kernel_width_px(surface_px_per_m, 1.0, surface_blur_circle_m),
-        refracted_k_g_px: kernel_width_px(background_px_per_m, 1.0, refracted_blur_circle_m),
+        surface_k_g_px: kernel_width_px(surface_px_per_m, surface_blur_circle_m),
+        refracted_k_g_px: kernel_width_px(background_px_per_m, refracted_blur_circle_m),
     }
 }
 
@@ -218,7 +225,7 @@ mod tests {
         assert!((blur_circle_diameter_m(0.006, 0.125, 0.4) - 0.004_125).abs() < 1e-7);
         assert_eq!(blur_circle_diameter_m(0.006, 0.4, 0.4), 0.0);
         // eq. 13: a 2000 px photo 0.5 m wide is 4000 px/m; 4.125 mm -> 16.5 px.
-        assert!((kernel_width_px(2000.0, 0.5, 0.004_125) - 16.5).abs() < 1e-4);
+        assert!((kernel_width_px(px_per_m(2000.0, 0.5), 0.004_125) - 16.5).abs() < 1e-4);
         assert_eq!(gaussian_variance_px2(16.5), 8.25);
         assert_eq!(kernel_radius_px(16.5), 8);
     }

@@ -1,17 +1,12 @@
-//! Gaze-dependent defocus on the GPU's side of the CPU: the blur stacks the renderer samples
-//! (eq. 10-12 at evenly spaced K_g, built once per scene) and, per frame, the kernel widths of
-//! eq. 13-14 for the gaze image the gaze pipeline chose.
-//!
-//! Per-pixel cost does not grow with K_g: each image is one trilinear fetch from its stack.
-//! While the gaze image is unknown (no valid gaze yet, or a blink held too long), nothing is
-//! blurred.
+//! Blur stacks: each defocused image (background photo, surface texture) blurred once per
+//! scene on the CPU by eq. 10-12 at evenly spaced K_g, uploaded as a 3-D texture the renderer
+//! samples with one trilinear fetch, so per-pixel cost does not grow with K_g.
 
 use rayon::prelude::*;
-use vitreous_render::{Defocus, Look};
-use vitreous_xr::FrameInput;
 
-use crate::gaze::defocus::{PUPIL_MAX_MM, blur_circle_diameter_m, gaussian_kernel, image_blur};
-use crate::gaze::{GazeConfig, GazeImage, GazeOverride, GazePipeline, GazeState, ImageDistances};
+use crate::gaze::GazeImage;
+use crate::gaze::blur::{PUPIL_MAX_MM, gaussian_kernel};
+use crate::look::DefocusModel;
 use crate::output::{linear_to_srgb, srgb_to_linear};
 use crate::scene::{Image, PixelData, Scene};
 
@@ -49,53 +44,6 @@ impl BlurStack {
     }
 }
 
-/// The numbers eq. 13-14 need of a scene: image distances, pixels per metre of each image's
-/// photo, and the pupil.
-#[derive(Clone, Copy, Debug)]
-pub struct DefocusModel {
-    /// Distances of the surface and refracted images from the viewing position, metres.
-    pub distances: ImageDistances,
-    /// Pupil diameter A_p, metres.
-    pub pupil_m: f32,
-    /// W_p / W_l of the surface texture: texels per metre on the object's surface.
-    pub surface_px_per_m: f32,
-    /// W_p / W_l of the background photo: pixels per metre on the background plane.
-    pub background_px_per_m: f32,
-}
-
-impl DefocusModel {
-    /// The model of `scene` with pupil diameter `pupil_m`.
-    pub fn new(scene: &Scene, pupil_m: f32) -> DefocusModel {
-        DefocusModel {
-            distances: ImageDistances::for_scene(scene),
-            pupil_m,
-            background_px_per_m: scene.background.photo.width as f32 / scene.background.size_m.x,
-            // u runs once around the object: texels per metre of its circumference.
-            surface_px_per_m: scene.object.surface_texture.as_ref().map_or(1.0, |t| {
-                t.width as f32 / (std::f32::consts::PI * 2.0 * scene.object.radius_m)
-            }),
-        }
-    }
-
-    /// The blur of both images for a gaze image (eq. 13-14); `None` while it is unknown.
-    pub fn defocus(&self, image: GazeImage) -> Option<Defocus> {
-        if image == GazeImage::Unknown {
-            return None;
-        }
-        let blur = image_blur(
-            image,
-            &self.distances,
-            self.pupil_m,
-            self.surface_px_per_m,
-            self.background_px_per_m,
-        );
-        Some(Defocus {
-            refracted_k_g_px: blur.refracted_k_g_px,
-            surface_k_g_px: blur.surface_k_g_px,
-        })
-    }
-}
-
 /// A scene's defocus model and the blur stacks the renderer samples.
 #[derive(Clone, Debug)]
 pub struct DefocusSetup {
@@ -112,11 +60,17 @@ impl DefocusSetup {
     /// pupil can change without rebuilding them.
     pub fn new(scene: &Scene, pupil_m: f32) -> DefocusSetup {
         let model = DefocusModel::new(scene, pupil_m);
-        let (s, r) = (model.distances.surface_m, model.distances.refracted_m);
-        let max_pupil_m = PUPIL_MAX_MM / 1000.0;
-        let max_background_k =
-            model.background_px_per_m * blur_circle_diameter_m(max_pupil_m, r, s);
-        let max_surface_k = model.surface_px_per_m * blur_circle_diameter_m(max_pupil_m, s, r);
+        // The deepest blur of each image: the other image in focus, at the largest pupil.
+        let deepest = DefocusModel {
+            pupil_m: PUPIL_MAX_MM / 1000.0,
+            ..model
+        };
+        let max_background_k = deepest
+            .defocus(GazeImage::Surface)
+            .map_or(0.0, |d| d.refracted_k_g_px);
+        let max_surface_k = deepest
+            .defocus(GazeImage::Refracted)
+            .map_or(0.0, |d| d.surface_k_g_px);
         let (background, surface) = rayon::join(
             || build_stack(&scene.background.photo, max_background_k),
             || {
@@ -131,56 +85,6 @@ impl DefocusSetup {
             model,
             background,
             surface,
-        }
-    }
-}
-
-/// Decides each frame's look: the effect set's fixed part, and the defocus that the gaze
-/// pipeline (vergence -> depth filter -> gaze image, METHOD.md section 5) asks for.
-pub struct LookPlanner {
-    /// The effect set's look without defocus amounts.
-    base: Look,
-    /// Gaze pipeline and defocus model, when defocus is on.
-    defocus: Option<(GazePipeline, DefocusModel)>,
-}
-
-impl LookPlanner {
-    /// A planner for `base` (see `views::look`); with `defocus`, the gaze pipeline runs with
-    /// `gaze` as its configuration.
-    pub fn new(base: Look, defocus: Option<(GazeConfig, DefocusModel)>) -> LookPlanner {
-        LookPlanner {
-            base,
-            defocus: defocus.map(|(config, model)| (GazePipeline::new(config), model)),
-        }
-    }
-
-    /// Forces the gaze image (or lets the tracker choose again) from now on; no effect
-    /// without defocus. The gaze pipeline keeps its tracking state.
-    pub fn set_gaze_override(&mut self, image: GazeOverride) {
-        if let Some((pipeline, _)) = &mut self.defocus {
-            pipeline.set_override(image);
-        }
-    }
-
-    /// The forced gaze image; `None` without defocus.
-    pub fn gaze_override(&self) -> Option<GazeOverride> {
-        self.defocus
-            .as_ref()
-            .map(|(pipeline, _)| pipeline.config().override_image)
-    }
-
-    /// The look of a frame, and the gaze state behind its defocus (when defocus is on).
-    pub fn plan(&mut self, input: &FrameInput) -> (Look, Option<GazeState>) {
-        match &mut self.defocus {
-            None => (self.base, None),
-            Some((pipeline, model)) => {
-                let state = pipeline.update(input.gaze.as_ref(), input.time_ns);
-                let look = Look {
-                    defocus: model.defocus(state.image),
-                    ..self.base
-                };
-                (look, Some(state))
-            }
         }
     }
 }
@@ -265,7 +169,7 @@ pub fn to_linear(image: &Image) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gaze::defocus::blur_reference;
+    use crate::gaze::blur::blur_reference;
 
     #[test]
     fn separable_blur_equals_the_literal_convolution() {

@@ -1,5 +1,6 @@
 //! `vitreous trace analyze` and `vitreous trace plot`: how fast and how steadily each depth
-//! filter's gaze-image decision follows the gaze on a trace (issue 4, items 5 and 6).
+//! filter's gaze-image decision follows the gaze on a trace. This file holds the analysis;
+//! `plot.rs` draws it.
 //!
 //! # Figures
 //! The trace is replayed through a [`GazePipeline`] per filter, one update per trace sample
@@ -25,16 +26,18 @@
 
 use std::fmt;
 use std::path::Path;
-use std::sync::Once;
 
-use anyhow::{Context, Result, anyhow};
-use plotters::prelude::*;
+use anyhow::{Context, Result};
 use vitreous_xr::TraceSample;
-use vitreous_xr::synth::{GazePhase, GazeTarget};
+use vitreous_xr::synth::GazePhase;
 
 use crate::gaze::vergence::{FixationDepth, VergenceConfig, VergenceEstimator};
 use crate::gaze::{FilterKind, GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances};
-use crate::scene::load_scene;
+use crate::scene::{gaze_image_of_target, load_scene};
+
+mod plot;
+
+pub use plot::{plot, plot_trace_file};
 
 /// Default persistence of a raw-depth crossing that counts as a gaze change, nanoseconds.
 pub const DEFAULT_PERSIST_NS: i64 = 200_000_000;
@@ -164,12 +167,10 @@ pub fn raw_depths(samples: &[TraceSample], vergence: VergenceConfig) -> Vec<(i64
     out
 }
 
-/// The truth timeline of ground-truth phases.
+/// The truth timeline of ground-truth phases of a trace whose targets are laid out as
+/// [`crate::scene::synth_params_for`] does (surface, then refracted).
 pub fn timeline_from_phases(phases: &[GazePhase]) -> TruthTimeline {
-    let image = |p: &GazePhase| match p.target {
-        GazeTarget::Surface => GazeImage::Surface,
-        GazeTarget::Refracted => GazeImage::Refracted,
-    };
+    let image = |p: &GazePhase| gaze_image_of_target(p.target);
     let mut changes = Vec::new();
     for w in phases.windows(2) {
         if image(&w[0]) != image(&w[1]) {
@@ -449,8 +450,9 @@ impl fmt::Display for AnalyzeReport {
 }
 
 /// `vitreous trace analyze TRACE --scene SCENE`: the image distances come from the scene
-/// ([`ImageDistances::for_scene`]); gaze changes are derived from the raw depth (a trace
-/// file carries no ground truth). `filters` empty means the default and every alternative.
+/// ([`Scene::image_distances`](crate::scene::Scene::image_distances)); gaze changes are
+/// derived from the raw depth (a trace file carries no ground truth). `filters` empty means
+/// the default and every alternative.
 pub fn analyze_trace_file(
     trace: &Path,
     scene: &Path,
@@ -460,18 +462,9 @@ pub fn analyze_trace_file(
     Ok(analyze(&samples, Truth::FromRawDepth, &config))
 }
 
-/// `vitreous trace plot TRACE --scene SCENE -o OUT`: see [`plot`].
-pub fn plot_trace_file(
-    trace: &Path,
-    scene: &Path,
-    filters: &[FilterKind],
-    out_png: &Path,
-) -> Result<()> {
-    let (samples, config) = load_inputs(trace, scene, filters)?;
-    plot(&samples, Truth::FromRawDepth, &config, out_png)
-}
-
-fn load_inputs(
+/// The trace's samples and the analysis settings for a scene (its image distances) and
+/// `filters` (empty: the default and every alternative).
+pub(super) fn load_inputs(
     trace: &Path,
     scene: &Path,
     filters: &[FilterKind],
@@ -479,246 +472,9 @@ fn load_inputs(
     let scene = load_scene(scene).with_context(|| format!("loading scene {}", scene.display()))?;
     let samples = vitreous_xr::read_trace(trace)
         .with_context(|| format!("reading trace {}", trace.display()))?;
-    let mut config = AnalyzeConfig::new(ImageDistances::for_scene(&scene));
+    let mut config = AnalyzeConfig::new(scene.image_distances());
     if !filters.is_empty() {
         config.filters = filters.to_vec();
     }
     Ok((samples, config))
-}
-
-/// Plot size, pixels.
-const PLOT_SIZE_PX: (u32, u32) = (1400, 800);
-/// The embedded font (DejaVu Sans, licence in `app/assets/fonts/LICENSE-DejaVu.txt`), so the
-/// plot needs no system fonts.
-static FONT_TTF: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
-
-fn register_font() -> Result<()> {
-    static ONCE: Once = Once::new();
-    let mut result = Ok(());
-    ONCE.call_once(|| {
-        result = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_TTF)
-            .map_err(|_| anyhow!("the embedded DejaVu Sans font could not be parsed"));
-    });
-    result
-}
-
-/// Colour of a gaze image in plots.
-fn image_colour(image: GazeImage) -> RGBColor {
-    match image {
-        GazeImage::Surface => RGBColor(31, 119, 180),
-        GazeImage::Refracted => RGBColor(230, 120, 20),
-        GazeImage::Unknown => RGBColor(200, 200, 200),
-    }
-}
-
-/// Line colours of the filters, in order.
-const FILTER_COLOURS: [RGBColor; 5] = [
-    RGBColor(0, 0, 0),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-];
-
-/// Draws raw and filtered fixation depth over time with the gaze-image decisions (like the
-/// paper's Fig. 11) as a PNG at `out_png`, written to `out_png.partial` then renamed.
-///
-/// Top: raw depth per tracker sample (grey dots), each filter's depth (lines), the two image
-/// distances and the threshold. Bottom: one strip per filter (and the truth) coloured by the
-/// gaze image over time (blue surface, orange refracted, grey unknown).
-pub fn plot(
-    samples: &[TraceSample],
-    truth: Truth<'_>,
-    config: &AnalyzeConfig,
-    out_png: &Path,
-) -> Result<()> {
-    register_font()?;
-    let raw = raw_depths(samples, config.vergence);
-    let timeline = match truth {
-        Truth::Phases(phases) => timeline_from_phases(phases),
-        Truth::FromRawDepth => timeline_from_raw_depth(&raw, &config.distances, config.persist_ns),
-    };
-    let t0 = samples.first().map_or(0, |s| s.time_ns);
-    let secs = |t: i64| (t - t0) as f64 * 1e-9;
-    let t_max = samples.last().map_or(1.0, |s| secs(s.time_ns)).max(1e-3);
-    let replays: Vec<(FilterKind, Vec<ReplayedFrame>)> = config
-        .filters
-        .iter()
-        .map(|&f| (f, replay(samples, config.gaze_config(f))))
-        .collect();
-    let d = config.distances;
-    let y_max = (d.surface_m.max(d.refracted_m) as f64 * 2.0)
-        .min(f64::from(config.vergence.max_depth_m))
-        .max(0.1);
-
-    let (w, h) = PLOT_SIZE_PX;
-    let mut rgb = vec![0u8; (w * h * 3) as usize];
-    {
-        let draw_err = |e: &dyn fmt::Display| anyhow!("drawing the plot: {e}");
-        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| draw_err(&e))?;
-        let rows = replays.len() + 1;
-        let strip_px = 28 * rows as u32 + 70;
-        let (upper, lower) = root.split_vertically(h - strip_px);
-        let truth_label = if matches!(truth, Truth::Phases(_)) {
-            "ground truth"
-        } else {
-            "raw-depth changes"
-        };
-        let mut chart = ChartBuilder::on(&upper)
-            .caption(
-                format!(
-                    "Fixation depth: raw and filtered (surface {:.2} m, refracted {:.2} m)",
-                    d.surface_m, d.refracted_m
-                ),
-                ("sans-serif", 22),
-            )
-            .margin(12)
-            .x_label_area_size(36)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..t_max, 0.0..y_max)
-            .map_err(|e| draw_err(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_desc("depth (m)")
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(|e| draw_err(&e))?;
-        let clamp = |v: f32| f64::from(v).clamp(0.0, y_max);
-        let grey = RGBColor(150, 150, 150);
-        chart
-            .draw_series(raw.iter().filter_map(|&(t, d)| {
-                d.map(|d| Circle::new((secs(t), clamp(d)), 2, grey.filled()))
-            }))
-            .map_err(|e| draw_err(&e))?
-            .label("raw depth")
-            .legend(move |(x, y)| Circle::new((x + 10, y), 3, grey.filled()));
-        for (image, dist) in [
-            (GazeImage::Surface, d.surface_m),
-            (GazeImage::Refracted, d.refracted_m),
-        ] {
-            let c = image_colour(image);
-            chart
-                .draw_series(LineSeries::new(
-                    [(0.0, clamp(dist)), (t_max, clamp(dist))],
-                    c.stroke_width(1),
-                ))
-                .map_err(|e| draw_err(&e))?
-                .label(format!("{image} image"))
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c));
-        }
-        let threshold = clamp(d.threshold_m());
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(0.0, threshold), (t_max, threshold)],
-                6,
-                4,
-                BLACK.stroke_width(1),
-            ))
-            .map_err(|e| draw_err(&e))?
-            .label("threshold")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
-        for (i, (kind, frames)) in replays.iter().enumerate() {
-            let c = FILTER_COLOURS[i % FILTER_COLOURS.len()];
-            // One line per stretch with a known depth.
-            let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-            for &(t, state) in frames {
-                match state.filtered_depth.depth_m() {
-                    Some(dm) => segments
-                        .last_mut()
-                        .into_iter()
-                        .for_each(|s| s.push((secs(t), clamp(dm)))),
-                    None if segments.last().is_some_and(|s| !s.is_empty()) => {
-                        segments.push(Vec::new())
-                    }
-                    None => {}
-                }
-            }
-            for (k, seg) in segments.into_iter().filter(|s| !s.is_empty()).enumerate() {
-                let series = chart
-                    .draw_series(LineSeries::new(seg, c.stroke_width(2)))
-                    .map_err(|e| draw_err(&e))?;
-                if k == 0 {
-                    series.label(kind.to_string()).legend(move |(x, y)| {
-                        PathElement::new([(x, y), (x + 20, y)], c.stroke_width(2))
-                    });
-                }
-            }
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(("sans-serif", 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| draw_err(&e))?;
-
-        // Decision strips: truth first, then one per filter.
-        let mut strips = ChartBuilder::on(&lower)
-            .margin_left(12)
-            .margin_right(12)
-            .margin_bottom(8)
-            .x_label_area_size(30)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..t_max, 0.0..rows as f64)
-            .map_err(|e| draw_err(&e))?;
-        strips
-            .configure_mesh()
-            .disable_mesh()
-            .disable_y_axis()
-            .x_desc("time (s)")
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(|e| draw_err(&e))?;
-        let row_top = |row: usize| (rows - row) as f64;
-        let mut bars: Vec<Rectangle<(f64, f64)>> = Vec::new();
-        let mut label_rows: Vec<(usize, String)> = vec![(0, truth_label.to_owned())];
-        // Truth row.
-        let mut truth_points: Vec<(f64, GazeImage)> = Vec::new();
-        if let Some((start, first)) = timeline.initial {
-            truth_points.push((secs(start).max(0.0), first));
-        }
-        truth_points.extend(timeline.changes.iter().map(|c| (secs(c.time_ns), c.to)));
-        let mut push_row = |row: usize, points: &[(f64, GazeImage)]| {
-            for (k, &(t, image)) in points.iter().enumerate() {
-                let end = points.get(k + 1).map_or(t_max, |p| p.0);
-                if end > t {
-                    bars.push(Rectangle::new(
-                        [(t, row_top(row) - 0.85), (end, row_top(row) - 0.15)],
-                        image_colour(image).filled(),
-                    ));
-                }
-            }
-        };
-        push_row(0, &truth_points);
-        for (i, (kind, frames)) in replays.iter().enumerate() {
-            let mut points: Vec<(f64, GazeImage)> = Vec::new();
-            for &(t, state) in frames {
-                if points.last().is_none_or(|p| p.1 != state.image) {
-                    points.push((secs(t), state.image));
-                }
-            }
-            push_row(i + 1, &points);
-            label_rows.push((i + 1, kind.to_string()));
-        }
-        strips.draw_series(bars).map_err(|e| draw_err(&e))?;
-        strips
-            .draw_series(label_rows.into_iter().map(|(row, text)| {
-                Text::new(
-                    text,
-                    (0.005 * t_max, row_top(row) - 0.4),
-                    ("sans-serif", 13).into_font().color(&BLACK),
-                )
-            }))
-            .map_err(|e| draw_err(&e))?;
-        root.present().map_err(|e| draw_err(&e))?;
-    }
-    let rgba: Vec<u8> = rgb
-        .chunks_exact(3)
-        .flat_map(|p| [p[0], p[1], p[2], 255])
-        .collect();
-    let png = crate::output::encode_png(&rgba, w, h)?;
-    crate::output::write_atomic(out_png, &png)
 }

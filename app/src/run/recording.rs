@@ -1,0 +1,125 @@
+//! `vitreous run --record`: each frame's head pose and gaze written as a trace, and the check
+//! that a replay of that trace with the null backend reproduces the session's views.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use serde::Serialize;
+use vitreous_xr::null::{NullBackend, NullConfig};
+use vitreous_xr::trace::{TraceSample, read_trace};
+use vitreous_xr::{Backend, FrameInput, GazeRay, GazeSample, Pose};
+
+use crate::scene::Scene;
+
+/// How well a replay of the recording reproduces the session's views.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReplayCheck {
+    /// Samples in the recording.
+    pub samples: u64,
+    /// Replay frames compared.
+    pub frames: u64,
+    /// Largest head position difference, metres.
+    pub max_head_position_m: f32,
+    /// Largest head orientation difference, degrees.
+    pub max_head_angle_deg: f32,
+    /// Largest eye position difference, metres (the replay puts eyes at the recorded gaze
+    /// origins, the runtime at its own eye positions: both should agree with the IPD).
+    pub max_eye_position_m: f32,
+}
+
+/// A trace sample for a frame: its head pose and gaze (an invalid gaze at the frame time when
+/// there is none).
+pub(super) fn trace_sample(input: &FrameInput) -> TraceSample {
+    TraceSample {
+        time_ns: input.time_ns,
+        head: input.head,
+        gaze: input.gaze.unwrap_or(GazeSample {
+            sample_time_ns: input.time_ns,
+            left: GazeRay::INVALID,
+            right: GazeRay::INVALID,
+            combined: None,
+            fixation: None,
+        }),
+    }
+}
+
+/// Replays the recording with the null backend at the session's mean frame rate and compares
+/// its views with the session's, interpolated at the replay's frame times.
+pub(super) fn replay_check(
+    path: &Path,
+    session: &[FrameInput],
+    scene: &Scene,
+) -> Result<ReplayCheck> {
+    let samples = read_trace(path).with_context(|| format!("reading back {}", path.display()))?;
+    if samples.len() < 2 || session.len() < 2 {
+        bail!("the recording {} has fewer than 2 samples", path.display());
+    }
+    let span_ns = session[session.len() - 1].time_ns - session[0].time_ns;
+    let rate_hz = (session.len() - 1) as f64 * 1e9 / span_ns as f64;
+    let mut null = NullBackend::new(
+        samples.clone(),
+        NullConfig {
+            frame_rate_hz: rate_hz,
+            max_frames: None,
+            fov: scene.output.fov,
+            ipd_m: scene.viewer.ipd_m,
+        },
+    )?;
+    let (mut frames, mut max_pos, mut max_ang, mut max_eye) = (0u64, 0f32, 0f32, 0f32);
+    while let Some(frame) = null.wait_frame()? {
+        null.end_frame(&frame)?;
+        let t = frame.time_ns;
+        let Some(b) = session.iter().position(|s| s.time_ns >= t) else {
+            break;
+        };
+        let expected = if session[b].time_ns == t || b == 0 {
+            session[b].clone()
+        } else {
+            let a = &session[b - 1];
+            let f = (t - a.time_ns) as f32 / (session[b].time_ns - a.time_ns) as f32;
+            let lerp = |p: &Pose, q: &Pose| Pose {
+                position: p.position.lerp(q.position, f),
+                orientation: p.orientation.slerp(q.orientation, f),
+            };
+            let mut e = a.clone();
+            e.head = lerp(&a.head, &session[b].head);
+            for eye in 0..2 {
+                e.views[eye].pose = lerp(&a.views[eye].pose, &session[b].views[eye].pose);
+            }
+            e
+        };
+        frames += 1;
+        max_pos = max_pos.max((frame.head.position - expected.head.position).length());
+        max_ang = max_ang.max(
+            frame
+                .head
+                .orientation
+                .angle_between(expected.head.orientation)
+                .to_degrees(),
+        );
+        for eye in 0..2 {
+            max_eye = max_eye
+                .max((frame.views[eye].pose.position - expected.views[eye].pose.position).length());
+        }
+    }
+    Ok(ReplayCheck {
+        samples: samples.len() as u64,
+        frames,
+        max_head_position_m: max_pos,
+        max_head_angle_deg: max_ang,
+        max_eye_position_m: max_eye,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::test_frame as frame;
+
+    #[test]
+    fn a_frame_without_gaze_records_an_invalid_gaze_at_its_time() {
+        let s = trace_sample(&frame());
+        assert_eq!(s.gaze.sample_time_ns, 5);
+        assert!(!s.gaze.left.valid && !s.gaze.right.valid);
+    }
+}

@@ -1,0 +1,565 @@
+//! Reading a scene file: the TOML parsed into its raw shape ([`SceneFile`]), every field
+//! range-checked with its line and column, every asset read, decoded and hashed, and the
+//! result resolved into a [`Scene`].
+
+use std::path::{Component, Path, PathBuf};
+
+use glam::{Mat4, Quat, Vec2, Vec3};
+use sha2::{Digest, Sha256};
+use toml::Spanned;
+use vitreous_xr::{Fov, Pose};
+
+use super::error::Source;
+use super::file::{LightFrame, PlaneToml, SceneFile};
+use super::{
+    Caustics, Environment, GazeChoice, Image, Inducer, IorSource, Light, Object, Output, RealPlane,
+    Scene, SceneError, Viewer, euler_xyz_deg,
+};
+use super::{file, image, mesh};
+use crate::effects::EffectSet;
+use crate::gaze::{FilterKind, FilterParseError, GazeOverride};
+
+/// Loads a scene file and every asset it names, checking ranges and decoding everything.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let text = match std::str::from_utf8(&bytes) {
+        Ok(text) => text,
+        Err(e) => {
+            let src = Source {
+                file: path,
+                text: std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default(),
+            };
+            return Err(SceneError::Syntax {
+                at: src.location(e.valid_up_to()),
+                field: "(top level)".into(),
+                message: "the file is not valid UTF-8".into(),
+            });
+        }
+    };
+    let mut loader = Loader {
+        src: Source { file: path, text },
+        dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        hasher: Sha256::new(),
+    };
+    loader.hash_part("scene", &bytes);
+    let raw: SceneFile = toml::from_str(text).map_err(|e| loader.src.toml_error(&e))?;
+    loader.resolve(raw)
+}
+
+struct Loader<'a> {
+    src: Source<'a>,
+    dir: PathBuf,
+    hasher: Sha256,
+}
+
+/// Both bounds of a range included.
+const CLOSED: (bool, bool) = (false, false);
+
+/// Largest accepted coordinate magnitude, metres.
+const MAX_COORD_M: f32 = 1000.0;
+
+impl Loader<'_> {
+    fn hash_part(&mut self, label: &str, bytes: &[u8]) {
+        self.hasher.update((label.len() as u64).to_le_bytes());
+        self.hasher.update(label.as_bytes());
+        self.hasher.update((bytes.len() as u64).to_le_bytes());
+        self.hasher.update(bytes);
+    }
+
+    /// Resolves an asset path against the scene's folder and reads (and hashes) it.
+    fn read_asset(
+        &mut self,
+        field: &str,
+        rel: &Spanned<String>,
+    ) -> Result<(PathBuf, Vec<u8>), SceneError> {
+        if rel.get_ref().trim().is_empty() {
+            return Err(self.src.invalid(
+                rel.span(),
+                field,
+                "expected a file path, found an empty string",
+            ));
+        }
+        let path = normalize(&self.dir.join(rel.get_ref()));
+        let bytes = std::fs::read(&path).map_err(|e| {
+            let reason = match e.kind() {
+                std::io::ErrorKind::NotFound => "file not found".to_owned(),
+                _ => format!("cannot read: {e}"),
+            };
+            self.src.asset(rel.span(), field, &path, reason)
+        })?;
+        self.hash_part(field, &bytes);
+        Ok((path, bytes))
+    }
+
+    fn photo(&mut self, field: &str, rel: &Spanned<String>) -> Result<Image, SceneError> {
+        let (path, bytes) = self.read_asset(field, rel)?;
+        image::decode_photo(&bytes)
+            .map_err(|reason| self.src.asset(rel.span(), field, &path, reason))
+    }
+
+    /// Exactly `N` numbers.
+    fn array<const N: usize>(
+        &self,
+        field: &str,
+        v: &Spanned<Vec<f32>>,
+    ) -> Result<[f32; N], SceneError> {
+        <[f32; N]>::try_from(v.get_ref().as_slice()).map_err(|_| {
+            self.src.invalid(
+                v.span(),
+                field,
+                format!(
+                    "expected an array of {N} numbers, found {}",
+                    v.get_ref().len()
+                ),
+            )
+        })
+    }
+
+    fn vec3(&self, field: &str, v: &Spanned<Vec<f32>>) -> Result<Vec3, SceneError> {
+        let value = Vec3::from_array(self.array(field, v)?);
+        if !value.is_finite() || value.abs().max_element() > MAX_COORD_M {
+            return Err(self.src.invalid(
+                v.span(),
+                field,
+                format!("expected finite coordinates within ±{MAX_COORD_M} m, found {value}"),
+            ));
+        }
+        Ok(value)
+    }
+
+    fn rotation(&self, field: &str, v: Option<&Spanned<Vec<f32>>>) -> Result<Quat, SceneError> {
+        let Some(v) = v else {
+            return Ok(Quat::IDENTITY);
+        };
+        let [x, y, z] = self.array(field, v)?;
+        if ![x, y, z].iter().all(|a| a.is_finite() && a.abs() <= 360.0) {
+            return Err(self.src.invalid(
+                v.span(),
+                field,
+                format!("expected three angles in -360..=360 degrees, found [{x}, {y}, {z}]"),
+            ));
+        }
+        Ok(euler_xyz_deg(Vec3::new(x, y, z)))
+    }
+
+    /// A number within `lo..=hi` (each bound exclusive where `open` says so), `default`
+    /// when absent.
+    fn number(
+        &self,
+        field: &str,
+        v: Option<&Spanned<f32>>,
+        default: f32,
+        (lo, hi): (f32, f32),
+        (lo_open, hi_open): (bool, bool),
+    ) -> Result<f32, SceneError> {
+        let Some(v) = v else {
+            return Ok(default);
+        };
+        let x = *v.get_ref();
+        let above = if lo_open { x > lo } else { x >= lo };
+        let below = if hi_open { x < hi } else { x <= hi };
+        if !(x.is_finite() && above && below) {
+            let lower = if lo_open { ">" } else { ">=" };
+            let upper = if hi_open { "<" } else { "<=" };
+            return Err(self.src.invalid(
+                v.span(),
+                field,
+                format!("expected a number {lower} {lo} and {upper} {hi}, found {x}"),
+            ));
+        }
+        Ok(x)
+    }
+
+    fn resolve(mut self, raw: SceneFile) -> Result<Scene, SceneError> {
+        let object = self.object(&raw.object)?;
+
+        let light_offset = self.vec3("light.position_m", &raw.light.position_m)?;
+        let light = Light {
+            position_m: match raw.light.frame {
+                LightFrame::World => light_offset,
+                LightFrame::Object => object.center_m + light_offset,
+            },
+            intensity: self.number(
+                "light.intensity",
+                raw.light.intensity.as_ref(),
+                1.0,
+                (0.0, 1.0e6),
+                CLOSED,
+            )?,
+            color: match &raw.light.color {
+                None => Vec3::ONE,
+                Some(c) => {
+                    let v = Vec3::from_array(self.array("light.color", c)?);
+                    if !v.is_finite() || v.min_element() < 0.0 || v.max_element() > 1000.0 {
+                        return Err(self.src.invalid(
+                            c.span(),
+                            "light.color",
+                            format!("expected linear RGB components in 0..=1000, found {v}"),
+                        ));
+                    }
+                    v
+                }
+            },
+        };
+
+        let floor = self.plane("floor", &raw.floor)?;
+        let background = self.plane("background", &raw.background)?;
+
+        let (env_path, env_bytes) = self.read_asset("environment.map", &raw.environment.map)?;
+        let latlong = image::decode_hdr(&env_bytes).map_err(|r| {
+            self.src
+                .asset(raw.environment.map.span(), "environment.map", &env_path, r)
+        })?;
+        let cube_map_path = match &raw.environment.cube_map {
+            Some(rel) => Some(self.read_asset("environment.cube_map", rel)?.0),
+            None => None,
+        };
+        let environment = Environment {
+            latlong,
+            path: env_path,
+            cube_map_path,
+        };
+
+        let v = &raw.viewer;
+        let viewer = Viewer {
+            ipd_m: self.number(
+                "viewer.ipd_mm",
+                v.ipd_mm.as_ref(),
+                63.0,
+                (40.0, 90.0),
+                CLOSED,
+            )? / 1000.0,
+            pupil_diameter_m: self.number(
+                "viewer.pupil_diameter_mm",
+                v.pupil_diameter_mm.as_ref(),
+                6.0,
+                (1.0, 9.0),
+                CLOSED,
+            )? / 1000.0,
+            head_position_m: match &v.head_position_m {
+                Some(p) => self.vec3("viewer.head_position_m", p)?,
+                None => Vec3::ZERO,
+            },
+        };
+
+        let o = &raw.output;
+        let pixels = |field: &str, v: Option<&Spanned<i64>>, default: u32| match v {
+            None => Ok(default),
+            Some(v) => match u32::try_from(*v.get_ref()) {
+                Ok(px) if (16..=8192).contains(&px) => Ok(px),
+                _ => Err(self.src.invalid(
+                    v.span(),
+                    field,
+                    format!("expected 16..=8192 pixels, found {}", v.get_ref()),
+                )),
+            },
+        };
+        let width_px = pixels("output.width_px", o.width_px.as_ref(), 1280)?;
+        let height_px = pixels("output.height_px", o.height_px.as_ref(), 960)?;
+        let h_deg = self.number(
+            "output.horizontal_fov_deg",
+            o.horizontal_fov_deg.as_ref(),
+            40.0,
+            (1.0, 170.0),
+            CLOSED,
+        )?;
+        let v_deg = self.number(
+            "output.vertical_fov_deg",
+            o.vertical_fov_deg.as_ref(),
+            30.0,
+            (1.0, 170.0),
+            CLOSED,
+        )?;
+        let output = Output {
+            width_px,
+            height_px,
+            fov: Fov::symmetric(h_deg.to_radians(), v_deg.to_radians()),
+        };
+
+        let effects = match &raw.effects.set {
+            None => EffectSet::NONE,
+            Some(s) => EffectSet::parse(s.get_ref())
+                .map_err(|e| self.src.invalid(s.span(), "effects.set", e.to_string()))?,
+        };
+
+        let inducer = self.inducer(&raw.inducer)?;
+        let caustics = Caustics {
+            bake: match &raw.caustics.bake {
+                None => None,
+                Some(rel) if rel.get_ref().trim().is_empty() => {
+                    return Err(self.src.invalid(
+                        rel.span(),
+                        "caustics.bake",
+                        "expected a file path, found an empty string",
+                    ));
+                }
+                Some(rel) => Some(normalize(&self.dir.join(rel.get_ref()))),
+            },
+            gain: None,
+        };
+        let gaze = GazeChoice {
+            filter: match &raw.gaze.filter {
+                None => FilterKind::default(),
+                Some(f) => f.get_ref().parse().map_err(|e: FilterParseError| {
+                    self.src.invalid(f.span(), "gaze.filter", e.to_string())
+                })?,
+            },
+            image: match &raw.gaze.image {
+                None => GazeOverride::Auto,
+                Some(i) => i.get_ref().parse().map_err(|_| {
+                    self.src.invalid(
+                        i.span(),
+                        "gaze.image",
+                        format!(
+                            "expected auto, surface or refracted, found '{}'",
+                            i.get_ref()
+                        ),
+                    )
+                })?,
+            },
+        };
+
+        let hash = self
+            .hasher
+            .finalize()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        Ok(Scene {
+            path: self.src.file.to_path_buf(),
+            hash,
+            object,
+            light,
+            floor,
+            background,
+            environment,
+            viewer,
+            output,
+            effects,
+            inducer,
+            gaze,
+            caustics,
+        })
+    }
+
+    fn inducer(&self, raw: &file::InducerToml) -> Result<Inducer, SceneError> {
+        let default = Inducer::default();
+        let resolution_px = match &raw.resolution_px {
+            None => default.resolution_px,
+            Some(v) => match u32::try_from(*v.get_ref()) {
+                Ok(px) if (16..=4096).contains(&px) => px,
+                _ => {
+                    return Err(self.src.invalid(
+                        v.span(),
+                        "inducer.resolution_px",
+                        format!("expected 16..=4096 texels, found {}", v.get_ref()),
+                    ));
+                }
+            },
+        };
+        Ok(Inducer {
+            k: self.number("inducer.k", raw.k.as_ref(), default.k, (0.0, 10.0), CLOSED)?,
+            ramp_width_m: self.number(
+                "inducer.ramp_width_m",
+                raw.ramp_width_m.as_ref(),
+                default.ramp_width_m,
+                (0.0, 100.0),
+                (true, false),
+            )?,
+            resolution_px,
+        })
+    }
+
+    fn object(&mut self, raw: &file::ObjectToml) -> Result<Object, SceneError> {
+        let (model_path, bytes) = self.read_asset("object.model", &raw.model)?;
+        let base = model_path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        let model = mesh::load_gltf(&bytes, &base).map_err(|r| {
+            self.src
+                .asset(raw.model.span(), "object.model", &model_path, r)
+        })?;
+        for buffer in &model.buffers {
+            self.hash_part("object.model buffer", buffer);
+        }
+
+        let (lo, hi) = model.mesh.bounds();
+        let largest_extent = (hi - lo).max_element();
+        let center_model = (lo + hi) / 2.0;
+        let radius_model = model
+            .mesh
+            .positions
+            .iter()
+            .map(|p| p.distance(center_model))
+            .fold(0.0f32, f32::max);
+        if !(largest_extent > 0.0 && largest_extent.is_finite()) {
+            return Err(self.src.asset(
+                raw.model.span(),
+                "object.model",
+                &model_path,
+                "the mesh has zero size",
+            ));
+        }
+
+        let (scale, scale_field, scale_span) = match (&raw.diameter_m, &raw.scale) {
+            (Some(d), Some(_)) => {
+                return Err(self.src.invalid(
+                    d.span(),
+                    "object.diameter_m",
+                    "give either `diameter_m` or `scale`, not both",
+                ));
+            }
+            (Some(d), None) => {
+                let d_m =
+                    self.number("object.diameter_m", Some(d), 0.0, (0.0, 10.0), (true, true))?;
+                if d_m >= 10.0 {
+                    return Err(self.src.invalid(
+                        d.span(),
+                        "object.diameter_m",
+                        format!("expected a number > 0 and < 10, found {d_m}"),
+                    ));
+                }
+                (d_m / largest_extent, "object.diameter_m", d.span())
+            }
+            (None, Some(s)) => (
+                self.number("object.scale", Some(s), 1.0, (0.0, 1.0e6), (true, false))?,
+                "object.scale",
+                s.span(),
+            ),
+            (None, None) => (1.0, "object.model", raw.model.span()),
+        };
+        let diameter_m = largest_extent * scale;
+        if !(diameter_m > 0.0 && diameter_m < 10.0) {
+            return Err(self.src.invalid(
+                scale_span,
+                scale_field,
+                format!(
+                    "the object would be {diameter_m} m across (model is {largest_extent} units \
+                     across, scale {scale}); expected more than 0 and less than 10 m"
+                ),
+            ));
+        }
+
+        let position = self.vec3("object.position_m", &raw.position_m)?;
+        let rotation = self.rotation("object.rotation_deg", raw.rotation_deg.as_ref())?;
+        let world_from_model =
+            Mat4::from_scale_rotation_translation(Vec3::splat(scale), rotation, position)
+                * Mat4::from_translation(-center_model);
+
+        let (ior, ior_source) = match (&raw.ior, model.ior) {
+            (Some(n), _) => (
+                self.number("object.ior", Some(n), 1.5, (1.0, 4.0), CLOSED)?,
+                IorSource::Scene,
+            ),
+            (None, Some(n)) if (1.0..=4.0).contains(&n) => (n, IorSource::Gltf),
+            (None, Some(n)) => {
+                return Err(self.src.asset(
+                    raw.model.span(),
+                    "object.model",
+                    &model_path,
+                    format!("KHR_materials_ior is {n}; expected 1..=4 (or set `object.ior`)"),
+                ));
+            }
+            (None, None) => (1.5, IorSource::Default),
+        };
+
+        let surface_texture = match &raw.surface_texture {
+            Some(rel) => Some(self.photo("object.surface_texture", rel)?),
+            None => None,
+        };
+        if surface_texture.is_none()
+            && let Some(t) = &raw.surface_transmittance
+        {
+            return Err(self.src.invalid(
+                t.span(),
+                "object.surface_transmittance",
+                "needs `object.surface_texture`",
+            ));
+        }
+        let default_transmittance = if surface_texture.is_some() { 0.8 } else { 1.0 };
+        let surface_transmittance = self.number(
+            "object.surface_transmittance",
+            raw.surface_transmittance.as_ref(),
+            default_transmittance,
+            (0.0, 1.0),
+            CLOSED,
+        )?;
+
+        Ok(Object {
+            mesh: model.mesh,
+            world_from_model,
+            center_m: position,
+            radius_m: radius_model * scale,
+            ior,
+            ior_source,
+            surface_texture,
+            surface_transmittance,
+            model_path,
+        })
+    }
+
+    fn plane(&mut self, table: &str, raw: &PlaneToml) -> Result<RealPlane, SceneError> {
+        let photo = self.photo(&format!("{table}.photo"), &raw.photo)?;
+        let size = Vec2::from_array(self.array(&format!("{table}.size_m"), &raw.size_m)?);
+        if !size.is_finite() || size.min_element() <= 0.0 || size.max_element() > 100.0 {
+            return Err(self.src.invalid(
+                raw.size_m.span(),
+                &format!("{table}.size_m"),
+                format!("expected [width, height] each > 0 and <= 100 m, found {size}"),
+            ));
+        }
+        let position = self.vec3(&format!("{table}.position_m"), &raw.position_m)?;
+        let orientation =
+            self.rotation(&format!("{table}.rotation_deg"), raw.rotation_deg.as_ref())?;
+        Ok(RealPlane {
+            photo,
+            size_m: size,
+            pose: Pose {
+                position,
+                orientation,
+            },
+        })
+    }
+}
+
+/// Removes `.` and `name/..` pairs without touching the file system (so that error
+/// messages show `config/models/x.glb`, not `config/scenes/../models/x.glb`).
+fn normalize(path: &Path) -> PathBuf {
+    let mut out: Vec<Component> = Vec::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => match out.last() {
+                Some(Component::Normal(_)) => {
+                    out.pop();
+                }
+                Some(Component::RootDir | Component::Prefix(_)) => {}
+                _ => out.push(c),
+            },
+            other => out.push(other),
+        }
+    }
+    if out.is_empty() {
+        PathBuf::from(".")
+    } else {
+        out.iter().collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normalize_folds_parent_components() {
+        assert_eq!(
+            normalize(Path::new("config/scenes/../models/a.glb")),
+            PathBuf::from("config/models/a.glb")
+        );
+        assert_eq!(normalize(Path::new("../x/./y")), PathBuf::from("../x/y"));
+    }
+}

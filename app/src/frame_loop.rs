@@ -34,6 +34,12 @@ pub trait FrameSink {
 
     /// Handles a finished frame (its input and its results), in frame order.
     fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()>;
+
+    /// Whether to end the run before the next frame (e.g. on Ctrl-C); frames in flight are
+    /// still finished and handed to [`FrameSink::finished`].
+    fn stop_requested(&self) -> bool {
+        false
+    }
 }
 
 /// Timing of one frame, as `summary.json` reports it.
@@ -55,7 +61,8 @@ pub struct FrameRecord {
     pub surface_k_g_px: Option<f32>,
 }
 
-/// Runs frames until the backend ends the session; returns each frame's timing.
+/// Runs frames until the backend ends the session or the sink asks to stop; returns each
+/// finished frame's timing.
 pub fn run<B: Backend>(
     backend: &mut B,
     renderer: &mut Renderer,
@@ -63,7 +70,10 @@ pub fn run<B: Backend>(
 ) -> Result<Vec<FrameRecord>> {
     let mut in_flight: VecDeque<(FrameInput, f64, Look)> = VecDeque::new();
     let mut records = Vec::new();
-    while let Some(input) = backend.wait_frame().context("waiting for the next frame")? {
+    while !sink.stop_requested() {
+        let Some(input) = backend.wait_frame().context("waiting for the next frame")? else {
+            break;
+        };
         sink.started(&input)?;
         let started = Instant::now();
         let plan = sink.plan(&input);

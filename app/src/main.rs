@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 use vitreous::bench::{BenchOptions, bench};
 use vitreous::effects::EffectSet;
 use vitreous::gaze::{FilterKind, GazeOverride};
+use vitreous::output::ensure_not_input;
 use vitreous::replay::{GazeSettings, ReplayOptions, replay};
 use vitreous::trace_analyze::{analyze_trace_file, plot_trace_file};
 use vitreous::trace_cmd::{self, SynthOptions};
@@ -32,7 +33,7 @@ enum Command {
         /// Scene file (TOML).
         scene: PathBuf,
         /// End the session after N frames (default: until the runtime or Ctrl-C ends it).
-        #[arg(long, value_name = "N")]
+        #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_frame_count)]
         frames: Option<u64>,
         /// Replay gaze from this trace when the headset has no eye tracker.
         #[arg(long, value_name = "FILE")]
@@ -72,10 +73,15 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Stop after N frames.
-        #[arg(long, value_name = "N")]
+        #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_frame_count)]
         frames: Option<u64>,
         /// Save every K-th frame (0: none).
-        #[arg(long, value_name = "K", default_value_t = 30)]
+        #[arg(
+            long,
+            value_name = "K",
+            default_value_t = 30,
+            allow_negative_numbers = true
+        )]
         save_every: u64,
         /// Eye image size overriding the scene's, e.g. 640x480.
         #[arg(long, value_name = "WxH", value_parser = parse_size)]
@@ -92,7 +98,12 @@ enum Command {
         #[arg(long)]
         device: Option<String>,
         /// Display frame rate of the replay, hertz.
-        #[arg(long, value_name = "HZ", default_value_t = 60.0)]
+        #[arg(
+            long,
+            value_name = "HZ",
+            default_value_t = 60.0,
+            allow_negative_numbers = true
+        )]
         rate: f64,
         /// No progress bar.
         #[arg(long)]
@@ -114,7 +125,7 @@ enum Command {
         #[arg(long, value_name = "FILTER")]
         filter: Option<FilterKind>,
         /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
-        #[arg(long = "pupil-mm", value_name = "MM")]
+        #[arg(long = "pupil-mm", value_name = "MM", allow_negative_numbers = true)]
         pupil_mm: Option<f32>,
     },
     /// Compare the frame time of the baseline and of effect sets, alternated frame by frame
@@ -129,7 +140,8 @@ enum Command {
         #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "1280x960")]
         size: (u32, u32),
         /// Timed frames per variant.
-        #[arg(long, value_name = "N", default_value_t = 60)]
+        #[arg(long, value_name = "N", default_value_t = 60, allow_negative_numbers = true,
+              value_parser = parse_frame_count_usize)]
         frames: usize,
         /// Reflected image with per-eye refraction.
         #[arg(long, value_enum, default_value_t = ReflectionArg::Phong)]
@@ -144,8 +156,41 @@ enum Command {
         #[arg(long)]
         device: Option<String>,
         /// Pupil diameters to sweep for effect sets with defocus, millimetres, e.g. 2,4,6,8.
-        #[arg(long = "pupil-mm", value_name = "MM", value_delimiter = ',')]
+        #[arg(
+            long = "pupil-mm",
+            value_name = "MM",
+            value_delimiter = ',',
+            allow_negative_numbers = true
+        )]
         pupils_mm: Vec<f32>,
+    },
+    /// Replay a scene again and again in one process (a new Vulkan device and renderer each
+    /// pass, validation on) and check that resident memory stays flat and validation silent.
+    Soak {
+        /// Scene file (TOML).
+        #[arg(default_value = "config/scenes/glass-sphere.toml")]
+        scene: PathBuf,
+        /// How long to keep replaying, minutes.
+        #[arg(
+            long,
+            value_name = "MIN",
+            default_value_t = 30.0,
+            allow_negative_numbers = true
+        )]
+        minutes: f64,
+        /// Effects (default: the scene's); e.g. all.
+        #[arg(long, value_name = "LIST", value_parser = parse_effects)]
+        effects: Option<EffectSet>,
+        /// Eye image size.
+        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "640x480")]
+        size: (u32, u32),
+        /// Frames per pass (at most the scene's 12 s synthetic trace at 60 Hz).
+        #[arg(long, value_name = "N", default_value_t = 120, allow_negative_numbers = true,
+              value_parser = parse_frame_count)]
+        frames: u64,
+        /// Write the report (every pass) as JSON here.
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
     },
     /// Trace tools.
     Trace {
@@ -206,16 +251,16 @@ enum TraceCommand {
         #[arg(short, long)]
         out: PathBuf,
         /// Length, seconds.
-        #[arg(long, default_value_t = 12.0)]
+        #[arg(long, default_value_t = 12.0, allow_negative_numbers = true)]
         duration: f32,
         /// Tracker sample rate, hertz.
-        #[arg(long, default_value_t = 30.0)]
+        #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
         rate: f32,
         /// Seconds between gaze switches.
-        #[arg(long, default_value_t = 3.0)]
+        #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
         switch_period: f32,
         /// Random seed (the same seed gives the same trace).
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
         seed: u64,
     },
 }
@@ -250,6 +295,24 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
+/// A frame count for `--frames`: a whole number of at least 1 (0 would be an empty run).
+fn parse_frame_count(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<i128>() {
+        Ok(n) if n >= 1 && n <= i128::from(u64::MAX) => Ok(n as u64),
+        Ok(n) if n < 1 => Err(format!(
+            "expected a number of frames of at least 1, got {n}"
+        )),
+        _ => Err(format!(
+            "expected a whole number of frames (1 or more), got '{s}'"
+        )),
+    }
+}
+
+fn parse_frame_count_usize(s: &str) -> Result<usize, String> {
+    let n = parse_frame_count(s)?;
+    usize::try_from(n).map_err(|_| format!("{n} frames is more than this machine can count"))
+}
+
 fn parse_blend(s: &str) -> Result<vitreous_xr::openxr::Blend, String> {
     vitreous_xr::openxr::Blend::parse(s)
         .ok_or_else(|| format!("expected additive, alpha-blend or opaque, got '{s}'"))
@@ -273,6 +336,11 @@ fn run(cli: Cli) -> Result<()> {
             effects,
             out,
         } => {
+            if let Some(record) = &record {
+                let mut inputs = vec![scene.as_path()];
+                inputs.extend(gaze_trace.as_deref());
+                ensure_not_input(record, "--record", &inputs)?;
+            }
             let s = vitreous::run::run(&vitreous::run::RunOptions {
                 scene,
                 frames,
@@ -398,7 +466,7 @@ fn run(cli: Cli) -> Result<()> {
             })?;
             println!(
                 "rendered {} frames of {}x{} per eye on {} in {:.1} s ({:.1} frames/s; median \
-                 GPU {} ms, CPU {:.2} ms per stereo frame)",
+                 GPU {} ms, CPU {} ms per stereo frame)",
                 summary.frames,
                 summary.width_px,
                 summary.height_px,
@@ -408,7 +476,9 @@ fn run(cli: Cli) -> Result<()> {
                 summary
                     .gpu_ms
                     .map_or("n/a".to_string(), |s| format!("{:.2}", s.median_ms)),
-                summary.cpu_ms.map_or(f64::NAN, |s| s.median_ms),
+                summary
+                    .cpu_ms
+                    .map_or("n/a".to_string(), |s| format!("{:.2}", s.median_ms)),
             );
             println!(
                 "wrote {} images and summary.json to {}",
@@ -445,6 +515,67 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
+        Command::Soak {
+            scene,
+            minutes,
+            effects,
+            size,
+            frames,
+            json,
+        } => {
+            if !(minutes.is_finite() && minutes > 0.0 && minutes <= 7.0 * 24.0 * 60.0) {
+                bail!("--minutes must be more than 0 and at most a week, got {minutes}");
+            }
+            let options = vitreous::soak::SoakOptions {
+                scene,
+                effects,
+                duration: std::time::Duration::from_secs_f64(minutes * 60.0),
+                size,
+                frames_per_pass: frames,
+                read_back_every: 10,
+            };
+            let report = vitreous::soak::soak(&options, |p| {
+                eprintln!(
+                    "soak: pass {} ({} frames): resident {} KiB, {} validation messages",
+                    p.pass, p.frames, p.rss_kib, p.validation_messages
+                );
+            })?;
+            if let Some(path) = &json {
+                let bytes = serde_json::to_vec_pretty(&report)?;
+                vitreous::output::write_atomic(path, &bytes)?;
+            }
+            println!(
+                "soak of {} ({}) on {}: {} passes, {} frames in {:.0} s; resident memory {} KiB \
+                 after warm-up, at most {} KiB later ({:+.2} %, limit {} %); {} validation messages",
+                report.scene,
+                report.effects,
+                report.device,
+                report.passes.len(),
+                report.frames,
+                report.wall_s,
+                report.rss_after_warm_up_kib,
+                report.rss_max_kib,
+                report.growth_percent,
+                vitreous::soak::MAX_GROWTH_PERCENT,
+                report.validation_messages
+            );
+            if !report.passed() {
+                bail!(
+                    "soak failed: {} passes (more than {} needed), memory growth {:.2} %, {} \
+                     validation messages{}",
+                    report.passes.len(),
+                    vitreous::soak::WARM_UP_PASSES,
+                    report.growth_percent,
+                    report.validation_messages,
+                    report
+                        .first_messages
+                        .first()
+                        .map(|m| format!(", first: {m}"))
+                        .unwrap_or_default()
+                );
+            }
+            Ok(())
+        }
         Command::Trace { command } => match command {
             TraceCommand::Analyze {
                 trace,
@@ -460,11 +591,13 @@ fn run(cli: Cli) -> Result<()> {
                 out,
                 filters,
             } => {
+                ensure_not_input(&out, "--out", &[&trace, &scene])?;
                 plot_trace_file(&trace, &scene, &filters, &out)?;
                 println!("wrote {}", out.display());
                 Ok(())
             }
             TraceCommand::Import { from, file, out } => {
+                ensure_not_input(&out, "-o", &[&file])?;
                 println!("{}", trace_cmd::import(&from, &file, &out)?);
                 Ok(())
             }
@@ -482,6 +615,7 @@ fn run(cli: Cli) -> Result<()> {
                         scene.display()
                     );
                 }
+                ensure_not_input(&out, "-o", &[&scene])?;
                 let options = SynthOptions {
                     duration_s: duration,
                     rate_hz: rate,
@@ -521,8 +655,47 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The error and its causes in one line, outermost first, leaving out a cause whose text the
+/// line already ends with (many errors quote their source in their own message).
+fn error_text(error: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in error.chain() {
+        let part = cause.to_string();
+        if text.ends_with(part.as_str()) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&part);
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn error_text_leaves_out_causes_already_quoted() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let e = anyhow::Error::new(io)
+            .context("reading a: no such file")
+            .context("loading b");
+        assert_eq!(error_text(&e), "loading b: reading a: no such file");
+    }
+
+    #[test]
+    fn frame_counts_below_one_are_refused_with_the_reason() {
+        assert_eq!(parse_frame_count("5"), Ok(5));
+        assert!(parse_frame_count("0").unwrap_err().contains("at least 1"));
+        assert!(parse_frame_count("-1").unwrap_err().contains("at least 1"));
+        assert!(parse_frame_count("x").unwrap_err().contains("whole number"));
     }
 }

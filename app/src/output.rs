@@ -5,7 +5,7 @@
 
 use std::fs;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{Context, Result};
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
@@ -15,25 +15,50 @@ use vitreous_render::Readback;
 /// Eye names in output file names, left then right.
 pub const EYE_NAMES: [&str; 2] = ["left", "right"];
 
-/// Writes `bytes` to `path` through a temporary file in the same folder.
+/// Writes `bytes` to `path` through a temporary file in the same folder, renamed into place
+/// once complete and synced: an interrupted write leaves either the old file or none, never a
+/// half-written one (the temporary file is removed when the write fails).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = temp_name(path);
-    let result = (|| {
-        let mut file = fs::File::create(&tmp)?;
+    use std::os::unix::fs::PermissionsExt;
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let result = (|| -> std::io::Result<()> {
+        let mut file = tempfile::Builder::new()
+            .prefix(".vitreous-")
+            .suffix(".partial")
+            // Like a plain create: 0666 less the umask, not tempfile's private 0600.
+            .permissions(fs::Permissions::from_mode(0o666))
+            .tempfile_in(dir)?;
         file.write_all(bytes)?;
-        file.sync_data()?;
-        fs::rename(&tmp, path)
+        file.as_file().sync_data()?;
+        file.persist(path).map_err(|e| e.error)?;
+        Ok(())
     })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
     result.with_context(|| format!("writing {}", path.display()))
 }
 
-fn temp_name(path: &Path) -> PathBuf {
-    let mut name = path.file_name().unwrap_or_default().to_os_string();
-    name.push(".partial");
-    path.with_file_name(name)
+/// Refuses an output path that is one of the command's input files, before anything is
+/// written (an output written over its own input would destroy the recording).
+pub fn ensure_not_input(out: &Path, option: &str, inputs: &[&Path]) -> Result<()> {
+    use std::os::unix::fs::MetadataExt;
+    let Ok(out_meta) = fs::metadata(out) else {
+        return Ok(()); // an output that does not exist yet cannot be an input
+    };
+    for input in inputs {
+        if let Ok(meta) = fs::metadata(input)
+            && meta.dev() == out_meta.dev()
+            && meta.ino() == out_meta.ino()
+        {
+            anyhow::bail!(
+                "{option} {} is the input file {}: choose another output file",
+                out.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Encodes RGBA8 pixels as PNG with fast compression (the default level costs ~0.7 s per
@@ -158,5 +183,26 @@ mod tests {
         assert_eq!(fs::read(&path).unwrap(), b"hello");
         let names: Vec<_> = fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(names.len(), 1);
+        use std::os::unix::fs::PermissionsExt;
+        let mode = fs::metadata(&path).unwrap().permissions().mode();
+        assert_ne!(
+            mode & 0o044,
+            0,
+            "written files are readable by others as a plain create makes them: {mode:o}"
+        );
+    }
+
+    #[test]
+    fn an_output_naming_an_input_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("in.csv");
+        fs::write(&input, "x").unwrap();
+        let e = ensure_not_input(&input, "-o", &[&input]).unwrap_err();
+        assert!(e.to_string().contains("is the input file"), "{e}");
+        // The same file under another name (a relative path through the folder).
+        let other = dir.path().join(".").join("in.csv");
+        assert!(ensure_not_input(&other, "-o", &[&input]).is_err());
+        assert!(ensure_not_input(&dir.path().join("out.csv"), "-o", &[&input]).is_ok());
+        assert_eq!(fs::read(&input).unwrap(), b"x");
     }
 }

@@ -159,11 +159,49 @@ pub struct ValidationSummary {
     pub messages: Vec<String>,
 }
 
+/// How a replay ended, as `summary.json` says it. Anything but `complete` means the output
+/// folder holds only part of the run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunStatus {
+    /// Written when the replay starts; still there after a crash, kill -9 or a full disk.
+    Running,
+    /// Every frame was rendered and every file written.
+    Complete,
+    /// Ended early by Ctrl-C or SIGTERM; the frames listed were finished.
+    Interrupted,
+    /// Ended by an error (named in `error`).
+    Failed,
+}
+
+/// The `summary.json` of a replay that has not finished (yet): it replaces any earlier run's
+/// summary before the first frame, so a folder never claims a success it does not hold.
+#[derive(Clone, Debug, Serialize)]
+struct UnfinishedSummary<'a> {
+    /// vitreous version.
+    vitreous_version: &'static str,
+    /// `running` or `failed`.
+    status: RunStatus,
+    /// Always false here.
+    complete: bool,
+    /// The scene file.
+    scene: &'a str,
+    /// The replayed trace file, or "synthetic".
+    trace: &'a str,
+    /// Why the replay failed (`failed` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<String>,
+}
+
 /// What `summary.json` holds.
 #[derive(Clone, Debug, Serialize)]
 pub struct ReplaySummary {
     /// vitreous version.
     pub vitreous_version: String,
+    /// `complete`, or `interrupted` when Ctrl-C/SIGTERM ended the replay early.
+    pub status: RunStatus,
+    /// True only when every frame asked for was rendered and saved.
+    pub complete: bool,
     /// The scene file.
     pub scene: String,
     /// Hex SHA-256 of the scene and its assets.
@@ -227,6 +265,10 @@ impl FrameSink for Saver<'_> {
         }
     }
 
+    fn stop_requested(&self) -> bool {
+        crate::interrupt::requested()
+    }
+
     fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()> {
         self.progress.inc(1);
         if let Some(readback) = &result.readback {
@@ -249,7 +291,10 @@ impl FrameSink for Saver<'_> {
 }
 
 /// Loads the trace or synthesises one for the scene.
-fn load_trace(scene: &Scene, trace: Option<&Path>) -> Result<(Vec<TraceSample>, String)> {
+pub(crate) fn load_trace(
+    scene: &Scene,
+    trace: Option<&Path>,
+) -> Result<(Vec<TraceSample>, String)> {
     match trace {
         Some(path) => {
             let samples =
@@ -289,6 +334,15 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     }
     let (samples, trace_name) = load_trace(&scene, options.trace.as_deref())?;
     let expected_frames = expected_frames(&samples, options.frame_rate_hz, options.frames);
+    if options.frames.is_none() && expected_frames > MAX_FRAMES_WITHOUT_LIMIT {
+        bail!(
+            "{trace_name} spans {:.0} s: at {} Hz that is {expected_frames} frames, more than the \
+             {MAX_FRAMES_WITHOUT_LIMIT} replayed without --frames; pass --frames N to replay part \
+             of it",
+            trace_span_s(&samples),
+            options.frame_rate_hz
+        );
+    }
     let mut backend = NullBackend::new(
         samples,
         NullConfig {
@@ -319,6 +373,22 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     let frames_dir = options.out.join("frames");
     fs::create_dir_all(&frames_dir)
         .with_context(|| format!("creating output folder {}", frames_dir.display()))?;
+    let scene_name = options.scene.display().to_string();
+    let summary_path = options.out.join("summary.json");
+    let unfinished = |status, error| UnfinishedSummary {
+        vitreous_version: env!("CARGO_PKG_VERSION"),
+        status,
+        complete: false,
+        scene: &scene_name,
+        trace: &trace_name,
+        error,
+    };
+    // First replace an earlier run's summary, then clear its frames: from here on the folder
+    // says it is incomplete until the final summary is written last.
+    let running = serde_json::to_vec_pretty(&unfinished(RunStatus::Running, None))?;
+    write_atomic(&summary_path, &running)?;
+    remove_earlier_frames(&frames_dir)?;
+    let signals = crate::interrupt::watch();
     let progress = if options.progress {
         let bar = ProgressBar::new(expected_frames);
         bar.set_style(
@@ -341,9 +411,21 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         progress,
     };
     let started = Instant::now();
-    let records = frame_loop::run(&mut backend, &mut renderer, &mut saver)?;
+    let records = match frame_loop::run(&mut backend, &mut renderer, &mut saver) {
+        Ok(records) => records,
+        Err(e) => {
+            saver.progress.abandon();
+            // Best effort: the `running` summary already marks the folder incomplete.
+            let failed = unfinished(RunStatus::Failed, Some(format!("{e:#}")));
+            if let Ok(json) = serde_json::to_vec_pretty(&failed) {
+                let _ = write_atomic(&summary_path, &json);
+            }
+            return Err(e);
+        }
+    };
     let wall_s = started.elapsed().as_secs_f64();
     saver.progress.finish_and_clear();
+    let interrupted = signals && crate::interrupt::requested();
 
     let v = renderer.context().validation();
     let validation = ValidationSummary {
@@ -352,9 +434,16 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         errors: v.errors(),
         messages: v.messages(),
     };
+    let status = if interrupted {
+        RunStatus::Interrupted
+    } else {
+        RunStatus::Complete
+    };
     let summary = ReplaySummary {
         vitreous_version: env!("CARGO_PKG_VERSION").into(),
-        scene: options.scene.display().to_string(),
+        status,
+        complete: status == RunStatus::Complete,
+        scene: scene_name.clone(),
         scene_hash: scene.hash.clone(),
         trace: trace_name,
         effects: effects.to_string(),
@@ -373,7 +462,14 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         per_frame: records,
     };
     let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;
-    write_atomic(&options.out.join("summary.json"), &json)?;
+    write_atomic(&summary_path, &json)?;
+    if interrupted {
+        bail!(
+            "interrupted after {} frames; {} marks the run incomplete",
+            summary.frames,
+            summary_path.display()
+        );
+    }
     if summary.validation.errors + summary.validation.warnings > 0 {
         bail!(
             "the Vulkan validation layers reported {} errors and {} warnings (see {}), first: {}",
@@ -399,12 +495,111 @@ pub fn check_size(width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
-/// How many frames the null backend will give for `samples` at `rate_hz`.
-fn expected_frames(samples: &[TraceSample], rate_hz: f64, limit: Option<u64>) -> u64 {
-    let span_s = match (samples.first(), samples.last()) {
-        (Some(a), Some(b)) => (b.time_ns - a.time_ns) as f64 * 1e-9,
+/// Most frames a replay renders without an explicit `--frames` (about 4.6 hours at 60 Hz): a
+/// trace that spans years, or whose clock jumps, is refused rather than replayed for ever.
+pub const MAX_FRAMES_WITHOUT_LIMIT: u64 = 1_000_000;
+
+/// Seconds from the first to the last sample (0 for fewer than two samples).
+fn trace_span_s(samples: &[TraceSample]) -> f64 {
+    match (samples.first(), samples.last()) {
+        (Some(a), Some(b)) => span_s(a.time_ns, b.time_ns),
         _ => 0.0,
+    }
+}
+
+/// Seconds between two trace times, in i128: the difference of two i64 times can overflow.
+fn span_s(first_ns: i64, last_ns: i64) -> f64 {
+    (i128::from(last_ns) - i128::from(first_ns)) as f64 * 1e-9
+}
+
+/// How many frames the null backend will give for `samples` at `rate_hz` (saturating).
+fn expected_frames(samples: &[TraceSample], rate_hz: f64, limit: Option<u64>) -> u64 {
+    frames_for_span(trace_span_s(samples), rate_hz, limit)
+}
+
+fn frames_for_span(span_s: f64, rate_hz: f64, limit: Option<u64>) -> u64 {
+    let n = (span_s.max(0.0) * rate_hz).floor();
+    let n = if n >= u64::MAX as f64 {
+        u64::MAX
+    } else {
+        n as u64 + 1
     };
-    let n = (span_s * rate_hz).floor() as u64 + 1;
     limit.map_or(n, |l| n.min(l))
+}
+
+/// Removes the frame images an earlier replay left in `frames_dir` (only files named as a
+/// replay names them, and temporary files of interrupted writes), so the folder never mixes
+/// two runs.
+fn remove_earlier_frames(frames_dir: &Path) -> Result<()> {
+    let entries =
+        fs::read_dir(frames_dir).with_context(|| format!("listing {}", frames_dir.display()))?;
+    for entry in entries {
+        let entry = entry.with_context(|| format!("listing {}", frames_dir.display()))?;
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        if is_replay_file_name(name) {
+            fs::remove_file(entry.path())
+                .with_context(|| format!("removing an earlier run's {}", entry.path().display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// `NNNNNN-left.png`, `NNNNNN-right-preview.png`, `NNNNNN-left-reference.png`, ... or a
+/// temporary file of an atomic write.
+fn is_replay_file_name(name: &str) -> bool {
+    if name.starts_with(".vitreous-") && name.ends_with(".partial") {
+        return true;
+    }
+    let Some(stem) = name.strip_suffix(".png") else {
+        return false;
+    };
+    let Some((digits, rest)) = stem.split_once('-') else {
+        return false;
+    };
+    digits.len() >= 6
+        && digits.bytes().all(|b| b.is_ascii_digit())
+        && ["left", "right"].iter().any(|eye| {
+            ["", "-preview", "-reference"]
+                .iter()
+                .any(|k| rest == format!("{eye}{k}"))
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_replay_output_names_are_treated_as_earlier_frames() {
+        for name in [
+            "000000-left.png",
+            "000030-right-preview.png",
+            "000060-left-reference.png",
+            "1234567-right.png",
+            ".vitreous-abc123.partial",
+        ] {
+            assert!(is_replay_file_name(name), "{name}");
+        }
+        for name in [
+            "notes.txt",
+            "left.png",
+            "00003-left.png",
+            "000030-middle.png",
+            "x-left.png",
+        ] {
+            assert!(!is_replay_file_name(name), "{name}");
+        }
+    }
+
+    #[test]
+    fn frame_count_of_a_trace_spanning_all_of_i64_saturates() {
+        let span = span_s(i64::MIN, i64::MAX);
+        assert!((span - 1.8446744e10).abs() < 1e4, "{span}");
+        let n = frames_for_span(span, 60.0, None);
+        assert!(n > MAX_FRAMES_WITHOUT_LIMIT);
+        assert_eq!(frames_for_span(span, 60.0, Some(5)), 5);
+        assert_eq!(frames_for_span(f64::INFINITY, 60.0, None), u64::MAX);
+        assert_eq!(frames_for_span(1.0, 60.0, None), 61);
+    }
 }

@@ -277,3 +277,82 @@ fn imported_real_trace_replays_from_a_fresh_import() {
     let text = std::fs::read_to_string(&target).unwrap();
     assert!(text.starts_with("# vitreous-trace v1"));
 }
+
+#[test]
+fn frame_counts_below_one_name_the_option() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    for bad in ["0", "-1"] {
+        let out = vitreous(
+            &[
+                "replay",
+                &scene("glass-sphere.toml"),
+                "--frames",
+                bad,
+                "--out",
+                out_dir.to_str().unwrap(),
+            ],
+            dir.path(),
+        );
+        assert_clean_failure(&out, &["--frames", "at least 1"]);
+        assert!(
+            !out_dir.exists(),
+            "output folder created for --frames {bad}"
+        );
+    }
+}
+
+#[test]
+fn import_onto_its_own_input_is_refused_and_the_recording_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let recording = dir.path().join("rec.csv");
+    std::fs::write(&recording, "time(100ns),x\n1,2\n").unwrap();
+    let before = std::fs::read(&recording).unwrap();
+    let rec = recording.to_str().unwrap();
+    let out = vitreous(
+        &[
+            "trace",
+            "import",
+            "--from",
+            "sranipal",
+            rec,
+            "-o",
+            "./rec.csv",
+        ],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["-o", "is the input file"]);
+    assert_eq!(std::fs::read(&recording).unwrap(), before);
+}
+
+#[test]
+fn an_unclosed_array_is_reported_on_its_own_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(workspace().join("config/scenes/glass-sphere.toml"))
+        .unwrap()
+        .replace(
+            "position_m = [0.0, -0.26, -1.5]",
+            "position_m = [0.0, -0.26, -1.5",
+        );
+    let line = 1 + text
+        .lines()
+        .position(|l| l.starts_with("position_m = [0.0, -0.26, -1.5"))
+        .unwrap();
+    let scenes = dir.path().join("scenes");
+    std::fs::create_dir(&scenes).unwrap();
+    let bad = write(&scenes, "open.toml", &text);
+    let out = vitreous(&["replay", &bad, "--frames", "1"], dir.path());
+    let message = assert_clean_failure(&out, &["object.position_m", "never closed"]);
+    assert!(
+        message.contains(&format!("open.toml:{line}:")),
+        "not reported at line {line}: {message}"
+    );
+}
+
+#[test]
+fn a_missing_scene_says_the_os_error_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = vitreous(&["replay", "nowhere.toml"], dir.path());
+    let message = assert_clean_failure(&out, &["nowhere.toml"]);
+    assert_eq!(message.matches("os error 2").count(), 1, "{message}");
+}

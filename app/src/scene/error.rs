@@ -26,13 +26,12 @@ impl fmt::Display for Location {
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file itself could not be read.
-    #[error("{}: cannot read the scene file: {source}", path.display())]
+    #[error("{}: cannot read the scene file: {error}", path.display())]
     Read {
         /// The scene file.
         path: PathBuf,
-        /// What the operating system said.
-        #[source]
-        source: std::io::Error,
+        /// What the operating system said (in the message, so not also a source).
+        error: std::io::Error,
     },
     /// The file is not valid TOML.
     #[error("{at}: in `{field}`: TOML syntax error: {message}")]
@@ -153,10 +152,31 @@ impl Source<'_> {
         let at = self.location(offset);
         let message = err.message().trim().to_owned();
         match toml::de::DeTable::parse(self.text) {
-            Err(_) => SceneError::Syntax {
-                at,
-                field: self.textual_key_path(offset),
-                message,
+            // An array or inline table left open is only noticed where the parser gives up,
+            // often in a later table: report the bracket that was never closed.
+            Err(_) => match unclosed_bracket(self.text, offset) {
+                Some((open, bracket)) => {
+                    let stop = self.location(offset);
+                    let (what, close) = if bracket == '[' {
+                        ("array", ']')
+                    } else {
+                        ("inline table", '}')
+                    };
+                    SceneError::Syntax {
+                        at: self.location(open),
+                        field: self.textual_key_path(open),
+                        message: format!(
+                            "this {what} is never closed with `{close}` (the parser stopped at \
+                             line {}, column {}: {message})",
+                            stop.line, stop.column
+                        ),
+                    }
+                }
+                None => SceneError::Syntax {
+                    at,
+                    field: self.textual_key_path(offset),
+                    message,
+                },
             },
             Ok(root) => {
                 let mut path = Vec::new();
@@ -207,6 +227,72 @@ impl Source<'_> {
     }
 }
 
+/// The byte offset and kind (`[` or `{`) of the outermost array or inline table that is open
+/// at `offset` and still open at the end of `text`, if any. Strings and comments are skipped;
+/// a `[` that starts a line outside any value is a table header.
+fn unclosed_bracket(text: &str, offset: usize) -> Option<(usize, char)> {
+    let bytes = text.as_bytes();
+    let mut stack: Vec<(usize, char)> = Vec::new();
+    let mut open_at_offset = None;
+    let mut line_start = true;
+    let mut i = 0;
+    while i < bytes.len() {
+        if i >= offset && open_at_offset.is_none() {
+            open_at_offset = Some(stack.first().copied());
+        }
+        let c = bytes[i];
+        match c {
+            b'#' => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+                continue;
+            }
+            b'"' | b'\'' => {
+                let triple = bytes[i..].starts_with(&[c, c, c]);
+                let quote_len = if triple { 3 } else { 1 };
+                i += quote_len;
+                while i < bytes.len() {
+                    if c == b'"' && bytes[i] == b'\\' {
+                        i += 2;
+                        continue;
+                    }
+                    if !triple && bytes[i] == b'\n' {
+                        break; // an unterminated one-line string ends at its line
+                    }
+                    if bytes[i] == c && (!triple || bytes[i..].starts_with(&[c, c, c])) {
+                        i += quote_len;
+                        break;
+                    }
+                    i += 1;
+                }
+                line_start = false;
+                continue;
+            }
+            b'[' if line_start && stack.is_empty() => {
+                // A `[table]` or `[[array of tables]]` header: skip to its end of line.
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+                continue;
+            }
+            b'[' | b'{' => stack.push((i, c as char)),
+            b']' | b'}' => {
+                stack.pop();
+            }
+            _ => {}
+        }
+        if c == b'\n' {
+            line_start = true;
+        } else if !c.is_ascii_whitespace() {
+            line_start = false;
+        }
+        i += 1;
+    }
+    let candidate = open_at_offset.unwrap_or_else(|| stack.first().copied())?;
+    stack.contains(&candidate).then_some(candidate)
+}
+
 fn table_header(line: &str) -> Option<String> {
     let inner = line.strip_prefix('[')?;
     let end = inner.find(']')?;
@@ -251,6 +337,28 @@ fn descend(value: &toml::de::DeValue<'_>, offset: usize, path: &mut Vec<String>)
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_unclosed_array_is_reported_where_it_opens() {
+        let text = "[object]\nmodel = \"m.glb\" # [not a bracket]\nposition_m = [0.0, -0.26, -1.5\n\n[light]\nposition_m = [0.0, 1.0, -1.0]\n";
+        let stopped = text.find("[light]").unwrap();
+        let (open, kind) = unclosed_bracket(text, stopped).unwrap();
+        assert_eq!(kind, '[');
+        let src = Source {
+            file: Path::new("s.toml"),
+            text,
+        };
+        assert_eq!(src.location(open).line, 3);
+        assert_eq!(src.textual_key_path(open), "object.position_m");
+    }
+
+    #[test]
+    fn a_closed_multi_line_array_is_not_blamed_for_an_error_inside_it() {
+        let text = "[object]\npos = [\n  1.0,\n  x,\n]\ns = \"a]b\"\n";
+        assert_eq!(unclosed_bracket(text, text.find('x').unwrap()), None);
+        let text = "a = \"[\" # {\nb = '''[\n'''\nc = [1, {x = 2}]\nd = = 1\n";
+        assert_eq!(unclosed_bracket(text, text.find("= =").unwrap()), None);
+    }
 
     #[test]
     fn location_counts_lines_and_characters_from_one() {

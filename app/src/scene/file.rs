@@ -4,6 +4,9 @@
 //! read as `Vec` and their length checked on resolving, because serde's arrays ignore extra
 //! elements.
 
+use std::io::Read;
+use std::path::Path;
+
 use serde::Deserialize;
 use toml::Spanned;
 
@@ -132,4 +135,26 @@ pub(crate) struct InducerToml {
     pub k: Option<Spanned<f32>>,
     pub ramp_width_m: Option<Spanned<f32>>,
     pub resolution_px: Option<Spanned<i64>>,
+}
+
+/// Largest scene file read, bytes: a scene is a short TOML text, and a huge file (a model or
+/// a recording named by mistake) must not be read whole into memory.
+pub const MAX_SCENE_FILE_BYTES: u64 = 1 << 20;
+
+/// Reads a scene file, refusing one larger than [`MAX_SCENE_FILE_BYTES`] without reading it.
+pub(crate) fn read_bounded(path: &Path) -> std::io::Result<Vec<u8>> {
+    let file = std::fs::File::open(path)?;
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENE_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_SCENE_FILE_BYTES {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "larger than {} KiB; a scene file is a short TOML text",
+                MAX_SCENE_FILE_BYTES / 1024
+            ),
+        ));
+    }
+    Ok(bytes)
 }

@@ -6,6 +6,12 @@ use std::io::Cursor;
 /// Largest accepted width or height of any image, pixels.
 pub const MAX_IMAGE_SIZE_PX: u32 = 16384;
 
+/// Most pixels accepted in one image (2^24, e.g. 4096 x 4096 or 16384 x 1024): 64 MiB decoded
+/// as sRGB RGBA8, 256 MiB as float RGBA. The limit is by memory, not by side: with defocus on, a
+/// photo's blur stack is [`crate::defocus::STACK_SLICES`] times its decoded size (1 GiB at
+/// this limit).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 24;
+
 /// A decoded image, rows top to bottom, RGBA interleaved.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
@@ -45,6 +51,20 @@ pub enum ImageError {
         /// Height in pixels.
         height: u64,
     },
+    /// More pixels than [`MAX_IMAGE_PIXELS`].
+    #[error(
+        "image is {width}x{height} px ({} Mpx, {} MiB decoded as RGBA8); at most {} Mpx is \
+         accepted (e.g. 4096x4096): scale the photo down",
+        width * height / 1_000_000,
+        width * height * 4 / (1 << 20),
+        MAX_IMAGE_PIXELS / 1_000_000
+    )]
+    TooManyPixels {
+        /// Width in pixels.
+        width: u64,
+        /// Height in pixels.
+        height: u64,
+    },
     /// The pixel buffer does not hold `width * height * 4` values.
     #[error("pixel buffer holds {actual} values, expected {expected}")]
     DataLength {
@@ -65,12 +85,15 @@ impl std::fmt::Debug for PixelData {
 }
 
 impl Image {
-    /// Checks that a size is usable: neither side zero nor above [`MAX_IMAGE_SIZE_PX`].
+    /// Checks that a size is usable: neither side zero nor above [`MAX_IMAGE_SIZE_PX`], and
+    /// at most [`MAX_IMAGE_PIXELS`] in all.
     pub fn check_dimensions(width: u64, height: u64) -> Result<(), ImageError> {
         if width == 0 || height == 0 {
             Err(ImageError::ZeroSize { width, height })
         } else if width > u64::from(MAX_IMAGE_SIZE_PX) || height > u64::from(MAX_IMAGE_SIZE_PX) {
             Err(ImageError::TooLarge { width, height })
+        } else if width * height > MAX_IMAGE_PIXELS {
+            Err(ImageError::TooManyPixels { width, height })
         } else {
             Ok(())
         }
@@ -111,7 +134,8 @@ fn decode_limits() -> image::Limits {
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_IMAGE_SIZE_PX);
     limits.max_image_height = Some(MAX_IMAGE_SIZE_PX);
-    limits.max_alloc = Some(4 << 30);
+    // The largest accepted image as float RGBA, plus room for the decoder's own buffers.
+    limits.max_alloc = Some(MAX_IMAGE_PIXELS * 16 + (64 << 20));
     limits
 }
 
@@ -224,7 +248,11 @@ mod tests {
         assert!(Image::check_dimensions(0, 5).is_err());
         assert!(Image::check_dimensions(5, 0).is_err());
         assert!(Image::check_dimensions(16385, 1).is_err());
-        assert!(Image::check_dimensions(16384, 16384).is_ok());
+        assert!(Image::check_dimensions(16384, 1024).is_ok());
+        assert!(Image::check_dimensions(4096, 4096).is_ok());
+        let e = Image::check_dimensions(16384, 16384).unwrap_err();
+        assert!(e.to_string().contains("1024 MiB"), "{e}");
+        assert!(Image::check_dimensions(4097, 4096).is_err());
     }
 
     #[test]

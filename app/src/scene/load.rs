@@ -21,9 +21,9 @@ use crate::gaze::{FilterKind, FilterParseError, GazeOverride};
 
 /// Loads a scene file and every asset it names, checking ranges and decoding everything.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
+    let bytes = file::read_bounded(path).map_err(|error| SceneError::Read {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let text = match std::str::from_utf8(&bytes) {
         Ok(text) => text,

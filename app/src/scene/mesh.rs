@@ -59,6 +59,9 @@ pub(crate) struct LoadedModel {
     pub buffers: Vec<Vec<u8>>,
 }
 
+/// Largest vertex coordinate accepted, model units: far beyond any real model in metres,
+/// millimetres or inches, and small enough that extents and centres stay finite in f32.
+const MAX_MODEL_COORD: f32 = 1.0e6;
 /// Deepest node hierarchy accepted.
 const MAX_NODE_DEPTH: usize = 64;
 /// Most node visits accepted (a node shared by several parents is visited once per path).
@@ -265,7 +268,12 @@ impl Builder<'_> {
 
         let normal_matrix = Mat3::from_mat4(world);
         let det = normal_matrix.determinant();
-        if !det.is_finite() || det.abs() < 1e-12 {
+        if !det.is_finite() {
+            return Err(format!(
+                "node transform overflows (scale determinant {det})"
+            ));
+        }
+        if det.abs() < 1e-12 {
             return Err("node transform is singular (zero scale)".into());
         }
         let normal_matrix = normal_matrix.inverse().transpose();
@@ -278,6 +286,16 @@ impl Builder<'_> {
             .collect();
         if let Some(p) = world_positions.iter().find(|p| !p.is_finite()) {
             return Err(format!("transformed position {p} is not finite"));
+        }
+        if let Some((i, p)) = world_positions
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.abs().max_element() > MAX_MODEL_COORD)
+        {
+            return Err(format!(
+                "vertex {i} is at {p} (after node transforms), outside the ±{MAX_MODEL_COORD:e} \
+                 model units accepted"
+            ));
         }
         let uv_at = |i: usize| uvs.as_ref().map_or(Vec2::ZERO, |u| Vec2::from_array(u[i]));
 
@@ -566,6 +584,19 @@ mod tests {
             .err()
             .unwrap();
         assert!(err.contains("out of range for 3 vertices"), "{err}");
+    }
+
+    #[test]
+    fn vertices_far_beyond_any_model_are_refused_by_position_not_as_zero_size() {
+        let gltf = triangle_gltf("0,1,2", r#","translation":[3e38,0,0]"#);
+        let err = load_gltf(gltf.as_bytes(), Path::new(".")).err().unwrap();
+        assert!(
+            err.contains("vertex 0") && err.contains("model units"),
+            "{err}"
+        );
+        let gltf = triangle_gltf("0,1,2", r#","scale":[3e38,3e38,3e38]"#);
+        let err = load_gltf(gltf.as_bytes(), Path::new(".")).err().unwrap();
+        assert!(err.contains("overflows"), "{err}");
     }
 
     #[test]

@@ -1,0 +1,233 @@
+//! `vitreous soak`: replay a trace again and again in one process, each pass with a new
+//! Vulkan device and renderer, and watch resident memory and the validation layers. On a CPU
+//! device (lavapipe) GPU memory is process memory, so a leaked buffer or image shows here as
+//! growth from pass to pass; a pass that leaves the device dirty shows as validation messages.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use serde::Serialize;
+use vitreous_render::renderer::{FrameResult, Want};
+use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
+use vitreous_xr::FrameInput;
+use vitreous_xr::null::{NullBackend, NullConfig};
+
+use crate::look::LookPlanner;
+use crate::effects::EffectSet;
+use crate::frame_loop::{self, FramePlan, FrameSink};
+use crate::replay::{GazeSettings, check_size, load_trace, planner_for};
+use crate::scene::load_scene;
+use crate::views;
+
+/// Passes left out of the memory comparison: the first passes grow the allocator's pools and
+/// the driver's shader caches.
+pub const WARM_UP_PASSES: usize = 2;
+
+/// Largest growth of resident memory after warm-up that still counts as flat, percent.
+pub const MAX_GROWTH_PERCENT: f64 = 1.0;
+
+/// Options of a soak run.
+#[derive(Clone, Debug)]
+pub struct SoakOptions {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// Effects (default: every effect the scene's assets allow).
+    pub effects: Option<EffectSet>,
+    /// How long to keep replaying.
+    pub duration: Duration,
+    /// Eye image size, pixels.
+    pub size: (u32, u32),
+    /// Frames per pass, at most the scene's synthetic trace (721 frames at 60 Hz), replayed
+    /// from its start each pass.
+    pub frames_per_pass: u64,
+    /// Read back every K-th frame (exercises the readback path).
+    pub read_back_every: u64,
+}
+
+/// One pass: a device, a renderer, a replay, teardown.
+#[derive(Clone, Debug, Serialize)]
+pub struct SoakPass {
+    /// Pass number, from 0.
+    pub pass: usize,
+    /// Frames rendered.
+    pub frames: u64,
+    /// Resident memory after the pass's teardown, kibibytes.
+    pub rss_kib: u64,
+    /// Validation errors and warnings of the pass.
+    pub validation_messages: u32,
+}
+
+/// The result of a soak run.
+#[derive(Clone, Debug, Serialize)]
+pub struct SoakReport {
+    /// The scene file.
+    pub scene: String,
+    /// Effects rendered.
+    pub effects: String,
+    /// Vulkan device.
+    pub device: String,
+    /// Wall-clock seconds.
+    pub wall_s: f64,
+    /// Frames over all passes.
+    pub frames: u64,
+    /// Every pass.
+    pub passes: Vec<SoakPass>,
+    /// Resident memory after the first pass past warm-up, kibibytes.
+    pub rss_after_warm_up_kib: u64,
+    /// Largest resident memory after a later pass, kibibytes.
+    pub rss_max_kib: u64,
+    /// Growth of the largest over the warm-up figure, percent.
+    pub growth_percent: f64,
+    /// Validation messages over all passes.
+    pub validation_messages: u32,
+    /// The first validation messages' texts.
+    pub first_messages: Vec<String>,
+}
+
+impl SoakReport {
+    /// Whether memory stayed flat and validation was silent.
+    pub fn passed(&self) -> bool {
+        self.passes.len() > WARM_UP_PASSES
+            && self.growth_percent <= MAX_GROWTH_PERCENT
+            && self.validation_messages == 0
+    }
+}
+
+/// Renders every frame, reads back some, keeps nothing.
+struct Discard {
+    planner: LookPlanner,
+    read_back_every: u64,
+}
+
+impl FrameSink for Discard {
+    fn plan(&mut self, input: &FrameInput) -> FramePlan {
+        let read = input.index.is_multiple_of(self.read_back_every);
+        FramePlan {
+            look: self.planner.plan(input).0,
+            want: Want {
+                eyes: read,
+                world: read,
+            },
+        }
+    }
+
+    fn finished(&mut self, _input: &FrameInput, _result: &FrameResult) -> Result<()> {
+        Ok(())
+    }
+
+    fn stop_requested(&self) -> bool {
+        crate::interrupt::requested()
+    }
+}
+
+/// Resident memory of this process, kibibytes (Linux `/proc/self/statm`).
+pub fn resident_kib() -> Result<u64> {
+    let statm = std::fs::read_to_string("/proc/self/statm").context("reading /proc/self/statm")?;
+    let pages: u64 = statm
+        .split_whitespace()
+        .nth(1)
+        .and_then(|v| v.parse().ok())
+        .context("parsing /proc/self/statm")?;
+    Ok(pages * 4)
+}
+
+/// Runs the soak; `progress` is called after every pass.
+pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Result<SoakReport> {
+    let mut scene = load_scene(&options.scene)?;
+    let effects = options.effects.unwrap_or(scene.effects);
+    effects.ensure_implemented()?;
+    if effects.caustics {
+        scene.load_caustics()?;
+    }
+    check_size(options.size.0, options.size.1)?;
+    if options.frames_per_pass == 0 || options.read_back_every == 0 {
+        bail!("frames per pass and the readback interval must be at least 1");
+    }
+    let (samples, _) = load_trace(&scene, None)?;
+    let signals = crate::interrupt::watch();
+
+    let started = Instant::now();
+    let mut passes = Vec::new();
+    let mut device = String::new();
+    let mut first_messages = Vec::new();
+    while passes.is_empty() || started.elapsed() < options.duration {
+        if signals && crate::interrupt::requested() {
+            break;
+        }
+        let mut backend = NullBackend::new(
+            samples.clone(),
+            NullConfig {
+                frame_rate_hz: 60.0,
+                max_frames: Some(options.frames_per_pass),
+                fov: scene.output.fov,
+                ipd_m: scene.viewer.ipd_m,
+            },
+        )?;
+        let ctx = GpuContext::headless(&ContextOptions {
+            validation: true,
+            device_name: None,
+        })
+        .context("setting up the Vulkan device")?;
+        device.clone_from(&ctx.device_name);
+        let (planner, defocus) = planner_for(
+            &scene,
+            &effects,
+            Reflection::Phong,
+            &GazeSettings::default(),
+        )?;
+        let mut renderer = Renderer::new(
+            ctx,
+            &views::scene_desc(&scene, defocus.as_ref()),
+            options.size.0,
+            options.size.1,
+        )
+        .context("preparing the renderer")?;
+        drop(defocus);
+        let mut sink = Discard {
+            planner,
+            read_back_every: options.read_back_every,
+        };
+        let records = frame_loop::run(&mut backend, &mut renderer, &mut sink)?;
+        let log = renderer.context().validation();
+        let messages = log.errors() + log.warnings();
+        if first_messages.len() < 5 {
+            first_messages.extend(log.messages().into_iter().take(5 - first_messages.len()));
+        }
+        drop(renderer);
+        let pass = SoakPass {
+            pass: passes.len(),
+            frames: records.len() as u64,
+            rss_kib: resident_kib()?,
+            validation_messages: messages,
+        };
+        progress(&pass);
+        passes.push(pass);
+    }
+
+    let settled: Vec<u64> = passes
+        .iter()
+        .skip(WARM_UP_PASSES)
+        .map(|p| p.rss_kib)
+        .collect();
+    let rss_after_warm_up_kib = settled.first().copied().unwrap_or(0);
+    let rss_max_kib = settled.iter().copied().max().unwrap_or(0);
+    let growth_percent = if rss_after_warm_up_kib > 0 {
+        (rss_max_kib as f64 / rss_after_warm_up_kib as f64 - 1.0) * 100.0
+    } else {
+        0.0
+    };
+    Ok(SoakReport {
+        scene: options.scene.display().to_string(),
+        effects: effects.to_string(),
+        device,
+        wall_s: started.elapsed().as_secs_f64(),
+        frames: passes.iter().map(|p| p.frames).sum(),
+        validation_messages: passes.iter().map(|p| p.validation_messages).sum(),
+        passes,
+        rss_after_warm_up_kib,
+        rss_max_kib,
+        growth_percent,
+        first_messages,
+    })
+}

@@ -9,6 +9,7 @@
 pub mod frame;
 pub mod null;
 pub mod openxr;
+pub mod records;
 pub mod sranipal;
 pub mod synth;
 pub mod trace;

@@ -30,14 +30,14 @@
 
 use std::fmt;
 use std::fs::File;
-use std::io::{self, BufRead, BufReader};
+use std::io::{BufReader, Read};
 use std::path::Path;
 
 use glam::{Quat, Vec3};
-use thiserror::Error;
 
 use crate::frame::{GazeRay, GazeSample, Pose};
-use crate::trace::{TraceSample, clean_ray};
+use crate::records::{Record, RecordReader};
+use crate::trace::{TraceError, TraceSample, clean_ray};
 
 /// SRanipal validity bits needed for a usable gaze ray: gaze origin (bit 0) and gaze
 /// direction (bit 1).
@@ -65,94 +65,9 @@ const HELMET_ROT: [&str; 3] = ["helmet_rot_x", "helmet_rot_y", "helmet_rot_z"];
 /// Nanoseconds per .NET tick.
 const NS_PER_TICK: i64 = 100;
 
-/// Everything that can go wrong importing an SRanipal CSV. Messages name the file, the line
-/// (1-based, the header is line 1) and the column.
-#[derive(Debug, Error)]
-pub enum ImportError {
-    /// The file could not be opened or read.
-    #[error("{file}: {context}: {source}")]
-    Io {
-        /// File name.
-        file: String,
-        /// What was being done, with the line number when known.
-        context: String,
-        /// The underlying error.
-        #[source]
-        source: io::Error,
-    },
-    /// The file has no header row.
-    #[error(
-        "{file}: empty file; expected a `;`-separated SRanipal header row starting with `{TIME}`"
-    )]
-    Empty {
-        /// File name.
-        file: String,
-    },
-    /// A column the importer needs is not in the header row.
-    #[error("{file}:{line}: header row has no column `{column}`; is this an SRanipal recording?")]
-    MissingColumn {
-        /// File name.
-        file: String,
-        /// Line number of the header row.
-        line: usize,
-        /// The missing column name.
-        column: &'static str,
-    },
-    /// A data row has a different number of fields from the header row.
-    #[error(
-        "{file}:{line}: {found} `;`-separated fields, expected {expected} as in the header row"
-    )]
-    FieldCount {
-        /// File name.
-        file: String,
-        /// Line number (1-based).
-        line: usize,
-        /// Fields found.
-        found: usize,
-        /// Fields in the header row.
-        expected: usize,
-    },
-    /// A field could not be parsed.
-    #[error("{file}:{line}: column `{column}`: expected {expected}, found `{found}`")]
-    BadField {
-        /// File name.
-        file: String,
-        /// Line number (1-based).
-        line: usize,
-        /// Column name.
-        column: &'static str,
-        /// The text found.
-        found: String,
-        /// What the column holds.
-        expected: &'static str,
-    },
-    /// A head pose value is NaN or infinite.
-    #[error("{file}:{line}: column `{column}`: expected a finite number, found {value}")]
-    NonFinite {
-        /// File name.
-        file: String,
-        /// Line number (1-based).
-        line: usize,
-        /// Column name.
-        column: &'static str,
-        /// The value found.
-        value: f32,
-    },
-    /// A row's time is so far from the first row's that nanoseconds overflow an `i64`.
-    #[error(
-        "{file}:{line}: column `{TIME}`: {ticks} ticks is too far from the first row's {first_ticks} (nanoseconds overflow)"
-    )]
-    TimeRange {
-        /// File name.
-        file: String,
-        /// Line number (1-based).
-        line: usize,
-        /// This row's ticks.
-        ticks: i64,
-        /// The first row's ticks.
-        first_ticks: i64,
-    },
-}
+/// Everything that can go wrong importing an SRanipal CSV: the trace error type, which
+/// names the file, the line (1-based, the header is line 1) and the column.
+pub type ImportError = TraceError;
 
 /// A summary of an import, for a CLI to print.
 #[derive(Clone, Debug, PartialEq)]
@@ -235,68 +150,38 @@ pub fn import_sranipal_with_report(
     parse_sranipal(BufReader::new(file), &name)
 }
 
-/// Imports SRanipal CSV text from any buffered reader; `name` is used in error messages.
+/// Imports SRanipal CSV text from any reader; `name` is used in error messages.
 pub fn parse_sranipal(
-    mut reader: impl BufRead,
+    reader: impl Read,
     name: &str,
 ) -> Result<(Vec<TraceSample>, ImportReport), ImportError> {
-    let mut buf = String::new();
-    let mut line = 0usize;
-    let mut next_line = |buf: &mut String| -> Result<Option<usize>, ImportError> {
-        buf.clear();
-        let n = reader.read_line(buf).map_err(|source| ImportError::Io {
-            file: name.to_owned(),
-            context: format!("reading line {}", line + 1),
-            source,
-        })?;
-        if n == 0 {
-            return Ok(None);
-        }
-        line += 1;
-        let len = buf.trim_end_matches(['\n', '\r']).len();
-        buf.truncate(len);
-        Ok(Some(line))
+    let mut records = RecordReader::new(reader, name, b';');
+    let empty = || ImportError::Empty {
+        file: name.to_owned(),
+        expected: "a `;`-separated SRanipal header row starting with `time(100ns)`",
     };
-
-    let Some(header_line) = next_line(&mut buf)? else {
-        return Err(ImportError::Empty {
-            file: name.to_owned(),
-        });
+    let Some(header) = records.next_record()? else {
+        return Err(empty());
     };
-    let header: Vec<String> = buf
-        .trim_start_matches('\u{feff}')
-        .split(';')
-        .map(|s| s.trim().to_owned())
+    let names: Vec<&str> = header
+        .fields()
+        .map(|h| h.trim_start_matches('\u{feff}').trim())
         .collect();
-    if header.iter().all(|h| h.is_empty()) {
-        return Err(ImportError::Empty {
-            file: name.to_owned(),
-        });
+    if names.iter().all(|h| h.is_empty()) {
+        return Err(empty());
     }
-    let cols = Columns::find(&header, name, header_line)?;
+    let cols = Columns::find(&names, name, header.line())?;
+    let width = names.len();
 
     let mut importer = Importer::default();
     let mut rows = 0usize;
-    while let Some(line) = next_line(&mut buf)? {
-        if buf.trim().is_empty() {
+    while let Some(record) = records.next_record()? {
+        if record.is_blank() {
             continue;
         }
         rows += 1;
-        let fields: Vec<&str> = buf.split(';').map(str::trim).collect();
-        if fields.len() != header.len() {
-            return Err(ImportError::FieldCount {
-                file: name.to_owned(),
-                line,
-                found: fields.len(),
-                expected: header.len(),
-            });
-        }
-        let row = Row {
-            name,
-            line,
-            fields: &fields,
-        };
-        importer.push(&cols, &row)?;
+        record.expect_len(width)?;
+        importer.push(&cols, &record)?;
     }
     Ok(importer.finish(name, rows))
 }
@@ -312,11 +197,11 @@ struct Columns {
 }
 
 impl Columns {
-    fn find(header: &[String], file: &str, line: usize) -> Result<Columns, ImportError> {
+    fn find(header: &[&str], file: &str, line: usize) -> Result<Columns, ImportError> {
         let idx = |column: &'static str| {
             header
                 .iter()
-                .position(|h| h == column)
+                .position(|h| *h == column)
                 .ok_or_else(|| ImportError::MissingColumn {
                     file: file.to_owned(),
                     line,
@@ -337,88 +222,25 @@ impl Columns {
     }
 }
 
-/// One data row, with what error messages need.
-struct Row<'a> {
-    name: &'a str,
-    line: usize,
-    fields: &'a [&'a str],
-}
-
-impl Row<'_> {
-    fn bad(&self, column: &'static str, found: &str, expected: &'static str) -> ImportError {
-        ImportError::BadField {
-            file: self.name.to_owned(),
-            line: self.line,
-            column,
-            found: found.chars().take(60).collect(),
-            expected,
-        }
+/// One eye's ray in the OpenXR head frame, from a data row.
+fn eye_ray(row: &Record<'_>, cols: &Columns, eye: usize) -> Result<GazeRay, ImportError> {
+    let (valid_name, origin_names, direct_names) = if eye == 0 {
+        (VALID_L, ORIGIN_L, DIRECT_L)
+    } else {
+        (VALID_R, ORIGIN_R, DIRECT_R)
+    };
+    let flags = row.i64(
+        cols.valid[eye],
+        valid_name,
+        "an SRanipal validity bit mask (integer)",
+    )?;
+    if flags & i64::from(GAZE_VALID_MASK) != i64::from(GAZE_VALID_MASK) {
+        // The tracker says it has no ray; its numbers are not read.
+        return Ok(GazeRay::INVALID);
     }
-
-    fn i64(
-        &self,
-        index: usize,
-        column: &'static str,
-        expected: &'static str,
-    ) -> Result<i64, ImportError> {
-        let text = self.fields[index];
-        text.parse().map_err(|_| self.bad(column, text, expected))
-    }
-
-    fn f32(&self, index: usize, column: &'static str) -> Result<f32, ImportError> {
-        let text = self.fields[index];
-        text.parse()
-            .map_err(|_| self.bad(column, text, "a decimal number"))
-    }
-
-    fn vec3(&self, index: [usize; 3], names: [&'static str; 3]) -> Result<Vec3, ImportError> {
-        Ok(Vec3::new(
-            self.f32(index[0], names[0])?,
-            self.f32(index[1], names[1])?,
-            self.f32(index[2], names[2])?,
-        ))
-    }
-
-    /// A head pose vector: must be finite.
-    fn finite_vec3(
-        &self,
-        index: [usize; 3],
-        names: [&'static str; 3],
-    ) -> Result<Vec3, ImportError> {
-        let v = self.vec3(index, names)?;
-        for (value, column) in v.to_array().into_iter().zip(names) {
-            if !value.is_finite() {
-                return Err(ImportError::NonFinite {
-                    file: self.name.to_owned(),
-                    line: self.line,
-                    column,
-                    value,
-                });
-            }
-        }
-        Ok(v)
-    }
-
-    /// One eye's ray in the OpenXR head frame.
-    fn eye(&self, cols: &Columns, eye: usize) -> Result<GazeRay, ImportError> {
-        let (valid_name, origin_names, direct_names) = if eye == 0 {
-            (VALID_L, ORIGIN_L, DIRECT_L)
-        } else {
-            (VALID_R, ORIGIN_R, DIRECT_R)
-        };
-        let flags = self.i64(
-            cols.valid[eye],
-            valid_name,
-            "an SRanipal validity bit mask (integer)",
-        )?;
-        if flags & i64::from(GAZE_VALID_MASK) != i64::from(GAZE_VALID_MASK) {
-            // The tracker says it has no ray; its numbers are not read.
-            return Ok(GazeRay::INVALID);
-        }
-        let origin_mm = self.vec3(cols.origin[eye], origin_names)?;
-        let direction = self.vec3(cols.direct[eye], direct_names)?;
-        Ok(sranipal_ray_to_openxr(origin_mm, direction))
-    }
+    let origin_mm = row.vec3(cols.origin[eye], origin_names)?;
+    let direction = row.vec3(cols.direct[eye], direct_names)?;
+    Ok(sranipal_ray_to_openxr(origin_mm, direction))
 }
 
 /// Converts an SRanipal gaze ray (origin in millimetres, +x to the wearer's left, +z forward)
@@ -479,12 +301,12 @@ struct Anchor {
 }
 
 impl Importer {
-    fn push(&mut self, cols: &Columns, row: &Row<'_>) -> Result<(), ImportError> {
+    fn push(&mut self, cols: &Columns, row: &Record<'_>) -> Result<(), ImportError> {
         let ticks = row.i64(cols.time, TIME, "an integer count of 100 ns ticks")?;
         let position = row.finite_vec3(cols.helmet_pos, HELMET_POS)?;
         let euler_deg = row.finite_vec3(cols.helmet_rot, HELMET_ROT)?;
-        let left = row.eye(cols, 0)?;
-        let right = row.eye(cols, 1)?;
+        let left = eye_ray(row, cols, 0)?;
+        let right = eye_ray(row, cols, 1)?;
         let pose = unity_pose_to_openxr(position, euler_deg);
 
         let anchor = *self.anchor.get_or_insert_with(|| {
@@ -500,16 +322,16 @@ impl Importer {
             .checked_sub(anchor.first_ticks)
             .and_then(|d| d.checked_mul(NS_PER_TICK))
             .ok_or(ImportError::TimeRange {
-                file: row.name.to_owned(),
-                line: row.line,
+                file: row.file().to_owned(),
+                line: row.line(),
                 ticks,
                 first_ticks: anchor.first_ticks,
             })?;
         if self.samples.last().is_some_and(|s| time_ns <= s.time_ns) {
             tracing::warn!(
                 "{}:{}: time {} ticks is not after the previous row; row dropped",
-                row.name,
-                row.line,
+                row.file(),
+                row.line(),
                 ticks
             );
             self.dropped_rows += 1;

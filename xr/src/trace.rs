@@ -18,13 +18,14 @@
 //! refuses, and flushes after every sample so a crash loses at most the sample being written.
 
 use std::fs::File;
-use std::io::{self, BufRead, BufReader, BufWriter, Write};
+use std::io::{self, BufReader, BufWriter, Read, Write};
 use std::path::Path;
 
 use glam::{Quat, Vec3};
 use thiserror::Error;
 
 use crate::frame::{GazeRay, GazeSample, Pose};
+use crate::records::{Record, RecordReader, printable};
 
 /// The first line of every version-1 trace.
 pub const VERSION_LINE: &str = "# vitreous-trace v1";
@@ -97,8 +98,10 @@ pub struct TraceSample {
     pub gaze: GazeSample,
 }
 
-/// Everything that can go wrong reading or writing a trace. Messages name the file, the line
-/// (1-based) and the column where they can.
+/// Everything that can go wrong reading or writing a trace, or importing one from another
+/// format ([`crate::sranipal`] uses this type too). Messages name the file, the line
+/// (1-based) and the column where they can; quoted file content is escaped and shortened
+/// ([`crate::records::printable`]).
 #[derive(Debug, Error)]
 pub enum TraceError {
     /// The file could not be opened, read or written.
@@ -112,11 +115,23 @@ pub enum TraceError {
         #[source]
         source: io::Error,
     },
-    /// The file has no lines at all.
-    #[error("{file}: empty file; expected first line `{VERSION_LINE}`")]
+    /// The file has no lines, or only empty ones.
+    #[error("{file}: empty file; expected {expected}")]
     Empty {
         /// File name.
         file: String,
+        /// What the first line should hold.
+        expected: &'static str,
+    },
+    /// A line is not valid UTF-8 text.
+    #[error("{file}:{line}: field {field} is not valid UTF-8 text")]
+    NotUtf8 {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// Field number (1-based).
+        field: usize,
     },
     /// The first line is not a vitreous trace version line.
     #[error("{file}:{line}: not a vitreous trace: expected `{VERSION_LINE}`, found `{found}`")]
@@ -160,17 +175,46 @@ pub enum TraceError {
         /// The name expected (empty when the header is too long).
         expected: &'static str,
     },
-    /// A sample line has the wrong number of fields.
-    #[error("{file}:{line}: {found} fields, expected {expected} (one per column)")]
+    /// A data line has a different number of fields from the column header.
+    #[error(
+        "{file}:{line}: {found} `{separator}`-separated fields, expected {expected} (one per column of the header)"
+    )]
     FieldCount {
         /// File name.
         file: String,
         /// Line number (1-based).
         line: usize,
-        /// Number of comma-separated fields found.
+        /// Number of fields found.
         found: usize,
-        /// Number of columns of the format.
+        /// Number of columns of the header.
         expected: usize,
+        /// The field separator of the format.
+        separator: char,
+    },
+    /// A column the SRanipal importer needs is not in the header row.
+    #[error("{file}:{line}: header row has no column `{column}`; is this an SRanipal recording?")]
+    MissingColumn {
+        /// File name.
+        file: String,
+        /// Line number of the header row.
+        line: usize,
+        /// The missing column name.
+        column: &'static str,
+    },
+    /// An SRanipal row's time is so far from the first row's that nanoseconds overflow an
+    /// `i64`.
+    #[error(
+        "{file}:{line}: column `time(100ns)`: {ticks} ticks is too far from the first row's {first_ticks} (nanoseconds overflow)"
+    )]
+    TimeRange {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// This row's ticks.
+        ticks: i64,
+        /// The first row's ticks.
+        first_ticks: i64,
     },
     /// A field could not be parsed.
     #[error("{file}:{line}: column `{column}`: expected {expected}, found `{found}`")]
@@ -266,34 +310,6 @@ pub enum TraceError {
         /// The first empty column of the group.
         column: &'static str,
     },
-}
-
-/// Builds a `BadField` error without repeating the struct each time.
-fn bad_field(
-    file: &str,
-    line: usize,
-    col: usize,
-    found: &str,
-    expected: &'static str,
-) -> TraceError {
-    TraceError::BadField {
-        file: file.to_owned(),
-        line,
-        column: COLUMNS[col],
-        found: shorten(found),
-        expected,
-    }
-}
-
-/// Keeps error messages readable when a line is garbage.
-fn shorten(s: &str) -> String {
-    const MAX: usize = 60;
-    if s.chars().count() <= MAX {
-        s.to_owned()
-    } else {
-        let head: String = s.chars().take(MAX).collect();
-        format!("{head}...")
-    }
 }
 
 /// Checks a head pose and its times; normalises small quaternion drift. Shared by the reader
@@ -393,43 +409,35 @@ pub fn clean_ray(ray: GazeRay) -> GazeRay {
     }
 }
 
-/// Parses a required float field (any finite or non-finite value; callers check finiteness).
-fn parse_f32(file: &str, line: usize, fields: &[&str], col: usize) -> Result<f32, TraceError> {
-    let text = fields[col];
-    text.parse::<f32>()
-        .map_err(|_| bad_field(file, line, col, text, "a decimal number"))
+/// Column names of the three columns starting at `col`.
+fn names3(col: usize) -> [&'static str; 3] {
+    [COLUMNS[col], COLUMNS[col + 1], COLUMNS[col + 2]]
+}
+
+/// Parses three consecutive float fields starting at column `col`.
+fn parse_vec3(record: &Record<'_>, col: usize) -> Result<Vec3, TraceError> {
+    record.vec3([col, col + 1, col + 2], names3(col))
 }
 
 /// Parses a required integer time field.
-fn parse_i64(file: &str, line: usize, fields: &[&str], col: usize) -> Result<i64, TraceError> {
-    let text = fields[col];
-    text.parse::<i64>()
-        .map_err(|_| bad_field(file, line, col, text, "an integer number of nanoseconds"))
-}
-
-/// Parses three consecutive float fields.
-fn parse_vec3(file: &str, line: usize, fields: &[&str], col: usize) -> Result<Vec3, TraceError> {
-    Ok(Vec3::new(
-        parse_f32(file, line, fields, col)?,
-        parse_f32(file, line, fields, col + 1)?,
-        parse_f32(file, line, fields, col + 2)?,
-    ))
+fn parse_time(record: &Record<'_>, col: usize) -> Result<i64, TraceError> {
+    record.i64(col, COLUMNS[col], "an integer number of nanoseconds")
 }
 
 /// Parses a ray group: `valid, origin xyz, dir xyz` starting at `col`. The caller has checked
 /// that the valid flag is present.
-fn parse_ray(file: &str, line: usize, fields: &[&str], col: usize) -> Result<GazeRay, TraceError> {
-    let valid = match fields[col] {
+fn parse_ray(record: &Record<'_>, col: usize) -> Result<GazeRay, TraceError> {
+    let valid = match record.field(col) {
         "1" => true,
         "0" => false,
-        other => return Err(bad_field(file, line, col, other, "0 or 1")),
+        other => return Err(record.bad(COLUMNS[col], other, "0 or 1")),
     };
     if !valid {
         // An invalid ray's numbers are meaningless: they may be empty and are not read.
         return Ok(GazeRay::INVALID);
     }
-    let origin = parse_vec3(file, line, fields, col + 1)?;
-    let direction = parse_vec3(file, line, fields, col + 4)?;
+    let origin = parse_vec3(record, col + 1)?;
+    let direction = parse_vec3(record, col + 4)?;
     Ok(clean_ray(GazeRay {
         origin,
         direction,
@@ -437,35 +445,28 @@ fn parse_ray(file: &str, line: usize, fields: &[&str], col: usize) -> Result<Gaz
     }))
 }
 
-/// Parses one sample line (already split into trimmed fields) without the time-order checks.
-fn parse_fields(file: &str, line: usize, fields: &[&str]) -> Result<TraceSample, TraceError> {
-    if fields.len() != COLUMNS.len() {
-        return Err(TraceError::FieldCount {
-            file: file.to_owned(),
-            line,
-            found: fields.len(),
-            expected: COLUMNS.len(),
-        });
-    }
-    let time_ns = parse_i64(file, line, fields, 0)?;
-    let position = parse_vec3(file, line, fields, 1)?;
+/// Parses one sample line without the time-order checks.
+fn parse_record(record: &Record<'_>) -> Result<TraceSample, TraceError> {
+    record.expect_len(COLUMNS.len())?;
+    let time_ns = parse_time(record, 0)?;
+    let position = parse_vec3(record, 1)?;
     let orientation = Quat::from_xyzw(
-        parse_f32(file, line, fields, 4)?,
-        parse_f32(file, line, fields, 5)?,
-        parse_f32(file, line, fields, 6)?,
-        parse_f32(file, line, fields, 7)?,
+        record.f32(4, COLUMNS[4])?,
+        record.f32(5, COLUMNS[5])?,
+        record.f32(6, COLUMNS[6])?,
+        record.f32(7, COLUMNS[7])?,
     );
-    let gaze_time_ns = parse_i64(file, line, fields, 8)?;
-    let left = parse_ray(file, line, fields, LEFT)?;
-    let right = parse_ray(file, line, fields, RIGHT)?;
+    let gaze_time_ns = parse_time(record, 8)?;
+    let left = parse_ray(record, LEFT)?;
+    let right = parse_ray(record, RIGHT)?;
 
-    let combined = match optional_group(file, line, fields, COMBINED, 7, "combined")? {
+    let combined = match optional_group(record, COMBINED, 7, "combined")? {
         false => None,
-        true => Some(parse_ray(file, line, fields, COMBINED)?),
+        true => Some(parse_ray(record, COMBINED)?),
     };
-    let fixation = match optional_group(file, line, fields, FIXATION, 3, "fixation")? {
+    let fixation = match optional_group(record, FIXATION, 3, "fixation")? {
         false => None,
-        true => Some(parse_vec3(file, line, fields, FIXATION)?),
+        true => Some(parse_vec3(record, FIXATION)?),
     };
     Ok(TraceSample {
         time_ns,
@@ -486,23 +487,21 @@ fn parse_fields(file: &str, line: usize, fields: &[&str]) -> Result<TraceSample,
 /// Whether an optional group is present. All empty: absent. For the combined ray, a `0` flag
 /// with empty numbers is allowed (present but invalid); otherwise every field must be filled.
 fn optional_group(
-    file: &str,
-    line: usize,
-    fields: &[&str],
+    record: &Record<'_>,
     col: usize,
     len: usize,
     group: &'static str,
 ) -> Result<bool, TraceError> {
-    let group_fields = &fields[col..col + len];
-    if group_fields.iter().all(|f| f.is_empty()) {
+    let empty = |i: usize| record.field(col + i).is_empty();
+    if (0..len).all(empty) {
         return Ok(false);
     }
-    let flag_only_invalid = group == "combined" && group_fields[0] == "0";
+    let flag_only_invalid = group == "combined" && record.field(col) == "0";
     let needed = if flag_only_invalid { 1 } else { len };
-    if let Some(i) = group_fields[..needed].iter().position(|f| f.is_empty()) {
+    if let Some(i) = (0..needed).find(|&i| empty(i)) {
         return Err(TraceError::PartialGroup {
-            file: file.to_owned(),
-            line,
+            file: record.file().to_owned(),
+            line: record.line(),
             group,
             column: COLUMNS[col + i],
         });
@@ -515,19 +514,13 @@ fn optional_group(
 /// The version and column header lines are checked by the constructor; samples are parsed
 /// and checked one line at a time as the iterator is advanced. After the first error the
 /// iterator ends.
-pub struct TraceReader<R> {
-    /// The text being read.
-    reader: R,
-    /// File name used in error messages.
-    name: String,
-    /// Number of the last line read (1-based).
-    line: usize,
+pub struct TraceReader<R: Read> {
+    /// The lines being read.
+    records: RecordReader<R>,
     /// Time and gaze time of the previous sample, for the ordering checks.
     previous: Option<(i64, i64)>,
     /// Set after an error or the end of the input: the iterator is fused.
     done: bool,
-    /// Reused line buffer.
-    buf: String,
 }
 
 impl TraceReader<BufReader<File>> {
@@ -544,17 +537,14 @@ impl TraceReader<BufReader<File>> {
     }
 }
 
-impl<R: BufRead> TraceReader<R> {
-    /// Reads a trace from any buffered reader; `name` is used in error messages. Checks the
-    /// version and column header lines.
+impl<R: Read> TraceReader<R> {
+    /// Reads a trace from any reader; `name` is used in error messages. Checks the version
+    /// and column header lines.
     pub fn new(reader: R, name: impl Into<String>) -> Result<Self, TraceError> {
         let mut this = TraceReader {
-            reader,
-            name: name.into(),
-            line: 0,
+            records: RecordReader::new(reader, name, b','),
             previous: None,
             done: false,
-            buf: String::new(),
         };
         this.read_headers()?;
         Ok(this)
@@ -562,82 +552,53 @@ impl<R: BufRead> TraceReader<R> {
 
     /// The file name used in error messages.
     pub fn name(&self) -> &str {
-        &self.name
-    }
-
-    /// Reads the next physical line into `self.buf` without its line ending; `false` at EOF.
-    fn next_line(&mut self) -> Result<bool, TraceError> {
-        self.buf.clear();
-        let n = self
-            .reader
-            .read_line(&mut self.buf)
-            .map_err(|source| TraceError::Io {
-                file: self.name.clone(),
-                context: format!("reading line {}", self.line + 1),
-                source,
-            })?;
-        if n == 0 {
-            return Ok(false);
-        }
-        self.line += 1;
-        let trimmed = self.buf.trim_end_matches(['\n', '\r']).len();
-        self.buf.truncate(trimmed);
-        Ok(true)
-    }
-
-    /// Reads the next line that is neither blank nor a `#` comment; `false` at EOF.
-    fn next_content_line(&mut self) -> Result<bool, TraceError> {
-        loop {
-            if !self.next_line()? {
-                return Ok(false);
-            }
-            let t = self.buf.trim();
-            if !t.is_empty() && !t.starts_with('#') {
-                return Ok(true);
-            }
-        }
+        self.records.file()
     }
 
     /// Checks the version line and the column header line.
     fn read_headers(&mut self) -> Result<(), TraceError> {
-        if !self.next_line()? {
+        let name = self.records.file().to_owned();
+        let Some(first) = self.records.next_record()? else {
             return Err(TraceError::Empty {
-                file: self.name.clone(),
+                file: name,
+                expected: "first line `# vitreous-trace v1`",
             });
-        }
-        let first = self.buf.trim_start_matches('\u{feff}').trim();
-        match first.strip_prefix(VERSION_PREFIX) {
+        };
+        let text = first.text();
+        let text = text.trim_start_matches('\u{feff}').trim();
+        match text.strip_prefix(VERSION_PREFIX) {
             Some("v1") => {}
             Some(version) => {
                 return Err(TraceError::UnsupportedVersion {
-                    file: self.name.clone(),
-                    line: self.line,
-                    version: shorten(version.trim()),
+                    file: name,
+                    line: first.line(),
+                    version: printable(version.trim()),
                 });
             }
             None => {
                 return Err(TraceError::BadVersionLine {
-                    file: self.name.clone(),
-                    line: self.line,
-                    found: shorten(first),
+                    file: name,
+                    line: first.line(),
+                    found: printable(text),
                 });
             }
         }
-        if !self.next_content_line()? {
-            return Err(TraceError::MissingColumnHeader {
-                file: self.name.clone(),
-            });
-        }
-        let names: Vec<&str> = self.buf.split(',').map(str::trim).collect();
-        for i in 0..names.len().max(COLUMNS.len()) {
-            let found = names.get(i).copied().unwrap_or("");
+        let Some(header) = self.records.next_content_record()? else {
+            return Err(TraceError::MissingColumnHeader { file: name });
+        };
+        for i in 0..header.len().max(COLUMNS.len()) {
+            let found = if i < header.len() {
+                header.field(i)
+            } else {
+                ""
+            };
             let expected = COLUMNS.get(i).copied().unwrap_or("");
             if found != expected {
                 return Err(TraceError::BadColumnHeader {
-                    file: self.name.clone(),
-                    line: self.line,
+                    file: name,
+                    line: header.line(),
                     column: i + 1,
-                    found: shorten(found),
+                    found: printable(found),
                     expected,
                 });
             }
@@ -647,18 +608,17 @@ impl<R: BufRead> TraceReader<R> {
 
     /// Reads, parses and checks the next sample.
     fn next_sample(&mut self) -> Result<Option<TraceSample>, TraceError> {
-        if !self.next_content_line()? {
+        let Some(record) = self.records.next_content_record()? else {
             return Ok(None);
-        }
-        let fields: Vec<&str> = self.buf.split(',').map(str::trim).collect();
-        let raw = parse_fields(&self.name, self.line, &fields)?;
-        let sample = check_sample(&self.name, self.line, &raw, self.previous)?;
+        };
+        let raw = parse_record(&record)?;
+        let sample = check_sample(record.file(), record.line(), &raw, self.previous)?;
         self.previous = Some((sample.time_ns, sample.gaze.sample_time_ns));
         Ok(Some(sample))
     }
 }
 
-impl<R: BufRead> Iterator for TraceReader<R> {
+impl<R: Read> Iterator for TraceReader<R> {
     type Item = Result<TraceSample, TraceError>;
 
     fn next(&mut self) -> Option<Self::Item> {
@@ -679,7 +639,7 @@ impl<R: BufRead> Iterator for TraceReader<R> {
     }
 }
 
-impl<R: BufRead> std::iter::FusedIterator for TraceReader<R> {}
+impl<R: Read> std::iter::FusedIterator for TraceReader<R> {}
 
 /// Reads a whole trace file into memory.
 pub fn read_trace(path: impl AsRef<Path>) -> Result<Vec<TraceSample>, TraceError> {

@@ -11,6 +11,9 @@
 //! Line numbers are counted here, not taken from the parser (whose count skips the empty
 //! lines before a record and does not count a lone `\r`): without quoting, every non-empty
 //! line is exactly one record, so the n-th record is the n-th non-empty line.
+//!
+//! Reading is bounded: a line longer than [`MAX_LINE_BYTES`] is refused as soon as the limit
+//! is passed, so a huge file without line endings is never held in memory whole.
 
 use std::collections::VecDeque;
 use std::io::{self, Read};
@@ -21,6 +24,10 @@ use crate::trace::TraceError;
 
 /// At most this many characters of file content are quoted in an error message.
 pub const QUOTED_CHARS: usize = 60;
+
+/// The longest line the trace reader and the SRanipal importer accept, in bytes, line ending
+/// not counted (64 KiB). A trace line is under 1 KiB and an SRanipal row a few hundred bytes.
+pub const MAX_LINE_BYTES: usize = 64 * 1024;
 
 /// File content as it may appear in a message: control characters, NUL and other
 /// non-printing characters escaped (`\0`, `\u{1b}`, ...), cut after [`QUOTED_CHARS`]
@@ -37,50 +44,103 @@ pub fn printable(text: &str) -> String {
     out
 }
 
+/// A line passed the length limit: the payload of the I/O error [`LineNumbers`] returns.
+#[derive(Debug)]
+struct LineTooLong {
+    /// Line number (1-based).
+    line: usize,
+    /// The limit passed, bytes.
+    limit: usize,
+    /// The first bytes of the line.
+    start: Vec<u8>,
+}
+
+impl std::fmt::Display for LineTooLong {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "line {} is longer than {} bytes", self.line, self.limit)
+    }
+}
+
+impl std::error::Error for LineTooLong {}
+
 /// A reader that notes the number of every non-empty line passing through it, ending lines
-/// as the CSV parser does (`\n`, `\r` and `\r\n` each end one line).
+/// as the CSV parser does (`\n`, `\r` and `\r\n` each end one line), and fails once a line
+/// grows past a limit.
 struct LineNumbers<R> {
     /// The bytes being read.
     inner: R,
+    /// The longest line allowed, bytes.
+    limit: usize,
     /// Lines ended so far.
     ended: usize,
-    /// Whether the current line has a byte other than a line ending yet.
-    in_content: bool,
+    /// Bytes of the current line so far.
+    run: usize,
     /// Whether the last byte was `\r` (a following `\n` then ends no further line).
     after_cr: bool,
     /// Numbers (1-based) of the non-empty lines read ahead by the parser and not yet handed
     /// out as records; at most one per two bytes of the parser's buffer.
     pending: VecDeque<usize>,
+    /// The first bytes of the current line, for the message when it is too long.
+    start: Vec<u8>,
+    /// The error to return from the next read, once a line has passed the limit.
+    failed: Option<io::Error>,
 }
 
 impl<R> LineNumbers<R> {
-    fn new(inner: R) -> Self {
+    /// Bytes of a line kept for the message: enough for [`QUOTED_CHARS`] characters.
+    const START_BYTES: usize = 4 * QUOTED_CHARS;
+
+    fn new(inner: R, limit: usize) -> Self {
         LineNumbers {
             inner,
+            limit,
             ended: 0,
-            in_content: false,
+            run: 0,
             after_cr: false,
             pending: VecDeque::new(),
+            start: Vec::new(),
+            failed: None,
         }
     }
 }
 
 impl<R: Read> Read for LineNumbers<R> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        if let Some(error) = self.failed.take() {
+            return Err(error);
+        }
         let n = self.inner.read(buf)?;
-        for &b in &buf[..n] {
+        for (i, &b) in buf[..n].iter().enumerate() {
             match b {
                 b'\n' if self.after_cr => self.after_cr = false,
                 b'\n' | b'\r' => {
                     self.ended += 1;
-                    self.in_content = false;
+                    self.run = 0;
+                    self.start.clear();
                     self.after_cr = b == b'\r';
                 }
                 _ => {
                     self.after_cr = false;
-                    if !self.in_content {
-                        self.in_content = true;
+                    if self.run == 0 {
                         self.pending.push_back(self.ended + 1);
+                    }
+                    self.run += 1;
+                    if self.start.len() < Self::START_BYTES {
+                        self.start.push(b);
+                    }
+                    if self.run > self.limit {
+                        let error = io::Error::other(LineTooLong {
+                            line: self.ended + 1,
+                            limit: self.limit,
+                            start: std::mem::take(&mut self.start),
+                        });
+                        // The lines before this one are handed out first: the parser reads
+                        // again, and gets the error, since this line has not ended.
+                        if i == 0 {
+                            return Err(error);
+                        }
+                        self.failed = Some(error);
+                        return Ok(i);
                     }
                 }
             }
@@ -91,7 +151,7 @@ impl<R: Read> Read for LineNumbers<R> {
 
 /// Reads delimiter-separated records one at a time, tracking the line of each for messages.
 pub(crate) struct RecordReader<R: Read> {
-    /// The CSV parser, over the input with its lines numbered.
+    /// The CSV parser, over the input with its lines numbered and bounded.
     csv: csv::Reader<LineNumbers<R>>,
     /// File name used in error messages.
     file: String,
@@ -107,13 +167,18 @@ impl<R: Read> RecordReader<R> {
     /// Reads records separated by `separator` (an ASCII character) from `reader`; `file` is
     /// the name used in error messages.
     pub(crate) fn new(reader: R, file: impl Into<String>, separator: u8) -> Self {
+        RecordReader::with_line_limit(reader, file, separator, MAX_LINE_BYTES)
+    }
+
+    /// Like [`RecordReader::new`], refusing lines longer than `limit` bytes.
+    fn with_line_limit(reader: R, file: impl Into<String>, separator: u8, limit: usize) -> Self {
         let csv = csv::ReaderBuilder::new()
             .delimiter(separator)
             .has_headers(false)
             .flexible(true)
             .quoting(false)
             .trim(csv::Trim::All)
-            .from_reader(LineNumbers::new(reader));
+            .from_reader(LineNumbers::new(reader, limit));
         RecordReader {
             csv,
             file: file.into(),
@@ -173,10 +238,21 @@ impl<R: Read> RecordReader<R> {
     /// Turns a CSV error into a trace error naming the file and line.
     fn read_error(&mut self, error: csv::Error) -> TraceError {
         match error.into_kind() {
-            csv::ErrorKind::Io(source) => TraceError::Io {
-                file: self.file.clone(),
-                context: format!("reading line {}", self.line + 1),
-                source,
+            csv::ErrorKind::Io(source) => match source
+                .get_ref()
+                .and_then(|e| e.downcast_ref::<LineTooLong>())
+            {
+                Some(long) => TraceError::LineTooLong {
+                    file: self.file.clone(),
+                    line: long.line,
+                    limit: long.limit,
+                    start: printable(&String::from_utf8_lossy(&long.start)),
+                },
+                None => TraceError::Io {
+                    file: self.file.clone(),
+                    context: format!("reading line {}", self.line + 1),
+                    source,
+                },
             },
             csv::ErrorKind::Utf8 { err, .. } => TraceError::NotUtf8 {
                 file: self.file.clone(),
@@ -372,6 +448,53 @@ mod tests {
             ),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_line_past_the_limit_is_refused_with_its_start_escaped() {
+        let text = format!("a,b\r\n\nc,d\n\0{}\n", "x".repeat(100));
+        let mut r = RecordReader::with_line_limit(text.as_bytes(), "t.csv", b',', 50);
+        assert!(r.next_record().unwrap().is_some());
+        assert!(r.next_record().unwrap().is_some());
+        let e = r.next_record().unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::LineTooLong {
+                    line: 4,
+                    limit: 50,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        let message = e.to_string();
+        assert!(message.starts_with("t.csv:4:"), "{message}");
+        assert!(message.contains("\\0xxx"), "{message}");
+        assert!(!message.contains('\0'), "{message}");
+        // Lines up to the limit are fine.
+        let text = format!("{}\n", "y".repeat(50));
+        let mut r = RecordReader::with_line_limit(text.as_bytes(), "t.csv", b',', 50);
+        assert!(r.next_record().unwrap().is_some());
+    }
+
+    #[test]
+    fn a_long_input_without_line_endings_stops_at_the_limit() {
+        // An endless stream of NULs: reading must stop soon after the limit.
+        let mut r = RecordReader::new(io::repeat(0), "zeros", b',');
+        let e = r.next_record().unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::LineTooLong {
+                    line: 1,
+                    limit: MAX_LINE_BYTES,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(!e.to_string().contains('\0'));
     }
 
     #[test]

@@ -654,6 +654,21 @@ mod tests {
     }
 
     #[test]
+    fn a_huge_row_is_refused_with_its_start_escaped() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.csv");
+        let mut text = format!("{MINI_HEADER}\n").into_bytes();
+        text.extend(std::iter::repeat_n(0u8, 2 << 20));
+        std::fs::write(&path, &text).unwrap();
+        let e = import_sranipal(&path).unwrap_err();
+        assert!(matches!(e, ImportError::LineTooLong { line: 2, .. }), "{e}");
+        let message = e.to_string();
+        assert!(message.contains("huge.csv:2:"), "{message}");
+        assert!(message.contains("\\0\\0"), "{message}");
+        assert!(!message.contains('\0'), "{message}");
+    }
+
+    #[test]
     fn repeated_times_are_dropped_and_counted() {
         let a = mini_row(Vec3::ZERO, Vec3::ZERO, 10);
         let b = mini_row(Vec3::ZERO, Vec3::ZERO, 10);

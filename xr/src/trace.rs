@@ -123,6 +123,18 @@ pub enum TraceError {
         /// What the first line should hold.
         expected: &'static str,
     },
+    /// A line is longer than the readers accept ([`crate::records::MAX_LINE_BYTES`]).
+    #[error("{file}:{line}: line is longer than {limit} bytes; it starts `{start}`")]
+    LineTooLong {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// The limit, bytes.
+        limit: usize,
+        /// The start of the line, escaped and shortened.
+        start: String,
+    },
     /// A line is not valid UTF-8 text.
     #[error("{file}:{line}: field {field} is not valid UTF-8 text")]
     NotUtf8 {
@@ -880,6 +892,45 @@ mod tests {
     fn missing_file_names_the_file() {
         let e = read_trace("/nonexistent/dir/x.trace").unwrap_err();
         assert!(e.to_string().contains("/nonexistent/dir/x.trace"), "{e}");
+    }
+
+    #[test]
+    fn a_huge_line_is_refused_without_reading_it_whole_or_printing_it_raw() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.trace");
+        let mut text = good_text(1).into_bytes();
+        let mut huge = b"1\0\x1b".repeat(1 << 20);
+        huge.push(b'\n');
+        text.extend_from_slice(&huge);
+        std::fs::write(&path, &text).unwrap();
+        let e = read_trace(&path).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TraceError::LineTooLong {
+                    line: 4,
+                    limit: crate::records::MAX_LINE_BYTES,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        let message = e.to_string();
+        assert!(message.contains("huge.trace:4:"), "{message}");
+        assert!(message.contains("1\\0\\u{1b}1"), "{message}");
+        assert!(!message.chars().any(char::is_control), "{message}");
+        assert!(message.len() < 400, "{message}");
+        // The same bytes as the first line: refused before the version check quotes them.
+        std::fs::write(&path, &huge).unwrap();
+        let e = read_trace(&path).unwrap_err();
+        assert!(matches!(e, TraceError::LineTooLong { line: 1, .. }), "{e}");
+    }
+
+    #[test]
+    fn control_characters_in_a_field_are_escaped() {
+        let text = with_field(&good_text(1), 3, 2, "1\u{7}\u{0}");
+        let e = read_str(&text).unwrap_err();
+        assert!(e.to_string().contains("1\\u{7}\\0"), "{e}");
     }
 
     #[test]

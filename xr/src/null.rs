@@ -24,7 +24,7 @@ use glam::Vec3;
 use thiserror::Error;
 
 use crate::frame::{Backend, EyeView, Fov, FrameInput, GazeSample, Pose};
-use crate::trace::{TraceError, TraceReader, TraceSample};
+use crate::trace::{MAX_SAMPLE_GAP_NS, MAX_TRACE_SPAN_NS, TraceError, TraceReader, TraceSample};
 
 /// How the null backend turns a trace into frames.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -71,6 +71,25 @@ pub enum NullError {
         value: String,
         /// What it should be.
         expected: &'static str,
+    },
+    /// Samples handed in directly span more time than a trace may
+    /// ([`MAX_SAMPLE_GAP_NS`] after the previous sample, [`MAX_TRACE_SPAN_NS`] after the first).
+    #[error(
+        "{source_name}: sample {index}: time_ns {time_ns} is too far after {what} {reference_ns} (at most {limit_s} s)"
+    )]
+    TooLong {
+        /// Name of the trace.
+        source_name: String,
+        /// Index of the offending sample (0-based).
+        index: u64,
+        /// Its time.
+        time_ns: i64,
+        /// Which earlier sample the limit is measured from.
+        what: &'static str,
+        /// That sample's time.
+        reference_ns: i64,
+        /// The limit, seconds.
+        limit_s: i64,
     },
     /// Samples handed in directly are not in time order.
     #[error(
@@ -120,6 +139,8 @@ pub struct NullBackend {
     origin_count: [u64; 2],
     /// Time of the first sample, nanoseconds.
     t0_ns: i64,
+    /// Time of the first sample, once read (for the span check).
+    first_ns: Option<i64>,
     /// Index of the next frame to hand out.
     next_index: u64,
     /// The frame handed out and not yet ended.
@@ -183,6 +204,7 @@ impl NullBackend {
             origin_sum_m: [Vec3::ZERO; 2],
             origin_count: [0; 2],
             t0_ns: 0,
+            first_ns: None,
             next_index: 0,
             pending: None,
             done: false,
@@ -243,7 +265,28 @@ impl NullBackend {
             if sample.gaze.sample_time_ns < prev.gaze.sample_time_ns {
                 return Err(out_of_order("gaze time decreasing", prev.time_ns));
             }
+            // The trace reader checks the same limits with the line; samples handed in
+            // directly get them here.
+            let first_ns = self.first_ns.unwrap_or(prev.time_ns);
+            let too_long = |reference_ns: i64, what, limit_ns: i64| {
+                (i128::from(sample.time_ns) - i128::from(reference_ns) > i128::from(limit_ns)).then(
+                    || NullError::TooLong {
+                        source_name: self.name.clone(),
+                        index,
+                        time_ns: sample.time_ns,
+                        what,
+                        reference_ns,
+                        limit_s: limit_ns / 1_000_000_000,
+                    },
+                )
+            };
+            if let Some(e) = too_long(prev.time_ns, "the previous sample's", MAX_SAMPLE_GAP_NS)
+                .or_else(|| too_long(first_ns, "the first sample's", MAX_TRACE_SPAN_NS))
+            {
+                return Err(e);
+            }
         }
+        self.first_ns.get_or_insert(sample.time_ns);
         self.buffer.push_back(sample);
         self.read_count += 1;
         Ok(true)
@@ -276,7 +319,9 @@ impl NullBackend {
         let head = match self.buffer.get(a + 1) {
             Some(b) if self.buffer[a].time_ns < time_ns => {
                 let sa = &self.buffer[a];
-                let f = (time_ns - sa.time_ns) as f64 / (b.time_ns - sa.time_ns) as f64;
+                // In 128 bits: the differences of any two i64 times fit.
+                let f = (i128::from(time_ns) - i128::from(sa.time_ns)) as f64
+                    / (i128::from(b.time_ns) - i128::from(sa.time_ns)) as f64;
                 interpolate(&sa.head, &b.head, f as f32)
             }
             _ => self.buffer[a].head,
@@ -359,10 +404,18 @@ impl Backend for NullBackend {
             self.done = true;
             return Ok(None);
         }
+        // A frame time past the end of i64 is past the last sample: the replay ends (saturating
+        // instead would show the last sample forever).
         let offset_ns = (index as f64 * 1e9 / self.config.frame_rate_hz).round();
-        let time_ns = self
-            .t0_ns
-            .saturating_add(offset_ns.min(i64::MAX as f64) as i64);
+        let time_ns = if offset_ns < i64::MAX as f64 {
+            self.t0_ns.checked_add(offset_ns as i64)
+        } else {
+            None
+        };
+        let Some(time_ns) = time_ns else {
+            self.done = true;
+            return Ok(None);
+        };
         match self.frame_at(index, time_ns) {
             Ok(Some(frame)) => {
                 self.next_index += 1;
@@ -629,6 +682,56 @@ mod tests {
             ..NullConfig::default()
         };
         assert!(NullBackend::new(ten_ms_trace(), bad_rate).is_err());
+    }
+
+    #[test]
+    fn samples_spanning_too_long_are_refused() {
+        let gap = vec![
+            sample(0, Vec3::ZERO, 0.0),
+            sample(MAX_SAMPLE_GAP_NS + 1, Vec3::ZERO, 0.0),
+        ];
+        let mut b = NullBackend::new(gap, NullConfig::default()).unwrap();
+        let e = b.wait_frame().unwrap_err();
+        assert!(matches!(e, NullError::TooLong { index: 1, .. }), "{e}");
+        let overflow = vec![
+            sample(i64::MIN, Vec3::ZERO, 0.0),
+            sample(i64::MAX, Vec3::ZERO, 0.0),
+        ];
+        let mut b = NullBackend::new(overflow, NullConfig::default()).unwrap();
+        assert!(matches!(b.wait_frame(), Err(NullError::TooLong { .. })));
+        let step = MAX_SAMPLE_GAP_NS;
+        let long: Vec<_> = (0..=MAX_TRACE_SPAN_NS / step + 1)
+            .map(|i| sample(i * step, Vec3::ZERO, 0.0))
+            .collect();
+        let config = NullConfig {
+            frame_rate_hz: 1e-3,
+            ..NullConfig::default()
+        };
+        let mut b = NullBackend::new(long, config).unwrap();
+        let e = loop {
+            match b.wait_frame() {
+                Ok(Some(f)) => b.end_frame(&f).unwrap(),
+                Ok(None) => panic!("replay ended without refusing the trace"),
+                Err(e) => break e,
+            }
+        };
+        assert!(e.to_string().contains("the first sample's"), "{e}");
+    }
+
+    #[test]
+    fn a_trace_ending_near_the_end_of_time_ends_the_replay() {
+        let near_end = vec![
+            sample(i64::MAX - 20_000_000, Vec3::ZERO, 0.0),
+            sample(i64::MAX, Vec3::ZERO, 0.0),
+        ];
+        let mut b = NullBackend::new(near_end, NullConfig::default()).unwrap();
+        let mut frames = 0;
+        while let Some(f) = b.wait_frame().unwrap() {
+            b.end_frame(&f).unwrap();
+            frames += 1;
+            assert!(frames < 10, "replay does not end");
+        }
+        assert_eq!(frames, 2);
     }
 
     #[test]

@@ -27,6 +27,8 @@
 //!   motion relative to the first row, are kept.
 //! - **Time**: nanoseconds since the first row; the gaze sample time is the row time. Rows
 //!   whose time is not after the previous kept row are dropped and counted in the report.
+//!   The trace limits apply: a gap over [`crate::trace::MAX_SAMPLE_GAP_NS`] after the
+//!   previous row, or a span over [`crate::trace::MAX_TRACE_SPAN_NS`], fails the import.
 
 use std::fmt;
 use std::fs::File;
@@ -37,7 +39,7 @@ use glam::{Quat, Vec3};
 
 use crate::frame::{GazeRay, GazeSample, Pose};
 use crate::records::{Record, RecordReader};
-use crate::trace::{TraceError, TraceSample, clean_ray};
+use crate::trace::{TraceError, TraceSample, check_span, clean_ray};
 
 /// SRanipal validity bits needed for a usable gaze ray: gaze origin (bit 0) and gaze
 /// direction (bit 1).
@@ -336,6 +338,9 @@ impl Importer {
             );
             self.dropped_rows += 1;
             return Ok(());
+        }
+        if let Some(last) = self.samples.last() {
+            check_span(row.file(), row.line(), time_ns, last.time_ns, 0)?;
         }
         self.samples.push(TraceSample {
             time_ns,
@@ -666,6 +671,18 @@ mod tests {
         assert!(message.contains("huge.csv:2:"), "{message}");
         assert!(message.contains("\\0\\0"), "{message}");
         assert!(!message.contains('\0'), "{message}");
+    }
+
+    #[test]
+    fn clock_jumps_are_refused_with_the_line() {
+        let a = mini_row(Vec3::ZERO, Vec3::ZERO, 10);
+        // One hour later, in 100 ns ticks.
+        let b = mini_row(Vec3::ZERO, Vec3::ZERO, 10 + 36_000_000_000);
+        let e = parse(&format!("{MINI_HEADER}\n{a}\n{b}\n")).unwrap_err();
+        assert!(matches!(e, ImportError::GapTooLong { line: 3, .. }), "{e}");
+        let c = mini_row(Vec3::ZERO, Vec3::ZERO, i64::MAX);
+        let e = parse(&format!("{MINI_HEADER}\n{a}\n{c}\n")).unwrap_err();
+        assert!(matches!(e, ImportError::TimeRange { line: 3, .. }), "{e}");
     }
 
     #[test]

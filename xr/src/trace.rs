@@ -80,6 +80,15 @@ const FIXATION: usize = 30;
 /// the quaternion is normalised (text round-off, other tools' rounding).
 pub const QUAT_NORM_TOLERANCE: f32 = 1e-3;
 
+/// The longest trace accepted: 24 hours from the first sample's `time_ns` to the last's.
+/// Replay at 90 Hz then takes under 8 million frames; anything longer is a clock error.
+pub const MAX_TRACE_SPAN_NS: i64 = 24 * 3600 * 1_000_000_000;
+
+/// The longest gap accepted between the `time_ns` of consecutive samples: 10 minutes. A
+/// longer pause in a recording is a clock jump, and replaying it would show one frozen pose
+/// for that long.
+pub const MAX_SAMPLE_GAP_NS: i64 = 10 * 60 * 1_000_000_000;
+
 /// Below this length a gaze direction counts as zero (the ray is then invalid).
 const MIN_DIRECTION_LENGTH: f32 = 1e-6;
 
@@ -280,6 +289,41 @@ pub enum TraceError {
         /// The previous sample's time.
         previous_ns: i64,
     },
+    /// `time_ns` is further after the previous sample's than [`MAX_SAMPLE_GAP_NS`].
+    #[error(
+        "{file}:{line}: column `time_ns`: {time_ns} is {gap_s:.1} s after the previous sample's {previous_ns}; the longest gap between samples is {} s",
+        MAX_SAMPLE_GAP_NS / 1_000_000_000
+    )]
+    GapTooLong {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// This sample's time.
+        time_ns: i64,
+        /// The previous sample's time.
+        previous_ns: i64,
+        /// The gap, seconds.
+        gap_s: f64,
+    },
+    /// `time_ns` is further after the first sample's than [`MAX_TRACE_SPAN_NS`].
+    #[error(
+        "{file}:{line}: column `time_ns`: {time_ns} is {span_s:.1} s after the first sample's {first_ns}; the longest trace is {} s ({} hours)",
+        MAX_TRACE_SPAN_NS / 1_000_000_000,
+        MAX_TRACE_SPAN_NS / 3_600_000_000_000
+    )]
+    SpanTooLong {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// This sample's time.
+        time_ns: i64,
+        /// The first sample's time.
+        first_ns: i64,
+        /// The span, seconds.
+        span_s: f64,
+    },
     /// `gaze_time_ns` is later than the head pose time of the same line.
     #[error(
         "{file}:{line}: column `gaze_time_ns`: {gaze_time_ns} is after time_ns {time_ns}; a line pairs a head pose with the newest gaze sample at or before it"
@@ -324,13 +368,70 @@ pub enum TraceError {
     },
 }
 
+/// What the checks of a sample need to know of the samples before it.
+#[derive(Clone, Copy, Debug)]
+struct Preceding {
+    /// The first sample's time.
+    first_ns: i64,
+    /// The previous sample's time.
+    time_ns: i64,
+    /// The previous sample's gaze time.
+    gaze_time_ns: i64,
+}
+
+impl Preceding {
+    /// What follows a sample accepted after `before`.
+    fn after(before: Option<Preceding>, sample: &TraceSample) -> Preceding {
+        Preceding {
+            first_ns: before.map_or(sample.time_ns, |b| b.first_ns),
+            time_ns: sample.time_ns,
+            gaze_time_ns: sample.gaze.sample_time_ns,
+        }
+    }
+}
+
+/// Nanoseconds from `from` to `to`, seconds (no overflow: computed in 128 bits).
+fn span_s(from: i64, to: i64) -> f64 {
+    (i128::from(to) - i128::from(from)) as f64 * 1e-9
+}
+
+/// Checks the replay time limits: the gap to the previous sample and the span from the first
+/// are at most [`MAX_SAMPLE_GAP_NS`] and [`MAX_TRACE_SPAN_NS`]. `time_ns` is after both.
+pub(crate) fn check_span(
+    file: &str,
+    line: usize,
+    time_ns: i64,
+    previous_ns: i64,
+    first_ns: i64,
+) -> Result<(), TraceError> {
+    if i128::from(time_ns) - i128::from(previous_ns) > i128::from(MAX_SAMPLE_GAP_NS) {
+        return Err(TraceError::GapTooLong {
+            file: file.to_owned(),
+            line,
+            time_ns,
+            previous_ns,
+            gap_s: span_s(previous_ns, time_ns),
+        });
+    }
+    if i128::from(time_ns) - i128::from(first_ns) > i128::from(MAX_TRACE_SPAN_NS) {
+        return Err(TraceError::SpanTooLong {
+            file: file.to_owned(),
+            line,
+            time_ns,
+            first_ns,
+            span_s: span_s(first_ns, time_ns),
+        });
+    }
+    Ok(())
+}
+
 /// Checks a head pose and its times; normalises small quaternion drift. Shared by the reader
 /// and the writer so that what one accepts the other does too.
 fn check_sample(
     file: &str,
     line: usize,
     sample: &TraceSample,
-    previous: Option<(i64, i64)>,
+    previous: Option<Preceding>,
 ) -> Result<TraceSample, TraceError> {
     let p = sample.head.position;
     let q = sample.head.orientation;
@@ -354,21 +455,22 @@ fn check_sample(
         });
     }
     let gaze_time_ns = sample.gaze.sample_time_ns;
-    if let Some((previous_ns, previous_gaze_ns)) = previous {
-        if sample.time_ns <= previous_ns {
+    if let Some(before) = previous {
+        if sample.time_ns <= before.time_ns {
             return Err(TraceError::TimeNotIncreasing {
                 file: file.to_owned(),
                 line,
                 time_ns: sample.time_ns,
-                previous_ns,
+                previous_ns: before.time_ns,
             });
         }
-        if gaze_time_ns < previous_gaze_ns {
+        check_span(file, line, sample.time_ns, before.time_ns, before.first_ns)?;
+        if gaze_time_ns < before.gaze_time_ns {
             return Err(TraceError::GazeTimeBackwards {
                 file: file.to_owned(),
                 line,
                 gaze_time_ns,
-                previous_ns: previous_gaze_ns,
+                previous_ns: before.gaze_time_ns,
             });
         }
     }
@@ -529,8 +631,8 @@ fn optional_group(
 pub struct TraceReader<R: Read> {
     /// The lines being read.
     records: RecordReader<R>,
-    /// Time and gaze time of the previous sample, for the ordering checks.
-    previous: Option<(i64, i64)>,
+    /// What the ordering checks need of the samples before.
+    previous: Option<Preceding>,
     /// Set after an error or the end of the input: the iterator is fused.
     done: bool,
 }
@@ -625,7 +727,7 @@ impl<R: Read> TraceReader<R> {
         };
         let raw = parse_record(&record)?;
         let sample = check_sample(record.file(), record.line(), &raw, self.previous)?;
-        self.previous = Some((sample.time_ns, sample.gaze.sample_time_ns));
+        self.previous = Some(Preceding::after(self.previous, &sample));
         Ok(Some(sample))
     }
 }
@@ -669,8 +771,8 @@ pub struct TraceWriter<W: Write> {
     name: String,
     /// Line number the next sample will have (1-based).
     line: usize,
-    /// Time and gaze time of the previous sample, for the ordering checks.
-    previous: Option<(i64, i64)>,
+    /// What the ordering checks need of the samples before.
+    previous: Option<Preceding>,
     /// Reused line buffer.
     buf: String,
 }
@@ -738,7 +840,7 @@ impl<W: Write> TraceWriter<W> {
         }
         b.push('\n');
         self.flush_buf("writing sample")?;
-        self.previous = Some((s.time_ns, s.gaze.sample_time_ns));
+        self.previous = Some(Preceding::after(self.previous, &s));
         self.line += 1;
         Ok(())
     }
@@ -1119,6 +1221,52 @@ mod tests {
         // Equal gaze times are fine: a faster head tracker repeats the gaze sample.
         let text = with_field(&good_text(3), 4, 8, "995");
         assert!(read_str(&text).is_ok());
+    }
+
+    #[test]
+    fn traces_that_would_replay_for_ages_are_refused() {
+        // A gap of years before the last sample.
+        let years_ns = 3 * 365 * 86_400 * 1_000_000_000i64;
+        let text = with_field(&good_text(3), 5, 0, &years_ns.to_string());
+        let e = read_str(&text).unwrap_err();
+        assert!(matches!(e, TraceError::GapTooLong { line: 5, .. }), "{e}");
+        assert!(e.to_string().contains("test.trace:5"), "{e}");
+        // A span overflowing 64-bit nanoseconds.
+        let text = with_field(
+            &with_field(&good_text(2), 3, 0, &i64::MIN.to_string()),
+            3,
+            8,
+            &i64::MIN.to_string(),
+        );
+        let text = with_field(&text, 4, 0, &i64::MAX.to_string());
+        let e = read_str(&text).unwrap_err();
+        assert!(matches!(e, TraceError::GapTooLong { line: 4, .. }), "{e}");
+        // Many gaps under the limit adding up to more than the longest trace.
+        let step = MAX_SAMPLE_GAP_NS;
+        let count = MAX_TRACE_SPAN_NS / step + 2;
+        let samples: Vec<_> = (0..count).map(|i| sample(i * step + 10)).collect();
+        let mut w = TraceWriter::new(Vec::new()).unwrap();
+        for s in &samples[..samples.len() - 1] {
+            w.write(s).unwrap();
+        }
+        let e = w.write(&samples[samples.len() - 1]).unwrap_err();
+        assert!(matches!(e, TraceError::SpanTooLong { .. }), "{e}");
+        let mut text = String::from_utf8(w.finish().unwrap()).unwrap();
+        let last = samples[samples.len() - 1];
+        let last_line = to_text(&[last]).lines().nth(2).unwrap().to_owned();
+        text.push_str(&last_line);
+        let e = read_str(&text).unwrap_err();
+        assert!(
+            matches!(e, TraceError::SpanTooLong { line, .. } if line == samples.len() + 2),
+            "{e}"
+        );
+        assert!(
+            e.to_string().contains("the longest trace is 86400 s"),
+            "{e}"
+        );
+        // Exactly at the limits is fine.
+        let at_limit = [sample(0), sample(MAX_SAMPLE_GAP_NS)];
+        assert_eq!(read_str(&to_text(&at_limit)).unwrap().len(), 2);
     }
 
     #[test]

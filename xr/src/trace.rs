@@ -16,14 +16,16 @@
 //!
 //! The writer runs the same checks before writing, so it never produces a file the reader
 //! refuses, and flushes after every sample so a crash loses at most the sample being written.
+//! A trace file ([`TraceWriter::create`]) appears under its name only once finished.
 
 use std::fs::File;
-use std::io::{self, BufReader, BufWriter, Read, Write};
+use std::io::{self, BufReader, Read, Write};
 use std::path::Path;
 
 use glam::{Quat, Vec3};
 use thiserror::Error;
 
+pub use crate::atomic_file::AtomicFile;
 use crate::frame::{GazeRay, GazeSample, Pose};
 use crate::records::{Record, RecordReader, printable};
 
@@ -775,19 +777,26 @@ pub struct TraceWriter<W: Write> {
     previous: Option<Preceding>,
     /// Reused line buffer.
     buf: String,
+    /// What [`TraceWriter::finish`] does after flushing: nothing, or commit a file.
+    complete: fn(&mut W) -> io::Result<()>,
 }
 
-impl TraceWriter<BufWriter<File>> {
-    /// Creates (or truncates) a trace file and writes its header lines.
+impl TraceWriter<AtomicFile> {
+    /// Starts a trace file and writes its header lines. The trace is written to a temporary
+    /// file in the same folder (flushed after every sample) and appears under `path`,
+    /// replacing any earlier file, only when [`TraceWriter::finish`] succeeds; see
+    /// [`AtomicFile`].
     pub fn create(path: impl AsRef<Path>) -> Result<Self, TraceError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let file = File::create(path).map_err(|source| TraceError::Io {
+        let file = AtomicFile::create(path).map_err(|source| TraceError::Io {
             file: name.clone(),
             context: "creating trace".to_owned(),
             source,
         })?;
-        TraceWriter::with_name(BufWriter::new(file), name)
+        let mut this = TraceWriter::with_name(file, name)?;
+        this.complete = AtomicFile::commit;
+        Ok(this)
     }
 }
 
@@ -806,6 +815,7 @@ impl<W: Write> TraceWriter<W> {
             line: 3,
             previous: None,
             buf: String::new(),
+            complete: |_| Ok(()),
         };
         this.buf = format!("{VERSION_LINE}\n{}\n", COLUMNS.join(","));
         this.flush_buf("writing header")?;
@@ -845,11 +855,16 @@ impl<W: Write> TraceWriter<W> {
         Ok(())
     }
 
-    /// Flushes and returns the underlying writer.
+    /// Flushes and returns the underlying writer; for a file from [`TraceWriter::create`],
+    /// first moves it to its final name.
     pub fn finish(mut self) -> Result<W, TraceError> {
-        self.writer.flush().map_err(|source| TraceError::Io {
+        let result = self
+            .writer
+            .flush()
+            .and_then(|()| (self.complete)(&mut self.writer));
+        result.map_err(|source| TraceError::Io {
             file: self.name.clone(),
-            context: "flushing trace".to_owned(),
+            context: "finishing trace".to_owned(),
             source,
         })?;
         Ok(self.writer)
@@ -984,10 +999,17 @@ mod tests {
         for s in &samples {
             w.write(s).unwrap();
         }
-        // Flushed per sample: readable before finish().
-        assert_eq!(read_trace(&path).unwrap(), samples);
+        // Nothing under the final name before finish().
+        assert!(!path.exists());
         w.finish().unwrap();
         assert_eq!(read_trace(&path).unwrap(), samples);
+        // Writing it again replaces it only on finish; an abandoned writer leaves it as it was
+        // and no temporary file behind.
+        let mut w = TraceWriter::create(&path).unwrap();
+        w.write(&samples[0]).unwrap();
+        drop(w);
+        assert_eq!(read_trace(&path).unwrap(), samples);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

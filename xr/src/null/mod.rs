@@ -78,7 +78,8 @@ pub enum NullError {
         expected: &'static str,
     },
     /// Samples handed in directly span more time than a trace may
-    /// ([`MAX_SAMPLE_GAP_NS`] after the previous sample, [`MAX_TRACE_SPAN_NS`] after the first).
+    /// ([`crate::trace::MAX_SAMPLE_GAP_NS`] after the previous sample,
+    /// [`crate::trace::MAX_TRACE_SPAN_NS`] after the first).
     #[error(
         "{source_name}: sample {index}: time_ns {time_ns} is too far after {what} {reference_ns} (at most {limit_s} s)"
     )]

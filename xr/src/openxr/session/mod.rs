@@ -99,7 +99,7 @@ struct Pending {
     depth_image: Option<u32>,
 }
 
-/// A live OpenXR session; the [`Backend`] of `vitreous run`.
+/// A live OpenXR session; the [`crate::Backend`] of `vitreous run`.
 pub struct Session {
     /// Frame submission; dropped before the session.
     stream: xr::FrameStream<xr::Vulkan>,

@@ -536,8 +536,9 @@ fn run(cli: Cli) -> Result<()> {
             };
             let report = vitreous::soak::soak(&options, |p| {
                 eprintln!(
-                    "soak: pass {} ({} frames): resident {} KiB, {} validation messages",
-                    p.pass, p.frames, p.rss_kib, p.validation_messages
+                    "soak: pass {} ({} frames): resident {} KiB, heap in use {} KiB, {} \
+                     validation messages",
+                    p.pass, p.frames, p.rss_kib, p.heap_in_use_kib, p.validation_messages
                 );
             })?;
             if let Some(path) = &json {

@@ -52,8 +52,12 @@ pub struct SoakPass {
     pub pass: usize,
     /// Frames rendered.
     pub frames: u64,
-    /// Resident memory after the pass's teardown, kibibytes.
+    /// Resident memory after the pass's teardown (and after the C heap gave its free pages
+    /// back to the system), kibibytes.
     pub rss_kib: u64,
+    /// Bytes allocated and not freed on the C heap (Rust's, the Vulkan driver's and the
+    /// layers' allocations), kibibytes: growth here is a leak, not fragmentation.
+    pub heap_in_use_kib: u64,
     /// Validation errors and warnings of the pass.
     pub validation_messages: u32,
 }
@@ -119,6 +123,41 @@ impl FrameSink for Discard {
     fn stop_requested(&self) -> bool {
         crate::interrupt::requested()
     }
+}
+
+/// The C heap's statistics (glibc `struct mallinfo2`).
+#[repr(C)]
+#[derive(Default)]
+struct MallInfo2 {
+    arena: usize,
+    ordblks: usize,
+    smblks: usize,
+    hblks: usize,
+    hblkhd: usize,
+    usmblks: usize,
+    fsmblks: usize,
+    uordblks: usize,
+    fordblks: usize,
+    keepcost: usize,
+}
+
+unsafe extern "C" {
+    /// glibc: statistics of the main and thread heaps.
+    fn mallinfo2() -> MallInfo2;
+    /// glibc: gives free heap pages back to the system; returns 1 if any were.
+    fn malloc_trim(pad: usize) -> i32;
+}
+
+/// Gives free C-heap pages back to the system, then returns the bytes still allocated
+/// (ordinary and mmap'd blocks), kibibytes.
+pub fn trim_heap_and_measure_kib() -> u64 {
+    // SAFETY: both are plain glibc calls without preconditions; `mallinfo2` returns its
+    // struct by value, laid out as `MallInfo2` (glibc >= 2.33; Debian 12 has 2.36).
+    let info = unsafe {
+        malloc_trim(0);
+        mallinfo2()
+    };
+    ((info.uordblks + info.hblkhd) / 1024) as u64
 }
 
 /// Resident memory of this process, kibibytes (Linux `/proc/self/statm`).
@@ -195,9 +234,11 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
             first_messages.extend(log.messages().into_iter().take(5 - first_messages.len()));
         }
         drop(renderer);
+        let heap_in_use_kib = trim_heap_and_measure_kib();
         let pass = SoakPass {
             pass: passes.len(),
             frames: records.len() as u64,
+            heap_in_use_kib,
             rss_kib: resident_kib()?,
             validation_messages: messages,
         };

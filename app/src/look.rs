@@ -83,6 +83,17 @@ impl LookPlanner {
         }
     }
 
+    /// A planner with the same settings and no gaze history, for a replay that starts over.
+    pub fn restarted(&self) -> LookPlanner {
+        LookPlanner {
+            base: self.base,
+            defocus: self
+                .defocus
+                .as_ref()
+                .map(|(pipeline, model)| (GazePipeline::new(*pipeline.config()), *model)),
+        }
+    }
+
     /// Forces the gaze image (or lets the tracker choose again) from now on; no effect
     /// without defocus. The gaze pipeline keeps its tracking state.
     pub fn set_gaze_override(&mut self, image: GazeOverride) {

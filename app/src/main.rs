@@ -191,6 +191,12 @@ enum Command {
         /// Write the report (every pass) as JSON here.
         #[arg(long, value_name = "FILE")]
         json: Option<PathBuf>,
+        /// A new Vulkan device and renderer for every pass instead of one for the whole run.
+        #[arg(long)]
+        recreate: bool,
+        /// Validation layers off (to tell the layer's own memory from the driver's).
+        #[arg(long)]
+        no_validation: bool,
     },
     /// Trace tools.
     Trace {
@@ -522,6 +528,8 @@ fn run(cli: Cli) -> Result<()> {
             size,
             frames,
             json,
+            recreate,
+            no_validation,
         } => {
             if !(minutes.is_finite() && minutes > 0.0 && minutes <= 7.0 * 24.0 * 60.0) {
                 bail!("--minutes must be more than 0 and at most a week, got {minutes}");
@@ -533,6 +541,8 @@ fn run(cli: Cli) -> Result<()> {
                 size,
                 frames_per_pass: frames,
                 read_back_every: 10,
+                validation: !no_validation,
+                recreate,
             };
             let report = vitreous::soak::soak(&options, |p| {
                 eprintln!(

@@ -1,7 +1,8 @@
-//! `vitreous soak`: replay a trace again and again in one process, each pass with a new
-//! Vulkan device and renderer, and watch resident memory and the validation layers. On a CPU
-//! device (lavapipe) GPU memory is process memory, so a leaked buffer or image shows here as
-//! growth from pass to pass; a pass that leaves the device dirty shows as validation messages.
+//! `vitreous soak`: replay a trace again and again in one process, as one long session on one
+//! Vulkan device and renderer (or, with `recreate`, a new device and renderer each pass), and
+//! watch resident memory, the C heap and the validation layers. On a CPU device (lavapipe) GPU
+//! memory is process memory, so a leaked buffer or image shows here as growth from pass to
+//! pass; a pass that leaves the device dirty shows as validation messages.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -43,9 +44,15 @@ pub struct SoakOptions {
     pub frames_per_pass: u64,
     /// Read back every K-th frame (exercises the readback path).
     pub read_back_every: u64,
+    /// Vulkan validation layers on (the soak's purpose; off only to tell a layer's own memory
+    /// from the driver's).
+    pub validation: bool,
+    /// A new Vulkan device and renderer for every pass (tests teardown) instead of one for the
+    /// whole run (a long session).
+    pub recreate: bool,
 }
 
-/// One pass: a device, a renderer, a replay, teardown.
+/// One pass: the trace replayed once from its start.
 #[derive(Clone, Debug, Serialize)]
 pub struct SoakPass {
     /// Pass number, from 0.
@@ -190,10 +197,37 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
     let mut passes = Vec::new();
     let mut device = String::new();
     let mut first_messages = Vec::new();
+    let mut current: Option<(Renderer, LookPlanner)> = None;
+    let mut messages_before = 0;
     while passes.is_empty() || started.elapsed() < options.duration {
         if signals && crate::interrupt::requested() {
             break;
         }
+        if options.recreate {
+            current = None; // the old renderer and device go before the new ones are made
+        }
+        let (renderer, planner) = match &mut current {
+            Some(made) => made,
+            None => {
+                let ctx = GpuContext::headless(&ContextOptions {
+                    validation: options.validation,
+                    device_name: None,
+                })
+                .context("setting up the Vulkan device")?;
+                device.clone_from(&ctx.device_name);
+                let (planner, defocus) =
+                    planner_for(&scene, &effects, Reflection::Phong, &GazeSettings::default())?;
+                let renderer = Renderer::new(
+                    ctx,
+                    &views::scene_desc(&scene, defocus.as_ref()),
+                    options.size.0,
+                    options.size.1,
+                )
+                .context("preparing the renderer")?;
+                messages_before = 0;
+                current.insert((renderer, planner))
+            }
+        };
         let mut backend = NullBackend::new(
             samples.clone(),
             NullConfig {
@@ -203,37 +237,21 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
                 ipd_m: scene.viewer.ipd_m,
             },
         )?;
-        let ctx = GpuContext::headless(&ContextOptions {
-            validation: true,
-            device_name: None,
-        })
-        .context("setting up the Vulkan device")?;
-        device.clone_from(&ctx.device_name);
-        let (planner, defocus) = planner_for(
-            &scene,
-            &effects,
-            Reflection::Phong,
-            &GazeSettings::default(),
-        )?;
-        let mut renderer = Renderer::new(
-            ctx,
-            &views::scene_desc(&scene, defocus.as_ref()),
-            options.size.0,
-            options.size.1,
-        )
-        .context("preparing the renderer")?;
-        drop(defocus);
         let mut sink = Discard {
-            planner,
+            planner: planner.restarted(),
             read_back_every: options.read_back_every,
         };
-        let records = frame_loop::run(&mut backend, &mut renderer, &mut sink)?;
+        let records = frame_loop::run(&mut backend, renderer, &mut sink)?;
         let log = renderer.context().validation();
-        let messages = log.errors() + log.warnings();
-        if first_messages.len() < 5 {
+        let messages_now = log.errors() + log.warnings();
+        let messages = messages_now - messages_before;
+        messages_before = messages_now;
+        if messages > 0 && first_messages.len() < 5 {
             first_messages.extend(log.messages().into_iter().take(5 - first_messages.len()));
         }
-        drop(renderer);
+        if options.recreate {
+            current = None;
+        }
         let heap_in_use_kib = trim_heap_and_measure_kib();
         let pass = SoakPass {
             pass: passes.len(),
@@ -245,6 +263,7 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
         progress(&pass);
         passes.push(pass);
     }
+    drop(current);
 
     let settled: Vec<u64> = passes
         .iter()

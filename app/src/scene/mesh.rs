@@ -64,6 +64,13 @@ const MAX_NODE_DEPTH: usize = 64;
 /// Most node visits accepted (a node shared by several parents is visited once per path).
 const MAX_NODE_VISITS: usize = 100_000;
 
+/// Loads a glTF or GLB file's bytes into one checked [`Mesh`] and the first
+/// `KHR_materials_ior` found; external buffers are read relative to `base`. The error names
+/// what is wrong with the file (no panic on any input).
+pub fn load_mesh(bytes: &[u8], base: &Path) -> Result<(Mesh, Option<f32>), String> {
+    load_gltf(bytes, base).map(|model| (model.mesh, model.ior))
+}
+
 /// Loads a glTF or GLB file's bytes; external buffers are read relative to `base`.
 pub(crate) fn load_gltf(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
     // Third-party decoders must not take the process down on hostile input; our own checks
@@ -73,14 +80,20 @@ pub(crate) fn load_gltf(bytes: &[u8], base: &Path) -> Result<LoadedModel, String
 }
 
 fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
-    let gltf::Gltf { document, mut blob } = gltf::Gltf::from_slice(bytes).map_err(|e| {
+    let invalid = |e: gltf::Error| {
         let e = e.to_string();
         if e.starts_with("invalid glTF") {
             e
         } else {
             format!("invalid glTF: {e}")
         }
-    })?;
+    };
+    let gltf::Gltf { document, mut blob } =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+    // gltf-json's own validation indexes the POSITION accessor before checking that it
+    // exists, so that is checked first.
+    check_position_accessors(document.as_json())?;
+    let document = gltf::Document::from_json(document.into_json()).map_err(invalid)?;
 
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
@@ -137,6 +150,30 @@ fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
         ior: out.ior,
         buffers,
     })
+}
+
+/// Every primitive's POSITION attribute names an accessor that exists.
+fn check_position_accessors(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::Checked;
+
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(index) = primitive
+                .attributes
+                .get(&Checked::Valid(Semantic::Positions))
+                && index.value() >= root.accessors.len()
+            {
+                return Err(format!(
+                    "invalid glTF: meshes[{m}].primitives[{p}].attributes.POSITION: accessor {} \
+                     does not exist (the file has {})",
+                    index.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn describe(e: &gltf::Error) -> String {
@@ -566,6 +603,15 @@ mod tests {
             .err()
             .unwrap();
         assert!(err.contains("out of range for 3 vertices"), "{err}");
+    }
+
+    #[test]
+    fn missing_position_accessor_is_an_error_not_a_panic() {
+        let gltf = triangle_gltf("0,1,2", "").replace(r#""POSITION":0"#, r#""POSITION":7"#);
+        let err = load_gltf_inner(gltf.as_bytes(), Path::new("."))
+            .err()
+            .unwrap();
+        assert!(err.contains("POSITION: accessor 7 does not exist"), "{err}");
     }
 
     #[test]

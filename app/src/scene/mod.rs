@@ -26,7 +26,7 @@ use crate::gaze::{FilterKind, FilterParseError, GazeOverride};
 
 pub use error::{Location, SceneError};
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
-pub use mesh::Mesh;
+pub use mesh::{Mesh, load_mesh};
 
 use error::Source;
 use file::{LightFrame, PlaneToml, SceneFile};

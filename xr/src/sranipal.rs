@@ -152,6 +152,21 @@ pub enum ImportError {
         /// The first row's ticks.
         first_ticks: i64,
     },
+    /// A row's helmet position is so far from the first row's that the re-anchored position
+    /// is not a finite `f32`.
+    #[error(
+        "{file}:{line}: columns `helmet_pos_*`: {position_m} m is too far from the first row's {first_m} m (the difference overflows)"
+    )]
+    PositionRange {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// This row's position, metres (OpenXR axes).
+        position_m: Vec3,
+        /// The first row's position, metres (OpenXR axes).
+        first_m: Vec3,
+    },
 }
 
 /// A summary of an import, for a CLI to print.
@@ -515,10 +530,19 @@ impl Importer {
             self.dropped_rows += 1;
             return Ok(());
         }
+        let head_position = anchor.unyaw * (pose.position - anchor.position);
+        if !head_position.is_finite() {
+            return Err(ImportError::PositionRange {
+                file: row.name.to_owned(),
+                line: row.line,
+                position_m: pose.position,
+                first_m: anchor.position,
+            });
+        }
         self.samples.push(TraceSample {
             time_ns,
             head: Pose {
-                position: anchor.unyaw * (pose.position - anchor.position),
+                position: head_position,
                 orientation: (anchor.unyaw * pose.orientation).normalize(),
             },
             gaze: GazeSample {
@@ -829,6 +853,22 @@ mod tests {
             "{e}"
         );
         assert!(matches!(parse(""), Err(ImportError::Empty { .. })));
+    }
+
+    #[test]
+    fn positions_too_far_apart_are_an_error_not_a_non_finite_pose() {
+        let a = mini_row(Vec3::ZERO, Vec3::new(-3e38, 0.0, 0.0), 1);
+        let b = mini_row(Vec3::ZERO, Vec3::new(3e38, 0.0, 0.0), 2);
+        let e = parse(&format!("{MINI_HEADER}\n{a}\n{b}\n")).unwrap_err();
+        assert!(
+            matches!(e, ImportError::PositionRange { line: 3, .. }),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .starts_with("mini.csv:3: columns `helmet_pos_*`"),
+            "{e}"
+        );
     }
 
     #[test]

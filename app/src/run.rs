@@ -370,7 +370,7 @@ struct RunSink {
     /// The readback result.
     readback: Option<ReadbackCheck>,
     /// Where head pose and gaze are recorded, if asked.
-    writer: Option<TraceWriter<std::io::BufWriter<std::fs::File>>>,
+    writer: Option<TraceWriter<vitreous_xr::trace::AtomicFile>>,
     /// Every frame's input, for the replay check.
     recorded: Vec<FrameInput>,
 }

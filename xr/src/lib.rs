@@ -6,9 +6,11 @@
 //!
 //! Axes everywhere are OpenXR's: right-handed, +x right, +y up, -z forward, metres.
 
+pub mod atomic_file;
 pub mod frame;
 pub mod null;
 pub mod openxr;
+pub mod records;
 pub mod sranipal;
 pub mod synth;
 pub mod trace;

@@ -1,0 +1,312 @@
+//! The null backend: replays a trace as frames, with no headset and no real-time pacing.
+//!
+//! Frame `k` is displayed at `t0 + k / frame_rate_hz` (rounded to the nanosecond), where `t0`
+//! is the first sample's time, for as long as that time is not after the last sample's time
+//! (or until `max_frames`). For each frame:
+//! - the head pose is interpolated between the samples around the frame time (position
+//!   linearly, orientation by slerp);
+//! - the gaze is the newest sample whose `sample_time_ns` is at or before the frame time, so a
+//!   30 Hz tracker seen by a 90 Hz loop gives the same sample (same `sample_time_ns`) to about
+//!   three frames: samples are never invented or interpolated;
+//! - each eye's position in the head frame is the running mean of that eye's valid gaze-ray
+//!   origins over every gaze sample up to the frame time (±`ipd_m / 2` along head x until one
+//!   is valid); the eye views are the head pose moved to those positions, with the head's
+//!   orientation (displays are fixed to the head) and the configured field of view.
+//!
+//! Samples are pulled from the source only as far as needed, so a streaming [`TraceReader`]
+//! replays arbitrarily long traces in constant memory (apart from gaze samples repeated
+//! across many head samples).
+mod sampling;
+#[cfg(test)]
+mod tests;
+
+use std::collections::VecDeque;
+use std::io::BufRead;
+
+use glam::Vec3;
+use thiserror::Error;
+
+use crate::frame::{Backend, Fov, FrameInput};
+use crate::trace::{TraceError, TraceReader, TraceSample};
+
+pub use sampling::interpolate;
+
+/// How the null backend turns a trace into frames.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NullConfig {
+    /// Frames per second of the replayed display, hertz.
+    pub frame_rate_hz: f64,
+    /// Stop after this many frames even if the trace goes on.
+    pub max_frames: Option<u64>,
+    /// Field of view of both eyes.
+    pub fov: Fov,
+    /// Eye separation used until the trace has a valid gaze origin for an eye, metres.
+    pub ipd_m: f32,
+}
+
+impl Default for NullConfig {
+    fn default() -> Self {
+        NullConfig {
+            frame_rate_hz: 60.0,
+            max_frames: None,
+            fov: Fov::symmetric(90f32.to_radians(), 90f32.to_radians()),
+            ipd_m: 0.063,
+        }
+    }
+}
+
+/// Errors of the null backend.
+#[derive(Debug, Error)]
+pub enum NullError {
+    /// The trace has no samples.
+    #[error("{source_name}: trace has no samples; nothing to replay")]
+    EmptyTrace {
+        /// Name of the trace (file name or description).
+        source_name: String,
+    },
+    /// Reading the trace failed.
+    #[error(transparent)]
+    Trace(#[from] TraceError),
+    /// A configuration value is out of range.
+    #[error("null backend config `{field}` is {value}; expected {expected}")]
+    BadConfig {
+        /// The field of [`NullConfig`].
+        field: &'static str,
+        /// Its value, printed.
+        value: String,
+        /// What it should be.
+        expected: &'static str,
+    },
+    /// Samples handed in directly span more time than a trace may
+    /// ([`crate::trace::MAX_SAMPLE_GAP_NS`] after the previous sample,
+    /// [`crate::trace::MAX_TRACE_SPAN_NS`] after the first).
+    #[error(
+        "{source_name}: sample {index}: time_ns {time_ns} is too far after {what} {reference_ns} (at most {limit_s} s)"
+    )]
+    TooLong {
+        /// Name of the trace.
+        source_name: String,
+        /// Index of the offending sample (0-based).
+        index: u64,
+        /// Its time.
+        time_ns: i64,
+        /// Which earlier sample the limit is measured from.
+        what: &'static str,
+        /// That sample's time.
+        reference_ns: i64,
+        /// The limit, seconds.
+        limit_s: i64,
+    },
+    /// Samples handed in directly are not in time order.
+    #[error(
+        "{source_name}: sample {index}: {what} (time_ns {time_ns}, previous time_ns {previous_ns}); samples must have strictly increasing time_ns, non-decreasing gaze times and gaze time <= time_ns"
+    )]
+    OutOfOrder {
+        /// Name of the trace.
+        source_name: String,
+        /// Index of the offending sample (0-based).
+        index: u64,
+        /// Which rule it breaks.
+        what: &'static str,
+        /// Its time.
+        time_ns: i64,
+        /// The previous sample's time.
+        previous_ns: i64,
+    },
+    /// `wait_frame` and `end_frame` were not called alternately for the same frame.
+    #[error("frame order: {0}")]
+    FrameOrder(String),
+}
+
+/// Where samples come from: a vector or a streaming reader, behind one interface.
+type SampleSource = Box<dyn Iterator<Item = Result<TraceSample, TraceError>> + Send>;
+
+/// A [`Backend`] that replays a trace. See the module documentation for the timing rules.
+pub struct NullBackend {
+    /// Replay settings.
+    config: NullConfig,
+    /// Name of the trace, for errors.
+    name: String,
+    /// Remaining samples not yet buffered.
+    source: SampleSource,
+    /// True once the source has ended.
+    exhausted: bool,
+    /// Samples still needed (head bracket and newest gaze onwards), oldest first.
+    buffer: VecDeque<TraceSample>,
+    /// Absolute index (in the trace) of `buffer[0]`.
+    buffer_base: u64,
+    /// Number of samples read from the source so far.
+    read_count: u64,
+    /// Samples with absolute index below this have been added to the eye-position means.
+    gaze_counted: u64,
+    /// Sum of valid gaze-ray origins per eye (left, right), head frame, metres.
+    origin_sum_m: [Vec3; 2],
+    /// Number of valid gaze-ray origins per eye.
+    origin_count: [u64; 2],
+    /// Time of the first sample, nanoseconds.
+    t0_ns: i64,
+    /// Time of the first sample, once read (for the span check).
+    first_ns: Option<i64>,
+    /// Index of the next frame to hand out.
+    next_index: u64,
+    /// The frame handed out and not yet ended.
+    pending: Option<u64>,
+    /// True once the replay has ended (or failed).
+    done: bool,
+}
+
+impl NullBackend {
+    /// Replays samples held in memory. They must be in time order (as a trace file is).
+    pub fn new(samples: Vec<TraceSample>, config: NullConfig) -> Result<Self, NullError> {
+        NullBackend::from_source(
+            Box::new(samples.into_iter().map(Ok)),
+            "<samples>".to_owned(),
+            config,
+        )
+    }
+
+    /// Replays a trace file as it is read.
+    pub fn from_reader<R: BufRead + Send + 'static>(
+        reader: TraceReader<R>,
+        config: NullConfig,
+    ) -> Result<Self, NullError> {
+        let name = reader.name().to_owned();
+        NullBackend::from_source(Box::new(reader), name, config)
+    }
+
+    /// Opens and replays a trace file.
+    pub fn open(path: impl AsRef<std::path::Path>, config: NullConfig) -> Result<Self, NullError> {
+        NullBackend::from_reader(TraceReader::open(path)?, config)
+    }
+
+    fn from_source(
+        source: SampleSource,
+        name: String,
+        config: NullConfig,
+    ) -> Result<Self, NullError> {
+        if !(config.frame_rate_hz.is_finite() && config.frame_rate_hz > 0.0) {
+            return Err(NullError::BadConfig {
+                field: "frame_rate_hz",
+                value: config.frame_rate_hz.to_string(),
+                expected: "a finite rate > 0 Hz",
+            });
+        }
+        if !(config.ipd_m.is_finite() && config.ipd_m >= 0.0) {
+            return Err(NullError::BadConfig {
+                field: "ipd_m",
+                value: config.ipd_m.to_string(),
+                expected: "a finite distance >= 0 m",
+            });
+        }
+        let mut this = NullBackend {
+            config,
+            name,
+            source,
+            exhausted: false,
+            buffer: VecDeque::new(),
+            buffer_base: 0,
+            read_count: 0,
+            gaze_counted: 0,
+            origin_sum_m: [Vec3::ZERO; 2],
+            origin_count: [0; 2],
+            t0_ns: 0,
+            first_ns: None,
+            next_index: 0,
+            pending: None,
+            done: false,
+        };
+        if !this.pull()? {
+            return Err(NullError::EmptyTrace {
+                source_name: this.name,
+            });
+        }
+        this.t0_ns = this.buffer[0].time_ns;
+        Ok(this)
+    }
+
+    /// The replay settings.
+    pub fn config(&self) -> &NullConfig {
+        &self.config
+    }
+
+    /// Time of the first sample, which is the time of frame 0, nanoseconds.
+    pub fn start_time_ns(&self) -> i64 {
+        self.t0_ns
+    }
+
+    /// Current estimate of the left and right eye positions in the head frame, metres.
+    pub fn eye_positions_head_m(&self) -> [Vec3; 2] {
+        let default_m = [
+            Vec3::new(-self.config.ipd_m / 2.0, 0.0, 0.0),
+            Vec3::new(self.config.ipd_m / 2.0, 0.0, 0.0),
+        ];
+        std::array::from_fn(|eye| match self.origin_count[eye] {
+            0 => default_m[eye],
+            n => self.origin_sum_m[eye] / n as f32,
+        })
+    }
+}
+
+impl Backend for NullBackend {
+    type Error = NullError;
+
+    fn wait_frame(&mut self) -> Result<Option<FrameInput>, NullError> {
+        if let Some(index) = self.pending {
+            return Err(NullError::FrameOrder(format!(
+                "wait_frame called before end_frame for frame {index}"
+            )));
+        }
+        if self.done {
+            return Ok(None);
+        }
+        let index = self.next_index;
+        if self.config.max_frames.is_some_and(|max| index >= max) {
+            self.done = true;
+            return Ok(None);
+        }
+        // A frame time past the end of i64 is past the last sample: the replay ends (saturating
+        // instead would show the last sample forever).
+        let offset_ns = (index as f64 * 1e9 / self.config.frame_rate_hz).round();
+        let time_ns = if offset_ns < i64::MAX as f64 {
+            self.t0_ns.checked_add(offset_ns as i64)
+        } else {
+            None
+        };
+        let Some(time_ns) = time_ns else {
+            self.done = true;
+            return Ok(None);
+        };
+        match self.frame_at(index, time_ns) {
+            Ok(Some(frame)) => {
+                self.next_index += 1;
+                self.pending = Some(index);
+                Ok(Some(frame))
+            }
+            Ok(None) => {
+                self.done = true;
+                Ok(None)
+            }
+            Err(e) => {
+                self.done = true;
+                Err(e)
+            }
+        }
+    }
+
+    fn end_frame(&mut self, frame: &FrameInput) -> Result<(), NullError> {
+        match self.pending {
+            Some(index) if index == frame.index => {
+                self.pending = None;
+                Ok(())
+            }
+            Some(index) => Err(NullError::FrameOrder(format!(
+                "end_frame for frame {} but frame {index} is the one in flight",
+                frame.index
+            ))),
+            None => Err(NullError::FrameOrder(format!(
+                "end_frame for frame {} with no frame in flight",
+                frame.index
+            ))),
+        }
+    }
+}

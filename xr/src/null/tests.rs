@@ -1,0 +1,299 @@
+//! Replays of small traces: frame times, gaze repetition, eye positions, interpolation,
+//! streaming, and the errors.
+
+use glam::Quat;
+
+use super::*;
+use crate::frame::{GazeRay, GazeSample, Pose};
+use crate::synth::{SynthParams, synthesize};
+use crate::trace::{MAX_SAMPLE_GAP_NS, MAX_TRACE_SPAN_NS, TraceWriter};
+
+fn sample(time_ns: i64, position: Vec3, yaw_rad: f32) -> TraceSample {
+    TraceSample {
+        time_ns,
+        head: Pose {
+            position,
+            orientation: Quat::from_rotation_y(yaw_rad),
+        },
+        gaze: GazeSample {
+            sample_time_ns: time_ns,
+            left: GazeRay::INVALID,
+            right: GazeRay::INVALID,
+            combined: None,
+            fixation: None,
+        },
+    }
+}
+
+fn run(backend: &mut NullBackend) -> Vec<FrameInput> {
+    let mut frames = Vec::new();
+    while let Some(f) = backend.wait_frame().unwrap() {
+        backend.end_frame(&f).unwrap();
+        frames.push(f);
+    }
+    frames
+}
+
+fn ten_ms_trace() -> Vec<TraceSample> {
+    (0..=10)
+        .map(|i| sample(5_000_000_000 + i * 10_000_000, Vec3::ZERO, 0.0))
+        .collect()
+}
+
+#[test]
+fn frame_count_and_times_follow_the_frame_rate() {
+    let mut b = NullBackend::new(ten_ms_trace(), NullConfig::default()).unwrap();
+    let frames = run(&mut b);
+    let times: Vec<i64> = frames.iter().map(|f| f.time_ns - 5_000_000_000).collect();
+    assert_eq!(
+        times,
+        [
+            0,
+            16_666_667,
+            33_333_333,
+            50_000_000,
+            66_666_667,
+            83_333_333,
+            100_000_000
+        ]
+    );
+    assert!(frames.iter().enumerate().all(|(i, f)| f.index == i as u64));
+    assert!(b.wait_frame().unwrap().is_none());
+
+    let config = NullConfig {
+        max_frames: Some(3),
+        ..NullConfig::default()
+    };
+    let mut b = NullBackend::new(ten_ms_trace(), config).unwrap();
+    assert_eq!(run(&mut b).len(), 3);
+}
+
+#[test]
+fn fast_loop_repeats_tracker_samples_without_inventing_any() {
+    let samples = synthesize(&SynthParams {
+        duration_s: 1.0,
+        rate_hz: 30.0,
+        blink_every_s: 0.0,
+        ..SynthParams::default()
+    });
+    assert_eq!(samples.len(), 31);
+    let config = NullConfig {
+        frame_rate_hz: 90.0,
+        ..NullConfig::default()
+    };
+    let mut b = NullBackend::new(samples.clone(), config).unwrap();
+    let frames = run(&mut b);
+    assert_eq!(frames.len(), 91);
+    for (k, f) in frames.iter().enumerate() {
+        let gaze = f.gaze.unwrap();
+        // Each 30 Hz sample serves three 90 Hz frames, unchanged.
+        assert_eq!(gaze, samples[k / 3].gaze, "frame {k}");
+        assert!(gaze.sample_time_ns <= f.time_ns);
+    }
+}
+
+#[test]
+fn views_are_an_ipd_apart_along_head_x() {
+    let samples = vec![
+        sample(0, Vec3::new(1.0, 1.6, 0.0), 0.7),
+        sample(1_000_000_000, Vec3::new(1.0, 1.6, 0.0), 0.7),
+    ];
+    let mut b = NullBackend::new(samples, NullConfig::default()).unwrap();
+    let f = b.wait_frame().unwrap().unwrap();
+    let head_x = f.head.transform_vector(Vec3::X);
+    let d = f.views[1].pose.position - f.views[0].pose.position;
+    assert!(d.abs_diff_eq(head_x * 0.063, 1e-6), "{d}");
+    assert_eq!(f.views[0].pose.orientation, f.head.orientation);
+    assert_eq!(f.views[1].fov, NullConfig::default().fov);
+    let mid = (f.views[0].pose.position + f.views[1].pose.position) / 2.0;
+    assert!(mid.abs_diff_eq(f.head.position, 1e-6));
+}
+
+#[test]
+fn eye_positions_are_the_mean_of_valid_gaze_origins() {
+    let mut samples = ten_ms_trace();
+    let ray = |x: f32| GazeRay {
+        origin: Vec3::new(x, 0.0, 0.03),
+        direction: Vec3::NEG_Z,
+        valid: true,
+    };
+    samples[0].gaze.left = ray(-0.030);
+    samples[1].gaze.left = ray(-0.034);
+    samples[1].gaze.right = ray(0.031);
+    let config = NullConfig {
+        frame_rate_hz: 100.0,
+        ..NullConfig::default()
+    };
+    let mut b = NullBackend::new(samples, config).unwrap();
+    let f0 = b.wait_frame().unwrap().unwrap();
+    b.end_frame(&f0).unwrap();
+    assert!(
+        f0.views[0]
+            .pose
+            .position
+            .abs_diff_eq(Vec3::new(-0.030, 0.0, 0.03), 1e-6)
+    );
+    assert!(
+        f0.views[1]
+            .pose
+            .position
+            .abs_diff_eq(Vec3::new(0.0315, 0.0, 0.0), 1e-6)
+    );
+    let f1 = b.wait_frame().unwrap().unwrap();
+    assert!(
+        f1.views[0]
+            .pose
+            .position
+            .abs_diff_eq(Vec3::new(-0.032, 0.0, 0.03), 1e-6)
+    );
+    assert!(
+        f1.views[1]
+            .pose
+            .position
+            .abs_diff_eq(Vec3::new(0.031, 0.0, 0.03), 1e-6)
+    );
+}
+
+#[test]
+fn head_pose_is_interpolated_midway() {
+    let samples = vec![
+        sample(0, Vec3::ZERO, 0.0),
+        sample(
+            1_000_000_000,
+            Vec3::new(1.0, 0.0, 0.0),
+            std::f32::consts::FRAC_PI_2,
+        ),
+    ];
+    let config = NullConfig {
+        frame_rate_hz: 2.0,
+        ..NullConfig::default()
+    };
+    let mut b = NullBackend::new(samples.clone(), config).unwrap();
+    let frames = run(&mut b);
+    assert_eq!(frames.len(), 3);
+    let mid = frames[1].head;
+    assert!(mid.position.abs_diff_eq(Vec3::new(0.5, 0.0, 0.0), 1e-6));
+    let expected = Quat::from_rotation_y(std::f32::consts::FRAC_PI_4);
+    assert!(
+        mid.orientation.abs_diff_eq(expected, 1e-6),
+        "{}",
+        mid.orientation
+    );
+    // Gaze is the newest sample at or before the frame, not an interpolation.
+    assert_eq!(frames[1].gaze.unwrap().sample_time_ns, 0);
+    assert_eq!(frames[2].head, samples[1].head);
+}
+
+#[test]
+fn streams_from_a_trace_reader() {
+    let samples = synthesize(&SynthParams {
+        duration_s: 2.0,
+        ..SynthParams::default()
+    });
+    let mut w = TraceWriter::new(Vec::new()).unwrap();
+    for s in &samples {
+        w.write(s).unwrap();
+    }
+    let text = w.finish().unwrap();
+    let reader = TraceReader::new(std::io::Cursor::new(text), "synth.trace").unwrap();
+    let mut streamed = NullBackend::from_reader(reader, NullConfig::default()).unwrap();
+    let mut in_memory = NullBackend::new(samples, NullConfig::default()).unwrap();
+    assert_eq!(run(&mut streamed), run(&mut in_memory));
+}
+
+#[test]
+fn empty_or_broken_traces_are_errors_not_panics() {
+    let e = NullBackend::new(Vec::new(), NullConfig::default())
+        .err()
+        .unwrap();
+    assert!(matches!(e, NullError::EmptyTrace { .. }), "{e}");
+    let header_only = format!(
+        "{}\n{}\n",
+        crate::trace::VERSION_LINE,
+        crate::trace::COLUMNS.join(",")
+    );
+    let reader = TraceReader::new(std::io::Cursor::new(header_only), "empty.trace").unwrap();
+    let e = NullBackend::from_reader(reader, NullConfig::default())
+        .err()
+        .unwrap();
+    assert!(e.to_string().contains("empty.trace"), "{e}");
+
+    let backwards = vec![sample(10, Vec3::ZERO, 0.0), sample(5, Vec3::ZERO, 0.0)];
+    let mut b = NullBackend::new(backwards, NullConfig::default()).unwrap();
+    assert!(matches!(
+        b.wait_frame(),
+        Err(NullError::OutOfOrder { index: 1, .. })
+    ));
+    assert!(b.wait_frame().unwrap().is_none());
+
+    let bad_rate = NullConfig {
+        frame_rate_hz: 0.0,
+        ..NullConfig::default()
+    };
+    assert!(NullBackend::new(ten_ms_trace(), bad_rate).is_err());
+}
+
+#[test]
+fn samples_spanning_too_long_are_refused() {
+    let gap = vec![
+        sample(0, Vec3::ZERO, 0.0),
+        sample(MAX_SAMPLE_GAP_NS + 1, Vec3::ZERO, 0.0),
+    ];
+    let mut b = NullBackend::new(gap, NullConfig::default()).unwrap();
+    let e = b.wait_frame().unwrap_err();
+    assert!(matches!(e, NullError::TooLong { index: 1, .. }), "{e}");
+    let overflow = vec![
+        sample(i64::MIN, Vec3::ZERO, 0.0),
+        sample(i64::MAX, Vec3::ZERO, 0.0),
+    ];
+    let mut b = NullBackend::new(overflow, NullConfig::default()).unwrap();
+    assert!(matches!(b.wait_frame(), Err(NullError::TooLong { .. })));
+    let step = MAX_SAMPLE_GAP_NS;
+    let long: Vec<_> = (0..=MAX_TRACE_SPAN_NS / step + 1)
+        .map(|i| sample(i * step, Vec3::ZERO, 0.0))
+        .collect();
+    let config = NullConfig {
+        frame_rate_hz: 1e-3,
+        ..NullConfig::default()
+    };
+    let mut b = NullBackend::new(long, config).unwrap();
+    let e = loop {
+        match b.wait_frame() {
+            Ok(Some(f)) => b.end_frame(&f).unwrap(),
+            Ok(None) => panic!("replay ended without refusing the trace"),
+            Err(e) => break e,
+        }
+    };
+    assert!(e.to_string().contains("the first sample's"), "{e}");
+}
+
+#[test]
+fn a_trace_ending_near_the_end_of_time_ends_the_replay() {
+    let near_end = vec![
+        sample(i64::MAX - 20_000_000, Vec3::ZERO, 0.0),
+        sample(i64::MAX, Vec3::ZERO, 0.0),
+    ];
+    let mut b = NullBackend::new(near_end, NullConfig::default()).unwrap();
+    let mut frames = 0;
+    while let Some(f) = b.wait_frame().unwrap() {
+        b.end_frame(&f).unwrap();
+        frames += 1;
+        assert!(frames < 10, "replay does not end");
+    }
+    assert_eq!(frames, 2);
+}
+
+#[test]
+fn frame_calls_must_alternate() {
+    let mut b = NullBackend::new(ten_ms_trace(), NullConfig::default()).unwrap();
+    let f = b.wait_frame().unwrap().unwrap();
+    assert!(matches!(b.wait_frame(), Err(NullError::FrameOrder(_))));
+    b.end_frame(&f).unwrap();
+    assert!(matches!(b.end_frame(&f), Err(NullError::FrameOrder(_))));
+}
+
+#[test]
+fn backend_is_send() {
+    fn is_send<T: Send>() {}
+    is_send::<NullBackend>();
+}

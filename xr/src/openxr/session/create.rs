@@ -1,0 +1,301 @@
+//! Making a session: the session itself, its reference spaces, the colour and depth
+//! swapchains, the gaze source and the controller actions, in the order OpenXR needs them.
+
+use std::sync::mpsc;
+
+use ash::vk;
+use ash::vk::Handle;
+use openxr as xr;
+
+use super::super::actions::Controls;
+use super::super::choose::{self, Blend, GazeOffer, GazeSource, SpaceChoice};
+use super::super::gaze::{ExtGaze, FbTracker, Gaze, TraceGaze};
+use super::super::state::State;
+use super::super::{
+    DepthOptions, OpenXrError, Result, Runtime, SessionOptions, SwapchainImages, VulkanHandles,
+    XrContext,
+};
+use super::{Session, SessionReport, install_ctrl_c};
+
+/// Creates the session; see [`Runtime::start`].
+///
+/// # Safety
+/// As [`Runtime::start`].
+pub(in crate::openxr) unsafe fn start(
+    rt: &Runtime,
+    vulkan: VulkanHandles,
+    options: &SessionOptions,
+) -> Result<(Session, SwapchainImages)> {
+    let info = xr::vulkan::SessionCreateInfo {
+        instance: vulkan.instance.as_raw() as _,
+        physical_device: vulkan.physical.as_raw() as _,
+        device: vulkan.device.as_raw() as _,
+        queue_family_index: vulkan.queue_family,
+        queue_index: vulkan.queue_index,
+    };
+    let (session, waiter, stream) =
+        unsafe { rt.instance.create_session::<xr::Vulkan>(rt.system, &info) }
+            .xr("xrCreateSession")?;
+
+    let spaces = session
+        .enumerate_reference_spaces()
+        .xr("xrEnumerateReferenceSpaces")?;
+    let space_choice = choose::choose_space(spaces.contains(&xr::ReferenceSpaceType::STAGE));
+    let space_type = match space_choice {
+        SpaceChoice::Stage => xr::ReferenceSpaceType::STAGE,
+        SpaceChoice::Local => xr::ReferenceSpaceType::LOCAL,
+    };
+    let space = session
+        .create_reference_space(space_type, xr::Posef::IDENTITY)
+        .xr("xrCreateReferenceSpace")?;
+    let view_space = session
+        .create_reference_space(xr::ReferenceSpaceType::VIEW, xr::Posef::IDENTITY)
+        .xr("xrCreateReferenceSpace(VIEW)")?;
+    tracing::info!("scene placed in the {space_choice:?} reference space");
+
+    let formats: Vec<i64> = session
+        .enumerate_swapchain_formats()
+        .xr("xrEnumerateSwapchainFormats")?
+        .into_iter()
+        .map(i64::from)
+        .collect();
+    let format = choose::choose_format(&formats).ok_or_else(|| {
+        OpenXrError::Unsupported(format!(
+            "the runtime offers no 8-bit RGBA/BGRA swapchain format (VkFormat codes offered: {formats:?})"
+        ))
+    })?;
+    tracing::info!(
+        "swapchain format VkFormat {} ({})",
+        format.vk_format,
+        if format.srgb {
+            "sRGB: the image encodes"
+        } else {
+            "UNORM: linear values stored as is"
+        }
+    );
+    let (w, h) = rt.info.size;
+    let swapchain = session
+        .create_swapchain(&xr::SwapchainCreateInfo {
+            create_flags: xr::SwapchainCreateFlags::EMPTY,
+            usage_flags: xr::SwapchainUsageFlags::COLOR_ATTACHMENT
+                | xr::SwapchainUsageFlags::TRANSFER_SRC,
+            format: format.vk_format as u32,
+            sample_count: 1,
+            width: w,
+            height: h,
+            face_count: 1,
+            array_size: 2,
+            mip_count: 1,
+        })
+        .xr("xrCreateSwapchain")?;
+    let images = swapchain
+        .enumerate_images()
+        .xr("xrEnumerateSwapchainImages")?
+        .into_iter()
+        .map(vk::Image::from_raw)
+        .collect();
+    let depth = match (rt.depth_layer, options.depth) {
+        (true, Some(d)) => depth_swapchain(&session, &formats, d, (w, h)),
+        (false, Some(_)) => {
+            tracing::info!(
+                "depth not submitted: the runtime does not offer XR_KHR_composition_layer_depth"
+            );
+            None
+        }
+        (_, None) => None,
+    };
+    let depth_images = match &depth {
+        Some((chain, _)) => match chain.enumerate_images() {
+            Ok(raw) => raw.into_iter().map(vk::Image::from_raw).collect(),
+            Err(e) => {
+                return Err(OpenXrError::Call {
+                    call: "xrEnumerateSwapchainImages(depth)",
+                    result: e,
+                });
+            }
+        },
+        None => Vec::new(),
+    };
+
+    let offer = GazeOffer {
+        fb_social: rt.fb_gaze && rt.info.fb_eye_tracking_supported,
+        ext_gaze_extension: rt.ext_gaze,
+        ext_gaze_supported: rt.info.eye_gaze_supported,
+        trace: options.gaze_trace.is_some(),
+    };
+    let mut source = choose::choose_gaze(offer);
+    if rt.ext_gaze && !rt.info.eye_gaze_supported {
+        tracing::info!(
+            "XR_EXT_eye_gaze_interaction is offered but the system has no eye tracker \
+             (supportsEyeGazeInteraction = false)"
+        );
+    }
+    let gaze = loop {
+        let made = match source {
+            GazeSource::FbSocial => FbTracker::new(&session).map(Gaze::FbSocial),
+            GazeSource::ExtGaze => ExtGaze::new(&session).map(Gaze::ExtGaze),
+            GazeSource::Trace => {
+                let path = options
+                    .gaze_trace
+                    .as_deref()
+                    .expect("chosen only with a trace");
+                TraceGaze::open(path).map(Gaze::Trace)
+            }
+            GazeSource::Manual => Ok(Gaze::Manual),
+        };
+        match made {
+            Ok(g) => break g,
+            // A bad trace is the user's error: say so.
+            Err(e) if source == GazeSource::Trace => return Err(e),
+            Err(e) => {
+                tracing::warn!("gaze source {source} failed ({e}); trying the next one");
+                source = match source {
+                    GazeSource::FbSocial if offer.ext_gaze_supported => GazeSource::ExtGaze,
+                    GazeSource::FbSocial | GazeSource::ExtGaze if offer.trace => GazeSource::Trace,
+                    _ => GazeSource::Manual,
+                };
+            }
+        }
+    };
+    // Controller actions: a failure here costs the live actions only, never the session.
+    let controls = match Controls::new(&rt.instance) {
+        Ok(c) => Some(c),
+        Err(e) => {
+            tracing::warn!("no live controller actions: {e}");
+            None
+        }
+    };
+    // xrAttachSessionActionSets may be called once per session: every set goes in together.
+    let mut action_sets: Vec<xr::ActionSet> = Vec::new();
+    if let Gaze::ExtGaze(g) = &gaze {
+        action_sets.push(g.set.clone());
+    }
+    if let Some(c) = &controls {
+        action_sets.push(c.set.clone());
+    }
+    if !action_sets.is_empty() {
+        let refs: Vec<&xr::ActionSet> = action_sets.iter().collect();
+        session
+            .attach_action_sets(&refs)
+            .xr("xrAttachSessionActionSets")?;
+    }
+    let action_profiles: Vec<String> = controls
+        .as_ref()
+        .map(|c| c.profiles.iter().map(|p| (*p).to_owned()).collect())
+        .unwrap_or_default();
+    if controls.is_some() {
+        tracing::info!(
+            "controller actions attached (select, menu on each hand; profiles: {})",
+            action_profiles.join(", ")
+        );
+    }
+    tracing::info!("gaze source: {}", gaze.source());
+    if gaze.source() == GazeSource::Manual {
+        tracing::warn!("no eye tracker and no --gaze-trace: the gaze image must be chosen by hand");
+    }
+
+    if options.handle_ctrl_c {
+        install_ctrl_c();
+    }
+    let blend = match rt.info.blend {
+        Blend::Additive => xr::EnvironmentBlendMode::ADDITIVE,
+        Blend::AlphaBlend => xr::EnvironmentBlendMode::ALPHA_BLEND,
+        Blend::Opaque => xr::EnvironmentBlendMode::OPAQUE,
+    };
+    let report = SessionReport {
+        states: vec![State::Idle],
+        gaze_source: Some(gaze.source()),
+        space: Some(space_choice),
+        blend: Some(rt.info.blend),
+        actions_attached: controls.is_some(),
+        action_profiles,
+        depth_format: depth.as_ref().map(|(_, d)| d.format.as_raw()),
+        ..SessionReport::default()
+    };
+    let out = SwapchainImages {
+        images,
+        format: vk::Format::from_raw(format.vk_format as i32),
+        srgb: format.srgb,
+        size: (w, h),
+        depth_images,
+    };
+    let (commands_tx, commands_rx) = mpsc::channel();
+    Ok((
+        Session {
+            stream,
+            waiter,
+            swapchain,
+            depth,
+            controls,
+            action_sets,
+            commands_tx,
+            commands_rx: Some(commands_rx),
+            gaze,
+            space,
+            view_space,
+            session,
+            instance: rt.instance.clone(),
+            events: xr::EventDataBuffer::new(),
+            blend,
+            world_behind: rt.info.blend.needs_world_behind(),
+            size: (w, h),
+            state: State::Idle,
+            running: false,
+            exit_requested: false,
+            quit: false,
+            world_from_space: None,
+            first_display: None,
+            next_index: 0,
+            pending: None,
+            options: options.clone(),
+            report,
+        },
+        out,
+    ))
+}
+
+/// Makes the 2-layer depth swapchain, or says why not and returns `None` (no depth is then
+/// submitted; nothing else changes).
+fn depth_swapchain(
+    session: &xr::Session<xr::Vulkan>,
+    formats: &[i64],
+    depth: DepthOptions,
+    (w, h): (u32, u32),
+) -> Option<(xr::Swapchain<xr::Vulkan>, DepthOptions)> {
+    let code = i64::from(depth.format.as_raw());
+    if !formats.contains(&code) {
+        tracing::warn!(
+            "depth not submitted: the runtime offers no {:?} swapchain (VkFormat codes \
+             offered: {formats:?})",
+            depth.format
+        );
+        return None;
+    }
+    let made = session.create_swapchain(&xr::SwapchainCreateInfo {
+        create_flags: xr::SwapchainCreateFlags::EMPTY,
+        usage_flags: xr::SwapchainUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        format: code as u32,
+        sample_count: 1,
+        width: w,
+        height: h,
+        face_count: 1,
+        array_size: 2,
+        mip_count: 1,
+    });
+    match made {
+        Ok(chain) => {
+            tracing::info!(
+                "depth submitted with XR_KHR_composition_layer_depth: {:?} swapchain, depth 0..1 \
+                 = {} m..{} m",
+                depth.format,
+                depth.near_m,
+                depth.far_m
+            );
+            Some((chain, depth))
+        }
+        Err(e) => {
+            tracing::warn!("depth not submitted: xrCreateSwapchain(depth) failed: {e}");
+            None
+        }
+    }
+}

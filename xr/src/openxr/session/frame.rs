@@ -1,0 +1,357 @@
+//! The frame scope: waiting for and beginning a frame, acquiring the swapchain images,
+//! locating the views, and ending the frame with its projection (and depth) layer; a session
+//! dropped mid-frame still ends its frame.
+
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+use openxr as xr;
+
+use super::super::state::{self, EndReason};
+use super::super::{DepthOptions, OpenXrError, Result, XrContext};
+use super::placement::{compose, place_scene, pose_of};
+use super::{INTERRUPTED, Pending, STATE_TIMEOUT, Session};
+use crate::frame::{Backend, EyeView, Fov, FrameInput, FrameTarget, Pose};
+
+impl Session {
+    /// Waits and begins a frame; `None` when the runtime says not to render it (it is then
+    /// ended here with no layers).
+    fn begin_frame(&mut self) -> Result<Option<xr::FrameState>> {
+        let frame = self.waiter.wait().xr("xrWaitFrame")?;
+        self.stream.begin().xr("xrBeginFrame")?;
+        if !frame.should_render || self.exit_requested {
+            self.stream
+                .end(frame.predicted_display_time, self.blend, &[])
+                .xr("xrEndFrame")?;
+            if !self.exit_requested {
+                self.report.frames_skipped += 1;
+            }
+            return Ok(None);
+        }
+        Ok(Some(frame))
+    }
+
+    /// Locates the head and eyes for a frame displayed at `display`.
+    fn locate(&mut self, display: xr::Time) -> Result<(Pose, Vec<xr::View>, bool)> {
+        let head = self
+            .view_space
+            .locate(&self.space, display)
+            .xr("xrLocateSpace")?;
+        let (flags, views) = self
+            .session
+            .locate_views(
+                xr::ViewConfigurationType::PRIMARY_STEREO,
+                display,
+                &self.space,
+            )
+            .xr("xrLocateViews")?;
+        let tracked = head.location_flags.contains(
+            xr::SpaceLocationFlags::POSITION_VALID | xr::SpaceLocationFlags::ORIENTATION_VALID,
+        ) && flags
+            .contains(xr::ViewStateFlags::POSITION_VALID | xr::ViewStateFlags::ORIENTATION_VALID);
+        Ok((pose_of(&head.pose), views, tracked))
+    }
+}
+
+impl Backend for Session {
+    type Error = OpenXrError;
+
+    fn wait_frame(&mut self) -> Result<Option<FrameInput>> {
+        if self.pending.is_some() {
+            return Err(OpenXrError::FrameOrder(
+                "wait_frame called twice without end_frame".into(),
+            ));
+        }
+        let mut since_change = Instant::now();
+        let mut last_state = self.state;
+        loop {
+            if INTERRUPTED.load(Ordering::SeqCst) {
+                self.stop(EndReason::Interrupted)?;
+            }
+            if self
+                .options
+                .max_frames
+                .is_some_and(|max| self.report.frames_submitted >= max)
+            {
+                self.stop(EndReason::FrameLimit)?;
+            }
+            self.poll_events()?;
+            if self.quit {
+                tracing::info!(
+                    "session over: {}",
+                    self.report.end_reason.unwrap_or(EndReason::RuntimeExit)
+                );
+                return Ok(None);
+            }
+            if self.state != last_state {
+                last_state = self.state;
+                since_change = Instant::now();
+            }
+            if !(self.running && state::runs_frames(self.state)) {
+                if since_change.elapsed() > STATE_TIMEOUT {
+                    return Err(OpenXrError::Unsupported(format!(
+                        "the session stayed {} for {} s (running: {}); is the runtime's \
+                         compositor working?",
+                        self.state,
+                        STATE_TIMEOUT.as_secs(),
+                        self.running
+                    )));
+                }
+                std::thread::sleep(Duration::from_millis(5));
+                continue;
+            }
+            let Some(frame) = self.begin_frame()? else {
+                continue;
+            };
+            let display = frame.predicted_display_time;
+            let image = self
+                .swapchain
+                .acquire_image()
+                .xr("xrAcquireSwapchainImage")?;
+            self.swapchain
+                .wait_image(xr::Duration::INFINITE)
+                .xr("xrWaitSwapchainImage")?;
+            let depth_image = match &mut self.depth {
+                Some((chain, _)) => {
+                    let i = chain.acquire_image().xr("xrAcquireSwapchainImage(depth)")?;
+                    chain
+                        .wait_image(xr::Duration::INFINITE)
+                        .xr("xrWaitSwapchainImage(depth)")?;
+                    Some(i)
+                }
+                None => None,
+            };
+            // Views are located after the wait for the image, as late as this loop allows.
+            let (head_space, views, tracked) = self.locate(display)?;
+            if !tracked {
+                self.report.frames_untracked += 1;
+            }
+            let first_display = *self.first_display.get_or_insert(display);
+            let placed = *self.world_from_space.get_or_insert_with(|| {
+                place_scene(
+                    &head_space,
+                    self.options.viewer_position_m,
+                    self.options.scene_origin,
+                )
+            });
+            // Live actions (and the eye-gaze action) are synced before the gaze is sampled and
+            // before the placement is used, so a nudge shows in this very frame.
+            self.sync_actions(compose(&placed, &head_space).position)?;
+            let world_from_space = self.world_from_space.unwrap_or(placed);
+            let gaze = self
+                .gaze
+                .sample(&self.session, &self.view_space, display, first_display);
+            let eye = |v: &xr::View| EyeView {
+                pose: compose(&world_from_space, &pose_of(&v.pose)),
+                fov: Fov {
+                    angle_left_rad: v.fov.angle_left,
+                    angle_right_rad: v.fov.angle_right,
+                    angle_up_rad: v.fov.angle_up,
+                    angle_down_rad: v.fov.angle_down,
+                },
+            };
+            let input = FrameInput {
+                index: self.next_index,
+                time_ns: display.as_nanos(),
+                head: compose(&world_from_space, &head_space),
+                views: [eye(&views[0]), eye(&views[1])],
+                gaze,
+            };
+            self.pending = Some((
+                Pending {
+                    display,
+                    views,
+                    index: self.next_index,
+                    depth_image,
+                },
+                image,
+            ));
+            self.next_index += 1;
+            return Ok(Some(input));
+        }
+    }
+
+    fn frame_target(&self) -> FrameTarget {
+        match &self.pending {
+            Some((pending, image)) => FrameTarget::Swapchain {
+                index: *image,
+                depth_index: pending.depth_image,
+                world_behind: self.world_behind,
+            },
+            None => FrameTarget::Own,
+        }
+    }
+
+    fn end_frame(&mut self, frame: &FrameInput) -> Result<()> {
+        let Some((pending, _)) = self.pending.take() else {
+            return Err(OpenXrError::FrameOrder(
+                "end_frame without wait_frame".into(),
+            ));
+        };
+        if pending.index != frame.index {
+            return Err(OpenXrError::FrameOrder(format!(
+                "end_frame for frame {} but frame {} is in flight",
+                frame.index, pending.index
+            )));
+        }
+        self.swapchain
+            .release_image()
+            .xr("xrReleaseSwapchainImage")?;
+        if let (Some((chain, _)), Some(_)) = (&mut self.depth, pending.depth_image) {
+            chain.release_image().xr("xrReleaseSwapchainImage(depth)")?;
+        }
+        let (w, h) = self.size;
+        let rect = xr::Rect2Di {
+            offset: xr::Offset2Di { x: 0, y: 0 },
+            extent: xr::Extent2Di {
+                width: w as i32,
+                height: h as i32,
+            },
+        };
+        let mut views: Vec<_> = pending
+            .views
+            .iter()
+            .enumerate()
+            .map(|(eye, v)| {
+                xr::CompositionLayerProjectionView::new()
+                    .pose(v.pose)
+                    .fov(v.fov)
+                    .sub_image(
+                        xr::SwapchainSubImage::new()
+                            .swapchain(&self.swapchain)
+                            .image_array_index(eye as u32)
+                            .image_rect(rect),
+                    )
+            })
+            .collect();
+        // Depth: the safe API cannot chain XrCompositionLayerDepthInfoKHR, so each view is
+        // rebuilt from its raw struct with the depth info behind `next`. `depth_infos` lives
+        // (unmoved) until xrEndFrame has returned.
+        let mut depth_infos: Vec<xr::sys::CompositionLayerDepthInfoKHR> = Vec::new();
+        if let (Some((chain, options)), Some(_)) = (&self.depth, pending.depth_image) {
+            depth_infos = (0..views.len() as u32)
+                .map(|eye| depth_info(chain.as_raw(), eye, rect, options))
+                .collect();
+            let mut raw: Vec<xr::sys::CompositionLayerProjectionView> =
+                views.iter().map(|v| *v.as_raw()).collect();
+            // SAFETY: `depth_infos` is not touched again before xrEndFrame returns; the
+            // rebuilt views keep the colour swapchain they referenced (still alive in self).
+            unsafe {
+                chain_depth(&mut raw, &mut depth_infos);
+                views = raw
+                    .into_iter()
+                    .map(|r| xr::CompositionLayerProjectionView::from_raw(r))
+                    .collect();
+            }
+        }
+        let layer = xr::CompositionLayerProjection::new()
+            .space(&self.space)
+            .views(&views);
+        self.stream
+            .end(pending.display, self.blend, &[&layer])
+            .xr("xrEndFrame")?;
+        drop(depth_infos);
+        self.report.frames_submitted += 1;
+        if pending.depth_image.is_some() {
+            self.report.frames_with_depth += 1;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        // A session dropped mid-frame (an error in the app) still ends its frame, so the
+        // runtime is not left waiting.
+        if let Some((pending, _)) = self.pending.take() {
+            let _ = self.swapchain.release_image();
+            if let (Some((chain, _)), Some(_)) = (&mut self.depth, pending.depth_image) {
+                let _ = chain.release_image();
+            }
+            let _ = self.stream.end(pending.display, self.blend, &[]);
+        }
+        if self.running {
+            let _ = self.session.request_exit();
+        }
+    }
+}
+
+/// The depth info of one eye's layer: image `layer` of `swapchain` over `rect`, depth 0..1
+/// from `near_m` to `far_m` (a standard, not reversed, projection).
+pub(crate) fn depth_info(
+    swapchain: xr::sys::Swapchain,
+    layer: u32,
+    rect: xr::Rect2Di,
+    depth: &DepthOptions,
+) -> xr::sys::CompositionLayerDepthInfoKHR {
+    xr::sys::CompositionLayerDepthInfoKHR {
+        ty: xr::sys::CompositionLayerDepthInfoKHR::TYPE,
+        next: std::ptr::null(),
+        sub_image: xr::sys::SwapchainSubImage {
+            swapchain,
+            image_rect: rect,
+            image_array_index: layer,
+        },
+        min_depth: 0.0,
+        max_depth: 1.0,
+        near_z: depth.near_m,
+        far_z: depth.far_m,
+    }
+}
+
+/// Chains each view's depth info into its `next` (keeping whatever was chained before behind
+/// it).
+///
+/// # Safety
+/// `infos` must outlive every use of `views` (xrEndFrame), and must not move.
+pub(crate) unsafe fn chain_depth(
+    views: &mut [xr::sys::CompositionLayerProjectionView],
+    infos: &mut [xr::sys::CompositionLayerDepthInfoKHR],
+) {
+    for (view, info) in views.iter_mut().zip(infos.iter_mut()) {
+        info.next = view.next;
+        view.next = info as *const xr::sys::CompositionLayerDepthInfoKHR as *const _;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ash::vk;
+
+    #[test]
+    fn each_view_chains_its_depth_info() {
+        let rect = xr::Rect2Di {
+            offset: xr::Offset2Di { x: 0, y: 0 },
+            extent: xr::Extent2Di {
+                width: 320,
+                height: 240,
+            },
+        };
+        let options = DepthOptions {
+            format: vk::Format::D32_SFLOAT,
+            near_m: 0.02,
+            far_m: 100.0,
+        };
+        let chain = <xr::sys::Swapchain as xr::sys::Handle>::from_raw(7);
+        let mut infos: Vec<_> = (0..2)
+            .map(|l| depth_info(chain, l, rect, &options))
+            .collect();
+        let view = *xr::CompositionLayerProjectionView::<xr::Vulkan>::new().as_raw();
+        let mut views = [view, view];
+        unsafe { chain_depth(&mut views, &mut infos) };
+        for (eye, v) in views.iter().enumerate() {
+            let info = unsafe { &*(v.next as *const xr::sys::CompositionLayerDepthInfoKHR) };
+            assert_eq!(
+                info.ty,
+                xr::sys::StructureType::COMPOSITION_LAYER_DEPTH_INFO_KHR
+            );
+            assert!(info.next.is_null());
+            assert_eq!(info.sub_image.swapchain, chain);
+            assert_eq!(info.sub_image.image_array_index, eye as u32);
+            assert_eq!(info.sub_image.image_rect.extent.width, 320);
+            assert_eq!((info.min_depth, info.max_depth), (0.0, 1.0));
+            assert_eq!((info.near_z, info.far_z), (0.02, 100.0));
+        }
+    }
+}

@@ -1,0 +1,190 @@
+//! The live session: what it holds and reports, and the commands it takes. It is made in
+//! [`create`], driven by the OpenXR state machine in [`state_machine`], hands out and submits
+//! frames in [`frame`], and places the scene with [`placement`].
+//!
+//! The order of the fields of [`Session`] is its teardown order (Rust drops fields in
+//! declaration order): frame stream, waiter, swapchains, actions, gaze, spaces, then the
+//! session.
+
+mod create;
+mod frame;
+mod placement;
+mod state_machine;
+
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use glam::Vec3;
+use openxr as xr;
+
+use super::DepthOptions;
+use super::SessionOptions;
+use super::actions::{Command, Controls};
+use super::choose::{Blend, GazeSource, SpaceChoice};
+use super::gaze::Gaze;
+use super::state::{EndReason, State};
+use crate::frame::Pose;
+
+pub(super) use create::start;
+use placement::re_register;
+
+/// Set by the Ctrl-C handler; polled by every session.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+/// Whether the handler is installed (it can be only once per process).
+static HANDLER: OnceLock<bool> = OnceLock::new();
+
+/// Installs the Ctrl-C handler once; false when another handler was already set.
+fn install_ctrl_c() -> bool {
+    *HANDLER.get_or_init(|| {
+        ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst))
+            .map_err(|e| tracing::warn!("cannot handle Ctrl-C: {e}"))
+            .is_ok()
+    })
+}
+
+/// How long the session waits for the runtime to make it READY or walk it to EXITING.
+const STATE_TIMEOUT: Duration = Duration::from_secs(20);
+
+/// What a finished (or running) session did.
+#[derive(Clone, Debug, Default)]
+pub struct SessionReport {
+    /// Every state the session reached, in order (repeats collapsed).
+    pub states: Vec<State>,
+    /// Frames handed to the app and submitted with a projection layer.
+    pub frames_submitted: u64,
+    /// Frames the runtime said not to render (submitted without layers).
+    pub frames_skipped: u64,
+    /// Why the session ended (None while running).
+    pub end_reason: Option<EndReason>,
+    /// The gaze source.
+    pub gaze_source: Option<GazeSource>,
+    /// The reference space.
+    pub space: Option<SpaceChoice>,
+    /// The blend mode.
+    pub blend: Option<Blend>,
+    /// Frames whose views the runtime could not locate fully (pose not valid).
+    pub frames_untracked: u64,
+    /// The controller action set was created and attached to the session.
+    pub actions_attached: bool,
+    /// Interaction profiles whose suggested bindings the runtime accepted.
+    pub action_profiles: Vec<String>,
+    /// Successful xrSyncActions calls (one per FOCUSED frame).
+    pub action_syncs: u64,
+    /// Commands the live actions gave.
+    pub commands: u64,
+    /// Frames submitted with depth (XR_KHR_composition_layer_depth).
+    pub frames_with_depth: u64,
+    /// The depth swapchain's format (VkFormat code) when depth is submitted.
+    pub depth_format: Option<i32>,
+}
+
+impl SessionReport {
+    /// Whether the session reached `state`.
+    pub fn reached(&self, state: State) -> bool {
+        self.states.contains(&state)
+    }
+}
+
+/// A frame handed out and not yet ended.
+struct Pending {
+    /// Its predicted display time.
+    display: xr::Time,
+    /// The located views, in the runtime's space (for the projection layer).
+    views: Vec<xr::View>,
+    /// Its index.
+    index: u64,
+    /// The depth swapchain image acquired for it, when depth is submitted.
+    depth_image: Option<u32>,
+}
+
+/// A live OpenXR session; the [`crate::Backend`] of `vitreous run`.
+pub struct Session {
+    /// Frame submission; dropped before the session.
+    stream: xr::FrameStream<xr::Vulkan>,
+    /// Frame pacing.
+    waiter: xr::FrameWaiter,
+    /// The one 2-layer swapchain.
+    swapchain: xr::Swapchain<xr::Vulkan>,
+    /// The 2-layer depth swapchain, when depth is submitted, and its near/far planes.
+    depth: Option<(xr::Swapchain<xr::Vulkan>, DepthOptions)>,
+    /// The controller actions, when their set could be made.
+    controls: Option<Controls>,
+    /// Every action set attached to the session (synced together each FOCUSED frame).
+    action_sets: Vec<xr::ActionSet>,
+    /// Where commands go for the app (see [`Session::take_commands`]).
+    commands_tx: mpsc::Sender<Command>,
+    /// The app's end, until taken.
+    commands_rx: Option<mpsc::Receiver<Command>>,
+    /// The gaze source (holds spaces/trackers of the session).
+    gaze: Gaze,
+    /// The app space the scene is placed in (STAGE or LOCAL).
+    space: xr::Space,
+    /// The VIEW space (the head).
+    view_space: xr::Space,
+    /// The session.
+    session: xr::Session<xr::Vulkan>,
+    /// The instance, for events.
+    instance: xr::Instance,
+    /// Event storage.
+    events: xr::EventDataBuffer,
+    /// Blend mode submitted with every frame.
+    blend: xr::EnvironmentBlendMode,
+    /// Whether the real world is drawn behind the glass.
+    world_behind: bool,
+    /// Eye image size, pixels.
+    size: (u32, u32),
+    /// Current state.
+    state: State,
+    /// Between xrBeginSession and xrEndSession.
+    running: bool,
+    /// xrRequestExitSession was called.
+    exit_requested: bool,
+    /// Set to quit on the next wait.
+    quit: bool,
+    /// Scene frame from app space; fixed at the first located head pose.
+    world_from_space: Option<Pose>,
+    /// Display time of the first frame.
+    first_display: Option<xr::Time>,
+    /// Next frame index.
+    next_index: u64,
+    /// The frame in flight and the swapchain image acquired for it.
+    pending: Option<(Pending, u32)>,
+    /// Options.
+    options: SessionOptions,
+    /// What happened.
+    report: SessionReport,
+}
+
+impl Session {
+    /// What the session did so far.
+    pub fn report(&self) -> &SessionReport {
+        &self.report
+    }
+
+    /// Eye image size, pixels.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// The commands of the live actions, as they come (each is also logged, and Nudge and
+    /// Rotate are applied to the scene's placement by the session itself). `None` after the
+    /// first call.
+    pub fn take_commands(&mut self) -> Option<mpsc::Receiver<Command>> {
+        self.commands_rx.take()
+    }
+
+    /// Applies a command as if a live action gave it (Nudge and Rotate re-register the scene;
+    /// every command is passed on to [`Session::take_commands`]'s receiver). `head_m` is the
+    /// head's position in the scene frame.
+    pub fn command(&mut self, command: Command, head_m: Vec3) {
+        tracing::info!("live action: {command}");
+        self.report.commands += 1;
+        if let Some(w) = &mut self.world_from_space {
+            *w = re_register(w, command, head_m);
+        }
+        // The app may have dropped its receiver: then nobody wants the rest.
+        let _ = self.commands_tx.send(command);
+    }
+}

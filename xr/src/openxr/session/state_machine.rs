@@ -1,0 +1,144 @@
+//! The session state machine: OpenXR events, xrBeginSession/xrEndSession as the runtime
+//! walks the states, ending on request, and the live actions synced while FOCUSED.
+
+use glam::Vec3;
+use openxr as xr;
+
+use super::super::state::{self, Action, EndReason, State};
+use super::super::{Result, XrContext};
+use super::Session;
+
+impl Session {
+    /// xrSyncActions with every attached set, then the controller commands; only while
+    /// FOCUSED (input goes to the focused session only).
+    pub(super) fn sync_actions(&mut self, head_m: Vec3) -> Result<()> {
+        if self.state != State::Focused || self.action_sets.is_empty() {
+            return Ok(());
+        }
+        let active: Vec<xr::ActiveActionSet<'_>> = self
+            .action_sets
+            .iter()
+            .map(xr::ActiveActionSet::new)
+            .collect();
+        self.session.sync_actions(&active).xr("xrSyncActions")?;
+        self.report.action_syncs += 1;
+        let commands = match &self.controls {
+            Some(c) => c.commands(&self.session)?,
+            None => Vec::new(),
+        };
+        for command in commands {
+            self.command(command, head_m);
+        }
+        Ok(())
+    }
+
+    fn set_state(&mut self, s: State) {
+        self.state = s;
+        if self.report.states.last() != Some(&s) {
+            self.report.states.push(s);
+        }
+        tracing::info!("session state {s}");
+    }
+
+    fn end_with(&mut self, reason: EndReason) {
+        if self.report.end_reason.is_none() {
+            self.report.end_reason = Some(reason);
+        }
+    }
+
+    /// Handles pending events; applies the state machine.
+    pub(super) fn poll_events(&mut self) -> Result<()> {
+        loop {
+            let event = self
+                .instance
+                .poll_event(&mut self.events)
+                .xr("xrPollEvent")?;
+            let Some(event) = event else { break };
+            match event {
+                xr::Event::SessionStateChanged(e) => {
+                    let s = state_of(e.state());
+                    // Copy out before `self` is borrowed mutably again.
+                    self.set_state(s);
+                    match state::on_state(s, self.running) {
+                        Action::Begin => {
+                            self.session
+                                .begin(xr::ViewConfigurationType::PRIMARY_STEREO)
+                                .xr("xrBeginSession")?;
+                            self.running = true;
+                        }
+                        Action::End => {
+                            self.session.end().xr("xrEndSession")?;
+                            self.running = false;
+                            if !self.exit_requested {
+                                self.end_with(EndReason::RuntimeExit);
+                            }
+                        }
+                        Action::EndAndQuit => {
+                            let _ = self.session.end();
+                            self.running = false;
+                            self.end_with(EndReason::SessionLost);
+                            self.quit = true;
+                        }
+                        Action::Quit => {
+                            if s == State::LossPending {
+                                self.end_with(EndReason::SessionLost);
+                            } else {
+                                self.end_with(EndReason::RuntimeExit);
+                            }
+                            self.quit = true;
+                        }
+                        Action::Continue => {}
+                    }
+                }
+                xr::Event::InstanceLossPending(_) => {
+                    tracing::warn!("the OpenXR runtime is going away (instance loss pending)");
+                    if self.running {
+                        let _ = self.session.end();
+                        self.running = false;
+                    }
+                    self.end_with(EndReason::InstanceLost);
+                    self.quit = true;
+                }
+                xr::Event::EventsLost(e) => {
+                    tracing::warn!("the runtime dropped {} events", e.lost_event_count());
+                }
+                _ => {}
+            }
+            if self.quit {
+                break;
+            }
+        }
+        Ok(())
+    }
+
+    /// Asks the runtime to end the session (or quits at once if it never ran).
+    pub(super) fn stop(&mut self, reason: EndReason) -> Result<()> {
+        self.end_with(reason);
+        if self.exit_requested {
+            return Ok(());
+        }
+        self.exit_requested = true;
+        if self.running {
+            tracing::info!("ending the session: {reason}");
+            self.session.request_exit().xr("xrRequestExitSession")?;
+        } else {
+            self.quit = true;
+        }
+        Ok(())
+    }
+}
+
+/// vitreous' state for an OpenXR one.
+fn state_of(s: xr::SessionState) -> State {
+    match s {
+        xr::SessionState::IDLE => State::Idle,
+        xr::SessionState::READY => State::Ready,
+        xr::SessionState::SYNCHRONIZED => State::Synchronized,
+        xr::SessionState::VISIBLE => State::Visible,
+        xr::SessionState::FOCUSED => State::Focused,
+        xr::SessionState::STOPPING => State::Stopping,
+        xr::SessionState::LOSS_PENDING => State::LossPending,
+        xr::SessionState::EXITING => State::Exiting,
+        _ => State::Unknown,
+    }
+}

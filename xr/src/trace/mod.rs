@@ -1,0 +1,115 @@
+//! The vitreous trace format, version 1: head poses and eye-tracker samples as UTF-8 text.
+//!
+//! One sample per line, comma-separated, after a version line and a column header line. The
+//! full description (every column, its unit and axes) is in `docs/trace-format.md`; the short
+//! version:
+//!
+//! ```text
+//! # vitreous-trace v1
+//! time_ns,head_x_m,head_y_m,head_z_m,head_qx,head_qy,head_qz,head_qw,gaze_time_ns,left_valid,...
+//! 0,0,0,0,0,0,0,1,0,1,-0.032,0,0,0,0,-1,1,0.032,0,0,0,0,-1,,,,,,,,,,
+//! ```
+//!
+//! The reader is strict about what the replay depends on (times, head pose) and lenient about
+//! what trackers really produce: a gaze ray with a NaN/infinite value or a zero direction is
+//! read as an invalid ray of that eye instead of failing the whole trace.
+//!
+//! The writer runs the same checks before writing, so it never produces a file the reader
+//! refuses, and flushes after every sample so a crash loses at most the sample being written.
+//! A trace file ([`TraceWriter::create`]) appears under its name only once finished.
+
+mod error;
+mod read;
+#[cfg(test)]
+mod test_traces;
+mod validate;
+mod write;
+
+use crate::frame::{GazeSample, Pose};
+
+pub use crate::atomic_file::AtomicFile;
+pub use error::TraceError;
+pub use read::{TraceReader, read_trace};
+pub(crate) use validate::check_span;
+pub use validate::clean_ray;
+pub use write::TraceWriter;
+
+/// The first line of every version-1 trace.
+pub const VERSION_LINE: &str = "# vitreous-trace v1";
+
+/// What the version line starts with, whatever the version.
+const VERSION_PREFIX: &str = "# vitreous-trace ";
+
+/// The column names of version 1, in file order (the second non-comment line of a trace).
+pub const COLUMNS: [&str; 33] = [
+    "time_ns",
+    "head_x_m",
+    "head_y_m",
+    "head_z_m",
+    "head_qx",
+    "head_qy",
+    "head_qz",
+    "head_qw",
+    "gaze_time_ns",
+    "left_valid",
+    "left_origin_x_m",
+    "left_origin_y_m",
+    "left_origin_z_m",
+    "left_dir_x",
+    "left_dir_y",
+    "left_dir_z",
+    "right_valid",
+    "right_origin_x_m",
+    "right_origin_y_m",
+    "right_origin_z_m",
+    "right_dir_x",
+    "right_dir_y",
+    "right_dir_z",
+    "combined_valid",
+    "combined_origin_x_m",
+    "combined_origin_y_m",
+    "combined_origin_z_m",
+    "combined_dir_x",
+    "combined_dir_y",
+    "combined_dir_z",
+    "fixation_x_m",
+    "fixation_y_m",
+    "fixation_z_m",
+];
+
+/// Index of the first column of each group in [`COLUMNS`].
+const LEFT: usize = 9;
+const RIGHT: usize = 16;
+const COMBINED: usize = 23;
+const FIXATION: usize = 30;
+
+/// How far the head quaternion's norm may be from 1 before the sample is refused; within it
+/// the quaternion is normalised (text round-off, other tools' rounding).
+pub const QUAT_NORM_TOLERANCE: f32 = 1e-3;
+
+/// The longest trace accepted: 24 hours from the first sample's `time_ns` to the last's.
+/// Replay at 90 Hz then takes under 8 million frames; anything longer is a clock error.
+pub const MAX_TRACE_SPAN_NS: i64 = 24 * 3600 * 1_000_000_000;
+
+/// The longest gap accepted between the `time_ns` of consecutive samples: 10 minutes. A
+/// longer pause in a recording is a clock jump, and replaying it would show one frozen pose
+/// for that long.
+pub const MAX_SAMPLE_GAP_NS: i64 = 10 * 60 * 1_000_000_000;
+
+/// Below this length a gaze direction counts as zero (the ray is then invalid).
+const MIN_DIRECTION_LENGTH: f32 = 1e-6;
+
+/// Vectors whose squared length is within this of 1 are kept bit-exact instead of being
+/// normalised again, so that writing then reading a sample gives the same numbers.
+const UNIT_EPSILON: f32 = 1e-6;
+
+/// One line of a trace: a head pose and the newest eye-tracker sample at that time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TraceSample {
+    /// Time of the head pose, nanoseconds on the trace clock. Strictly increasing in a trace.
+    pub time_ns: i64,
+    /// Head pose in the world frame (OpenXR LOCAL-like axes, metres).
+    pub head: Pose,
+    /// The eye-tracker sample, rays in the head frame. `gaze.sample_time_ns <= time_ns`.
+    pub gaze: GazeSample,
+}

@@ -1,0 +1,83 @@
+//! Traces for the tests of this module: samples, their text, and that text corrupted.
+
+use glam::{Quat, Vec3};
+
+use super::*;
+use crate::frame::GazeRay;
+
+pub(super) fn ray(origin: Vec3, direction: Vec3) -> GazeRay {
+    GazeRay {
+        origin,
+        direction: direction.normalize(),
+        valid: true,
+    }
+}
+
+pub(super) fn sample(time_ns: i64) -> TraceSample {
+    TraceSample {
+        time_ns,
+        head: Pose {
+            position: Vec3::new(0.1, 1.6, -0.2),
+            orientation: Quat::from_rotation_y(0.3),
+        },
+        gaze: GazeSample {
+            sample_time_ns: time_ns - 5,
+            left: ray(Vec3::new(-0.032, 0.0, 0.01), Vec3::new(0.1, 0.0, -1.0)),
+            right: ray(Vec3::new(0.032, 0.0, 0.01), Vec3::new(-0.1, 0.0, -1.0)),
+            combined: None,
+            fixation: None,
+        },
+    }
+}
+
+pub(super) fn to_text(samples: &[TraceSample]) -> String {
+    let mut w = TraceWriter::new(Vec::new()).unwrap();
+    for s in samples {
+        w.write(s).unwrap();
+    }
+    String::from_utf8(w.finish().unwrap()).unwrap()
+}
+
+pub(super) fn read_str(text: &str) -> Result<Vec<TraceSample>, TraceError> {
+    TraceReader::new(text.as_bytes(), "test.trace")?.collect()
+}
+
+/// A valid trace text with `n` samples, for corrupting one line in the tests.
+pub(super) fn good_text(n: i64) -> String {
+    to_text(&(1..=n).map(|i| sample(i * 1000)).collect::<Vec<_>>())
+}
+
+/// Replaces field `col` of physical line `line` (1-based).
+pub(super) fn with_field(text: &str, line: usize, col: usize, value: &str) -> String {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i + 1 == line {
+                let mut f: Vec<&str> = l.split(',').collect();
+                f[col] = value;
+                f.join(",")
+            } else {
+                l.to_owned()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+pub(super) fn line_of(e: &TraceError) -> Option<usize> {
+    use TraceError::*;
+    match e {
+        BadVersionLine { line, .. }
+        | UnsupportedVersion { line, .. }
+        | BadColumnHeader { line, .. }
+        | FieldCount { line, .. }
+        | BadField { line, .. }
+        | NonFinite { line, .. }
+        | NonUnitQuaternion { line, .. }
+        | TimeNotIncreasing { line, .. }
+        | GazeAfterPose { line, .. }
+        | GazeTimeBackwards { line, .. }
+        | PartialGroup { line, .. } => Some(*line),
+        _ => None,
+    }
+}

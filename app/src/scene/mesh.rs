@@ -88,6 +88,7 @@ fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
             format!("invalid glTF: {e}")
         }
     };
+    check_glb_length(bytes)?;
     let gltf::Gltf { document, mut blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
     // gltf-json's own validation indexes the POSITION accessor before checking that it
@@ -150,6 +151,26 @@ fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
         ior: out.ior,
         buffers,
     })
+}
+
+/// Size of the GLB file header: magic, version, total length.
+const GLB_HEADER_LEN: u32 = 12;
+
+/// A GLB's declared total length covers at least its header (the gltf crate subtracts the
+/// header size from it unchecked).
+fn check_glb_length(bytes: &[u8]) -> Result<(), String> {
+    let declared = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes);
+    match declared {
+        Some(length) if length < GLB_HEADER_LEN => Err(format!(
+            "invalid glTF: the GLB header declares a total length of {length} bytes, less than \
+             the {GLB_HEADER_LEN}-byte header itself"
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Every primitive's POSITION attribute names an accessor that exists.
@@ -612,6 +633,14 @@ mod tests {
             .err()
             .unwrap();
         assert!(err.contains("POSITION: accessor 7 does not exist"), "{err}");
+    }
+
+    #[test]
+    fn glb_length_shorter_than_its_header_is_an_error_not_a_panic() {
+        let mut glb = b"glTF\x02\0\0\0\x03\0\0\0".to_vec();
+        glb.extend_from_slice(&[0; 16]);
+        let err = load_gltf_inner(&glb, Path::new(".")).err().unwrap();
+        assert!(err.contains("total length of 3 bytes"), "{err}");
     }
 
     #[test]

@@ -14,9 +14,9 @@ use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 
-use crate::look::LookPlanner;
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
+use crate::look::LookPlanner;
 use crate::replay::{GazeSettings, check_size, load_trace, planner_for};
 use crate::scene::load_scene;
 use crate::views;
@@ -215,8 +215,12 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
                 })
                 .context("setting up the Vulkan device")?;
                 device.clone_from(&ctx.device_name);
-                let (planner, defocus) =
-                    planner_for(&scene, &effects, Reflection::Phong, &GazeSettings::default())?;
+                let (planner, defocus) = planner_for(
+                    &scene,
+                    &effects,
+                    Reflection::Phong,
+                    &GazeSettings::default(),
+                )?;
                 let renderer = Renderer::new(
                     ctx,
                     &views::scene_desc(&scene, defocus.as_ref()),

@@ -67,6 +67,13 @@ const MAX_NODE_DEPTH: usize = 64;
 /// Most node visits accepted (a node shared by several parents is visited once per path).
 const MAX_NODE_VISITS: usize = 100_000;
 
+/// Loads a glTF or GLB file's bytes into one checked [`Mesh`] and the first
+/// `KHR_materials_ior` found; external buffers are read relative to `base`. The error names
+/// what is wrong with the file (no panic on any input).
+pub fn load_mesh(bytes: &[u8], base: &Path) -> Result<(Mesh, Option<f32>), String> {
+    load_gltf(bytes, base).map(|model| (model.mesh, model.ior))
+}
+
 /// Loads a glTF or GLB file's bytes; external buffers are read relative to `base`.
 pub(crate) fn load_gltf(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
     // Third-party decoders must not take the process down on hostile input; our own checks
@@ -76,14 +83,21 @@ pub(crate) fn load_gltf(bytes: &[u8], base: &Path) -> Result<LoadedModel, String
 }
 
 fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
-    let gltf::Gltf { document, mut blob } = gltf::Gltf::from_slice(bytes).map_err(|e| {
+    let invalid = |e: gltf::Error| {
         let e = e.to_string();
         if e.starts_with("invalid glTF") {
             e
         } else {
             format!("invalid glTF: {e}")
         }
-    })?;
+    };
+    check_glb_length(bytes)?;
+    let gltf::Gltf { document, mut blob } =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+    // gltf-json's own validation indexes the POSITION accessor before checking that it
+    // exists, so that is checked first.
+    check_position_accessors(document.as_json())?;
+    let document = gltf::Document::from_json(document.into_json()).map_err(invalid)?;
 
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
@@ -140,6 +154,50 @@ fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
         ior: out.ior,
         buffers,
     })
+}
+
+/// Size of the GLB file header: magic, version, total length.
+const GLB_HEADER_LEN: u32 = 12;
+
+/// A GLB's declared total length covers at least its header (the gltf crate subtracts the
+/// header size from it unchecked).
+fn check_glb_length(bytes: &[u8]) -> Result<(), String> {
+    let declared = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes);
+    match declared {
+        Some(length) if length < GLB_HEADER_LEN => Err(format!(
+            "invalid glTF: the GLB header declares a total length of {length} bytes, less than \
+             the {GLB_HEADER_LEN}-byte header itself"
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Every primitive's POSITION attribute names an accessor that exists.
+fn check_position_accessors(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::Checked;
+
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(index) = primitive
+                .attributes
+                .get(&Checked::Valid(Semantic::Positions))
+                && index.value() >= root.accessors.len()
+            {
+                return Err(format!(
+                    "invalid glTF: meshes[{m}].primitives[{p}].attributes.POSITION: accessor {} \
+                     does not exist (the file has {})",
+                    index.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn describe(e: &gltf::Error) -> String {
@@ -597,6 +655,23 @@ mod tests {
         let gltf = triangle_gltf("0,1,2", r#","scale":[3e38,3e38,3e38]"#);
         let err = load_gltf(gltf.as_bytes(), Path::new(".")).err().unwrap();
         assert!(err.contains("overflows"), "{err}");
+    }
+
+    #[test]
+    fn missing_position_accessor_is_an_error_not_a_panic() {
+        let gltf = triangle_gltf("0,1,2", "").replace(r#""POSITION":0"#, r#""POSITION":7"#);
+        let err = load_gltf_inner(gltf.as_bytes(), Path::new("."))
+            .err()
+            .unwrap();
+        assert!(err.contains("POSITION: accessor 7 does not exist"), "{err}");
+    }
+
+    #[test]
+    fn glb_length_shorter_than_its_header_is_an_error_not_a_panic() {
+        let mut glb = b"glTF\x02\0\0\0\x03\0\0\0".to_vec();
+        glb.extend_from_slice(&[0; 16]);
+        let err = load_gltf_inner(&glb, Path::new(".")).err().unwrap();
+        assert!(err.contains("total length of 3 bytes"), "{err}");
     }
 
     #[test]

@@ -34,7 +34,7 @@ pub use fixation::{
 };
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
 pub use load::load_scene;
-pub use mesh::Mesh;
+pub use mesh::{Mesh, load_mesh};
 
 /// A fully loaded scene, in the world frame described in the module docs.
 #[derive(Clone, Debug)]

@@ -250,10 +250,22 @@ impl Importer {
         if let Some(last) = self.samples.last() {
             check_span(row.file(), row.line(), time_ns, last.time_ns, 0)?;
         }
+        // Positions near the f32 limits can make the re-anchored one overflow: a NaN head
+        // pose no trace reader accepts.
+        let head_position = anchor.unyaw * (pose.position - anchor.position);
+        if let Some(axis) = (0..3).find(|&i| !head_position[i].is_finite()) {
+            return Err(ImportError::BadField {
+                file: row.file().to_owned(),
+                line: row.line(),
+                column: HELMET_POS[axis],
+                found: position[axis].to_string(),
+                expected: "a position whose distance from the first row's fits in an f32",
+            });
+        }
         self.samples.push(TraceSample {
             time_ns,
             head: Pose {
-                position: anchor.unyaw * (pose.position - anchor.position),
+                position: head_position,
                 orientation: (anchor.unyaw * pose.orientation).normalize(),
             },
             gaze: GazeSample {

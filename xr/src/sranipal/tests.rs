@@ -284,6 +284,24 @@ fn clock_jumps_are_refused_with_the_line() {
 }
 
 #[test]
+fn positions_too_far_apart_are_an_error_not_a_non_finite_pose() {
+    let a = mini_row(Vec3::ZERO, Vec3::new(-3e38, 0.0, 0.0), 1);
+    let b = mini_row(Vec3::ZERO, Vec3::new(3e38, 0.0, 0.0), 2);
+    let e = parse(&format!("{MINI_HEADER}\n{a}\n{b}\n")).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ImportError::BadField {
+                line: 3,
+                column: "helmet_pos_x",
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+#[test]
 fn repeated_times_are_dropped_and_counted() {
     let a = mini_row(Vec3::ZERO, Vec3::ZERO, 10);
     let b = mini_row(Vec3::ZERO, Vec3::ZERO, 10);

@@ -1,0 +1,137 @@
+//! Fuzz targets for the readers that take files from users: the trace v1 reader, the
+//! SRanipal importer, the scene loader and the glTF model path.
+//!
+//! Each target is a plain function from bytes to nothing that must not panic on any input.
+//! `fuzz_targets/*.rs` hand them to libFuzzer (`tools/fuzz`, `cargo fuzz`); the corpus test
+//! in `tests/corpus.rs` runs them over `corpus/<target>/` on stable as part of `cargo test`.
+//! Besides "no panic", the targets check properties the readers promise: whatever the trace
+//! reader accepts the writer writes back to the same samples, whatever the SRanipal importer
+//! produces is a valid trace, and every error message can be formatted.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use vitreous_xr::trace::{TraceReader, TraceSample, TraceWriter};
+
+/// Names of the targets, as in `fuzz_targets/` and `corpus/`.
+pub const TARGETS: [&str; 4] = ["trace_v1", "sranipal", "scene", "gltf"];
+
+/// Runs the target called `name` (one of [`TARGETS`]) on `data`; `false` for an unknown name.
+pub fn run(name: &str, data: &[u8]) -> bool {
+    match name {
+        "trace_v1" => trace_v1(data),
+        "sranipal" => sranipal(data),
+        "scene" => scene(data),
+        "gltf" => gltf(data),
+        _ => return false,
+    }
+    true
+}
+
+/// Trace v1 text: read every sample; when all are accepted, write them with
+/// [`TraceWriter`] and read the result back, which must give the same samples.
+pub fn trace_v1(data: &[u8]) {
+    let samples = match read_all(data) {
+        Ok(samples) => samples,
+        Err(message) => {
+            assert!(!message.is_empty());
+            return;
+        }
+    };
+    let written = write_all(&samples);
+    let again =
+        read_all(&written).unwrap_or_else(|e| panic!("a written trace does not read back: {e}"));
+    assert_eq!(samples, again, "writing then reading changed the samples");
+}
+
+/// SRanipal CSV text: import it; the samples of a successful import must make a valid trace
+/// that reads back unchanged, and the report must format.
+pub fn sranipal(data: &[u8]) {
+    match vitreous_xr::sranipal::parse_sranipal(data, "fuzz.csv") {
+        Ok((samples, report)) => {
+            assert!(!report.to_string().is_empty());
+            let written = write_all(&samples);
+            let again = read_all(&written)
+                .unwrap_or_else(|e| panic!("an imported trace does not read back: {e}"));
+            assert_eq!(
+                samples, again,
+                "the imported trace changed when written and read"
+            );
+        }
+        Err(e) => assert!(!e.to_string().is_empty()),
+    }
+}
+
+/// Scene TOML text: written as `scene.toml` into a folder holding the small assets of
+/// `assets/` (`model.glb`, `photo.png`, `env.hdr`) and loaded with
+/// [`vitreous::scene::load_scene`].
+pub fn scene(data: &[u8]) {
+    let path = asset_dir().join("scene.toml");
+    fs::write(&path, data).unwrap_or_else(|e| panic!("cannot write {}: {e}", path.display()));
+    match vitreous::scene::load_scene(&path) {
+        Ok(scene) => assert!(!format!("{scene:?}").is_empty()),
+        Err(e) => assert!(!e.to_string().is_empty()),
+    }
+}
+
+/// glTF or GLB bytes: loaded with [`vitreous::scene::load_mesh`], external buffers resolved
+/// against the same asset folder; an accepted mesh must be consistent.
+pub fn gltf(data: &[u8]) {
+    match vitreous::scene::load_mesh(data, asset_dir()) {
+        Ok((mesh, _ior)) => {
+            let n = mesh.positions.len();
+            assert!(n > 0 && mesh.indices.len() % 3 == 0, "{mesh:?}");
+            assert_eq!(mesh.normals.len(), n, "one normal per vertex");
+            assert_eq!(mesh.uvs.len(), n, "one uv per vertex");
+            assert!(
+                mesh.indices.iter().all(|&i| (i as usize) < n),
+                "an index is out of range"
+            );
+        }
+        Err(e) => assert!(!e.is_empty()),
+    }
+}
+
+/// Reads a whole trace from bytes; the error as its message.
+fn read_all(data: &[u8]) -> Result<Vec<TraceSample>, String> {
+    let reader = TraceReader::new(data, "fuzz.csv").map_err(|e| e.to_string())?;
+    reader
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())
+}
+
+/// Writes samples as a trace; every one must be accepted.
+fn write_all(samples: &[TraceSample]) -> Vec<u8> {
+    let mut writer = TraceWriter::new(Vec::new()).expect("writing to memory");
+    for (i, sample) in samples.iter().enumerate() {
+        if let Err(e) = writer.write(sample) {
+            panic!("sample {i} was accepted but cannot be written: {e}\n{sample:?}");
+        }
+    }
+    writer.finish().expect("flushing to memory")
+}
+
+/// A folder, made once per process, holding copies of the files in `assets/`; the scene
+/// target writes its input there.
+fn asset_dir() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = tempfile::Builder::new()
+            .prefix("vitreous-fuzz-")
+            .tempdir()
+            .expect("creating a temporary folder")
+            .keep();
+        let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+        let entries = fs::read_dir(&assets)
+            .unwrap_or_else(|e| panic!("cannot list {}: {e}", assets.display()));
+        for entry in entries {
+            let from = entry.expect("listing assets").path();
+            if let Some(name) = from.file_name() {
+                fs::copy(&from, dir.join(name))
+                    .unwrap_or_else(|e| panic!("cannot copy {}: {e}", from.display()));
+            }
+        }
+        dir
+    })
+}

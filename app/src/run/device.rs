@@ -17,6 +17,8 @@ fn creation(e: impl std::fmt::Display) -> RenderError {
 }
 
 impl DeviceCreator for XrDeviceCreator<'_> {
+    /// # Safety
+    /// As [`DeviceCreator::create_instance`].
     unsafe fn create_instance(
         &mut self,
         entry: &ash::Entry,
@@ -25,6 +27,8 @@ impl DeviceCreator for XrDeviceCreator<'_> {
         self.runtime
             .check_vulkan_version(API_VERSION)
             .map_err(creation)?;
+        // SAFETY: `info` is valid (this function's own contract); the caller (GpuContext) owns
+        // the instance and destroys it after every session of the runtime is gone.
         unsafe { self.runtime.create_vulkan_instance(entry, info) }.map_err(creation)
     }
 
@@ -39,13 +43,18 @@ impl DeviceCreator for XrDeviceCreator<'_> {
             .map_err(creation)
     }
 
+    /// # Safety
+    /// As [`DeviceCreator::create_device`].
     unsafe fn create_device(
         &mut self,
         instance: &ash::Instance,
         physical: vk::PhysicalDevice,
         info: &vk::DeviceCreateInfo,
     ) -> Result<ash::Device, RenderError> {
+        // SAFETY: loading the Vulkan loader only runs its initialisation.
         let entry = unsafe { ash::Entry::load() }?;
+        // SAFETY: `physical` came from `pick_physical_device`, i.e. from the runtime, and
+        // `info` is valid (this function's own contract).
         unsafe {
             self.runtime
                 .create_vulkan_device(&entry, instance, physical, info)

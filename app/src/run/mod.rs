@@ -306,6 +306,9 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
     )
     .context("preparing the renderer")?;
     drop(defocus);
+    // SAFETY: `handles` are the instance, device and queue this runtime created for the
+    // renderer's context (XrDeviceCreator); the renderer owns them and outlives `session`,
+    // which is dropped before it at the end of this function.
     let (mut session, images) = unsafe {
         runtime.start(
             handles,
@@ -331,6 +334,8 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
             images.format
         );
     }
+    // SAFETY: the images are the session's swapchain images, made on the renderer's device;
+    // the session (which owns them) is dropped only after the renderer detaches them.
     unsafe {
         renderer.attach_external_with_depth(&images.images, images.format, &images.depth_images)
     }

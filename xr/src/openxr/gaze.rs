@@ -89,6 +89,8 @@ impl FbTracker {
             next: std::ptr::null(),
         };
         let mut tracker = <xr::sys::EyeTrackerFB as xr::sys::Handle>::NULL;
+        // SAFETY: `fp` was loaded from this session's instance with the extension enabled;
+        // `info` and `tracker` are valid for the call.
         let r = unsafe { (fp.create_eye_tracker)(session.as_raw(), &info, &mut tracker) };
         if r != xr::sys::Result::SUCCESS {
             return Err(r).xr("xrCreateEyeTrackerFB");
@@ -107,6 +109,8 @@ impl FbTracker {
         // SAFETY: EyeGazesFB is plain data; zeroed then typed is its valid output state.
         let mut gazes: xr::sys::EyeGazesFB = unsafe { std::mem::zeroed() };
         gazes.ty = xr::sys::EyeGazesFB::TYPE;
+        // SAFETY: `self.tracker` is live until drop; `info` and `gazes` are valid, typed
+        // structs that outlive the call.
         let r = unsafe { (fp.get_eye_gazes)(self.tracker, &info, &mut gazes) };
         if r != xr::sys::Result::SUCCESS {
             return None;
@@ -131,6 +135,8 @@ impl FbTracker {
 impl Drop for FbTracker {
     fn drop(&mut self) {
         if let Some(fp) = self.instance.exts().fb_eye_tracking_social {
+            // SAFETY: the tracker was created by this instance's function table and is not
+            // used after this drop.
             unsafe { (fp.destroy_eye_tracker)(self.tracker) };
         }
     }
@@ -190,6 +196,7 @@ impl ExtGaze {
         let mut location: xr::sys::SpaceLocation = unsafe { std::mem::zeroed() };
         location.ty = xr::sys::SpaceLocation::TYPE;
         location.next = &mut sample_time as *mut _ as *mut _;
+        // SAFETY: see above: the spaces are live, `location` and its chain outlive the call.
         let r = unsafe {
             (fp.locate_space)(
                 self.space.as_raw(),

@@ -175,6 +175,7 @@ pub struct Runtime {
 impl Runtime {
     /// Loads the OpenXR loader, creates the instance and finds the headset.
     pub fn new(options: &OpenXrOptions) -> Result<Runtime> {
+        // SAFETY: loading the OpenXR loader only runs its initialisation.
         let entry =
             unsafe { xr::Entry::load(&()) }.map_err(|e| OpenXrError::NoLoader(e.to_string()))?;
         let available = entry
@@ -376,6 +377,8 @@ impl Runtime {
         info: &vk::InstanceCreateInfo,
     ) -> Result<ash::Instance> {
         let gipa = entry.static_fn().get_instance_proc_addr;
+        // SAFETY: `info` is valid (the caller's contract) and `gipa` is the loader's own
+        // vkGetInstanceProcAddr; the runtime only reads both during the call.
         let raw = unsafe {
             self.instance.create_vulkan_instance(
                 self.system,
@@ -393,11 +396,14 @@ impl Runtime {
         })?;
         let handle = vk::Instance::from_raw(raw as u64);
         self.vk_instance = Some(handle);
+        // SAFETY: `handle` is the instance the runtime just created with this entry's loader.
         Ok(unsafe { ash::Instance::load(entry.static_fn(), handle) })
     }
 
     /// The physical device the runtime's headset is driven by (xrGetVulkanGraphicsDevice2KHR).
     pub fn vulkan_physical_device(&self, instance: &ash::Instance) -> Result<vk::PhysicalDevice> {
+        // SAFETY: `instance` was created through this runtime (create_vulkan_instance), on
+        // this system.
         let raw = unsafe {
             self.instance
                 .vulkan_graphics_device(self.system, instance.handle().as_raw() as _)
@@ -418,6 +424,7 @@ impl Runtime {
         info: &vk::DeviceCreateInfo,
     ) -> Result<ash::Device> {
         let gipa = entry.static_fn().get_instance_proc_addr;
+        // SAFETY: `physical` came from the runtime and `info` is valid (the caller's contract).
         let raw = unsafe {
             self.instance.create_vulkan_device(
                 self.system,
@@ -434,6 +441,7 @@ impl Runtime {
             call: "vkCreateDevice",
             result: vk::Result::from_raw(result),
         })?;
+        // SAFETY: `raw` is the device the runtime just created on `instance`.
         Ok(unsafe { ash::Device::load(instance.fp_v1_0(), vk::Device::from_raw(raw as u64)) })
     }
 }
@@ -512,6 +520,8 @@ impl Runtime {
         vulkan: VulkanHandles,
         options: &SessionOptions,
     ) -> Result<(Session, SwapchainImages)> {
+        // SAFETY: forwarded contract: `vulkan` holds this runtime's handles, which outlive the
+        // session.
         unsafe { session::start(self, vulkan, options) }
     }
 }

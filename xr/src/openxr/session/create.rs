@@ -33,6 +33,8 @@ pub(in crate::openxr) unsafe fn start(
         queue_family_index: vulkan.queue_family,
         queue_index: vulkan.queue_index,
     };
+    // SAFETY: `info` holds the Vulkan handles this runtime created (this function's
+    // contract), which outlive the session.
     let (session, waiter, stream) =
         unsafe { rt.instance.create_session::<xr::Vulkan>(rt.system, &info) }
             .xr("xrCreateSession")?;

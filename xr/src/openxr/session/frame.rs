@@ -339,8 +339,10 @@ mod tests {
             .collect();
         let view = *xr::CompositionLayerProjectionView::<xr::Vulkan>::new().as_raw();
         let mut views = [view, view];
+        // SAFETY: `infos` lives, unmoved, until the end of this test, past every use of `views`.
         unsafe { chain_depth(&mut views, &mut infos) };
         for (eye, v) in views.iter().enumerate() {
+            // SAFETY: `chain_depth` set `next` to an element of `infos`, still alive here.
             let info = unsafe { &*(v.next as *const xr::sys::CompositionLayerDepthInfoKHR) };
             assert_eq!(
                 info.ty,

@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod blur_stack;
 pub mod caustics;
+pub mod cli_values;
 pub mod effects;
 pub mod frame_loop;
 pub mod gaze;

@@ -4,12 +4,18 @@
 //! While the gaze image is unknown (no valid gaze yet, or a blink held too long), nothing is
 //! blurred.
 
-use vitreous_render::{Defocus, Look};
+use anyhow::Result;
+use vitreous_render::{Defocus, Look, Reflection};
 use vitreous_xr::FrameInput;
 
-use crate::gaze::blur::{image_blur, px_per_m};
-use crate::gaze::{GazeConfig, GazeImage, GazeOverride, GazePipeline, GazeState, ImageDistances};
+use crate::blur_stack::DefocusSetup;
+use crate::effects::EffectSet;
+use crate::gaze::blur::{check_pupil_diameter_m, image_blur, px_per_m};
+use crate::gaze::{
+    FilterKind, GazeConfig, GazeImage, GazeOverride, GazePipeline, GazeState, ImageDistances,
+};
 use crate::scene::Scene;
+use crate::views;
 
 /// The numbers eq. 13-14 need of a scene: image distances, pixels per metre of each image's
 /// photo, and the pupil.
@@ -123,4 +129,63 @@ impl LookPlanner {
             }
         }
     }
+}
+
+/// How the gaze pipeline runs (METHOD.md section 5); `None` keeps the scene's choice.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GazeSettings {
+    /// Depth filter overriding the scene's `[gaze] filter`.
+    pub filter: Option<FilterKind>,
+    /// Experimenter override of the gaze image, overriding the scene's `[gaze] image`.
+    pub image: Option<GazeOverride>,
+    /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
+    pub pupil_mm: Option<f32>,
+}
+
+/// The per-frame look planner for a scene and effect set, and the defocus stacks to upload
+/// (built when defocus is on).
+pub fn planner_for(
+    scene: &Scene,
+    effects: &EffectSet,
+    reflection: Reflection,
+    gaze: &GazeSettings,
+) -> Result<(LookPlanner, Option<DefocusSetup>)> {
+    let (mut planners, setup) = planners_for(scene, &[*effects], reflection, gaze)?;
+    Ok((planners.remove(0), setup))
+}
+
+/// One look planner per effect set in `sets` (in that order), sharing one defocus setup (blur
+/// stacks), built when any of the sets has defocus on.
+pub fn planners_for(
+    scene: &Scene,
+    sets: &[EffectSet],
+    reflection: Reflection,
+    gaze: &GazeSettings,
+) -> Result<(Vec<LookPlanner>, Option<DefocusSetup>)> {
+    let setup = if sets.iter().any(|e| e.defocus) {
+        let pupil_m = match gaze.pupil_mm {
+            Some(mm) => check_pupil_diameter_m(mm / 1000.0)?,
+            None => scene.viewer.pupil_diameter_m,
+        };
+        Some(DefocusSetup::new(scene, pupil_m))
+    } else {
+        None
+    };
+    let planners = sets
+        .iter()
+        .map(|effects| {
+            let base = views::look(effects, reflection);
+            let defocus = match (&setup, effects.defocus) {
+                (Some(setup), true) => {
+                    let mut config = GazeConfig::new(setup.model.distances);
+                    config.filter = gaze.filter.unwrap_or(scene.gaze.filter);
+                    config.override_image = gaze.image.unwrap_or(scene.gaze.image);
+                    Some((config, setup.model))
+                }
+                _ => None,
+            };
+            LookPlanner::new(base, defocus)
+        })
+        .collect();
+    Ok((planners, setup))
 }

@@ -6,6 +6,9 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use vitreous::bench::{BenchOptions, bench};
+use vitreous::cli_values::{
+    parse_blend, parse_effects, parse_frame_count, parse_frame_count_usize, parse_size,
+};
 use vitreous::effects::EffectSet;
 use vitreous::gaze::{FilterKind, GazeOverride};
 use vitreous::output::ensure_not_input;
@@ -289,45 +292,6 @@ impl From<ReflectionArg> for Reflection {
     }
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT like 1280x960, got '{s}'"))?;
-    let parse = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("expected WIDTHxHEIGHT with whole numbers, got '{s}'"))
-    };
-    Ok((parse(w)?, parse(h)?))
-}
-
-/// A frame count for `--frames`: a whole number of at least 1 (0 would be an empty run).
-fn parse_frame_count(s: &str) -> Result<u64, String> {
-    match s.trim().parse::<i128>() {
-        Ok(n) if n >= 1 && n <= i128::from(u64::MAX) => Ok(n as u64),
-        Ok(n) if n < 1 => Err(format!(
-            "expected a number of frames of at least 1, got {n}"
-        )),
-        _ => Err(format!(
-            "expected a whole number of frames (1 or more), got '{s}'"
-        )),
-    }
-}
-
-fn parse_frame_count_usize(s: &str) -> Result<usize, String> {
-    let n = parse_frame_count(s)?;
-    usize::try_from(n).map_err(|_| format!("{n} frames is more than this machine can count"))
-}
-
-fn parse_blend(s: &str) -> Result<vitreous_xr::openxr::Blend, String> {
-    vitreous_xr::openxr::Blend::parse(s)
-        .ok_or_else(|| format!("expected additive, alpha-blend or opaque, got '{s}'"))
-}
-
-fn parse_effects(s: &str) -> Result<EffectSet, String> {
-    EffectSet::parse(s).map_err(|e| e.to_string())
-}
-
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Run {
@@ -360,64 +324,7 @@ fn run(cli: Cli) -> Result<()> {
                 out,
                 ..Default::default()
             })?;
-            println!(
-                "session on {} ({}): states {}; {} frames submitted ({} skipped) at {}x{} per \
-                 eye, {:.1} frames/s; blend {}; gaze {}; ended: {}",
-                s.runtime,
-                s.system,
-                s.states.join(" > "),
-                s.frames_submitted,
-                s.frames_skipped,
-                s.width_px,
-                s.height_px,
-                s.frames_per_second,
-                s.blend,
-                s.gaze_source,
-                s.end_reason
-            );
-            println!(
-                "vulkan validation: {} errors, {} warnings (enabled: {})",
-                s.validation.errors, s.validation.warnings, s.validation.enabled
-            );
-            println!(
-                "actions attached: {}, syncs: {}, commands: {} (profiles: {}; conditions: {}; \
-                 final condition {}, gaze image {})",
-                s.actions_attached,
-                s.action_syncs,
-                s.commands,
-                s.action_profiles.join(", "),
-                s.conditions.join(" > "),
-                s.final_condition,
-                s.final_gaze_image
-            );
-            println!(
-                "depth submitted: {} ({}), {} of {} frames with depth",
-                s.depth_submitted,
-                s.depth_format.as_deref().unwrap_or("no depth swapchain"),
-                s.frames_with_depth,
-                s.frames_submitted
-            );
-            if let Some(c) = &s.readback {
-                println!(
-                    "readback of frame {}: object in {:.1} % of its region ({} of {} px), mean {:.1}",
-                    c.frame,
-                    c.object_fraction * 100.0,
-                    c.object_px,
-                    c.region_px,
-                    c.mean_value
-                );
-            }
-            if let Some(r) = &s.replay_check {
-                println!(
-                    "recording replayed: {} samples, {} frames; max head difference {:.2e} m, \
-                     {:.2e} deg; max eye position difference {:.4} m",
-                    r.samples,
-                    r.frames,
-                    r.max_head_position_m,
-                    r.max_head_angle_deg,
-                    r.max_eye_position_m
-                );
-            }
+            print!("{}", s.report());
             Ok(())
         }
         Command::Replay {
@@ -470,22 +377,7 @@ fn run(cli: Cli) -> Result<()> {
                     pupil_mm,
                 },
             })?;
-            println!(
-                "rendered {} frames of {}x{} per eye on {} in {:.1} s ({:.1} frames/s; median \
-                 GPU {} ms, CPU {} ms per stereo frame)",
-                summary.frames,
-                summary.width_px,
-                summary.height_px,
-                summary.device,
-                summary.wall_s,
-                summary.frames_per_second,
-                summary
-                    .gpu_ms
-                    .map_or("n/a".to_string(), |s| format!("{:.2}", s.median_ms)),
-                summary
-                    .cpu_ms
-                    .map_or("n/a".to_string(), |s| format!("{:.2}", s.median_ms)),
-            );
+            println!("{}", summary.summary_line());
             println!(
                 "wrote {} images and summary.json to {}",
                 summary.saved.len(),
@@ -544,48 +436,13 @@ fn run(cli: Cli) -> Result<()> {
                 validation: !no_validation,
                 recreate,
             };
-            let report = vitreous::soak::soak(&options, |p| {
-                eprintln!(
-                    "soak: pass {} ({} frames): resident {} KiB, heap in use {} KiB, {} \
-                     validation messages",
-                    p.pass, p.frames, p.rss_kib, p.heap_in_use_kib, p.validation_messages
-                );
-            })?;
+            let report = vitreous::soak::soak(&options, |p| eprintln!("soak: {p}"))?;
             if let Some(path) = &json {
                 let bytes = serde_json::to_vec_pretty(&report)?;
                 vitreous::output::write_atomic(path, &bytes)?;
             }
-            println!(
-                "soak of {} ({}) on {}: {} passes, {} frames in {:.0} s; resident memory {} KiB \
-                 after warm-up, at most {} KiB later ({:+.2} %, limit {} %); {} validation messages",
-                report.scene,
-                report.effects,
-                report.device,
-                report.passes.len(),
-                report.frames,
-                report.wall_s,
-                report.rss_after_warm_up_kib,
-                report.rss_max_kib,
-                report.growth_percent,
-                vitreous::soak::MAX_GROWTH_PERCENT,
-                report.validation_messages
-            );
-            if !report.passed() {
-                bail!(
-                    "soak failed: {} passes (more than {} needed), memory growth {:.2} %, {} \
-                     validation messages{}",
-                    report.passes.len(),
-                    vitreous::soak::WARM_UP_PASSES,
-                    report.growth_percent,
-                    report.validation_messages,
-                    report
-                        .first_messages
-                        .first()
-                        .map(|m| format!(", first: {m}"))
-                        .unwrap_or_default()
-                );
-            }
-            Ok(())
+            println!("{}", report.summary_line());
+            report.verdict()
         }
         Command::Trace { command } => match command {
             TraceCommand::Analyze {
@@ -700,13 +557,5 @@ mod tests {
             .context("reading a: no such file")
             .context("loading b");
         assert_eq!(error_text(&e), "loading b: reading a: no such file");
-    }
-
-    #[test]
-    fn frame_counts_below_one_are_refused_with_the_reason() {
-        assert_eq!(parse_frame_count("5"), Ok(5));
-        assert!(parse_frame_count("0").unwrap_err().contains("at least 1"));
-        assert!(parse_frame_count("-1").unwrap_err().contains("at least 1"));
-        assert!(parse_frame_count("x").unwrap_err().contains("whole number"));
     }
 }

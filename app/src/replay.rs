@@ -14,11 +14,9 @@ use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{TraceSample, read_trace};
 
-use crate::blur_stack::DefocusSetup;
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
-use crate::gaze::blur::check_pupil_diameter_m;
-use crate::gaze::{FilterKind, GazeConfig, GazeOverride};
+pub use crate::look::GazeSettings;
 use crate::look::LookPlanner;
 use crate::output::{self, write_atomic};
 use crate::reference_view::side_by_side;
@@ -57,65 +55,6 @@ pub struct ReplayOptions {
     pub reference: bool,
     /// Depth filter and gaze-image override of the gaze pipeline (used with defocus).
     pub gaze: GazeSettings,
-}
-
-/// How the gaze pipeline runs (METHOD.md section 5); `None` keeps the scene's choice.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct GazeSettings {
-    /// Depth filter overriding the scene's `[gaze] filter`.
-    pub filter: Option<FilterKind>,
-    /// Experimenter override of the gaze image, overriding the scene's `[gaze] image`.
-    pub image: Option<GazeOverride>,
-    /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
-    pub pupil_mm: Option<f32>,
-}
-
-/// The per-frame look planner for a scene and effect set, and the defocus stacks to upload
-/// (built when defocus is on).
-pub fn planner_for(
-    scene: &Scene,
-    effects: &EffectSet,
-    reflection: Reflection,
-    gaze: &GazeSettings,
-) -> Result<(LookPlanner, Option<DefocusSetup>)> {
-    let (mut planners, setup) = planners_for(scene, &[*effects], reflection, gaze)?;
-    Ok((planners.remove(0), setup))
-}
-
-/// One look planner per effect set in `sets` (in that order), sharing one defocus setup (blur
-/// stacks), built when any of the sets has defocus on.
-pub fn planners_for(
-    scene: &Scene,
-    sets: &[EffectSet],
-    reflection: Reflection,
-    gaze: &GazeSettings,
-) -> Result<(Vec<LookPlanner>, Option<DefocusSetup>)> {
-    let setup = if sets.iter().any(|e| e.defocus) {
-        let pupil_m = match gaze.pupil_mm {
-            Some(mm) => check_pupil_diameter_m(mm / 1000.0)?,
-            None => scene.viewer.pupil_diameter_m,
-        };
-        Some(DefocusSetup::new(scene, pupil_m))
-    } else {
-        None
-    };
-    let planners = sets
-        .iter()
-        .map(|effects| {
-            let base = views::look(effects, reflection);
-            let defocus = match (&setup, effects.defocus) {
-                (Some(setup), true) => {
-                    let mut config = GazeConfig::new(setup.model.distances);
-                    config.filter = gaze.filter.unwrap_or(scene.gaze.filter);
-                    config.override_image = gaze.image.unwrap_or(scene.gaze.image);
-                    Some((config, setup.model))
-                }
-                _ => None,
-            };
-            LookPlanner::new(base, defocus)
-        })
-        .collect();
-    Ok((planners, setup))
 }
 
 /// Median and spread of a timing.
@@ -236,6 +175,26 @@ pub struct ReplaySummary {
     pub saved: Vec<String>,
     /// Every frame's timing.
     pub per_frame: Vec<FrameRecord>,
+}
+
+impl ReplaySummary {
+    /// Frames, size, device and timings in one line.
+    pub fn summary_line(&self) -> String {
+        let median =
+            |s: Option<Spread>| s.map_or("n/a".to_string(), |s| format!("{:.2}", s.median_ms));
+        format!(
+            "rendered {} frames of {}x{} per eye on {} in {:.1} s ({:.1} frames/s; median GPU {} \
+             ms, CPU {} ms per stereo frame)",
+            self.frames,
+            self.width_px,
+            self.height_px,
+            self.device,
+            self.wall_s,
+            self.frames_per_second,
+            median(self.gpu_ms),
+            median(self.cpu_ms),
+        )
+    }
 }
 
 /// The largest eye image side accepted, pixels.
@@ -360,7 +319,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     })
     .context("setting up the Vulkan device")?;
     let (device, driver) = (ctx.device_name.clone(), ctx.driver.clone());
-    let (planner, defocus) = planner_for(&scene, &effects, options.reflection, &options.gaze)?;
+    let (planner, defocus) =
+        crate::look::planner_for(&scene, &effects, options.reflection, &options.gaze)?;
     let mut renderer = Renderer::new(
         ctx,
         &views::scene_desc(&scene, defocus.as_ref()),

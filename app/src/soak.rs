@@ -17,7 +17,8 @@ use vitreous_xr::null::{NullBackend, NullConfig};
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::look::LookPlanner;
-use crate::replay::{GazeSettings, check_size, load_trace, planner_for};
+use crate::look::{GazeSettings, planner_for};
+use crate::replay::{check_size, load_trace};
 use crate::scene::load_scene;
 use crate::views;
 
@@ -69,6 +70,16 @@ pub struct SoakPass {
     pub validation_messages: u32,
 }
 
+impl std::fmt::Display for SoakPass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "pass {} ({} frames): resident {} KiB, heap in use {} KiB, {} validation messages",
+            self.pass, self.frames, self.rss_kib, self.heap_in_use_kib, self.validation_messages
+        )
+    }
+}
+
 /// The result of a soak run.
 #[derive(Clone, Debug, Serialize)]
 pub struct SoakReport {
@@ -102,6 +113,44 @@ impl SoakReport {
         self.passes.len() > WARM_UP_PASSES
             && self.growth_percent <= MAX_GROWTH_PERCENT
             && self.validation_messages == 0
+    }
+
+    /// The result in one line.
+    pub fn summary_line(&self) -> String {
+        format!(
+            "soak of {} ({}) on {}: {} passes, {} frames in {:.0} s; resident memory {} KiB \
+             after warm-up, at most {} KiB later ({:+.2} %, limit {} %); {} validation messages",
+            self.scene,
+            self.effects,
+            self.device,
+            self.passes.len(),
+            self.frames,
+            self.wall_s,
+            self.rss_after_warm_up_kib,
+            self.rss_max_kib,
+            self.growth_percent,
+            MAX_GROWTH_PERCENT,
+            self.validation_messages
+        )
+    }
+
+    /// An error saying why the soak failed, unless it [`passed`](Self::passed).
+    pub fn verdict(&self) -> Result<()> {
+        if self.passed() {
+            return Ok(());
+        }
+        bail!(
+            "soak failed: {} passes (more than {} needed), memory growth {:.2} %, {} validation \
+             messages{}",
+            self.passes.len(),
+            WARM_UP_PASSES,
+            self.growth_percent,
+            self.validation_messages,
+            self.first_messages
+                .first()
+                .map(|m| format!(", first: {m}"))
+                .unwrap_or_default()
+        )
     }
 }
 

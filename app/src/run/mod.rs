@@ -48,8 +48,8 @@ pub use recording::ReplayCheck;
 
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
+use crate::look::{GazeSettings, planners_for};
 use crate::output::write_atomic;
-use crate::replay::{GazeSettings, planners_for};
 use crate::replay::{Spread, ValidationSummary};
 use crate::scene::load_scene;
 use crate::views;
@@ -165,6 +165,79 @@ pub struct RunSummary {
     pub depth_format: Option<String>,
     /// Frames submitted with depth.
     pub frames_with_depth: u64,
+}
+
+impl RunSummary {
+    /// The summary as `vitreous run` prints it: one line per topic.
+    pub fn report(&self) -> String {
+        use std::fmt::Write as _;
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "session on {} ({}): states {}; {} frames submitted ({} skipped) at {}x{} per \
+             eye, {:.1} frames/s; blend {}; gaze {}; ended: {}",
+            self.runtime,
+            self.system,
+            self.states.join(" > "),
+            self.frames_submitted,
+            self.frames_skipped,
+            self.width_px,
+            self.height_px,
+            self.frames_per_second,
+            self.blend,
+            self.gaze_source,
+            self.end_reason
+        );
+        let _ = writeln!(
+            out,
+            "vulkan validation: {} errors, {} warnings (enabled: {})",
+            self.validation.errors, self.validation.warnings, self.validation.enabled
+        );
+        let _ = writeln!(
+            out,
+            "actions attached: {}, syncs: {}, commands: {} (profiles: {}; conditions: {}; \
+             final condition {}, gaze image {})",
+            self.actions_attached,
+            self.action_syncs,
+            self.commands,
+            self.action_profiles.join(", "),
+            self.conditions.join(" > "),
+            self.final_condition,
+            self.final_gaze_image
+        );
+        let _ = writeln!(
+            out,
+            "depth submitted: {} ({}), {} of {} frames with depth",
+            self.depth_submitted,
+            self.depth_format.as_deref().unwrap_or("no depth swapchain"),
+            self.frames_with_depth,
+            self.frames_submitted
+        );
+        if let Some(c) = &self.readback {
+            let _ = writeln!(
+                out,
+                "readback of frame {}: object in {:.1} % of its region ({} of {} px), mean {:.1}",
+                c.frame,
+                c.object_fraction * 100.0,
+                c.object_px,
+                c.region_px,
+                c.mean_value
+            );
+        }
+        if let Some(r) = &self.replay_check {
+            let _ = writeln!(
+                out,
+                "recording replayed: {} samples, {} frames; max head difference {:.2e} m, \
+                 {:.2e} deg; max eye position difference {:.4} m",
+                r.samples,
+                r.frames,
+                r.max_head_position_m,
+                r.max_head_angle_deg,
+                r.max_eye_position_m
+            );
+        }
+        out
+    }
 }
 
 /// Records frames and checks a readback.

@@ -13,6 +13,7 @@
 //! `file.rs` is the file's raw TOML shape, `error.rs` its errors, `image.rs` and `mesh.rs`
 //! the assets, `fixation.rs` where a viewer of the scene looks.
 
+mod accessor;
 mod error;
 mod file;
 mod fixation;

@@ -1,0 +1,68 @@
+//! Command-line values: each parser takes the text after an option and returns the value or a
+//! message saying what was expected and what was found (clap names the option).
+
+use crate::effects::EffectSet;
+
+/// `WIDTHxHEIGHT` (`1280x960`) in whole pixels.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT like 1280x960, got '{s}'"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("expected WIDTHxHEIGHT with whole numbers, got '{s}'"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+/// A frame count for `--frames`: a whole number of at least 1 (0 would be an empty run).
+pub fn parse_frame_count(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<i128>() {
+        Ok(n) if n >= 1 && n <= i128::from(u64::MAX) => Ok(n as u64),
+        Ok(n) if n < 1 => Err(format!(
+            "expected a number of frames of at least 1, got {n}"
+        )),
+        _ => Err(format!(
+            "expected a whole number of frames (1 or more), got '{s}'"
+        )),
+    }
+}
+
+/// As [`parse_frame_count`], for counts held in `usize`.
+pub fn parse_frame_count_usize(s: &str) -> Result<usize, String> {
+    let n = parse_frame_count(s)?;
+    usize::try_from(n).map_err(|_| format!("{n} frames is more than this machine can count"))
+}
+
+/// An OpenXR environment blend mode by its command-line name.
+pub fn parse_blend(s: &str) -> Result<vitreous_xr::openxr::Blend, String> {
+    vitreous_xr::openxr::Blend::parse(s)
+        .ok_or_else(|| format!("expected additive, alpha-blend or opaque, got '{s}'"))
+}
+
+/// An effect set or condition (`O4`, `c`, `disparity,defocus`).
+pub fn parse_effects(s: &str) -> Result<EffectSet, String> {
+    EffectSet::parse(s).map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_counts_below_one_are_refused_with_the_reason() {
+        assert_eq!(parse_frame_count("5"), Ok(5));
+        assert!(parse_frame_count("0").unwrap_err().contains("at least 1"));
+        assert!(parse_frame_count("-1").unwrap_err().contains("at least 1"));
+        assert!(parse_frame_count("x").unwrap_err().contains("whole number"));
+    }
+
+    #[test]
+    fn sizes_are_width_x_height_in_whole_pixels() {
+        assert_eq!(parse_size("1280x960"), Ok((1280, 960)));
+        assert_eq!(parse_size("64X48"), Ok((64, 48)));
+        assert!(parse_size("wide").unwrap_err().contains("WIDTHxHEIGHT"));
+        assert!(parse_size("-1x5").is_err());
+    }
+}

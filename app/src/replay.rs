@@ -256,8 +256,7 @@ pub(crate) fn load_trace(
 ) -> Result<(Vec<TraceSample>, String)> {
     match trace {
         Some(path) => {
-            let samples =
-                read_trace(path).with_context(|| format!("reading trace {}", path.display()))?;
+            let samples = read_trace(path).context("reading the trace")?;
             if samples.is_empty() {
                 bail!("trace {} has no samples: nothing to replay", path.display());
             }

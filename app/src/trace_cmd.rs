@@ -30,7 +30,7 @@ pub fn import(from: &str, file: &Path, out: &Path) -> Result<String> {
         other => bail!("unknown recording format '{other}'; supported: sranipal"),
     }
     let (samples, report) = vitreous_xr::sranipal::import_sranipal_with_report(file)
-        .with_context(|| format!("importing {}", file.display()))?;
+        .context("importing the recording")?;
     if samples.is_empty() {
         bail!(
             "{} holds no usable samples (rows read: {}); nothing written",

@@ -141,19 +141,20 @@ pub(crate) struct InducerToml {
 /// a recording named by mistake) must not be read whole into memory.
 pub const MAX_SCENE_FILE_BYTES: u64 = 1 << 20;
 
-/// Reads a scene file, refusing one larger than [`MAX_SCENE_FILE_BYTES`] without reading it.
-pub(crate) fn read_bounded(path: &Path) -> std::io::Result<Vec<u8>> {
+/// Largest asset file read (model, photo, environment map), bytes: far above any image within
+/// the pixel limit or any model an eye-level scene needs.
+pub const MAX_ASSET_FILE_BYTES: u64 = 256 << 20;
+
+/// Reads a file, refusing one larger than `limit` bytes without reading it whole; `what`
+/// says in the message what the file should be.
+pub(crate) fn read_bounded(path: &Path, limit: u64, what: &str) -> std::io::Result<Vec<u8>> {
     let file = std::fs::File::open(path)?;
     let mut bytes = Vec::new();
-    file.take(MAX_SCENE_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > MAX_SCENE_FILE_BYTES {
+    file.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
-            format!(
-                "larger than {} KiB; a scene file is a short TOML text",
-                MAX_SCENE_FILE_BYTES / 1024
-            ),
+            format!("larger than {} KiB; {what}", limit / 1024),
         ));
     }
     Ok(bytes)

@@ -21,7 +21,12 @@ use crate::gaze::{FilterKind, FilterParseError, GazeOverride};
 
 /// Loads a scene file and every asset it names, checking ranges and decoding everything.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let bytes = file::read_bounded(path).map_err(|error| SceneError::Read {
+    let bytes = file::read_bounded(
+        path,
+        file::MAX_SCENE_FILE_BYTES,
+        "a scene file is a short TOML text",
+    )
+    .map_err(|error| SceneError::Read {
         path: path.to_path_buf(),
         error,
     })?;
@@ -83,7 +88,12 @@ impl Loader<'_> {
             ));
         }
         let path = normalize(&self.dir.join(rel.get_ref()));
-        let bytes = std::fs::read(&path).map_err(|e| {
+        let bytes = file::read_bounded(
+            &path,
+            file::MAX_ASSET_FILE_BYTES,
+            "models, photos and maps are accepted up to that size",
+        )
+        .map_err(|e| {
             let reason = match e.kind() {
                 std::io::ErrorKind::NotFound => "file not found".to_owned(),
                 _ => format!("cannot read: {e}"),

@@ -469,9 +469,9 @@ pub(super) fn load_inputs(
     scene: &Path,
     filters: &[FilterKind],
 ) -> Result<(Vec<TraceSample>, AnalyzeConfig)> {
-    let scene = load_scene(scene).with_context(|| format!("loading scene {}", scene.display()))?;
-    let samples = vitreous_xr::read_trace(trace)
-        .with_context(|| format!("reading trace {}", trace.display()))?;
+    let scene = load_scene(scene).context("loading the scene")?;
+    // The trace's errors name its file and line.
+    let samples = vitreous_xr::read_trace(trace).context("reading the trace")?;
     let mut config = AnalyzeConfig::new(scene.image_distances());
     if !filters.is_empty() {
         config.filters = filters.to_vec();

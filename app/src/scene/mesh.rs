@@ -97,6 +97,7 @@ fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
     // gltf-json's own validation indexes the POSITION accessor before checking that it
     // exists, so that is checked first.
     check_position_accessors(document.as_json())?;
+    check_buffer_uris(document.as_json())?;
     let document = gltf::Document::from_json(document.into_json()).map_err(invalid)?;
 
     let mut buffers = Vec::new();
@@ -174,6 +175,50 @@ fn check_glb_length(bytes: &[u8]) -> Result<(), String> {
         )),
         _ => Ok(()),
     }
+}
+
+/// Every relative buffer URI percent-decodes to UTF-8 text (the gltf crate unwraps that
+/// decoding).
+fn check_buffer_uris(root: &gltf::json::Root) -> Result<(), String> {
+    for (i, buffer) in root.buffers.iter().enumerate() {
+        let Some(uri) = buffer.uri.as_deref() else {
+            continue;
+        };
+        if uri.contains(':') {
+            continue; // data: and file: URIs are not percent-decoded
+        }
+        if std::str::from_utf8(&percent_decode(uri)).is_err() {
+            return Err(format!(
+                "invalid glTF: buffers[{i}].uri: its percent-escapes decode to bytes that are not \
+                 UTF-8 text"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `%XX` escapes replaced by their bytes; anything else kept as it is.
+fn percent_decode(text: &str) -> Vec<u8> {
+    let bytes = text.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = bytes
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
+        match (bytes[i], hex) {
+            (b'%', Some(byte)) => {
+                out.push(byte);
+                i += 3;
+            }
+            (b, _) => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    out
 }
 
 /// Every primitive's POSITION attribute names an accessor that exists.
@@ -509,6 +554,19 @@ mod tests {
         glb.extend_from_slice(&[0; 16]);
         let err = load_gltf_inner(&glb, Path::new(".")).err().unwrap();
         assert!(err.contains("total length of 3 bytes"), "{err}");
+    }
+
+    #[test]
+    fn buffer_uri_escaping_to_non_utf8_is_an_error_not_a_panic() {
+        let gltf = triangle_gltf("0,1,2", "").replace(
+            "data:application/octet-stream;base64,",
+            "data%AAapplication/octet-stream;base64,",
+        );
+        let err = load_gltf_inner(gltf.as_bytes(), Path::new("."))
+            .err()
+            .unwrap();
+        assert!(err.contains("buffers[0].uri"), "{err}");
+        assert_eq!(percent_decode("a%20b%zz%4"), b"a b%zz%4");
     }
 
     #[test]

@@ -25,6 +25,7 @@ fn looking_at(time_ns: i64, depth_m: f32) -> GazeSample {
         right: eye(0.0315),
         combined: None,
         fixation: None,
+        pupil_diameter_m: [None, None],
     }
 }
 

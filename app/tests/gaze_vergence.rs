@@ -23,6 +23,7 @@ fn sample(time_ns: i64, left: GazeRay, right: GazeRay) -> GazeSample {
         right,
         combined: None,
         fixation: None,
+        pupil_diameter_m: [None, None],
     }
 }
 

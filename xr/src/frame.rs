@@ -100,6 +100,8 @@ pub struct GazeSample {
     pub combined: Option<GazeRay>,
     /// A fixation point in the head frame (metres), when the source computed one.
     pub fixation: Option<Vec3>,
+    /// Measured pupil diameters (left, right), metres, when the source reports them.
+    pub pupil_diameter_m: [Option<f32>; 2],
 }
 
 /// What a backend hands the frame loop for one frame.

@@ -303,6 +303,7 @@ pub fn synthesize_with_truth(params: &SynthParams) -> Result<SynthTrace, SynthEr
                 right,
                 combined: None,
                 fixation: None,
+                pupil_diameter_m: [None, None],
             },
         });
     }

@@ -293,6 +293,7 @@ mod tests {
             right,
             combined: None,
             fixation: None,
+            pupil_diameter_m: [None, None],
         }
     }
 

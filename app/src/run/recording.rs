@@ -39,6 +39,7 @@ pub(super) fn trace_sample(input: &FrameInput) -> TraceSample {
             right: GazeRay::INVALID,
             combined: None,
             fixation: None,
+            pupil_diameter_m: [None, None],
         }),
     }
 }

@@ -21,6 +21,7 @@ fn sample(time_ns: i64, position: Vec3, yaw_rad: f32) -> TraceSample {
             right: GazeRay::INVALID,
             combined: None,
             fixation: None,
+            pupil_diameter_m: [None, None],
         },
     }
 }

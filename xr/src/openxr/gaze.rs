@@ -128,6 +128,7 @@ impl FbTracker {
             right: eye(&gazes.gaze[1]),
             combined: None,
             fixation: None,
+            pupil_diameter_m: [None, None],
         })
     }
 }
@@ -222,6 +223,7 @@ impl ExtGaze {
             right: GazeRay::INVALID,
             combined: Some(combined),
             fixation: None,
+            pupil_diameter_m: [None, None],
         })
     }
 }
@@ -288,6 +290,7 @@ mod tests {
                 right: ray,
                 combined: None,
                 fixation: None,
+                pupil_diameter_m: [None, None],
             },
         }
     }

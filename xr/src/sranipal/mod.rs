@@ -274,6 +274,7 @@ impl Importer {
                 right,
                 combined: None,
                 fixation: None,
+                pupil_diameter_m: [None, None],
             },
         });
         Ok(())

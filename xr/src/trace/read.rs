@@ -84,6 +84,7 @@ fn parse_record(record: &Record<'_>) -> Result<TraceSample, TraceError> {
             right,
             combined,
             fixation,
+            pupil_diameter_m: [None, None],
         },
     })
 }

@@ -26,6 +26,7 @@ pub(super) fn sample(time_ns: i64) -> TraceSample {
             right: ray(Vec3::new(0.032, 0.0, 0.01), Vec3::new(-0.1, 0.0, -1.0)),
             combined: None,
             fixation: None,
+            pupil_diameter_m: [None, None],
         },
     }
 }

@@ -239,6 +239,7 @@ mod tests {
                             right,
                             combined,
                             fixation,
+                            pupil_diameter_m: [None, None],
                         },
                     };
                     (dt, lag, sample)

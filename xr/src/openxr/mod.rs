@@ -28,6 +28,7 @@ pub mod actions;
 pub mod choose;
 mod error;
 mod gaze;
+pub mod ml_eye_tracker;
 mod session;
 pub mod state;
 

@@ -227,7 +227,7 @@ mod tests {
         ];
         for (i, image) in images.into_iter().enumerate() {
             input.index = i as u64;
-            let d = decision(image, 0.004 + 0.001 * i as f32);
+            let d = decision(image, (4 + i) as f32 / 1000.0);
             log.record(&input, "disparity,defocus", Some(&d)).unwrap();
         }
         log.record(&input, "none", None).unwrap();

@@ -478,7 +478,7 @@ mod tests {
         let doc = include_str!("../../../docs/trace-format.md");
         let at = doc.find("```text\n# vitreous-trace v1.1").unwrap() + "```text\n".len();
         let end = at + doc[at..].find("```").unwrap();
-        let mut reader = TraceReader::new(doc[at..end].as_bytes(), "doc").unwrap();
+        let mut reader = TraceReader::new(&doc.as_bytes()[at..end], "doc").unwrap();
         assert_eq!(reader.version(), TraceVersion::V1_1);
         let samples: Vec<_> = reader.by_ref().collect::<Result<_, _>>().unwrap();
         assert_eq!(samples.len(), 2);

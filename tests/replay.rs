@@ -172,3 +172,90 @@ fn visual_effects_scene_replays_its_shipped_synthetic_trace() {
         Check::Visible,
     );
 }
+
+/// The shipped synthetic trace alternates the gaze between the sphere's surface and the
+/// background seen through it every 3 s: `frames.csv` follows it frame by frame, the summary
+/// counts the switches, and with `[gaze] pupil = "measured"` A_p follows the trace's pupils.
+#[test]
+fn frames_csv_follows_the_synthetic_traces_alternating_fixation() {
+    use vitreous::frame_log::{FRAME_LOG_HEADER, FRAME_LOG_NAME};
+    use vitreous::scene::gaze_image_of_target;
+
+    let dir = tempfile::tempdir().unwrap();
+    // The shipped scene with a measured pupil, its assets named from the workspace.
+    let config = workspace().join("config");
+    let text = std::fs::read_to_string(config.join("scenes/visual-effects.toml"))
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", config.display()));
+    let scene_path = dir.path().join("measured-pupil.toml");
+    std::fs::write(
+        &scene_path,
+        format!("{text}\n[gaze]\npupil = \"measured\"\n"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let mut opts = options(
+        "visual-effects.toml",
+        Some("synthetic-visual-effects.csv"),
+        &out,
+    );
+    opts.scene = scene_path;
+    opts.frames = None;
+    opts.frame_rate_hz = 10.0;
+    opts.save_every = 0;
+    opts.size = Some((64, 48));
+    opts.effects = Some(vitreous::effects::EffectSet::parse("defocus").unwrap());
+    let summary = replay(&opts).expect("replay succeeds with validation on");
+    assert_eq!(summary.frames, 121, "12 s at 10 Hz");
+
+    let log = std::fs::read_to_string(out.join(FRAME_LOG_NAME)).unwrap();
+    let mut lines = log.lines();
+    assert_eq!(lines.next(), Some(FRAME_LOG_HEADER));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 121);
+    let images: Vec<&str> = rows.iter().map(|r| r[4]).collect();
+    // The trace's truth: the synthesiser's phases for the scene (12 s, as shipped).
+    let scene = load_scene(&workspace().join("config/scenes/visual-effects.toml")).unwrap();
+    let params = vitreous_xr::synth::SynthParams {
+        duration_s: 12.0,
+        ..vitreous::trace_cmd::synth_params_for(&scene)
+    };
+    let truth = vitreous_xr::synth::synthesize_with_truth(&params).unwrap();
+    assert!(truth.phases.len() >= 4);
+    for phase in &truth.phases {
+        // 2.5 s into each phase the eq. 15 mean has settled on the new depth.
+        let frame = ((phase.start_ns as f64 * 1e-9 + 2.5) * 10.0) as usize;
+        if frame < rows.len() {
+            assert_eq!(
+                images[frame],
+                gaze_image_of_target(phase.target).to_string(),
+                "frame {frame}: {:?}",
+                rows[frame]
+            );
+        }
+    }
+    let known: Vec<&str> = images.iter().copied().filter(|i| *i != "unknown").collect();
+    let changes = known.windows(2).filter(|w| w[0] != w[1]).count() as u64;
+    assert!(changes >= 3, "{images:?}");
+    assert_eq!(summary.gaze_image_switches, changes);
+    // The image not looked at is blurred, the one looked at is not.
+    for r in &rows {
+        let (k_surface, k_refracted) = (r[5], r[6]);
+        match r[4] {
+            "surface" => assert!(k_surface == "0" && k_refracted.parse::<f32>().unwrap() > 1.0),
+            "refracted" => {
+                assert!(k_refracted == "0" && k_surface.parse::<f32>().unwrap() > 0.1)
+            }
+            _ => assert!(k_surface.is_empty() && k_refracted.is_empty()),
+        }
+    }
+    let pupil = summary.pupil.expect("defocus reports the pupil");
+    assert_eq!(pupil.source, "measured");
+    assert!(pupil.measured_samples > 100, "{pupil:?}");
+    let (min, max) = (pupil.min_mm.unwrap(), pupil.max_mm.unwrap());
+    assert!(3.4 < min && min < max && max < 5.1, "{pupil:?}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(json["gaze_image_switches"], changes);
+    assert_eq!(json["pupil"]["source"], "measured");
+}

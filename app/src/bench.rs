@@ -139,8 +139,10 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         match (&setup, set.defocus) {
             (Some(setup), true) => {
                 for &pupil_m in &pupils_m {
+                    // Each variant times its own fixed A_p, whatever the scene's source.
                     let model = DefocusModel {
                         pupil_m,
+                        pupil_source: crate::gaze::PupilSource::Paper,
                         ..setup.model
                     };
                     labels.push(format!("{set} A_p={:.0}mm", pupil_m * 1000.0));

@@ -1,10 +1,18 @@
 //! Each frame's look: the effect set's fixed part plus the gaze-dependent defocus (eq. 13-14)
 //! of the gaze image the gaze pipeline chose.
 //!
+//! Eq. 13-14 are evaluated every frame from where the wearer's eyes are: the image distances
+//! are those of the frame's viewing position (the midpoint of the two eye positions,
+//! [`viewing_position_m`]) to the scene's fixation points ([`ViewingGeometry`], the same
+//! geometry the scene's fixed viewer uses), and the gaze-image decision compares the fixation
+//! depth with those distances. A_p is the fixed pupil diameter or the tracker's measurement,
+//! smoothed ([`PupilFilter`]).
+//!
 //! While the gaze image is unknown (no valid gaze yet, or a blink held too long), nothing is
 //! blurred.
 
 use anyhow::Result;
+use glam::Vec3;
 use vitreous_render::{Defocus, Look, Reflection};
 use vitreous_xr::FrameInput;
 
@@ -13,18 +21,24 @@ use crate::effects::EffectSet;
 use crate::gaze::blur::{check_pupil_diameter_m, image_blur, px_per_m};
 use crate::gaze::{
     FilterKind, GazeConfig, GazeImage, GazeOverride, GazePipeline, GazeState, ImageDistances,
+    PupilFilter, PupilSource,
 };
-use crate::scene::Scene;
+use crate::scene::{Scene, ViewingGeometry};
 use crate::views;
 
-/// The numbers eq. 13-14 need of a scene: image distances, pixels per metre of each image's
-/// photo, and the pupil.
+/// The numbers eq. 13-14 need of a scene: where the images lie, pixels per metre of each
+/// image's photo, and the pupil.
 #[derive(Clone, Copy, Debug)]
 pub struct DefocusModel {
-    /// Distances of the surface and refracted images from the viewing position, metres.
+    /// Distances of the surface and refracted images from the scene's fixed viewing position,
+    /// metres (what the blur stacks are sized for; frames use [`DefocusModel::distances_from`]).
     pub distances: ImageDistances,
-    /// Pupil diameter A_p, metres.
+    /// The object and background plane the image distances are measured to.
+    pub geometry: ViewingGeometry,
+    /// The fixed pupil diameter A_p, metres.
     pub pupil_m: f32,
+    /// Where each frame's A_p comes from.
+    pub pupil_source: PupilSource,
     /// W_p / W_l of the surface texture: texels per metre on the object's surface.
     pub surface_px_per_m: f32,
     /// W_p / W_l of the background photo: pixels per metre on the background plane.
@@ -32,11 +46,13 @@ pub struct DefocusModel {
 }
 
 impl DefocusModel {
-    /// The model of `scene` with pupil diameter `pupil_m`.
+    /// The model of `scene` with fixed pupil diameter `pupil_m` and the scene's pupil source.
     pub fn new(scene: &Scene, pupil_m: f32) -> DefocusModel {
         DefocusModel {
             distances: scene.image_distances(),
+            geometry: scene.viewing_geometry(),
             pupil_m,
+            pupil_source: scene.gaze.pupil,
             background_px_per_m: px_per_m(
                 scene.background.photo.width as f32,
                 scene.background.size_m.x,
@@ -51,15 +67,32 @@ impl DefocusModel {
         }
     }
 
-    /// The blur of both images for a gaze image (eq. 13-14); `None` while it is unknown.
+    /// The image distances from a viewer at `viewing_m` (scene frame, metres).
+    pub fn distances_from(&self, viewing_m: Vec3) -> ImageDistances {
+        self.geometry.distances_from(viewing_m)
+    }
+
+    /// The blur of both images for a gaze image (eq. 13-14) from the fixed viewing position
+    /// with the fixed pupil; `None` while it is unknown.
     pub fn defocus(&self, image: GazeImage) -> Option<Defocus> {
+        self.defocus_at(image, &self.distances, self.pupil_m)
+    }
+
+    /// The blur of both images for a gaze image (eq. 13-14) with the images at `distances` and
+    /// pupil diameter `pupil_m`; `None` while the gaze image is unknown.
+    pub fn defocus_at(
+        &self,
+        image: GazeImage,
+        distances: &ImageDistances,
+        pupil_m: f32,
+    ) -> Option<Defocus> {
         if image == GazeImage::Unknown {
             return None;
         }
         let blur = image_blur(
             image,
-            &self.distances,
-            self.pupil_m,
+            distances,
+            pupil_m,
             self.surface_px_per_m,
             self.background_px_per_m,
         );
@@ -70,13 +103,56 @@ impl DefocusModel {
     }
 }
 
+/// Where a frame is viewed from: the midpoint of its two eye positions (scene frame, metres).
+pub fn viewing_position_m(input: &FrameInput) -> Vec3 {
+    (input.views[0].pose.position + input.views[1].pose.position) * 0.5
+}
+
+/// What the defocus of one frame was decided from, for the per-frame log and the summaries.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DefocusFrame {
+    /// The gaze image after the override (unknown: no defocus).
+    pub image: GazeImage,
+    /// The image distances from this frame's viewing position, metres.
+    pub distances: ImageDistances,
+    /// K_g of each image by eq. 13-14 (`None` while the gaze image is unknown).
+    pub defocus: Option<Defocus>,
+    /// A_p used, metres.
+    pub pupil_m: f32,
+    /// Whether A_p is a measurement (false: the fixed value).
+    pub pupil_measured: bool,
+}
+
+/// The per-frame state of defocus: the gaze pipeline, the model and the pupil filter.
+struct DefocusPlan {
+    /// Vergence, depth filter and gaze-image decision.
+    pipeline: GazePipeline,
+    /// The scene's numbers of eq. 13-14.
+    model: DefocusModel,
+    /// A_p frame by frame.
+    pupil: PupilFilter,
+    /// The newest frame's decision.
+    last: Option<DefocusFrame>,
+}
+
+impl DefocusPlan {
+    fn new(config: GazeConfig, model: DefocusModel) -> DefocusPlan {
+        DefocusPlan {
+            pipeline: GazePipeline::new(config),
+            model,
+            pupil: PupilFilter::new(model.pupil_source, model.pupil_m),
+            last: None,
+        }
+    }
+}
+
 /// Decides each frame's look: the effect set's fixed part, and the defocus that the gaze
 /// pipeline (vergence -> depth filter -> gaze image, METHOD.md section 5) asks for.
 pub struct LookPlanner {
     /// The effect set's look without defocus amounts.
     base: Look,
-    /// Gaze pipeline and defocus model, when defocus is on.
-    defocus: Option<(GazePipeline, DefocusModel)>,
+    /// Gaze pipeline, defocus model and pupil, when defocus is on.
+    defocus: Option<DefocusPlan>,
 }
 
 impl LookPlanner {
@@ -85,7 +161,7 @@ impl LookPlanner {
     pub fn new(base: Look, defocus: Option<(GazeConfig, DefocusModel)>) -> LookPlanner {
         LookPlanner {
             base,
-            defocus: defocus.map(|(config, model)| (GazePipeline::new(config), model)),
+            defocus: defocus.map(|(config, model)| DefocusPlan::new(config, model)),
         }
     }
 
@@ -96,15 +172,15 @@ impl LookPlanner {
             defocus: self
                 .defocus
                 .as_ref()
-                .map(|(pipeline, model)| (GazePipeline::new(*pipeline.config()), *model)),
+                .map(|d| DefocusPlan::new(*d.pipeline.config(), d.model)),
         }
     }
 
     /// Forces the gaze image (or lets the tracker choose again) from now on; no effect
     /// without defocus. The gaze pipeline keeps its tracking state.
     pub fn set_gaze_override(&mut self, image: GazeOverride) {
-        if let Some((pipeline, _)) = &mut self.defocus {
-            pipeline.set_override(image);
+        if let Some(d) = &mut self.defocus {
+            d.pipeline.set_override(image);
         }
     }
 
@@ -112,22 +188,50 @@ impl LookPlanner {
     pub fn gaze_override(&self) -> Option<GazeOverride> {
         self.defocus
             .as_ref()
-            .map(|(pipeline, _)| pipeline.config().override_image)
+            .map(|d| d.pipeline.config().override_image)
     }
 
-    /// The look of a frame, and the gaze state behind its defocus (when defocus is on).
+    /// The look of a frame, and the gaze state behind its defocus (when defocus is on). The
+    /// image distances are those of the frame's viewing position ([`viewing_position_m`]).
     pub fn plan(&mut self, input: &FrameInput) -> (Look, Option<GazeState>) {
         match &mut self.defocus {
             None => (self.base, None),
-            Some((pipeline, model)) => {
-                let state = pipeline.update(input.gaze.as_ref(), input.time_ns);
+            Some(d) => {
+                let distances = d.model.distances_from(viewing_position_m(input));
+                d.pipeline.set_distances(distances);
+                let state = d.pipeline.update(input.gaze.as_ref(), input.time_ns);
+                let pupil = d.pupil.update(input.gaze.as_ref());
+                let defocus = d
+                    .model
+                    .defocus_at(state.image, &distances, pupil.diameter_m);
+                d.last = Some(DefocusFrame {
+                    image: state.image,
+                    distances,
+                    defocus,
+                    pupil_m: pupil.diameter_m,
+                    pupil_measured: pupil.measured,
+                });
                 let look = Look {
-                    defocus: model.defocus(state.image),
+                    defocus,
                     ..self.base
                 };
                 (look, Some(state))
             }
         }
+    }
+
+    /// The defocus decision of the newest planned frame; `None` without defocus or before the
+    /// first frame.
+    pub fn last_defocus(&self) -> Option<&DefocusFrame> {
+        self.defocus.as_ref().and_then(|d| d.last.as_ref())
+    }
+
+    /// Where A_p comes from and how many tracker samples had a measurement; `None` without
+    /// defocus.
+    pub fn pupil_source(&self) -> Option<(PupilSource, u64)> {
+        self.defocus
+            .as_ref()
+            .map(|d| (d.pupil.source(), d.pupil.measured_samples()))
     }
 }
 
@@ -167,6 +271,15 @@ pub fn planners_for(
             Some(mm) => check_pupil_diameter_m(mm / 1000.0)?,
             None => scene.viewer.pupil_diameter_m,
         };
+        if scene.gaze.pupil == PupilSource::Measured {
+            tracing::info!(
+                "A_p: the eye tracker's pupil diameters, smoothed ({:.1} mm until the first \
+                 measurement)",
+                pupil_m * 1000.0
+            );
+        } else {
+            tracing::info!("A_p: fixed {:.1} mm", pupil_m * 1000.0);
+        }
         Some(DefocusSetup::new(scene, pupil_m))
     } else {
         None
@@ -188,4 +301,159 @@ pub fn planners_for(
         })
         .collect();
     Ok((planners, setup))
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Quat, Vec3};
+    use vitreous_render::Reflection;
+    use vitreous_xr::null::{NullBackend, NullConfig};
+    use vitreous_xr::trace::TraceSample;
+    use vitreous_xr::{Backend, GazeRay, GazeSample, Pose};
+
+    use super::*;
+
+    /// The visual-effects scene: a sphere 0.15 m across centred 0.2 m ahead of the viewer's
+    /// start position, the background plane 0.4 m ahead, facing the viewer.
+    const SPHERE_RADIUS_M: f32 = 0.075;
+    const SPHERE_Z_M: f32 = -0.2;
+    const BACKGROUND_Z_M: f32 = -0.4;
+    const IPD_M: f32 = 0.063;
+
+    fn scene() -> Scene {
+        crate::scene::load_scene(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../config/scenes/visual-effects.toml"),
+        )
+        .expect("shipped scene")
+    }
+
+    fn planner(scene: &Scene, image: GazeOverride) -> LookPlanner {
+        let effects = EffectSet::parse("defocus").unwrap();
+        let model = DefocusModel::new(scene, 0.006);
+        let mut config = GazeConfig::new(model.distances);
+        config.override_image = image;
+        LookPlanner::new(
+            views::look(&effects, Reflection::default()),
+            Some((config, model)),
+        )
+    }
+
+    /// A head at `head_z_m` on the axis through the sphere, facing it, both eyes fixating
+    /// the world point `target`.
+    fn sample(time_ns: i64, head_z_m: f32, target: Vec3) -> TraceSample {
+        let head = Vec3::new(0.0, 0.0, head_z_m);
+        let eye = |x: f32| {
+            let origin = Vec3::new(x, 0.0, 0.0);
+            GazeRay {
+                origin,
+                direction: (target - head - origin).normalize(),
+                valid: true,
+            }
+        };
+        TraceSample {
+            time_ns,
+            head: Pose {
+                position: head,
+                orientation: Quat::IDENTITY,
+            },
+            gaze: GazeSample {
+                sample_time_ns: time_ns,
+                left: eye(-IPD_M / 2.0),
+                right: eye(IPD_M / 2.0),
+                combined: None,
+                fixation: None,
+                pupil_diameter_m: [None, None],
+            },
+        }
+    }
+
+    #[test]
+    fn at_the_fixed_viewing_position_frames_get_the_scenes_distances_and_blur() {
+        let scene = scene();
+        let head = scene.viewer.head_position_m;
+        let mut input = crate::run::test_frame();
+        input.head.position = head;
+        input.views[0].pose.position = head - Vec3::X * scene.viewer.ipd_m / 2.0;
+        input.views[1].pose.position = head + Vec3::X * scene.viewer.ipd_m / 2.0;
+        let model = DefocusModel::new(&scene, 0.006);
+        assert_eq!(
+            model.distances_from(viewing_position_m(&input)),
+            scene.image_distances()
+        );
+        for (image, gaze) in [
+            (GazeOverride::Surface, GazeImage::Surface),
+            (GazeOverride::Refracted, GazeImage::Refracted),
+        ] {
+            let mut p = planner(&scene, image);
+            let (look, _) = p.plan(&input);
+            assert_eq!(look.defocus, model.defocus(gaze));
+            let d = p.last_defocus().unwrap();
+            assert_eq!(d.distances, scene.image_distances());
+            assert_eq!((d.pupil_m, d.pupil_measured), (0.006, false));
+        }
+    }
+
+    /// Replays a head moving from 0.1 m behind the start position to 0.05 m in front of it
+    /// while the eyes fixate the sphere's front: every frame's K_g of the refracted image is
+    /// eq. 13-14 with that frame's distances, and the decision stays on the surface image
+    /// (with the start position's distances the first depths would read as refracted).
+    #[test]
+    fn a_moving_head_changes_the_distances_the_decision_and_k_g_every_frame() {
+        let scene = scene();
+        let front = Vec3::new(0.0, 0.0, SPHERE_Z_M + SPHERE_RADIUS_M);
+        let samples: Vec<TraceSample> = (0..=150)
+            .map(|i| sample(i * 10_000_000, 0.1 - 0.001 * i as f32, front))
+            .collect();
+        let start_depth = 0.1 - front.z;
+        assert_eq!(
+            scene.image_distances().nearest(start_depth),
+            GazeImage::Refracted,
+            "the fixed distances would decide otherwise, so the test can tell"
+        );
+        let mut backend = NullBackend::new(
+            samples,
+            NullConfig {
+                frame_rate_hz: 50.0,
+                ipd_m: IPD_M,
+                ..NullConfig::default()
+            },
+        )
+        .unwrap();
+        let mut p = planner(&scene, GazeOverride::Auto);
+        let background_px_per_m = scene.background.photo.width as f32 / 0.6;
+        let (mut frames, mut k_seen) = (0, Vec::new());
+        while let Some(input) = backend.wait_frame().unwrap() {
+            backend.end_frame(&input).unwrap();
+            let (look, _) = p.plan(&input);
+            let z = input.head.position.z;
+            let d_s = (z - SPHERE_Z_M) - SPHERE_RADIUS_M;
+            let d_r = z - BACKGROUND_Z_M;
+            let d = p.last_defocus().unwrap();
+            assert!((d.distances.surface_m - d_s).abs() < 1e-5, "{d:?} at z {z}");
+            assert!(
+                (d.distances.refracted_m - d_r).abs() < 1e-5,
+                "{d:?} at z {z}"
+            );
+            assert_eq!(
+                d.image,
+                GazeImage::Surface,
+                "frame {} at z {z}",
+                input.index
+            );
+            let expected_k = background_px_per_m * 0.006 * (d_r - d_s) / d_s;
+            let k = look.defocus.unwrap().refracted_k_g_px;
+            assert!(
+                (k - expected_k).abs() < 1e-3 * expected_k,
+                "frame {}: K_g {k} px, expected {expected_k} px",
+                input.index
+            );
+            assert_eq!(look.defocus.unwrap().surface_k_g_px, 0.0);
+            k_seen.push(k);
+            frames += 1;
+        }
+        assert_eq!(frames, 76);
+        // Nearer the sphere the background is relatively further behind it: more blur.
+        assert!(k_seen.windows(2).all(|w| w[1] > w[0]), "{k_seen:?}");
+    }
 }

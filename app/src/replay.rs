@@ -1,5 +1,6 @@
 //! `vitreous replay`: a recorded (or synthesised) trace through the real frame loop on a real
-//! Vulkan device, writing per-eye images, see-through previews and `summary.json`.
+//! Vulkan device, writing per-eye images, see-through previews, the per-frame defocus log
+//! `frames.csv` and `summary.json`.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -15,6 +16,7 @@ use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{TraceSample, read_trace};
 
 use crate::effects::EffectSet;
+use crate::frame_log::{FrameLog, PupilSummary};
 use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
 pub use crate::look::GazeSettings;
 use crate::look::LookPlanner;
@@ -173,6 +175,10 @@ pub struct ReplaySummary {
     pub gpu_ms: Option<Spread>,
     /// Files written, relative to the output folder.
     pub saved: Vec<String>,
+    /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
+    pub gaze_image_switches: u64,
+    /// Where A_p came from and the values used (`null` without defocus).
+    pub pupil: Option<PupilSummary>,
     /// Every frame's timing.
     pub per_frame: Vec<FrameRecord>,
 }
@@ -210,13 +216,26 @@ struct Saver<'a> {
     save_every: u64,
     saved: Vec<String>,
     progress: ProgressBar,
+    /// The per-frame log (`frames.csv`).
+    log: FrameLog,
+    /// The effect set's name, as the log gives it.
+    condition: String,
+    /// The first error writing the log, reported when the next frame finishes.
+    log_error: Option<anyhow::Error>,
 }
 
 impl FrameSink for Saver<'_> {
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         let save = self.save_every > 0 && input.index.is_multiple_of(self.save_every);
+        let look = self.planner.plan(input).0;
+        if let Err(e) = self
+            .log
+            .record(input, &self.condition, self.planner.last_defocus())
+        {
+            self.log_error.get_or_insert(e);
+        }
         FramePlan {
-            look: self.planner.plan(input).0,
+            look,
             want: Want {
                 eyes: save,
                 world: save,
@@ -229,6 +248,9 @@ impl FrameSink for Saver<'_> {
     }
 
     fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()> {
+        if let Some(e) = self.log_error.take() {
+            return Err(e);
+        }
         self.progress.inc(1);
         if let Some(readback) = &result.readback {
             let names = output::write_frame(&self.dir, input.index, readback)?;
@@ -347,6 +369,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     let running = serde_json::to_vec_pretty(&unfinished(RunStatus::Running, None))?;
     write_atomic(&summary_path, &running)?;
     remove_earlier_frames(&frames_dir)?;
+    let log = FrameLog::create(&options.out)?;
     let signals = crate::interrupt::watch();
     let progress = if options.progress {
         let bar = ProgressBar::new(expected_frames);
@@ -368,6 +391,9 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         planner,
         saved: Vec::new(),
         progress,
+        log,
+        condition: effects.to_string(),
+        log_error: None,
     };
     let started = Instant::now();
     let records = match frame_loop::run(&mut backend, &mut renderer, &mut saver) {
@@ -385,6 +411,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     let wall_s = started.elapsed().as_secs_f64();
     saver.progress.finish_and_clear();
     let interrupted = signals && crate::interrupt::requested();
+    // The log holds exactly the frames rendered, also when interrupted.
+    saver.log.finish()?;
 
     let v = renderer.context().validation();
     let validation = ValidationSummary {
@@ -418,6 +446,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         cpu_ms: Spread::of(records.iter().map(|r| r.cpu_ms)),
         gpu_ms: Spread::of(records.iter().filter_map(|r| r.gpu_ms)),
         saved: saver.saved,
+        gaze_image_switches: saver.log.gaze_image_switches(),
+        pupil: saver.log.pupil_summary(saver.planner.pupil_source()),
         per_frame: records,
     };
     let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;

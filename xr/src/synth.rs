@@ -13,7 +13,10 @@
 //!
 //! `fixation` and `combined` are `None` in every sample: the consumer computes vergence from
 //! the two rays, as with a real tracker. The true target of each moment is in
-//! [`SynthTrace::phases`].
+//! [`SynthTrace::phases`]. Each eye's pupil diameter drifts slowly between 3.5 and 5 mm
+//! (`synth/pupil.rs`); it is unknown (`None`) while the eye blinks.
+
+mod pupil;
 
 use glam::{Mat3, Quat, Vec3};
 use thiserror::Error;
@@ -294,6 +297,7 @@ pub fn synthesize_with_truth(params: &SynthParams) -> Result<SynthTrace, SynthEr
         };
         let left = eye(-1.0);
         let right = eye(1.0);
+        let pupils = pupil::pupil_diameters_m(p.seed, t_s);
         samples.push(TraceSample {
             time_ns,
             head,
@@ -303,7 +307,10 @@ pub fn synthesize_with_truth(params: &SynthParams) -> Result<SynthTrace, SynthEr
                 right,
                 combined: None,
                 fixation: None,
-                pupil_diameter_m: [None, None],
+                pupil_diameter_m: [
+                    left.valid.then_some(pupils[0]),
+                    right.valid.then_some(pupils[1]),
+                ],
             },
         });
     }

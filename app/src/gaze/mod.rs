@@ -15,11 +15,13 @@
 pub mod blur;
 pub mod filter;
 pub mod image;
+pub mod pupil;
 pub mod vergence;
 
 pub use blur::{DefocusError, GaussianKernel, ImageBlur, blur_reference, image_blur};
 pub use filter::{DepthFilter, FilterKind, FilterParseError, OneEuroParams, SampleFilter};
 pub use image::{GazeImage, GazeOverride, ImageDistances, ImageSelector};
+pub use pupil::{PupilEstimate, PupilFilter, PupilSource, PupilSourceParseError};
 pub use vergence::{FixationDepth, VergenceConfig, VergenceEstimator};
 
 use vitreous_xr::GazeSample;
@@ -98,6 +100,14 @@ impl GazePipeline {
     /// Changes the override (e.g. a live experimenter action); the tracking state is kept.
     pub fn set_override(&mut self, override_image: GazeOverride) {
         self.config.override_image = override_image;
+    }
+
+    /// Moves the two images to new distances (the viewer moved): the next update decides with
+    /// the switch depths of these distances, and d_f is the gaze image's new distance. The
+    /// current decision and the filters' history are kept.
+    pub fn set_distances(&mut self, distances: ImageDistances) {
+        self.config.distances = distances;
+        self.selector.distances = distances;
     }
 
     /// Runs one frame: `gaze` is the newest tracker sample at or before the frame (as in

@@ -60,6 +60,17 @@ impl LiveLooks {
         self.conditions[self.current].0
     }
 
+    /// The planner of the condition shown (its newest defocus decision, its pupil source).
+    pub fn planner(&self) -> &LookPlanner {
+        &self.conditions[self.current].1
+    }
+
+    /// Where A_p comes from and the tracker samples with a measurement, of the conditions with
+    /// defocus (all share the scene's pupil source; the counts of the first one).
+    pub fn pupil_source(&self) -> Option<(crate::gaze::PupilSource, u64)> {
+        self.conditions.iter().find_map(|(_, p)| p.pupil_source())
+    }
+
     /// The forced gaze image.
     pub fn gaze(&self) -> GazeOverride {
         self.gaze

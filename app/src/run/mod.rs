@@ -47,6 +47,7 @@ pub use readback::{LIT_THRESHOLD, MIN_OBJECT_FRACTION, ReadbackCheck};
 pub use recording::ReplayCheck;
 
 use crate::effects::EffectSet;
+use crate::frame_log::{FrameLog, PupilSummary};
 use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::look::{GazeSettings, planners_for};
 use crate::output::write_atomic;
@@ -165,6 +166,10 @@ pub struct RunSummary {
     pub depth_format: Option<String>,
     /// Frames submitted with depth.
     pub frames_with_depth: u64,
+    /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
+    pub gaze_image_switches: u64,
+    /// Where A_p came from and the values used (`null` when no condition has defocus).
+    pub pupil: Option<PupilSummary>,
 }
 
 impl RunSummary {
@@ -260,6 +265,10 @@ struct RunSink {
     writer: Option<TraceWriter<vitreous_xr::trace::AtomicFile>>,
     /// Every frame's input, for the replay check.
     recorded: Vec<FrameInput>,
+    /// The per-frame log (`frames.csv` with `--out`).
+    log: FrameLog,
+    /// The first error writing the log, reported when the next frame finishes.
+    log_error: Option<anyhow::Error>,
 }
 
 impl FrameSink for RunSink {
@@ -281,8 +290,16 @@ impl FrameSink for RunSink {
                 }
             }
         }
+        let look = self.looks.plan(input);
+        let condition = self.looks.condition().to_string();
+        if let Err(e) = self
+            .log
+            .record(input, &condition, self.looks.planner().last_defocus())
+        {
+            self.log_error.get_or_insert(e);
+        }
         FramePlan {
-            look: self.looks.plan(input),
+            look,
             want: Want {
                 eyes: read,
                 world: read,
@@ -291,6 +308,9 @@ impl FrameSink for RunSink {
     }
 
     fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()> {
+        if let Some(e) = self.log_error.take() {
+            return Err(e);
+        }
         if let Some(rb) = &result.readback {
             self.readback = Some(check_readback(
                 input,
@@ -420,6 +440,13 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         ),
         None => None,
     };
+    let log = match &options.out {
+        Some(out) => {
+            fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+            FrameLog::create(out)?
+        }
+        None => FrameLog::in_memory(),
+    };
     let world_behind = info.blend.needs_world_behind();
     let mut sink = RunSink {
         looks: LiveLooks::new(
@@ -437,6 +464,8 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         readback: None,
         writer,
         recorded: Vec::new(),
+        log,
+        log_error: None,
     };
     let started = Instant::now();
     let result = frame_loop::run(&mut session, &mut renderer, &mut sink);
@@ -452,6 +481,7 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         w.finish().context("closing the recording")?;
     }
     let records = result?;
+    sink.log.finish()?;
 
     let v = renderer.context().validation();
     let validation = ValidationSummary {
@@ -522,6 +552,8 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
             .depth_format
             .map(|f| format!("{:?}", vk::Format::from_raw(f))),
         frames_with_depth: report.frames_with_depth,
+        gaze_image_switches: sink.log.gaze_image_switches(),
+        pupil: sink.log.pupil_summary(sink.looks.pupil_source()),
     };
     if let Some(out) = &options.out {
         fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;

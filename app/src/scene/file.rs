@@ -46,6 +46,7 @@ pub(crate) struct CausticsToml {
 pub(crate) struct GazeToml {
     pub filter: Option<Spanned<String>>,
     pub image: Option<Spanned<String>>,
+    pub pupil: Option<Spanned<String>>,
 }
 
 /// `[object]`: the virtual transparent object.

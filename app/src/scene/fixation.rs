@@ -35,21 +35,35 @@ pub struct FixationPoints {
     pub refracted_m: Vec3,
 }
 
-impl Scene {
-    /// The points a viewer at the scene's head position fixates.
-    pub fn fixation_points(&self) -> FixationPoints {
-        let head = self.viewer.head_position_m;
-        let center = self.object.center_m;
-        let to_object = (center - head).normalize_or(Vec3::NEG_Z);
-        let surface_m = center - to_object * self.object.radius_m;
-        let plane_point = self.background.pose.position;
-        let normal = self.background.normal();
+/// What the fixation points depend on besides where the viewer is: the object's centre and
+/// radius and the background plane, in the scene (world) frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewingGeometry {
+    /// Centre of the object, metres.
+    pub center_m: Vec3,
+    /// Radius of the object's bounding sphere, metres.
+    pub radius_m: f32,
+    /// A point of the background plane (its centre), metres.
+    pub plane_point_m: Vec3,
+    /// Unit normal of the background plane.
+    pub plane_normal: Vec3,
+}
+
+impl ViewingGeometry {
+    /// The points a viewer at `head_m` fixates: the surface point facing the viewer on the line
+    /// to the object's centre, and the background point on that line behind the object (0.2 m
+    /// behind the centre when the plane is not behind the object along it).
+    pub fn points_from(&self, head_m: Vec3) -> FixationPoints {
+        let center = self.center_m;
+        let to_object = (center - head_m).normalize_or(Vec3::NEG_Z);
+        let surface_m = center - to_object * self.radius_m;
+        let normal = self.plane_normal;
         let denom = to_object.dot(normal);
         let behind = center + to_object * FALLBACK_REFRACTED_DEPTH_M;
         let refracted_m = if denom.abs() > 1e-3 {
-            let t = (plane_point - head).dot(normal) / denom;
-            if t > (center - head).length() {
-                head + to_object * t
+            let t = (self.plane_point_m - head_m).dot(normal) / denom;
+            if t > (center - head_m).length() {
+                head_m + to_object * t
             } else {
                 behind
             }
@@ -57,17 +71,43 @@ impl Scene {
             behind
         };
         FixationPoints {
-            head_m: head,
+            head_m,
             surface_m,
             refracted_m,
         }
     }
 
+    /// The distances of the surface and refracted images from a viewer at `head_m`, to the
+    /// points of [`ViewingGeometry::points_from`]. Eq. 13-14 take these every frame with the
+    /// frame's viewing position.
+    pub fn distances_from(&self, head_m: Vec3) -> ImageDistances {
+        let p = self.points_from(head_m);
+        ImageDistances::from_points(p.head_m, p.surface_m, p.refracted_m)
+    }
+}
+
+impl Scene {
+    /// The object and background plane the fixation points are found on.
+    pub fn viewing_geometry(&self) -> ViewingGeometry {
+        ViewingGeometry {
+            center_m: self.object.center_m,
+            radius_m: self.object.radius_m,
+            plane_point_m: self.background.pose.position,
+            plane_normal: self.background.normal(),
+        }
+    }
+
+    /// The points a viewer at the scene's head position fixates.
+    pub fn fixation_points(&self) -> FixationPoints {
+        self.viewing_geometry()
+            .points_from(self.viewer.head_position_m)
+    }
+
     /// The distances of the surface and refracted images from the viewer's head, to the
     /// points of [`Scene::fixation_points`].
     pub fn image_distances(&self) -> ImageDistances {
-        let p = self.fixation_points();
-        ImageDistances::from_points(p.head_m, p.surface_m, p.refracted_m)
+        self.viewing_geometry()
+            .distances_from(self.viewer.head_position_m)
     }
 }
 

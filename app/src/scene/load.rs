@@ -17,7 +17,7 @@ use super::{
 };
 use super::{file, image, mesh};
 use crate::effects::EffectSet;
-use crate::gaze::{FilterKind, FilterParseError, GazeOverride};
+use crate::gaze::{FilterKind, FilterParseError, GazeOverride, PupilSource};
 
 /// Loads a scene file and every asset it names, checking ranges and decoding everything.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
@@ -327,6 +327,16 @@ impl Loader<'_> {
                             "expected auto, surface or refracted, found '{}'",
                             i.get_ref()
                         ),
+                    )
+                })?,
+            },
+            pupil: match &raw.gaze.pupil {
+                None => PupilSource::default(),
+                Some(p) => p.get_ref().parse().map_err(|_| {
+                    self.src.invalid(
+                        p.span(),
+                        "gaze.pupil",
+                        format!("expected paper or measured, found '{}'", p.get_ref()),
                     )
                 })?,
             },

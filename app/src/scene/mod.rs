@@ -27,11 +27,12 @@ use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
 use vitreous_xr::{Fov, Pose};
 
 use crate::effects::EffectSet;
-use crate::gaze::{FilterKind, GazeOverride};
+use crate::gaze::{FilterKind, GazeOverride, PupilSource};
 
 pub use error::{Location, SceneError};
 pub use fixation::{
-    FixationPoints, REFRACTED_TARGET, SURFACE_TARGET, gaze_image_of_target, synth_params_for,
+    FixationPoints, REFRACTED_TARGET, SURFACE_TARGET, ViewingGeometry, gaze_image_of_target,
+    synth_params_for,
 };
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
 pub use load::load_scene;
@@ -126,6 +127,8 @@ pub struct GazeChoice {
     pub filter: FilterKind,
     /// Gaze image: auto, or forced to the surface or the refracted image.
     pub image: GazeOverride,
+    /// Where A_p comes from: the fixed `[viewer] pupil_diameter_mm` or the tracker.
+    pub pupil: PupilSource,
 }
 
 /// Where the object's refractive index came from.

@@ -4,6 +4,8 @@ use std::io;
 
 use thiserror::Error;
 
+#[cfg(doc)]
+use super::PUPIL_RANGE_M;
 use super::{MAX_SAMPLE_GAP_NS, MAX_TRACE_SPAN_NS, QUAT_NORM_TOLERANCE, VERSION_LINE};
 
 /// Everything that can go wrong reading or writing a trace, or importing one from another
@@ -65,7 +67,7 @@ pub enum TraceError {
     },
     /// The version line names a version this reader does not know.
     #[error(
-        "{file}:{line}: unsupported trace version `{version}`; this reader understands only v1"
+        "{file}:{line}: unsupported trace version `{version}`; this reader understands v1 and v1.1"
     )]
     UnsupportedVersion {
         /// File name.
@@ -81,7 +83,7 @@ pub enum TraceError {
         /// File name.
         file: String,
     },
-    /// The column header line does not list the version-1 columns in order.
+    /// The column header line does not list the columns of the file's version in order.
     #[error("{file}:{line}: column {column} of the header is `{found}`, expected `{expected}`")]
     BadColumnHeader {
         /// File name.
@@ -150,7 +152,7 @@ pub enum TraceError {
         /// What the column holds.
         expected: &'static str,
     },
-    /// A time or head-pose value is NaN or infinite.
+    /// A time, head-pose or pupil value is NaN or infinite.
     #[error("{file}:{line}: column `{column}`: expected a finite number, found {value}")]
     NonFinite {
         /// File name.
@@ -160,6 +162,20 @@ pub enum TraceError {
         /// Column name.
         column: &'static str,
         /// The value found.
+        value: f32,
+    },
+    /// A pupil diameter is outside [`PUPIL_RANGE_M`] (1-10 mm).
+    #[error(
+        "{file}:{line}: column `{column}`: pupil diameter {value} m is outside 1-10 mm (metres expected; empty when unknown)"
+    )]
+    PupilOutOfRange {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// Column name.
+        column: &'static str,
+        /// The value found, metres.
         value: f32,
     },
     /// The head orientation quaternion is too far from unit length.

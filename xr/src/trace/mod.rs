@@ -1,4 +1,5 @@
-//! The vitreous trace format, version 1: head poses and eye-tracker samples as UTF-8 text.
+//! The vitreous trace format, version 1 (and its minor version 1.1, which adds the per-eye
+//! pupil diameters): head poses and eye-tracker samples as UTF-8 text.
 //!
 //! One sample per line, comma-separated, after a version line and a column header line. The
 //! full description (every column, its unit and axes) is in `docs/trace-format.md`; the short
@@ -13,6 +14,9 @@
 //! The reader is strict about what the replay depends on (times, head pose) and lenient about
 //! what trackers really produce: a gaze ray with a NaN/infinite value or a zero direction is
 //! read as an invalid ray of that eye instead of failing the whole trace.
+//!
+//! The reader takes both versions; the writer writes v1.1 (its pupil columns are empty where
+//! a sample has no measurement).
 //!
 //! The writer runs the same checks before writing, so it never produces a file the reader
 //! refuses, and flushes after every sample so a crash loses at most the sample being written.
@@ -36,6 +40,10 @@ pub use write::TraceWriter;
 
 /// The first line of every version-1 trace.
 pub const VERSION_LINE: &str = "# vitreous-trace v1";
+
+/// The first line of a version-1.1 trace (version 1 plus the per-eye pupil diameters); the
+/// writer writes this version.
+pub const VERSION_LINE_V1_1: &str = "# vitreous-trace v1.1";
 
 /// What the version line starts with, whatever the version.
 const VERSION_PREFIX: &str = "# vitreous-trace ";
@@ -77,11 +85,57 @@ pub const COLUMNS: [&str; 33] = [
     "fixation_z_m",
 ];
 
-/// Index of the first column of each group in [`COLUMNS`].
+/// The column names of version 1.1, in file order: those of version 1, then the per-eye
+/// pupil diameters (`left_pupil_m`, `right_pupil_m`).
+pub const COLUMNS_V1_1: [&str; 35] = {
+    let mut out = [""; 35];
+    let mut i = 0;
+    while i < COLUMNS.len() {
+        out[i] = COLUMNS[i];
+        i += 1;
+    }
+    out[PUPILS] = "left_pupil_m";
+    out[PUPILS + 1] = "right_pupil_m";
+    out
+};
+
+/// The versions of the format this crate reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TraceVersion {
+    /// `# vitreous-trace v1`: 33 columns.
+    V1,
+    /// `# vitreous-trace v1.1`: 35 columns, version 1's and the pupil diameters.
+    V1_1,
+}
+
+impl TraceVersion {
+    /// The column names of this version, in file order.
+    pub fn columns(self) -> &'static [&'static str] {
+        match self {
+            TraceVersion::V1 => &COLUMNS,
+            TraceVersion::V1_1 => &COLUMNS_V1_1,
+        }
+    }
+
+    /// The version line.
+    pub fn version_line(self) -> &'static str {
+        match self {
+            TraceVersion::V1 => VERSION_LINE,
+            TraceVersion::V1_1 => VERSION_LINE_V1_1,
+        }
+    }
+}
+
+/// The range of pupil diameters a trace may hold, metres (1-10 mm): a value outside it is a
+/// unit mistake or a tracker's placeholder, refused like any other bad field.
+pub const PUPIL_RANGE_M: std::ops::RangeInclusive<f32> = 0.001..=0.010;
+
+/// Index of the first column of each group in [`COLUMNS`] ([`COLUMNS_V1_1`] for the pupils).
 const LEFT: usize = 9;
 const RIGHT: usize = 16;
 const COMBINED: usize = 23;
 const FIXATION: usize = 30;
+const PUPILS: usize = 33;
 
 /// How far the head quaternion's norm may be from 1 before the sample is refused; within it
 /// the quaternion is normalised (text round-off, other tools' rounding).

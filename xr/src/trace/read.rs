@@ -8,7 +8,8 @@ use glam::{Quat, Vec3};
 
 use super::validate::{Preceding, check_sample};
 use super::{
-    COLUMNS, COMBINED, FIXATION, LEFT, RIGHT, TraceError, TraceSample, VERSION_PREFIX, clean_ray,
+    COLUMNS, COLUMNS_V1_1, COMBINED, FIXATION, LEFT, PUPILS, RIGHT, TraceError, TraceSample,
+    TraceVersion, VERSION_PREFIX, clean_ray,
 };
 use crate::frame::{GazeRay, GazeSample, Pose};
 use crate::records::{Record, RecordReader, printable};
@@ -49,9 +50,18 @@ fn parse_ray(record: &Record<'_>, col: usize) -> Result<GazeRay, TraceError> {
     }))
 }
 
-/// Parses one sample line without the time-order checks.
-fn parse_record(record: &Record<'_>) -> Result<TraceSample, TraceError> {
-    record.expect_len(COLUMNS.len())?;
+/// Parses an optional pupil diameter column (empty: unknown). Its range is checked with the
+/// rest of the sample.
+fn parse_pupil(record: &Record<'_>, col: usize) -> Result<Option<f32>, TraceError> {
+    if record.field(col).is_empty() {
+        return Ok(None);
+    }
+    record.f32(col, COLUMNS_V1_1[col]).map(Some)
+}
+
+/// Parses one sample line of a trace of `version` without the time-order checks.
+fn parse_record(record: &Record<'_>, version: TraceVersion) -> Result<TraceSample, TraceError> {
+    record.expect_len(version.columns().len())?;
     let time_ns = parse_time(record, 0)?;
     let position = parse_vec3(record, 1)?;
     let orientation = Quat::from_xyzw(
@@ -72,6 +82,13 @@ fn parse_record(record: &Record<'_>) -> Result<TraceSample, TraceError> {
         false => None,
         true => Some(parse_vec3(record, FIXATION)?),
     };
+    let pupil_diameter_m = match version {
+        TraceVersion::V1 => [None, None],
+        TraceVersion::V1_1 => [
+            parse_pupil(record, PUPILS)?,
+            parse_pupil(record, PUPILS + 1)?,
+        ],
+    };
     Ok(TraceSample {
         time_ns,
         head: Pose {
@@ -84,7 +101,7 @@ fn parse_record(record: &Record<'_>) -> Result<TraceSample, TraceError> {
             right,
             combined,
             fixation,
-            pupil_diameter_m: [None, None],
+            pupil_diameter_m,
         },
     })
 }
@@ -114,7 +131,7 @@ fn optional_group(
     Ok(true)
 }
 
-/// Streams [`TraceSample`]s out of a version-1 trace.
+/// Streams [`TraceSample`]s out of a version-1 or version-1.1 trace.
 ///
 /// The version and column header lines are checked by the constructor; samples are parsed
 /// and checked one line at a time as the iterator is advanced. After the first error the
@@ -126,6 +143,8 @@ pub struct TraceReader<R: Read> {
     previous: Option<Preceding>,
     /// Set after an error or the end of the input: the iterator is fused.
     done: bool,
+    /// The version named by the first line.
+    version: TraceVersion,
 }
 
 impl TraceReader<BufReader<File>> {
@@ -150,9 +169,15 @@ impl<R: Read> TraceReader<R> {
             records: RecordReader::new(reader, name, b','),
             previous: None,
             done: false,
+            version: TraceVersion::V1,
         };
         this.read_headers()?;
         Ok(this)
+    }
+
+    /// The version of the trace, from its first line.
+    pub fn version(&self) -> TraceVersion {
+        self.version
     }
 
     /// The file name used in error messages.
@@ -172,7 +197,8 @@ impl<R: Read> TraceReader<R> {
         let text = first.text();
         let text = text.trim_start_matches('\u{feff}').trim();
         match text.strip_prefix(VERSION_PREFIX) {
-            Some("v1") => {}
+            Some("v1") => self.version = TraceVersion::V1,
+            Some("v1.1") => self.version = TraceVersion::V1_1,
             Some(version) => {
                 return Err(TraceError::UnsupportedVersion {
                     file: name,
@@ -191,13 +217,14 @@ impl<R: Read> TraceReader<R> {
         let Some(header) = self.records.next_content_record()? else {
             return Err(TraceError::MissingColumnHeader { file: name });
         };
-        for i in 0..header.len().max(COLUMNS.len()) {
+        let columns = self.version.columns();
+        for i in 0..header.len().max(columns.len()) {
             let found = if i < header.len() {
                 header.field(i)
             } else {
                 ""
             };
-            let expected = COLUMNS.get(i).copied().unwrap_or("");
+            let expected = columns.get(i).copied().unwrap_or("");
             if found != expected {
                 return Err(TraceError::BadColumnHeader {
                     file: name,
@@ -216,7 +243,7 @@ impl<R: Read> TraceReader<R> {
         let Some(record) = self.records.next_content_record()? else {
             return Ok(None);
         };
-        let raw = parse_record(&record)?;
+        let raw = parse_record(&record, self.version)?;
         let sample = check_sample(record.file(), record.line(), &raw, self.previous)?;
         self.previous = Some(Preceding::after(self.previous, &sample));
         Ok(Some(sample))
@@ -378,8 +405,8 @@ mod tests {
                 e,
                 TraceError::FieldCount {
                     line: 5,
-                    found: 34,
-                    expected: 33,
+                    found: 36,
+                    expected: 35,
                     ..
                 }
             ),
@@ -444,6 +471,22 @@ mod tests {
             samples[1].gaze.sample_time_ns
         );
         assert_eq!(samples[2].gaze.fixation, Some(Vec3::new(0.0, 0.0, -0.6)));
+    }
+
+    #[test]
+    fn version_1_1_example_in_the_format_doc_reads_with_pupils() {
+        let doc = include_str!("../../../docs/trace-format.md");
+        let at = doc.find("```text\n# vitreous-trace v1.1").unwrap() + "```text\n".len();
+        let end = at + doc[at..].find("```").unwrap();
+        let mut reader = TraceReader::new(&doc.as_bytes()[at..end], "doc").unwrap();
+        assert_eq!(reader.version(), TraceVersion::V1_1);
+        let samples: Vec<_> = reader.by_ref().collect::<Result<_, _>>().unwrap();
+        assert_eq!(samples.len(), 2);
+        assert_eq!(
+            samples[0].gaze.pupil_diameter_m,
+            [Some(0.0042), Some(0.0041)]
+        );
+        assert_eq!(samples[1].gaze.pupil_diameter_m, [None, Some(0.0041)]);
     }
 
     #[test]

@@ -78,7 +78,8 @@ pub(super) fn line_of(e: &TraceError) -> Option<usize> {
         | TimeNotIncreasing { line, .. }
         | GazeAfterPose { line, .. }
         | GazeTimeBackwards { line, .. }
-        | PartialGroup { line, .. } => Some(*line),
+        | PartialGroup { line, .. }
+        | PupilOutOfRange { line, .. } => Some(*line),
         _ => None,
     }
 }

@@ -4,8 +4,8 @@
 use glam::Quat;
 
 use super::{
-    COLUMNS, MAX_SAMPLE_GAP_NS, MAX_TRACE_SPAN_NS, MIN_DIRECTION_LENGTH, QUAT_NORM_TOLERANCE,
-    TraceError, TraceSample, UNIT_EPSILON,
+    COLUMNS, COLUMNS_V1_1, MAX_SAMPLE_GAP_NS, MAX_TRACE_SPAN_NS, MIN_DIRECTION_LENGTH,
+    PUPIL_RANGE_M, PUPILS, QUAT_NORM_TOLERANCE, TraceError, TraceSample, UNIT_EPSILON,
 };
 use crate::frame::GazeRay;
 
@@ -66,7 +66,8 @@ pub(crate) fn check_span(
     Ok(())
 }
 
-/// Checks a head pose and its times; normalises small quaternion drift. Shared by the reader
+/// Checks a head pose and its times, and the pupil diameters (finite, within
+/// [`PUPIL_RANGE_M`]); normalises small quaternion drift. Shared by the reader
 /// and the writer so that what one accepts the other does too.
 pub(super) fn check_sample(
     file: &str,
@@ -83,6 +84,26 @@ pub(super) fn check_sample(
                 file: file.to_owned(),
                 line,
                 column: COLUMNS[1 + i],
+                value,
+            });
+        }
+    }
+    for (eye, pupil) in sample.gaze.pupil_diameter_m.iter().enumerate() {
+        let Some(value) = *pupil else { continue };
+        let column = COLUMNS_V1_1[PUPILS + eye];
+        if !value.is_finite() {
+            return Err(TraceError::NonFinite {
+                file: file.to_owned(),
+                line,
+                column,
+                value,
+            });
+        }
+        if !PUPIL_RANGE_M.contains(&value) {
+            return Err(TraceError::PupilOutOfRange {
+                file: file.to_owned(),
+                line,
+                column,
                 value,
             });
         }
@@ -307,6 +328,37 @@ mod tests {
         let s = read_str(&text).unwrap();
         assert!(s[0].gaze.left.valid);
         assert!(s[0].gaze.left.direction.abs_diff_eq(Vec3::NEG_Z, 1e-6));
+    }
+
+    #[test]
+    fn pupil_diameters_must_be_finite_plausible_numbers() {
+        let text = with_field(&good_text(2), 3, PUPILS, "0.0041");
+        let s = read_str(&text).unwrap();
+        assert_eq!(s[0].gaze.pupil_diameter_m, [Some(0.0041), None]);
+        let cases = [
+            (PUPILS, "4.1", "left_pupil_m", "outside 1-10 mm"),
+            (PUPILS + 1, "0", "right_pupil_m", "outside 1-10 mm"),
+            (PUPILS + 1, "NaN", "right_pupil_m", "finite"),
+            (PUPILS, "4mm", "left_pupil_m", "decimal"),
+        ];
+        for (col, value, column, says) in cases {
+            let text = with_field(&good_text(2), 4, col, value);
+            let e = read_str(&text).unwrap_err();
+            assert_eq!(line_of(&e), Some(4), "{e}");
+            let message = e.to_string();
+            assert!(
+                message.contains("test.trace:4") && message.contains(column),
+                "{message}"
+            );
+            assert!(message.contains(says), "{message}");
+        }
+        let mut bad = sample(10);
+        bad.gaze.pupil_diameter_m = [Some(0.02), None];
+        let mut w = TraceWriter::new(Vec::new()).unwrap();
+        assert!(matches!(
+            w.write(&bad),
+            Err(TraceError::PupilOutOfRange { .. })
+        ));
     }
 
     #[test]

@@ -4,10 +4,10 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use super::validate::{Preceding, check_sample};
-use super::{AtomicFile, COLUMNS, TraceError, TraceSample, VERSION_LINE};
+use super::{AtomicFile, COLUMNS_V1_1, TraceError, TraceSample, VERSION_LINE_V1_1};
 use crate::frame::GazeRay;
 
-/// Writes [`TraceSample`]s as a version-1 trace.
+/// Writes [`TraceSample`]s as a version-1.1 trace (version 1 and the pupil diameters).
 ///
 /// Every sample is checked like the reader checks it (finite head pose, unit quaternion,
 /// increasing times, gaze time not after the pose time) and flushed once written.
@@ -62,14 +62,14 @@ impl<W: Write> TraceWriter<W> {
             buf: String::new(),
             complete: |_| Ok(()),
         };
-        this.buf = format!("{VERSION_LINE}\n{}\n", COLUMNS.join(","));
+        this.buf = format!("{VERSION_LINE_V1_1}\n{}\n", COLUMNS_V1_1.join(","));
         this.flush_buf("writing header")?;
         Ok(this)
     }
 
     /// Checks and writes one sample, then flushes. Invalid gaze rays (flagged, non-finite,
     /// zero direction) are written as `0` with empty numbers; a non-finite fixation point is
-    /// written as absent.
+    /// written as absent; an unknown pupil diameter as an empty field.
     pub fn write(&mut self, sample: &TraceSample) -> Result<(), TraceError> {
         use std::fmt::Write as _;
 
@@ -92,6 +92,14 @@ impl<W: Write> TraceWriter<W> {
                 let _ = write!(b, ",{},{},{}", f.x, f.y, f.z);
             }
             None => b.push_str(",,,"),
+        }
+        for pupil in s.gaze.pupil_diameter_m {
+            match pupil {
+                Some(d) => {
+                    let _ = write!(b, ",{d}");
+                }
+                None => b.push(','),
+            }
         }
         b.push('\n');
         self.flush_buf("writing sample")?;
@@ -159,8 +167,39 @@ mod tests {
         samples[2].gaze.combined = Some(ray(Vec3::ZERO, Vec3::new(0.0, 0.1, -1.0)));
         samples[3].gaze.combined = Some(GazeRay::INVALID);
         samples[4].gaze.fixation = Some(Vec3::new(0.01, -0.02, -0.75));
+        samples[0].gaze.pupil_diameter_m = [Some(0.0041), Some(0.003_95)];
+        samples[2].gaze.pupil_diameter_m = [None, Some(0.0062)];
         let text = to_text(&samples);
+        assert!(text.starts_with("# vitreous-trace v1.1\n"), "{text}");
         assert_eq!(read_str(&text).unwrap(), samples);
+    }
+
+    #[test]
+    fn version_1_files_read_as_before_without_pupils() {
+        let mut samples: Vec<_> = (1..=3).map(|i| sample(i * 1000)).collect();
+        samples[1].gaze.left = GazeRay::INVALID;
+        // The same samples as a version-1 file: the pupil columns cut off.
+        let v1: Vec<String> = to_text(&samples)
+            .lines()
+            .enumerate()
+            .map(|(i, line)| match i {
+                0 => VERSION_LINE.to_owned(),
+                _ => line.rsplitn(3, ',').nth(2).unwrap().to_owned(),
+            })
+            .collect();
+        assert_eq!(v1[1], COLUMNS.join(","));
+        assert_eq!(v1[2].split(',').count(), COLUMNS.len());
+        let v1 = v1.join("\n");
+        let mut r = TraceReader::new(v1.as_bytes(), "v1.trace").unwrap();
+        assert_eq!(r.version(), TraceVersion::V1);
+        let read: Vec<_> = r.by_ref().collect::<Result<_, _>>().unwrap();
+        assert_eq!(read, samples);
+        // A v1 file with the pupil columns is refused at its header.
+        let e = read_str(&to_text(&samples).replacen("v1.1", "v1", 1)).unwrap_err();
+        assert!(
+            matches!(e, TraceError::BadColumnHeader { column: 34, .. }),
+            "{e}"
+        );
     }
 
     #[test]
@@ -222,10 +261,14 @@ mod tests {
             arb_vec3(1.0),
             -3.0f32..3.0,
             (arb_ray(), arb_ray(), proptest::option::of(arb_ray())),
-            proptest::option::of(arb_vec3(10.0)),
+            (
+                proptest::option::of(arb_vec3(10.0)),
+                proptest::option::of(0.001f32..=0.010),
+                proptest::option::of(0.001f32..=0.010),
+            ),
         )
             .prop_map(
-                |(dt, lag, position, axis, angle, (left, right, combined), fixation)| {
+                |(dt, lag, position, axis, angle, (left, right, combined), (fixation, lp, rp))| {
                     let axis = axis.try_normalize().unwrap_or(Vec3::Y);
                     let sample = TraceSample {
                         time_ns: 0,
@@ -239,7 +282,7 @@ mod tests {
                             right,
                             combined,
                             fixation,
-                            pupil_diameter_m: [None, None],
+                            pupil_diameter_m: [lp, rp],
                         },
                     };
                     (dt, lag, sample)

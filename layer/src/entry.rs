@@ -187,21 +187,8 @@ unsafe extern "system" fn create_api_layer_instance(
             })
             .collect();
         let split = extensions::split(&names, &prepared.config.gaze);
-        if let Some(ext) = split.not_offered.first() {
-            report(format!(
-                "the app enabled {} but VITREOUS_SIM_GAZE does not offer it (offered: {}); \
-                 write the manifest again with tools/sim-layer so both agree",
-                ext.name().to_string_lossy(),
-                prepared
-                    .config
-                    .gaze
-                    .iter()
-                    .map(|e| e.short())
-                    .collect::<Vec<_>>()
-                    .join(",")
-            ));
-            return sys::Result::ERROR_EXTENSION_NOT_PRESENT;
-        }
+        // The layer's extensions it does not offer go on to the runtime, which may have them
+        // (Monado lists XR_EXT_eye_gaze_interaction) or refuses them.
         let forwarded: Vec<*const c_char> = split.forwarded.iter().map(|n| n.as_ptr()).collect();
         let mut next_create_info = *info;
         next_create_info.enabled_extension_count = forwarded.len() as u32;

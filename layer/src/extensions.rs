@@ -13,7 +13,8 @@ pub struct Split<'a> {
     pub forwarded: Vec<&'a CStr>,
     /// The layer's extensions the app enabled, in the app's order, without repeats.
     pub owned: Vec<GazeExtension>,
-    /// The layer's extensions the app enabled but the configuration does not offer.
+    /// The layer's extensions the app enabled but the configuration does not offer (passed
+    /// on: the runtime may have them).
     pub not_offered: Vec<GazeExtension>,
 }
 

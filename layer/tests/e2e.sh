@@ -1,0 +1,187 @@
+#!/usr/bin/env bash
+# End-to-end check of the simulated see-through headset layer on a headless Monado (null
+# compositor, simulated HMD): `vitreous run` with the layer and the OpenXR core validation
+# layer enabled, once per eye extension, fed with a synthesised visual-effects trace.
+# For each case: FOCUSED reached, the frames submitted, the gaze source the case offers, a
+# valid gaze in every recorded frame, 0 OpenXR core-validation messages, the ADDITIVE blend
+# chosen by the app and recorded by the layer for every submitted frame (forwarded to Monado as
+# OPAQUE), and a clean runtime exit.
+#
+# usage: layer/tests/e2e.sh [--frames N] [--keep] [CASE...]
+#   CASE                    fb, ext, ml (default: fb ext; ml once `vitreous run` reads it)
+#   VITREOUS_BIN            the vitreous binary (default target/debug/vitreous)
+#   VITREOUS_SIM_LAYER_LIB  the layer library (default target/debug/libvitreous_sim_layer.so)
+#   VITREOUS_MONADO_PREFIX  provisioned prefix (see tools/monado/provision)
+# Build first: cargo build -p vitreous -p vitreous-sim-layer. Exit status 0 only if every
+# case passed; one PASS line per case on stderr.
+set -euo pipefail
+
+here=$(cd "$(dirname "$0")" && pwd)
+repo=$(cd "$here/../.." && pwd)
+frames=100
+keep=0
+cases=()
+while [ $# -gt 0 ]; do
+    case $1 in
+    --frames)
+        frames=$2
+        shift
+        ;;
+    --keep) keep=1 ;;
+    -h | --help)
+        sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'
+        exit 0
+        ;;
+    fb | ext | ml) cases+=("$1") ;;
+    *)
+        echo "sim-layer e2e: unknown argument '$1' (try --help)" >&2
+        exit 2
+        ;;
+    esac
+    shift
+done
+[ ${#cases[@]} -gt 0 ] || cases=(fb ext)
+
+say() { echo "sim-layer e2e: $*" >&2; }
+fail() {
+    echo "sim-layer e2e: FAIL: $*" >&2
+    exit 1
+}
+
+bin=${VITREOUS_BIN:-$repo/target/debug/vitreous}
+lib=${VITREOUS_SIM_LAYER_LIB:-$repo/target/debug/libvitreous_sim_layer.so}
+[ -x "$bin" ] || fail "no vitreous binary at $bin (cargo build -p vitreous)"
+[ -f "$lib" ] || fail "no layer library at $lib (cargo build -p vitreous-sim-layer)"
+
+prefix=$("$repo/tools/monado/provision" --quiet) || fail "provisioning Monado failed"
+# shellcheck disable=SC1091
+source "$prefix/env.sh"
+validation_layers=$XR_API_LAYER_PATH
+
+work=$(mktemp -d "${TMPDIR:-/tmp}/vitreous-sim-layer.XXXXXX")
+export XDG_RUNTIME_DIR="$work/xdg"
+mkdir -m 700 -p "$XDG_RUNTIME_DIR"
+service_pid=
+cleanup() {
+    # Only the service this script started, by its pid.
+    if [ -n "$service_pid" ] && kill -0 "$service_pid" 2>/dev/null; then
+        kill "$service_pid" 2>/dev/null || true
+        wait "$service_pid" 2>/dev/null || true
+    fi
+    exec 3>&- 2>/dev/null || true
+    if [ "$keep" = 1 ]; then
+        say "kept $work"
+    else
+        rm -rf "$work"
+    fi
+}
+trap cleanup EXIT
+
+mkfifo "$work/service.in"
+exec 3<>"$work/service.in"
+XRT_COMPOSITOR_NULL=1 SIMULATED_ENABLE=1 XRT_LOG=info \
+    "${XR_LOADER[@]}" "$prefix/root/usr/bin/monado-service" \
+    <"$work/service.in" >"$work/service.log" 2>&1 &
+service_pid=$!
+for _ in $(seq 150); do
+    [ -S "$XDG_RUNTIME_DIR/monado_comp_ipc" ] && break
+    kill -0 "$service_pid" 2>/dev/null || {
+        tail -20 "$work/service.log" >&2
+        fail "monado-service died while starting (log above)"
+    }
+    sleep 0.2
+done
+[ -S "$XDG_RUNTIME_DIR/monado_comp_ipc" ] || fail "monado-service did not open its IPC socket in 30 s"
+
+scene="$repo/config/scenes/visual-effects.toml"
+"$bin" --log warn trace synth --scene "$scene" --out "$work/gaze.trace" --duration 12 >/dev/null ||
+    fail "synthesising the gaze trace failed"
+
+# The layer nearest the app, core validation below it: validation then checks the calls the
+# layer makes to the runtime (docs/sim-layer.md explains the order).
+layer_order=${VITREOUS_SIM_LAYER_ORDER:-XR_APILAYER_VITREOUS_simulated_ost:XR_APILAYER_LUNARG_core_validation}
+
+run_case() {
+    local name=$1 ext_name col
+    case $name in
+    fb) ext_name=XR_FB_eye_tracking_social col=10 ;;
+    ext) ext_name=XR_EXT_eye_gaze_interaction col=24 ;;
+    ml) ext_name=XR_ML_eye_tracker col=10 ;;
+    esac
+    local dir="$work/$name"
+    mkdir -p "$dir"
+    "$repo/tools/sim-layer" --lib "$lib" --gaze "$name" "$dir/layers" >/dev/null 2>&1 ||
+        fail "$name: tools/sim-layer failed"
+    set +e
+    XR_API_LAYER_PATH="$dir/layers:$validation_layers" XR_ENABLE_API_LAYERS="$layer_order" \
+        VITREOUS_SIM_GAZE=$name VITREOUS_SIM_TRACE="$work/gaze.trace" \
+        VITREOUS_SIM_SUBMITTED="$dir/submitted.csv" timeout 300 \
+        "${XR_LOADER[@]}" "$bin" --log info run "$scene" --frames "$frames" --validate \
+        --record "$dir/recorded.trace" --out "$dir/run" >"$dir/app.log" 2>&1
+    local rc=$?
+    set -e
+    sed -i 's/\x1b\[[0-9;]*m//g' "$dir/app.log"
+    if [ "$rc" != 0 ]; then
+        tail -25 "$dir/app.log" >&2
+        fail "$name: vitreous run exited with status $rc (log above)"
+    fi
+    local summary="$dir/run/summary.json"
+    [ -f "$summary" ] || fail "$name: no summary.json"
+    field() { sed -n "s/^ *\"$1\": \(.*\),\{0,1\}$/\1/p" "$summary" | head -n1 | sed 's/,$//'; }
+
+    if ! grep -q "\"$ext_name\"" "$summary"; then
+        [ "$name" = ml ] && {
+            say "SKIP $name: vitreous run does not enable $ext_name yet"
+            return 0
+        }
+        fail "$name: the app did not enable $ext_name (extensions: $(grep -A12 '"extensions"' "$summary" | tr -d ' \n'))"
+    fi
+    [ "$(field reached_focused)" = true ] || fail "$name: the session never reached FOCUSED"
+    local submitted
+    submitted=$(field frames_submitted)
+    [ "$submitted" -ge $((frames * 9 / 10)) ] || fail "$name: only $submitted of $frames frames were submitted"
+    local source
+    source=$(field gaze_source | tr -d '"')
+    case $source in
+    *"$ext_name"*) ;;
+    *) fail "$name: gaze source is '$source', expected $ext_name" ;;
+    esac
+    grep -q 'Core Validation Layer is initialized' "$dir/app.log" || fail "$name: the OpenXR core validation layer did not load"
+    local xr_messages
+    xr_messages=$(grep -c -E 'VALID_ERROR|VALID_WARNING' "$dir/app.log" || true)
+    [ "$xr_messages" = 0 ] || {
+        grep -E 'VALID_ERROR|VALID_WARNING' "$dir/app.log" | sort | uniq -c | head -5 >&2
+        fail "$name: OpenXR core validation reported $xr_messages messages"
+    }
+    [ "$(field blend | tr -d '"')" = additive ] || fail "$name: the app chose blend $(field blend), expected additive"
+    # The layer's record of what the app submitted: a header, then one line per xrEndFrame.
+    local lines additive layered
+    lines=$(($(wc -l <"$dir/submitted.csv") - 1))
+    additive=$(awk -F, 'NR > 1 && $3 == "additive" && $7 == "opaque"' "$dir/submitted.csv" | wc -l)
+    layered=$(awk -F, 'NR > 1 && $4 >= 1 && $5 ~ /^projection/' "$dir/submitted.csv" | wc -l)
+    [ "$additive" = "$lines" ] || fail "$name: $additive of $lines recorded frames were ADDITIVE forwarded as OPAQUE"
+    [ "$layered" = "$submitted" ] || fail "$name: the layer recorded $layered frames with a projection layer, the app $submitted"
+    # Every recorded frame carries a valid gaze (left eye for per-eye sources, the combined
+    # ray for EXT): column $col of the recording.
+    local rows valid
+    rows=$(($(wc -l <"$dir/recorded.trace") - 2))
+    valid=$(awk -F, -v c="$col" 'NR > 2 && $c == "1"' "$dir/recorded.trace" | wc -l)
+    [ "$rows" -gt 0 ] && [ "$valid" = "$rows" ] || fail "$name: $valid of $rows recorded frames have a valid gaze"
+    say "PASS $name ($ext_name): FOCUSED, $submitted frames, gaze valid in $valid/$rows, \
+OpenXR validation 0, $lines frames recorded ADDITIVE ($layered with a projection layer), forwarded OPAQUE"
+}
+
+for c in "${cases[@]}"; do
+    run_case "$c"
+done
+
+echo quit >&3
+for _ in $(seq 100); do
+    kill -0 "$service_pid" 2>/dev/null || break
+    sleep 0.1
+done
+kill -0 "$service_pid" 2>/dev/null && fail "monado-service did not exit within 10 s of being asked"
+wait "$service_pid" && service_rc=0 || service_rc=$?
+service_pid=
+[ "$service_rc" = 0 ] || fail "monado-service exited with status $service_rc"
+say "all cases passed"

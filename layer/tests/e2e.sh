@@ -101,6 +101,48 @@ scene="$repo/config/scenes/visual-effects.toml"
 # layer makes to the runtime (docs/sim-layer.md explains the order).
 layer_order=${VITREOUS_SIM_LAYER_ORDER:-XR_APILAYER_VITREOUS_simulated_ost:XR_APILAYER_LUNARG_core_validation}
 
+# Prints the largest angle, in degrees, between the gaze the app recorded and the synthesised trace's
+# gaze interpolated (normalised lerp) at the recorded sample time, with trace time zero at the
+# first frame's display time ($3). $1 the trace, $2 the recording, $4 fb (left eye) or ext
+# (combined: the trace's own, else the mean of its valid eyes); then the number of recorded frames
+# whose gaze validity differs from the trace's nearer sample.
+gaze_error_deg() {
+    awk -F, -v t0="$3" -v mode="$4" '
+        function unit(i) { n = sqrt(x[i] ^ 2 + y[i] ^ 2 + z[i] ^ 2); x[i] /= n; y[i] /= n; z[i] /= n }
+        /^#/ || $1 == "time_ns" { next }
+        FNR == NR {
+            if (m > 0 && t[m] == $9) next
+            m++; t[m] = $9; ok[m] = 0
+            if (mode == "fb" && $10 == "1") { x[m] = $14; y[m] = $15; z[m] = $16; ok[m] = 1 }
+            if (mode == "ext" && $24 != "") { if ($24 == "1") { x[m] = $28; y[m] = $29; z[m] = $30; ok[m] = 1 } }
+            else if (mode == "ext" && ($10 == "1" || $17 == "1")) {
+                x[m] = ($10 == "1" ? $14 : 0) + ($17 == "1" ? $21 : 0); ok[m] = 1
+                y[m] = ($10 == "1" ? $15 : 0) + ($17 == "1" ? $22 : 0)
+                z[m] = ($10 == "1" ? $16 : 0) + ($17 == "1" ? $23 : 0)
+            }
+            if (ok[m]) unit(m)
+            next
+        }
+        {
+            tt = $9 - t0; v = (mode == "fb") ? $10 : $24; c = (mode == "fb") ? 14 : 28
+            for (i = 1; i < m && t[i + 1] < tt; i++) {}
+            # Validity comes from the nearer sample.
+            near = (i < m && tt - t[i] >= t[i + 1] - tt) ? i + 1 : i
+            if ((v == "1") != (ok[near] == 1)) mismatched++
+            if (v != "1" || i >= m || !ok[i] || !ok[i + 1] || tt < t[1]) next
+            w = (tt - t[i]) / (t[i + 1] - t[i])
+            ax = x[i] + (x[i + 1] - x[i]) * w; ay = y[i] + (y[i + 1] - y[i]) * w; az = z[i] + (z[i + 1] - z[i]) * w
+            n = sqrt(ax ^ 2 + ay ^ 2 + az ^ 2)
+            d = (ax * $c + ay * $(c + 1) + az * $(c + 2)) / n
+            if (d > 1) d = 1
+            a = atan2(sqrt(1 - d * d), d) * 180 / 3.14159265358979
+            if (a > worst) worst = a
+            compared++
+        }
+        END { if (compared == 0) print "none", mismatched + 0; else printf "%.4f %d\n", worst, mismatched }
+    ' "$1" "$2"
+}
+
 run_case() {
     local name=$1 ext_name col
     case $name in
@@ -161,14 +203,20 @@ run_case() {
     layered=$(awk -F, 'NR > 1 && $4 >= 1 && $5 ~ /^projection/' "$dir/submitted.csv" | wc -l)
     [ "$additive" = "$lines" ] || fail "$name: $additive of $lines recorded frames were ADDITIVE forwarded as OPAQUE"
     [ "$layered" = "$submitted" ] || fail "$name: the layer recorded $layered frames with a projection layer, the app $submitted"
-    # Every recorded frame carries a valid gaze (left eye for per-eye sources, the combined
-    # ray for EXT): column $col of the recording.
+    # Every recorded frame carries a gaze (column $col holds its validity).
     local rows valid
     rows=$(($(wc -l <"$dir/recorded.trace") - 2))
     valid=$(awk -F, -v c="$col" 'NR > 2 && $c == "1"' "$dir/recorded.trace" | wc -l)
-    [ "$rows" -gt 0 ] && [ "$valid" = "$rows" ] || fail "$name: $valid of $rows recorded frames have a valid gaze"
-    say "PASS $name ($ext_name): FOCUSED, $submitted frames, gaze valid in $valid/$rows, \
-OpenXR validation 0, $lines frames recorded ADDITIVE ($layered with a projection layer), forwarded OPAQUE"
+    [ "$rows" -ge "$submitted" ] && [ "$valid" -gt 0 ] || fail "$name: $valid of $rows recorded frames have a valid gaze"
+    # The gaze values: the trace's, interpolated at the time the layer stamped them.
+    local first err mismatched
+    first=$(awk -F, 'NR == 2 { print $2 }' "$dir/submitted.csv")
+    read -r err mismatched < <(gaze_error_deg "$work/gaze.trace" "$dir/recorded.trace" "$first" "${name/ml/fb}")
+    [ "$err" != none ] && awk -v e="$err" 'BEGIN { exit !(e < 0.1) }' ||
+        fail "$name: the recorded gaze is $err deg from the trace's (more than 0.1 deg)"
+    [ "$mismatched" = 0 ] || fail "$name: $mismatched recorded frames differ from the trace in gaze validity"
+    say "PASS $name ($ext_name): FOCUSED, $submitted frames, gaze in $rows (valid in $valid as in the trace, \
+within $err deg of it), OpenXR validation 0, $lines frames recorded ADDITIVE ($layered with a projection layer), forwarded OPAQUE"
 }
 
 for c in "${cases[@]}"; do

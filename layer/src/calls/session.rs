@@ -196,10 +196,14 @@ pub unsafe extern "system" fn end_frame(
                 .unwrap_or(&[sys::EnvironmentBlendMode::OPAQUE]),
         );
         if let Some(log) = log {
-            let layers: Vec<LayerInfo> = (0..app.layer_count as usize)
+            let count = if app.layers.is_null() {
+                0
+            } else {
+                app.layer_count as usize
+            };
+            let layers: Vec<LayerInfo> = (0..count)
                 .filter_map(|i| {
-                    // SAFETY: the app's array of `layer_count` layer pointers (null when
-                    // the count is 0, then this is not reached).
+                    // SAFETY: the app's non-null array of `layer_count` layer pointers.
                     let p = unsafe { *app.layers.add(i) };
                     // SAFETY: each non-null entry is a valid composition layer header.
                     unsafe { p.as_ref() }.map(|l| LayerInfo {

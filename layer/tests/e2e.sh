@@ -2,16 +2,19 @@
 # End-to-end check of the simulated see-through headset layer on a headless Monado (null
 # compositor, simulated HMD): `vitreous run` with the layer and the OpenXR core validation
 # layer enabled, once per eye extension, fed with a synthesised visual-effects trace.
-# For each case: FOCUSED reached, the frames submitted, the gaze source the case offers, a
-# valid gaze in every recorded frame, 0 OpenXR core-validation messages, the ADDITIVE blend
-# chosen by the app and recorded by the layer for every submitted frame (forwarded to Monado as
-# OPAQUE), and a clean runtime exit.
+# For each case: FOCUSED reached, the frames submitted, the gaze source the case offers, a gaze
+# in every recorded frame that is valid exactly when the trace's is and within 0.1 deg of the
+# trace interpolated at its time, 0 OpenXR core-validation messages, the blend mode (ADDITIVE,
+# or ALPHA_BLEND for `alpha`) used by the app and recorded by the layer for every submitted
+# frame (forwarded to Monado as OPAQUE), and a clean runtime exit.
 #
 # usage: layer/tests/e2e.sh [--frames N] [--keep] [CASE...]
-#   CASE                    fb, ext, ml (default: fb ext; ml once `vitreous run` reads it)
+#   CASE                    fb, ext, ml (default: fb ext; ml once `vitreous run` reads it),
+#                           alpha (FB gaze, `--blend alpha-blend`)
 #   VITREOUS_BIN            the vitreous binary (default target/debug/vitreous)
 #   VITREOUS_SIM_LAYER_LIB  the layer library (default target/debug/libvitreous_sim_layer.so)
 #   VITREOUS_MONADO_PREFIX  provisioned prefix (see tools/monado/provision)
+#   VITREOUS_SIM_LAYER_ORDER  XR_ENABLE_API_LAYERS (default: the layer, then core validation)
 # Build first: cargo build -p vitreous -p vitreous-sim-layer. Exit status 0 only if every
 # case passed; one PASS line per case on stderr.
 set -euo pipefail
@@ -29,10 +32,10 @@ while [ $# -gt 0 ]; do
         ;;
     --keep) keep=1 ;;
     -h | --help)
-        sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'
+        sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'
         exit 0
         ;;
-    fb | ext | ml) cases+=("$1") ;;
+    fb | ext | ml | alpha) cases+=("$1") ;;
     *)
         echo "sim-layer e2e: unknown argument '$1' (try --help)" >&2
         exit 2
@@ -144,21 +147,22 @@ gaze_error_deg() {
 }
 
 run_case() {
-    local name=$1 ext_name col
+    local name=$1 gaze=$1 ext_name col blend=additive blend_args=()
     case $name in
     fb) ext_name=XR_FB_eye_tracking_social col=10 ;;
     ext) ext_name=XR_EXT_eye_gaze_interaction col=24 ;;
     ml) ext_name=XR_ML_eye_tracker col=10 ;;
+    alpha) gaze=fb ext_name=XR_FB_eye_tracking_social col=10 blend=alpha_blend blend_args=(--blend alpha-blend) ;;
     esac
     local dir="$work/$name"
     mkdir -p "$dir"
-    "$repo/tools/sim-layer" --lib "$lib" --gaze "$name" "$dir/layers" >/dev/null 2>&1 ||
+    "$repo/tools/sim-layer" --lib "$lib" --gaze "$gaze" "$dir/layers" >/dev/null 2>&1 ||
         fail "$name: tools/sim-layer failed"
     set +e
     XR_API_LAYER_PATH="$dir/layers:$validation_layers" XR_ENABLE_API_LAYERS="$layer_order" \
-        VITREOUS_SIM_GAZE=$name VITREOUS_SIM_TRACE="$work/gaze.trace" \
+        VITREOUS_SIM_GAZE=$gaze VITREOUS_SIM_TRACE="$work/gaze.trace" \
         VITREOUS_SIM_SUBMITTED="$dir/submitted.csv" timeout 300 \
-        "${XR_LOADER[@]}" "$bin" --log info run "$scene" --frames "$frames" --validate \
+        "${XR_LOADER[@]}" "$bin" --log info run "$scene" --frames "$frames" --validate "${blend_args[@]}" \
         --record "$dir/recorded.trace" --out "$dir/run" >"$dir/app.log" 2>&1
     local rc=$?
     set -e
@@ -195,13 +199,13 @@ run_case() {
         grep -E 'VALID_ERROR|VALID_WARNING' "$dir/app.log" | sort | uniq -c | head -5 >&2
         fail "$name: OpenXR core validation reported $xr_messages messages"
     }
-    [ "$(field blend | tr -d '"')" = additive ] || fail "$name: the app chose blend $(field blend), expected additive"
+    [ "$(field blend | tr -d '"' | tr - _)" = "$blend" ] || fail "$name: the app used blend $(field blend), expected $blend"
     # The layer's record of what the app submitted: a header, then one line per xrEndFrame.
     local lines additive layered
     lines=$(($(wc -l <"$dir/submitted.csv") - 1))
-    additive=$(awk -F, 'NR > 1 && $3 == "additive" && $7 == "opaque"' "$dir/submitted.csv" | wc -l)
+    additive=$(awk -F, -v b="$blend" 'NR > 1 && $3 == b && $7 == "opaque"' "$dir/submitted.csv" | wc -l)
     layered=$(awk -F, 'NR > 1 && $4 >= 1 && $5 ~ /^projection/' "$dir/submitted.csv" | wc -l)
-    [ "$additive" = "$lines" ] || fail "$name: $additive of $lines recorded frames were ADDITIVE forwarded as OPAQUE"
+    [ "$additive" = "$lines" ] || fail "$name: $additive of $lines recorded frames were $blend forwarded as opaque"
     [ "$layered" = "$submitted" ] || fail "$name: the layer recorded $layered frames with a projection layer, the app $submitted"
     # Every recorded frame carries a gaze (column $col holds its validity).
     local rows valid
@@ -211,12 +215,12 @@ run_case() {
     # The gaze values: the trace's, interpolated at the time the layer stamped them.
     local first err mismatched
     first=$(awk -F, 'NR == 2 { print $2 }' "$dir/submitted.csv")
-    read -r err mismatched < <(gaze_error_deg "$work/gaze.trace" "$dir/recorded.trace" "$first" "${name/ml/fb}")
+    read -r err mismatched < <(gaze_error_deg "$work/gaze.trace" "$dir/recorded.trace" "$first" "${gaze/ml/fb}")
     [ "$err" != none ] && awk -v e="$err" 'BEGIN { exit !(e < 0.1) }' ||
         fail "$name: the recorded gaze is $err deg from the trace's (more than 0.1 deg)"
     [ "$mismatched" = 0 ] || fail "$name: $mismatched recorded frames differ from the trace in gaze validity"
     say "PASS $name ($ext_name): FOCUSED, $submitted frames, gaze in $rows (valid in $valid as in the trace, \
-within $err deg of it), OpenXR validation 0, $lines frames recorded ADDITIVE ($layered with a projection layer), forwarded OPAQUE"
+within $err deg of it), OpenXR validation 0, $lines frames recorded $blend ($layered with a projection layer), forwarded opaque"
 }
 
 for c in "${cases[@]}"; do

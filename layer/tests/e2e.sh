@@ -9,8 +9,8 @@
 # frame (forwarded to Monado as OPAQUE), and a clean runtime exit.
 #
 # usage: layer/tests/e2e.sh [--frames N] [--keep] [CASE...]
-#   CASE                    fb, ext, ml (default: fb ext; ml once `vitreous run` reads it),
-#                           alpha (FB gaze, `--blend alpha-blend`)
+#   CASE                    fb, ext, alpha (FB gaze, `--blend alpha-blend`), ml (default:
+#                           fb ext alpha; ml once `vitreous run` reads XR_ML_eye_tracker)
 #   VITREOUS_BIN            the vitreous binary (default target/debug/vitreous)
 #   VITREOUS_SIM_LAYER_LIB  the layer library (default target/debug/libvitreous_sim_layer.so)
 #   VITREOUS_MONADO_PREFIX  provisioned prefix (see tools/monado/provision)
@@ -32,7 +32,7 @@ while [ $# -gt 0 ]; do
         ;;
     --keep) keep=1 ;;
     -h | --help)
-        sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'
+        sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'
         exit 0
         ;;
     fb | ext | ml | alpha) cases+=("$1") ;;
@@ -43,7 +43,7 @@ while [ $# -gt 0 ]; do
     esac
     shift
 done
-[ ${#cases[@]} -gt 0 ] || cases=(fb ext)
+[ ${#cases[@]} -gt 0 ] || cases=(fb ext alpha)
 
 say() { echo "sim-layer e2e: $*" >&2; }
 fail() {

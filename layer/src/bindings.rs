@@ -1,0 +1,100 @@
+//! Suggested bindings of the eye-gaze interaction profile: the layer takes them (the runtime
+//! has no such device, or does not know the profile once the extension is removed from the
+//! instance) and remembers which actions they bind.
+
+use openxr::sys;
+
+/// What to do with one `xrSuggestInteractionProfileBindings` call.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Plan {
+    /// Not the eye-gaze profile: pass the call on unchanged.
+    Forward,
+    /// The eye-gaze profile with only the gaze pose bound: answer it here; these actions are
+    /// now gaze actions.
+    Absorb(Vec<sys::Action>),
+    /// The eye-gaze profile with a binding path the profile does not have.
+    Reject,
+}
+
+/// The paths that identify the profile and its one input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GazePaths {
+    /// `/interaction_profiles/ext/eye_gaze_interaction`.
+    pub profile: sys::Path,
+    /// `/user/eyes_ext/input/gaze_ext/pose`.
+    pub pose: sys::Path,
+}
+
+/// The profile's path.
+pub const PROFILE: &std::ffi::CStr = c"/interaction_profiles/ext/eye_gaze_interaction";
+/// The gaze pose input's path.
+pub const POSE: &std::ffi::CStr = c"/user/eyes_ext/input/gaze_ext/pose";
+
+/// Decides what to do with a suggestion of `bindings` for `profile`.
+pub fn plan(
+    paths: &GazePaths,
+    profile: sys::Path,
+    bindings: &[sys::ActionSuggestedBinding],
+) -> Plan {
+    if profile != paths.profile {
+        return Plan::Forward;
+    }
+    if bindings.iter().any(|b| b.binding != paths.pose) {
+        return Plan::Reject;
+    }
+    let mut actions: Vec<sys::Action> = Vec::new();
+    for b in bindings {
+        if !actions.contains(&b.action) {
+            actions.push(b.action);
+        }
+    }
+    Plan::Absorb(actions)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sys::Handle;
+
+    fn paths() -> GazePaths {
+        GazePaths {
+            profile: sys::Path::from_raw(10),
+            pose: sys::Path::from_raw(11),
+        }
+    }
+
+    fn binding(action: u64, path: u64) -> sys::ActionSuggestedBinding {
+        sys::ActionSuggestedBinding {
+            action: sys::Action::from_raw(action),
+            binding: sys::Path::from_raw(path),
+        }
+    }
+
+    #[test]
+    fn other_profiles_go_to_the_runtime() {
+        assert_eq!(
+            plan(&paths(), sys::Path::from_raw(3), &[binding(1, 11)]),
+            Plan::Forward
+        );
+    }
+
+    #[test]
+    fn gaze_bindings_are_taken_and_their_actions_remembered() {
+        assert_eq!(
+            plan(
+                &paths(),
+                paths().profile,
+                &[binding(1, 11), binding(2, 11), binding(1, 11)]
+            ),
+            Plan::Absorb(vec![sys::Action::from_raw(1), sys::Action::from_raw(2)])
+        );
+    }
+
+    #[test]
+    fn a_path_the_profile_lacks_is_rejected() {
+        assert_eq!(
+            plan(&paths(), paths().profile, &[binding(1, 11), binding(2, 12)]),
+            Plan::Reject
+        );
+    }
+}

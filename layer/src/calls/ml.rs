@@ -1,0 +1,409 @@
+//! `XR_ML_eye_tracker` (Magic Leap 2): combined, per-eye and fixation poses with confidence,
+//! pupil diameters, and the simplest honest answers for what a trace does not hold.
+//!
+//! - Fixation pose: its position is the vergence point (the trace's fixation column when
+//!   present, else the closest point between the two eye rays), its -z axis looks there from
+//!   the mid-point of the eyes; HIGH confidence with both eyes valid, else LOW.
+//! - Pupil data: the trace's per-eye pupil diameter, else `valid = FALSE`.
+//! - Geometric data: openness 1 for a valid eye ray, 0 otherwise; the eye-in-skull position
+//!   is not simulated (0, 0).
+//! - Gaze behaviour: `valid = FALSE`, type UNKNOWN.
+//! - Static data: a maximum eye width and height of 1 (the layer's openness is already 0..1).
+//!
+//! The calls without a time (pupil, geometric, behaviour) answer for the display time of the
+//! session's newest frame.
+
+use openxr::sys::{self, Handle};
+use vitreous_xr::openxr::ml_eye_tracker::{
+    ConfidenceML, EyeML, EyeTrackerCreateInfoML, EyeTrackerGazeBehaviorML,
+    EyeTrackerGeometricDataML, EyeTrackerGetInfoML, EyeTrackerML, EyeTrackerPoseML,
+    EyeTrackerPosesGetInfoML, EyeTrackerPosesML, EyeTrackerPupilDataML, EyeTrackerStaticDataML,
+    GazeBehaviorTypeML, pose_flags, structure_type,
+};
+use vitreous_xr::{GazeRay, GazeSample, Pose};
+
+use super::{SessionContext, in_base};
+use crate::config::GazeExtension;
+use crate::entry::guard;
+use crate::eye_geometry::{combined_ray, fixation_point, pose_along, ray_pose};
+use crate::registry::{TrackerState, registry};
+use crate::two_call;
+
+/// The session context of an ML tracker the layer made.
+fn tracker_context(tracker: EyeTrackerML) -> Option<SessionContext> {
+    let reg = registry();
+    let t = reg.trackers.get(&tracker.0)?;
+    if t.kind != GazeExtension::Ml {
+        return None;
+    }
+    SessionContext::of(&reg, t.session)
+}
+
+/// Whether a structure pointer is non-null and of raw type `raw`.
+///
+/// # Safety
+/// `ty` must be null or point to a structure's readable `type` field.
+unsafe fn typed(ty: *const sys::StructureType, raw: i32) -> bool {
+    // SAFETY: guaranteed by the caller.
+    unsafe { ty.as_ref() }.is_some_and(|t| structure_type::is(*t, raw))
+}
+
+/// `xrCreateEyeTrackerML`.
+///
+/// # Safety
+/// As `xrCreateEyeTrackerML`.
+pub unsafe extern "system" fn create_eye_tracker(
+    session: sys::Session,
+    info: *const EyeTrackerCreateInfoML,
+    tracker: *mut EyeTrackerML,
+) -> sys::Result {
+    guard("xrCreateEyeTrackerML", || {
+        // SAFETY: the app's create info, null or valid; `type` is its first field.
+        if !unsafe { typed(info.cast(), structure_type::CREATE_INFO) } {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        }
+        // SAFETY: the app's output, null or valid.
+        let Some(out) = (unsafe { tracker.as_mut() }) else {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        };
+        let mut reg = registry();
+        if !reg.sessions.contains_key(&session.into_raw()) {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        }
+        let h = reg.new_handle();
+        reg.trackers.insert(
+            h,
+            TrackerState {
+                session: session.into_raw(),
+                kind: GazeExtension::Ml,
+            },
+        );
+        *out = EyeTrackerML(h);
+        sys::Result::SUCCESS
+    })
+}
+
+/// `xrDestroyEyeTrackerML`.
+///
+/// # Safety
+/// As `xrDestroyEyeTrackerML`.
+pub unsafe extern "system" fn destroy_eye_tracker(tracker: EyeTrackerML) -> sys::Result {
+    guard("xrDestroyEyeTrackerML", || {
+        let mut reg = registry();
+        match reg.trackers.get(&tracker.0) {
+            Some(t) if t.kind == GazeExtension::Ml => {
+                reg.trackers.remove(&tracker.0);
+                sys::Result::SUCCESS
+            }
+            _ => sys::Result::ERROR_HANDLE_INVALID,
+        }
+    })
+}
+
+/// `xrGetEyeTrackerStaticDataML`.
+///
+/// # Safety
+/// As `xrGetEyeTrackerStaticDataML`.
+pub unsafe extern "system" fn get_static_data(
+    tracker: EyeTrackerML,
+    info: *const EyeTrackerGetInfoML,
+    data: *mut EyeTrackerStaticDataML,
+) -> sys::Result {
+    guard("xrGetEyeTrackerStaticDataML", || {
+        if tracker_context(tracker).is_none() {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        }
+        // SAFETY: the app's structures, null or valid; `type` is their first field.
+        let ok = unsafe {
+            typed(info.cast(), structure_type::STATIC_DATA_GET_INFO)
+                && typed(data.cast(), structure_type::STATIC_DATA)
+        };
+        if !ok {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        }
+        // SAFETY: checked non-null and typed above.
+        let out = unsafe { &mut *data };
+        out.eye_width_max = 1.0;
+        out.eye_height_max = 1.0;
+        sys::Result::SUCCESS
+    })
+}
+
+/// The four poses of a sample in the head frame, with validity and confidence:
+/// gaze, left, right, fixation.
+pub fn head_frame_poses(sample: &GazeSample) -> [(Option<Pose>, ConfidenceML); 4] {
+    let both = sample.left.valid && sample.right.valid;
+    let either = sample.left.valid || sample.right.valid;
+    let eye = |r: &GazeRay| {
+        if r.valid {
+            (Some(ray_pose(r)), ConfidenceML::HIGH)
+        } else {
+            (None, ConfidenceML::LOW)
+        }
+    };
+    let combined = combined_ray(sample);
+    let gaze = if combined.valid {
+        let confidence = if both || (sample.combined.is_some() && !either) {
+            ConfidenceML::HIGH
+        } else {
+            ConfidenceML::MEDIUM
+        };
+        (Some(ray_pose(&combined)), confidence)
+    } else {
+        (None, ConfidenceML::LOW)
+    };
+    let fixation = match fixation_point(sample) {
+        Some(point) => {
+            // Look at the point from between the eyes (or the combined origin).
+            let from = if both {
+                (sample.left.origin + sample.right.origin) * 0.5
+            } else {
+                combined.origin
+            };
+            let mut pose = pose_along(from, point - from);
+            pose.position = point;
+            let confidence = if both {
+                ConfidenceML::HIGH
+            } else {
+                ConfidenceML::LOW
+            };
+            (Some(pose), confidence)
+        }
+        None => (None, ConfidenceML::LOW),
+    };
+    [gaze, eye(&sample.left), eye(&sample.right), fixation]
+}
+
+/// `xrGetEyeTrackerPosesML`: the requested poses in `baseSpace` at `time`.
+///
+/// # Safety
+/// As `xrGetEyeTrackerPosesML`.
+pub unsafe extern "system" fn get_poses(
+    tracker: EyeTrackerML,
+    info: *const EyeTrackerPosesGetInfoML,
+    poses: *mut EyeTrackerPosesML,
+) -> sys::Result {
+    guard("xrGetEyeTrackerPosesML", || {
+        let Some(ctx) = tracker_context(tracker) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the app's structures, null or valid; `type` is their first field.
+        let ok = unsafe {
+            typed(info.cast(), structure_type::POSES_GET_INFO)
+                && typed(poses.cast(), structure_type::POSES)
+        };
+        if !ok {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        }
+        // SAFETY: checked non-null and typed above.
+        let (info, out) = unsafe { (&*info, &mut *poses) };
+        let Some(sample) = ctx.gaze_at(info.time.as_nanos()) else {
+            return sys::Result::ERROR_RUNTIME_FAILURE;
+        };
+        let head = ctx.head_to_base(info.base_space, info.time);
+        let wanted = [
+            pose_flags::GAZE,
+            pose_flags::LEFT,
+            pose_flags::RIGHT,
+            pose_flags::FIXATION,
+        ];
+        let slots: [&mut EyeTrackerPoseML; 4] = [
+            &mut out.gaze_pose,
+            &mut out.left_pose,
+            &mut out.right_pose,
+            &mut out.fixation_pose,
+        ];
+        let time = sys::Time::from_nanos(sample.sample_time_ns);
+        for ((slot, (pose, confidence)), flag) in
+            slots.into_iter().zip(head_frame_poses(&sample)).zip(wanted)
+        {
+            slot.time = time;
+            match (info.pose_flags & flag != 0, pose, &head) {
+                (true, Some(pose), Some((view_in_base, _))) => {
+                    slot.valid = sys::TRUE;
+                    slot.pose = in_base(view_in_base, &pose);
+                    slot.confidence = confidence;
+                }
+                _ => {
+                    slot.valid = sys::FALSE;
+                    slot.pose = sys::Posef::IDENTITY;
+                    slot.confidence = ConfidenceML::LOW;
+                }
+            }
+        }
+        sys::Result::SUCCESS
+    })
+}
+
+/// `xrGetEyeTrackerPupilDataML` (two-call idiom, left then right).
+///
+/// # Safety
+/// As `xrGetEyeTrackerPupilDataML`.
+pub unsafe extern "system" fn get_pupil_data(
+    tracker: EyeTrackerML,
+    info: *const EyeTrackerGetInfoML,
+    capacity: u32,
+    count: *mut u32,
+    data: *mut EyeTrackerPupilDataML,
+) -> sys::Result {
+    guard("xrGetEyeTrackerPupilDataML", || {
+        let Some(ctx) = tracker_context(tracker) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the app's get info, null or valid; `type` is its first field.
+        if !unsafe { typed(info.cast(), structure_type::PUPIL_DATA_GET_INFO) } {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        }
+        let Some(sample) = ctx.gaze_now() else {
+            return sys::Result::ERROR_RUNTIME_FAILURE;
+        };
+        // SAFETY: the app's pointers, valid as the call defines them.
+        let (count, out) = unsafe { (count.as_mut(), two_call::out_slice(capacity, data)) };
+        two_call::answer_with(
+            2,
+            capacity,
+            count,
+            out,
+            |slot: &mut EyeTrackerPupilDataML, i| {
+                slot.eye = if i == 0 { EyeML::LEFT } else { EyeML::RIGHT };
+                slot.time = sys::Time::from_nanos(sample.sample_time_ns);
+                match sample.pupil_diameter_m[i] {
+                    Some(d) => {
+                        slot.valid = sys::TRUE;
+                        slot.pupil_diameter = d;
+                    }
+                    None => {
+                        slot.valid = sys::FALSE;
+                        slot.pupil_diameter = 0.0;
+                    }
+                }
+            },
+        )
+    })
+}
+
+/// `xrGetEyeTrackerGeometricDataML` (two-call idiom, left then right).
+///
+/// # Safety
+/// As `xrGetEyeTrackerGeometricDataML`.
+pub unsafe extern "system" fn get_geometric_data(
+    tracker: EyeTrackerML,
+    info: *const EyeTrackerGetInfoML,
+    capacity: u32,
+    count: *mut u32,
+    data: *mut EyeTrackerGeometricDataML,
+) -> sys::Result {
+    guard("xrGetEyeTrackerGeometricDataML", || {
+        let Some(ctx) = tracker_context(tracker) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the app's get info, null or valid; `type` is its first field.
+        if !unsafe { typed(info.cast(), structure_type::GEOMETRIC_DATA_GET_INFO) } {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        }
+        let Some(sample) = ctx.gaze_now() else {
+            return sys::Result::ERROR_RUNTIME_FAILURE;
+        };
+        let rays = [sample.left, sample.right];
+        // SAFETY: the app's pointers, valid as the call defines them.
+        let (count, out) = unsafe { (count.as_mut(), two_call::out_slice(capacity, data)) };
+        two_call::answer_with(
+            2,
+            capacity,
+            count,
+            out,
+            |slot: &mut EyeTrackerGeometricDataML, i| {
+                slot.eye = if i == 0 { EyeML::LEFT } else { EyeML::RIGHT };
+                slot.time = sys::Time::from_nanos(sample.sample_time_ns);
+                slot.valid = sys::TRUE;
+                slot.eye_openness = if rays[i].valid { 1.0 } else { 0.0 };
+                slot.eye_in_skull_position = sys::Vector2f { x: 0.0, y: 0.0 };
+            },
+        )
+    })
+}
+
+/// `xrGetEyeTrackerGazeBehaviorML`: the trace holds no classification: `valid = FALSE`.
+///
+/// # Safety
+/// As `xrGetEyeTrackerGazeBehaviorML`.
+pub unsafe extern "system" fn get_gaze_behavior(
+    tracker: EyeTrackerML,
+    info: *const EyeTrackerGetInfoML,
+    behavior: *mut EyeTrackerGazeBehaviorML,
+) -> sys::Result {
+    guard("xrGetEyeTrackerGazeBehaviorML", || {
+        let Some(ctx) = tracker_context(tracker) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the app's structures, null or valid; `type` is their first field.
+        let ok = unsafe {
+            typed(info.cast(), structure_type::GAZE_BEHAVIOR_GET_INFO)
+                && typed(behavior.cast(), structure_type::GAZE_BEHAVIOR)
+        };
+        if !ok {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        }
+        // SAFETY: checked non-null and typed above.
+        let out = unsafe { &mut *behavior };
+        out.time = sys::Time::from_nanos(ctx.latest_display_ns.unwrap_or(0));
+        out.valid = sys::FALSE;
+        out.gaze_behavior_type = GazeBehaviorTypeML::UNKNOWN;
+        out.onset_time = sys::Time::from_nanos(0);
+        out.duration = 0;
+        sys::Result::SUCCESS
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    fn ray(origin: Vec3, to: Vec3) -> GazeRay {
+        GazeRay {
+            origin,
+            direction: (to - origin).normalize(),
+            valid: true,
+        }
+    }
+
+    #[test]
+    fn fixation_pose_sits_at_the_vergence_point_looking_from_between_the_eyes() {
+        let target = Vec3::new(0.05, -0.02, -0.6);
+        let l = Vec3::new(-0.032, 0.0, 0.0);
+        let r = Vec3::new(0.032, 0.0, 0.0);
+        let s = GazeSample {
+            sample_time_ns: 0,
+            left: ray(l, target),
+            right: ray(r, target),
+            combined: None,
+            fixation: None,
+            pupil_diameter_m: [None, None],
+        };
+        let [gaze, left, right, fixation] = head_frame_poses(&s);
+        let (p, c) = fixation;
+        let p = p.unwrap();
+        assert_eq!(c, ConfidenceML::HIGH);
+        assert!((p.position - target).length() < 1e-5);
+        let look = p.orientation * Vec3::NEG_Z;
+        assert!((look - target.normalize()).length() < 1e-5);
+        assert_eq!(gaze.1, ConfidenceML::HIGH);
+        assert!(left.0.is_some() && right.0.is_some());
+    }
+
+    #[test]
+    fn one_eye_lost_lowers_confidence_and_drops_the_vergence() {
+        let s = GazeSample {
+            sample_time_ns: 0,
+            left: ray(Vec3::new(-0.032, 0.0, 0.0), Vec3::new(0.0, 0.0, -1.0)),
+            right: GazeRay::INVALID,
+            combined: None,
+            fixation: None,
+            pupil_diameter_m: [None, None],
+        };
+        let [gaze, _, right, fixation] = head_frame_poses(&s);
+        assert_eq!(gaze.1, ConfidenceML::MEDIUM);
+        assert!(right.0.is_none() && fixation.0.is_none());
+    }
+}

@@ -1,0 +1,164 @@
+//! The layer's OpenXR entry points, and what they share: the context of a session copied out
+//! of the registry, and locating spaces relative to the head.
+//!
+//! Every entry point runs its body in [`guard`](crate::entry::guard), takes what it needs
+//! from the registry under the lock, and calls down the chain without it.
+
+pub mod fb;
+pub mod instance;
+pub mod ml;
+pub mod session;
+
+use std::ffi::c_void;
+use std::sync::Arc;
+
+use openxr::sys::{self, Handle};
+use vitreous_xr::{GazeSample, Pose};
+
+use crate::config::{Config, GazeExtension};
+use crate::eye_geometry::{from_posef, inverse};
+use crate::next::NextTable;
+use crate::registry::Registry;
+use crate::timeline::{GazeTimeline, TimeBase};
+
+/// How many structures of a `next` chain the layer looks at before giving up (a chain that
+/// long is a loop).
+const MAX_CHAIN: usize = 64;
+
+/// The structures of a `next` chain, in order.
+///
+/// # Safety
+/// `first` must be null or the start of a valid chain of OpenXR structures.
+pub unsafe fn chain(first: *mut c_void) -> Vec<*mut sys::BaseOutStructure> {
+    let mut out = Vec::new();
+    let mut p = first as *mut sys::BaseOutStructure;
+    while !p.is_null() && out.len() < MAX_CHAIN {
+        out.push(p);
+        // SAFETY: `p` is a structure of the valid chain (caller's guarantee).
+        p = unsafe { (*p).next };
+    }
+    out
+}
+
+/// Every location flag: what a tracked pose reports.
+pub fn all_location_flags() -> sys::SpaceLocationFlags {
+    sys::SpaceLocationFlags::ORIENTATION_VALID
+        | sys::SpaceLocationFlags::POSITION_VALID
+        | sys::SpaceLocationFlags::ORIENTATION_TRACKED
+        | sys::SpaceLocationFlags::POSITION_TRACKED
+}
+
+/// What a call about a session needs, copied out of the registry.
+#[derive(Clone)]
+pub struct SessionContext {
+    /// The session.
+    pub session: sys::Session,
+    /// Its instance.
+    pub instance: sys::Instance,
+    /// The next layer's functions.
+    pub next: Arc<NextTable>,
+    /// The configuration.
+    pub config: Arc<Config>,
+    /// The layer's extensions the app enabled.
+    pub owned: Vec<GazeExtension>,
+    /// The layer's VIEW space: the head.
+    pub view_space: sys::Space,
+    /// The trace's eye data.
+    pub timeline: Option<Arc<GazeTimeline>>,
+    /// The session's clock mapping (after the first `xrWaitFrame`).
+    pub time_base: Option<TimeBase>,
+    /// The newest predicted display time.
+    pub latest_display_ns: Option<i64>,
+}
+
+impl SessionContext {
+    /// The context of `session`, if the layer knows it.
+    pub fn of(reg: &Registry, session: u64) -> Option<SessionContext> {
+        let (s, i) = reg.session(session)?;
+        let timeline = i.timeline.clone();
+        let time_base = match (&timeline, s.first_display_ns) {
+            (Some(t), Some(first)) => Some(TimeBase {
+                first_display_ns: first,
+                trace_start_ns: t.start_ns(),
+            }),
+            _ => None,
+        };
+        Some(SessionContext {
+            session: sys::Session::from_raw(session),
+            instance: sys::Instance::from_raw(s.instance),
+            next: i.next.clone(),
+            config: i.config.clone(),
+            owned: i.owned.clone(),
+            view_space: s.view_space,
+            timeline,
+            time_base,
+            latest_display_ns: s.latest_display_ns,
+        })
+    }
+
+    /// The eye data at runtime time `time_ns`, its `sample_time_ns` on the runtime clock.
+    /// Before the session's first frame there is no clock mapping yet: the trace's first
+    /// sample, stamped `time_ns`.
+    pub fn gaze_at(&self, time_ns: i64) -> Option<GazeSample> {
+        let timeline = self.timeline.as_ref()?;
+        Some(match self.time_base {
+            Some(base) => {
+                let mut s = timeline.at(base.to_trace(time_ns));
+                s.sample_time_ns = base.to_runtime(s.sample_time_ns);
+                s
+            }
+            None => {
+                let mut s = timeline.at(i64::MIN);
+                s.sample_time_ns = time_ns;
+                s
+            }
+        })
+    }
+
+    /// The eye data at the newest frame's display time (for the calls that name no time).
+    pub fn gaze_now(&self) -> Option<GazeSample> {
+        self.gaze_at(self.latest_display_ns.unwrap_or(0))
+    }
+
+    /// Where `space` is in the head (VIEW) frame at `time`, located by the next layer, with
+    /// the location flags. `None` when the next layer fails.
+    pub fn runtime_space_in_view(
+        &self,
+        space: sys::Space,
+        time: sys::Time,
+    ) -> Option<(Pose, sys::SpaceLocationFlags)> {
+        let mut loc = sys::SpaceLocation {
+            ty: sys::SpaceLocation::TYPE,
+            next: std::ptr::null_mut(),
+            location_flags: sys::SpaceLocationFlags::EMPTY,
+            pose: sys::Posef::IDENTITY,
+        };
+        // SAFETY: both spaces belong to this session's chain (the view space is the layer's,
+        // `space` the caller's); `loc` is a valid output structure.
+        let r = unsafe { (self.next.locate_space)(space, self.view_space, time, &mut loc) };
+        if r.into_raw() < 0 {
+            return None;
+        }
+        Some((from_posef(&loc.pose), loc.location_flags))
+    }
+
+    /// The transform from the head frame into `base` at `time` (`view_in_base`), when the
+    /// runtime locates `base` with a valid position and orientation.
+    pub fn head_to_base(
+        &self,
+        base: sys::Space,
+        time: sys::Time,
+    ) -> Option<(Pose, sys::SpaceLocationFlags)> {
+        let (base_in_view, flags) = self.runtime_space_in_view(base, time)?;
+        let needed =
+            sys::SpaceLocationFlags::ORIENTATION_VALID | sys::SpaceLocationFlags::POSITION_VALID;
+        flags
+            .contains(needed)
+            .then(|| (inverse(&base_in_view), flags))
+    }
+}
+
+/// The pose of a valid head-frame ray in `base`, given `view_in_base`.
+pub fn in_base(view_in_base: &Pose, head_frame_pose: &Pose) -> sys::Posef {
+    crate::eye_geometry::to_posef(&crate::eye_geometry::compose(view_in_base, head_frame_pose))
+}

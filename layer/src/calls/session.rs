@@ -1,0 +1,467 @@
+//! Session-level calls: the head space the layer keeps per session, the frame clock, the
+//! submitted-frames record and blend-mode substitution, and the eye-gaze action's space.
+
+use openxr::sys::{self, Handle};
+
+use super::{SessionContext, all_location_flags, chain};
+use crate::blend;
+use crate::config::GazeExtension;
+use crate::entry::{guard, report};
+use crate::eye_geometry::{combined_ray, compose, from_posef, ray_pose, relative, to_posef};
+use crate::registry::{SessionState, SpaceState, registry};
+use crate::submitted::{FrameInfo, LayerInfo};
+use vitreous_xr::Pose;
+
+/// `xrCreateSession`: passed on; the layer then makes its VIEW space in the new session.
+///
+/// # Safety
+/// As `xrCreateSession`.
+pub unsafe extern "system" fn create_session(
+    instance: sys::Instance,
+    info: *const sys::SessionCreateInfo,
+    session: *mut sys::Session,
+) -> sys::Result {
+    guard("xrCreateSession", || {
+        let Some(next) = registry()
+            .instances
+            .get(&instance.into_raw())
+            .map(|i| i.next.clone())
+        else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the next layer's function with the app's arguments.
+        let r = unsafe { (next.create_session)(instance, info, session) };
+        if r.into_raw() < 0 {
+            return r;
+        }
+        // SAFETY: on success `info` was valid and the new session was written.
+        let (system, created) = unsafe { ((*info).system_id, *session) };
+        let view_info = sys::ReferenceSpaceCreateInfo {
+            ty: sys::ReferenceSpaceCreateInfo::TYPE,
+            next: std::ptr::null(),
+            reference_space_type: sys::ReferenceSpaceType::VIEW,
+            pose_in_reference_space: sys::Posef::IDENTITY,
+        };
+        let mut view_space = sys::Space::NULL;
+        // SAFETY: the new session is live; the create info and output are valid.
+        let rv = unsafe { (next.create_reference_space)(created, &view_info, &mut view_space) };
+        if rv.into_raw() < 0 {
+            report(format!("creating the head (VIEW) space failed: {rv:?}"));
+            // SAFETY: undoing the creation above; the session is not used afterwards.
+            unsafe { (next.destroy_session)(created) };
+            return sys::Result::ERROR_RUNTIME_FAILURE;
+        }
+        registry().sessions.insert(
+            created.into_raw(),
+            SessionState {
+                instance: instance.into_raw(),
+                system,
+                view_space,
+                first_display_ns: None,
+                latest_display_ns: None,
+                frames_ended: 0,
+                runtime_blend: None,
+            },
+        );
+        r
+    })
+}
+
+/// `xrDestroySession`: the layer's head space is destroyed, then the session.
+///
+/// # Safety
+/// As `xrDestroySession`.
+pub unsafe extern "system" fn destroy_session(session: sys::Session) -> sys::Result {
+    guard("xrDestroySession", || {
+        let (ctx, state) = {
+            let mut reg = registry();
+            let Some(ctx) = SessionContext::of(&reg, session.into_raw()) else {
+                return sys::Result::ERROR_HANDLE_INVALID;
+            };
+            (ctx, reg.remove_session(session.into_raw()))
+        };
+        if let Some(state) = state {
+            // SAFETY: the layer's own space of this live session.
+            unsafe { (ctx.next.destroy_space)(state.view_space) };
+        }
+        // SAFETY: the next layer's function for its live session.
+        unsafe { (ctx.next.destroy_session)(session) }
+    })
+}
+
+/// `xrBeginSession`: passed on; the layer then learns the runtime's blend modes for the
+/// session's view configuration.
+///
+/// # Safety
+/// As `xrBeginSession`.
+pub unsafe extern "system" fn begin_session(
+    session: sys::Session,
+    info: *const sys::SessionBeginInfo,
+) -> sys::Result {
+    guard("xrBeginSession", || {
+        let Some((ctx, system)) = ({
+            let reg = registry();
+            SessionContext::of(&reg, session.into_raw())
+                .zip(reg.sessions.get(&session.into_raw()).map(|s| s.system))
+        }) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the next layer's function with the app's arguments.
+        let r = unsafe { (ctx.next.begin_session)(session, info) };
+        if r.into_raw() < 0 {
+            return r;
+        }
+        // SAFETY: on success `info` was valid.
+        let view = unsafe { (*info).primary_view_configuration_type };
+        match ctx.next.runtime_blend_modes(ctx.instance, system, view) {
+            Ok(modes) => {
+                if let Some(s) = registry().sessions.get_mut(&session.into_raw()) {
+                    s.runtime_blend = Some(modes);
+                }
+            }
+            Err(e) => report(format!(
+                "the runtime's blend modes could not be listed: {e:?}"
+            )),
+        }
+        r
+    })
+}
+
+/// `xrWaitFrame`: passed on; the first predicted display time starts the trace clock.
+///
+/// # Safety
+/// As `xrWaitFrame`.
+pub unsafe extern "system" fn wait_frame(
+    session: sys::Session,
+    info: *const sys::FrameWaitInfo,
+    state: *mut sys::FrameState,
+) -> sys::Result {
+    guard("xrWaitFrame", || {
+        let Some(ctx) = SessionContext::of(&registry(), session.into_raw()) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the next layer's function with the app's arguments (the lock is not held:
+        // this call blocks).
+        let r = unsafe { (ctx.next.wait_frame)(session, info, state) };
+        if r.into_raw() < 0 {
+            return r;
+        }
+        // SAFETY: on success the runtime filled `state`.
+        let display = unsafe { (*state).predicted_display_time.as_nanos() };
+        if let Some(s) = registry().sessions.get_mut(&session.into_raw()) {
+            s.first_display_ns.get_or_insert(display);
+            s.latest_display_ns = Some(display);
+        }
+        r
+    })
+}
+
+/// `xrEndFrame`: the frame is recorded to the submitted-frames CSV, then passed on with a
+/// blend mode the runtime offers in place of one only the layer offered.
+///
+/// # Safety
+/// As `xrEndFrame`.
+pub unsafe extern "system" fn end_frame(
+    session: sys::Session,
+    info: *const sys::FrameEndInfo,
+) -> sys::Result {
+    guard("xrEndFrame", || {
+        let found = {
+            let mut reg = registry();
+            let added = SessionContext::of(&reg, session.into_raw())
+                .map(|c| (c.next.clone(), c.config.blend.clone()));
+            let instance_log = reg
+                .session(session.into_raw())
+                .and_then(|(_, i)| i.submitted.clone());
+            reg.sessions.get_mut(&session.into_raw()).and_then(|s| {
+                let frame = s.frames_ended;
+                s.frames_ended += 1;
+                added.map(|(next, added)| {
+                    (next, added, s.runtime_blend.clone(), frame, instance_log)
+                })
+            })
+        };
+        let Some((next, added, runtime_blend, frame, log)) = found else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the app's structure, null or valid.
+        let Some(app) = (unsafe { info.as_ref() }) else {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        };
+        let runtime_mode = blend::for_runtime(
+            app.environment_blend_mode,
+            &added,
+            runtime_blend
+                .as_deref()
+                .unwrap_or(&[sys::EnvironmentBlendMode::OPAQUE]),
+        );
+        if let Some(log) = log {
+            let count = if app.layers.is_null() {
+                0
+            } else {
+                app.layer_count as usize
+            };
+            let layers: Vec<LayerInfo> = (0..count)
+                .filter_map(|i| {
+                    // SAFETY: the app's non-null array of `layer_count` layer pointers.
+                    let p = unsafe { *app.layers.add(i) };
+                    // SAFETY: each non-null entry is a valid composition layer header.
+                    unsafe { p.as_ref() }.map(|l| LayerInfo {
+                        ty: l.ty,
+                        flags: l.layer_flags.into_raw(),
+                    })
+                })
+                .collect();
+            let frame_info = FrameInfo {
+                frame,
+                display_time_ns: app.display_time.as_nanos(),
+                blend: app.environment_blend_mode,
+                runtime_blend: runtime_mode,
+                layers,
+            };
+            let mut log = log.lock().unwrap_or_else(|e| e.into_inner());
+            if let Err(e) = log.write(&frame_info) {
+                report(format!("writing the submitted-frames CSV: {e}"));
+            }
+        }
+        let mut forwarded = *app;
+        forwarded.environment_blend_mode = runtime_mode;
+        // SAFETY: a copy of the app's valid structure, pointing at the app's layers.
+        unsafe { (next.end_frame)(session, &forwarded) }
+    })
+}
+
+/// `xrCreateReferenceSpace`: passed on; the layer notes the space's session.
+///
+/// # Safety
+/// As `xrCreateReferenceSpace`.
+pub unsafe extern "system" fn create_reference_space(
+    session: sys::Session,
+    info: *const sys::ReferenceSpaceCreateInfo,
+    space: *mut sys::Space,
+) -> sys::Result {
+    guard("xrCreateReferenceSpace", || {
+        let Some(ctx) = SessionContext::of(&registry(), session.into_raw()) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the next layer's function with the app's arguments.
+        let r = unsafe { (ctx.next.create_reference_space)(session, info, space) };
+        if r.into_raw() >= 0 {
+            // SAFETY: on success the new space was written.
+            let created = unsafe { *space };
+            registry().spaces.insert(
+                created.into_raw(),
+                SpaceState {
+                    session: session.into_raw(),
+                    gaze_offset: None,
+                },
+            );
+        }
+        r
+    })
+}
+
+/// `xrCreateActionSpace`: created in the runtime (so the handle is real); for an eye-gaze
+/// action the layer remembers it and answers its location itself.
+///
+/// # Safety
+/// As `xrCreateActionSpace`.
+pub unsafe extern "system" fn create_action_space(
+    session: sys::Session,
+    info: *const sys::ActionSpaceCreateInfo,
+    space: *mut sys::Space,
+) -> sys::Result {
+    guard("xrCreateActionSpace", || {
+        let Some((ctx, gaze_actions)) = ({
+            let reg = registry();
+            SessionContext::of(&reg, session.into_raw()).map(|c| {
+                let actions = reg
+                    .instances
+                    .get(&c.instance.into_raw())
+                    .map(|i| i.gaze_actions.clone())
+                    .unwrap_or_default();
+                (c, actions)
+            })
+        }) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the next layer's function with the app's arguments.
+        let r = unsafe { (ctx.next.create_action_space)(session, info, space) };
+        if r.into_raw() < 0 {
+            return r;
+        }
+        // SAFETY: on success `info` was valid and the new space was written.
+        let (action, offset, created) =
+            unsafe { ((*info).action, (*info).pose_in_action_space, *space) };
+        let gaze_offset = (ctx.owned.contains(&GazeExtension::Ext)
+            && gaze_actions.contains(&action.into_raw()))
+        .then(|| from_posef(&offset));
+        registry().spaces.insert(
+            created.into_raw(),
+            SpaceState {
+                session: session.into_raw(),
+                gaze_offset,
+            },
+        );
+        r
+    })
+}
+
+/// `xrDestroySpace`: passed on; the layer forgets the space.
+///
+/// # Safety
+/// As `xrDestroySpace`.
+pub unsafe extern "system" fn destroy_space(space: sys::Space) -> sys::Result {
+    guard("xrDestroySpace", || {
+        let next = {
+            let mut reg = registry();
+            let next = reg.next_for_space(space.into_raw());
+            reg.spaces.remove(&space.into_raw());
+            next
+        };
+        let Some(next) = next else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the next layer's function with the app's live space.
+        unsafe { (next.destroy_space)(space) }
+    })
+}
+
+/// Where a space is in the head frame at `time`: the gaze pose for an eye-gaze action space
+/// (`None` flags when the gaze is invalid), else as the runtime locates it.
+fn in_view(
+    ctx: &SessionContext,
+    space: sys::Space,
+    gaze_offset: Option<Pose>,
+    time: sys::Time,
+) -> Option<(Pose, sys::SpaceLocationFlags)> {
+    match gaze_offset {
+        Some(offset) => {
+            let ray = combined_ray(&ctx.gaze_at(time.as_nanos())?);
+            if !ray.valid {
+                return Some((Pose::IDENTITY, sys::SpaceLocationFlags::EMPTY));
+            }
+            Some((compose(&ray_pose(&ray), &offset), all_location_flags()))
+        }
+        None => ctx.runtime_space_in_view(space, time),
+    }
+}
+
+/// `xrLocateSpace`: an eye-gaze action space is located from the trace's combined gaze at
+/// `time` composed with the runtime's head pose; other spaces go to the runtime.
+///
+/// # Safety
+/// As `xrLocateSpace`.
+pub unsafe extern "system" fn locate_space(
+    space: sys::Space,
+    base: sys::Space,
+    time: sys::Time,
+    location: *mut sys::SpaceLocation,
+) -> sys::Result {
+    guard("xrLocateSpace", || {
+        let (next, gaze) = {
+            let reg = registry();
+            let a = reg.spaces.get(&space.into_raw()).copied();
+            let b = reg.spaces.get(&base.into_raw()).copied();
+            let gaze_session = [a, b]
+                .into_iter()
+                .flatten()
+                .find(|s| s.gaze_offset.is_some())
+                .map(|s| s.session);
+            let ctx = gaze_session.and_then(|s| SessionContext::of(&reg, s));
+            (
+                reg.next_for_space(space.into_raw()),
+                ctx.map(|c| {
+                    (
+                        c,
+                        a.and_then(|s| s.gaze_offset),
+                        b.and_then(|s| s.gaze_offset),
+                    )
+                }),
+            )
+        };
+        let Some((ctx, a_offset, b_offset)) = gaze else {
+            let Some(next) = next else {
+                return sys::Result::ERROR_HANDLE_INVALID;
+            };
+            // SAFETY: the next layer's function with the app's arguments.
+            return unsafe { (next.locate_space)(space, base, time, location) };
+        };
+        // SAFETY: the app's output structure, null or valid.
+        let Some(loc) = (unsafe { location.as_mut() }) else {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        };
+        let (Some((a, fa)), Some((b, fb))) = (
+            in_view(&ctx, space, a_offset, time),
+            in_view(&ctx, base, b_offset, time),
+        ) else {
+            return sys::Result::ERROR_RUNTIME_FAILURE;
+        };
+        let flags = if fa.is_empty() || fb.is_empty() {
+            sys::SpaceLocationFlags::EMPTY
+        } else {
+            fa & fb
+        };
+        loc.location_flags = flags;
+        loc.pose = if flags.is_empty() {
+            sys::Posef::IDENTITY
+        } else {
+            to_posef(&relative(&a, &b))
+        };
+        let sample_time = ctx
+            .gaze_at(time.as_nanos())
+            .map_or(time.as_nanos(), |g| g.sample_time_ns);
+        // SAFETY: the app's chain of valid output structures.
+        for n in unsafe { chain(loc.next) } {
+            // SAFETY: `n` is a valid structure; it is written only as the type it declares.
+            unsafe {
+                if (*n).ty == sys::EyeGazeSampleTimeEXT::TYPE {
+                    (*(n as *mut sys::EyeGazeSampleTimeEXT)).time =
+                        sys::Time::from_nanos(sample_time);
+                } else if (*n).ty == sys::SpaceVelocity::TYPE {
+                    (*(n as *mut sys::SpaceVelocity)).velocity_flags =
+                        sys::SpaceVelocityFlags::EMPTY;
+                }
+            }
+        }
+        sys::Result::SUCCESS
+    })
+}
+
+/// `xrGetActionStatePose`: an eye-gaze action is active (the simulated tracker is always
+/// on); other actions go to the runtime.
+///
+/// # Safety
+/// As `xrGetActionStatePose`.
+pub unsafe extern "system" fn get_action_state_pose(
+    session: sys::Session,
+    info: *const sys::ActionStateGetInfo,
+    state: *mut sys::ActionStatePose,
+) -> sys::Result {
+    guard("xrGetActionStatePose", || {
+        let found = {
+            let reg = registry();
+            SessionContext::of(&reg, session.into_raw()).map(|c| {
+                let gaze = reg
+                    .instances
+                    .get(&c.instance.into_raw())
+                    .map(|i| i.gaze_actions.clone())
+                    .unwrap_or_default();
+                (c, gaze)
+            })
+        };
+        let Some((ctx, gaze_actions)) = found else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the app's structures, null or valid.
+        let (Some(get), Some(out)) = (unsafe { info.as_ref() }, unsafe { state.as_mut() }) else {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        };
+        if gaze_actions.contains(&get.action.into_raw()) {
+            out.is_active = sys::TRUE;
+            return sys::Result::SUCCESS;
+        }
+        // SAFETY: the next layer's function with the app's arguments.
+        unsafe { (ctx.next.get_action_state_pose)(session, info, state) }
+    })
+}

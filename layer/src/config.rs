@@ -1,0 +1,263 @@
+//! What the simulated headset offers, read from the environment when an instance is created.
+//!
+//! - `VITREOUS_SIM_TRACE`: the trace v1 file the eye data comes from (needed whenever an eye
+//!   extension is offered).
+//! - `VITREOUS_SIM_GAZE`: comma list of `ml`, `fb`, `ext` (default all three; `none` for none):
+//!   which eye-tracking extensions the layer offers.
+//! - `VITREOUS_SIM_BLEND`: comma list of `additive`, `alpha_blend` (default both, in that
+//!   order; `none` for none): the blend modes listed before the runtime's own.
+//! - `VITREOUS_SIM_SUBMITTED`: a CSV file that gets one line per submitted frame.
+
+use std::ffi::CStr;
+use std::fmt;
+use std::path::PathBuf;
+
+use openxr::sys;
+
+/// Environment variable naming the trace file.
+pub const TRACE_VAR: &str = "VITREOUS_SIM_TRACE";
+/// Environment variable choosing the eye-tracking extensions.
+pub const GAZE_VAR: &str = "VITREOUS_SIM_GAZE";
+/// Environment variable choosing the added blend modes.
+pub const BLEND_VAR: &str = "VITREOUS_SIM_BLEND";
+/// Environment variable naming the submitted-frames CSV.
+pub const SUBMITTED_VAR: &str = "VITREOUS_SIM_SUBMITTED";
+
+/// An eye-tracking extension the layer can provide.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GazeExtension {
+    /// `XR_ML_eye_tracker`: per-eye, combined and fixation poses, pupils.
+    Ml,
+    /// `XR_FB_eye_tracking_social`: a pose per eye.
+    Fb,
+    /// `XR_EXT_eye_gaze_interaction`: one combined ray through an action.
+    Ext,
+}
+
+impl GazeExtension {
+    /// All three, in the default order.
+    pub const ALL: [GazeExtension; 3] = [GazeExtension::Ml, GazeExtension::Fb, GazeExtension::Ext];
+
+    /// The extension's name.
+    pub fn name(self) -> &'static CStr {
+        match self {
+            GazeExtension::Ml => c"XR_ML_eye_tracker",
+            GazeExtension::Fb => c"XR_FB_eye_tracking_social",
+            GazeExtension::Ext => c"XR_EXT_eye_gaze_interaction",
+        }
+    }
+
+    /// The extension's specification version, as the manifest lists it.
+    pub fn spec_version(self) -> u32 {
+        match self {
+            GazeExtension::Ml => 1,
+            GazeExtension::Fb => sys::FB_eye_tracking_social_SPEC_VERSION,
+            GazeExtension::Ext => sys::EXT_eye_gaze_interaction_SPEC_VERSION,
+        }
+    }
+
+    /// The short name used in `VITREOUS_SIM_GAZE`.
+    pub fn short(self) -> &'static str {
+        match self {
+            GazeExtension::Ml => "ml",
+            GazeExtension::Fb => "fb",
+            GazeExtension::Ext => "ext",
+        }
+    }
+
+    /// The extension whose name is `name`, if it is one of the layer's.
+    pub fn from_name(name: &CStr) -> Option<GazeExtension> {
+        GazeExtension::ALL.into_iter().find(|e| e.name() == name)
+    }
+}
+
+/// What is wrong with an environment variable.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ConfigError {
+    /// The variable.
+    pub var: &'static str,
+    /// Its value.
+    pub value: String,
+    /// What was expected.
+    pub expected: &'static str,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}={:?}: expected {}",
+            self.var, self.value, self.expected
+        )
+    }
+}
+
+/// The simulated headset's configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    /// The eye-tracking extensions offered, without repeats.
+    pub gaze: Vec<GazeExtension>,
+    /// The blend modes listed before the runtime's, without repeats.
+    pub blend: Vec<sys::EnvironmentBlendMode>,
+    /// The trace file.
+    pub trace: Option<PathBuf>,
+    /// The submitted-frames CSV.
+    pub submitted: Option<PathBuf>,
+}
+
+impl Config {
+    /// Reads the process environment.
+    pub fn from_env() -> Result<Config, ConfigError> {
+        Config::from_vars(|name| std::env::var_os(name).map(|v| v.to_string_lossy().into_owned()))
+    }
+
+    /// Reads the variables through `get` (the environment, or a table in tests). Empty
+    /// values count as unset.
+    pub fn from_vars(get: impl Fn(&str) -> Option<String>) -> Result<Config, ConfigError> {
+        let get = |name: &str| get(name).filter(|v| !v.trim().is_empty());
+        Ok(Config {
+            gaze: parse_gaze(get(GAZE_VAR).as_deref())?,
+            blend: parse_blend(get(BLEND_VAR).as_deref())?,
+            trace: get(TRACE_VAR).map(PathBuf::from),
+            submitted: get(SUBMITTED_VAR).map(PathBuf::from),
+        })
+    }
+
+    /// Whether `ext` is offered.
+    pub fn offers(&self, ext: GazeExtension) -> bool {
+        self.gaze.contains(&ext)
+    }
+}
+
+/// Splits a comma list into trimmed, lower-case, non-empty items.
+fn items(value: &str) -> impl Iterator<Item = String> + '_ {
+    value
+        .split(',')
+        .map(|s| s.trim().to_ascii_lowercase())
+        .filter(|s| !s.is_empty())
+}
+
+/// Parses `VITREOUS_SIM_GAZE` (unset: all three).
+pub fn parse_gaze(value: Option<&str>) -> Result<Vec<GazeExtension>, ConfigError> {
+    let Some(value) = value else {
+        return Ok(GazeExtension::ALL.to_vec());
+    };
+    let mut out = Vec::new();
+    for item in items(value) {
+        let ext = match item.as_str() {
+            "none" => continue,
+            "ml" => GazeExtension::Ml,
+            "fb" => GazeExtension::Fb,
+            "ext" => GazeExtension::Ext,
+            _ => {
+                return Err(ConfigError {
+                    var: GAZE_VAR,
+                    value: value.to_owned(),
+                    expected: "a comma list of ml, fb, ext (or none)",
+                });
+            }
+        };
+        if !out.contains(&ext) {
+            out.push(ext);
+        }
+    }
+    Ok(out)
+}
+
+/// Parses `VITREOUS_SIM_BLEND` (unset: ADDITIVE then ALPHA_BLEND).
+pub fn parse_blend(value: Option<&str>) -> Result<Vec<sys::EnvironmentBlendMode>, ConfigError> {
+    use sys::EnvironmentBlendMode as M;
+    let Some(value) = value else {
+        return Ok(vec![M::ADDITIVE, M::ALPHA_BLEND]);
+    };
+    let mut out = Vec::new();
+    for item in items(value) {
+        let mode = match item.as_str() {
+            "none" => continue,
+            "additive" => M::ADDITIVE,
+            "alpha_blend" | "alpha-blend" | "alpha" => M::ALPHA_BLEND,
+            _ => {
+                return Err(ConfigError {
+                    var: BLEND_VAR,
+                    value: value.to_owned(),
+                    expected: "a comma list of additive, alpha_blend (or none)",
+                });
+            }
+        };
+        if !out.contains(&mode) {
+            out.push(mode);
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sys::EnvironmentBlendMode as M;
+    use vitreous_xr::openxr::ml_eye_tracker;
+
+    fn config(vars: &[(&str, &str)]) -> Result<Config, ConfigError> {
+        Config::from_vars(|name| {
+            vars.iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, v)| (*v).to_owned())
+        })
+    }
+
+    #[test]
+    fn defaults_offer_everything() {
+        let c = config(&[]).unwrap();
+        assert_eq!(c.gaze, GazeExtension::ALL.to_vec());
+        assert_eq!(c.blend, vec![M::ADDITIVE, M::ALPHA_BLEND]);
+        assert_eq!((c.trace, c.submitted), (None, None));
+    }
+
+    #[test]
+    fn gaze_list_is_parsed_in_order_without_repeats() {
+        let c = config(&[(GAZE_VAR, " EXT, fb,ext ")]).unwrap();
+        assert_eq!(c.gaze, vec![GazeExtension::Ext, GazeExtension::Fb]);
+        assert!(c.offers(GazeExtension::Fb) && !c.offers(GazeExtension::Ml));
+        assert!(config(&[(GAZE_VAR, "none")]).unwrap().gaze.is_empty());
+        // Empty counts as unset.
+        assert_eq!(config(&[(GAZE_VAR, "")]).unwrap().gaze.len(), 3);
+    }
+
+    #[test]
+    fn unknown_names_are_refused_with_the_variable_named() {
+        let e = config(&[(GAZE_VAR, "ml,htc")]).unwrap_err();
+        assert_eq!(e.var, GAZE_VAR);
+        assert!(
+            e.to_string().contains("VITREOUS_SIM_GAZE=\"ml,htc\""),
+            "{e}"
+        );
+        let e = config(&[(BLEND_VAR, "opaque")]).unwrap_err();
+        assert_eq!(e.var, BLEND_VAR);
+    }
+
+    #[test]
+    fn blend_list_accepts_spellings_and_none() {
+        let c = config(&[(BLEND_VAR, "alpha-blend,additive")]).unwrap();
+        assert_eq!(c.blend, vec![M::ALPHA_BLEND, M::ADDITIVE]);
+        assert!(config(&[(BLEND_VAR, "none")]).unwrap().blend.is_empty());
+    }
+
+    #[test]
+    fn paths_are_taken_as_given() {
+        let c = config(&[(TRACE_VAR, "/tmp/a.trace"), (SUBMITTED_VAR, "/tmp/s.csv")]).unwrap();
+        assert_eq!(c.trace, Some(PathBuf::from("/tmp/a.trace")));
+        assert_eq!(c.submitted, Some(PathBuf::from("/tmp/s.csv")));
+    }
+
+    #[test]
+    fn extension_names_round_trip() {
+        for e in GazeExtension::ALL {
+            assert_eq!(GazeExtension::from_name(e.name()), Some(e));
+        }
+        assert_eq!(
+            GazeExtension::Ml.name().to_str().unwrap(),
+            ml_eye_tracker::EXTENSION_NAME
+        );
+        assert_eq!(GazeExtension::from_name(c"XR_KHR_vulkan_enable2"), None);
+    }
+}

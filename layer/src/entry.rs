@@ -1,0 +1,478 @@
+//! The loader interface: `xrNegotiateLoaderApiLayerInterface` (the library's one exported
+//! symbol), `xrCreateApiLayerInstance` and the layer's `xrGetInstanceProcAddr`.
+
+use std::collections::HashSet;
+use std::ffi::{CStr, c_char};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::{Arc, Mutex};
+
+use openxr::sys::{self, pfn};
+use vitreous_xr::openxr::ml_eye_tracker as ml;
+
+use crate::bindings::{self, GazePaths};
+use crate::calls;
+use crate::config::{Config, GazeExtension, TRACE_VAR};
+use crate::extensions;
+use crate::next::NextTable;
+use crate::registry::{InstanceState, registry};
+use crate::submitted::SubmittedLog;
+use crate::timeline::GazeTimeline;
+
+/// The layer's name, as its manifest gives it.
+pub const LAYER_NAME: &CStr = c"XR_APILAYER_VITREOUS_simulated_ost";
+
+/// Prints a message for the user on stderr, prefixed with the layer's name.
+pub fn report(message: impl std::fmt::Display) {
+    eprintln!("vitreous-sim-layer: {message}");
+}
+
+/// Runs an entry point's body, turning a panic into `XR_ERROR_RUNTIME_FAILURE` so it never
+/// unwinds into the caller's C frames.
+pub fn guard(call: &str, body: impl FnOnce() -> sys::Result) -> sys::Result {
+    match catch_unwind(AssertUnwindSafe(body)) {
+        Ok(r) => r,
+        Err(_) => {
+            report(format!(
+                "{call} panicked; returning XR_ERROR_RUNTIME_FAILURE"
+            ));
+            sys::Result::ERROR_RUNTIME_FAILURE
+        }
+    }
+}
+
+/// The loader calls this first, to agree on the interface version and learn the layer's
+/// `xrGetInstanceProcAddr` and `xrCreateApiLayerInstance`.
+///
+/// # Safety
+/// `loader_info` and `request` must be null or point to valid structures of their types;
+/// `layer_name` must be null or a NUL-terminated string.
+#[unsafe(no_mangle)]
+pub unsafe extern "system" fn xrNegotiateLoaderApiLayerInterface(
+    loader_info: *const sys::NegotiateLoaderInfo,
+    layer_name: *const c_char,
+    request: *mut sys::NegotiateApiLayerRequest,
+) -> sys::Result {
+    guard("xrNegotiateLoaderApiLayerInterface", || {
+        // SAFETY: the caller guarantees both are null or valid.
+        let (Some(info), Some(request)) =
+            (unsafe { loader_info.as_ref() }, unsafe { request.as_mut() })
+        else {
+            return sys::Result::ERROR_INITIALIZATION_FAILED;
+        };
+        if !layer_name.is_null() {
+            // SAFETY: the caller guarantees a NUL-terminated string.
+            let name = unsafe { CStr::from_ptr(layer_name) };
+            if name != LAYER_NAME {
+                report(format!(
+                    "asked to load as {:?}; this library is {:?}",
+                    name, LAYER_NAME
+                ));
+                return sys::Result::ERROR_INITIALIZATION_FAILED;
+            }
+        }
+        let interface = sys::CURRENT_LOADER_API_LAYER_VERSION as u32;
+        if info.struct_type != sys::LoaderInterfaceStructs::LOADER_INFO
+            || info.struct_version != sys::NegotiateLoaderInfo::VERSION
+            || info.struct_size != std::mem::size_of::<sys::NegotiateLoaderInfo>()
+            || request.struct_type != sys::LoaderInterfaceStructs::API_LAYER_REQUEST
+            || request.struct_version != sys::NegotiateApiLayerRequest::VERSION
+            || request.struct_size != std::mem::size_of::<sys::NegotiateApiLayerRequest>()
+            || info.min_interface_version > interface
+            || info.max_interface_version < interface
+        {
+            report("the loader's negotiation structures are not the version this layer knows");
+            return sys::Result::ERROR_INITIALIZATION_FAILED;
+        }
+        request.layer_interface_version = interface;
+        request.layer_api_version =
+            if sys::CURRENT_API_VERSION.into_raw() <= info.max_api_version.into_raw() {
+                sys::CURRENT_API_VERSION
+            } else {
+                info.max_api_version
+            };
+        request.get_instance_proc_addr = Some(get_instance_proc_addr);
+        request.create_api_layer_instance = Some(create_api_layer_instance);
+        sys::Result::SUCCESS
+    })
+}
+
+/// What instance creation needs from the environment, or the message and result to fail with.
+struct Prepared {
+    /// The configuration.
+    config: Config,
+    /// The trace's eye data (when an eye extension is offered).
+    timeline: Option<GazeTimeline>,
+    /// The submitted-frames CSV.
+    submitted: Option<SubmittedLog>,
+}
+
+/// Reads the configuration, the trace and opens the CSV.
+fn prepare() -> Result<Prepared, String> {
+    let config = Config::from_env().map_err(|e| e.to_string())?;
+    let timeline = if config.gaze.is_empty() {
+        None
+    } else {
+        let Some(path) = &config.trace else {
+            return Err(format!(
+                "{TRACE_VAR} is not set: it must name the trace (v1) the eye data comes from"
+            ));
+        };
+        let samples =
+            vitreous_xr::read_trace(path).map_err(|e| format!("reading {TRACE_VAR}: {e}"))?;
+        Some(
+            GazeTimeline::new(&samples)
+                .ok_or_else(|| format!("{TRACE_VAR}: {} has no samples", path.display()))?,
+        )
+    };
+    let submitted = match &config.submitted {
+        None => None,
+        Some(path) => Some(SubmittedLog::create(path).map_err(|e| {
+            format!(
+                "{}: creating {}: {e}",
+                crate::config::SUBMITTED_VAR,
+                path.display()
+            )
+        })?),
+    };
+    Ok(Prepared {
+        config,
+        timeline,
+        submitted,
+    })
+}
+
+/// The instance-creation call of the layer chain: removes the layer's extensions from the
+/// create info, creates the instance below, and sets up the layer's state for it.
+///
+/// # Safety
+/// The pointers must be valid as the loader interface defines them.
+unsafe extern "system" fn create_api_layer_instance(
+    info: *const sys::InstanceCreateInfo,
+    layer_info: *const sys::ApiLayerCreateInfo,
+    instance: *mut sys::Instance,
+) -> sys::Result {
+    guard("xrCreateApiLayerInstance", || {
+        // SAFETY: the loader passes valid structures or null.
+        let (Some(info), Some(layer_info)) =
+            (unsafe { info.as_ref() }, unsafe { layer_info.as_ref() })
+        else {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        };
+        // SAFETY: as above; `next_info` is this layer's entry in the chain.
+        let Some(next_info) = (unsafe { layer_info.next_info.as_ref() }) else {
+            return sys::Result::ERROR_INITIALIZATION_FAILED;
+        };
+        let (Some(next_gipa), Some(next_create)) = (
+            next_info.next_get_instance_proc_addr,
+            next_info.next_create_api_layer_instance,
+        ) else {
+            return sys::Result::ERROR_INITIALIZATION_FAILED;
+        };
+
+        let prepared = match prepare() {
+            Ok(p) => p,
+            Err(message) => {
+                report(message);
+                return sys::Result::ERROR_INITIALIZATION_FAILED;
+            }
+        };
+
+        let names: Vec<&CStr> = (0..info.enabled_extension_count as usize)
+            .filter_map(|i| {
+                // SAFETY: the app's array holds `enabled_extension_count` pointers to
+                // NUL-terminated names (xrCreateInstance's valid usage).
+                let p = unsafe { *info.enabled_extension_names.add(i) };
+                // SAFETY: as above.
+                (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) })
+            })
+            .collect();
+        let split = extensions::split(&names, &prepared.config.gaze);
+        // The layer's extensions it does not offer go on to the runtime, which may have them
+        // (Monado lists XR_EXT_eye_gaze_interaction) or refuses them.
+        let forwarded: Vec<*const c_char> = split.forwarded.iter().map(|n| n.as_ptr()).collect();
+        let mut next_create_info = *info;
+        next_create_info.enabled_extension_count = forwarded.len() as u32;
+        next_create_info.enabled_extension_names = if forwarded.is_empty() {
+            std::ptr::null()
+        } else {
+            forwarded.as_ptr()
+        };
+        let mut next_layer_info = *layer_info;
+        next_layer_info.next_info = next_info.next;
+
+        // SAFETY: the create infos are valid copies of the app's with a shorter extension
+        // list that lives across the call; `instance` is the app's output pointer.
+        let r = unsafe { next_create(&next_create_info, &next_layer_info, instance) };
+        if r.into_raw() < 0 {
+            return r;
+        }
+        // SAFETY: on success the next layer wrote the new instance.
+        let created = unsafe { *instance };
+        // SAFETY: `next_gipa` is the next layer's and `created` is live.
+        let next = match unsafe { NextTable::load(next_gipa, created) } {
+            Ok(n) => n,
+            Err(message) => {
+                report(message);
+                // SAFETY: undoing the creation above: the next layer's own destroy function.
+                let destroy = unsafe { lookup_destroy(next_gipa, created) };
+                if let Some(destroy) = destroy {
+                    // SAFETY: `created` is live and not used afterwards.
+                    unsafe { destroy(created) };
+                }
+                return sys::Result::ERROR_INITIALIZATION_FAILED;
+            }
+        };
+        let gaze_paths = if split.owned.contains(&GazeExtension::Ext) {
+            match gaze_paths(&next, created) {
+                Ok(p) => Some(p),
+                Err(r) => {
+                    report(format!(
+                        "xrStringToPath for the eye-gaze profile failed: {r:?}"
+                    ));
+                    // SAFETY: `created` is live and not used afterwards.
+                    unsafe { (next.destroy_instance)(created) };
+                    return sys::Result::ERROR_INITIALIZATION_FAILED;
+                }
+            }
+        } else {
+            None
+        };
+        let state = InstanceState {
+            next: Arc::new(next),
+            config: Arc::new(prepared.config),
+            owned: split.owned,
+            timeline: prepared.timeline.map(Arc::new),
+            gaze_paths,
+            gaze_actions: HashSet::new(),
+            submitted: prepared.submitted.map(|s| Arc::new(Mutex::new(s))),
+        };
+        registry()
+            .instances
+            .insert(sys::Handle::into_raw(created), state);
+        r
+    })
+}
+
+/// The next layer's `xrDestroyInstance`, to undo a creation the layer cannot finish.
+///
+/// # Safety
+/// As [`NextTable::load`].
+unsafe fn lookup_destroy(
+    gipa: pfn::GetInstanceProcAddr,
+    instance: sys::Instance,
+) -> Option<pfn::DestroyInstance> {
+    let mut f: Option<pfn::VoidFunction> = None;
+    // SAFETY: guaranteed by the caller.
+    unsafe { gipa(instance, c"xrDestroyInstance".as_ptr(), &mut f) };
+    // SAFETY: the function of that name has that signature.
+    f.map(|f| unsafe { std::mem::transmute::<pfn::VoidFunction, pfn::DestroyInstance>(f) })
+}
+
+/// The eye-gaze profile's paths in a new instance.
+fn gaze_paths(next: &NextTable, instance: sys::Instance) -> Result<GazePaths, sys::Result> {
+    let path = |s: &CStr| {
+        let mut p = sys::Path::NULL;
+        // SAFETY: `instance` is live; `s` is NUL-terminated; `p` is writable.
+        let r = unsafe { (next.string_to_path)(instance, s.as_ptr(), &mut p) };
+        if r == sys::Result::SUCCESS {
+            Ok(p)
+        } else {
+            Err(r)
+        }
+    };
+    Ok(GazePaths {
+        profile: path(bindings::PROFILE)?,
+        pose: path(bindings::POSE)?,
+    })
+}
+
+/// Casts one of the layer's entry points to the loader's generic function type.
+macro_rules! entry {
+    ($f:expr, $ty:ty) => {{
+        let f: $ty = $f;
+        // SAFETY: function pointers have one size; the caller casts it back to `$ty`, the
+        // type OpenXR defines for the name it asked for.
+        Some(unsafe { std::mem::transmute::<$ty, pfn::VoidFunction>(f) })
+    }};
+}
+
+/// The layer's own function for `name`, and the extension the app must have enabled for it
+/// (`None`: core).
+fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::VoidFunction>)> {
+    use GazeExtension::{Fb, Ml};
+    let f = match name {
+        b"xrGetInstanceProcAddr" => (
+            None,
+            entry!(get_instance_proc_addr, pfn::GetInstanceProcAddr),
+        ),
+        b"xrDestroyInstance" => (
+            None,
+            entry!(calls::instance::destroy_instance, pfn::DestroyInstance),
+        ),
+        b"xrGetSystemProperties" => (
+            None,
+            entry!(
+                calls::instance::get_system_properties,
+                pfn::GetSystemProperties
+            ),
+        ),
+        b"xrEnumerateEnvironmentBlendModes" => (
+            None,
+            entry!(
+                calls::instance::enumerate_environment_blend_modes,
+                pfn::EnumerateEnvironmentBlendModes
+            ),
+        ),
+        b"xrSuggestInteractionProfileBindings" => (
+            None,
+            entry!(
+                calls::instance::suggest_interaction_profile_bindings,
+                pfn::SuggestInteractionProfileBindings
+            ),
+        ),
+        b"xrCreateSession" => (
+            None,
+            entry!(calls::session::create_session, pfn::CreateSession),
+        ),
+        b"xrDestroySession" => (
+            None,
+            entry!(calls::session::destroy_session, pfn::DestroySession),
+        ),
+        b"xrBeginSession" => (
+            None,
+            entry!(calls::session::begin_session, pfn::BeginSession),
+        ),
+        b"xrWaitFrame" => (None, entry!(calls::session::wait_frame, pfn::WaitFrame)),
+        b"xrEndFrame" => (None, entry!(calls::session::end_frame, pfn::EndFrame)),
+        b"xrCreateReferenceSpace" => (
+            None,
+            entry!(
+                calls::session::create_reference_space,
+                pfn::CreateReferenceSpace
+            ),
+        ),
+        b"xrCreateActionSpace" => (
+            None,
+            entry!(calls::session::create_action_space, pfn::CreateActionSpace),
+        ),
+        b"xrLocateSpace" => (None, entry!(calls::session::locate_space, pfn::LocateSpace)),
+        b"xrDestroySpace" => (
+            None,
+            entry!(calls::session::destroy_space, pfn::DestroySpace),
+        ),
+        b"xrGetActionStatePose" => (
+            None,
+            entry!(
+                calls::session::get_action_state_pose,
+                pfn::GetActionStatePose
+            ),
+        ),
+        b"xrCreateEyeTrackerFB" => (
+            Some(Fb),
+            entry!(calls::fb::create_eye_tracker, pfn::CreateEyeTrackerFB),
+        ),
+        b"xrDestroyEyeTrackerFB" => (
+            Some(Fb),
+            entry!(calls::fb::destroy_eye_tracker, pfn::DestroyEyeTrackerFB),
+        ),
+        b"xrGetEyeGazesFB" => (
+            Some(Fb),
+            entry!(calls::fb::get_eye_gazes, pfn::GetEyeGazesFB),
+        ),
+        b"xrCreateEyeTrackerML" => (
+            Some(Ml),
+            entry!(calls::ml::create_eye_tracker, ml::CreateEyeTrackerML),
+        ),
+        b"xrDestroyEyeTrackerML" => (
+            Some(Ml),
+            entry!(calls::ml::destroy_eye_tracker, ml::DestroyEyeTrackerML),
+        ),
+        b"xrGetEyeTrackerStaticDataML" => (
+            Some(Ml),
+            entry!(calls::ml::get_static_data, ml::GetEyeTrackerStaticDataML),
+        ),
+        b"xrGetEyeTrackerPosesML" => (
+            Some(Ml),
+            entry!(calls::ml::get_poses, ml::GetEyeTrackerPosesML),
+        ),
+        b"xrGetEyeTrackerPupilDataML" => (
+            Some(Ml),
+            entry!(calls::ml::get_pupil_data, ml::GetEyeTrackerPupilDataML),
+        ),
+        b"xrGetEyeTrackerGeometricDataML" => (
+            Some(Ml),
+            entry!(
+                calls::ml::get_geometric_data,
+                ml::GetEyeTrackerGeometricDataML
+            ),
+        ),
+        b"xrGetEyeTrackerGazeBehaviorML" => (
+            Some(Ml),
+            entry!(
+                calls::ml::get_gaze_behavior,
+                ml::GetEyeTrackerGazeBehaviorML
+            ),
+        ),
+        _ => return None,
+    };
+    Some(f)
+}
+
+/// The layer's `xrGetInstanceProcAddr`: its own functions (extension functions only when the
+/// app enabled the extension), everything else from the next layer.
+///
+/// # Safety
+/// `name` must be a NUL-terminated string and `function` null or writable.
+unsafe extern "system" fn get_instance_proc_addr(
+    instance: sys::Instance,
+    name: *const c_char,
+    function: *mut Option<pfn::VoidFunction>,
+) -> sys::Result {
+    guard("xrGetInstanceProcAddr", || {
+        // SAFETY: the caller guarantees `function` is null or writable.
+        let Some(function) = (unsafe { function.as_mut() }) else {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        };
+        *function = None;
+        if name.is_null() {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        }
+        // SAFETY: the caller guarantees a NUL-terminated string.
+        let name_c = unsafe { CStr::from_ptr(name) };
+        let (owned, offered, next) = {
+            let reg = registry();
+            match reg.instances.get(&sys::Handle::into_raw(instance)) {
+                Some(i) => (
+                    i.owned.clone(),
+                    i.config.gaze.clone(),
+                    Some(i.next.get_instance_proc_addr),
+                ),
+                None => (Vec::new(), Vec::new(), None),
+            }
+        };
+        if let Some((needs, f)) = own_function(name_c.to_bytes()) {
+            match needs {
+                None => {
+                    *function = f;
+                    return sys::Result::SUCCESS;
+                }
+                Some(ext) if owned.contains(&ext) => {
+                    *function = f;
+                    return sys::Result::SUCCESS;
+                }
+                // Offered by the layer but not enabled by the app; or no instance yet.
+                Some(ext) if offered.contains(&ext) || next.is_none() => {
+                    return sys::Result::ERROR_FUNCTION_UNSUPPORTED;
+                }
+                // Not offered by the layer: the runtime may have the extension itself.
+                Some(_) => {}
+            }
+        }
+        match next {
+            // SAFETY: the next layer's gipa with the caller's valid arguments.
+            Some(next) => unsafe { next(instance, name, function) },
+            None if sys::Handle::into_raw(instance) == 0 => sys::Result::ERROR_FUNCTION_UNSUPPORTED,
+            None => sys::Result::ERROR_HANDLE_INVALID,
+        }
+    })
+}

@@ -1,0 +1,86 @@
+//! The app's enabled-extension list, split into the extensions the layer provides (they must
+//! not reach the runtime, which may not know them, or may list them without the hardware:
+//! Monado lists XR_EXT_eye_gaze_interaction with no eye tracker) and the rest.
+
+use std::ffi::CStr;
+
+use crate::config::GazeExtension;
+
+/// The result of [`split`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Split<'a> {
+    /// The names to pass on, in the app's order.
+    pub forwarded: Vec<&'a CStr>,
+    /// The layer's extensions the app enabled, in the app's order, without repeats.
+    pub owned: Vec<GazeExtension>,
+    /// The layer's extensions the app enabled but the configuration does not offer (passed
+    /// on: the runtime may have them).
+    pub not_offered: Vec<GazeExtension>,
+}
+
+/// Splits `enabled` into what the layer handles (those in `offered`) and what goes on.
+/// An extension of the layer that is not offered is reported in `not_offered` and also
+/// passed on (the runtime may have it).
+pub fn split<'a>(enabled: &[&'a CStr], offered: &[GazeExtension]) -> Split<'a> {
+    let mut out = Split {
+        forwarded: Vec::with_capacity(enabled.len()),
+        owned: Vec::new(),
+        not_offered: Vec::new(),
+    };
+    for &name in enabled {
+        match GazeExtension::from_name(name) {
+            Some(ext) if offered.contains(&ext) => {
+                if !out.owned.contains(&ext) {
+                    out.owned.push(ext);
+                }
+            }
+            Some(ext) => {
+                if !out.not_offered.contains(&ext) {
+                    out.not_offered.push(ext);
+                }
+                out.forwarded.push(name);
+            }
+            None => out.forwarded.push(name),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use GazeExtension::*;
+
+    #[test]
+    fn the_layers_extensions_are_removed_and_the_rest_kept_in_order() {
+        let enabled = [
+            c"XR_KHR_vulkan_enable2",
+            c"XR_EXT_eye_gaze_interaction",
+            c"XR_KHR_composition_layer_depth",
+            c"XR_FB_eye_tracking_social",
+            c"XR_EXT_eye_gaze_interaction",
+        ];
+        let s = split(&enabled, &GazeExtension::ALL);
+        assert_eq!(
+            s.forwarded,
+            vec![c"XR_KHR_vulkan_enable2", c"XR_KHR_composition_layer_depth"]
+        );
+        assert_eq!(s.owned, vec![Ext, Fb]);
+        assert!(s.not_offered.is_empty());
+    }
+
+    #[test]
+    fn extensions_not_offered_are_passed_on_and_reported() {
+        let enabled = [c"XR_ML_eye_tracker", c"XR_EXT_eye_gaze_interaction"];
+        let s = split(&enabled, &[Ext]);
+        assert_eq!(s.forwarded, vec![c"XR_ML_eye_tracker"]);
+        assert_eq!(s.owned, vec![Ext]);
+        assert_eq!(s.not_offered, vec![Ml]);
+    }
+
+    #[test]
+    fn nothing_enabled_gives_nothing() {
+        let s = split(&[], &GazeExtension::ALL);
+        assert!(s.forwarded.is_empty() && s.owned.is_empty());
+    }
+}

@@ -1,0 +1,178 @@
+//! The next layer's (or the runtime's) functions that the layer calls, loaded once per
+//! instance through the next `xrGetInstanceProcAddr`.
+
+use std::ffi::CStr;
+
+use openxr::sys::{self, pfn};
+
+/// The functions of the next layer down the chain that this layer calls.
+#[derive(Clone, Copy)]
+pub struct NextTable {
+    /// `xrGetInstanceProcAddr`: everything the layer does not handle goes here.
+    pub get_instance_proc_addr: pfn::GetInstanceProcAddr,
+    /// `xrDestroyInstance`.
+    pub destroy_instance: pfn::DestroyInstance,
+    /// `xrGetSystemProperties`.
+    pub get_system_properties: pfn::GetSystemProperties,
+    /// `xrEnumerateEnvironmentBlendModes`.
+    pub enumerate_environment_blend_modes: pfn::EnumerateEnvironmentBlendModes,
+    /// `xrStringToPath`.
+    pub string_to_path: pfn::StringToPath,
+    /// `xrCreateSession`.
+    pub create_session: pfn::CreateSession,
+    /// `xrDestroySession`.
+    pub destroy_session: pfn::DestroySession,
+    /// `xrBeginSession`.
+    pub begin_session: pfn::BeginSession,
+    /// `xrWaitFrame`.
+    pub wait_frame: pfn::WaitFrame,
+    /// `xrEndFrame`.
+    pub end_frame: pfn::EndFrame,
+    /// `xrCreateReferenceSpace`.
+    pub create_reference_space: pfn::CreateReferenceSpace,
+    /// `xrCreateActionSpace`.
+    pub create_action_space: pfn::CreateActionSpace,
+    /// `xrLocateSpace`.
+    pub locate_space: pfn::LocateSpace,
+    /// `xrDestroySpace`.
+    pub destroy_space: pfn::DestroySpace,
+    /// `xrSuggestInteractionProfileBindings`.
+    pub suggest_interaction_profile_bindings: pfn::SuggestInteractionProfileBindings,
+    /// `xrGetActionStatePose`.
+    pub get_action_state_pose: pfn::GetActionStatePose,
+}
+
+/// Looks up one function through `gipa`.
+///
+/// # Safety
+/// `gipa` must be a valid `xrGetInstanceProcAddr` and `instance` a live instance of its chain.
+unsafe fn lookup(
+    gipa: pfn::GetInstanceProcAddr,
+    instance: sys::Instance,
+    name: &CStr,
+) -> Result<pfn::VoidFunction, String> {
+    let mut f: Option<pfn::VoidFunction> = None;
+    // SAFETY: guaranteed by the caller; `name` is NUL-terminated and `f` is writable.
+    let r = unsafe { gipa(instance, name.as_ptr(), &mut f) };
+    match f {
+        Some(f) if r == sys::Result::SUCCESS => Ok(f),
+        _ => Err(format!(
+            "the next layer has no {} ({r:?})",
+            name.to_string_lossy()
+        )),
+    }
+}
+
+/// Loads `$name` as the function pointer type `$ty`.
+macro_rules! load {
+    ($gipa:expr, $instance:expr, $name:literal, $ty:ty) => {{
+        // SAFETY: the caller of `NextTable::load` guarantees `$gipa` and `$instance`.
+        let f = unsafe { lookup($gipa, $instance, $name)? };
+        // SAFETY: the loader interface returns, under this name, a function with the
+        // signature OpenXR defines for it, which is the type of the field being set.
+        unsafe { std::mem::transmute::<pfn::VoidFunction, $ty>(f) }
+    }};
+}
+
+impl NextTable {
+    /// Loads the table from the next layer.
+    ///
+    /// # Safety
+    /// `gipa` must be the next layer's `xrGetInstanceProcAddr` and `instance` an instance
+    /// it created that is still alive.
+    pub unsafe fn load(
+        gipa: pfn::GetInstanceProcAddr,
+        instance: sys::Instance,
+    ) -> Result<NextTable, String> {
+        Ok(NextTable {
+            get_instance_proc_addr: gipa,
+            destroy_instance: load!(gipa, instance, c"xrDestroyInstance", pfn::DestroyInstance),
+            get_system_properties: load!(
+                gipa,
+                instance,
+                c"xrGetSystemProperties",
+                pfn::GetSystemProperties
+            ),
+            enumerate_environment_blend_modes: load!(
+                gipa,
+                instance,
+                c"xrEnumerateEnvironmentBlendModes",
+                pfn::EnumerateEnvironmentBlendModes
+            ),
+            string_to_path: load!(gipa, instance, c"xrStringToPath", pfn::StringToPath),
+            create_session: load!(gipa, instance, c"xrCreateSession", pfn::CreateSession),
+            destroy_session: load!(gipa, instance, c"xrDestroySession", pfn::DestroySession),
+            begin_session: load!(gipa, instance, c"xrBeginSession", pfn::BeginSession),
+            wait_frame: load!(gipa, instance, c"xrWaitFrame", pfn::WaitFrame),
+            end_frame: load!(gipa, instance, c"xrEndFrame", pfn::EndFrame),
+            create_reference_space: load!(
+                gipa,
+                instance,
+                c"xrCreateReferenceSpace",
+                pfn::CreateReferenceSpace
+            ),
+            create_action_space: load!(
+                gipa,
+                instance,
+                c"xrCreateActionSpace",
+                pfn::CreateActionSpace
+            ),
+            locate_space: load!(gipa, instance, c"xrLocateSpace", pfn::LocateSpace),
+            destroy_space: load!(gipa, instance, c"xrDestroySpace", pfn::DestroySpace),
+            suggest_interaction_profile_bindings: load!(
+                gipa,
+                instance,
+                c"xrSuggestInteractionProfileBindings",
+                pfn::SuggestInteractionProfileBindings
+            ),
+            get_action_state_pose: load!(
+                gipa,
+                instance,
+                c"xrGetActionStatePose",
+                pfn::GetActionStatePose
+            ),
+        })
+    }
+
+    /// The runtime's blend modes for a system and view configuration (two calls).
+    pub fn runtime_blend_modes(
+        &self,
+        instance: sys::Instance,
+        system: sys::SystemId,
+        view: sys::ViewConfigurationType,
+    ) -> Result<Vec<sys::EnvironmentBlendMode>, sys::Result> {
+        let mut n = 0u32;
+        // SAFETY: the table was loaded for `instance`'s chain; a null array with capacity 0
+        // asks for the count.
+        let r = unsafe {
+            (self.enumerate_environment_blend_modes)(
+                instance,
+                system,
+                view,
+                0,
+                &mut n,
+                std::ptr::null_mut(),
+            )
+        };
+        if r.into_raw() < 0 {
+            return Err(r);
+        }
+        let mut modes = vec![sys::EnvironmentBlendMode::OPAQUE; n as usize];
+        // SAFETY: `modes` holds `n` writable elements.
+        let r = unsafe {
+            (self.enumerate_environment_blend_modes)(
+                instance,
+                system,
+                view,
+                n,
+                &mut n,
+                modes.as_mut_ptr(),
+            )
+        };
+        if r.into_raw() < 0 {
+            return Err(r);
+        }
+        modes.truncate(n as usize);
+        Ok(modes)
+    }
+}

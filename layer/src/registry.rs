@@ -1,0 +1,189 @@
+//! The layer's state: one entry per instance, session, space and eye tracker the layer
+//! knows, keyed by the raw handle, behind one mutex. Calls copy what they need out of it and
+//! release the lock before calling down the chain (xrWaitFrame blocks).
+
+use std::collections::{HashMap, HashSet};
+use std::sync::{Arc, LazyLock, Mutex, MutexGuard};
+
+use openxr::sys;
+use vitreous_xr::Pose;
+
+use crate::bindings::GazePaths;
+use crate::config::{Config, GazeExtension};
+use crate::next::NextTable;
+use crate::submitted::SubmittedLog;
+use crate::timeline::GazeTimeline;
+
+/// What the layer keeps per instance.
+pub struct InstanceState {
+    /// The next layer's functions.
+    pub next: Arc<NextTable>,
+    /// The configuration read when the instance was created.
+    pub config: Arc<Config>,
+    /// The layer's extensions the app enabled.
+    pub owned: Vec<GazeExtension>,
+    /// The trace's eye data (present whenever an eye extension is offered).
+    pub timeline: Option<Arc<GazeTimeline>>,
+    /// The eye-gaze profile's paths (when XR_EXT_eye_gaze_interaction is enabled).
+    pub gaze_paths: Option<GazePaths>,
+    /// Actions bound to the eye-gaze pose.
+    pub gaze_actions: HashSet<u64>,
+    /// The submitted-frames CSV.
+    pub submitted: Option<Arc<Mutex<SubmittedLog>>>,
+}
+
+impl InstanceState {
+    /// Whether the app enabled `ext` and the layer provides it.
+    pub fn owns(&self, ext: GazeExtension) -> bool {
+        self.owned.contains(&ext)
+    }
+}
+
+/// What the layer keeps per session.
+#[derive(Clone, Debug)]
+pub struct SessionState {
+    /// The instance's raw handle.
+    pub instance: u64,
+    /// The system the session runs on.
+    pub system: sys::SystemId,
+    /// A VIEW reference space the layer created in the runtime: the head.
+    pub view_space: sys::Space,
+    /// The predicted display time of the first `xrWaitFrame`: trace time zero.
+    pub first_display_ns: Option<i64>,
+    /// The predicted display time of the newest `xrWaitFrame`.
+    pub latest_display_ns: Option<i64>,
+    /// How many frames the app has ended.
+    pub frames_ended: u64,
+    /// The runtime's blend modes for the session's view configuration (known after
+    /// `xrBeginSession`).
+    pub runtime_blend: Option<Vec<sys::EnvironmentBlendMode>>,
+}
+
+/// What the layer keeps per space it saw created.
+#[derive(Clone, Copy, Debug)]
+pub struct SpaceState {
+    /// The session's raw handle.
+    pub session: u64,
+    /// For the action space of an eye-gaze action: its pose in the action space.
+    pub gaze_offset: Option<Pose>,
+}
+
+/// An eye tracker the layer made.
+#[derive(Clone, Copy, Debug)]
+pub struct TrackerState {
+    /// The session's raw handle.
+    pub session: u64,
+    /// Which extension made it.
+    pub kind: GazeExtension,
+}
+
+/// All of the layer's state.
+pub struct Registry {
+    /// Instances by handle.
+    pub instances: HashMap<u64, InstanceState>,
+    /// Sessions by handle.
+    pub sessions: HashMap<u64, SessionState>,
+    /// Spaces by handle.
+    pub spaces: HashMap<u64, SpaceState>,
+    /// Eye trackers by the handle the layer gave them.
+    pub trackers: HashMap<u64, TrackerState>,
+    /// The next handle the layer gives out.
+    next_handle: u64,
+}
+
+/// The first handle the layer gives out: unlike the small counters and pointers runtimes use,
+/// so a mix-up shows in logs.
+const FIRST_HANDLE: u64 = 0x5649_5452_0000_0001;
+
+impl Registry {
+    /// An empty registry.
+    fn new() -> Registry {
+        Registry {
+            instances: HashMap::new(),
+            sessions: HashMap::new(),
+            spaces: HashMap::new(),
+            trackers: HashMap::new(),
+            next_handle: FIRST_HANDLE,
+        }
+    }
+
+    /// A new handle: unique in the process, never zero.
+    pub fn new_handle(&mut self) -> u64 {
+        let h = self.next_handle;
+        self.next_handle = self.next_handle.wrapping_add(1).max(1);
+        h
+    }
+
+    /// A session's state and its instance's.
+    pub fn session(&self, session: u64) -> Option<(&SessionState, &InstanceState)> {
+        let s = self.sessions.get(&session)?;
+        let i = self.instances.get(&s.instance)?;
+        Some((s, i))
+    }
+
+    /// The next-layer table to call for a space: its session's instance, or, for a space the
+    /// layer did not see created, the only instance (`None` when there are several).
+    pub fn next_for_space(&self, space: u64) -> Option<Arc<NextTable>> {
+        if let Some(s) = self.spaces.get(&space)
+            && let Some((_, i)) = self.session(s.session)
+        {
+            return Some(i.next.clone());
+        }
+        self.only_instance().map(|i| i.next.clone())
+    }
+
+    /// The instance, when exactly one exists.
+    pub fn only_instance(&self) -> Option<&InstanceState> {
+        let mut it = self.instances.values();
+        match (it.next(), it.next()) {
+            (Some(i), None) => Some(i),
+            _ => None,
+        }
+    }
+
+    /// Forgets a session and everything made from it.
+    pub fn remove_session(&mut self, session: u64) -> Option<SessionState> {
+        self.spaces.retain(|_, s| s.session != session);
+        self.trackers.retain(|_, t| t.session != session);
+        self.sessions.remove(&session)
+    }
+
+    /// Forgets an instance and everything made from it.
+    pub fn remove_instance(&mut self, instance: u64) {
+        let sessions: Vec<u64> = self
+            .sessions
+            .iter()
+            .filter(|(_, s)| s.instance == instance)
+            .map(|(h, _)| *h)
+            .collect();
+        for s in sessions {
+            self.remove_session(s);
+        }
+        self.instances.remove(&instance);
+    }
+}
+
+/// The process's registry.
+static REGISTRY: LazyLock<Mutex<Registry>> = LazyLock::new(|| Mutex::new(Registry::new()));
+
+/// Locks the registry. A panic while it was held (caught at the entry point) does not make
+/// it unusable: every update leaves it consistent before anything can panic.
+pub fn registry() -> MutexGuard<'static, Registry> {
+    REGISTRY.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn handles_are_unique_and_non_zero() {
+        let mut r = Registry::new();
+        let a = r.new_handle();
+        let b = r.new_handle();
+        assert!(a != 0 && b != 0 && a != b);
+        r.next_handle = u64::MAX;
+        assert_eq!(r.new_handle(), u64::MAX);
+        assert_ne!(r.new_handle(), 0);
+    }
+}

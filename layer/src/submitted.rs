@@ -1,0 +1,159 @@
+//! The submitted-frames CSV (`VITREOUS_SIM_SUBMITTED`): one line per `xrEndFrame` the app
+//! makes, written and flushed before the frame goes on to the runtime, so a test can check
+//! what the app submitted even if the session dies.
+//!
+//! ```text
+//! frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend
+//! 0,1234567890,additive,1,projection,0x0,opaque
+//! ```
+//!
+//! `frame` counts the session's `xrEndFrame` calls from 0; `blend` is the app's
+//! `environmentBlendMode`, `runtime_blend` the one forwarded to the runtime; `layer_types`
+//! and `layer_flags` (hexadecimal `XrCompositionLayerFlags`) hold one entry per layer,
+//! `;`-separated, in submission order.
+
+use std::fs::File;
+use std::io::{self, Write};
+use std::path::Path;
+
+use openxr::sys;
+
+use crate::blend;
+
+/// The header line.
+pub const HEADER: &str = "frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend";
+
+/// One submitted composition layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LayerInfo {
+    /// The layer's structure type.
+    pub ty: sys::StructureType,
+    /// Its `layerFlags`.
+    pub flags: u64,
+}
+
+/// One submitted frame.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FrameInfo {
+    /// Index of the frame in its session.
+    pub frame: u64,
+    /// The frame's display time, ns.
+    pub display_time_ns: i64,
+    /// The app's blend mode.
+    pub blend: sys::EnvironmentBlendMode,
+    /// The blend mode forwarded to the runtime.
+    pub runtime_blend: sys::EnvironmentBlendMode,
+    /// The layers.
+    pub layers: Vec<LayerInfo>,
+}
+
+/// A short name for a composition layer type.
+fn layer_type_name(ty: sys::StructureType) -> String {
+    use sys::StructureType as S;
+    match ty {
+        S::COMPOSITION_LAYER_PROJECTION => "projection".to_owned(),
+        S::COMPOSITION_LAYER_QUAD => "quad".to_owned(),
+        S::COMPOSITION_LAYER_CYLINDER_KHR => "cylinder".to_owned(),
+        S::COMPOSITION_LAYER_CUBE_KHR => "cube".to_owned(),
+        S::COMPOSITION_LAYER_EQUIRECT_KHR => "equirect".to_owned(),
+        S::COMPOSITION_LAYER_EQUIRECT2_KHR => "equirect2".to_owned(),
+        S::COMPOSITION_LAYER_PASSTHROUGH_FB => "passthrough_fb".to_owned(),
+        other => other.into_raw().to_string(),
+    }
+}
+
+/// The CSV line of a frame, with its newline.
+pub fn line(f: &FrameInfo) -> String {
+    let types: Vec<String> = f.layers.iter().map(|l| layer_type_name(l.ty)).collect();
+    let flags: Vec<String> = f.layers.iter().map(|l| format!("{:#x}", l.flags)).collect();
+    format!(
+        "{},{},{},{},{},{},{}\n",
+        f.frame,
+        f.display_time_ns,
+        blend::name(f.blend),
+        f.layers.len(),
+        types.join(";"),
+        flags.join(";"),
+        blend::name(f.runtime_blend)
+    )
+}
+
+/// The open CSV file.
+#[derive(Debug)]
+pub struct SubmittedLog {
+    /// The file, unbuffered: every line is one write.
+    file: File,
+}
+
+impl SubmittedLog {
+    /// Creates (truncates) the file and writes the header.
+    pub fn create(path: &Path) -> io::Result<SubmittedLog> {
+        let mut file = File::create(path)?;
+        file.write_all(format!("{HEADER}\n").as_bytes())?;
+        Ok(SubmittedLog { file })
+    }
+
+    /// Appends a frame's line.
+    pub fn write(&mut self, frame: &FrameInfo) -> io::Result<()> {
+        self.file.write_all(line(frame).as_bytes())?;
+        self.file.flush()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_frame_is_one_line_with_layers_separated() {
+        let f = FrameInfo {
+            frame: 3,
+            display_time_ns: 42,
+            blend: sys::EnvironmentBlendMode::ALPHA_BLEND,
+            runtime_blend: sys::EnvironmentBlendMode::OPAQUE,
+            layers: vec![
+                LayerInfo {
+                    ty: sys::StructureType::COMPOSITION_LAYER_PROJECTION,
+                    flags: 0x1 | 0x2,
+                },
+                LayerInfo {
+                    ty: sys::StructureType::COMPOSITION_LAYER_QUAD,
+                    flags: 0,
+                },
+            ],
+        };
+        assert_eq!(
+            line(&f),
+            "3,42,alpha_blend,2,projection;quad,0x3;0x0,opaque\n"
+        );
+        let empty = FrameInfo {
+            layers: vec![],
+            ..f
+        };
+        assert_eq!(line(&empty), "3,42,alpha_blend,0,,,opaque\n");
+    }
+
+    #[test]
+    fn the_file_gets_a_header_and_flushed_lines() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.csv");
+        let mut log = SubmittedLog::create(&path).unwrap();
+        let f = FrameInfo {
+            frame: 0,
+            display_time_ns: 1,
+            blend: sys::EnvironmentBlendMode::ADDITIVE,
+            runtime_blend: sys::EnvironmentBlendMode::OPAQUE,
+            layers: vec![LayerInfo {
+                ty: sys::StructureType::COMPOSITION_LAYER_PROJECTION,
+                flags: 0x2,
+            }],
+        };
+        log.write(&f).unwrap();
+        // Read while the log is still open: the line is already there.
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(
+            text,
+            format!("{HEADER}\n0,1,additive,1,projection,0x2,opaque\n")
+        );
+    }
+}

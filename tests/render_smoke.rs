@@ -244,3 +244,149 @@ fn failed_construction_unwinds_without_leaks_at_every_step() {
     }
     panic!("construction still failing after 200 injected failures");
 }
+
+/// Each display blend mode composes as it must: ADDITIVE on black (alpha 1), ALPHA_BLEND the
+/// same light premultiplied over alpha 0 (the world shows through), OPAQUE over the real-world
+/// photos; the object in all three.
+#[test]
+fn each_composition_draws_the_object_over_what_its_display_needs() {
+    use vitreous_render::Composition;
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: true,
+        device_name: None,
+    })
+    .expect("Vulkan device with validation");
+    let (positions, normals, uvs, indices) = uv_sphere(32, 16);
+    let env = flat_environment(16, 8, 0.8);
+    let photo = grey_photo(4, 4, 128);
+    let photo_desc = TextureDesc {
+        width: 4,
+        height: 4,
+        data: TexelData::Srgb8(&photo),
+    };
+    // The background photo plane fills the view far behind the object.
+    let background = glam::Mat4::from_scale_rotation_translation(
+        Vec3::new(10.0, 10.0, 1.0),
+        Quat::IDENTITY,
+        Vec3::new(0.0, 0.0, -2.0),
+    );
+    let scene = SceneDesc {
+        mesh: MeshRef {
+            positions: &positions,
+            normals: &normals,
+            uvs: &uvs,
+            indices: &indices,
+        },
+        world_from_model: place(Vec3::new(0.0, 0.0, -0.5), 0.05),
+        ior: 1.5,
+        environment: TextureDesc {
+            width: 16,
+            height: 8,
+            data: TexelData::LinearF32(&env),
+        },
+        floor: PlaneDesc {
+            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -5.0, -0.5)),
+            photo: photo_desc,
+        },
+        background: PlaneDesc {
+            world_from_plane: background,
+            photo: photo_desc,
+        },
+        exposure: 1.0,
+        surface: None,
+        surface_transmittance: 1.0,
+        light: LightDesc {
+            position_m: Vec3::new(0.0, 1.0, 0.0),
+            radiance: Vec3::ONE,
+        },
+        background_stack: None,
+        surface_stack: None,
+        inducer: vitreous_render::InducerDesc {
+            resolution_px: 32,
+            ..vitreous_render::InducerDesc::PAPER
+        },
+        caustics: None,
+    };
+    let (w, h) = (96u32, 72u32);
+    let mut renderer = Renderer::new(ctx, &scene, w, h).expect("renderer");
+    let fov = Fov {
+        left_rad: -0.35,
+        right_rad: 0.35,
+        up_rad: 0.27,
+        down_rad: -0.27,
+    };
+    let params = FrameParams {
+        eyes: [-0.0315f32, 0.0315]
+            .map(|x| EyeParams::new(Vec3::new(x, 0.0, 0.0), Quat::IDENTITY, fov)),
+        look: Look::default(),
+    };
+    let want = Want {
+        eyes: true,
+        world: true,
+    };
+    let mut render = |c: Composition| {
+        let mut results: Vec<_> = renderer
+            .submit_composed(&params, want, c)
+            .unwrap()
+            .into_iter()
+            .collect();
+        results.extend(renderer.flush().unwrap());
+        results.pop().unwrap().readback.unwrap()
+    };
+    let additive = render(Composition::Additive);
+    let alpha = render(Composition::AlphaBlend);
+    let opaque = render(Composition::Opaque);
+    // A 10x10 px corner of each eye, far from the object.
+    let corner = |rgba: &[u8]| -> Vec<[u8; 4]> {
+        (0..10)
+            .flat_map(|row| (0..10).map(move |col| (row * w + col) as usize * 4))
+            .map(|i| [rgba[i], rgba[i + 1], rgba[i + 2], rgba[i + 3]])
+            .collect()
+    };
+    for eye in 0..2 {
+        let (_, lit) = lit_centroid(&additive.eyes[eye], w, 10).expect("object on additive");
+        assert!(lit > 50, "eye {eye}: {lit} lit px");
+        assert!(
+            corner(&additive.eyes[eye])
+                .iter()
+                .all(|p| *p == [0, 0, 0, 255])
+        );
+        // ALPHA_BLEND: the same light, alpha 0 everywhere.
+        let (a, b) = (&additive.eyes[eye], &alpha.eyes[eye]);
+        assert!(
+            b.chunks_exact(4).all(|p| p[3] == 0),
+            "eye {eye}: alpha above 0"
+        );
+        assert!(
+            a.chunks_exact(4)
+                .zip(b.chunks_exact(4))
+                .all(|(p, q)| p[..3] == q[..3]),
+            "eye {eye}: alpha-blend colour differs from additive"
+        );
+        // OPAQUE: the real world where the object is not, and the object where it is.
+        let world = &opaque.world.as_ref().unwrap()[eye];
+        let seen = corner(&opaque.eyes[eye]);
+        assert!(
+            seen.iter().all(|p| p[0] > 40 && p[3] == 255),
+            "{:?}",
+            seen[0]
+        );
+        assert_eq!(seen, corner(world));
+        let differs = opaque.eyes[eye]
+            .chunks_exact(4)
+            .zip(world.chunks_exact(4))
+            .filter(|(p, q)| p[..3].iter().zip(&q[..3]).any(|(x, y)| x.abs_diff(*y) > 8))
+            .count();
+        assert!(
+            differs > 50,
+            "eye {eye}: object over the world in {differs} px"
+        );
+    }
+    let v = renderer.context().validation();
+    assert_eq!(
+        v.errors() + v.warnings(),
+        0,
+        "validation messages: {:#?}",
+        v.messages()
+    );
+}

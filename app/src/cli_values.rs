@@ -41,6 +41,12 @@ pub fn parse_blend(s: &str) -> Result<vitreous_xr::openxr::Blend, String> {
         .ok_or_else(|| format!("expected additive, alpha-blend or opaque, got '{s}'"))
 }
 
+/// A gaze source for `--gaze`: `auto`, `ml`, `fb`, `ext`, `trace` or `manual`.
+pub fn parse_gaze(s: &str) -> Result<vitreous_xr::openxr::GazeChoice, String> {
+    vitreous_xr::openxr::GazeChoice::parse(s)
+        .ok_or_else(|| format!("expected auto, ml, fb, ext, trace or manual, got '{s}'"))
+}
+
 /// An effect set or condition (`O4`, `c`, `disparity,defocus`).
 pub fn parse_effects(s: &str) -> Result<EffectSet, String> {
     EffectSet::parse(s).map_err(|e| e.to_string())

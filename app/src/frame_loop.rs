@@ -8,7 +8,8 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{Look, Renderer};
+use vitreous_render::{Composition, Look, Renderer};
+use vitreous_xr::openxr::Blend;
 use vitreous_xr::{Backend, FrameInput, FrameTarget};
 
 use crate::views;
@@ -74,26 +75,16 @@ pub fn run<B: Backend>(
         let Some(input) = backend.wait_frame().context("waiting for the next frame")? else {
             break;
         };
-        sink.started(&input)?;
-        let started = Instant::now();
-        let plan = sink.plan(&input);
-        let params = views::frame_params(&input, plan.look);
-        let prepare_ms = started.elapsed().as_secs_f64() * 1e3;
-        let done = match backend.frame_target() {
-            FrameTarget::Own => renderer.submit(&params, plan.want),
-            FrameTarget::Swapchain {
-                index,
-                depth_index,
-                world_behind,
-            } => renderer.submit_external_with_depth(
-                index as usize,
-                depth_index.map(|d| d as usize),
-                &params,
-                plan.want,
-                world_behind,
-            ),
-        }
-        .context("rendering a frame")?;
+        // Between wait_frame and end_frame an error must give the frame back to the backend
+        // (release its images, end it unshown) before it is returned.
+        let drawn = draw(backend, renderer, sink, &input);
+        let (prepare_ms, plan, done) = match drawn {
+            Ok(d) => d,
+            Err(e) => {
+                backend.abandon_frame();
+                return Err(e);
+            }
+        };
         backend.end_frame(&input).context("ending a frame")?;
         in_flight.push_back((input, prepare_ms, plan.look));
         if let Some(result) = done {
@@ -104,6 +95,46 @@ pub fn run<B: Backend>(
         finish(&mut in_flight, sink, &mut records, result)?;
     }
     Ok(records)
+}
+
+/// Plans and renders one frame where the backend says; returns the CPU time of the planning
+/// (milliseconds), the plan, and the result of a frame that finished meanwhile.
+fn draw<B: Backend>(
+    backend: &B,
+    renderer: &mut Renderer,
+    sink: &mut dyn FrameSink,
+    input: &FrameInput,
+) -> Result<(f64, FramePlan, Option<FrameResult>)> {
+    sink.started(input)?;
+    let started = Instant::now();
+    let plan = sink.plan(input);
+    let params = views::frame_params(input, plan.look);
+    let prepare_ms = started.elapsed().as_secs_f64() * 1e3;
+    let done = match backend.frame_target() {
+        FrameTarget::Own => renderer.submit(&params, plan.want),
+        FrameTarget::Swapchain {
+            index,
+            depth_index,
+            blend,
+        } => renderer.submit_external_with_depth(
+            index as usize,
+            depth_index.map(|d| d as usize),
+            &params,
+            plan.want,
+            composition_for(blend),
+        ),
+    }
+    .context("rendering a frame")?;
+    Ok((prepare_ms, plan, done))
+}
+
+/// How the renderer composes the eye images for a display blend mode.
+pub fn composition_for(blend: Blend) -> Composition {
+    match blend {
+        Blend::Additive => Composition::Additive,
+        Blend::AlphaBlend => Composition::AlphaBlend,
+        Blend::Opaque => Composition::Opaque,
+    }
 }
 
 /// Hands the oldest frame in flight, now finished, to the sink and records its timing.

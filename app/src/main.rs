@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use vitreous::bench::{BenchOptions, bench};
 use vitreous::cli_values::{
-    parse_blend, parse_effects, parse_frame_count, parse_frame_count_usize, parse_size,
+    parse_blend, parse_effects, parse_frame_count, parse_frame_count_usize, parse_gaze, parse_size,
 };
 use vitreous::effects::EffectSet;
 use vitreous::gaze::{FilterKind, GazeOverride};
@@ -38,9 +38,15 @@ enum Command {
         /// End the session after N frames (default: until the runtime or Ctrl-C ends it).
         #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_frame_count)]
         frames: Option<u64>,
-        /// Replay gaze from this trace when the headset has no eye tracker.
+        /// Replay gaze from this trace when the headset has no per-eye eye tracker (with
+        /// XR_EXT_eye_gaze_interaction's combined ray alone, it decides the gaze image).
         #[arg(long, value_name = "FILE")]
         gaze_trace: Option<PathBuf>,
+        /// Gaze source: auto (XR_ML_eye_tracker, then XR_FB_eye_tracking_social, then
+        /// XR_EXT_eye_gaze_interaction, then the trace, then manual), or one of ml, fb, ext,
+        /// trace, manual (an error when it is not offered).
+        #[arg(long, value_name = "SOURCE", value_parser = parse_gaze, default_value = "auto")]
+        gaze: vitreous_xr::openxr::GazeChoice,
         /// Record head pose and gaze of every frame into this trace file.
         #[arg(long, value_name = "FILE")]
         record: Option<PathBuf>,
@@ -298,6 +304,7 @@ fn run(cli: Cli) -> Result<()> {
             scene,
             frames,
             gaze_trace,
+            gaze,
             record,
             validate,
             readback_check,
@@ -315,6 +322,7 @@ fn run(cli: Cli) -> Result<()> {
                 scene,
                 frames,
                 gaze_trace,
+                gaze,
                 record,
                 validate,
                 readback_check,

@@ -203,7 +203,7 @@ impl GlassPass {
                 attributes: &attributes,
                 cull: vk::CullModeFlags::BACK,
                 depth: true,
-                blend: Blend::Replace,
+                blend: Blend::ReplaceColor,
             },
         )?;
         let pool = pipeline::pool(

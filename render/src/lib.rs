@@ -46,7 +46,7 @@ pub use error::{RenderError, Result};
 /// The floor passes under their earlier name.
 pub use floor as inducer;
 pub use floor::InducerFields;
-pub use renderer::{FrameResult, FrameTiming, Readback, Renderer, Want};
+pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
     BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData,
     TextureDesc,

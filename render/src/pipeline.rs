@@ -21,6 +21,9 @@ use crate::shaders;
 pub enum Blend {
     /// Overwrite (each layer owns its pixels).
     Replace,
+    /// Overwrite the colour and keep the target's alpha (the eye passes' alpha is the one
+    /// their clear value sets, see [`crate::renderer::Composition`]).
+    ReplaceColor,
     /// Add to the target's colour (ONE, ONE) without touching alpha: light added on top.
     Add,
 }
@@ -118,6 +121,13 @@ pub fn create(ctx: &GpuContext, spec: &PipelineSpec) -> Result<Owned<vk::Pipelin
         Blend::Replace => vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(false)
             .color_write_mask(vk::ColorComponentFlags::RGBA),
+        Blend::ReplaceColor => vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(false)
+            .color_write_mask(
+                vk::ColorComponentFlags::R
+                    | vk::ColorComponentFlags::G
+                    | vk::ColorComponentFlags::B,
+            ),
     }];
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
     let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];

@@ -17,7 +17,10 @@ use crate::scene::{GpuScene, SceneDesc};
 use crate::target::{self, StereoTarget};
 use crate::world::WorldPass;
 
+mod composition;
 mod external;
+
+pub use composition::Composition;
 
 /// Frames that may be in flight at once.
 pub const PIPELINE_DEPTH: usize = 2;
@@ -250,6 +253,25 @@ impl Renderer {
         self.submit_to(params, want, None)
     }
 
+    /// Like [`Renderer::submit`], composed for a display that blends as `composition` says
+    /// (what is drawn behind the glass, and the alpha written); [`Renderer::submit`] is
+    /// [`Composition::Additive`].
+    pub fn submit_composed(
+        &mut self,
+        params: &FrameParams,
+        want: Want,
+        composition: Composition,
+    ) -> Result<Option<FrameResult>> {
+        self.submit_to(
+            params,
+            want,
+            Some(external::ExternalDraw {
+                image: external::OWN_TARGET,
+                composition,
+            }),
+        )
+    }
+
     /// [`Renderer::submit`], drawing into an attached external image when `draw` says so.
     fn submit_to(
         &mut self,
@@ -390,22 +412,22 @@ impl Renderer {
         // Where the eyes go: the renderer's own target, or an attached external image (left in
         // COLOR_ATTACHMENT_OPTIMAL by its render pass), with the real world drawn behind when
         // the display shows no real world of its own.
-        let (eye_framebuffers, eye_image, eye_pass, world_behind) =
-            match (draw, self.external.as_ref()) {
-                (Some(draw), Some(ext)) => (
-                    ext.framebuffers(draw.image),
-                    ext.images[draw.image],
-                    ext.render_pass(),
-                    draw.world_behind,
-                ),
-                _ => (
-                    self.eye_target.framebuffers(),
-                    self.eye_target.color.image,
-                    self.render_pass.raw(),
-                    false,
-                ),
-            };
-        let external_image = draw.is_some() && self.external.is_some();
+        let composition = draw.map_or(Composition::Additive, |d| d.composition);
+        let external = draw.filter(|d| d.image != external::OWN_TARGET);
+        let (eye_framebuffers, eye_image, eye_pass) = match (external, self.external.as_ref()) {
+            (Some(draw), Some(ext)) => (
+                ext.framebuffers(draw.image),
+                ext.images[draw.image],
+                ext.render_pass(),
+            ),
+            _ => (
+                self.eye_target.framebuffers(),
+                self.eye_target.color.image,
+                self.render_pass.raw(),
+            ),
+        };
+        let world_behind = composition.world_behind();
+        let external_image = external.is_some() && self.external.is_some();
         let mut prepared = Prepared::default();
         // SAFETY: the caller's contract (recording, previous use finished); every pass is
         // given a command buffer in the state its `record`/`prepare` requires: `prepare`
@@ -425,7 +447,12 @@ impl Renderer {
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 0);
             }
             for (index, eye) in params.eyes.iter().enumerate() {
-                self.begin_pass(cmd, eye_pass, eye_framebuffers[index]);
+                self.begin_pass(
+                    cmd,
+                    eye_pass,
+                    eye_framebuffers[index],
+                    composition.clear_alpha(),
+                );
                 if world_behind {
                     self.world.record(&self.ctx, cmd, eye);
                 }
@@ -456,6 +483,7 @@ impl Renderer {
                         cmd,
                         self.render_pass.raw(),
                         self.world_target.framebuffers()[index],
+                        1.0,
                     );
                     self.world.record(&self.ctx, cmd, eye);
                     d.cmd_end_render_pass(cmd);
@@ -529,7 +557,8 @@ impl Renderer {
         prepared
     }
 
-    /// Begins `render_pass` on `framebuffer`, clearing to black (no light) and far depth.
+    /// Begins `render_pass` on `framebuffer`, clearing to black (no light) with alpha `alpha`
+    /// (which the eye passes keep) and far depth.
     ///
     /// # Safety
     /// `cmd` must be recording outside any render pass; the framebuffer must belong to a
@@ -539,11 +568,12 @@ impl Renderer {
         cmd: vk::CommandBuffer,
         render_pass: vk::RenderPass,
         framebuffer: vk::Framebuffer,
+        alpha: f32,
     ) {
         let clear = [
             vk::ClearValue {
                 color: vk::ClearColorValue {
-                    float32: [0.0, 0.0, 0.0, 1.0],
+                    float32: [0.0, 0.0, 0.0, alpha],
                 },
             },
             vk::ClearValue {

@@ -69,7 +69,7 @@ impl WorldPass {
                 attributes: &[],
                 cull: vk::CullModeFlags::NONE,
                 depth: true,
-                blend: Blend::Replace,
+                blend: Blend::ReplaceColor,
             },
         )?;
         let pool = pipeline::pool(

@@ -133,6 +133,13 @@ pub trait Backend {
     /// Tells the backend the frame handed out by the last `wait_frame` has been rendered.
     fn end_frame(&mut self, frame: &FrameInput) -> Result<(), Self::Error>;
 
+    /// Leaves the frame handed out by the last `wait_frame` without showing it, when the app
+    /// failed before [`Backend::end_frame`]: whatever the frame holds (display images, the
+    /// begun frame) is given back. Never fails: clean-up errors are the backend's to log, so
+    /// the app's error stays the one reported. Backends with nothing to give back keep the
+    /// default, which does nothing.
+    fn abandon_frame(&mut self) {}
+
     /// Where the frame handed out by the last `wait_frame` is to be drawn. Backends that
     /// own no display images (the null backend) keep the default, [`FrameTarget::Own`].
     fn frame_target(&self) -> FrameTarget {
@@ -145,15 +152,15 @@ pub trait Backend {
 pub enum FrameTarget {
     /// The renderer's own images (replay, previews, readback).
     Own,
-    /// Image `index` of the backend's swapchain, handed to the renderer before the loop; with
-    /// `world_behind`, the real world is drawn behind the glass (an opaque display).
+    /// Image `index` of the backend's swapchain, handed to the renderer before the loop,
+    /// composed for the display's blend mode (what is drawn behind the glass, which alpha).
     Swapchain {
         /// Index of the swapchain image acquired for this frame.
         index: u32,
         /// Index of the depth swapchain image acquired for this frame, when depth is
         /// submitted (XR_KHR_composition_layer_depth); the renderer writes its depth there.
         depth_index: Option<u32>,
-        /// Draw the scene's real-world photos behind the glass.
-        world_behind: bool,
+        /// How the display blends the image with the real world.
+        blend: crate::openxr::Blend,
     },
 }

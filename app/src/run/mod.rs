@@ -36,14 +36,16 @@ use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
 use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::ash::vk;
 use vitreous_xr::openxr::{
-    Blend, Command, DepthOptions, OpenXrOptions, Runtime, SessionOptions, SessionReport, State,
-    VulkanHandles,
+    Blend, Command, DepthOptions, GazeChoice, OpenXrOptions, Runtime, SessionOptions,
+    SessionReport, State, VulkanHandles,
 };
 use vitreous_xr::trace::TraceWriter;
 
 pub use device::XrDeviceCreator;
 pub use live::{CONDITION_CYCLE, GAZE_IMAGE_CYCLE, LiveLooks, STUDY_CONDITIONS, live_conditions};
-pub use readback::{LIT_THRESHOLD, MIN_OBJECT_FRACTION, ReadbackCheck};
+pub use readback::{
+    AWAY_RADII, LIT_THRESHOLD, MIN_AWAY_FRACTION, MIN_OBJECT_FRACTION, ReadbackCheck,
+};
 pub use recording::ReplayCheck;
 
 use crate::effects::EffectSet;
@@ -64,8 +66,11 @@ pub struct RunOptions {
     pub scene: PathBuf,
     /// End the session after this many frames (None: until the runtime or Ctrl-C ends it).
     pub frames: Option<u64>,
-    /// Gaze replayed from this trace when the headset has no eye tracker.
+    /// Gaze replayed from this trace when the headset has no per-eye eye tracker (with the
+    /// combined XR_EXT_eye_gaze_interaction ray alone, it decides the gaze image).
     pub gaze_trace: Option<PathBuf>,
+    /// Which gaze source to use (`--gaze`): the best offered, or a forced one.
+    pub gaze: GazeChoice,
     /// Record head pose and gaze of every frame into this trace file.
     pub record: Option<PathBuf>,
     /// Turn on the Vulkan validation layers and the OpenXR core validation layer; any Vulkan
@@ -100,14 +105,22 @@ pub struct RunSummary {
     pub extensions: Vec<String>,
     /// Blend modes offered.
     pub blend_modes_offered: Vec<String>,
-    /// The blend mode used.
+    /// The blend mode used: `additive`, `alpha-blend` or `opaque`.
     pub blend: String,
     /// Whether the real world was drawn behind the glass (opaque displays).
     pub world_behind: bool,
     /// The reference space.
     pub space: String,
-    /// The gaze source.
+    /// The gaze source: `ml` (XR_ML_eye_tracker), `fb` (XR_FB_eye_tracking_social), `ext`
+    /// (XR_EXT_eye_gaze_interaction), `trace` or `manual`.
     pub gaze_source: String,
+    /// The gaze source's samples.
+    pub gaze_samples: GazeSamples,
+    /// XrEventDataReferenceSpaceChangePending events for the scene's space (each re-anchored
+    /// the scene at the next head pose).
+    pub space_changes: u64,
+    /// Frames begun but left unshown after an error (ended with no layers).
+    pub frames_abandoned: u64,
     /// Swapchain format and whether it encodes sRGB.
     pub swapchain_format: String,
     /// Session states reached, in order.
@@ -180,7 +193,8 @@ impl RunSummary {
         let _ = writeln!(
             out,
             "session on {} ({}): states {}; {} frames submitted ({} skipped) at {}x{} per \
-             eye, {:.1} frames/s; blend {}; gaze {}; ended: {}",
+             eye, {:.1} frames/s; blend {}; gaze {} ({} of {} frames with a fresh sample); \
+             ended: {}",
             self.runtime,
             self.system,
             self.states.join(" > "),
@@ -191,8 +205,18 @@ impl RunSummary {
             self.frames_per_second,
             self.blend,
             self.gaze_source,
+            self.gaze_samples.fresh_frames,
+            self.gaze_samples.frames,
             self.end_reason
         );
+        if self.space_changes + self.frames_abandoned > 0 {
+            let _ = writeln!(
+                out,
+                "reference space changes: {} (scene re-anchored each time); frames left \
+                 unshown after an error: {}",
+                self.space_changes, self.frames_abandoned
+            );
+        }
         let _ = writeln!(
             out,
             "vulkan validation: {} errors, {} warnings (enabled: {})",
@@ -221,12 +245,18 @@ impl RunSummary {
         if let Some(c) = &self.readback {
             let _ = writeln!(
                 out,
-                "readback of frame {}: object in {:.1} % of its region ({} of {} px), mean {:.1}",
+                "readback of frame {} ({}): object in {:.1} % of its region ({} of {} px), mean \
+                 {:.1}; {:.1} % of the {} px away from it as the blend mode needs; {} px with \
+                 alpha above 0",
                 c.frame,
+                c.blend,
                 c.object_fraction * 100.0,
                 c.object_px,
                 c.region_px,
-                c.mean_value
+                c.mean_value,
+                c.away_fraction * 100.0,
+                c.away_px,
+                c.alpha_nonzero_px
             );
         }
         if let Some(r) = &self.replay_check {
@@ -245,6 +275,18 @@ impl RunSummary {
     }
 }
 
+/// The gaze source's samples over the session.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct GazeSamples {
+    /// Frames the source was asked for a sample.
+    pub frames: u64,
+    /// Frames it gave a sample (for `ext`: the runtime's combined ray, also when the trace
+    /// decides the gaze image).
+    pub received: u64,
+    /// Frames whose sample was newer than any before: a fresh sample.
+    pub fresh_frames: u64,
+}
+
 /// Records frames and checks a readback.
 struct RunSink {
     /// Decides each frame's look (effect condition, gaze-dependent defocus).
@@ -257,8 +299,8 @@ struct RunSink {
     object_center_m: glam::Vec3,
     /// The object's radius.
     object_radius_m: f32,
-    /// Whether the world is drawn behind.
-    world_behind: bool,
+    /// The blend mode the images are composed for.
+    blend: Blend,
     /// The readback result.
     readback: Option<ReadbackCheck>,
     /// Where head pose and gaze are recorded, if asked.
@@ -317,7 +359,7 @@ impl FrameSink for RunSink {
                 rb,
                 self.object_center_m,
                 self.object_radius_m,
-                self.world_behind,
+                self.blend,
             ));
         }
         Ok(())
@@ -408,6 +450,7 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
             &SessionOptions {
                 max_frames: options.frames,
                 gaze_trace: options.gaze_trace.clone(),
+                gaze: options.gaze,
                 scene_origin: None,
                 viewer_position_m: scene.viewer.head_position_m,
                 handle_ctrl_c: true,
@@ -460,7 +503,7 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
             .then(|| options.frames.map_or(10, |n| (n / 2).min(10)).max(1) - 1),
         object_center_m: scene.object.center_m,
         object_radius_m: scene.object.radius_m,
-        world_behind,
+        blend: info.blend,
         readback: None,
         writer,
         recorded: Vec::new(),
@@ -472,15 +515,18 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
     let wall_s = started.elapsed().as_secs_f64();
     // Teardown order: images out of the renderer, then the session, then (at the end) the
     // device with the renderer, then the OpenXR instance.
-    renderer
+    // The loop's error is the one reported; a clean-up failing after it (releasing the images
+    // of a lost device) is logged.
+    let detached = renderer
         .detach_external()
-        .context("releasing the swapchain images")?;
+        .context("releasing the swapchain images");
     let report: SessionReport = session.report().clone();
     drop(session);
-    if let Some(w) = sink.writer.take() {
-        w.finish().context("closing the recording")?;
-    }
-    let records = result?;
+    let closed = match sink.writer.take() {
+        Some(w) => w.finish().map(drop).context("closing the recording"),
+        None => Ok(()),
+    };
+    let records = first_error(first_error(result, detached), closed)?;
     sink.log.finish()?;
 
     let v = renderer.context().validation();
@@ -513,8 +559,15 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         space: report.space.map(|s| format!("{s:?}")).unwrap_or_default(),
         gaze_source: report
             .gaze_source
-            .map(|g| g.to_string())
+            .map(|g| g.key().to_owned())
             .unwrap_or_default(),
+        gaze_samples: GazeSamples {
+            frames: report.gaze_samples.frames,
+            received: report.gaze_samples.received,
+            fresh_frames: report.gaze_samples.fresh,
+        },
+        space_changes: report.space_changes,
+        frames_abandoned: report.frames_abandoned,
         swapchain_format: format!("{:?} (sRGB: {})", images.format, images.srgb),
         states: report.states.iter().map(ToString::to_string).collect(),
         reached_focused: report.reached(State::Focused),
@@ -577,18 +630,48 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         match &summary.readback {
             Some(c) if c.passed => {}
             Some(c) => bail!(
-                "readback check failed: frame {} shows the object in {:.1} % of its region \
-                 ({} of {} px); expected at least {:.0} %",
+                "readback check failed ({} blend): frame {} shows the object in {:.1} % of its \
+                 region ({} of {} px; expected at least {:.0} %), {:.1} % of the pixels away \
+                 from it as the blend mode needs (expected at least {:.0} %: {}), {} px with \
+                 alpha above 0{}",
+                c.blend,
                 c.frame,
                 c.object_fraction * 100.0,
                 c.object_px,
                 c.region_px,
-                MIN_OBJECT_FRACTION * 100.0
+                MIN_OBJECT_FRACTION * 100.0,
+                c.away_fraction * 100.0,
+                MIN_AWAY_FRACTION * 100.0,
+                if info.blend.needs_world_behind() {
+                    "the real-world photos"
+                } else {
+                    "black"
+                },
+                c.alpha_nonzero_px,
+                if info.blend.uses_source_alpha() {
+                    " (expected none)"
+                } else {
+                    ""
+                }
             ),
             None => bail!("readback check: no frame was read back (the session ended first)"),
         }
     }
     Ok(summary)
+}
+
+/// `result`, unless it succeeded and `cleanup` (done after it) failed: the first error is the
+/// one returned; a clean-up error after a failure is logged.
+fn first_error<T>(result: Result<T>, cleanup: Result<()>) -> Result<T> {
+    match (result, cleanup) {
+        (Ok(v), Ok(())) => Ok(v),
+        (Ok(_), Err(e)) => Err(e),
+        (Err(e), Ok(())) => Err(e),
+        (Err(e), Err(later)) => {
+            tracing::warn!("after the failure, also: {later:#}");
+            Err(e)
+        }
+    }
 }
 
 /// A frame at time 5 ns with identity poses and no gaze, for the tests of this module's parts.
@@ -605,5 +688,23 @@ pub(crate) fn test_frame() -> FrameInput {
         head: Pose::IDENTITY,
         views: [view, view],
         gaze: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_error_is_the_one_reported() {
+        let lost = || -> Result<u32> { Err(anyhow::anyhow!("device lost")) };
+        let cleanup = || -> Result<()> { Err(anyhow::anyhow!("releasing the swapchain images")) };
+        let e = first_error(lost(), cleanup()).unwrap_err();
+        assert_eq!(e.to_string(), "device lost");
+        let e = first_error(Ok(3), cleanup()).unwrap_err();
+        assert_eq!(e.to_string(), "releasing the swapchain images");
+        assert_eq!(first_error(Ok(3), Ok(())).unwrap(), 3);
+        let e = first_error(first_error(lost(), Ok(())), cleanup()).unwrap_err();
+        assert_eq!(e.to_string(), "device lost");
     }
 }

@@ -1,15 +1,21 @@
 //! The readback check of `vitreous run --readback-check`: one submitted swapchain image read
-//! back and the object's projected disc searched for lit pixels, so a run proves it drew the
-//! object where the headset looks.
+//! back; the object's projected disc is searched for lit pixels (the run drew the object where
+//! the headset looks), and the pixels away from it are checked against what the blend mode
+//! needs there: black on ADDITIVE and ALPHA_BLEND (nothing added to the world), the scene's
+//! real-world photos on OPAQUE; on ALPHA_BLEND every pixel's alpha must be 0 (premultiplied
+//! colour over alpha 0, so the world shows through).
 
 use serde::Serialize;
 use vitreous_xr::FrameInput;
+use vitreous_xr::openxr::Blend;
 
 /// What the readback of a submitted swapchain image showed.
 #[derive(Clone, Debug, Serialize)]
 pub struct ReadbackCheck {
     /// Index of the frame read back.
     pub frame: u64,
+    /// The blend mode the image was composed for.
+    pub blend: String,
     /// Pixels (both eyes) inside the object's projected disc.
     pub region_px: u64,
     /// Of those, pixels where the submitted image differs from the real world alone (or from
@@ -19,7 +25,16 @@ pub struct ReadbackCheck {
     pub object_fraction: f64,
     /// Mean sRGB value (0-255) of the submitted image inside the region.
     pub mean_value: f64,
-    /// Whether the check passed (`object_fraction >= MIN_OBJECT_FRACTION`).
+    /// Pixels (both eyes) away from the object: outside [`AWAY_RADII`] times its disc.
+    pub away_px: u64,
+    /// Share of those showing what the blend mode needs there (within [`LIT_THRESHOLD`]):
+    /// black (ADDITIVE, ALPHA_BLEND) or the real-world photos (OPAQUE).
+    pub away_fraction: f64,
+    /// Pixels (both eyes) whose alpha is not 0 (must be none on ALPHA_BLEND).
+    pub alpha_nonzero_px: u64,
+    /// Whether the check passed: the object shows (`object_fraction >=
+    /// MIN_OBJECT_FRACTION`), the pixels away from it are as the blend mode needs
+    /// (`away_fraction >= MIN_AWAY_FRACTION`), and on ALPHA_BLEND no alpha is above 0.
     pub passed: bool,
 }
 
@@ -27,52 +42,79 @@ pub struct ReadbackCheck {
 pub const LIT_THRESHOLD: u8 = 8;
 /// Share of the object's region that must show it.
 pub const MIN_OBJECT_FRACTION: f64 = 0.2;
+/// Pixels farther than this many object radii from its projected centre are "away" from it.
+pub const AWAY_RADII: f32 = 2.0;
+/// Share of the pixels away from the object that must show what the blend mode needs (the
+/// rest: the light the shadow inducer and the caustics add to the floor around the object).
+pub const MIN_AWAY_FRACTION: f64 = 0.8;
 
-/// Counts the object's pixels in a readback of both eyes (see [`ReadbackCheck`]).
+/// Checks a readback of both eyes (see [`ReadbackCheck`]); `rb.world` (the real world alone)
+/// is what OPAQUE must show away from the object.
 pub(super) fn check_readback(
     input: &FrameInput,
     rb: &vitreous_render::Readback,
     center_m: glam::Vec3,
     radius_m: f32,
-    world_behind: bool,
+    blend: Blend,
 ) -> ReadbackCheck {
+    let world_behind = blend.needs_world_behind();
     let (w, h) = (rb.width as usize, rb.height as usize);
     let (mut region, mut object, mut sum) = (0u64, 0u64, 0f64);
+    let (mut away, mut away_ok, mut alpha_nonzero) = (0u64, 0u64, 0u64);
     for eye in 0..2 {
         let view = &input.views[eye];
-        // The object's centre in the eye frame, projected with the eye's (asymmetric) fov.
-        let p = view.pose.orientation.conjugate() * (center_m - view.pose.position);
-        if p.z >= -1e-4 {
-            continue;
-        }
-        let (l, r) = (
-            view.fov.angle_left_rad.tan(),
-            view.fov.angle_right_rad.tan(),
-        );
-        let (d, u) = (view.fov.angle_down_rad.tan(), view.fov.angle_up_rad.tan());
-        let (x, y) = (p.x / -p.z, p.y / -p.z);
-        let px = (x - l) / (r - l) * w as f32;
-        let py = (u - y) / (u - d) * h as f32;
-        let rad = (radius_m / p.length()).min(1.0).asin().tan();
-        let (rx, ry) = (rad / (r - l) * w as f32, rad / (u - d) * h as f32);
         let image = &rb.eyes[eye];
         let world = rb.world.as_ref().map(|wv| &wv[eye]);
+        // The object's centre in the eye frame, projected with the eye's (asymmetric) fov;
+        // behind the eye there is no disc and every pixel is away from it.
+        let p = view.pose.orientation.conjugate() * (center_m - view.pose.position);
+        let disc = (p.z < -1e-4).then(|| {
+            let (l, r) = (
+                view.fov.angle_left_rad.tan(),
+                view.fov.angle_right_rad.tan(),
+            );
+            let (d, u) = (view.fov.angle_down_rad.tan(), view.fov.angle_up_rad.tan());
+            let (x, y) = (p.x / -p.z, p.y / -p.z);
+            let px = (x - l) / (r - l) * w as f32;
+            let py = (u - y) / (u - d) * h as f32;
+            let rad = (radius_m / p.length()).min(1.0).asin().tan();
+            (px, py, rad / (r - l) * w as f32, rad / (u - d) * h as f32)
+        });
         for row in 0..h {
             for col in 0..w {
-                let dx = (col as f32 + 0.5 - px) / rx;
-                let dy = (row as f32 + 0.5 - py) / ry;
-                if dx * dx + dy * dy > 1.0 {
+                let i = (row * w + col) * 4;
+                let got = &image[i..i + 3];
+                if image[i + 3] != 0 {
+                    alpha_nonzero += 1;
+                }
+                let r2 = disc.map_or(f32::INFINITY, |(px, py, rx, ry)| {
+                    let dx = (col as f32 + 0.5 - px) / rx;
+                    let dy = (row as f32 + 0.5 - py) / ry;
+                    dx * dx + dy * dy
+                });
+                let like_world = |wv: &Vec<u8>| {
+                    got.iter()
+                        .zip(&wv[i..i + 3])
+                        .all(|(&a, &b)| a.abs_diff(b) <= LIT_THRESHOLD)
+                };
+                if r2 > AWAY_RADII * AWAY_RADII {
+                    away += 1;
+                    let ok = match (world_behind, world) {
+                        (true, Some(wv)) => like_world(wv),
+                        (true, None) => false,
+                        (false, _) => got.iter().all(|&a| a <= LIT_THRESHOLD),
+                    };
+                    if ok {
+                        away_ok += 1;
+                    }
+                }
+                if r2 > 1.0 {
                     continue;
                 }
                 region += 1;
-                let i = (row * w + col) * 4;
-                let got = &image[i..i + 3];
                 sum += got.iter().map(|&v| f64::from(v)).sum::<f64>() / 3.0;
                 let lit = match (world_behind, world) {
-                    (true, Some(wv)) => got
-                        .iter()
-                        .zip(&wv[i..i + 3])
-                        .any(|(&a, &b)| a.abs_diff(b) > LIT_THRESHOLD),
+                    (true, Some(wv)) => !like_world(wv),
                     _ => got.iter().any(|&a| a > LIT_THRESHOLD),
                 };
                 if lit {
@@ -81,22 +123,29 @@ pub(super) fn check_readback(
             }
         }
     }
-    let fraction = if region == 0 {
-        0.0
-    } else {
-        object as f64 / region as f64
-    };
+    let share = |n: u64, of: u64| if of == 0 { 0.0 } else { n as f64 / of as f64 };
+    let object_fraction = share(object, region);
+    let away_fraction = share(away_ok, away);
+    let alpha_ok = !blend.uses_source_alpha() || alpha_nonzero == 0;
     ReadbackCheck {
         frame: input.index,
+        blend: blend.to_string(),
         region_px: region,
         object_px: object,
-        object_fraction: fraction,
+        object_fraction,
         mean_value: if region == 0 {
             0.0
         } else {
             sum / region as f64
         },
-        passed: region > 0 && fraction >= MIN_OBJECT_FRACTION,
+        away_px: away,
+        away_fraction,
+        alpha_nonzero_px: alpha_nonzero,
+        passed: region > 0
+            && object_fraction >= MIN_OBJECT_FRACTION
+            && away > 0
+            && away_fraction >= MIN_AWAY_FRACTION
+            && alpha_ok,
     }
 }
 
@@ -105,35 +154,131 @@ mod tests {
     use super::*;
     use crate::run::test_frame as frame;
 
-    #[test]
-    fn readback_check_counts_lit_pixels_in_the_object_disc() {
-        let (w, h) = (32u32, 32u32);
-        let mut lit = vec![0u8; (w * h * 4) as usize];
-        for px in lit.chunks_exact_mut(4) {
-            px.copy_from_slice(&[200, 200, 200, 255]);
+    const W: u32 = 32;
+    const H: u32 = 32;
+
+    /// An image of `background` with the pixels within 4 px of the centre `object`.
+    fn image(background: [u8; 4], object: [u8; 4]) -> Vec<u8> {
+        let mut out = Vec::new();
+        for row in 0..H {
+            for col in 0..W {
+                let (dx, dy) = (col as f32 + 0.5 - 16.0, row as f32 + 0.5 - 16.0);
+                out.extend(if dx * dx + dy * dy < 16.0 {
+                    object
+                } else {
+                    background
+                });
+            }
         }
-        let dark = vec![0u8; (w * h * 4) as usize];
-        let rb = |eyes: [Vec<u8>; 2]| vitreous_render::Readback {
-            width: w,
-            height: h,
-            eyes,
-            world: None,
-        };
-        let center = glam::Vec3::new(0.0, 0.0, -1.0);
-        let c = check_readback(&frame(), &rb([lit.clone(), lit]), center, 0.1, false);
-        assert!(
-            c.passed && c.region_px > 0 && c.object_px == c.region_px,
-            "{c:?}"
-        );
-        let c = check_readback(&frame(), &rb([dark.clone(), dark]), center, 0.1, false);
-        assert!(!c.passed && c.object_px == 0);
-        // Behind the viewer: no region, no pass.
+        out
+    }
+
+    fn readback(eye: Vec<u8>, world: Option<Vec<u8>>) -> vitreous_render::Readback {
+        vitreous_render::Readback {
+            width: W,
+            height: H,
+            eyes: [eye.clone(), eye],
+            world: world.map(|w| [w.clone(), w]),
+        }
+    }
+
+    /// The test frame's fov is 1 rad across 32 px: a 0.1 m object 1 m ahead covers a disc
+    /// of about 3.2 px radius at the centre.
+    const CENTER: glam::Vec3 = glam::Vec3::new(0.0, 0.0, -1.0);
+
+    #[test]
+    fn additive_needs_the_object_on_black() {
+        let on_black = image([0, 0, 0, 255], [200, 200, 200, 255]);
         let c = check_readback(
             &frame(),
-            &rb([vec![0; (w * h * 4) as usize], vec![0; (w * h * 4) as usize]]),
+            &readback(on_black, None),
+            CENTER,
+            0.1,
+            Blend::Additive,
+        );
+        assert!(
+            c.passed && c.object_px == c.region_px && c.away_fraction == 1.0,
+            "{c:?}"
+        );
+        // The world drawn behind on an additive display: fails.
+        let on_grey = image([128, 128, 128, 255], [200, 200, 200, 255]);
+        let c = check_readback(
+            &frame(),
+            &readback(on_grey, None),
+            CENTER,
+            0.1,
+            Blend::Additive,
+        );
+        assert!(!c.passed && c.away_fraction == 0.0, "{c:?}");
+        let dark = image([0, 0, 0, 255], [0, 0, 0, 255]);
+        let c = check_readback(
+            &frame(),
+            &readback(dark, None),
+            CENTER,
+            0.1,
+            Blend::Additive,
+        );
+        assert!(!c.passed && c.object_px == 0);
+    }
+
+    #[test]
+    fn alpha_blend_needs_alpha_zero_everywhere() {
+        let premultiplied = image([0, 0, 0, 0], [200, 200, 200, 0]);
+        let c = check_readback(
+            &frame(),
+            &readback(premultiplied, None),
+            CENTER,
+            0.1,
+            Blend::AlphaBlend,
+        );
+        assert!(c.passed && c.alpha_nonzero_px == 0, "{c:?}");
+        // The same colour with opaque alpha would hide the world: fails.
+        let opaque = image([0, 0, 0, 255], [200, 200, 200, 255]);
+        let c = check_readback(
+            &frame(),
+            &readback(opaque, None),
+            CENTER,
+            0.1,
+            Blend::AlphaBlend,
+        );
+        assert!(
+            !c.passed && c.alpha_nonzero_px == u64::from(2 * W * H),
+            "{c:?}"
+        );
+    }
+
+    #[test]
+    fn opaque_needs_the_world_photo_behind_the_object() {
+        let world = image([90, 100, 110, 255], [90, 100, 110, 255]);
+        let drawn = image([90, 100, 110, 255], [200, 200, 200, 255]);
+        let c = check_readback(
+            &frame(),
+            &readback(drawn, Some(world.clone())),
+            CENTER,
+            0.1,
+            Blend::Opaque,
+        );
+        assert!(c.passed && c.away_fraction == 1.0, "{c:?}");
+        let on_black = image([0, 0, 0, 255], [200, 200, 200, 255]);
+        let c = check_readback(
+            &frame(),
+            &readback(on_black, Some(world)),
+            CENTER,
+            0.1,
+            Blend::Opaque,
+        );
+        assert!(!c.passed && c.away_fraction == 0.0, "{c:?}");
+    }
+
+    #[test]
+    fn an_object_behind_the_viewer_fails() {
+        let lit = image([200, 200, 200, 255], [200, 200, 200, 255]);
+        let c = check_readback(
+            &frame(),
+            &readback(lit, None),
             glam::Vec3::new(0.0, 0.0, 1.0),
             0.1,
-            false,
+            Blend::Additive,
         );
         assert!(!c.passed && c.region_px == 0);
     }

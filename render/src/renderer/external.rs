@@ -16,7 +16,7 @@
 
 use ash::vk;
 
-use super::{FrameResult, Renderer, Want};
+use super::{Composition, FrameResult, Renderer, Want};
 use crate::camera::FrameParams;
 use crate::error::{RenderError, Result, VkContext};
 use crate::owned::Owned;
@@ -53,11 +53,15 @@ impl External {
 /// Which external image a frame is drawn into, and how.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct ExternalDraw {
-    /// Slot: index into [`External::images`] and [`External::framebuffers`].
+    /// Slot: index into [`External::images`] and [`External::framebuffers`], or
+    /// [`OWN_TARGET`].
     pub(super) image: usize,
-    /// Draw the real world (floor and background photos) behind the glass.
-    pub(super) world_behind: bool,
+    /// What is drawn behind the glass and the alpha left.
+    pub(super) composition: Composition,
 }
+
+/// The [`ExternalDraw::image`] that means the renderer's own eye images.
+pub(super) const OWN_TARGET: usize = usize::MAX;
 
 impl External {
     /// The render pass the external framebuffers belong to.
@@ -275,10 +279,11 @@ impl Renderer {
     }
 
     /// Like [`Renderer::submit`], drawing into attached external image `image` (its index in
-    /// the slice given to [`Renderer::attach_external`]). With `world_behind`, the real world
-    /// (the scene's floor and background photos) is drawn behind the glass, for displays that
-    /// show no real world of their own (OpenXR's OPAQUE blend mode). A readback (`want.eyes`)
-    /// copies the external image itself.
+    /// the slice given to [`Renderer::attach_external`]), composed for the display as
+    /// `composition` says: with [`Composition::Opaque`] the real world (the scene's floor and
+    /// background photos) is drawn behind the glass, for displays that show no real world of
+    /// their own; [`Composition::AlphaBlend`] leaves alpha 0. A readback (`want.eyes`) copies
+    /// the external image itself.
     ///
     /// The caller must have waited for the image to be free (OpenXR: xrWaitSwapchainImage); the
     /// rendering is submitted to the queue on return, as OpenXR requires before the image is
@@ -288,9 +293,9 @@ impl Renderer {
         image: usize,
         params: &FrameParams,
         want: Want,
-        world_behind: bool,
+        composition: Composition,
     ) -> Result<Option<FrameResult>> {
-        self.submit_external_with_depth(image, None, params, want, world_behind)
+        self.submit_external_with_depth(image, None, params, want, composition)
     }
 
     /// Like [`Renderer::submit_external`], writing depth into attached external depth image
@@ -303,7 +308,7 @@ impl Renderer {
         depth: Option<usize>,
         params: &FrameParams,
         want: Want,
-        world_behind: bool,
+        composition: Composition,
     ) -> Result<Option<FrameResult>> {
         let count = self.external_count();
         if image >= count {
@@ -327,7 +332,7 @@ impl Renderer {
             want,
             Some(ExternalDraw {
                 image: slot,
-                world_behind,
+                composition,
             }),
         )
     }

@@ -22,6 +22,13 @@ impl Blend {
         self == Blend::Opaque
     }
 
+    /// Whether the submitted image's alpha is used: ALPHA_BLEND shows premultiplied colour
+    /// over the real world by its alpha (vitreous submits alpha 0, so the light adds onto the
+    /// world); ADDITIVE and OPAQUE ignore alpha.
+    pub fn uses_source_alpha(self) -> bool {
+        self == Blend::AlphaBlend
+    }
+
     /// Parses `additive`, `alpha-blend` (or `alpha`) and `opaque`.
     pub fn parse(s: &str) -> Option<Blend> {
         match s.trim().to_ascii_lowercase().as_str() {
@@ -82,9 +89,14 @@ pub fn choose_blend(offered: &[Blend], wanted: Option<Blend>) -> Result<Blend, S
 /// Where gaze comes from in a live session.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum GazeSource {
+    /// XR_ML_eye_tracker (Magic Leap 2): a pose per eye, the fixation (vergence) point and the
+    /// pupil diameters.
+    MlEyeTracker,
     /// XR_FB_eye_tracking_social: a pose per eye, so fixation depth (vergence) is known.
     FbSocial,
-    /// XR_EXT_eye_gaze_interaction: one combined ray with its sample time; no depth.
+    /// XR_EXT_eye_gaze_interaction: one combined ray with its sample time; no depth. Its
+    /// samples are read and recorded, but the gaze image is decided from the trace (when
+    /// given) or by hand.
     ExtGaze,
     /// A recorded trace's gaze, replayed by time since the session's first frame.
     Trace,
@@ -92,9 +104,31 @@ pub enum GazeSource {
     Manual,
 }
 
+impl GazeSource {
+    /// Whether the source gives each eye's gaze, which automatic defocus needs (eq. 15).
+    pub fn per_eye(self) -> bool {
+        matches!(
+            self,
+            GazeSource::MlEyeTracker | GazeSource::FbSocial | GazeSource::Trace
+        )
+    }
+
+    /// A short name for summaries: `ml`, `fb`, `ext`, `trace`, `manual` (as `--gaze` takes).
+    pub fn key(self) -> &'static str {
+        match self {
+            GazeSource::MlEyeTracker => "ml",
+            GazeSource::FbSocial => "fb",
+            GazeSource::ExtGaze => "ext",
+            GazeSource::Trace => "trace",
+            GazeSource::Manual => "manual",
+        }
+    }
+}
+
 impl fmt::Display for GazeSource {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
+            GazeSource::MlEyeTracker => "XR_ML_eye_tracker (per-eye poses, fixation, pupils)",
             GazeSource::FbSocial => "XR_FB_eye_tracking_social (per-eye poses)",
             GazeSource::ExtGaze => "XR_EXT_eye_gaze_interaction (combined ray)",
             GazeSource::Trace => "recorded trace (--gaze-trace)",
@@ -103,9 +137,36 @@ impl fmt::Display for GazeSource {
     }
 }
 
+/// Which gaze source `--gaze` asks for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum GazeChoice {
+    /// The best the runtime offers (see [`choose_gaze`]).
+    #[default]
+    Auto,
+    /// This source, or an error when it is not offered.
+    Forced(GazeSource),
+}
+
+impl GazeChoice {
+    /// Parses `auto`, `ml`, `fb`, `ext`, `trace` or `manual`.
+    pub fn parse(s: &str) -> Option<GazeChoice> {
+        Some(match s.trim().to_ascii_lowercase().as_str() {
+            "auto" => GazeChoice::Auto,
+            "ml" => GazeChoice::Forced(GazeSource::MlEyeTracker),
+            "fb" => GazeChoice::Forced(GazeSource::FbSocial),
+            "ext" => GazeChoice::Forced(GazeSource::ExtGaze),
+            "trace" => GazeChoice::Forced(GazeSource::Trace),
+            "manual" => GazeChoice::Forced(GazeSource::Manual),
+            _ => return None,
+        })
+    }
+}
+
 /// What the runtime and the command line offer for gaze.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct GazeOffer {
+    /// XR_ML_eye_tracker is enabled and the system supports it.
+    pub ml_eye_tracker: bool,
     /// XR_FB_eye_tracking_social is enabled and the system supports it.
     pub fb_social: bool,
     /// XR_EXT_eye_gaze_interaction is enabled.
@@ -116,16 +177,60 @@ pub struct GazeOffer {
     pub trace: bool,
 }
 
-/// Chooses the gaze source: per-eye poses, then the combined ray, then a trace, then manual.
-pub fn choose_gaze(offer: GazeOffer) -> GazeSource {
-    if offer.fb_social {
-        GazeSource::FbSocial
-    } else if offer.ext_gaze_extension && offer.ext_gaze_supported {
-        GazeSource::ExtGaze
-    } else if offer.trace {
-        GazeSource::Trace
-    } else {
-        GazeSource::Manual
+impl GazeOffer {
+    /// Whether `source` is offered.
+    pub fn offers(&self, source: GazeSource) -> bool {
+        match source {
+            GazeSource::MlEyeTracker => self.ml_eye_tracker,
+            GazeSource::FbSocial => self.fb_social,
+            GazeSource::ExtGaze => self.ext_gaze_extension && self.ext_gaze_supported,
+            GazeSource::Trace => self.trace,
+            GazeSource::Manual => true,
+        }
+    }
+
+    /// The offered sources, best first: per-eye ML, per-eye FB, the combined EXT ray, the
+    /// trace, manual.
+    pub fn ranked(&self) -> Vec<GazeSource> {
+        [
+            GazeSource::MlEyeTracker,
+            GazeSource::FbSocial,
+            GazeSource::ExtGaze,
+            GazeSource::Trace,
+            GazeSource::Manual,
+        ]
+        .into_iter()
+        .filter(|s| self.offers(*s))
+        .collect()
+    }
+}
+
+/// Chooses the gaze source: the forced one when offered (`Err` says what is offered when it is
+/// not), else the best offered one (see [`GazeOffer::ranked`]).
+pub fn choose_gaze(offer: GazeOffer, choice: GazeChoice) -> Result<GazeSource, String> {
+    match choice {
+        GazeChoice::Forced(source) if offer.offers(source) => Ok(source),
+        GazeChoice::Forced(source) => Err(format!(
+            "--gaze {} was asked for but {} (offered: {})",
+            source.key(),
+            match source {
+                GazeSource::MlEyeTracker =>
+                    "the runtime does not offer XR_ML_eye_tracker on this system",
+                GazeSource::FbSocial =>
+                    "the runtime does not offer XR_FB_eye_tracking_social on this system",
+                GazeSource::ExtGaze =>
+                    "the runtime does not offer XR_EXT_eye_gaze_interaction with an eye tracker",
+                GazeSource::Trace => "no --gaze-trace was given",
+                GazeSource::Manual => "manual is always offered",
+            },
+            offer
+                .ranked()
+                .iter()
+                .map(|s| s.key())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+        GazeChoice::Auto => Ok(offer.ranked()[0]),
     }
 }
 
@@ -224,35 +329,73 @@ mod tests {
         assert!(Blend::Opaque.needs_world_behind());
         assert!(!Blend::Additive.needs_world_behind());
         assert!(!Blend::AlphaBlend.needs_world_behind());
+        assert!(Blend::AlphaBlend.uses_source_alpha());
+        assert!(!Blend::Additive.uses_source_alpha() && !Blend::Opaque.uses_source_alpha());
         assert_eq!(Blend::parse("Alpha-Blend"), Some(Blend::AlphaBlend));
         assert_eq!(Blend::parse("glass"), None);
     }
 
     #[test]
-    fn gaze_source_order_is_per_eye_then_combined_then_trace_then_manual() {
+    fn gaze_source_order_is_ml_then_fb_then_combined_then_trace_then_manual() {
         let all = GazeOffer {
+            ml_eye_tracker: true,
             fb_social: true,
             ext_gaze_extension: true,
             ext_gaze_supported: true,
             trace: true,
         };
-        assert_eq!(choose_gaze(all), GazeSource::FbSocial);
-        let no_fb = GazeOffer {
-            fb_social: false,
+        let auto = |o| choose_gaze(o, GazeChoice::Auto).unwrap();
+        assert_eq!(auto(all), GazeSource::MlEyeTracker);
+        let no_ml = GazeOffer {
+            ml_eye_tracker: false,
             ..all
         };
-        assert_eq!(choose_gaze(no_fb), GazeSource::ExtGaze);
+        assert_eq!(auto(no_ml), GazeSource::FbSocial);
+        let no_fb = GazeOffer {
+            fb_social: false,
+            ..no_ml
+        };
+        assert_eq!(auto(no_fb), GazeSource::ExtGaze);
+        assert!(!GazeSource::ExtGaze.per_eye() && GazeSource::MlEyeTracker.per_eye());
         // Monado's case: the extension is listed but no device has eyes.
         let listed_only = GazeOffer {
             ext_gaze_supported: false,
             ..no_fb
         };
-        assert_eq!(choose_gaze(listed_only), GazeSource::Trace);
+        assert_eq!(auto(listed_only), GazeSource::Trace);
         let nothing = GazeOffer {
             trace: false,
             ..listed_only
         };
-        assert_eq!(choose_gaze(nothing), GazeSource::Manual);
+        assert_eq!(auto(nothing), GazeSource::Manual);
+    }
+
+    #[test]
+    fn a_forced_gaze_source_is_used_or_refused_with_what_is_offered() {
+        let fb_only = GazeOffer {
+            fb_social: true,
+            ..GazeOffer::default()
+        };
+        let ml = GazeChoice::parse("ML").unwrap();
+        let err = choose_gaze(fb_only, ml).unwrap_err();
+        assert!(
+            err.contains("XR_ML_eye_tracker") && err.contains("offered: fb, manual"),
+            "{err}"
+        );
+        assert_eq!(
+            choose_gaze(fb_only, GazeChoice::parse("manual").unwrap()),
+            Ok(GazeSource::Manual)
+        );
+        let err = choose_gaze(fb_only, GazeChoice::parse("trace").unwrap()).unwrap_err();
+        assert!(err.contains("--gaze-trace"), "{err}");
+        assert_eq!(GazeChoice::parse("auto"), Some(GazeChoice::Auto));
+        assert_eq!(GazeChoice::parse("eyes"), None);
+        for s in ["ml", "fb", "ext", "trace", "manual"] {
+            match GazeChoice::parse(s) {
+                Some(GazeChoice::Forced(g)) => assert_eq!(g.key(), s),
+                other => panic!("{s}: {other:?}"),
+            }
+        }
     }
 
     #[test]

@@ -1,36 +1,58 @@
-//! Gaze sources of a live session: XR_FB_eye_tracking_social (per-eye poses),
-//! XR_EXT_eye_gaze_interaction (a combined ray with its sample time), a recorded trace replayed
-//! by time since the session's first frame, or none (manual). All give rays in the head (VIEW)
-//! frame, as [`GazeSample`] wants.
+//! Gaze sources of a live session: XR_ML_eye_tracker (per-eye poses, fixation point, pupil
+//! diameters), XR_FB_eye_tracking_social (per-eye poses), XR_EXT_eye_gaze_interaction (a
+//! combined ray with its sample time), a recorded trace replayed by time since the session's
+//! first frame, or none (manual). All give rays in the head (VIEW) frame, as [`GazeSample`]
+//! wants.
+//!
+//! The combined EXT ray has no depth, so it cannot drive the gaze image: with it, the frame's
+//! per-eye gaze comes from the trace (when one is given; else there is none and the gaze image
+//! is chosen by hand), and the EXT ray is carried as the sample's combined ray, so a recording
+//! holds exactly what decided each frame.
 
+use std::ffi::CStr;
 use std::path::Path;
 
 use glam::{Quat, Vec3};
 use openxr as xr;
 
 use super::choose::GazeSource;
+use super::ml_eye_tracker as ml;
 use super::{OpenXrError, Result, XrContext};
 use crate::frame::{GazeRay, GazeSample};
 use crate::trace::{TraceSample, read_trace};
 
 /// A gaze source, ready to sample.
 pub(super) enum Gaze {
+    /// Per-eye, fixation and pupil data from a Magic Leap eye tracker.
+    MlEyeTracker(MlTracker),
     /// Per-eye poses from an FB eye tracker.
     FbSocial(FbTracker),
-    /// The combined ray of the eye-gaze interaction profile.
-    ExtGaze(ExtGaze),
+    /// The combined ray of the eye-gaze interaction profile, and the trace whose per-eye gaze
+    /// decides the gaze image (none: decided by hand).
+    Combined(ExtGaze, Option<TraceGaze>),
     /// A trace's gaze by elapsed time.
     Trace(TraceGaze),
     /// No gaze.
     Manual,
 }
 
+/// What one frame's gaze sampling gave.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct Sampled {
+    /// The frame's gaze (what the look planner and a recording get).
+    pub(super) frame: Option<GazeSample>,
+    /// The sample time of the source's own sample, when it gave one (for EXT: the runtime's
+    /// combined ray, even when the frame's gaze comes from the trace).
+    pub(super) source_time_ns: Option<i64>,
+}
+
 impl Gaze {
     /// Which source this is.
     pub(super) fn source(&self) -> GazeSource {
         match self {
+            Gaze::MlEyeTracker(_) => GazeSource::MlEyeTracker,
             Gaze::FbSocial(_) => GazeSource::FbSocial,
-            Gaze::ExtGaze(_) => GazeSource::ExtGaze,
+            Gaze::Combined(..) => GazeSource::ExtGaze,
             Gaze::Trace(_) => GazeSource::Trace,
             Gaze::Manual => GazeSource::Manual,
         }
@@ -44,12 +66,68 @@ impl Gaze {
         view_space: &xr::Space,
         display: xr::Time,
         first_display: xr::Time,
-    ) -> Option<GazeSample> {
+    ) -> Sampled {
+        let own = |g: Option<GazeSample>| Sampled {
+            frame: g,
+            source_time_ns: g.map(|g| g.sample_time_ns),
+        };
         match self {
-            Gaze::FbSocial(t) => t.sample(view_space, display),
-            Gaze::ExtGaze(g) => g.sample(session, view_space, display),
-            Gaze::Trace(t) => t.sample(display.as_nanos(), first_display.as_nanos()),
-            Gaze::Manual => None,
+            Gaze::MlEyeTracker(t) => own(t.sample(view_space, display)),
+            Gaze::FbSocial(t) => own(t.sample(view_space, display)),
+            Gaze::Combined(g, trace) => {
+                let ext = g.sample(session, view_space, display);
+                let decided = trace
+                    .as_mut()
+                    .and_then(|t| t.sample(display.as_nanos(), first_display.as_nanos()));
+                Sampled {
+                    frame: with_combined(decided, ext),
+                    source_time_ns: ext.map(|e| e.sample_time_ns),
+                }
+            }
+            Gaze::Trace(t) => own(t.sample(display.as_nanos(), first_display.as_nanos())),
+            Gaze::Manual => Sampled::default(),
+        }
+    }
+}
+
+/// The frame's gaze with the EXT source: the trace's sample (its per-eye rays decide) carrying
+/// the runtime's combined ray; without a trace, the runtime's sample alone (no per-eye rays,
+/// so no decision).
+fn with_combined(decided: Option<GazeSample>, ext: Option<GazeSample>) -> Option<GazeSample> {
+    match (decided, ext) {
+        (Some(mut d), Some(e)) => {
+            d.combined = e.combined;
+            Some(d)
+        }
+        (Some(d), None) => Some(d),
+        (None, e) => e,
+    }
+}
+
+/// How many gaze samples the source gave and how many frames saw a new one.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GazeTally {
+    /// Frames the source was asked for a sample.
+    pub frames: u64,
+    /// Frames it gave one (new or not).
+    pub received: u64,
+    /// Frames whose sample was newer than every earlier frame's: a fresh sample.
+    pub fresh: u64,
+    /// The newest sample time seen, nanoseconds.
+    newest_ns: Option<i64>,
+}
+
+impl GazeTally {
+    /// Counts one frame's sampling.
+    pub(super) fn count(&mut self, sampled: &Sampled) {
+        self.frames += 1;
+        let Some(t) = sampled.source_time_ns else {
+            return;
+        };
+        self.received += 1;
+        if self.newest_ns.is_none_or(|n| t > n) {
+            self.fresh += 1;
+            self.newest_ns = Some(t);
         }
     }
 }
@@ -140,6 +218,179 @@ impl Drop for FbTracker {
             // used after this drop.
             unsafe { (fp.destroy_eye_tracker)(self.tracker) };
         }
+    }
+}
+
+/// An XR_ML_eye_tracker tracker and the functions it is used with (loaded through
+/// xrGetInstanceProcAddr: the `openxr` crate does not carry the extension).
+pub(super) struct MlTracker {
+    /// The tracker handle; destroyed on drop.
+    tracker: ml::EyeTrackerML,
+    /// `xrDestroyEyeTrackerML`.
+    destroy: ml::DestroyEyeTrackerML,
+    /// `xrGetEyeTrackerPosesML`.
+    get_poses: ml::GetEyeTrackerPosesML,
+    /// `xrGetEyeTrackerPupilDataML`.
+    get_pupils: ml::GetEyeTrackerPupilDataML,
+}
+
+/// Loads an instance function by name.
+///
+/// # Safety
+/// `T` must be the function pointer type of the function named `name`.
+unsafe fn load<T: Copy>(instance: &xr::Instance, name: &CStr) -> Result<T> {
+    let mut f: Option<xr::sys::pfn::VoidFunction> = None;
+    // SAFETY: a live instance and a nul-terminated name; `f` outlives the call.
+    let r = unsafe {
+        (instance.entry().fp().get_instance_proc_addr)(instance.as_raw(), name.as_ptr(), &mut f)
+    };
+    match f {
+        Some(f) if r == xr::sys::Result::SUCCESS => {
+            assert_eq!(
+                std::mem::size_of::<T>(),
+                std::mem::size_of::<xr::sys::pfn::VoidFunction>()
+            );
+            // SAFETY: the runtime returned the function named `name`, whose type is `T` (this
+            // function's contract); both are plain function pointers of the same size.
+            Ok(unsafe { std::mem::transmute_copy::<xr::sys::pfn::VoidFunction, T>(&f) })
+        }
+        _ => Err(OpenXrError::Call {
+            call: "xrGetInstanceProcAddr",
+            result: if r == xr::sys::Result::SUCCESS {
+                xr::sys::Result::ERROR_FUNCTION_UNSUPPORTED
+            } else {
+                r
+            },
+        }),
+    }
+}
+
+impl MlTracker {
+    /// Loads the extension's functions and creates the tracker (the extension must be enabled
+    /// on the session's instance).
+    pub(super) fn new(session: &xr::Session<xr::Vulkan>) -> Result<MlTracker> {
+        let instance = session.instance();
+        // SAFETY: each name is paired with its function pointer type from the extension's
+        // declarations (ml_eye_tracker).
+        let (create, destroy, get_poses, get_pupils) = unsafe {
+            (
+                load::<ml::CreateEyeTrackerML>(instance, c"xrCreateEyeTrackerML")?,
+                load::<ml::DestroyEyeTrackerML>(instance, c"xrDestroyEyeTrackerML")?,
+                load::<ml::GetEyeTrackerPosesML>(instance, c"xrGetEyeTrackerPosesML")?,
+                load::<ml::GetEyeTrackerPupilDataML>(instance, c"xrGetEyeTrackerPupilDataML")?,
+            )
+        };
+        let info = ml::EyeTrackerCreateInfoML {
+            ty: xr::sys::StructureType::from_raw(ml::structure_type::CREATE_INFO),
+            next: std::ptr::null(),
+        };
+        let mut tracker = ml::EyeTrackerML::NULL;
+        // SAFETY: `create` is the runtime's xrCreateEyeTrackerML; the session is live and
+        // `info`, `tracker` are valid for the call.
+        let r = unsafe { create(session.as_raw(), &info, &mut tracker) };
+        if r != xr::sys::Result::SUCCESS {
+            return Err(r).xr("xrCreateEyeTrackerML");
+        }
+        Ok(MlTracker {
+            tracker,
+            destroy,
+            get_poses,
+            get_pupils,
+        })
+    }
+
+    /// Per-eye rays, the combined ray and the fixation point in the head frame, and the pupil
+    /// diameters; the sample time is the newest valid pose's.
+    fn sample(&mut self, view_space: &xr::Space, display: xr::Time) -> Option<GazeSample> {
+        let info = ml::EyeTrackerPosesGetInfoML {
+            ty: xr::sys::StructureType::from_raw(ml::structure_type::POSES_GET_INFO),
+            next: std::ptr::null(),
+            base_space: view_space.as_raw(),
+            time: display,
+            pose_flags: ml::pose_flags::ALL,
+        };
+        let mut poses = ml::EyeTrackerPosesML::empty();
+        // SAFETY: the tracker is live until drop; `info` and `poses` are typed and outlive the
+        // call.
+        let r = unsafe { (self.get_poses)(self.tracker, &info, &mut poses) };
+        if r != xr::sys::Result::SUCCESS {
+            return None;
+        }
+        let valid = |p: &ml::EyeTrackerPoseML| p.valid == xr::sys::TRUE;
+        let ray = |p: &ml::EyeTrackerPoseML| {
+            if valid(p) {
+                ray_of(&p.pose)
+            } else {
+                GazeRay::INVALID
+            }
+        };
+        let all = [
+            &poses.left_pose,
+            &poses.right_pose,
+            &poses.gaze_pose,
+            &poses.fixation_pose,
+        ];
+        let sample_time_ns = all
+            .iter()
+            .filter(|p| valid(p))
+            .map(|p| p.time.as_nanos())
+            .max()?;
+        let fixation = valid(&poses.fixation_pose).then(|| {
+            let p = poses.fixation_pose.pose.position;
+            Vec3::new(p.x, p.y, p.z)
+        });
+        Some(GazeSample {
+            sample_time_ns,
+            left: ray(&poses.left_pose),
+            right: ray(&poses.right_pose),
+            combined: Some(ray(&poses.gaze_pose)),
+            fixation,
+            pupil_diameter_m: self.pupils(),
+        })
+    }
+
+    /// The pupil diameters (left, right), metres, where the tracker measured them.
+    fn pupils(&mut self) -> [Option<f32>; 2] {
+        let info = ml::EyeTrackerGetInfoML {
+            ty: xr::sys::StructureType::from_raw(ml::structure_type::PUPIL_DATA_GET_INFO),
+            next: std::ptr::null(),
+        };
+        let mut data = [ml::EyeTrackerPupilDataML::empty(); 2];
+        let mut count = 0u32;
+        // SAFETY: the tracker is live; `data` has room for the capacity given and outlives
+        // the call, every element typed.
+        let r = unsafe {
+            (self.get_pupils)(
+                self.tracker,
+                &info,
+                data.len() as u32,
+                &mut count,
+                data.as_mut_ptr(),
+            )
+        };
+        let mut out = [None, None];
+        if r != xr::sys::Result::SUCCESS {
+            return out;
+        }
+        for d in data.iter().take(count as usize) {
+            let eye = match d.eye {
+                ml::EyeML::LEFT => 0,
+                ml::EyeML::RIGHT => 1,
+                _ => continue,
+            };
+            if d.valid == xr::sys::TRUE && d.pupil_diameter.is_finite() && d.pupil_diameter > 0.0 {
+                out[eye] = Some(d.pupil_diameter);
+            }
+        }
+        out
+    }
+}
+
+impl Drop for MlTracker {
+    fn drop(&mut self) {
+        // SAFETY: the tracker was created by this table's runtime and is not used after this
+        // drop.
+        unsafe { (self.destroy)(self.tracker) };
     }
 }
 
@@ -293,6 +544,45 @@ mod tests {
                 pupil_diameter_m: [None, None],
             },
         }
+    }
+
+    #[test]
+    fn fresh_samples_are_those_newer_than_any_before() {
+        let mut t = GazeTally::default();
+        let at = |ns: Option<i64>| Sampled {
+            frame: None,
+            source_time_ns: ns,
+        };
+        for ns in [Some(10), Some(10), None, Some(20), Some(15), Some(30)] {
+            t.count(&at(ns));
+        }
+        assert_eq!((t.frames, t.received, t.fresh), (6, 5, 3));
+    }
+
+    #[test]
+    fn the_combined_ray_rides_on_the_traces_per_eye_gaze() {
+        let trace = sample(0, 100, 1.0).gaze;
+        let combined = GazeRay {
+            origin: Vec3::ZERO,
+            direction: Vec3::X,
+            valid: true,
+        };
+        let ext = GazeSample {
+            sample_time_ns: 7,
+            left: GazeRay::INVALID,
+            right: GazeRay::INVALID,
+            combined: Some(combined),
+            fixation: None,
+            pupil_diameter_m: [None, None],
+        };
+        let merged = with_combined(Some(trace), Some(ext)).unwrap();
+        assert_eq!((merged.left, merged.right), (trace.left, trace.right));
+        assert_eq!(merged.sample_time_ns, 100);
+        assert_eq!(merged.combined, Some(combined));
+        // Without a trace the runtime's ray alone: no per-eye gaze, nothing decided.
+        let alone = with_combined(None, Some(ext)).unwrap();
+        assert!(!alone.left.valid && !alone.right.valid);
+        assert_eq!(with_combined(Some(trace), None), Some(trace));
     }
 
     #[test]

@@ -41,9 +41,10 @@ use openxr as xr;
 pub use actions::{Command, Cycle};
 /// The `ash` crate these APIs use, for callers without their own dependency on it.
 pub use ash;
-pub use choose::{Blend, ColorFormat, GazeSource};
+pub use choose::{Blend, ColorFormat, GazeChoice, GazeSource};
 pub(crate) use error::XrContext;
 pub use error::{OpenXrError, Result};
+pub use gaze::GazeTally;
 pub use session::{Session, SessionReport};
 pub use state::{EndReason, State};
 
@@ -87,6 +88,8 @@ pub struct RuntimeInfo {
     pub eye_gaze_supported: bool,
     /// The system supports XR_FB_eye_tracking_social.
     pub fb_eye_tracking_supported: bool,
+    /// The system supports XR_ML_eye_tracker (`XrSystemEyeTrackerPropertiesML`).
+    pub ml_eye_tracker_supported: bool,
     /// Vulkan versions the runtime accepts (min, max) as "major.minor".
     pub vulkan_versions: (String, String),
 }
@@ -105,6 +108,8 @@ pub struct Runtime {
     ext_gaze: bool,
     /// XR_FB_eye_tracking_social is enabled.
     fb_gaze: bool,
+    /// XR_ML_eye_tracker is enabled.
+    ml_gaze: bool,
     /// The Vulkan instance made through the runtime, for the device steps.
     vk_instance: Option<vk::Instance>,
 }
@@ -126,6 +131,12 @@ impl Runtime {
         wanted.ext_eye_gaze_interaction = available.ext_eye_gaze_interaction;
         wanted.fb_eye_tracking_social = available.fb_eye_tracking_social;
         wanted.khr_composition_layer_depth = available.khr_composition_layer_depth;
+        // XR_ML_eye_tracker is unknown to the `openxr` crate: enabled by name when listed.
+        let ml_name = ml_extension_name();
+        let ml_gaze = available.other.contains(&ml_name);
+        if ml_gaze {
+            wanted.other.push(ml_name);
+        }
         let mut layers = Vec::new();
         if options.validation {
             let installed = entry
@@ -162,11 +173,12 @@ impl Runtime {
         let sys_props = instance
             .system_properties(system)
             .xr("xrGetSystemProperties")?;
-        let (eye_gaze_supported, fb_eye_tracking_supported) = gaze_support(
+        let support = gaze_support(
             &instance,
             system,
             wanted.ext_eye_gaze_interaction,
             wanted.fb_eye_tracking_social,
+            ml_gaze,
         );
 
         let stereo = xr::ViewConfigurationType::PRIMARY_STEREO;
@@ -214,8 +226,9 @@ impl Runtime {
             recommended_size,
             max_size,
             size,
-            eye_gaze_supported,
-            fb_eye_tracking_supported,
+            eye_gaze_supported: support.ext,
+            fb_eye_tracking_supported: support.fb,
+            ml_eye_tracker_supported: support.ml,
             vulkan_versions: (
                 version(reqs.min_api_version_supported),
                 version(reqs.max_api_version_supported),
@@ -260,6 +273,7 @@ impl Runtime {
             depth_layer: wanted.khr_composition_layer_depth,
             ext_gaze: wanted.ext_eye_gaze_interaction,
             fb_gaze: wanted.fb_eye_tracking_social,
+            ml_gaze,
             vk_instance: None,
         })
     }
@@ -403,9 +417,11 @@ pub struct VulkanHandles {
 pub struct SessionOptions {
     /// End after this many rendered frames (None: until stopped).
     pub max_frames: Option<u64>,
-    /// Replay gaze from this trace (by time since the first frame) when no eye tracker is
-    /// available.
+    /// Replay gaze from this trace (by time since the first frame) when no per-eye eye
+    /// tracker is available (or when `gaze` forces it).
     pub gaze_trace: Option<std::path::PathBuf>,
+    /// Which gaze source to use (`--gaze`): the best offered, or a forced one.
+    pub gaze: GazeChoice,
     /// Where the scene's origin (the viewer's head at start) is put relative to the first
     /// located head pose; `None` puts it exactly there (yaw only).
     pub scene_origin: Option<Pose>,
@@ -463,13 +479,32 @@ impl Runtime {
     }
 }
 
-/// Which of the eye-gaze features the system supports (EXT interaction, FB social).
+/// Which eye trackers the system supports, of those whose extension is enabled.
+#[derive(Clone, Copy, Debug, Default)]
+struct GazeSupport {
+    /// XR_EXT_eye_gaze_interaction (`supportsEyeGazeInteraction`).
+    ext: bool,
+    /// XR_FB_eye_tracking_social (`supportsEyeTracking`).
+    fb: bool,
+    /// XR_ML_eye_tracker (`supportsEyeTracking`).
+    ml: bool,
+}
+
+/// XR_ML_eye_tracker's name as the `openxr` crate lists unknown extensions (nul-terminated).
+fn ml_extension_name() -> Vec<u8> {
+    let mut name = ml_eye_tracker::EXTENSION_NAME.as_bytes().to_vec();
+    name.push(0);
+    name
+}
+
+/// Asks the system which of the enabled eye-tracking extensions it supports.
 fn gaze_support(
     instance: &xr::Instance,
     system: xr::SystemId,
     ext: bool,
     fb: bool,
-) -> (bool, bool) {
+    ml: bool,
+) -> GazeSupport {
     let mut ext_props = xr::sys::SystemEyeGazeInteractionPropertiesEXT {
         ty: xr::sys::SystemEyeGazeInteractionPropertiesEXT::TYPE,
         next: std::ptr::null_mut(),
@@ -477,6 +512,11 @@ fn gaze_support(
     };
     let mut fb_props = xr::sys::SystemEyeTrackingPropertiesFB {
         ty: xr::sys::SystemEyeTrackingPropertiesFB::TYPE,
+        next: std::ptr::null_mut(),
+        supports_eye_tracking: xr::sys::FALSE,
+    };
+    let mut ml_props = ml_eye_tracker::SystemEyeTrackerPropertiesML {
+        ty: xr::sys::StructureType::from_raw(ml_eye_tracker::structure_type::SYSTEM_PROPERTIES),
         next: std::ptr::null_mut(),
         supports_eye_tracking: xr::sys::FALSE,
     };
@@ -489,8 +529,12 @@ fn gaze_support(
         fb_props.next = next;
         next = &mut fb_props as *mut _ as *mut _;
     }
+    if ml {
+        ml_props.next = next;
+        next = &mut ml_props as *mut _ as *mut _;
+    }
     if next.is_null() {
-        return (false, false);
+        return GazeSupport::default();
     }
     // SAFETY: a zeroed XrSystemProperties with a valid chain of output structs that live
     // across the call.
@@ -502,12 +546,13 @@ fn gaze_support(
     };
     if ok != xr::sys::Result::SUCCESS {
         tracing::warn!("xrGetSystemProperties with eye-tracking properties failed: {ok}");
-        return (false, false);
+        return GazeSupport::default();
     }
-    (
-        ext && ext_props.supports_eye_gaze_interaction == xr::sys::TRUE,
-        fb && fb_props.supports_eye_tracking == xr::sys::TRUE,
-    )
+    GazeSupport {
+        ext: ext && ext_props.supports_eye_gaze_interaction == xr::sys::TRUE,
+        fb: fb && fb_props.supports_eye_tracking == xr::sys::TRUE,
+        ml: ml && ml_props.supports_eye_tracking == xr::sys::TRUE,
+    }
 }
 
 /// The names of the extensions vitreous enables, for logs.
@@ -525,6 +570,9 @@ fn enabled_names(set: &xr::ExtensionSet) -> Vec<String> {
         if on {
             names.push(name.to_owned());
         }
+    }
+    for other in &set.other {
+        names.push(String::from_utf8_lossy(other.strip_suffix(&[0]).unwrap_or(other)).into_owned());
     }
     names
 }

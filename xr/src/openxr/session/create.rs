@@ -8,8 +8,8 @@ use ash::vk::Handle;
 use openxr as xr;
 
 use super::super::actions::Controls;
-use super::super::choose::{self, Blend, GazeOffer, GazeSource, SpaceChoice};
-use super::super::gaze::{ExtGaze, FbTracker, Gaze, TraceGaze};
+use super::super::choose::{self, Blend, GazeChoice, GazeOffer, GazeSource, SpaceChoice};
+use super::super::gaze::{ExtGaze, FbTracker, Gaze, MlTracker, TraceGaze};
 use super::super::state::State;
 use super::super::{
     DepthOptions, OpenXrError, Result, Runtime, SessionOptions, SwapchainImages, VulkanHandles,
@@ -120,45 +120,19 @@ pub(in crate::openxr) unsafe fn start(
     };
 
     let offer = GazeOffer {
+        ml_eye_tracker: rt.ml_gaze && rt.info.ml_eye_tracker_supported,
         fb_social: rt.fb_gaze && rt.info.fb_eye_tracking_supported,
         ext_gaze_extension: rt.ext_gaze,
         ext_gaze_supported: rt.info.eye_gaze_supported,
         trace: options.gaze_trace.is_some(),
     };
-    let mut source = choose::choose_gaze(offer);
     if rt.ext_gaze && !rt.info.eye_gaze_supported {
         tracing::info!(
             "XR_EXT_eye_gaze_interaction is offered but the system has no eye tracker \
              (supportsEyeGazeInteraction = false)"
         );
     }
-    let gaze = loop {
-        let made = match source {
-            GazeSource::FbSocial => FbTracker::new(&session).map(Gaze::FbSocial),
-            GazeSource::ExtGaze => ExtGaze::new(&session).map(Gaze::ExtGaze),
-            GazeSource::Trace => {
-                let path = options
-                    .gaze_trace
-                    .as_deref()
-                    .expect("chosen only with a trace");
-                TraceGaze::open(path).map(Gaze::Trace)
-            }
-            GazeSource::Manual => Ok(Gaze::Manual),
-        };
-        match made {
-            Ok(g) => break g,
-            // A bad trace is the user's error: say so.
-            Err(e) if source == GazeSource::Trace => return Err(e),
-            Err(e) => {
-                tracing::warn!("gaze source {source} failed ({e}); trying the next one");
-                source = match source {
-                    GazeSource::FbSocial if offer.ext_gaze_supported => GazeSource::ExtGaze,
-                    GazeSource::FbSocial | GazeSource::ExtGaze if offer.trace => GazeSource::Trace,
-                    _ => GazeSource::Manual,
-                };
-            }
-        }
-    };
+    let gaze = make_gaze(&session, options, offer)?;
     // Controller actions: a failure here costs the live actions only, never the session.
     let controls = match Controls::new(&rt.instance) {
         Ok(c) => Some(c),
@@ -169,7 +143,7 @@ pub(in crate::openxr) unsafe fn start(
     };
     // xrAttachSessionActionSets may be called once per session: every set goes in together.
     let mut action_sets: Vec<xr::ActionSet> = Vec::new();
-    if let Gaze::ExtGaze(g) = &gaze {
+    if let Gaze::Combined(g, _) = &gaze {
         action_sets.push(g.set.clone());
     }
     if let Some(c) = &controls {
@@ -192,8 +166,21 @@ pub(in crate::openxr) unsafe fn start(
         );
     }
     tracing::info!("gaze source: {}", gaze.source());
-    if gaze.source() == GazeSource::Manual {
-        tracing::warn!("no eye tracker and no --gaze-trace: the gaze image must be chosen by hand");
+    match &gaze {
+        Gaze::Combined(_, decided) => tracing::warn!(
+            "the runtime gives one combined gaze ray (XR_EXT_eye_gaze_interaction), which has no \
+             depth: automatic defocus needs per-eye gaze. The combined ray is read and \
+             recorded; the gaze image is decided {}",
+            if decided.is_some() {
+                "from the --gaze-trace's per-eye gaze"
+            } else {
+                "by hand (no --gaze-trace)"
+            }
+        ),
+        Gaze::Manual => tracing::warn!(
+            "no per-eye eye tracker and no --gaze-trace: the gaze image must be chosen by hand"
+        ),
+        _ => {}
     }
 
     if options.handle_ctrl_c {
@@ -234,12 +221,14 @@ pub(in crate::openxr) unsafe fn start(
             commands_rx: Some(commands_rx),
             gaze,
             space,
+            space_type,
             view_space,
             session,
             instance: rt.instance.clone(),
             events: xr::EventDataBuffer::new(),
             blend,
-            world_behind: rt.info.blend.needs_world_behind(),
+            layer_flags: layer_flags(rt.info.blend),
+            display_blend: rt.info.blend,
             size: (w, h),
             state: State::Idle,
             running: false,
@@ -248,12 +237,64 @@ pub(in crate::openxr) unsafe fn start(
             world_from_space: None,
             first_display: None,
             next_index: 0,
-            pending: None,
+            open: None,
             options: options.clone(),
             report,
         },
         out,
     ))
+}
+
+/// Makes the gaze source: the forced one (an error when it is not offered or cannot be
+/// made), else the best offered one that can be made, falling back down the order.
+fn make_gaze(
+    session: &xr::Session<xr::Vulkan>,
+    options: &SessionOptions,
+    offer: GazeOffer,
+) -> Result<Gaze> {
+    let trace = || -> Result<TraceGaze> {
+        match options.gaze_trace.as_deref() {
+            Some(path) => TraceGaze::open(path),
+            None => Err(OpenXrError::Unsupported("no --gaze-trace given".into())),
+        }
+    };
+    let make = |source: GazeSource| -> Result<Gaze> {
+        match source {
+            GazeSource::MlEyeTracker => MlTracker::new(session).map(Gaze::MlEyeTracker),
+            GazeSource::FbSocial => FbTracker::new(session).map(Gaze::FbSocial),
+            GazeSource::ExtGaze => {
+                // The trace decides the gaze image; the combined ray is read alongside.
+                let decided = if offer.trace { Some(trace()?) } else { None };
+                ExtGaze::new(session).map(|g| Gaze::Combined(g, decided))
+            }
+            GazeSource::Trace => trace().map(Gaze::Trace),
+            GazeSource::Manual => Ok(Gaze::Manual),
+        }
+    };
+    let forced = options.gaze != GazeChoice::Auto;
+    let first = choose::choose_gaze(offer, options.gaze).map_err(OpenXrError::Unsupported)?;
+    let ranked = offer.ranked();
+    let start = ranked.iter().position(|s| *s == first).unwrap_or(0);
+    for &source in &ranked[start..] {
+        match make(source) {
+            Ok(g) => return Ok(g),
+            // A forced source, and a bad trace (the user's error), fail the run.
+            Err(e) if forced || source == GazeSource::Trace => return Err(e),
+            Err(e) => tracing::warn!("gaze source {source} failed ({e}); trying the next one"),
+        }
+    }
+    Ok(Gaze::Manual)
+}
+
+/// The projection layer's flags for a blend mode: ALPHA_BLEND composes the premultiplied
+/// image by its alpha (XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT); the others show
+/// the colour alone.
+fn layer_flags(blend: Blend) -> xr::CompositionLayerFlags {
+    if blend.uses_source_alpha() {
+        xr::CompositionLayerFlags::BLEND_TEXTURE_SOURCE_ALPHA
+    } else {
+        xr::CompositionLayerFlags::EMPTY
+    }
 }
 
 /// Makes the 2-layer depth swapchain, or says why not and returns `None` (no depth is then

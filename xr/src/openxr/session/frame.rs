@@ -1,6 +1,12 @@
 //! The frame scope: waiting for and beginning a frame, acquiring the swapchain images,
-//! locating the views, and ending the frame with its projection (and depth) layer; a session
-//! dropped mid-frame still ends its frame.
+//! locating the views, and ending the frame with its projection (and depth) layer.
+//!
+//! From xrBeginFrame to xrEndFrame the session holds an [`OpenFrame`] that records what the
+//! frame has taken from the runtime. Every way out of it ends the frame: [`Backend::end_frame`]
+//! with the layer; an error while the frame is being prepared, [`Backend::abandon_frame`] (the
+//! app's error after the frame was handed out) and a session dropped mid-frame all unwind it
+//! ([`Session::abandon_open_frame`]): acquired images waited for and released, xrEndFrame with
+//! no layers. Errors of that clean-up are logged; the error that caused it is the one returned.
 
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -10,7 +16,8 @@ use openxr as xr;
 use super::super::state::{self, EndReason};
 use super::super::{DepthOptions, OpenXrError, Result, XrContext};
 use super::placement::{compose, place_scene, pose_of};
-use super::{INTERRUPTED, Pending, STATE_TIMEOUT, Session};
+use super::scope::{Handed, Hold, OpenFrame, Unwind};
+use super::{INTERRUPTED, STATE_TIMEOUT, Session};
 use crate::frame::{Backend, EyeView, Fov, FrameInput, FrameTarget, Pose};
 
 impl Session {
@@ -28,7 +35,41 @@ impl Session {
             }
             return Ok(None);
         }
+        self.open = Some(OpenFrame::begun(frame.predicted_display_time));
         Ok(Some(frame))
+    }
+
+    /// The open frame, which every step after xrBeginFrame needs.
+    fn open_frame(&mut self) -> Result<&mut OpenFrame> {
+        self.open
+            .as_mut()
+            .ok_or_else(|| OpenXrError::FrameOrder("no frame is begun".into()))
+    }
+
+    /// Acquires and waits for the colour (and depth) swapchain image of the open frame,
+    /// recording each step in it so an error can unwind exactly what was taken.
+    fn acquire_images(&mut self) -> Result<(u32, Option<u32>)> {
+        let image = self
+            .swapchain
+            .acquire_image()
+            .xr("xrAcquireSwapchainImage")?;
+        self.open_frame()?.color = Hold::Acquired;
+        self.swapchain
+            .wait_image(xr::Duration::INFINITE)
+            .xr("xrWaitSwapchainImage")?;
+        self.open_frame()?.color = Hold::Waited;
+        let Some((chain, _)) = &mut self.depth else {
+            return Ok((image, None));
+        };
+        let depth = chain.acquire_image().xr("xrAcquireSwapchainImage(depth)")?;
+        self.open_frame()?.depth = Hold::Acquired;
+        if let Some((chain, _)) = &mut self.depth {
+            chain
+                .wait_image(xr::Duration::INFINITE)
+                .xr("xrWaitSwapchainImage(depth)")?;
+        }
+        self.open_frame()?.depth = Hold::Waited;
+        Ok((image, Some(depth)))
     }
 
     /// Locates the head and eyes for a frame displayed at `display`.
@@ -51,13 +92,188 @@ impl Session {
             .contains(xr::ViewStateFlags::POSITION_VALID | xr::ViewStateFlags::ORIENTATION_VALID);
         Ok((pose_of(&head.pose), views, tracked))
     }
+
+    /// Everything between xrBeginFrame and handing the frame out: images, views, placement,
+    /// actions, gaze. Any error leaves the open frame for the caller to unwind.
+    fn prepare_frame(&mut self, display: xr::Time) -> Result<FrameInput> {
+        let (image, depth_image) = self.acquire_images()?;
+        // Views are located after the wait for the image, as late as this loop allows.
+        let (head_space, views, tracked) = self.locate(display)?;
+        if !tracked {
+            self.report.frames_untracked += 1;
+        }
+        let first_display = *self.first_display.get_or_insert(display);
+        let placed = match self.world_from_space {
+            Some(w) => w,
+            None => {
+                let placed = place_scene(
+                    &head_space,
+                    self.options.viewer_position_m,
+                    self.options.scene_origin,
+                );
+                if self.report.space_changes > 0 {
+                    tracing::info!(
+                        "scene re-anchored at the head pose of frame {}",
+                        self.next_index
+                    );
+                }
+                self.world_from_space = Some(placed);
+                placed
+            }
+        };
+        // Live actions (and the eye-gaze action) are synced before the gaze is sampled and
+        // before the placement is used, so a nudge shows in this very frame.
+        self.sync_actions(compose(&placed, &head_space).position)?;
+        let world_from_space = self.world_from_space.unwrap_or(placed);
+        let sampled = self
+            .gaze
+            .sample(&self.session, &self.view_space, display, first_display);
+        self.report.gaze_samples.count(&sampled);
+        let gaze = sampled.frame;
+        let eye = |v: &xr::View| EyeView {
+            pose: compose(&world_from_space, &pose_of(&v.pose)),
+            fov: Fov {
+                angle_left_rad: v.fov.angle_left,
+                angle_right_rad: v.fov.angle_right,
+                angle_up_rad: v.fov.angle_up,
+                angle_down_rad: v.fov.angle_down,
+            },
+        };
+        let input = FrameInput {
+            index: self.next_index,
+            time_ns: display.as_nanos(),
+            head: compose(&world_from_space, &head_space),
+            views: [eye(&views[0]), eye(&views[1])],
+            gaze,
+        };
+        self.open_frame()?.handed = Some(Handed {
+            index: self.next_index,
+            views,
+            image,
+            depth_image,
+        });
+        self.next_index += 1;
+        Ok(input)
+    }
+
+    /// Leaves the open frame, if any, without showing it: acquired images waited for and
+    /// released, xrEndFrame with no layers. Failures are logged (the caller is already on an
+    /// error path, or dropping the session); the frame counts as ended either way.
+    pub(super) fn abandon_open_frame(&mut self) {
+        let Some(open) = self.open.take() else {
+            return;
+        };
+        tracing::warn!(
+            "frame at {} ns left without being shown: ending it with no layers",
+            open.display.as_nanos()
+        );
+        for step in open.unwind() {
+            let done = match step {
+                Unwind::WaitColor => self
+                    .swapchain
+                    .wait_image(xr::Duration::INFINITE)
+                    .xr("xrWaitSwapchainImage"),
+                Unwind::ReleaseColor => {
+                    self.swapchain.release_image().xr("xrReleaseSwapchainImage")
+                }
+                Unwind::WaitDepth => match &mut self.depth {
+                    Some((chain, _)) => chain
+                        .wait_image(xr::Duration::INFINITE)
+                        .xr("xrWaitSwapchainImage(depth)"),
+                    None => Ok(()),
+                },
+                Unwind::ReleaseDepth => match &mut self.depth {
+                    Some((chain, _)) => chain.release_image().xr("xrReleaseSwapchainImage(depth)"),
+                    None => Ok(()),
+                },
+                Unwind::EndWithoutLayers => self
+                    .stream
+                    .end(open.display, self.blend, &[])
+                    .xr("xrEndFrame"),
+            };
+            if let Err(e) = done {
+                tracing::warn!("while leaving the frame: {e}");
+            }
+        }
+        self.report.frames_abandoned += 1;
+    }
+
+    /// Releases the handed-out frame's images and submits it with its projection layer.
+    fn submit_frame(&mut self, handed: &Handed, display: xr::Time) -> Result<()> {
+        self.swapchain
+            .release_image()
+            .xr("xrReleaseSwapchainImage")?;
+        self.open_frame()?.color = Hold::Free;
+        if let (Some((chain, _)), Some(_)) = (&mut self.depth, handed.depth_image) {
+            chain.release_image().xr("xrReleaseSwapchainImage(depth)")?;
+            self.open_frame()?.depth = Hold::Free;
+        }
+        let (w, h) = self.size;
+        let rect = xr::Rect2Di {
+            offset: xr::Offset2Di { x: 0, y: 0 },
+            extent: xr::Extent2Di {
+                width: w as i32,
+                height: h as i32,
+            },
+        };
+        let mut views: Vec<_> = handed
+            .views
+            .iter()
+            .enumerate()
+            .map(|(eye, v)| {
+                xr::CompositionLayerProjectionView::new()
+                    .pose(v.pose)
+                    .fov(v.fov)
+                    .sub_image(
+                        xr::SwapchainSubImage::new()
+                            .swapchain(&self.swapchain)
+                            .image_array_index(eye as u32)
+                            .image_rect(rect),
+                    )
+            })
+            .collect();
+        // Depth: the safe API cannot chain XrCompositionLayerDepthInfoKHR, so each view is
+        // rebuilt from its raw struct with the depth info behind `next`. `depth_infos` lives
+        // (unmoved) until xrEndFrame has returned.
+        let mut depth_infos: Vec<xr::sys::CompositionLayerDepthInfoKHR> = Vec::new();
+        if let (Some((chain, options)), Some(_)) = (&self.depth, handed.depth_image) {
+            depth_infos = (0..views.len() as u32)
+                .map(|eye| depth_info(chain.as_raw(), eye, rect, options))
+                .collect();
+            let mut raw: Vec<xr::sys::CompositionLayerProjectionView> =
+                views.iter().map(|v| *v.as_raw()).collect();
+            // SAFETY: `depth_infos` is not touched again before xrEndFrame returns; the
+            // rebuilt views keep the colour swapchain they referenced (still alive in self).
+            unsafe {
+                chain_depth(&mut raw, &mut depth_infos);
+                views = raw
+                    .into_iter()
+                    .map(|r| xr::CompositionLayerProjectionView::from_raw(r))
+                    .collect();
+            }
+        }
+        let layer = xr::CompositionLayerProjection::new()
+            .space(&self.space)
+            .views(&views)
+            .layer_flags(self.layer_flags);
+        self.stream
+            .end(display, self.blend, &[&layer])
+            .xr("xrEndFrame")?;
+        drop(depth_infos);
+        self.open = None;
+        self.report.frames_submitted += 1;
+        if handed.depth_image.is_some() {
+            self.report.frames_with_depth += 1;
+        }
+        Ok(())
+    }
 }
 
 impl Backend for Session {
     type Error = OpenXrError;
 
     fn wait_frame(&mut self) -> Result<Option<FrameInput>> {
-        if self.pending.is_some() {
+        if self.open.is_some() {
             return Err(OpenXrError::FrameOrder(
                 "wait_frame called twice without end_frame".into(),
             ));
@@ -103,159 +319,55 @@ impl Backend for Session {
             let Some(frame) = self.begin_frame()? else {
                 continue;
             };
-            let display = frame.predicted_display_time;
-            let image = self
-                .swapchain
-                .acquire_image()
-                .xr("xrAcquireSwapchainImage")?;
-            self.swapchain
-                .wait_image(xr::Duration::INFINITE)
-                .xr("xrWaitSwapchainImage")?;
-            let depth_image = match &mut self.depth {
-                Some((chain, _)) => {
-                    let i = chain.acquire_image().xr("xrAcquireSwapchainImage(depth)")?;
-                    chain
-                        .wait_image(xr::Duration::INFINITE)
-                        .xr("xrWaitSwapchainImage(depth)")?;
-                    Some(i)
+            return match self.prepare_frame(frame.predicted_display_time) {
+                Ok(input) => Ok(Some(input)),
+                Err(e) => {
+                    self.abandon_open_frame();
+                    Err(e)
                 }
-                None => None,
             };
-            // Views are located after the wait for the image, as late as this loop allows.
-            let (head_space, views, tracked) = self.locate(display)?;
-            if !tracked {
-                self.report.frames_untracked += 1;
-            }
-            let first_display = *self.first_display.get_or_insert(display);
-            let placed = *self.world_from_space.get_or_insert_with(|| {
-                place_scene(
-                    &head_space,
-                    self.options.viewer_position_m,
-                    self.options.scene_origin,
-                )
-            });
-            // Live actions (and the eye-gaze action) are synced before the gaze is sampled and
-            // before the placement is used, so a nudge shows in this very frame.
-            self.sync_actions(compose(&placed, &head_space).position)?;
-            let world_from_space = self.world_from_space.unwrap_or(placed);
-            let gaze = self
-                .gaze
-                .sample(&self.session, &self.view_space, display, first_display);
-            let eye = |v: &xr::View| EyeView {
-                pose: compose(&world_from_space, &pose_of(&v.pose)),
-                fov: Fov {
-                    angle_left_rad: v.fov.angle_left,
-                    angle_right_rad: v.fov.angle_right,
-                    angle_up_rad: v.fov.angle_up,
-                    angle_down_rad: v.fov.angle_down,
-                },
-            };
-            let input = FrameInput {
-                index: self.next_index,
-                time_ns: display.as_nanos(),
-                head: compose(&world_from_space, &head_space),
-                views: [eye(&views[0]), eye(&views[1])],
-                gaze,
-            };
-            self.pending = Some((
-                Pending {
-                    display,
-                    views,
-                    index: self.next_index,
-                    depth_image,
-                },
-                image,
-            ));
-            self.next_index += 1;
-            return Ok(Some(input));
         }
     }
 
     fn frame_target(&self) -> FrameTarget {
-        match &self.pending {
-            Some((pending, image)) => FrameTarget::Swapchain {
-                index: *image,
-                depth_index: pending.depth_image,
-                world_behind: self.world_behind,
+        match self.open.as_ref().and_then(|o| o.handed.as_ref()) {
+            Some(handed) => FrameTarget::Swapchain {
+                index: handed.image,
+                depth_index: handed.depth_image,
+                blend: self.display_blend,
             },
             None => FrameTarget::Own,
         }
     }
 
     fn end_frame(&mut self, frame: &FrameInput) -> Result<()> {
-        let Some((pending, _)) = self.pending.take() else {
+        let Some(open) = &self.open else {
             return Err(OpenXrError::FrameOrder(
                 "end_frame without wait_frame".into(),
             ));
         };
-        if pending.index != frame.index {
+        let display = open.display;
+        let Some(handed) = open.handed.clone() else {
+            return Err(OpenXrError::FrameOrder(
+                "end_frame for a frame that was not handed out".into(),
+            ));
+        };
+        if handed.index != frame.index {
             return Err(OpenXrError::FrameOrder(format!(
                 "end_frame for frame {} but frame {} is in flight",
-                frame.index, pending.index
+                frame.index, handed.index
             )));
         }
-        self.swapchain
-            .release_image()
-            .xr("xrReleaseSwapchainImage")?;
-        if let (Some((chain, _)), Some(_)) = (&mut self.depth, pending.depth_image) {
-            chain.release_image().xr("xrReleaseSwapchainImage(depth)")?;
+        let submitted = self.submit_frame(&handed, display);
+        if submitted.is_err() {
+            // Whatever is still held (an image not released, the frame not ended) goes back.
+            self.abandon_open_frame();
         }
-        let (w, h) = self.size;
-        let rect = xr::Rect2Di {
-            offset: xr::Offset2Di { x: 0, y: 0 },
-            extent: xr::Extent2Di {
-                width: w as i32,
-                height: h as i32,
-            },
-        };
-        let mut views: Vec<_> = pending
-            .views
-            .iter()
-            .enumerate()
-            .map(|(eye, v)| {
-                xr::CompositionLayerProjectionView::new()
-                    .pose(v.pose)
-                    .fov(v.fov)
-                    .sub_image(
-                        xr::SwapchainSubImage::new()
-                            .swapchain(&self.swapchain)
-                            .image_array_index(eye as u32)
-                            .image_rect(rect),
-                    )
-            })
-            .collect();
-        // Depth: the safe API cannot chain XrCompositionLayerDepthInfoKHR, so each view is
-        // rebuilt from its raw struct with the depth info behind `next`. `depth_infos` lives
-        // (unmoved) until xrEndFrame has returned.
-        let mut depth_infos: Vec<xr::sys::CompositionLayerDepthInfoKHR> = Vec::new();
-        if let (Some((chain, options)), Some(_)) = (&self.depth, pending.depth_image) {
-            depth_infos = (0..views.len() as u32)
-                .map(|eye| depth_info(chain.as_raw(), eye, rect, options))
-                .collect();
-            let mut raw: Vec<xr::sys::CompositionLayerProjectionView> =
-                views.iter().map(|v| *v.as_raw()).collect();
-            // SAFETY: `depth_infos` is not touched again before xrEndFrame returns; the
-            // rebuilt views keep the colour swapchain they referenced (still alive in self).
-            unsafe {
-                chain_depth(&mut raw, &mut depth_infos);
-                views = raw
-                    .into_iter()
-                    .map(|r| xr::CompositionLayerProjectionView::from_raw(r))
-                    .collect();
-            }
-        }
-        let layer = xr::CompositionLayerProjection::new()
-            .space(&self.space)
-            .views(&views);
-        self.stream
-            .end(pending.display, self.blend, &[&layer])
-            .xr("xrEndFrame")?;
-        drop(depth_infos);
-        self.report.frames_submitted += 1;
-        if pending.depth_image.is_some() {
-            self.report.frames_with_depth += 1;
-        }
-        Ok(())
+        submitted
+    }
+
+    fn abandon_frame(&mut self) {
+        self.abandon_open_frame();
     }
 }
 
@@ -263,13 +375,7 @@ impl Drop for Session {
     fn drop(&mut self) {
         // A session dropped mid-frame (an error in the app) still ends its frame, so the
         // runtime is not left waiting.
-        if let Some((pending, _)) = self.pending.take() {
-            let _ = self.swapchain.release_image();
-            if let (Some((chain, _)), Some(_)) = (&mut self.depth, pending.depth_image) {
-                let _ = chain.release_image();
-            }
-            let _ = self.stream.end(pending.display, self.blend, &[]);
-        }
+        self.abandon_open_frame();
         if self.running {
             let _ = self.session.request_exit();
         }

@@ -9,6 +9,7 @@
 mod create;
 mod frame;
 mod placement;
+mod scope;
 mod state_machine;
 
 use std::sync::OnceLock;
@@ -23,7 +24,7 @@ use super::DepthOptions;
 use super::SessionOptions;
 use super::actions::{Command, Controls};
 use super::choose::{Blend, GazeSource, SpaceChoice};
-use super::gaze::Gaze;
+use super::gaze::{Gaze, GazeTally};
 use super::state::{EndReason, State};
 use crate::frame::Pose;
 
@@ -60,6 +61,9 @@ pub struct SessionReport {
     pub end_reason: Option<EndReason>,
     /// The gaze source.
     pub gaze_source: Option<GazeSource>,
+    /// The gaze source's samples: frames asked, samples received, frames with a fresh one
+    /// (for XR_EXT_eye_gaze_interaction, the runtime's combined-ray samples).
+    pub gaze_samples: GazeTally,
     /// The reference space.
     pub space: Option<SpaceChoice>,
     /// The blend mode.
@@ -78,6 +82,12 @@ pub struct SessionReport {
     pub frames_with_depth: u64,
     /// The depth swapchain's format (VkFormat code) when depth is submitted.
     pub depth_format: Option<i32>,
+    /// Frames begun but left without being shown (an error before xrEndFrame): each was
+    /// ended with no layers and its images released.
+    pub frames_abandoned: u64,
+    /// XrEventDataReferenceSpaceChangePending events for the scene's space; each re-anchors
+    /// the scene at the next located head pose.
+    pub space_changes: u64,
 }
 
 impl SessionReport {
@@ -85,18 +95,6 @@ impl SessionReport {
     pub fn reached(&self, state: State) -> bool {
         self.states.contains(&state)
     }
-}
-
-/// A frame handed out and not yet ended.
-struct Pending {
-    /// Its predicted display time.
-    display: xr::Time,
-    /// The located views, in the runtime's space (for the projection layer).
-    views: Vec<xr::View>,
-    /// Its index.
-    index: u64,
-    /// The depth swapchain image acquired for it, when depth is submitted.
-    depth_image: Option<u32>,
 }
 
 /// A live OpenXR session; the [`crate::Backend`] of `vitreous run`.
@@ -121,6 +119,8 @@ pub struct Session {
     gaze: Gaze,
     /// The app space the scene is placed in (STAGE or LOCAL).
     space: xr::Space,
+    /// Its type, to match reference-space change events.
+    space_type: xr::ReferenceSpaceType,
     /// The VIEW space (the head).
     view_space: xr::Space,
     /// The session.
@@ -131,8 +131,10 @@ pub struct Session {
     events: xr::EventDataBuffer,
     /// Blend mode submitted with every frame.
     blend: xr::EnvironmentBlendMode,
-    /// Whether the real world is drawn behind the glass.
-    world_behind: bool,
+    /// Flags of the projection layer (source alpha for ALPHA_BLEND).
+    layer_flags: xr::CompositionLayerFlags,
+    /// The blend mode, as the renderer composes for it.
+    display_blend: Blend,
     /// Eye image size, pixels.
     size: (u32, u32),
     /// Current state.
@@ -143,14 +145,15 @@ pub struct Session {
     exit_requested: bool,
     /// Set to quit on the next wait.
     quit: bool,
-    /// Scene frame from app space; fixed at the first located head pose.
+    /// Scene frame from app space; fixed at the first located head pose (and again at the
+    /// first one after the space changed).
     world_from_space: Option<Pose>,
     /// Display time of the first frame.
     first_display: Option<xr::Time>,
     /// Next frame index.
     next_index: u64,
-    /// The frame in flight and the swapchain image acquired for it.
-    pending: Option<(Pending, u32)>,
+    /// The frame between xrBeginFrame and xrEndFrame, and what it holds.
+    open: Option<scope::OpenFrame>,
     /// Options.
     options: SessionOptions,
     /// What happened.

@@ -99,6 +99,18 @@ impl Session {
                     self.end_with(EndReason::InstanceLost);
                     self.quit = true;
                 }
+                xr::Event::ReferenceSpaceChangePending(e)
+                    if e.reference_space_type() == self.space_type =>
+                {
+                    self.report.space_changes += 1;
+                    self.world_from_space = None;
+                    tracing::info!(
+                        "the {:?} reference space changes (at {} ns): the scene is placed \
+                         again at the next head pose",
+                        e.reference_space_type(),
+                        e.change_time().as_nanos()
+                    );
+                }
                 xr::Event::EventsLost(e) => {
                     tracing::warn!("the runtime dropped {} events", e.lost_event_count());
                 }

@@ -449,3 +449,16 @@ fn missing_env_map_is_named() {
     let msg = expect_env_error(&data("bad-inputs/exr/no-such-map.exr"));
     assert!(msg.contains("file not found"), "{msg}");
 }
+
+#[test]
+fn gaze_pupil_source_is_read_and_a_bad_one_named() {
+    use vitreous::gaze::PupilSource;
+    let (_dir, _path, result) = load_text(&good_text());
+    assert_eq!(result.unwrap().gaze.pupil, PupilSource::Paper);
+    let text = format!("{}\n[gaze]\npupil = \"measured\"\n", good_text());
+    let (_dir, _path, result) = load_text(&text);
+    assert_eq!(result.unwrap().gaze.pupil, PupilSource::Measured);
+    let text = format!("{}\n[gaze]\npupil = \"tracker\"\n", good_text());
+    let msg = expect_error(&text, line_of(&text, "pupil ="), "gaze.pupil");
+    assert!(msg.contains("paper or measured"), "{msg}");
+}

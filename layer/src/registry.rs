@@ -64,8 +64,10 @@ pub struct SessionState {
 pub struct SpaceState {
     /// The session's raw handle.
     pub session: u64,
-    /// For the action space of an eye-gaze action: its pose in the action space.
-    pub gaze_offset: Option<Pose>,
+    /// For an action space: the action and the space's pose in the action space. Whether
+    /// the action is an eye-gaze action is decided when the space is located (its binding
+    /// may be suggested after the space is created).
+    pub action: Option<(u64, Pose)>,
 }
 
 /// An eye tracker the layer made.
@@ -130,6 +132,16 @@ impl Registry {
             return Some(i.next.clone());
         }
         self.only_instance().map(|i| i.next.clone())
+    }
+
+    /// For the action space of an eye-gaze action (XR_EXT_eye_gaze_interaction enabled):
+    /// its session and its pose in the action space.
+    pub fn gaze_space(&self, space: u64) -> Option<(u64, Pose)> {
+        let s = self.spaces.get(&space)?;
+        let (action, offset) = s.action?;
+        let (_, i) = self.session(s.session)?;
+        (i.owns(GazeExtension::Ext) && i.gaze_actions.contains(&action))
+            .then_some((s.session, offset))
     }
 
     /// The instance, when exactly one exists.

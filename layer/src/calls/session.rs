@@ -5,7 +5,6 @@ use openxr::sys::{self, Handle};
 
 use super::{SessionContext, all_location_flags, chain};
 use crate::blend;
-use crate::config::GazeExtension;
 use crate::entry::{guard, report};
 use crate::eye_geometry::{combined_ray, compose, from_posef, ray_pose, relative, to_posef};
 use crate::registry::{SessionState, SpaceState, registry};
@@ -253,7 +252,7 @@ pub unsafe extern "system" fn create_reference_space(
                 created.into_raw(),
                 SpaceState {
                     session: session.into_raw(),
-                    gaze_offset: None,
+                    action: None,
                 },
             );
         }
@@ -272,17 +271,7 @@ pub unsafe extern "system" fn create_action_space(
     space: *mut sys::Space,
 ) -> sys::Result {
     guard("xrCreateActionSpace", || {
-        let Some((ctx, gaze_actions)) = ({
-            let reg = registry();
-            SessionContext::of(&reg, session.into_raw()).map(|c| {
-                let actions = reg
-                    .instances
-                    .get(&c.instance.into_raw())
-                    .map(|i| i.gaze_actions.clone())
-                    .unwrap_or_default();
-                (c, actions)
-            })
-        }) else {
+        let Some(ctx) = SessionContext::of(&registry(), session.into_raw()) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the next layer's function with the app's arguments.
@@ -293,14 +282,11 @@ pub unsafe extern "system" fn create_action_space(
         // SAFETY: on success `info` was valid and the new space was written.
         let (action, offset, created) =
             unsafe { ((*info).action, (*info).pose_in_action_space, *space) };
-        let gaze_offset = (ctx.owned.contains(&GazeExtension::Ext)
-            && gaze_actions.contains(&action.into_raw()))
-        .then(|| from_posef(&offset));
         registry().spaces.insert(
             created.into_raw(),
             SpaceState {
                 session: session.into_raw(),
-                gaze_offset,
+                action: Some((action.into_raw(), from_posef(&offset))),
             },
         );
         r
@@ -361,23 +347,12 @@ pub unsafe extern "system" fn locate_space(
     guard("xrLocateSpace", || {
         let (next, gaze) = {
             let reg = registry();
-            let a = reg.spaces.get(&space.into_raw()).copied();
-            let b = reg.spaces.get(&base.into_raw()).copied();
-            let gaze_session = [a, b]
-                .into_iter()
-                .flatten()
-                .find(|s| s.gaze_offset.is_some())
-                .map(|s| s.session);
-            let ctx = gaze_session.and_then(|s| SessionContext::of(&reg, s));
+            let a = reg.gaze_space(space.into_raw());
+            let b = reg.gaze_space(base.into_raw());
+            let ctx = a.or(b).and_then(|(s, _)| SessionContext::of(&reg, s));
             (
                 reg.next_for_space(space.into_raw()),
-                ctx.map(|c| {
-                    (
-                        c,
-                        a.and_then(|s| s.gaze_offset),
-                        b.and_then(|s| s.gaze_offset),
-                    )
-                }),
+                ctx.map(|c| (c, a.map(|(_, o)| o), b.map(|(_, o)| o))),
             )
         };
         let Some((ctx, a_offset, b_offset)) = gaze else {

@@ -111,8 +111,9 @@ pub struct RunSummary {
     pub world_behind: bool,
     /// The reference space.
     pub space: String,
-    /// The gaze source: `ml` (XR_ML_eye_tracker), `fb` (XR_FB_eye_tracking_social), `ext`
-    /// (XR_EXT_eye_gaze_interaction), `trace` or `manual`.
+    /// The gaze source, named by its extension (`XR_ML_eye_tracker (...)`,
+    /// `XR_FB_eye_tracking_social (...)`, `XR_EXT_eye_gaze_interaction (...)`), or
+    /// `recorded trace (--gaze-trace)`, or `manual (no eye tracker)`.
     pub gaze_source: String,
     /// The gaze source's samples.
     pub gaze_samples: GazeSamples,
@@ -559,7 +560,7 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         space: report.space.map(|s| format!("{s:?}")).unwrap_or_default(),
         gaze_source: report
             .gaze_source
-            .map(|g| g.key().to_owned())
+            .map(|g| g.to_string())
             .unwrap_or_default(),
         gaze_samples: GazeSamples {
             frames: report.gaze_samples.frames,

@@ -246,10 +246,11 @@ unsafe fn load<T: Copy>(instance: &xr::Instance, name: &CStr) -> Result<T> {
     };
     match f {
         Some(f) if r == xr::sys::Result::SUCCESS => {
-            assert_eq!(
-                std::mem::size_of::<T>(),
-                std::mem::size_of::<xr::sys::pfn::VoidFunction>()
-            );
+            const {
+                assert!(
+                    std::mem::size_of::<T>() == std::mem::size_of::<xr::sys::pfn::VoidFunction>()
+                )
+            };
             // SAFETY: the runtime returned the function named `name`, whose type is `T` (this
             // function's contract); both are plain function pointers of the same size.
             Ok(unsafe { std::mem::transmute_copy::<xr::sys::pfn::VoidFunction, T>(&f) })

@@ -331,11 +331,18 @@ impl MlTracker {
             &poses.gaze_pose,
             &poses.fixation_pose,
         ];
-        let sample_time_ns = all
-            .iter()
-            .filter(|p| valid(p))
-            .map(|p| p.time.as_nanos())
-            .max()?;
+        // A blink (no valid pose) is a sample too: the filters hold through it. Its time is the
+        // newest the runtime stamped, else the display time asked for.
+        let newest = |only_valid: bool| {
+            all.iter()
+                .filter(|p| !only_valid || valid(p))
+                .map(|p| p.time.as_nanos())
+                .filter(|&t| t > 0)
+                .max()
+        };
+        let sample_time_ns = newest(true)
+            .or_else(|| newest(false))
+            .unwrap_or(display.as_nanos());
         let fixation = valid(&poses.fixation_pose).then(|| {
             let p = poses.fixation_pose.pose.position;
             Vec3::new(p.x, p.y, p.z)

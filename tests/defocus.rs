@@ -79,6 +79,7 @@ fn first_frame(scene: &Scene) -> FrameInput {
             max_frames: Some(1),
             fov: scene.output.fov,
             ipd_m: scene.viewer.ipd_m,
+            at_samples: false,
         },
     )
     .unwrap();
@@ -254,6 +255,7 @@ fn sharpness_by_gaze(scene: &Scene) -> Vec<(GazeImage, f64)> {
             max_frames: Some(frames.iter().max().unwrap() + 1),
             fov: scene.output.fov,
             ipd_m: scene.viewer.ipd_m,
+            at_samples: false,
         },
     )
     .unwrap();

@@ -28,6 +28,7 @@ fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOptions {
         effects: None,
         device: None,
         frame_rate_hz: 60.0,
+        at_samples: false,
         progress: false,
         reflection: vitreous_render::Reflection::Phong,
         reference: false,
@@ -91,6 +92,7 @@ fn check_geometry(scene_name: &str, trace: Option<&str>, check: Check) {
             max_frames: Some(31),
             fov: scene.output.fov,
             ipd_m: scene.viewer.ipd_m,
+            at_samples: false,
         },
     )
     .unwrap();

@@ -171,6 +171,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             max_frames: None,
             fov: scene.output.fov,
             ipd_m: scene.viewer.ipd_m,
+            at_samples: false,
         },
     )?;
     let mut inputs: Vec<FrameInput> = Vec::with_capacity(total);

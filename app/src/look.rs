@@ -244,6 +244,8 @@ pub struct GazeSettings {
     pub image: Option<GazeOverride>,
     /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
     pub pupil_mm: Option<f32>,
+    /// Where A_p comes from, overriding the scene's `[gaze] pupil`.
+    pub pupil_source: Option<PupilSource>,
 }
 
 /// The per-frame look planner for a scene and effect set, and the defocus stacks to upload
@@ -271,7 +273,8 @@ pub fn planners_for(
             Some(mm) => check_pupil_diameter_m(mm / 1000.0)?,
             None => scene.viewer.pupil_diameter_m,
         };
-        if scene.gaze.pupil == PupilSource::Measured {
+        let source = gaze.pupil_source.unwrap_or(scene.gaze.pupil);
+        if source == PupilSource::Measured {
             tracing::info!(
                 "A_p: the eye tracker's pupil diameters, smoothed ({:.1} mm until the first \
                  measurement)",
@@ -280,7 +283,9 @@ pub fn planners_for(
         } else {
             tracing::info!("A_p: fixed {:.1} mm", pupil_m * 1000.0);
         }
-        Some(DefocusSetup::new(scene, pupil_m))
+        let mut setup = DefocusSetup::new(scene, pupil_m);
+        setup.model.pupil_source = source;
+        Some(setup)
     } else {
         None
     };

@@ -10,7 +10,7 @@ use vitreous::cli_values::{
     parse_blend, parse_effects, parse_frame_count, parse_frame_count_usize, parse_gaze, parse_size,
 };
 use vitreous::effects::EffectSet;
-use vitreous::gaze::{FilterKind, GazeOverride};
+use vitreous::gaze::{FilterKind, GazeOverride, PupilSource};
 use vitreous::output::ensure_not_input;
 use vitreous::replay::{GazeSettings, ReplayOptions, replay};
 use vitreous::trace_analyze::{analyze_trace_file, plot_trace_file};
@@ -66,6 +66,10 @@ enum Command {
         /// Effects, overriding the scene's (as for replay).
         #[arg(long, value_name = "LIST", value_parser = parse_effects)]
         effects: Option<EffectSet>,
+        /// Where A_p (eq. 13) comes from, overriding the scene's `[gaze] pupil`: paper (the
+        /// fixed diameter) or measured (the eye tracker's, smoothed).
+        #[arg(long = "pupil", value_name = "SOURCE")]
+        pupil_source: Option<PupilSource>,
         /// Folder for summary.json (default: none written).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -114,6 +118,10 @@ enum Command {
             allow_negative_numbers = true
         )]
         rate: f64,
+        /// One frame per trace sample, at the sample's time, instead of --rate: how
+        /// `vitreous run` rendered the trace it recorded, so the two compare frame by frame.
+        #[arg(long, conflicts_with = "rate")]
+        at_samples: bool,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
@@ -136,6 +144,10 @@ enum Command {
         /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
         #[arg(long = "pupil-mm", value_name = "MM", allow_negative_numbers = true)]
         pupil_mm: Option<f32>,
+        /// Where A_p (eq. 13) comes from, overriding the scene's `[gaze] pupil`: paper (the
+        /// fixed diameter) or measured (the trace's pupil diameters, smoothed).
+        #[arg(long = "pupil", value_name = "SOURCE")]
+        pupil_source: Option<PupilSource>,
     },
     /// Compare the frame time of the baseline and of effect sets, alternated frame by frame
     /// in one process on one device; prints medians, spreads and ratios to the baseline.
@@ -311,6 +323,7 @@ fn run(cli: Cli) -> Result<()> {
             blend,
             size,
             effects,
+            pupil_source,
             out,
         } => {
             if let Some(record) = &record {
@@ -329,6 +342,7 @@ fn run(cli: Cli) -> Result<()> {
                 blend,
                 size,
                 effects,
+                pupil_source,
                 out,
                 ..Default::default()
             })?;
@@ -346,12 +360,14 @@ fn run(cli: Cli) -> Result<()> {
             effects,
             device,
             rate,
+            at_samples,
             quiet,
             reflection,
             reference,
             gaze_image,
             filter,
             pupil_mm,
+            pupil_source,
         } => {
             let out = match out {
                 Some(out) => out,
@@ -376,6 +392,7 @@ fn run(cli: Cli) -> Result<()> {
                 effects,
                 device,
                 frame_rate_hz: rate,
+                at_samples,
                 progress: !quiet,
                 reflection: reflection.into(),
                 reference,
@@ -383,6 +400,7 @@ fn run(cli: Cli) -> Result<()> {
                     filter,
                     image: gaze_image,
                     pupil_mm,
+                    pupil_source,
                 },
             })?;
             println!("{}", summary.summary_line());

@@ -49,6 +49,9 @@ pub struct ReplayOptions {
     pub device: Option<String>,
     /// Display frame rate of the replay, hertz.
     pub frame_rate_hz: f64,
+    /// One frame per trace sample at its time (as `vitreous run` rendered a recording),
+    /// instead of `frame_rate_hz`.
+    pub at_samples: bool,
     /// Show a progress bar.
     pub progress: bool,
     /// How the reflected image is drawn when per-eye refraction is on.
@@ -330,6 +333,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
             max_frames: options.frames,
             fov: scene.output.fov,
             ipd_m: scene.viewer.ipd_m,
+            at_samples: options.at_samples,
         },
     )
     .with_context(|| format!("replaying {trace_name}"))?;

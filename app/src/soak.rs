@@ -288,6 +288,7 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
                 max_frames: Some(options.frames_per_pass),
                 fov: scene.output.fov,
                 ipd_m: scene.viewer.ipd_m,
+                at_samples: false,
             },
         )?;
         let mut sink = Discard {

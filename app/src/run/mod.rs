@@ -86,6 +86,8 @@ pub struct RunOptions {
     pub effects: Option<EffectSet>,
     /// How the reflected image is drawn.
     pub reflection: Reflection,
+    /// Where A_p comes from, overriding the scene's `[gaze] pupil`.
+    pub pupil_source: Option<crate::gaze::PupilSource>,
     /// Where summary.json goes (None: not written).
     pub out: Option<PathBuf>,
 }
@@ -432,7 +434,10 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         &scene,
         &conditions,
         options.reflection,
-        &GazeSettings::default(),
+        &GazeSettings {
+            pupil_source: options.pupil_source,
+            ..GazeSettings::default()
+        },
     )?;
     let mut renderer = Renderer::new(
         ctx,

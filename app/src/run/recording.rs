@@ -64,6 +64,7 @@ pub(super) fn replay_check(
             max_frames: None,
             fov: scene.output.fov,
             ipd_m: scene.viewer.ipd_m,
+            at_samples: false,
         },
     )?;
     let (mut frames, mut max_pos, mut max_ang, mut max_eye) = (0u64, 0f32, 0f32, 0f32);

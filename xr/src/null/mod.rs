@@ -2,7 +2,9 @@
 //!
 //! Frame `k` is displayed at `t0 + k / frame_rate_hz` (rounded to the nanosecond), where `t0`
 //! is the first sample's time, for as long as that time is not after the last sample's time
-//! (or until `max_frames`). For each frame:
+//! (or until `max_frames`). With [`NullConfig::at_samples`], frame `k` is displayed at sample
+//! `k`'s own time instead: one frame per sample, as the live session that recorded the trace
+//! rendered it. For each frame:
 //! - the head pose is interpolated between the samples around the frame time (position
 //!   linearly, orientation by slerp);
 //! - the gaze is the newest sample whose `sample_time_ns` is at or before the frame time, so a
@@ -42,6 +44,8 @@ pub struct NullConfig {
     pub fov: Fov,
     /// Eye separation used until the trace has a valid gaze origin for an eye, metres.
     pub ipd_m: f32,
+    /// One frame per sample, at the sample's time, instead of `frame_rate_hz`.
+    pub at_samples: bool,
 }
 
 impl Default for NullConfig {
@@ -51,6 +55,7 @@ impl Default for NullConfig {
             max_frames: None,
             fov: Fov::symmetric(90f32.to_radians(), 90f32.to_radians()),
             ipd_m: 0.063,
+            at_samples: false,
         }
     }
 }
@@ -151,6 +156,8 @@ pub struct NullBackend {
     next_index: u64,
     /// The frame handed out and not yet ended.
     pending: Option<u64>,
+    /// Display time of the last frame handed out.
+    last_time_ns: Option<i64>,
     /// True once the replay has ended (or failed).
     done: bool,
 }
@@ -213,6 +220,7 @@ impl NullBackend {
             first_ns: None,
             next_index: 0,
             pending: None,
+            last_time_ns: None,
             done: false,
         };
         if !this.pull()? {
@@ -232,6 +240,24 @@ impl NullBackend {
     /// Time of the first sample, which is the time of frame 0, nanoseconds.
     pub fn start_time_ns(&self) -> i64 {
         self.t0_ns
+    }
+
+    /// The time of the first sample after the last frame handed out (the first sample for
+    /// frame 0); `None` once the trace has ended.
+    fn next_sample_time(&mut self) -> Result<Option<i64>, NullError> {
+        let after = self.last_time_ns;
+        loop {
+            if let Some(s) = self
+                .buffer
+                .iter()
+                .find(|s| after.is_none_or(|t| s.time_ns > t))
+            {
+                return Ok(Some(s.time_ns));
+            }
+            if self.exhausted || !self.pull()? {
+                return Ok(None);
+            }
+        }
     }
 
     /// Current estimate of the left and right eye positions in the head frame, metres.
@@ -264,13 +290,23 @@ impl Backend for NullBackend {
             self.done = true;
             return Ok(None);
         }
-        // A frame time past the end of i64 is past the last sample: the replay ends (saturating
-        // instead would show the last sample forever).
-        let offset_ns = (index as f64 * 1e9 / self.config.frame_rate_hz).round();
-        let time_ns = if offset_ns < i64::MAX as f64 {
-            self.t0_ns.checked_add(offset_ns as i64)
+        let time_ns = if self.config.at_samples {
+            match self.next_sample_time() {
+                Ok(t) => t,
+                Err(e) => {
+                    self.done = true;
+                    return Err(e);
+                }
+            }
         } else {
-            None
+            // A frame time past the end of i64 is past the last sample: the replay ends
+            // (saturating instead would show the last sample forever).
+            let offset_ns = (index as f64 * 1e9 / self.config.frame_rate_hz).round();
+            if offset_ns < i64::MAX as f64 {
+                self.t0_ns.checked_add(offset_ns as i64)
+            } else {
+                None
+            }
         };
         let Some(time_ns) = time_ns else {
             self.done = true;
@@ -279,6 +315,7 @@ impl Backend for NullBackend {
         match self.frame_at(index, time_ns) {
             Ok(Some(frame)) => {
                 self.next_index += 1;
+                self.last_time_ns = Some(time_ns);
                 self.pending = Some(index);
                 Ok(Some(frame))
             }

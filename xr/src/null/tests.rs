@@ -42,6 +42,41 @@ fn ten_ms_trace() -> Vec<TraceSample> {
 }
 
 #[test]
+fn at_samples_gives_one_frame_per_sample_at_its_time() {
+    // Irregular times, as a live session's frames are: 100 ms, then 50 ms, then 30 ms apart.
+    let times = [
+        1_000_000_000i64,
+        1_100_000_000,
+        1_150_000_000,
+        1_180_000_000,
+    ];
+    let samples: Vec<TraceSample> = times
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| sample(t, Vec3::new(i as f32 * 0.1, 0.0, 0.0), 0.0))
+        .collect();
+    let config = NullConfig {
+        at_samples: true,
+        ..NullConfig::default()
+    };
+    let mut b = NullBackend::new(samples.clone(), config).unwrap();
+    let frames = run(&mut b);
+    assert_eq!(frames.iter().map(|f| f.time_ns).collect::<Vec<_>>(), times);
+    // Each frame shows its own sample, not an interpolation between neighbours.
+    for (f, s) in frames.iter().zip(&samples) {
+        assert_eq!(f.head.position, s.head.position);
+        assert_eq!(f.gaze.map(|g| g.sample_time_ns), Some(s.time_ns));
+    }
+    let limited = NullConfig {
+        at_samples: true,
+        max_frames: Some(2),
+        ..NullConfig::default()
+    };
+    let mut b = NullBackend::new(samples, limited).unwrap();
+    assert_eq!(run(&mut b).len(), 2);
+}
+
+#[test]
 fn frame_count_and_times_follow_the_frame_rate() {
     let mut b = NullBackend::new(ten_ms_trace(), NullConfig::default()).unwrap();
     let frames = run(&mut b);

@@ -1,6 +1,6 @@
 //! Drives the simulated headset's three eye extensions through the OpenXR loader in a headless
 //! session (`XR_MND_headless`, which Monado offers), without Vulkan, and prints what each
-//! answers: the calls `layer/tests/e2e.sh` does not reach through `vitreous run`. Frames
+//! answers: the calls `tools/monado/sim-headset` does not reach through `vitreous run`. Frames
 //! are only waited for (Monado refuses `xrBeginFrame` in a headless session), so the blend
 //! substitution and the submitted-frames CSV are not exercised here.
 //!

@@ -1,0 +1,12 @@
+//! The command-line, scene-loading and gaze tests of `vitreous`, in one binary: each module is
+//! one subject.
+
+mod cli;
+mod gaze_defocus;
+mod gaze_filter;
+mod gaze_trace;
+mod gaze_vergence;
+mod interrupted;
+mod scene_errors;
+mod scene_load;
+mod scene_shipped;

@@ -1,0 +1,9 @@
+//! The end-to-end GPU tests, in one binary: each module is one subject (on lavapipe in CI,
+//! Vulkan validation on in every test).
+
+mod caustics;
+mod defocus;
+mod inducer;
+mod refraction;
+mod render_smoke;
+mod replay;

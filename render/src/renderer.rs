@@ -1,4 +1,8 @@
 //! The renderer: owns the GPU context, the scene's resources, the passes and the frame slots.
+//!
+//! Just over 600 lines: the passes live in their own modules; what stays here is the one idea
+//! of a frame (slot choice, recording every pass in order, submission for each composition and
+//! target), which reads best in one place.
 
 use std::time::Instant;
 

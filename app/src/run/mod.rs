@@ -18,19 +18,20 @@
 //!
 //! Parts: `device.rs` (Vulkan through the runtime), `live.rs` (conditions and live
 //! commands), `readback.rs` (the readback check), `recording.rs` (the recorded trace and its
-//! replay check); this file sets the session up, runs it and writes the summary.
+//! replay check), `summary.rs` (what the run reports); this file sets the session up, runs it
+//! and writes the summary.
 
 mod device;
 mod live;
 mod readback;
 mod recording;
+mod summary;
 
 use std::fs;
 use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
 use vitreous_xr::FrameInput;
@@ -47,9 +48,10 @@ pub use readback::{
     AWAY_RADII, LIT_THRESHOLD, MIN_AWAY_FRACTION, MIN_OBJECT_FRACTION, ReadbackCheck,
 };
 pub use recording::ReplayCheck;
+pub use summary::{GazeSamples, RunSummary};
 
 use crate::effects::EffectSet;
-use crate::frame_log::{FrameLog, PupilSummary};
+use crate::frame_log::FrameLog;
 use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::look::{GazeSettings, planners_for};
 use crate::output::write_atomic;
@@ -90,204 +92,6 @@ pub struct RunOptions {
     pub pupil_source: Option<crate::gaze::PupilSource>,
     /// Where summary.json goes (None: not written).
     pub out: Option<PathBuf>,
-}
-
-/// What `vitreous run` reports (and writes to summary.json).
-#[derive(Clone, Debug, Serialize)]
-pub struct RunSummary {
-    /// vitreous version.
-    pub vitreous_version: String,
-    /// The scene file.
-    pub scene: String,
-    /// OpenXR runtime name and version.
-    pub runtime: String,
-    /// The headset's name.
-    pub system: String,
-    /// Enabled OpenXR extensions.
-    pub extensions: Vec<String>,
-    /// Blend modes offered.
-    pub blend_modes_offered: Vec<String>,
-    /// The blend mode used: `additive`, `alpha-blend` or `opaque`.
-    pub blend: String,
-    /// Whether the real world was drawn behind the glass (opaque displays).
-    pub world_behind: bool,
-    /// The reference space.
-    pub space: String,
-    /// The gaze source, named by its extension (`XR_ML_eye_tracker (...)`,
-    /// `XR_FB_eye_tracking_social (...)`, `XR_EXT_eye_gaze_interaction (...)`), or
-    /// `recorded trace (--gaze-trace)`, or `manual (no eye tracker)`.
-    pub gaze_source: String,
-    /// The gaze source's samples.
-    pub gaze_samples: GazeSamples,
-    /// XrEventDataReferenceSpaceChangePending events for the scene's space (each re-anchored
-    /// the scene at the next head pose).
-    pub space_changes: u64,
-    /// Frames begun but left unshown after an error (ended with no layers).
-    pub frames_abandoned: u64,
-    /// Swapchain format and whether it encodes sRGB.
-    pub swapchain_format: String,
-    /// Session states reached, in order.
-    pub states: Vec<String>,
-    /// Whether FOCUSED was reached.
-    pub reached_focused: bool,
-    /// Why the session ended.
-    pub end_reason: String,
-    /// Frames submitted with a projection layer.
-    pub frames_submitted: u64,
-    /// Frames the runtime said not to render.
-    pub frames_skipped: u64,
-    /// Frames whose head pose was not fully tracked.
-    pub frames_untracked: u64,
-    /// Vulkan device and driver.
-    pub device: String,
-    /// Eye image size, pixels.
-    pub width_px: u32,
-    /// Eye image size, pixels.
-    pub height_px: u32,
-    /// Vulkan validation results.
-    pub validation: ValidationSummary,
-    /// Wall-clock time of the session's frame loop, seconds.
-    pub wall_s: f64,
-    /// Frames per second.
-    pub frames_per_second: f64,
-    /// CPU milliseconds per frame.
-    pub cpu_ms: Option<Spread>,
-    /// GPU milliseconds per frame.
-    pub gpu_ms: Option<Spread>,
-    /// The readback check, when asked for.
-    pub readback: Option<ReadbackCheck>,
-    /// The recording, when asked for.
-    pub recorded: Option<String>,
-    /// Samples recorded.
-    pub recorded_samples: u64,
-    /// Replay of the recording against the session's views, when recorded.
-    pub replay_check: Option<ReplayCheck>,
-    /// The controller action set was created and attached.
-    pub actions_attached: bool,
-    /// Interaction profiles whose bindings the runtime accepted.
-    pub action_profiles: Vec<String>,
-    /// xrSyncActions calls (one per FOCUSED frame).
-    pub action_syncs: u64,
-    /// Commands the live actions gave.
-    pub commands: u64,
-    /// The effect conditions the live actions cycle through, the first one the start.
-    pub conditions: Vec<String>,
-    /// The effect condition at the end.
-    pub final_condition: String,
-    /// The forced gaze image at the end (`auto`: the tracker decides).
-    pub final_gaze_image: String,
-    /// Whether depth was submitted (XR_KHR_composition_layer_depth).
-    pub depth_submitted: bool,
-    /// The depth swapchain's format, when depth was submitted.
-    pub depth_format: Option<String>,
-    /// Frames submitted with depth.
-    pub frames_with_depth: u64,
-    /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
-    pub gaze_image_switches: u64,
-    /// Where A_p came from and the values used (`null` when no condition has defocus).
-    pub pupil: Option<PupilSummary>,
-}
-
-impl RunSummary {
-    /// The summary as `vitreous run` prints it: one line per topic.
-    pub fn report(&self) -> String {
-        use std::fmt::Write as _;
-        let mut out = String::new();
-        let _ = writeln!(
-            out,
-            "session on {} ({}): states {}; {} frames submitted ({} skipped) at {}x{} per \
-             eye, {:.1} frames/s; blend {}; gaze {} ({} of {} frames with a fresh sample); \
-             ended: {}",
-            self.runtime,
-            self.system,
-            self.states.join(" > "),
-            self.frames_submitted,
-            self.frames_skipped,
-            self.width_px,
-            self.height_px,
-            self.frames_per_second,
-            self.blend,
-            self.gaze_source,
-            self.gaze_samples.fresh_frames,
-            self.gaze_samples.frames,
-            self.end_reason
-        );
-        if self.space_changes + self.frames_abandoned > 0 {
-            let _ = writeln!(
-                out,
-                "reference space changes: {} (scene re-anchored each time); frames left \
-                 unshown after an error: {}",
-                self.space_changes, self.frames_abandoned
-            );
-        }
-        let _ = writeln!(
-            out,
-            "vulkan validation: {} errors, {} warnings (enabled: {})",
-            self.validation.errors, self.validation.warnings, self.validation.enabled
-        );
-        let _ = writeln!(
-            out,
-            "actions attached: {}, syncs: {}, commands: {} (profiles: {}; conditions: {}; \
-             final condition {}, gaze image {})",
-            self.actions_attached,
-            self.action_syncs,
-            self.commands,
-            self.action_profiles.join(", "),
-            self.conditions.join(" > "),
-            self.final_condition,
-            self.final_gaze_image
-        );
-        let _ = writeln!(
-            out,
-            "depth submitted: {} ({}), {} of {} frames with depth",
-            self.depth_submitted,
-            self.depth_format.as_deref().unwrap_or("no depth swapchain"),
-            self.frames_with_depth,
-            self.frames_submitted
-        );
-        if let Some(c) = &self.readback {
-            let _ = writeln!(
-                out,
-                "readback of frame {} ({}): object in {:.1} % of its region ({} of {} px), mean \
-                 {:.1}; {:.1} % of the {} px away from it as the blend mode needs; {} px with \
-                 alpha above 0",
-                c.frame,
-                c.blend,
-                c.object_fraction * 100.0,
-                c.object_px,
-                c.region_px,
-                c.mean_value,
-                c.away_fraction * 100.0,
-                c.away_px,
-                c.alpha_nonzero_px
-            );
-        }
-        if let Some(r) = &self.replay_check {
-            let _ = writeln!(
-                out,
-                "recording replayed: {} samples, {} frames; max head difference {:.2e} m, \
-                 {:.2e} deg; max eye position difference {:.4} m",
-                r.samples,
-                r.frames,
-                r.max_head_position_m,
-                r.max_head_angle_deg,
-                r.max_eye_position_m
-            );
-        }
-        out
-    }
-}
-
-/// The gaze source's samples over the session.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
-pub struct GazeSamples {
-    /// Frames the source was asked for a sample.
-    pub frames: u64,
-    /// Frames it gave a sample (for `ext`: the runtime's combined ray, also when the trace
-    /// decides the gaze image).
-    pub received: u64,
-    /// Frames whose sample was newer than any before: a fresh sample.
-    pub fresh_frames: u64,
 }
 
 /// Records frames and checks a readback.

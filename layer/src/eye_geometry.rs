@@ -4,10 +4,8 @@
 
 use glam::{Mat3, Quat, Vec3};
 use openxr::sys;
+use vitreous_xr::crossing::{RayCrossing, closest_approach};
 use vitreous_xr::{GazeRay, GazeSample, Pose};
-
-/// Below this, two ray directions count as parallel (no vergence point).
-const PARALLEL_EPSILON: f32 = 1e-9;
 
 /// The pose at `origin` whose -z axis points along `direction` and whose +y axis is as close
 /// to the frame's +y (head up) as it can be, so a gaze pose has no roll of its own.
@@ -65,25 +63,10 @@ pub fn combined_ray(sample: &GazeSample) -> GazeRay {
 /// `None` when they are parallel or when that segment lies behind either origin (the eyes
 /// diverge).
 pub fn vergence_point(left: &GazeRay, right: &GazeRay) -> Option<Vec3> {
-    let (d1, d2) = (left.direction, right.direction);
-    let w = left.origin - right.origin;
-    let a = d1.dot(d1);
-    let b = d1.dot(d2);
-    let c = d2.dot(d2);
-    let d = d1.dot(w);
-    let e = d2.dot(w);
-    let denom = a * c - b * b;
-    if denom.abs() < PARALLEL_EPSILON {
-        return None;
+    match closest_approach(left, right) {
+        RayCrossing::Converge { point_m, .. } => Some(point_m),
+        RayCrossing::Parallel | RayCrossing::Divergent => None,
     }
-    let s = (b * e - c * d) / denom;
-    let t = (a * e - b * d) / denom;
-    if s < 0.0 || t < 0.0 {
-        return None;
-    }
-    let p1 = left.origin + d1 * s;
-    let p2 = right.origin + d2 * t;
-    Some((p1 + p2) * 0.5)
 }
 
 /// The fixation point of a sample in the head frame: the sample's own when it has one, else

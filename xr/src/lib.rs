@@ -7,6 +7,7 @@
 //! Axes everywhere are OpenXR's: right-handed, +x right, +y up, -z forward, metres.
 
 pub mod atomic_file;
+pub mod crossing;
 pub mod frame;
 pub mod null;
 pub mod openxr;

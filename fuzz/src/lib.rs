@@ -8,10 +8,13 @@
 //! reader accepts the writer writes back to the same samples, whatever the SRanipal importer
 //! produces is a valid trace, and every error message can be formatted.
 
+use std::collections::HashMap;
 use std::fs;
+use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use vitreous::scene::{Scene, SceneError, SceneFiles};
 use vitreous_xr::trace::{TraceReader, TraceSample, TraceWriter};
 
 /// Names of the targets, as in `fuzz_targets/` and `corpus/`.
@@ -63,16 +66,69 @@ pub fn sranipal(data: &[u8]) {
     }
 }
 
-/// Scene TOML text: written as `scene.toml` into a folder holding the small assets of
-/// `assets/` (`model.glb`, `photo.png`, `env.hdr`) and loaded with
-/// [`vitreous::scene::load_scene`].
+/// Scene TOML text: loaded with [`vitreous::scene::load_scene_from`] as `scene.toml` in a
+/// folder holding the small assets of `assets/` (`model.glb`, `photo.png`, `env.hdr`). The
+/// scene and the assets are served from memory: writing and reading files each time took
+/// half of every execution.
 pub fn scene(data: &[u8]) {
-    let path = asset_dir().join("scene.toml");
-    fs::write(&path, data).unwrap_or_else(|e| panic!("cannot write {}: {e}", path.display()));
-    match vitreous::scene::load_scene(&path) {
+    match load_scene(data) {
         Ok(scene) => assert!(!format!("{scene:?}").is_empty()),
         Err(e) => assert!(!e.to_string().is_empty()),
     }
+}
+
+/// What the scene target does with `data`: the scene it loads or the error.
+pub fn load_scene(data: &[u8]) -> Result<Scene, SceneError> {
+    let files = MemoryFiles {
+        scene_path: asset_dir().join("scene.toml"),
+        scene: data,
+        assets: assets(),
+    };
+    vitreous::scene::load_scene_from(&files.scene_path, &files)
+}
+
+/// The scene under test and the assets, by path.
+struct MemoryFiles<'a> {
+    scene_path: PathBuf,
+    scene: &'a [u8],
+    assets: &'a HashMap<PathBuf, Vec<u8>>,
+}
+
+impl SceneFiles for MemoryFiles<'_> {
+    fn read_bounded(&self, path: &Path, limit: u64, what: &str) -> io::Result<Vec<u8>> {
+        let bytes = if path == self.scene_path {
+            self.scene
+        } else {
+            self.assets
+                .get(path)
+                .ok_or_else(|| io::Error::from(io::ErrorKind::NotFound))?
+        };
+        if bytes.len() as u64 > limit {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("larger than {} KiB; {what}", limit / 1024),
+            ));
+        }
+        Ok(bytes.to_vec())
+    }
+}
+
+/// The files of [`asset_dir`], read once.
+fn assets() -> &'static HashMap<PathBuf, Vec<u8>> {
+    static ASSETS: OnceLock<HashMap<PathBuf, Vec<u8>>> = OnceLock::new();
+    ASSETS.get_or_init(|| {
+        let dir = asset_dir();
+        let entries =
+            fs::read_dir(dir).unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()));
+        entries
+            .map(|entry| {
+                let path = entry.expect("listing assets").path();
+                let bytes = fs::read(&path)
+                    .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+                (path, bytes)
+            })
+            .collect()
+    })
 }
 
 /// glTF or GLB bytes: loaded with [`vitreous::scene::load_mesh`], external buffers resolved
@@ -112,8 +168,8 @@ fn write_all(samples: &[TraceSample]) -> Vec<u8> {
     writer.finish().expect("flushing to memory")
 }
 
-/// A folder, made once per process, holding copies of the files in `assets/`; the scene
-/// target writes its input there.
+/// A folder, made once per process, holding copies of the files in `assets/`: where the glTF
+/// target's external buffers and the scene target's files are.
 fn asset_dir() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {

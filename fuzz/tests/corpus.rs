@@ -175,6 +175,18 @@ fn scene_survives_its_corpus() {
     check("scene");
 }
 
+/// The seeds are whole scenes: served from memory, each one loads, so the fuzzer starts past
+/// the asset reads rather than at "file not found".
+#[test]
+fn every_scene_seed_loads() {
+    for path in corpus("scene") {
+        let text = fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        if let Err(e) = vitreous_fuzz::load_scene(&text) {
+            panic!("{}: {e}", path.display());
+        }
+    }
+}
+
 #[test]
 fn gltf_survives_its_corpus() {
     check("gltf");

@@ -10,7 +10,7 @@ use toml::Spanned;
 use vitreous_xr::{Fov, Pose};
 
 use super::error::Source;
-use super::file::{LightFrame, PlaneToml, SceneFile};
+use super::file::{DiskFiles, LightFrame, PlaneToml, SceneFile, SceneFiles};
 use super::{
     Caustics, Environment, GazeChoice, Image, Inducer, IorSource, Light, Object, Output, RealPlane,
     Scene, SceneError, Viewer, euler_xyz_deg,
@@ -21,15 +21,23 @@ use crate::gaze::{FilterKind, FilterParseError, GazeOverride, PupilSource};
 
 /// Loads a scene file and every asset it names, checking ranges and decoding everything.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let bytes = file::read_bounded(
-        path,
-        file::MAX_SCENE_FILE_BYTES,
-        "a scene file is a short TOML text",
-    )
-    .map_err(|error| SceneError::Read {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    load_scene_from(path, &DiskFiles)
+}
+
+/// [`load_scene`] with the scene file and its assets read from `files`; paths are resolved
+/// and normalised as on disk before `files` is asked. A glTF model's external buffers are
+/// still read from the file system, next to where `files` says the model is.
+pub fn load_scene_from(path: &Path, files: &dyn SceneFiles) -> Result<Scene, SceneError> {
+    let bytes = files
+        .read_bounded(
+            path,
+            file::MAX_SCENE_FILE_BYTES,
+            "a scene file is a short TOML text",
+        )
+        .map_err(|error| SceneError::Read {
+            path: path.to_path_buf(),
+            error,
+        })?;
     let text = match std::str::from_utf8(&bytes) {
         Ok(text) => text,
         Err(e) => {
@@ -45,6 +53,7 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
         }
     };
     let mut loader = Loader {
+        files,
         src: Source { file: path, text },
         dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
         hasher: Sha256::new(),
@@ -55,6 +64,7 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 }
 
 struct Loader<'a> {
+    files: &'a dyn SceneFiles,
     src: Source<'a>,
     dir: PathBuf,
     hasher: Sha256,
@@ -88,18 +98,20 @@ impl Loader<'_> {
             ));
         }
         let path = normalize(&self.dir.join(rel.get_ref()));
-        let bytes = file::read_bounded(
-            &path,
-            file::MAX_ASSET_FILE_BYTES,
-            "models, photos and maps are accepted up to that size",
-        )
-        .map_err(|e| {
-            let reason = match e.kind() {
-                std::io::ErrorKind::NotFound => "file not found".to_owned(),
-                _ => format!("cannot read: {e}"),
-            };
-            self.src.asset(rel.span(), field, &path, reason)
-        })?;
+        let bytes = self
+            .files
+            .read_bounded(
+                &path,
+                file::MAX_ASSET_FILE_BYTES,
+                "models, photos and maps are accepted up to that size",
+            )
+            .map_err(|e| {
+                let reason = match e.kind() {
+                    std::io::ErrorKind::NotFound => "file not found".to_owned(),
+                    _ => format!("cannot read: {e}"),
+                };
+                self.src.asset(rel.span(), field, &path, reason)
+            })?;
         self.hash_part(field, &bytes);
         Ok((path, bytes))
     }

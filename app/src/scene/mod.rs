@@ -30,12 +30,13 @@ use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, GazeOverride, PupilSource};
 
 pub use error::{Location, SceneError};
+pub use file::{DiskFiles, SceneFiles};
 pub use fixation::{
     FixationPoints, REFRACTED_TARGET, SURFACE_TARGET, ViewingGeometry, gaze_image_of_target,
     synth_params_for,
 };
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
-pub use load::load_scene;
+pub use load::{load_scene, load_scene_from};
 pub use mesh::{Mesh, load_mesh};
 
 /// A fully loaded scene, in the world frame described in the module docs.

@@ -23,7 +23,7 @@ use super::choose::GazeSource;
 use super::ml_eye_tracker as ml;
 use super::{OpenXrError, Result, XrContext};
 use crate::frame::{GazeRay, GazeSample};
-use crate::trace::{TraceSample, read_trace};
+use crate::trace::{PUPIL_RANGE_M, TraceSample, read_trace};
 
 /// A gaze source, ready to sample.
 pub(super) enum Gaze {
@@ -390,12 +390,19 @@ impl MlTracker {
                 ml::EyeML::RIGHT => 1,
                 _ => continue,
             };
-            if d.valid == xr::sys::TRUE && d.pupil_diameter.is_finite() && d.pupil_diameter > 0.0 {
-                out[eye] = Some(d.pupil_diameter);
+            if let Some(diameter_m) = measured_pupil(d.valid, d.pupil_diameter) {
+                out[eye] = Some(diameter_m);
             }
         }
         out
     }
+}
+
+/// A pupil diameter the tracker marked valid, when it is one a trace can hold
+/// ([`PUPIL_RANGE_M`]); anything else (0, NaN, a value in millimetres) is no measurement, so
+/// that `run --record` never writes a sample the trace reader would refuse.
+fn measured_pupil(valid: xr::sys::Bool32, diameter_m: f32) -> Option<f32> {
+    (valid == xr::sys::TRUE && PUPIL_RANGE_M.contains(&diameter_m)).then_some(diameter_m)
 }
 
 impl Drop for MlTracker {
@@ -537,6 +544,15 @@ impl TraceGaze {
 mod tests {
     use super::*;
     use crate::frame::Pose;
+
+    #[test]
+    fn only_valid_plausible_pupils_are_measurements() {
+        assert_eq!(measured_pupil(xr::sys::TRUE, 0.004), Some(0.004));
+        assert_eq!(measured_pupil(xr::sys::FALSE, 0.004), None);
+        for odd in [0.0, -0.004, f32::NAN, f32::INFINITY, 4.0, 0.0004, 0.02] {
+            assert_eq!(measured_pupil(xr::sys::TRUE, odd), None, "{odd}");
+        }
+    }
 
     fn sample(time_ns: i64, gaze_ns: i64, x: f32) -> TraceSample {
         let ray = GazeRay {

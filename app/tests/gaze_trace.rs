@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use vitreous::gaze::{FilterKind, GazeConfig, GazeImage, GazeOverride, ImageDistances};
-use vitreous::trace_analyze::{AnalyzeConfig, Truth, analyze, plot, replay};
+use vitreous::trace_analyze::{AnalyzeConfig, FILTER_COLOURS, Truth, analyze, plot, replay};
 use vitreous_xr::synth::{FixationTarget, SynthParams, SynthTrace, synthesize_with_truth};
 
 /// The synthetic trace the alternative is tuned on: 30 Hz, 0.5 degree noise, blinks every
@@ -166,10 +166,152 @@ fn plot_writes_a_png_atomically() {
     let rgb = img.to_rgb8();
     let has = |c: [u8; 3]| rgb.pixels().any(|p| p.0 == c);
     assert!(has([31, 119, 180]) && has([230, 120, 20]));
+}
 
+/// The real recording's depths reach the far cap and its rays diverge: the lines must still
+/// stay inside the depth chart, and the far and diverging samples must be drawn.
+#[test]
+fn plot_lines_stay_inside_the_chart_and_far_samples_are_drawn() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = ImageDistances {
+        surface_m: 0.6,
+        refracted_m: 1.5,
+    };
     let samples =
         vitreous_xr::sranipal::import_sranipal(sranipal("TESTNA01_2D_Fist3.csv")).unwrap();
-    let real = dir.path().join("real.png");
-    plot(&samples, Truth::FromRawDepth, &AnalyzeConfig::new(d), &real).unwrap();
-    assert!(real.exists());
+    let out = dir.path().join("real.png");
+    let config = AnalyzeConfig::new(d);
+    let layout = plot(&samples, Truth::FromRawDepth, &config, &out).unwrap();
+    let rgb = image::open(&out).unwrap().to_rgb8();
+    let inside = |x: u32, y: u32| {
+        layout.chart_x_px.contains(&(x as i32)) && layout.chart_y_px.contains(&(y as i32))
+    };
+    for (i, c) in FILTER_COLOURS.iter().take(config.filters.len()).enumerate() {
+        let colour = [c.0, c.1, c.2];
+        let (mut drawn, mut outside) = (0, Vec::new());
+        for (x, y, p) in rgb.enumerate_pixels() {
+            if p.0 == colour {
+                drawn += 1;
+                if !inside(x, y) {
+                    outside.push((x, y));
+                }
+            }
+        }
+        assert!(drawn > 0, "filter {i} drew nothing");
+        assert!(
+            outside.is_empty(),
+            "filter {i}: {} pixels outside {layout:?}, e.g. {:?}",
+            outside.len(),
+            &outside[..outside.len().min(5)]
+        );
+    }
+    // Diverging samples (red dots below 0 D) and the raw samples are visible.
+    let count = |c: [u8; 3]| rgb.pixels().filter(|p| p.0 == c).count();
+    assert!(count([200, 60, 60]) > 50, "{}", count([200, 60, 60]));
+    assert!(count([150, 150, 150]) > 50);
+}
+
+#[test]
+#[ignore]
+fn experiment_print() {
+    let layouts: [(Vec3, Vec3); 3] = [
+        (Vec3::new(0.0, 0.0, -0.6), Vec3::new(0.0, -0.05, -1.5)),
+        (Vec3::new(0.0, 0.0, -0.125), Vec3::new(0.0, 0.0, -0.4)),
+        (Vec3::new(0.0, 0.0, -0.5), Vec3::new(0.0, 0.0, -0.8)),
+    ];
+    let kinds: Vec<FilterKind> = std::env::var("KINDS")
+        .map(|k| k.split(';').map(|x| x.parse().unwrap()).collect())
+        .unwrap_or_else(|_| FilterKind::all_default());
+    for (li, (s, r)) in layouts.iter().enumerate() {
+        let mut lat: Vec<Vec<i64>> = vec![Vec::new(); kinds.len()];
+        let mut clear: Vec<Vec<i64>> = vec![Vec::new(); kinds.len()];
+        let mut fals = vec![0; kinds.len()];
+        let mut miss = vec![0; kinds.len()];
+        let mut minep = vec![i64::MAX; kinds.len()];
+        let mut gapsw = vec![0; kinds.len()];
+        for seed in 1..=10 {
+            let p = SynthParams {
+                duration_s: 60.0,
+                seed,
+                targets: vec![FixationTarget::new("s", *s), FixationTarget::new("r", *r)],
+                ..SynthParams::default()
+            };
+            let trace = synthesize_with_truth(&p).unwrap();
+            let d = ImageDistances::from_points(p.head_position, *s, *r);
+            let mut c = AnalyzeConfig::new(d);
+            c.filters = kinds.clone();
+            let rep = analyze(&trace.samples, Truth::Phases(&trace.phases), &c);
+            for (k, f) in rep.filters.iter().enumerate() {
+                lat[k].extend(&f.latencies_ns);
+                clear[k].extend(&f.clear_latencies_ns);
+                fals[k] += f.false_switches;
+                miss[k] += f.missed;
+                minep[k] = minep[k].min(f.episodes_ns.iter().copied().min().unwrap_or(i64::MAX));
+                gapsw[k] += f.switches_after_gap;
+            }
+        }
+        for (k, kind) in kinds.iter().enumerate() {
+            let m = |v: &[i64]| v.iter().sum::<i64>() as f64 / v.len().max(1) as f64 / 1e6;
+            let mx = |v: &[i64]| *v.iter().max().unwrap_or(&0) as f64 / 1e6;
+            println!(
+                "L{li} {:<60} n={} mean {:.0} max {:.0} | clear n={} mean {:.0} max {:.0} | false {} missed {} minep {:.0} gapsw {}",
+                kind.to_string(),
+                lat[k].len(),
+                m(&lat[k]),
+                mx(&lat[k]),
+                clear[k].len(),
+                m(&clear[k]),
+                mx(&clear[k]),
+                fals[k],
+                miss[k],
+                minep[k] as f64 / 1e6,
+                gapsw[k]
+            );
+        }
+    }
+    let d = ImageDistances {
+        surface_m: 0.6,
+        refracted_m: 1.5,
+    };
+    for name in [
+        "TESTNA01_2D_Fist3.csv",
+        "TESTNA05_360VR_Spread7.csv",
+        "TESTNA10_360VR_Fist3.csv",
+    ] {
+        let samples = vitreous_xr::sranipal::import_sranipal(sranipal(name)).unwrap();
+        for d in [
+            d,
+            ImageDistances {
+                surface_m: 0.125,
+                refracted_m: 0.4,
+            },
+            ImageDistances {
+                surface_m: 0.5,
+                refracted_m: 0.8,
+            },
+        ] {
+            let mut c = AnalyzeConfig::new(d);
+            c.filters = kinds.clone();
+            let rep = analyze(&samples, Truth::FromRawDepth, &c);
+            println!(
+                "{name} {:?} gaps {} nodepth {}/{}",
+                (d.surface_m, d.refracted_m),
+                rep.gaps.len(),
+                rep.tracker_samples_without_depth,
+                rep.tracker_samples
+            );
+            for f in &rep.filters {
+                let j = f.to_json();
+                println!(
+                    "   {:<50} sw {} minep {:?} under {} gapsw {} agree {:?}",
+                    j.filter,
+                    j.switches,
+                    j.min_episode_ms,
+                    j.episodes_under_150ms,
+                    j.switches_within_150ms_after_gap,
+                    j.agree.map(|a| (a * 1000.0).round() / 10.0)
+                );
+            }
+        }
+    }
 }

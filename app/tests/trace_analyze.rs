@@ -282,3 +282,29 @@ fn fixation_filter_meets_the_real_recording_bar_on_sranipal() {
     }
     assert!(mean20_failures > 0);
 }
+
+/// A fallback note (here: samples with no valid eye ray but a fixation point) is printed once
+/// per run, not once per vergence estimator (`trace analyze` builds one for the raw depths and
+/// one per filter).
+#[test]
+fn analyze_prints_each_fallback_note_once_per_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("t.csv");
+    let mut writer = TraceWriter::create(&trace).unwrap();
+    for mut s in constructed_trace() {
+        if !s.gaze.left.valid {
+            s.gaze.fixation = Some(Vec3::new(0.0, 0.0, -0.6));
+        }
+        writer.write(&s).unwrap();
+    }
+    writer.finish().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_vitreous"))
+        .args(["trace", "analyze", trace.to_str().unwrap(), "--scene"])
+        .arg(workspace().join("config/scenes/visual-effects.toml"))
+        .env("RUST_LOG", "info")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(log.matches("carries a fixation point").count(), 1, "{log}");
+}

@@ -137,8 +137,8 @@ enum Command {
         /// refracted, as the paper's experimenter did; default: the scene's `[gaze] image`.
         #[arg(long, value_name = "IMAGE")]
         gaze_image: Option<GazeOverride>,
-        /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, ...; default: the
-        /// scene's `[gaze] filter`.
+        /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, fixation (the gaze image
+        /// decided per fixation), ...; default: the scene's `[gaze] filter`.
         #[arg(long, value_name = "FILTER")]
         filter: Option<FilterKind>,
         /// Pupil diameter A_p overriding the scene's, millimetres (1-9).

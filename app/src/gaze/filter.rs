@@ -532,7 +532,7 @@ mod tests {
         fn repeated_frames_of_one_sample_change_nothing(
             depths in proptest::collection::vec(0.05f32..10.0, 1..80),
             repeats in proptest::collection::vec(1usize..5, 80),
-            kind_index in 0usize..3,
+            kind_index in 0usize..4,
         ) {
             let kind = FilterKind::all_default()[kind_index];
             let (mut once, mut many) = (SampleFilter::new(kind), SampleFilter::new(kind));
@@ -556,6 +556,8 @@ mod tests {
             "median7",
             "one-euro",
             "one-euro:min_cutoff=2,beta=0.1,d_cutoff=1,pre_median=1",
+            "fixation",
+            "fixation:velocity=40,min_fixation=80,window=120,settle=200",
         ] {
             let kind: FilterKind = text.parse().unwrap();
             assert_eq!(kind.to_string(), text);
@@ -574,6 +576,9 @@ mod tests {
             "one-euro:beta",
             "one-euro:gamma=1",
             "one-euro:min_cutoff=0",
+            "fixation:velocity=0",
+            "fixation:speed=3",
+            "fixation:window",
         ] {
             let e = bad.parse::<FilterKind>().unwrap_err();
             assert!(e.to_string().contains("mean20"), "{e}");

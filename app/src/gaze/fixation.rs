@@ -90,6 +90,7 @@ impl Default for FixationParams {
 }
 
 impl FixationParams {
+    /// Milliseconds (as the parameters are given) to nanoseconds (as sample times are).
     fn ms_to_ns(ms: f32) -> i64 {
         (f64::from(ms) * 1e6).round() as i64
     }

@@ -137,8 +137,8 @@ enum Command {
         /// refracted, as the paper's experimenter did; default: the scene's `[gaze] image`.
         #[arg(long, value_name = "IMAGE")]
         gaze_image: Option<GazeOverride>,
-        /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, ...; default: the
-        /// scene's `[gaze] filter`.
+        /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, fixation (the gaze image
+        /// decided per fixation), ...; default: the scene's `[gaze] filter`.
         #[arg(long, value_name = "FILTER")]
         filter: Option<FilterKind>,
         /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
@@ -237,9 +237,13 @@ enum TraceCommand {
         #[arg(long)]
         scene: PathBuf,
         /// Filters to compare (repeatable): mean20, mean:N, median5, median:N,
-        /// one-euro[:min_cutoff=..,beta=..,d_cutoff=..,pre_median=..]; default all.
+        /// one-euro[:min_cutoff=..,beta=..,d_cutoff=..,pre_median=..],
+        /// fixation[:velocity=..,min_fixation=..,window=..,settle=..]; default all.
         #[arg(long = "filter", value_name = "FILTER")]
         filters: Vec<FilterKind>,
+        /// Write the figures as JSON on stdout instead of the tables.
+        #[arg(long)]
+        json: bool,
     },
     /// Plot raw and filtered fixation depth over time with the gaze-image decisions (like
     /// the paper's Fig. 11).
@@ -475,8 +479,14 @@ fn run(cli: Cli) -> Result<()> {
                 trace,
                 scene,
                 filters,
+                json,
             } => {
-                print!("{}", analyze_trace_file(&trace, &scene, &filters)?);
+                let report = analyze_trace_file(&trace, &scene, &filters)?;
+                if json {
+                    println!("{}", serde_json::to_string_pretty(&report.to_json())?);
+                } else {
+                    print!("{report}");
+                }
                 Ok(())
             }
             TraceCommand::Plot {

@@ -78,13 +78,49 @@ proptest! {
     }
 }
 
+proptest! {
+    /// The fixation filter too ingests each tracker sample once: frames repeating a sample
+    /// change neither its depth nor its decision.
+    #[test]
+    fn frames_repeating_tracker_samples_do_not_change_the_fixation_decision(
+        depths in proptest::collection::vec(prop_oneof![0.5f32..0.7, 1.3f32..1.7], 20..120),
+        frames_per_sample in proptest::collection::vec(1usize..5, 120),
+    ) {
+        let distances = ImageDistances { surface_m: 0.6, refracted_m: 1.5 };
+        let config = GazeConfig {
+            filter: "fixation".parse().unwrap(),
+            ..GazeConfig::new(distances)
+        };
+        let mut once = GazePipeline::new(config);
+        let mut per_frame = GazePipeline::new(config);
+        let sample_ns = 8_333_333i64;
+        for (n, &d) in depths.iter().enumerate() {
+            let g = looking_at(n as i64 * sample_ns, d);
+            let a = once.update(Some(&g), g.sample_time_ns);
+            let mut b = None;
+            for k in 0..frames_per_sample[n] {
+                b = Some(per_frame.update(Some(&g), g.sample_time_ns + k as i64 * 2_000_000));
+            }
+            let b = b.unwrap();
+            prop_assert_eq!(a.filtered_depth, b.filtered_depth);
+            prop_assert_eq!(a.image, b.image);
+        }
+    }
+}
+
 #[test]
 fn filters_parse_from_scene_style_names() {
     assert_eq!(
         "mean20".parse::<FilterKind>().unwrap(),
         FilterKind::default()
     );
-    for name in ["median", "one-euro", "mean:10"] {
+    for name in [
+        "median",
+        "one-euro",
+        "mean:10",
+        "fixation",
+        "Fixation:settle=200",
+    ] {
         assert!(name.parse::<FilterKind>().is_ok(), "{name}");
     }
     let e = "kalman".parse::<FilterKind>().unwrap_err().to_string();

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use vitreous::gaze::{FilterKind, GazeConfig, GazeImage, GazeOverride, ImageDistances};
-use vitreous::trace_analyze::{AnalyzeConfig, Truth, analyze, plot, replay};
+use vitreous::trace_analyze::{AnalyzeConfig, FILTER_COLOURS, Truth, analyze, plot, replay};
 use vitreous_xr::synth::{FixationTarget, SynthParams, SynthTrace, synthesize_with_truth};
 
 /// The synthetic trace the alternative is tuned on: 30 Hz, 0.5 degree noise, blinks every
@@ -166,10 +166,47 @@ fn plot_writes_a_png_atomically() {
     let rgb = img.to_rgb8();
     let has = |c: [u8; 3]| rgb.pixels().any(|p| p.0 == c);
     assert!(has([31, 119, 180]) && has([230, 120, 20]));
+}
 
+/// The real recording's depths reach the far cap and its rays diverge: the lines must still
+/// stay inside the depth chart, and the far and diverging samples must be drawn.
+#[test]
+fn plot_lines_stay_inside_the_chart_and_far_samples_are_drawn() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = ImageDistances {
+        surface_m: 0.6,
+        refracted_m: 1.5,
+    };
     let samples =
         vitreous_xr::sranipal::import_sranipal(sranipal("TESTNA01_2D_Fist3.csv")).unwrap();
-    let real = dir.path().join("real.png");
-    plot(&samples, Truth::FromRawDepth, &AnalyzeConfig::new(d), &real).unwrap();
-    assert!(real.exists());
+    let out = dir.path().join("real.png");
+    let config = AnalyzeConfig::new(d);
+    let layout = plot(&samples, Truth::FromRawDepth, &config, &out).unwrap();
+    let rgb = image::open(&out).unwrap().to_rgb8();
+    let inside = |x: u32, y: u32| {
+        layout.chart_x_px.contains(&(x as i32)) && layout.chart_y_px.contains(&(y as i32))
+    };
+    for (i, c) in FILTER_COLOURS.iter().take(config.filters.len()).enumerate() {
+        let colour = [c.0, c.1, c.2];
+        let (mut drawn, mut outside) = (0, Vec::new());
+        for (x, y, p) in rgb.enumerate_pixels() {
+            if p.0 == colour {
+                drawn += 1;
+                if !inside(x, y) {
+                    outside.push((x, y));
+                }
+            }
+        }
+        assert!(drawn > 0, "filter {i} drew nothing");
+        assert!(
+            outside.is_empty(),
+            "filter {i}: {} pixels outside {layout:?}, e.g. {:?}",
+            outside.len(),
+            &outside[..outside.len().min(5)]
+        );
+    }
+    // Diverging samples (red dots below 0 D) and the raw samples are visible.
+    let count = |c: [u8; 3]| rgb.pixels().filter(|p| p.0 == c).count();
+    assert!(count([200, 60, 60]) > 50, "{}", count([200, 60, 60]));
+    assert!(count([150, 150, 150]) > 50);
 }

@@ -18,6 +18,11 @@
 //!   One-Euro filter, an exponential smoother whose cut-off rises with the signal's speed,
 //!   after a 3-sample median that removes lone spikes. It runs on vergence in dioptres
 //!   (1 / depth), where the tracker's angular noise is about uniform, and returns a depth.
+//! - `fixation` (`fixation:velocity=DEG_S,min_fixation=MS,window=MS,settle=MS`): not a depth
+//!   filter but a decision per fixation (I-VT classification of the samples, a decision only
+//!   from a fixation that has lasted 60 ms, held through saccades and blinks, and none within
+//!   150 ms after a blink or a switch); see [`super::fixation`]. As a [`SampleFilter`] it
+//!   passes the depth through; [`super::GazePipeline`] runs it on whole samples.
 //!
 //! Before a window is full the mean and the median use the samples they have (documented
 //! start-up behaviour; eq. 15 itself is defined from the 20th sample on).
@@ -28,6 +33,7 @@ use std::str::FromStr;
 
 use thiserror::Error;
 
+use super::fixation::FixationParams;
 use super::vergence::FixationDepth;
 
 /// Window of eq. 15, samples.
@@ -90,6 +96,8 @@ pub enum FilterKind {
     },
     /// One-Euro filter on vergence (dioptres).
     OneEuro(OneEuroParams),
+    /// The gaze image decided per fixation ([`super::fixation`]).
+    Fixation(FixationParams),
 }
 
 impl Default for FilterKind {
@@ -109,8 +117,14 @@ impl FilterKind {
                 window: DEFAULT_MEDIAN_WINDOW,
             },
             FilterKind::OneEuro(OneEuroParams::default()),
+            FilterKind::Fixation(FixationParams::default()),
         ]
     }
+
+    /// The paper's eq. 15 (`mean20`), the reference every other filter is compared with.
+    pub const PAPER: FilterKind = FilterKind::Mean {
+        window: PAPER_WINDOW,
+    };
 
     /// The default followed by the alternatives.
     pub fn all_default() -> Vec<FilterKind> {
@@ -119,12 +133,14 @@ impl FilterKind {
         all
     }
 
-    /// A fresh filter of this kind.
-    pub fn build(&self) -> Box<dyn DepthFilter> {
+    /// A fresh depth filter of this kind; `None` for [`FilterKind::Fixation`], which decides
+    /// from whole samples rather than filtering depths.
+    pub fn build(&self) -> Option<Box<dyn DepthFilter>> {
         match *self {
-            FilterKind::Mean { window } => Box::new(MeanFilter::new(window)),
-            FilterKind::Median { window } => Box::new(MedianFilter::new(window)),
-            FilterKind::OneEuro(p) => Box::new(OneEuroFilter::new(p)),
+            FilterKind::Mean { window } => Some(Box::new(MeanFilter::new(window))),
+            FilterKind::Median { window } => Some(Box::new(MedianFilter::new(window))),
+            FilterKind::OneEuro(p) => Some(Box::new(OneEuroFilter::new(p))),
+            FilterKind::Fixation(_) => None,
         }
     }
 }
@@ -141,6 +157,12 @@ impl fmt::Display for FilterKind {
                 "one-euro:min_cutoff={},beta={},d_cutoff={},pre_median={}",
                 p.min_cutoff_hz, p.beta_m, p.d_cutoff_hz, p.pre_median
             ),
+            FilterKind::Fixation(p) if *p == FixationParams::default() => write!(f, "fixation"),
+            FilterKind::Fixation(p) => write!(
+                f,
+                "fixation:velocity={},min_fixation={},window={},settle={}",
+                p.velocity_deg_s, p.min_fixation_ms, p.window_ms, p.settle_ms
+            ),
         }
     }
 }
@@ -149,7 +171,8 @@ impl fmt::Display for FilterKind {
 #[derive(Debug, Error, PartialEq, Eq)]
 #[error(
     "depth filter `{text}`: {reason}; expected `mean20` (eq. 15), `mean:N`, `median`, \
-     `median:N` or `one-euro[:min_cutoff=HZ,beta=M,d_cutoff=HZ,pre_median=N]`"
+     `median:N`, `one-euro[:min_cutoff=HZ,beta=M,d_cutoff=HZ,pre_median=N]` or \
+     `fixation[:velocity=DEG_S,min_fixation=MS,window=MS,settle=MS]`"
 )]
 pub struct FilterParseError {
     /// The text given.
@@ -195,23 +218,49 @@ impl FromStr for FilterKind {
         if let Some(window) = window("mean", PAPER_WINDOW)? {
             return Ok(FilterKind::Mean { window });
         }
-        if matches!(name, "one-euro" | "one_euro" | "oneeuro" | "1euro") {
-            let mut p = OneEuroParams::default();
-            for pair in args
-                .unwrap_or("")
+        // KEY=VALUE pairs with finite values >= 0.
+        let pairs = || -> Result<Vec<(&str, f32)>, FilterParseError> {
+            args.unwrap_or("")
                 .split(',')
                 .filter(|a| !a.trim().is_empty())
-            {
-                let (key, value) = pair
-                    .split_once('=')
-                    .ok_or_else(|| err(format!("`{pair}` is not KEY=VALUE")))?;
-                let value: f32 = value
-                    .trim()
-                    .parse()
-                    .ok()
-                    .filter(|v: &f32| v.is_finite() && *v >= 0.0)
-                    .ok_or_else(|| err(format!("`{value}` is not a finite number >= 0")))?;
-                match key.trim() {
+                .map(|pair| {
+                    let (key, value) = pair
+                        .split_once('=')
+                        .ok_or_else(|| err(format!("`{pair}` is not KEY=VALUE")))?;
+                    let value: f32 = value
+                        .trim()
+                        .parse()
+                        .ok()
+                        .filter(|v: &f32| v.is_finite() && *v >= 0.0)
+                        .ok_or_else(|| err(format!("`{value}` is not a finite number >= 0")))?;
+                    Ok((key.trim(), value))
+                })
+                .collect()
+        };
+        if name == "fixation" {
+            let mut p = FixationParams::default();
+            for (key, value) in pairs()? {
+                match key {
+                    "velocity" | "velocity_deg_s" if value > 0.0 => p.velocity_deg_s = value,
+                    "min_fixation" | "min_fixation_ms" => p.min_fixation_ms = value,
+                    "window" | "window_ms" if value > 0.0 => p.window_ms = value,
+                    "settle" | "settle_ms" => p.settle_ms = value,
+                    "velocity" | "velocity_deg_s" | "window" | "window_ms" => {
+                        return Err(err(format!("{key} must be > 0")));
+                    }
+                    other => {
+                        return Err(err(format!(
+                            "unknown parameter `{other}` (velocity, min_fixation, window, settle)"
+                        )));
+                    }
+                }
+            }
+            return Ok(FilterKind::Fixation(p));
+        }
+        if matches!(name, "one-euro" | "one_euro" | "oneeuro" | "1euro") {
+            let mut p = OneEuroParams::default();
+            for (key, value) in pairs()? {
+                match key {
                     "min_cutoff" | "min_cutoff_hz" => p.min_cutoff_hz = value,
                     "beta" | "beta_m" => p.beta_m = value,
                     "d_cutoff" | "d_cutoff_hz" => p.d_cutoff_hz = value,
@@ -387,8 +436,8 @@ impl DepthFilter for OneEuroFilter {
 pub struct SampleFilter {
     /// What kind of filter runs.
     kind: FilterKind,
-    /// The filter.
-    inner: Box<dyn DepthFilter>,
+    /// The filter (`None`: the fixation kind, whose depth passes through here).
+    inner: Option<Box<dyn DepthFilter>>,
     /// Sample time of the last depth ingested, nanoseconds.
     last_sample_time_ns: Option<i64>,
     /// The last filtered depth, metres, with the time of its newest sample.
@@ -419,7 +468,9 @@ impl SampleFilter {
     pub fn feed(&mut self, raw: &FixationDepth) -> FixationDepth {
         match *raw {
             FixationDepth::Unknown => {
-                self.inner.reset();
+                if let Some(inner) = &mut self.inner {
+                    inner.reset();
+                }
                 self.last_sample_time_ns = None;
                 self.output = None;
             }
@@ -432,7 +483,10 @@ impl SampleFilter {
                     .is_none_or(|last| sample_time_ns > last)
                 {
                     self.last_sample_time_ns = Some(sample_time_ns);
-                    let filtered_m = self.inner.push(depth_m, sample_time_ns);
+                    let filtered_m = match &mut self.inner {
+                        Some(inner) => inner.push(depth_m, sample_time_ns),
+                        None => depth_m,
+                    };
                     self.output = Some((filtered_m, sample_time_ns));
                 }
             }
@@ -478,7 +532,7 @@ mod tests {
         fn repeated_frames_of_one_sample_change_nothing(
             depths in proptest::collection::vec(0.05f32..10.0, 1..80),
             repeats in proptest::collection::vec(1usize..5, 80),
-            kind_index in 0usize..3,
+            kind_index in 0usize..4,
         ) {
             let kind = FilterKind::all_default()[kind_index];
             let (mut once, mut many) = (SampleFilter::new(kind), SampleFilter::new(kind));
@@ -502,6 +556,8 @@ mod tests {
             "median7",
             "one-euro",
             "one-euro:min_cutoff=2,beta=0.1,d_cutoff=1,pre_median=1",
+            "fixation",
+            "fixation:velocity=40,min_fixation=80,window=120,settle=200",
         ] {
             let kind: FilterKind = text.parse().unwrap();
             assert_eq!(kind.to_string(), text);
@@ -520,6 +576,9 @@ mod tests {
             "one-euro:beta",
             "one-euro:gamma=1",
             "one-euro:min_cutoff=0",
+            "fixation:velocity=0",
+            "fixation:speed=3",
+            "fixation:window",
         ] {
             let e = bad.parse::<FilterKind>().unwrap_err();
             assert!(e.to_string().contains("mean20"), "{e}");

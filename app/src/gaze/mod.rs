@@ -9,17 +9,22 @@
 //! 3. [`image`]: the gaze image (surface or refracted) with hysteresis, or the experimenter's
 //!    override; the focus distance d_f is that image's distance.
 //!
+//! With the `fixation` filter, stages 2 and 3 are [`fixation`] instead: the samples are
+//! classified into fixations, saccades and gaps, and the image is decided per fixation.
+//!
 //! [`blur`] then turns d_f into the blur of the image not looked at (eq. 10-14).
 //! `docs/gaze.md` maps each equation to its function.
 
 pub mod blur;
 pub mod filter;
+pub mod fixation;
 pub mod image;
 pub mod pupil;
 pub mod vergence;
 
 pub use blur::{DefocusError, GaussianKernel, ImageBlur, blur_reference, image_blur};
 pub use filter::{DepthFilter, FilterKind, FilterParseError, OneEuroParams, SampleFilter};
+pub use fixation::{FixationFilter, FixationParams, SampleClass};
 pub use image::{GazeImage, GazeOverride, ImageDistances, ImageSelector};
 pub use pupil::{PupilEstimate, PupilFilter, PupilSource, PupilSourceParseError};
 pub use vergence::{FixationDepth, VergenceConfig, VergenceEstimator};
@@ -75,10 +80,22 @@ pub struct GazePipeline {
     config: GazeConfig,
     /// Stage 1.
     vergence: VergenceEstimator,
-    /// Stage 2.
-    filter: SampleFilter,
-    /// Stage 3.
-    selector: ImageSelector,
+    /// Stages 2 and 3.
+    decision: Decision,
+}
+
+/// How the gaze image is decided from the fixation depths.
+#[derive(Debug)]
+enum Decision {
+    /// A depth filter, then the image with hysteresis.
+    Depth {
+        /// Stage 2.
+        filter: SampleFilter,
+        /// Stage 3.
+        selector: ImageSelector,
+    },
+    /// Per fixation ([`fixation`]).
+    Fixation(FixationFilter),
 }
 
 impl GazePipeline {
@@ -87,8 +104,15 @@ impl GazePipeline {
         GazePipeline {
             config,
             vergence: VergenceEstimator::new(config.vergence),
-            filter: SampleFilter::new(config.filter),
-            selector: ImageSelector::new(config.distances, config.band),
+            decision: match config.filter {
+                FilterKind::Fixation(params) => {
+                    Decision::Fixation(FixationFilter::new(params, config.distances, config.band))
+                }
+                kind => Decision::Depth {
+                    filter: SampleFilter::new(kind),
+                    selector: ImageSelector::new(config.distances, config.band),
+                },
+            },
         }
     }
 
@@ -107,7 +131,10 @@ impl GazePipeline {
     /// current decision and the filters' history are kept.
     pub fn set_distances(&mut self, distances: ImageDistances) {
         self.config.distances = distances;
-        self.selector.distances = distances;
+        match &mut self.decision {
+            Decision::Depth { selector, .. } => selector.distances = distances,
+            Decision::Fixation(f) => f.set_distances(distances),
+        }
     }
 
     /// Runs one frame: `gaze` is the newest tracker sample at or before the frame (as in
@@ -115,8 +142,13 @@ impl GazePipeline {
     /// only when there is no sample).
     pub fn update(&mut self, gaze: Option<&GazeSample>, head_time_ns: i64) -> GazeState {
         let raw_depth = self.vergence.update(gaze, head_time_ns);
-        let filtered_depth = self.filter.feed(&raw_depth);
-        let tracked = self.selector.update(filtered_depth.depth_m());
+        let (filtered_depth, tracked) = match &mut self.decision {
+            Decision::Depth { filter, selector } => {
+                let filtered = filter.feed(&raw_depth);
+                (filtered, selector.update(filtered.depth_m()))
+            }
+            Decision::Fixation(f) => f.update(gaze, &raw_depth, self.vergence.measurement()),
+        };
         let image = self.config.override_image.apply(tracked);
         GazeState {
             raw_depth,

@@ -7,8 +7,11 @@
 //! measured from the midpoint between the eyes `m = (o_l + o_r) / 2` along the combined
 //! forward direction `f = normalize(d_l + d_r)` (the bisector of the two gaze directions):
 //! `depth_m = (p - m) . f`. For a fixated point this differs from the Euclidean distance
-//! `|p - m|` by the cosine of the angle between `f` and the direction to `p`, which is below
-//! 1e-4 relative for any fixation a tracker can measure; unlike the Euclidean distance it
+//! `|p - m|` by the cosine of the angle between `f` and the direction to `p`. Straight ahead
+//! the two agree; off axis `f` meets the baseline where the angle bisector of the triangle
+//! eye-point-eye does, not at `m`, so near eccentric fixations read short: 30 degrees off axis
+//! with a 63 mm baseline the bisector depth is 1.9e-3 (0.15 mm) short at 8 cm, 9.7e-3 at 5 cm,
+//! 8e-4 at 10 cm and under 1e-4 from 20 cm on (docs/gaze.md). Unlike the Euclidean distance it
 //! stays signed, so a crossing behind the eyes is recognisable.
 //!
 //! # Degenerate cases
@@ -23,9 +26,11 @@
 //!   fixation point, its distance from the head origin (between the eyes) is used; else when
 //!   it carries a valid combined ray and one eye is valid, the closest approach of those two
 //!   rays is used (half the baseline, same definition of depth); each fallback is logged once
-//!   with `tracing::info!`. A combined ray alone has no depth. Otherwise the last known depth
-//!   is held for [`VergenceConfig::hold_ns`] of sample time, then the depth is
-//!   [`FixationDepth::Unknown`].
+//!   per process with `tracing::info!`, however many estimators a command builds. A combined
+//!   ray alone has no depth. Otherwise the last known depth is held for
+//!   [`VergenceConfig::hold_ns`] of sample time, then the depth is [`FixationDepth::Unknown`].
+
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use vitreous_xr::GazeSample;
 pub use vitreous_xr::crossing::{RayCrossing, closest_approach};
@@ -106,7 +111,19 @@ impl Default for VergenceConfig {
     }
 }
 
-/// Which fallback a sample needed; each is logged once per estimator.
+/// What the newest tracker sample measured, before the hold: its depth and how the rays met.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measurement {
+    /// Tracker time of the sample, nanoseconds.
+    pub sample_time_ns: i64,
+    /// The depth it gave, clamped like [`FixationDepth::Known`], metres.
+    pub depth_m: f32,
+    /// Whether the rays diverged (their closest approach lies behind the eyes); with
+    /// [`DivergentRays::Far`] the depth is then `max_depth_m`.
+    pub divergent: bool,
+}
+
+/// Which fallback a sample needed; each is logged once per process.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Fallback {
     FixationPoint,
@@ -121,8 +138,8 @@ pub struct VergenceEstimator {
     config: VergenceConfig,
     /// The last measured depth and its sample time.
     last_known: Option<(f32, i64)>,
-    /// Fallbacks already logged (indexed by `Fallback as usize`).
-    logged: [bool; 3],
+    /// What the sample of the newest update measured (`None`: no sample, or no depth).
+    measurement: Option<Measurement>,
 }
 
 impl VergenceEstimator {
@@ -131,13 +148,20 @@ impl VergenceEstimator {
         VergenceEstimator {
             config,
             last_known: None,
-            logged: [false; 3],
+            measurement: None,
         }
     }
 
     /// The settings.
     pub fn config(&self) -> &VergenceConfig {
         &self.config
+    }
+
+    /// What the sample of the newest [`update`](Self::update) measured: `None` when that
+    /// update had no sample or the sample gave no depth (a blink, a lost eye), even while an
+    /// older depth is held.
+    pub fn measurement(&self) -> Option<Measurement> {
+        self.measurement
     }
 
     /// The depth for a frame: `gaze` is the newest tracker sample (if any), `now_ns` the
@@ -148,9 +172,15 @@ impl VergenceEstimator {
             Some(g) => (g.sample_time_ns, self.measure(g)),
             None => (now_ns, None),
         };
-        if let Some(depth_m) = measured {
+        self.measurement = None;
+        if let Some((depth_m, divergent)) = measured {
             let depth_m = depth_m.clamp(self.config.min_depth_m, self.config.max_depth_m);
             self.last_known = Some((depth_m, now_ns));
+            self.measurement = Some(Measurement {
+                sample_time_ns: now_ns,
+                depth_m,
+                divergent,
+            });
             return FixationDepth::Known {
                 depth_m,
                 sample_time_ns: now_ns,
@@ -172,14 +202,15 @@ impl VergenceEstimator {
         }
     }
 
-    /// The unclamped depth one sample gives, or `None` when it gives none.
-    fn measure(&mut self, g: &GazeSample) -> Option<f32> {
+    /// The unclamped depth one sample gives and whether its rays diverged, or `None` when it
+    /// gives none.
+    fn measure(&mut self, g: &GazeSample) -> Option<(f32, bool)> {
         let far = self.config.max_depth_m;
         let from_crossing = |c: RayCrossing, divergent: DivergentRays| match c {
-            RayCrossing::Converge { depth_m, .. } => Some(depth_m.min(far)),
-            RayCrossing::Parallel => Some(far),
+            RayCrossing::Converge { depth_m, .. } => Some((depth_m.min(far), false)),
+            RayCrossing::Parallel => Some((far, false)),
             RayCrossing::Divergent => match divergent {
-                DivergentRays::Far => Some(far),
+                DivergentRays::Far => Some((far, true)),
                 DivergentRays::Unknown => None,
             },
         };
@@ -187,42 +218,52 @@ impl VergenceEstimator {
             return from_crossing(closest_approach(&g.left, &g.right), self.config.divergent);
         }
         if let Some(p) = g.fixation.filter(|p| p.is_finite()) {
-            self.log_once(Fallback::FixationPoint);
-            return Some(p.length());
+            log_once(Fallback::FixationPoint);
+            return Some((p.length(), false));
         }
         let combined = g.combined.filter(|c| c.valid);
         if let Some(c) = combined {
             let eye = [g.left, g.right].into_iter().find(|r| r.valid);
             if let Some(eye) = eye {
-                self.log_once(Fallback::CombinedRay);
+                log_once(Fallback::CombinedRay);
                 return from_crossing(closest_approach(&c, &eye), self.config.divergent);
             }
-            self.log_once(Fallback::CombinedOnly);
+            log_once(Fallback::CombinedOnly);
         }
         None
     }
+}
 
-    fn log_once(&mut self, which: Fallback) {
-        let seen = &mut self.logged[which as usize];
-        if *seen {
-            return;
-        }
-        *seen = true;
-        match which {
-            Fallback::FixationPoint => tracing::info!(
-                "gaze: a sample without two valid eye rays carries a fixation point; using its \
-                 distance from the head as the fixation depth"
-            ),
-            Fallback::CombinedRay => tracing::info!(
-                "gaze: a sample with one valid eye ray carries a combined ray; using their \
-                 closest approach as the fixation point"
-            ),
-            Fallback::CombinedOnly => tracing::info!(
-                "gaze: a sample carries only a combined gaze ray, which gives no depth; \
-                 holding the last depth"
-            ),
-        }
+/// Fallbacks already logged in this process (indexed by `Fallback as usize`). One run builds
+/// several estimators (the live pipeline, `trace analyze`'s raw depths and one per filter), and
+/// the note is about the tracker, not about an estimator, so it is printed once per process.
+static LOGGED: [AtomicBool; 3] = [
+    AtomicBool::new(false),
+    AtomicBool::new(false),
+    AtomicBool::new(false),
+];
+
+/// Logs the note of a fallback the first time any estimator of this process needs it; returns
+/// whether this call logged it.
+fn log_once(which: Fallback) -> bool {
+    if LOGGED[which as usize].swap(true, Ordering::Relaxed) {
+        return false;
     }
+    match which {
+        Fallback::FixationPoint => tracing::info!(
+            "gaze: a sample without two valid eye rays carries a fixation point; using its \
+             distance from the head as the fixation depth"
+        ),
+        Fallback::CombinedRay => tracing::info!(
+            "gaze: a sample with one valid eye ray carries a combined ray; using their \
+             closest approach as the fixation point"
+        ),
+        Fallback::CombinedOnly => tracing::info!(
+            "gaze: a sample carries only a combined gaze ray, which gives no depth; \
+             holding the last depth"
+        ),
+    }
+    true
 }
 
 #[cfg(test)]

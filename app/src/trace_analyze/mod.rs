@@ -22,22 +22,34 @@
 //!   switch after it is left out (the trace ended first);
 //! - every switch not matched to a gaze change is a **false switch**;
 //! - **agree** is the fraction of samples (after the truth is first known) whose decision is
-//!   the true image; unknown decisions count as disagreeing.
+//!   the true image; unknown decisions count as disagreeing;
+//! - an **episode** is a stretch of one decision: from the first decision or a switch to the
+//!   next switch (unknown stretches bridged, as for switches). The last episode, cut short by
+//!   the end of the trace, is not counted;
+//! - a **gap** is a blink or a dropout: a run of tracker samples without a depth, or more than
+//!   [`DROPOUT_NS`] between two consecutive tracker samples. It ends at the next sample with a
+//!   depth. A switch during a gap or less than [`SETTLE_NS`] after it ends is counted in
+//!   `switches_within_150ms_after_gap`.
+//!
+//! `vitreous trace analyze --json` writes the same figures as JSON ([`AnalyzeReport::to_json`]).
 
 use std::fmt;
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use serde::Serialize;
 use vitreous_xr::TraceSample;
 use vitreous_xr::synth::GazePhase;
 
-use crate::gaze::vergence::{FixationDepth, VergenceConfig, VergenceEstimator};
+pub use crate::gaze::fixation::DROPOUT_NS;
+use crate::gaze::fixation::{DEFAULT_VELOCITY_DEG_S, Step, VelocityClassifier, combined_direction};
+use crate::gaze::vergence::{VergenceConfig, VergenceEstimator};
 use crate::gaze::{FilterKind, GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances};
 use crate::scene::{gaze_image_of_target, load_scene};
 
 mod plot;
 
-pub use plot::{plot, plot_trace_file};
+pub use plot::{FILTER_COLOURS, PlotLayout, plot, plot_trace_file};
 
 /// Default persistence of a raw-depth crossing that counts as a gaze change, nanoseconds.
 pub const DEFAULT_PERSIST_NS: i64 = 200_000_000;
@@ -45,6 +57,10 @@ pub const DEFAULT_PERSIST_NS: i64 = 200_000_000;
 /// A last gaze change this close to the end of the trace with no switch after it is left
 /// out (neither missed nor timed): the trace ended before any filter could follow, nanoseconds.
 pub const UNRESOLVED_NS: i64 = 1_000_000_000;
+
+/// Episodes shorter than this, and switches this soon after a gap, are counted apart
+/// (`episodes_under_150ms`, `switches_within_150ms_after_gap`), nanoseconds.
+pub const SETTLE_NS: i64 = 150_000_000;
 
 /// What to analyse with.
 #[derive(Clone, Debug, PartialEq)]
@@ -142,29 +158,56 @@ pub fn replay(samples: &[TraceSample], config: GazeConfig) -> Vec<ReplayedFrame>
         .collect()
 }
 
-/// The raw depth of each tracker sample (each sample once, held depths skipped), with the
-/// sample time.
-pub fn raw_depths(samples: &[TraceSample], vergence: VergenceConfig) -> Vec<(i64, Option<f32>)> {
+/// One tracker sample as the analysis sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RawSample {
+    /// Tracker time, nanoseconds.
+    pub time_ns: i64,
+    /// The depth this sample measured (`None`: blink, lost eye), metres.
+    pub depth_m: Option<f32>,
+    /// Whether its rays diverged (the depth is then the far cap).
+    pub divergent: bool,
+    /// How the I-VT classifier of the `fixation` filter saw it.
+    pub step: Step,
+}
+
+/// Each tracker sample once (held depths skipped), with its depth, divergence and I-VT step
+/// (classified with `velocity_deg_s`).
+pub fn raw_samples(
+    samples: &[TraceSample],
+    vergence: VergenceConfig,
+    velocity_deg_s: f32,
+) -> Vec<RawSample> {
     let mut estimator = VergenceEstimator::new(vergence);
+    let mut classifier = VelocityClassifier::new(velocity_deg_s);
     let mut last: Option<i64> = None;
     let mut out = Vec::new();
     for s in samples {
         let t = s.gaze.sample_time_ns;
-        let depth = estimator.update(Some(&s.gaze), s.time_ns);
+        estimator.update(Some(&s.gaze), s.time_ns);
         if last.is_some_and(|l| t <= l) {
             continue;
         }
         last = Some(t);
-        let fresh = match depth {
-            FixationDepth::Known {
-                depth_m,
-                sample_time_ns,
-            } if sample_time_ns == t => Some(depth_m),
-            _ => None,
-        };
-        out.push((t, fresh));
+        let fresh = estimator.measurement().filter(|m| m.sample_time_ns == t);
+        let direction = fresh.and_then(|_| combined_direction(&s.gaze));
+        out.push(RawSample {
+            time_ns: t,
+            depth_m: fresh.map(|m| m.depth_m),
+            divergent: fresh.is_some_and(|m| m.divergent),
+            step: classifier.step(t, direction),
+        });
     }
     out
+}
+
+/// The raw depth of each tracker sample (each sample once, held depths skipped), with the
+/// sample time.
+pub fn raw_depths(samples: &[TraceSample], vergence: VergenceConfig) -> Vec<(i64, Option<f32>)> {
+    raw_samples(samples, vergence, DEFAULT_VELOCITY_DEG_S)
+        .into_iter()
+        .map(|r| (r.time_ns, r.depth_m))
+        .collect()
 }
 
 /// The truth timeline of ground-truth phases of a trace whose targets are laid out as
@@ -227,6 +270,43 @@ pub fn timeline_from_raw_depth(
     timeline
 }
 
+/// A blink or dropout: from its first sample without depth (or the last sample before a
+/// dropout) to the first sample with a depth after it, nanoseconds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Gap {
+    /// Start, nanoseconds on the trace clock.
+    pub start_ns: i64,
+    /// End: the first sample with a depth after the gap, nanoseconds.
+    pub end_ns: i64,
+}
+
+/// The gaps (module docs) of raw depths; a gap still open at the end of the trace is left out.
+pub fn gaps(raw: &[(i64, Option<f32>)]) -> Vec<Gap> {
+    let mut gaps = Vec::new();
+    let mut open: Option<i64> = None;
+    let mut previous: Option<i64> = None;
+    for &(t, depth) in raw {
+        if depth.is_none() {
+            open.get_or_insert(t);
+        } else {
+            let dropout = previous.is_some_and(|p| t - p > DROPOUT_NS);
+            match (open.take(), previous) {
+                (Some(start), _) => gaps.push(Gap {
+                    start_ns: start,
+                    end_ns: t,
+                }),
+                (None, Some(p)) if dropout => gaps.push(Gap {
+                    start_ns: p,
+                    end_ns: t,
+                }),
+                _ => {}
+            }
+        }
+        previous = Some(t);
+    }
+    gaps
+}
+
 /// The figures of one filter on one trace.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FilterReport {
@@ -243,6 +323,13 @@ pub struct FilterReport {
     /// Fraction of samples whose decision is the true image (0..1), when the truth is known
     /// for some sample.
     pub agreement: Option<f64>,
+    /// Length of each complete decision episode (module docs), nanoseconds.
+    pub episodes_ns: Vec<i64>,
+    /// Switches during a gap or less than [`SETTLE_NS`] after it ended.
+    pub switches_after_gap: usize,
+    /// Switch latency of each matched gaze change with no gap in the [`SETTLE_NS`] after it,
+    /// nanoseconds (a change hidden by a blink cannot be seen before the blink ends).
+    pub clear_latencies_ns: Vec<i64>,
 }
 
 impl FilterReport {
@@ -267,6 +354,104 @@ impl FilterReport {
     pub fn max_latency_ms(&self) -> Option<f64> {
         self.latencies_ns.iter().max().map(|&v| v as f64 / 1e6)
     }
+
+    /// Shortest complete decision episode, milliseconds.
+    pub fn min_episode_ms(&self) -> Option<f64> {
+        self.episodes_ns.iter().min().map(|&v| v as f64 / 1e6)
+    }
+
+    /// Complete decision episodes shorter than [`SETTLE_NS`].
+    pub fn episodes_under_settle(&self) -> usize {
+        self.episodes_ns.iter().filter(|&&e| e < SETTLE_NS).count()
+    }
+
+    /// The figures as `trace analyze --json` writes them.
+    pub fn to_json(&self) -> FilterJson {
+        let ms = |v: &[i64]| -> (Option<f64>, Option<f64>) {
+            let mean = (!v.is_empty())
+                .then(|| v.iter().map(|&l| l as f64).sum::<f64>() / v.len() as f64 / 1e6);
+            (mean, v.iter().max().map(|&m| m as f64 / 1e6))
+        };
+        let (mean_ms, max_ms) = ms(&self.latencies_ns);
+        let (clear_mean_ms, clear_max_ms) = ms(&self.clear_latencies_ns);
+        FilterJson {
+            filter: self.filter.to_string(),
+            switches: self.switches,
+            false_switches: self.false_switches,
+            missed: self.missed,
+            mean_ms,
+            median_ms: self.median_latency_ms(),
+            max_ms,
+            clear_mean_ms,
+            clear_max_ms,
+            agree: self.agreement,
+            episodes: self.episodes_ns.len(),
+            min_episode_ms: self.min_episode_ms(),
+            episodes_under_150ms: self.episodes_under_settle(),
+            switches_within_150ms_after_gap: self.switches_after_gap,
+        }
+    }
+}
+
+/// One filter's figures in `trace analyze --json` (see the module docs for the definitions).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FilterJson {
+    /// The filter's name.
+    pub filter: String,
+    /// Switches between surface and refracted.
+    pub switches: usize,
+    /// Switches matched to no gaze change.
+    #[serde(rename = "false")]
+    pub false_switches: usize,
+    /// Gaze changes never followed.
+    pub missed: usize,
+    /// Mean switch latency, milliseconds (`null`: no matched change).
+    pub mean_ms: Option<f64>,
+    /// Median switch latency, milliseconds.
+    pub median_ms: Option<f64>,
+    /// Largest switch latency, milliseconds.
+    pub max_ms: Option<f64>,
+    /// Mean latency over the changes with no gap in the 150 ms after them, milliseconds.
+    pub clear_mean_ms: Option<f64>,
+    /// Largest latency over the changes with no gap in the 150 ms after them, milliseconds.
+    pub clear_max_ms: Option<f64>,
+    /// Fraction of samples whose decision is the true image, 0..1.
+    pub agree: Option<f64>,
+    /// Complete decision episodes.
+    pub episodes: usize,
+    /// Shortest complete decision episode, milliseconds.
+    pub min_episode_ms: Option<f64>,
+    /// Complete decision episodes shorter than 150 ms.
+    pub episodes_under_150ms: usize,
+    /// Switches during a gap or less than 150 ms after it ended.
+    pub switches_within_150ms_after_gap: usize,
+}
+
+/// `trace analyze --json`: the trace's figures and one entry per filter.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AnalyzeJson {
+    /// Trace samples (lines).
+    pub samples: usize,
+    /// Distinct tracker samples.
+    pub tracker_samples: usize,
+    /// Tracker samples with no depth.
+    pub tracker_samples_without_depth: usize,
+    /// First to last sample, seconds.
+    pub duration_s: f64,
+    /// Surface image distance, metres.
+    pub surface_m: f32,
+    /// Refracted image distance, metres.
+    pub refracted_m: f32,
+    /// Decision threshold (geometric mean of the distances), metres.
+    pub threshold_m: f32,
+    /// Whether the gaze changes are ground truth (else derived from the raw depth).
+    pub ground_truth: bool,
+    /// Gaze changes.
+    pub gaze_changes: usize,
+    /// Blinks and dropouts.
+    pub gaps: usize,
+    /// One entry per filter, in the configured order.
+    pub filters: Vec<FilterJson>,
 }
 
 /// What `vitreous trace analyze` reports.
@@ -290,6 +475,8 @@ pub struct AnalyzeReport {
     pub persist_ns: i64,
     /// The true timeline.
     pub truth: TruthTimeline,
+    /// Blinks and dropouts of the trace.
+    pub gaps: Vec<Gap>,
     /// One report per filter, in the configured order.
     pub filters: Vec<FilterReport>,
 }
@@ -300,10 +487,32 @@ impl AnalyzeReport {
         (self.duration_s > 0.0 && self.tracker_samples > 1)
             .then(|| (self.tracker_samples - 1) as f64 / self.duration_s)
     }
+
+    /// The figures as `trace analyze --json` writes them.
+    pub fn to_json(&self) -> AnalyzeJson {
+        AnalyzeJson {
+            samples: self.samples,
+            tracker_samples: self.tracker_samples,
+            tracker_samples_without_depth: self.tracker_samples_without_depth,
+            duration_s: self.duration_s,
+            surface_m: self.distances.surface_m,
+            refracted_m: self.distances.refracted_m,
+            threshold_m: self.distances.threshold_m(),
+            ground_truth: self.ground_truth,
+            gaze_changes: self.truth.changes.len(),
+            gaps: self.gaps.len(),
+            filters: self.filters.iter().map(FilterReport::to_json).collect(),
+        }
+    }
 }
 
-/// Scores one replay against the truth.
-pub fn score(frames: &[ReplayedFrame], truth: &TruthTimeline, filter: FilterKind) -> FilterReport {
+/// Scores one replay against the truth and the trace's gaps.
+pub fn score(
+    frames: &[ReplayedFrame],
+    truth: &TruthTimeline,
+    gaps: &[Gap],
+    filter: FilterKind,
+) -> FilterReport {
     // Switch times and targets; the shown image (bridging unknown) before each frame.
     let mut switches: Vec<(i64, GazeImage)> = Vec::new();
     let mut shown: Option<GazeImage> = None;
@@ -321,6 +530,29 @@ pub fn score(frames: &[ReplayedFrame], truth: &TruthTimeline, filter: FilterKind
         }
     }
     let end_ns = frames.last().map_or(0, |f| f.0 + 1);
+    let first_decision = frames
+        .iter()
+        .find(|f| f.1.image != GazeImage::Unknown)
+        .map(|f| f.0);
+    let episodes_ns: Vec<i64> = first_decision
+        .into_iter()
+        .chain(switches.iter().map(|s| s.0))
+        .collect::<Vec<_>>()
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .collect();
+    let switches_after_gap = switches
+        .iter()
+        .filter(|&&(t, _)| {
+            gaps.iter()
+                .any(|g| g.start_ns <= t && t < g.end_ns + SETTLE_NS)
+        })
+        .count();
+    let hidden = |t: i64| {
+        gaps.iter()
+            .any(|g| g.start_ns < t + SETTLE_NS && g.end_ns > t)
+    };
+    let mut clear_latencies_ns = Vec::new();
     let mut matched = vec![false; switches.len()];
     let mut latencies_ns = Vec::new();
     let mut missed = 0;
@@ -333,6 +565,9 @@ pub fn score(frames: &[ReplayedFrame], truth: &TruthTimeline, filter: FilterKind
             Some(i) => {
                 matched[i] = true;
                 latencies_ns.push(switches[i].0 - change.time_ns);
+                if !hidden(change.time_ns) {
+                    clear_latencies_ns.push(switches[i].0 - change.time_ns);
+                }
             }
             // The trace ended before the decision could follow: not counted.
             None if k + 1 == truth.changes.len() && until - change.time_ns < UNRESOLVED_NS => {}
@@ -355,6 +590,9 @@ pub fn score(frames: &[ReplayedFrame], truth: &TruthTimeline, filter: FilterKind
         missed,
         latencies_ns,
         agreement: (judged > 0).then(|| agree as f64 / judged as f64),
+        episodes_ns,
+        switches_after_gap,
+        clear_latencies_ns,
     }
 }
 
@@ -365,10 +603,11 @@ pub fn analyze(samples: &[TraceSample], truth: Truth<'_>, config: &AnalyzeConfig
         Truth::Phases(phases) => timeline_from_phases(phases),
         Truth::FromRawDepth => timeline_from_raw_depth(&raw, &config.distances, config.persist_ns),
     };
+    let gaps = gaps(&raw);
     let filters = config
         .filters
         .iter()
-        .map(|&f| score(&replay(samples, config.gaze_config(f)), &timeline, f))
+        .map(|&f| score(&replay(samples, config.gaze_config(f)), &timeline, &gaps, f))
         .collect();
     let selector = crate::gaze::ImageSelector::new(config.distances, config.band);
     let duration_s = match (samples.first(), samples.last()) {
@@ -385,6 +624,7 @@ pub fn analyze(samples: &[TraceSample], truth: Truth<'_>, config: &AnalyzeConfig
         ground_truth: matches!(truth, Truth::Phases(_)),
         persist_ns: config.persist_ns,
         truth: timeline,
+        gaps,
         filters,
     }
 }
@@ -443,6 +683,27 @@ impl fmt::Display for AnalyzeReport {
                 ms(r.max_latency_ms()),
                 r.agreement
                     .map_or("-".to_owned(), |a| format!("{:.1}%", a * 100.0)),
+            )?;
+        }
+        writeln!(
+            f,
+            "decision episodes; {} blinks or dropouts (gaps):",
+            self.gaps.len()
+        )?;
+        writeln!(
+            f,
+            "{:<44} {:>8} {:>14} {:>15} {:>26}",
+            "filter", "episodes", "min episode ms", "under 150 ms", "switches <150 ms after gap"
+        )?;
+        for r in &self.filters {
+            writeln!(
+                f,
+                "{:<44} {:>8} {:>14} {:>15} {:>26}",
+                r.filter.to_string(),
+                r.episodes_ns.len(),
+                ms(r.min_episode_ms()),
+                r.episodes_under_settle(),
+                r.switches_after_gap,
             )?;
         }
         Ok(())

@@ -1,5 +1,12 @@
 //! `vitreous trace plot`: raw and filtered fixation depth over time with each filter's
 //! gaze-image decisions, drawn as a PNG (like the paper's Fig. 11).
+//!
+//! Depth is drawn as vergence in dioptres (1 / depth), where the tracker's angular noise is
+//! about even and a far fixation stays in view (10 m is 0.1 D); samples whose rays diverge are
+//! drawn in a band below 0 D. Fixations (as the `fixation` filter's classifier finds them,
+//! at least 60 ms long) are shaded. plotters does not clip to the plotting area, so every
+//! value is clamped to the axis range less the marker size and lines are one pixel wide: nothing
+//! is drawn outside the chart.
 
 use std::fmt;
 use std::path::Path;
@@ -10,9 +17,10 @@ use plotters::prelude::*;
 use vitreous_xr::TraceSample;
 
 use super::{
-    AnalyzeConfig, ReplayedFrame, Truth, load_inputs, raw_depths, replay, timeline_from_phases,
-    timeline_from_raw_depth,
+    AnalyzeConfig, RawSample, ReplayedFrame, Truth, load_inputs, raw_samples, replay,
+    timeline_from_phases, timeline_from_raw_depth,
 };
+use crate::gaze::fixation::{DEFAULT_MIN_FIXATION_MS, DEFAULT_VELOCITY_DEG_S, fixation_spans};
 use crate::gaze::{FilterKind, GazeImage};
 
 /// `vitreous trace plot TRACE --scene SCENE -o OUT`: see [`plot`].
@@ -23,7 +31,16 @@ pub fn plot_trace_file(
     out_png: &Path,
 ) -> Result<()> {
     let (samples, config) = load_inputs(trace, scene, filters)?;
-    plot(&samples, Truth::FromRawDepth, &config, out_png)
+    plot(&samples, Truth::FromRawDepth, &config, out_png).map(|_| ())
+}
+
+/// Where `plot` drew its depth chart, pixels of the PNG.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PlotLayout {
+    /// Columns of the depth chart's plotting area (half-open).
+    pub chart_x_px: std::ops::Range<i32>,
+    /// Rows of the depth chart's plotting area (half-open).
+    pub chart_y_px: std::ops::Range<i32>,
 }
 
 /// Plot size, pixels.
@@ -51,32 +68,46 @@ fn image_colour(image: GazeImage) -> RGBColor {
     }
 }
 
-/// Line colours of the filters, in order.
-const FILTER_COLOURS: [RGBColor; 5] = [
-    RGBColor(0, 0, 0),
+/// Line colours of the filters, in order (none of them grey, so text never has them).
+pub const FILTER_COLOURS: [RGBColor; 5] = [
+    RGBColor(110, 40, 150),
     RGBColor(44, 160, 44),
     RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
+    RGBColor(0, 150, 170),
     RGBColor(140, 86, 75),
 ];
 
+/// Colour of the fixation shading.
+const FIXATION_SHADE: RGBColor = RGBColor(236, 236, 228);
+
+/// Vergence at which diverging samples are drawn, dioptres (a band below 0 D).
+const DIVERGING_D: f64 = -0.2;
+
+/// Radius of the raw-sample markers, pixels.
+const MARKER_PX: i32 = 2;
+
 /// Draws raw and filtered fixation depth over time with the gaze-image decisions (like the
-/// paper's Fig. 11) as a PNG at `out_png`, written to `out_png.partial` then renamed.
+/// paper's Fig. 11) as a PNG at `out_png`, written to `out_png.partial` then renamed; returns
+/// where the depth chart lies in the image.
 ///
-/// Top: raw depth per tracker sample (grey dots), each filter's depth (lines), the two image
-/// distances and the threshold. Bottom: one strip per filter (and the truth) coloured by the
-/// gaze image over time (blue surface, orange refracted, grey unknown).
+/// Top: vergence (dioptres) of each tracker sample (grey dots; diverging rays as red dots
+/// below 0 D), each filter's depth (lines), the two images and the threshold, over shaded
+/// fixations. Bottom: one strip per filter (and the truth) coloured by the gaze image over
+/// time (blue surface, orange refracted, grey unknown).
 pub fn plot(
     samples: &[TraceSample],
     truth: Truth<'_>,
     config: &AnalyzeConfig,
     out_png: &Path,
-) -> Result<()> {
+) -> Result<PlotLayout> {
     register_font()?;
-    let raw = raw_depths(samples, config.vergence);
+    let raw: Vec<RawSample> = raw_samples(samples, config.vergence, DEFAULT_VELOCITY_DEG_S);
+    let raw_depths: Vec<(i64, Option<f32>)> = raw.iter().map(|r| (r.time_ns, r.depth_m)).collect();
     let timeline = match truth {
         Truth::Phases(phases) => timeline_from_phases(phases),
-        Truth::FromRawDepth => timeline_from_raw_depth(&raw, &config.distances, config.persist_ns),
+        Truth::FromRawDepth => {
+            timeline_from_raw_depth(&raw_depths, &config.distances, config.persist_ns)
+        }
     };
     let t0 = samples.first().map_or(0, |s| s.time_ns);
     let secs = |t: i64| (t - t0) as f64 * 1e-9;
@@ -87,9 +118,10 @@ pub fn plot(
         .map(|&f| (f, replay(samples, config.gaze_config(f))))
         .collect();
     let d = config.distances;
-    let y_max = (d.surface_m.max(d.refracted_m) as f64 * 2.0)
-        .min(f64::from(config.vergence.max_depth_m))
-        .max(0.1);
+    let dioptres = |depth_m: f32| 1.0 / f64::from(depth_m.max(1e-3));
+    let y_top = (dioptres(d.surface_m.min(d.refracted_m)) * 1.6).max(1.0);
+    let y_bottom = DIVERGING_D * 2.0;
+    let layout;
 
     let (w, h) = PLOT_SIZE_PX;
     let mut rgb = vec![0u8; (w * h * 3) as usize];
@@ -108,47 +140,106 @@ pub fn plot(
         let mut chart = ChartBuilder::on(&upper)
             .caption(
                 format!(
-                    "Fixation depth: raw and filtered (surface {:.2} m, refracted {:.2} m)",
+                    "Vergence: raw and filtered (surface {:.2} m, refracted {:.2} m)",
                     d.surface_m, d.refracted_m
                 ),
                 ("sans-serif", 22),
             )
             .margin(12)
             .x_label_area_size(36)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..t_max, 0.0..y_max)
+            .y_label_area_size(118)
+            .build_cartesian_2d(0.0..t_max, y_bottom..y_top)
             .map_err(|e| draw_err(&e))?;
         chart
             .configure_mesh()
             .x_desc("time (s)")
-            .y_desc("depth (m)")
+            .y_desc("vergence (dioptres = 1 / depth in m)")
+            .y_label_formatter(&|v: &f64| {
+                if *v < -1e-9 {
+                    "diverging".to_owned()
+                } else if *v < 1e-9 {
+                    "0 (far)".to_owned()
+                } else {
+                    format!("{v:.1} ({:.2} m)", 1.0 / v)
+                }
+            })
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| draw_err(&e))?;
-        let clamp = |v: f32| f64::from(v).clamp(0.0, y_max);
-        let grey = RGBColor(150, 150, 150);
+        let (x_px, y_px) = chart.plotting_area().get_pixel_range();
+        layout = PlotLayout {
+            chart_x_px: x_px.clone(),
+            chart_y_px: y_px.clone(),
+        };
+        // Keep markers of radius MARKER_PX (and one-pixel lines) inside the plotting area.
+        let pad_y =
+            (y_top - y_bottom) * f64::from(MARKER_PX + 1) / f64::from(y_px.len().max(1) as i32);
+        let pad_x = t_max * f64::from(MARKER_PX + 1) / f64::from(x_px.len().max(1) as i32);
+        let clamp_y = |v: f64| v.clamp(y_bottom + pad_y, y_top - pad_y);
+        let clamp_t = |t: f64| t.clamp(pad_x, t_max - pad_x);
+
+        // Fixations, shaded behind everything.
+        let times: Vec<i64> = raw.iter().map(|r| r.time_ns).collect();
+        let steps: Vec<_> = raw.iter().map(|r| r.step).collect();
+        let min_ns = (f64::from(DEFAULT_MIN_FIXATION_MS) * 1e6) as i64;
         chart
-            .draw_series(raw.iter().filter_map(|&(t, d)| {
-                d.map(|d| Circle::new((secs(t), clamp(d)), 2, grey.filled()))
-            }))
+            .draw_series(
+                fixation_spans(&times, &steps, min_ns)
+                    .into_iter()
+                    .map(|(a, b)| {
+                        Rectangle::new(
+                            [
+                                (secs(a).clamp(0.0, t_max), y_top),
+                                (secs(b).clamp(0.0, t_max), y_bottom),
+                            ],
+                            FIXATION_SHADE.filled(),
+                        )
+                    }),
+            )
             .map_err(|e| draw_err(&e))?
-            .label("raw depth")
-            .legend(move |(x, y)| Circle::new((x + 10, y), 3, grey.filled()));
+            .label("fixation (I-VT)")
+            .legend(|(x, y)| {
+                Rectangle::new([(x, y - 5), (x + 20, y + 5)], FIXATION_SHADE.filled())
+            });
+        let grey = RGBColor(150, 150, 150);
+        let red = RGBColor(200, 60, 60);
+        for (divergent, colour, label) in
+            [(false, grey, "raw vergence"), (true, red, "diverging rays")]
+        {
+            chart
+                .draw_series(
+                    raw.iter()
+                        .filter(|r| r.divergent == divergent)
+                        .filter_map(|r| {
+                            let v = if divergent {
+                                DIVERGING_D
+                            } else {
+                                dioptres(r.depth_m?)
+                            };
+                            Some(Circle::new(
+                                (clamp_t(secs(r.time_ns)), clamp_y(v)),
+                                MARKER_PX,
+                                colour.filled(),
+                            ))
+                        }),
+                )
+                .map_err(|e| draw_err(&e))?
+                .label(label)
+                .legend(move |(x, y)| Circle::new((x + 10, y), 3, colour.filled()));
+        }
         for (image, dist) in [
             (GazeImage::Surface, d.surface_m),
             (GazeImage::Refracted, d.refracted_m),
         ] {
             let c = image_colour(image);
+            let v = clamp_y(dioptres(dist));
             chart
-                .draw_series(LineSeries::new(
-                    [(0.0, clamp(dist)), (t_max, clamp(dist))],
-                    c.stroke_width(1),
-                ))
+                .draw_series(LineSeries::new([(0.0, v), (t_max, v)], c.stroke_width(1)))
                 .map_err(|e| draw_err(&e))?
                 .label(format!("{image} image"))
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c));
         }
-        let threshold = clamp(d.threshold_m());
+        let threshold = clamp_y(dioptres(d.threshold_m()));
         chart
             .draw_series(DashedLineSeries::new(
                 [(0.0, threshold), (t_max, threshold)],
@@ -168,7 +259,7 @@ pub fn plot(
                     Some(dm) => segments
                         .last_mut()
                         .into_iter()
-                        .for_each(|s| s.push((secs(t), clamp(dm)))),
+                        .for_each(|s| s.push((clamp_t(secs(t)), clamp_y(dioptres(dm))))),
                     None if segments.last().is_some_and(|s| !s.is_empty()) => {
                         segments.push(Vec::new())
                     }
@@ -177,11 +268,11 @@ pub fn plot(
             }
             for (k, seg) in segments.into_iter().filter(|s| !s.is_empty()).enumerate() {
                 let series = chart
-                    .draw_series(LineSeries::new(seg, c.stroke_width(2)))
+                    .draw_series(LineSeries::new(seg, c.stroke_width(1)))
                     .map_err(|e| draw_err(&e))?;
                 if k == 0 {
                     series.label(kind.to_string()).legend(move |(x, y)| {
-                        PathElement::new([(x, y), (x + 20, y)], c.stroke_width(2))
+                        PathElement::new([(x, y), (x + 20, y)], c.stroke_width(1))
                     });
                 }
             }
@@ -201,7 +292,7 @@ pub fn plot(
             .margin_right(12)
             .margin_bottom(8)
             .x_label_area_size(30)
-            .y_label_area_size(60)
+            .y_label_area_size(118)
             .build_cartesian_2d(0.0..t_max, 0.0..rows as f64)
             .map_err(|e| draw_err(&e))?;
         strips
@@ -260,5 +351,6 @@ pub fn plot(
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
     let png = crate::output::encode_png(&rgba, w, h)?;
-    crate::output::write_atomic(out_png, &png)
+    crate::output::write_atomic(out_png, &png)?;
+    Ok(layout)
 }

@@ -10,3 +10,4 @@ mod interrupted;
 mod scene_errors;
 mod scene_load;
 mod scene_shipped;
+mod trace_import;

@@ -284,9 +284,11 @@ impl Stream {
 
     /// The part file holding record `i` and the record's number (1-based) in it.
     pub(super) fn locate(&self, i: usize) -> (&str, usize) {
-        let k = self.parts.partition_point(|&(_, start)| start <= i) - 1;
-        let (file, start) = &self.parts[k];
-        (file, i - start + 1)
+        let k = self.parts.partition_point(|&(_, start)| start <= i);
+        match k.checked_sub(1).and_then(|k| self.parts.get(k)) {
+            Some((file, start)) => (file, i - start + 1),
+            None => ("", i + 1),
+        }
     }
 }
 

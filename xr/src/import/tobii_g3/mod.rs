@@ -287,8 +287,8 @@ fn timestamp_ns(seconds: Option<f64>, file: &str, line: usize) -> Result<i64, Re
         expected: "seconds since the recording started (a finite number)",
     };
     let s = seconds.ok_or_else(|| bad("nothing".to_owned()))?;
-    // 9e9 s (285 years) keeps nanoseconds inside an i64.
-    if !s.is_finite() || s.abs() > 9.0e9 {
+    // 4e9 s (127 years) either way keeps nanoseconds, and the difference of two, in an i64.
+    if !s.is_finite() || s.abs() > 4.0e9 {
         return Err(bad(s.to_string()));
     }
     Ok((s * 1e9).round() as i64)

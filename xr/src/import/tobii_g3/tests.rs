@@ -260,6 +260,14 @@ fn malformed_files_name_the_file_and_line() {
         ("\n\n".to_owned(), "gazedata.gz: no `gaze` records"),
         (
             format!(
+                "{}\n{}\n",
+                good.replace("\"timestamp\":0.0", "\"timestamp\":-3.9e9"),
+                second.replace("\"timestamp\":0.01", "\"timestamp\":3.9e9")
+            ),
+            "s after the previous sample's",
+        ),
+        (
+            format!(
                 "{good}\n{}\n",
                 second.replace("\"timestamp\":0.01", "\"timestamp\":700")
             ),

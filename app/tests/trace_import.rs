@@ -54,7 +54,7 @@ fn import_tobii_g3_folder_and_gaze_file_write_the_same_trace() {
     let report = assert_success(&import("tobii-g3", &data("tobii_g3"), &a));
     for needle in [
         "Tobii Pro Glasses 3",
-        "100 samples",
+        "200 samples",
         "gyroscope",
         "approximated:",
     ] {
@@ -65,7 +65,7 @@ fn import_tobii_g3_folder_and_gaze_file_write_the_same_trace() {
     assert!(text.starts_with("# vitreous-trace v1.1\n"), "{text}");
     assert_eq!(text, std::fs::read_to_string(&b).unwrap());
     let samples = read_trace(&a).unwrap();
-    assert_eq!(samples.len(), 100);
+    assert_eq!(samples.len(), 200);
     // Pupils carried into the v1.1 columns; both eyes valid where the recording has them.
     assert_eq!(
         samples[0].gaze.pupil_diameter_m,
@@ -86,6 +86,7 @@ fn import_tobii_g3_of_a_broken_recording_fails_and_writes_nothing() {
     std::fs::write(rec.join("gazedata.gz"), &gz[..gz.len() - 40]).unwrap();
     let out = import("tobii-g3", &rec, &target);
     assert_failure(&out, &["gazedata.gz", "reading line", "cut short"]);
+    assert_eq!(out.status.code(), Some(1));
     assert!(!target.exists());
     // A malformed JSON line, named by file and line.
     std::fs::write(

@@ -59,17 +59,19 @@ fn parse(
     }
 }
 
-/// The fixture's targets (Tobii frame, mm): near (0.4 m, a little right) and far (2 m, left).
-const NEAR: [f64; 3] = [-40.0, -30.0, 400.0];
-const FAR: [f64; 3] = [150.0, 60.0, 2000.0];
+/// The fixture's targets (Tobii frame, mm), either side of the 0.22 m threshold between the
+/// images of `config/scenes/visual-effects.toml`: near (0.14 m from the scene camera, a little
+/// right and down) and far (0.45 m, left and up).
+const NEAR: [f64; 3] = [-15.0, -25.0, 135.0];
+const FAR: [f64; 3] = [40.0, 30.0, 445.0];
 
-/// The gaze and IMU text of the fixture: 2 s at 50 Hz, the gaze switching between the near
+/// The gaze and IMU text of the fixture: 4 s at 50 Hz, the gaze switching between the near
 /// and far targets every 0.5 s, both eyes lost for 100 ms at 1.2 s, the left eye alone lost
 /// at 1.5 s; the head turning left at 10 deg/s while level, the IMU at 100 Hz with
 /// magnetometer lines at 10 Hz.
 fn fixture_text() -> (String, String) {
     let mut gaze = String::new();
-    for i in 0..100 {
+    for i in 0..200 {
         let t = 0.02 * f64::from(i) + 3.5;
         let target = DVec3::from_array(if (i / 25) % 2 == 0 { NEAR } else { FAR });
         let line = match i {
@@ -84,7 +86,7 @@ fn fixture_text() -> (String, String) {
         gaze.push('\n');
     }
     let mut imu = String::new();
-    for i in 0..=200 {
+    for i in 0..=400 {
         let t = 0.01 * f64::from(i) + 3.5;
         let line = json!({"type": "imu", "timestamp": t, "data": {
             "accelerometer": [0.02, 9.81, -0.01],
@@ -130,14 +132,14 @@ fn depth(s: &TraceSample) -> f32 {
 fn committed_fixture_gives_the_geometry_it_was_made_from() {
     let (samples, report) = import_tobii_g3(data_dir()).unwrap();
     eprintln!("{report}");
-    assert_eq!((report.records, report.samples), (100, 100));
+    assert_eq!((report.records, report.samples), (200, 200));
     assert_eq!((report.lost_samples, report.one_eye_samples), (5, 1));
-    assert_eq!(report.head, HeadSource::Gyroscope { records: 201 });
+    assert_eq!(report.head, HeadSource::Gyroscope { records: 401 });
     let ipd = report.median_ipd_mm.unwrap();
     assert!((ipd - 63.0).abs() < 0.2, "{ipd}");
     // Times start at 0 and step 20 ms.
     assert_eq!(samples[0].time_ns, 0);
-    assert_eq!(samples[99].time_ns, 1_980_000_000);
+    assert_eq!(samples[199].time_ns, 3_980_000_000);
     // Fixation depths follow the targets; the trace's fixation point is gaze3d.
     let near = tobii_to_openxr(DVec3::from_array(NEAR).as_vec3()) / 1000.0;
     let far = tobii_to_openxr(DVec3::from_array(FAR).as_vec3()) / 1000.0;
@@ -157,9 +159,9 @@ fn committed_fixture_gives_the_geometry_it_was_made_from() {
     assert!(near.x > 0.0 && near.y < 0.0 && near.z < 0.0);
     // The left eye sits at -x in OpenXR axes.
     assert!(samples[0].gaze.left.origin.x < -0.03);
-    // The head turned left at 10 deg/s: 19.8 degrees by the last sample, staying level.
-    let forward = samples[99].head.transform_vector(Vec3::NEG_Z);
-    let expected = Quat::from_rotation_y(19.8f32.to_radians()) * Vec3::NEG_Z;
+    // The head turned left at 10 deg/s: 39.8 degrees by the last sample, staying level.
+    let forward = samples[199].head.transform_vector(Vec3::NEG_Z);
+    let expected = Quat::from_rotation_y(39.8f32.to_radians()) * Vec3::NEG_Z;
     assert!(
         forward.abs_diff_eq(expected, 2e-3),
         "{forward} vs {expected}"
@@ -189,7 +191,7 @@ fn recording_folder_gaze_file_and_plain_text_import_alike() {
     let mut two = gzip(&(lines[..40].join("\n") + "\n"));
     two.extend(gzip(&lines[40..].join("\n")));
     let (e, _) = parse(&two, None).unwrap();
-    assert_eq!(e.len(), 100);
+    assert_eq!(e.len(), 200);
 }
 
 #[test]

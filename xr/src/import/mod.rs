@@ -8,6 +8,7 @@
 //! and approximations of every format.
 
 mod error;
+mod eye_centre;
 pub mod neon;
 mod orientation;
 mod report;

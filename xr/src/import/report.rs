@@ -2,6 +2,8 @@
 
 use std::fmt;
 
+use glam::Vec3;
+
 use crate::trace::TraceSample;
 
 /// Where the head orientation of an imported trace comes from.
@@ -52,6 +54,10 @@ pub struct RecordingReport {
     pub median_ipd_mm: Option<f32>,
     /// Time from the first to the last sample, seconds.
     pub duration_s: f64,
+    /// Where the head frame's origin, the middle of the eyes, lies from the scene camera
+    /// (OpenXR axes, metres); `None` when no sample has both eyes valid and the origin stays
+    /// at the scene camera.
+    pub head_origin_m: Option<Vec3>,
     /// Where the head orientation comes from.
     pub head: HeadSource,
     /// What the import had to assume or approximate, one sentence each.
@@ -101,6 +107,7 @@ impl RecordingReport {
             right_valid_fraction: fraction(right),
             median_ipd_mm,
             duration_s,
+            head_origin_m: None,
             head: HeadSource::None,
             approximations: Vec::new(),
         }
@@ -155,6 +162,16 @@ impl fmt::Display for RecordingReport {
         match self.median_ipd_mm {
             Some(ipd) => write!(f, ", median eye distance {ipd:.1} mm")?,
             None => write!(f, ", eye distance unknown (no sample with both eyes valid)")?,
+        }
+        match self.head_origin_m {
+            Some(o) => write!(
+                f,
+                "; head origin: middle of the eyes, ({:.1}, {:.1}, {:.1}) mm from the scene camera",
+                o.x * 1000.0,
+                o.y * 1000.0,
+                o.z * 1000.0
+            )?,
+            None => write!(f, "; head origin: the scene camera")?,
         }
         match self.head {
             HeadSource::None => write!(f, "; head: no IMU data, identity pose")?,

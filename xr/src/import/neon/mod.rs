@@ -16,8 +16,9 @@
 //! Conversions, into the OpenXR conventions of this crate:
 //! - **Frames**: Neon's 3D eye data are in the scene camera's frame (OpenCV axes: +x right,
 //!   +y down, +z forward, mm). The trace's head frame is that frame turned half a turn
-//!   about x: `(x, y, z) -> (x, -y, -z)`, millimetres to metres; its origin is the scene
-//!   camera.
+//!   about x: `(x, y, z) -> (x, -y, -z)`, millimetres to metres, with its origin then moved
+//!   from the scene camera to the middle of the eyes (the median midpoint of the two eyeball
+//!   centres over the recording).
 //! - **Gaze**: the gaze point (pixels) is undistorted into a direction from the scene camera.
 //!   That is the *visual* gaze. The eye-state optical axes are not used: the optical axis is
 //!   about 5 degrees from the visual axis, so their vergence says nothing about depth.
@@ -44,6 +45,7 @@ use std::path::Path;
 
 use glam::{DVec3, Quat, Vec3};
 
+use super::eye_centre::centre_on_eyes;
 use super::orientation::{OrientationTrack, unyaw};
 use super::{HeadSource, RecordingError, RecordingReport};
 use crate::frame::{GazeRay, GazeSample, Pose};
@@ -351,7 +353,15 @@ impl Inputs {
                  are written as invalid"
             ));
         }
+        let head_origin = centre_on_eyes(&mut samples);
+        if head_origin.is_none() {
+            notes.push(
+                "no sample has both eyes valid: the head frame's origin stays at the scene camera"
+                    .to_owned(),
+            );
+        }
         let mut report = RecordingReport::from_samples(FORMAT, self.name, &samples);
+        report.head_origin_m = head_origin;
         report.records = self.gaze.len();
         report.dropped_records = dropped;
         report.blink_samples = in_blinks;

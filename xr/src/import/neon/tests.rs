@@ -163,6 +163,13 @@ fn committed_fixture_gives_the_geometry_it_was_made_from() {
     let ipd = report.median_ipd_mm.unwrap();
     assert!((ipd - 63.5).abs() < 0.1, "{ipd}");
     assert_eq!(samples[199].time_ns, 995_000_000);
+    // The head frame's origin is the middle of the eyeball centres.
+    let left = openxr(DVec3::from_array(LEFT_EYE.map(f64::from))) / 1000.0;
+    let right = openxr(DVec3::from_array(RIGHT_EYE.map(f64::from))) / 1000.0;
+    let centre = (left + right) / 2.0;
+    let origin = report.head_origin_m.unwrap();
+    assert!(origin.abs_diff_eq(centre, 1e-7), "{origin}");
+    assert!(left.x < 0.0 && left.y < 0.0 && left.z > 0.0);
     for (i, s) in samples.iter().enumerate() {
         let t_s = i as f64 * 0.005;
         let blink = (0.3..=0.4).contains(&t_s);
@@ -176,12 +183,14 @@ fn committed_fixture_gives_the_geometry_it_was_made_from() {
         let expected = openxr(target(t_s).normalize());
         let combined = s.gaze.combined.unwrap();
         assert!(combined.direction.angle_between(expected) < 2e-4, "{i}");
-        assert_eq!(combined.origin, Vec3::ZERO);
-        // Eye rays from the eyeball centres (left at -x, below and behind the camera),
-        // parallel to the visual gaze: depth is not measured.
-        let left = openxr(DVec3::from_array(LEFT_EYE.map(f64::from))) / 1000.0;
-        assert!(s.gaze.left.origin.abs_diff_eq(left, 1e-7));
-        assert!(left.x < 0.0 && left.y < 0.0 && left.z > 0.0);
+        assert!(
+            combined.origin.abs_diff_eq(-centre, 1e-7),
+            "from the scene camera"
+        );
+        // Eye rays from the eyeball centres, parallel to the visual gaze: depth is not
+        // measured.
+        assert!(s.gaze.left.origin.abs_diff_eq(left - centre, 1e-7));
+        assert!(s.gaze.right.origin.abs_diff_eq(right - centre, 1e-7));
         assert_eq!(s.gaze.left.direction, combined.direction);
         assert_eq!(s.gaze.right.direction, combined.direction);
         let [l, r] = s.gaze.pupil_diameter_m.map(Option::unwrap);

@@ -13,8 +13,8 @@
 //! - **Frames**: Tobii's 3D data are in the scene camera's frame, origin at the camera,
 //!   right-handed, **+x to the wearer's left, +y up, +z forward**, millimetres. The trace's
 //!   head frame is this frame turned half a turn about y: `(x, y, z) -> (-x, y, -z)`,
-//!   millimetres to metres. The head frame's origin is therefore the scene camera (about 1 cm
-//!   above and 3 cm in front of the eyes), not the point between the eyes.
+//!   millimetres to metres, with its origin then moved from the scene camera to the middle of
+//!   the eyes (the median midpoint of the two `gazeorigin`s over the recording).
 //! - **Eyes**: an eye is valid when its `gazeorigin` and `gazedirection` are both present
 //!   and make a finite ray with a non-zero direction. `gaze3d` becomes the trace's fixation
 //!   point. Pupil diameters outside 1-10 mm are left out and counted.
@@ -38,6 +38,7 @@ use glam::{DVec3, Quat, Vec3};
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
 
+use super::eye_centre::centre_on_eyes;
 use super::orientation::{OrientationTrack, level_from_gravity, unyaw};
 use super::{HeadSource, RecordingError, RecordingReport};
 use crate::frame::{GazeRay, GazeSample, Pose};
@@ -158,7 +159,15 @@ pub fn parse_tobii_g3(
             "{gaze_name}: {dropped} gaze lines whose time is not after the previous one dropped"
         );
     }
+    let head_origin = centre_on_eyes(&mut samples);
+    if head_origin.is_none() {
+        approximations.push(
+            "no sample has both eyes valid: the head frame's origin stays at the scene camera"
+                .to_owned(),
+        );
+    }
     let mut report = RecordingReport::from_samples(FORMAT, gaze_name.to_owned(), &samples);
+    report.head_origin_m = head_origin;
     report.records = gaze.records.len();
     report.dropped_records = dropped;
     report.skipped_lines = gaze.skipped;

@@ -120,10 +120,10 @@ fn write_tobii_fixture() {
     std::fs::write(data_dir().join("imudata.gz"), gzip(&imu)).unwrap();
 }
 
-/// The depth of a sample's two rays, metres.
-fn depth(s: &TraceSample) -> f32 {
+/// Where a sample's two rays cross, head frame, metres.
+fn crossing(s: &TraceSample) -> Vec3 {
     match closest_approach(&s.gaze.left, &s.gaze.right) {
-        RayCrossing::Converge { point_m, .. } => point_m.length(),
+        RayCrossing::Converge { point_m, .. } => point_m,
         other => panic!("rays do not cross: {other:?}"),
     }
 }
@@ -140,17 +140,23 @@ fn committed_fixture_gives_the_geometry_it_was_made_from() {
     // Times start at 0 and step 20 ms.
     assert_eq!(samples[0].time_ns, 0);
     assert_eq!(samples[199].time_ns, 3_980_000_000);
-    // Fixation depths follow the targets; the trace's fixation point is gaze3d.
-    let near = tobii_to_openxr(DVec3::from_array(NEAR).as_vec3()) / 1000.0;
-    let far = tobii_to_openxr(DVec3::from_array(FAR).as_vec3()) / 1000.0;
+    // The head frame's origin is the middle of the eyes, given from the scene camera.
+    let to_openxr = |v: [f64; 3]| tobii_to_openxr(DVec3::from_array(v).as_vec3()) / 1000.0;
+    let centre = (to_openxr(LEFT_EYE) + to_openxr(RIGHT_EYE)) / 2.0;
+    let origin = report.head_origin_m.unwrap();
+    assert!(origin.abs_diff_eq(centre, 1e-7), "{origin}");
+    assert!(
+        origin.y < 0.0 && origin.z > 0.0,
+        "eyes below and behind the camera"
+    );
+    // The rays cross at the targets; the trace's fixation point is gaze3d.
+    let near = to_openxr(NEAR) - centre;
+    let far = to_openxr(FAR) - centre;
     for (i, s) in samples.iter().enumerate() {
         let target = if (i / 25) % 2 == 0 { near } else { far };
         if s.gaze.left.valid && s.gaze.right.valid {
-            let d = depth(s);
-            assert!(
-                (d - target.length()).abs() < 1e-3 * target.length(),
-                "{i}: {d}"
-            );
+            let p = crossing(s);
+            assert!(p.distance(target) < 1e-3 * target.length(), "{i}: {p}");
             assert!(s.gaze.fixation.unwrap().abs_diff_eq(target, 1e-6));
             assert_eq!(s.gaze.pupil_diameter_m, [Some(0.0039), Some(0.0041)]);
         }

@@ -1,6 +1,6 @@
 //! Import of Pupil Labs Neon native recordings (the folder the Companion app writes).
 //!
-//! Streams read (see [`raw`] for the file pairs and `.dtype` layouts):
+//! Streams read (`NAME psN.raw` with `NAME psN.time`, layouts in `NAME.dtype`; see `raw.rs`):
 //!
 //! | stream | fields read | use |
 //! |---|---|---|

@@ -262,10 +262,12 @@ enum TraceCommand {
     },
     /// Import a recording from another tool into the vitreous trace format.
     Import {
-        /// Recording format: sranipal (HTC Vive Pro Eye SRanipal CSV export).
+        /// Recording format: sranipal (HTC Vive Pro Eye SRanipal CSV export), tobii-g3
+        /// (Tobii Pro Glasses 3 recording folder or its gazedata.gz), neon (Pupil Labs Neon
+        /// native recording folder). See docs/trace-import.md.
         #[arg(long)]
         from: String,
-        /// The recording.
+        /// The recording (file or folder, by format).
         file: PathBuf,
         /// Output trace file.
         #[arg(short, long)]

@@ -2,13 +2,13 @@
 //! for a scene.
 
 use std::io::Cursor;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use vitreous_xr::synth::{SynthParams, synthesize_with_truth};
 use vitreous_xr::trace::{TraceSample, TraceWriter};
 
-use crate::output::write_atomic;
+use crate::output::{ensure_not_input, write_atomic};
 use crate::scene::{REFRACTED_TARGET, SURFACE_TARGET, load_scene};
 
 pub use crate::scene::synth_params_for;
@@ -23,19 +23,40 @@ pub fn write_trace_file(samples: &[TraceSample], out: &Path) -> Result<()> {
     write_atomic(out, &bytes)
 }
 
-/// `vitreous trace import --from sranipal FILE -o OUT`.
+/// The recording formats `vitreous trace import --from` takes.
+pub const IMPORT_FORMATS: &str = "sranipal, tobii-g3, neon";
+
+/// `vitreous trace import --from FORMAT FILE -o OUT`: `sranipal` (a CSV), `tobii-g3` (a
+/// recording folder or its gazedata.gz) or `neon` (a native recording folder).
 pub fn import(from: &str, file: &Path, out: &Path) -> Result<String> {
-    match from {
-        "sranipal" => {}
-        other => bail!("unknown recording format '{other}'; supported: sranipal"),
-    }
-    let (samples, report) = vitreous_xr::sranipal::import_sranipal_with_report(file)
-        .context("importing the recording")?;
+    let inputs = recording_files(from, file);
+    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    ensure_not_input(out, "-o", &inputs)?;
+    let (samples, report, rows) = match from {
+        "sranipal" => {
+            let (samples, report) = vitreous_xr::sranipal::import_sranipal_with_report(file)
+                .context("importing the recording")?;
+            let rows = report.rows;
+            (samples, report.to_string(), rows)
+        }
+        "tobii-g3" => {
+            let (samples, report) = vitreous_xr::import::tobii_g3::import_tobii_g3(file)
+                .context("importing the Tobii Pro Glasses 3 recording")?;
+            let rows = report.records;
+            (samples, report.to_string(), rows)
+        }
+        "neon" => {
+            let (samples, report) = vitreous_xr::import::neon::import_neon(file)
+                .context("importing the Neon recording")?;
+            let rows = report.records;
+            (samples, report.to_string(), rows)
+        }
+        other => bail!("unknown recording format '{other}'; supported: {IMPORT_FORMATS}"),
+    };
     if samples.is_empty() {
         bail!(
-            "{} holds no usable samples (rows read: {}); nothing written",
-            file.display(),
-            report.rows
+            "{} holds no usable samples (rows read: {rows}); nothing written",
+            file.display()
         );
     }
     write_trace_file(&samples, out)?;
@@ -44,6 +65,22 @@ pub fn import(from: &str, file: &Path, out: &Path) -> Result<String> {
         out.display(),
         samples.len()
     ))
+}
+
+/// The files an import may read: every file of a recording folder, or the named file and, for
+/// Tobii, the IMU file beside it. The output must not replace any of them.
+fn recording_files(from: &str, file: &Path) -> Vec<PathBuf> {
+    if file.is_dir() {
+        return std::fs::read_dir(file)
+            .map(|entries| entries.filter_map(|e| e.ok().map(|e| e.path())).collect())
+            .unwrap_or_default();
+    }
+    let mut files = vec![file.to_path_buf()];
+    if from == "tobii-g3" {
+        let folder = file.parent().unwrap_or(Path::new(""));
+        files.extend(["imudata.gz", "imudata"].map(|n| folder.join(n)));
+    }
+    files
 }
 
 /// Options of `vitreous trace synth`.

@@ -11,3 +11,4 @@ mod scene_errors;
 mod scene_load;
 mod scene_shipped;
 mod trace_analyze;
+mod trace_import;

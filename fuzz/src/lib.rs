@@ -1,5 +1,5 @@
 //! Fuzz targets for the readers that take files from users: the trace v1 reader, the
-//! SRanipal importer, the scene loader and the glTF model path.
+//! SRanipal and Tobii Pro Glasses 3 importers, the scene loader and the glTF model path.
 //!
 //! Each target is a plain function from bytes to nothing that must not panic on any input.
 //! `fuzz_targets/*.rs` hand them to libFuzzer (`tools/fuzz`, `cargo fuzz`); the corpus test
@@ -18,13 +18,14 @@ use vitreous::scene::{Scene, SceneError, SceneFiles};
 use vitreous_xr::trace::{TraceReader, TraceSample, TraceWriter};
 
 /// Names of the targets, as in `fuzz_targets/` and `corpus/`.
-pub const TARGETS: [&str; 4] = ["trace_v1", "sranipal", "scene", "gltf"];
+pub const TARGETS: [&str; 5] = ["trace_v1", "sranipal", "tobii_g3", "scene", "gltf"];
 
 /// Runs the target called `name` (one of [`TARGETS`]) on `data`; `false` for an unknown name.
 pub fn run(name: &str, data: &[u8]) -> bool {
     match name {
         "trace_v1" => trace_v1(data),
         "sranipal" => sranipal(data),
+        "tobii_g3" => tobii_g3(data),
         "scene" => scene(data),
         "gltf" => gltf(data),
         _ => return false,
@@ -52,6 +53,24 @@ pub fn trace_v1(data: &[u8]) {
 /// that reads back unchanged, and the report must format.
 pub fn sranipal(data: &[u8]) {
     match vitreous_xr::sranipal::parse_sranipal(data, "fuzz.csv") {
+        Ok((samples, report)) => {
+            assert!(!report.to_string().is_empty());
+            let written = write_all(&samples);
+            let again = read_all(&written)
+                .unwrap_or_else(|e| panic!("an imported trace does not read back: {e}"));
+            assert_eq!(
+                samples, again,
+                "the imported trace changed when written and read"
+            );
+        }
+        Err(e) => assert!(!e.to_string().is_empty()),
+    }
+}
+
+/// Tobii Pro Glasses 3 gaze data (gzip-compressed or plain JSON lines): import it; like
+/// [`sranipal`], a successful import must make a valid trace that reads back unchanged.
+pub fn tobii_g3(data: &[u8]) {
+    match vitreous_xr::import::tobii_g3::parse_tobii_g3(data, "fuzz.gz", None) {
         Ok((samples, report)) => {
             assert!(!report.to_string().is_empty());
             let written = write_all(&samples);

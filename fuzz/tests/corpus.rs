@@ -171,6 +171,11 @@ fn sranipal_survives_its_corpus() {
 }
 
 #[test]
+fn tobii_g3_survives_its_corpus() {
+    check("tobii_g3");
+}
+
+#[test]
 fn scene_survives_its_corpus() {
     check("scene");
 }
@@ -196,7 +201,7 @@ fn gltf_survives_its_corpus() {
 fn every_target_has_a_test_and_a_corpus() {
     assert_eq!(
         vitreous_fuzz::TARGETS,
-        ["trace_v1", "sranipal", "scene", "gltf"]
+        ["trace_v1", "sranipal", "tobii_g3", "scene", "gltf"]
     );
     for target in vitreous_fuzz::TARGETS {
         assert!(!corpus(target).is_empty(), "corpus/{target} is empty");

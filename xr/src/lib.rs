@@ -9,6 +9,7 @@
 pub mod atomic_file;
 pub mod crossing;
 pub mod frame;
+pub mod import;
 pub mod null;
 pub mod openxr;
 pub mod records;

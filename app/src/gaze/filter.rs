@@ -18,7 +18,7 @@
 //!   One-Euro filter, an exponential smoother whose cut-off rises with the signal's speed,
 //!   after a 3-sample median that removes lone spikes. It runs on vergence in dioptres
 //!   (1 / depth), where the tracker's angular noise is about uniform, and returns a depth.
-//! - `fixation` (`fixation:velocity=DEG_S,min_fixation=MS,window=MS,settle=MS`): not a depth
+//! - `fixation` (`fixation:velocity=DEG_S,min_fixation=MS,window=MS,max_window=MS,settle=MS`): not a depth
 //!   filter but a decision per fixation (I-VT classification of the samples, a decision only
 //!   from a fixation that has lasted 60 ms, held through saccades and blinks, and none within
 //!   150 ms after a blink or a switch); see [`super::fixation`]. As a [`SampleFilter`] it
@@ -160,8 +160,8 @@ impl fmt::Display for FilterKind {
             FilterKind::Fixation(p) if *p == FixationParams::default() => write!(f, "fixation"),
             FilterKind::Fixation(p) => write!(
                 f,
-                "fixation:velocity={},min_fixation={},window={},settle={}",
-                p.velocity_deg_s, p.min_fixation_ms, p.window_ms, p.settle_ms
+                "fixation:velocity={},min_fixation={},window={},max_window={},settle={}",
+                p.velocity_deg_s, p.min_fixation_ms, p.window_ms, p.max_window_ms, p.settle_ms
             ),
         }
     }
@@ -172,7 +172,7 @@ impl fmt::Display for FilterKind {
 #[error(
     "depth filter `{text}`: {reason}; expected `mean20` (eq. 15), `mean:N`, `median`, \
      `median:N`, `one-euro[:min_cutoff=HZ,beta=M,d_cutoff=HZ,pre_median=N]` or \
-     `fixation[:velocity=DEG_S,min_fixation=MS,window=MS,settle=MS]`"
+     `fixation[:velocity=DEG_S,min_fixation=MS,window=MS,max_window=MS,settle=MS]`"
 )]
 pub struct FilterParseError {
     /// The text given.
@@ -244,13 +244,15 @@ impl FromStr for FilterKind {
                     "velocity" | "velocity_deg_s" if value > 0.0 => p.velocity_deg_s = value,
                     "min_fixation" | "min_fixation_ms" => p.min_fixation_ms = value,
                     "window" | "window_ms" if value > 0.0 => p.window_ms = value,
+                    "max_window" | "max_window_ms" => p.max_window_ms = value,
                     "settle" | "settle_ms" => p.settle_ms = value,
                     "velocity" | "velocity_deg_s" | "window" | "window_ms" => {
                         return Err(err(format!("{key} must be > 0")));
                     }
                     other => {
                         return Err(err(format!(
-                            "unknown parameter `{other}` (velocity, min_fixation, window, settle)"
+                            "unknown parameter `{other}` (velocity, min_fixation, window, \
+                             max_window, settle)"
                         )));
                     }
                 }
@@ -557,7 +559,7 @@ mod tests {
             "one-euro",
             "one-euro:min_cutoff=2,beta=0.1,d_cutoff=1,pre_median=1",
             "fixation",
-            "fixation:velocity=40,min_fixation=80,window=120,settle=200",
+            "fixation:velocity=40,min_fixation=80,window=120,max_window=160,settle=200",
         ] {
             let kind: FilterKind = text.parse().unwrap();
             assert_eq!(kind.to_string(), text);

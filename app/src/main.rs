@@ -138,7 +138,8 @@ enum Command {
         #[arg(long, value_name = "IMAGE")]
         gaze_image: Option<GazeOverride>,
         /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, fixation (the gaze image
-        /// decided per fixation), ...; default: the scene's `[gaze] filter`.
+        /// decided per fixation), ...; default: the scene's `[gaze] filter` (fixation if it
+        /// names none).
         #[arg(long, value_name = "FILTER")]
         filter: Option<FilterKind>,
         /// Pupil diameter A_p overriding the scene's, millimetres (1-9).

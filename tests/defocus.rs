@@ -241,7 +241,11 @@ fn sharpness_by_gaze(scene: &Scene) -> Vec<(GazeImage, f64)> {
     let effects = vitreous::effects::EffectSet::parse("O5").unwrap();
     let mut look = views::look(&effects, Reflection::EnvironmentFresnel);
     look.reflection = Reflection::EnvironmentFresnel;
-    let config = GazeConfig::new(setup.model.distances);
+    // The scene's filter (eq. 15, whose 20-sample mean the frames above wait for).
+    let config = GazeConfig {
+        filter: scene.gaze.filter,
+        ..GazeConfig::new(setup.model.distances)
+    };
     let mut sink = Keep {
         planner: LookPlanner::new(look, Some((config, setup.model))),
         frames: frames.clone(),

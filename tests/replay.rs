@@ -189,12 +189,11 @@ fn frames_csv_follows_the_synthetic_traces_alternating_fixation() {
     let text = std::fs::read_to_string(config.join("scenes/visual-effects.toml"))
         .unwrap()
         .replace("\"../", &format!("\"{}/", config.display()));
+    // The scene has a `[gaze]` table already (its filter): the pupil goes into it.
+    assert_eq!(text.matches("\n[gaze]\n").count(), 1);
+    let text = text.replace("\n[gaze]\n", "\n[gaze]\npupil = \"measured\"\n");
     let scene_path = dir.path().join("measured-pupil.toml");
-    std::fs::write(
-        &scene_path,
-        format!("{text}\n[gaze]\npupil = \"measured\"\n"),
-    )
-    .unwrap();
+    std::fs::write(&scene_path, text).unwrap();
     let out = dir.path().join("out");
     let mut opts = options(
         "visual-effects.toml",

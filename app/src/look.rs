@@ -337,6 +337,8 @@ mod tests {
         let effects = EffectSet::parse("defocus").unwrap();
         let model = DefocusModel::new(scene, 0.006);
         let mut config = GazeConfig::new(model.distances);
+        // The scene's filter (eq. 15), as `run` and `replay` take it.
+        config.filter = scene.gaze.filter;
         config.override_image = image;
         LookPlanner::new(
             views::look(&effects, Reflection::default()),

@@ -138,7 +138,8 @@ enum Command {
         #[arg(long, value_name = "IMAGE")]
         gaze_image: Option<GazeOverride>,
         /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, fixation (the gaze image
-        /// decided per fixation), ...; default: the scene's `[gaze] filter`.
+        /// decided per fixation), ...; default: the scene's `[gaze] filter` (fixation if it
+        /// names none).
         #[arg(long, value_name = "FILTER")]
         filter: Option<FilterKind>,
         /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
@@ -238,7 +239,7 @@ enum TraceCommand {
         scene: PathBuf,
         /// Filters to compare (repeatable): mean20, mean:N, median5, median:N,
         /// one-euro[:min_cutoff=..,beta=..,d_cutoff=..,pre_median=..],
-        /// fixation[:velocity=..,min_fixation=..,window=..,settle=..]; default all.
+        /// fixation[:velocity=..,min_fixation=..,window=..,max_window=..,settle=..]; default all.
         #[arg(long = "filter", value_name = "FILTER")]
         filters: Vec<FilterKind>,
         /// Write the figures as JSON on stdout instead of the tables.

@@ -32,7 +32,7 @@ fn looking_at(time_ns: i64, depth_m: f32) -> GazeSample {
 proptest! {
     #[test]
     fn sample_filter_output_is_eq15(depths in proptest::collection::vec(0.05f32..10.0, 20..200)) {
-        let mut f = SampleFilter::new(FilterKind::default());
+        let mut f = SampleFilter::new(FilterKind::PAPER);
         let exact: Vec<f64> = depths.iter().map(|&d| f64::from(d)).collect();
         for (n, &d) in depths.iter().enumerate() {
             let out = f.feed(&FixationDepth::Known { depth_m: d, sample_time_ns: n as i64 });
@@ -53,8 +53,12 @@ proptest! {
         frames_per_sample in proptest::collection::vec(1usize..6, 80),
     ) {
         let distances = ImageDistances { surface_m: 0.6, refracted_m: 1.5 };
-        let mut once = GazePipeline::new(GazeConfig::new(distances));
-        let mut per_frame = GazePipeline::new(GazeConfig::new(distances));
+        let config = GazeConfig {
+            filter: FilterKind::PAPER,
+            ..GazeConfig::new(distances)
+        };
+        let mut once = GazePipeline::new(config);
+        let mut per_frame = GazePipeline::new(config);
         let mut raw = Vec::new();
         let sample_ns = 33_333_333i64;
         for (n, &d) in depths.iter().enumerate() {
@@ -110,8 +114,9 @@ proptest! {
 
 #[test]
 fn filters_parse_from_scene_style_names() {
+    assert_eq!("mean20".parse::<FilterKind>().unwrap(), FilterKind::PAPER);
     assert_eq!(
-        "mean20".parse::<FilterKind>().unwrap(),
+        "fixation".parse::<FilterKind>().unwrap(),
         FilterKind::default()
     );
     for name in [

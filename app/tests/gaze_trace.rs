@@ -35,7 +35,7 @@ fn default_and_alternatives_follow_the_synthetic_truth() {
         );
         assert_eq!(report.truth.changes.len(), 20);
         let mean20 = &report.filters[0];
-        assert_eq!(mean20.filter, FilterKind::default());
+        assert_eq!(mean20.filter, FilterKind::PAPER);
         for r in &report.filters {
             assert_eq!(r.missed, 0, "seed {seed}:\n{report}");
             assert!(r.agreement.unwrap() > 0.8, "seed {seed}:\n{report}");
@@ -56,7 +56,7 @@ fn one_euro_meets_the_latency_target_at_30_hz() {
     for seed in 1..=5 {
         let (trace, d) = alternating(seed);
         let mut config = AnalyzeConfig::new(d);
-        config.filters = vec![FilterKind::default(), "one-euro".parse().unwrap()];
+        config.filters = vec![FilterKind::PAPER, "one-euro".parse().unwrap()];
         let report = analyze(&trace.samples, Truth::Phases(&trace.phases), &config);
         let (mean20, alt) = (&report.filters[0], &report.filters[1]);
         assert!(
@@ -90,13 +90,31 @@ fn blinks_produce_no_spurious_switch() {
         for r in &report.filters {
             assert_eq!(r.switches, 0, "{report}");
         }
-        // During each blink the image stays what it was: never unknown (250 ms < 300 ms hold).
-        let frames = replay(&trace.samples, GazeConfig::new(d));
-        assert!(
-            frames[1..]
+        // During each blink the image stays what it was: never unknown once decided (250 ms <
+        // 300 ms hold), with the default filter and with eq. 15.
+        for filter in [FilterKind::default(), FilterKind::PAPER] {
+            let frames = replay(
+                &trace.samples,
+                GazeConfig {
+                    filter,
+                    ..GazeConfig::new(d)
+                },
+            );
+            let first = frames
                 .iter()
-                .all(|(_, s)| s.image != GazeImage::Unknown)
-        );
+                .position(|(_, s)| s.image != GazeImage::Unknown)
+                .unwrap();
+            assert!(
+                first * 33 <= 200,
+                "{filter}: first decision at frame {first}"
+            );
+            assert!(
+                frames[first..]
+                    .iter()
+                    .all(|(_, s)| s.image != GazeImage::Unknown),
+                "{filter}"
+            );
+        }
     }
 }
 

@@ -133,6 +133,8 @@ fn visual_effects_keeps_the_papers_distances() {
     // Unity (1, 1, -1) relative to the observer.
     assert_eq!(scene.light.position_m, Vec3::new(1.0, 1.0, 1.0));
     assert_eq!(scene.viewer.pupil_diameter_m, 0.006);
+    // The study's gaze image followed eq. 15, not the default filter.
+    assert_eq!(scene.gaze.filter, vitreous::gaze::FilterKind::PAPER);
     // Documented: at 0.2 m the 150 mm sphere overfills the 40 x 30 degree view.
     assert!(!sphere_in_view(&scene, object.center_m, object.radius_m));
     assert!(sphere_in_view(&scene, object.center_m, 0.01));

@@ -4,13 +4,14 @@
 //! Per frame, [`GazePipeline::update`] runs:
 //! 1. [`vergence`]: the fixation depth of the newest tracker sample (closest approach of the
 //!    two gaze rays), held through blinks for a bounded time;
-//! 2. [`filter`]: eq. 15's 20-sample moving average (or a lower-latency alternative) over
-//!    tracker samples, each ingested once however many frames see it;
+//! 2. [`filter`]: eq. 15's 20-sample moving average (or another depth filter) over tracker
+//!    samples, each ingested once however many frames see it;
 //! 3. [`image`]: the gaze image (surface or refracted) with hysteresis, or the experimenter's
 //!    override; the focus distance d_f is that image's distance.
 //!
-//! With the `fixation` filter, stages 2 and 3 are [`fixation`] instead: the samples are
-//! classified into fixations, saccades and gaps, and the image is decided per fixation.
+//! With the `fixation` filter (the default), stages 2 and 3 are [`fixation`] instead: the
+//! samples are classified into fixations, saccades and gaps, and the image is decided per
+//! fixation.
 //!
 //! [`blur`] then turns d_f into the blur of the image not looked at (eq. 10-14).
 //! `docs/gaze.md` maps each equation to its function.
@@ -47,7 +48,8 @@ pub struct GazeConfig {
 }
 
 impl GazeConfig {
-    /// Defaults (eq. 15 filter, 10 m cap, 300 ms hold, band 0.2, auto) for given distances.
+    /// Defaults (`fixation` filter, 10 m cap, 300 ms hold, band 0.2, auto) for given
+    /// distances.
     pub fn new(distances: ImageDistances) -> Self {
         GazeConfig {
             vergence: VergenceConfig::default(),

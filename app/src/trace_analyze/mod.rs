@@ -71,7 +71,7 @@ pub struct AnalyzeConfig {
     pub vergence: VergenceConfig,
     /// Hysteresis band of the gaze-image decision (see `gaze::image`).
     pub band: f32,
-    /// The filters compared, the default (eq. 15) first by convention.
+    /// The filters compared, eq. 15 (the paper's, the reference) first by convention.
     pub filters: Vec<FilterKind>,
     /// How long a raw-depth crossing must persist to count as a gaze change when there is
     /// no ground truth, nanoseconds.
@@ -713,7 +713,7 @@ impl fmt::Display for AnalyzeReport {
 /// `vitreous trace analyze TRACE --scene SCENE`: the image distances come from the scene
 /// ([`Scene::image_distances`](crate::scene::Scene::image_distances)); gaze changes are
 /// derived from the raw depth (a trace file carries no ground truth). `filters` empty means
-/// the default and every alternative.
+/// every offered filter ([`FilterKind::all_default`]).
 pub fn analyze_trace_file(
     trace: &Path,
     scene: &Path,
@@ -724,7 +724,7 @@ pub fn analyze_trace_file(
 }
 
 /// The trace's samples and the analysis settings for a scene (its image distances) and
-/// `filters` (empty: the default and every alternative).
+/// `filters` (empty: every offered filter).
 pub(super) fn load_inputs(
     trace: &Path,
     scene: &Path,

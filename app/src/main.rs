@@ -66,6 +66,9 @@ enum Command {
         /// Effects, overriding the scene's (as for replay).
         #[arg(long, value_name = "LIST", value_parser = parse_effects)]
         effects: Option<EffectSet>,
+        /// Fixation-depth filter overriding the scene's `[gaze] filter` (as for replay).
+        #[arg(long, value_name = "FILTER")]
+        filter: Option<FilterKind>,
         /// Where A_p (eq. 13) comes from, overriding the scene's `[gaze] pupil`: paper (the
         /// fixed diameter) or measured (the eye tracker's, smoothed).
         #[arg(long = "pupil", value_name = "SOURCE")]
@@ -330,6 +333,7 @@ fn run(cli: Cli) -> Result<()> {
             blend,
             size,
             effects,
+            filter,
             pupil_source,
             out,
         } => {
@@ -349,6 +353,7 @@ fn run(cli: Cli) -> Result<()> {
                 blend,
                 size,
                 effects,
+                filter,
                 pupil_source,
                 out,
                 ..Default::default()

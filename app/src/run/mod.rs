@@ -88,6 +88,8 @@ pub struct RunOptions {
     pub effects: Option<EffectSet>,
     /// How the reflected image is drawn.
     pub reflection: Reflection,
+    /// Fixation-depth filter overriding the scene's `[gaze] filter`.
+    pub filter: Option<crate::gaze::FilterKind>,
     /// Where A_p comes from, overriding the scene's `[gaze] pupil`.
     pub pupil_source: Option<crate::gaze::PupilSource>,
     /// Where summary.json goes (None: not written).
@@ -239,6 +241,7 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         &conditions,
         options.reflection,
         &GazeSettings {
+            filter: options.filter,
             pupil_source: options.pupil_source,
             ..GazeSettings::default()
         },

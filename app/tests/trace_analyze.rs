@@ -282,6 +282,32 @@ fn default_filter_meets_the_real_recording_bar_on_sranipal() {
     assert!(mean20_failures > 0);
 }
 
+/// The same bar on the imported Tobii Pro Glasses 3 fixture (fixations alternating either side of
+/// the visual-effects threshold, a dropout, one eye lost): the default filter follows every change
+/// without a short episode or a switch right after the dropout. The Neon fixture carries no
+/// fixation depth (one gaze point: the eye rays are parallel), so it never switches.
+#[test]
+fn default_filter_meets_the_real_recording_bar_on_the_import_fixtures() {
+    let data = workspace().join("xr/tests/data");
+    let (tobii, _) = vitreous_xr::import::tobii_g3::import_tobii_g3(data.join("tobii_g3")).unwrap();
+    // The images of config/scenes/visual-effects.toml, which the fixture's depths straddle.
+    let mut config = AnalyzeConfig::new(ImageDistances {
+        surface_m: 0.125,
+        refracted_m: 0.4,
+    });
+    config.filters = vec![FilterKind::default()];
+    let report = analyze(&tobii, Truth::FromRawDepth, &config);
+    let default = &report.filters[0];
+    assert!(default.switches >= 6, "{report}");
+    assert_eq!((default.false_switches, default.missed), (0, 0), "{report}");
+    assert_eq!(default.episodes_under_settle(), 0, "{report}");
+    assert_eq!(default.switches_after_gap, 0, "{report}");
+
+    let (neon, _) = vitreous_xr::import::neon::import_neon(data.join("neon")).unwrap();
+    let report = analyze(&neon, Truth::FromRawDepth, &config);
+    assert_eq!(report.filters[0].switches, 0, "{report}");
+}
+
 /// A fallback note (here: samples with no valid eye ray but a fixation point) is printed once
 /// per run, not once per vergence estimator (`trace analyze` builds one for the raw depths and
 /// one per filter).

@@ -52,25 +52,23 @@ pub fn trace_v1(data: &[u8]) {
 /// SRanipal CSV text: import it; the samples of a successful import must make a valid trace
 /// that reads back unchanged, and the report must format.
 pub fn sranipal(data: &[u8]) {
-    match vitreous_xr::sranipal::parse_sranipal(data, "fuzz.csv") {
-        Ok((samples, report)) => {
-            assert!(!report.to_string().is_empty());
-            let written = write_all(&samples);
-            let again = read_all(&written)
-                .unwrap_or_else(|e| panic!("an imported trace does not read back: {e}"));
-            assert_eq!(
-                samples, again,
-                "the imported trace changed when written and read"
-            );
-        }
-        Err(e) => assert!(!e.to_string().is_empty()),
-    }
+    check_import(vitreous_xr::sranipal::parse_sranipal(data, "fuzz.csv"));
 }
 
 /// Tobii Pro Glasses 3 gaze data (gzip-compressed or plain JSON lines): import it; like
 /// [`sranipal`], a successful import must make a valid trace that reads back unchanged.
 pub fn tobii_g3(data: &[u8]) {
-    match vitreous_xr::import::tobii_g3::parse_tobii_g3(data, "fuzz.gz", None) {
+    check_import(vitreous_xr::import::tobii_g3::parse_tobii_g3(
+        data, "fuzz.gz", None,
+    ));
+}
+
+/// An importer's result: the samples of a success must make a valid trace that reads back
+/// unchanged, and the report (or the error) must format.
+fn check_import(
+    result: Result<(Vec<TraceSample>, impl std::fmt::Display), impl std::fmt::Display>,
+) {
+    match result {
         Ok((samples, report)) => {
             assert!(!report.to_string().is_empty());
             let written = write_all(&samples);

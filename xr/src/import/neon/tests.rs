@@ -7,7 +7,6 @@ use glam::{DVec3, Quat, Vec3};
 use proptest::prelude::*;
 
 use super::*;
-use crate::trace::{TraceReader, TraceWriter};
 
 /// A wide-angle scene camera of the kind Neon has.
 const CAMERA: SceneCamera = SceneCamera {
@@ -342,15 +341,6 @@ proptest! {
         let (samples, report) = import_neon(dir.path()).unwrap();
         prop_assert_eq!(samples.len(), raw.len());
         prop_assert_eq!(report.records, raw.len());
-        let mut writer = TraceWriter::new(Vec::new()).unwrap();
-        for s in &samples {
-            writer.write(s).unwrap();
-        }
-        let bytes = writer.finish().unwrap();
-        let read: Vec<TraceSample> = TraceReader::new(&bytes[..], "t.trace")
-            .unwrap()
-            .collect::<Result<_, _>>()
-            .unwrap();
-        prop_assert_eq!(read, samples);
+        prop_assert_eq!(crate::import::written_and_read(&samples), samples);
     }
 }

@@ -12,7 +12,6 @@ use serde_json::{Value, json};
 
 use super::*;
 use crate::crossing::{RayCrossing, closest_approach};
-use crate::trace::{TraceReader, TraceWriter};
 
 /// Eye centres in Tobii's frame (mm): the left eye is at +x.
 const LEFT_EYE: [f64; 3] = [31.0, -9.0, -28.0];
@@ -372,15 +371,6 @@ proptest! {
         let (samples, report) = parse(&gzip(&text), with_imu.then_some(imu.as_bytes())).unwrap();
         prop_assert_eq!(samples.len(), lines.len());
         prop_assert_eq!(report.samples, lines.len());
-        let mut writer = TraceWriter::new(Vec::new()).unwrap();
-        for s in &samples {
-            writer.write(s).unwrap();
-        }
-        let bytes = writer.finish().unwrap();
-        let read: Vec<TraceSample> = TraceReader::new(&bytes[..], "t.trace")
-            .unwrap()
-            .collect::<Result<_, _>>()
-            .unwrap();
-        prop_assert_eq!(read, samples);
+        prop_assert_eq!(crate::import::written_and_read(&samples), samples);
     }
 }

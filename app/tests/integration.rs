@@ -10,4 +10,5 @@ mod interrupted;
 mod scene_errors;
 mod scene_load;
 mod scene_shipped;
+mod study_analyze;
 mod trace_analyze;

@@ -7,7 +7,7 @@ use std::path::Path;
 use serde_json::{Map, Value, json};
 
 use super::responses::{ResponseKind, Responses, ResponsesError};
-use super::scheffe::{self, LEVELS, Scheffe};
+use super::scheffe::{self, Scheffe};
 use super::thurstone::{self, CaseV, PROPORTION_CLIP};
 
 /// The analysis of one responses file.
@@ -201,11 +201,11 @@ impl fmt::Display for Analysis {
                                 [true, false] => "*",
                                 _ => "",
                             };
-                            writeln!(
-                                f,
+                            let line = format!(
                                 "  {:<16} - {:<16} {:>8.4} {}",
                                 r.conditions[pair.a], r.conditions[pair.b], pair.difference, mark
-                            )?;
+                            );
+                            writeln!(f, "{}", line.trim_end())?;
                         }
                         Ok(())
                     }
@@ -219,12 +219,13 @@ impl fmt::Display for Analysis {
     }
 }
 
-/// The levels of [`LEVELS`] as JSON keys, for readers of the report.
+/// The levels of [`scheffe::LEVELS`] as JSON keys, for readers of the report.
 pub const LEVEL_KEYS: [&str; 2] = ["0.05", "0.01"];
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::study::scheffe::LEVELS;
 
     #[test]
     fn level_keys_match_the_levels() {

@@ -118,10 +118,10 @@ pub fn nakaya(conditions: Vec<String>, ratings: &[Vec<Vec<f64>>]) -> Scheffe {
     let main = differences.iter().map(|d| d * d).sum::<f64>() / (2.0 * tf * nf);
     let mut antisymmetric = 0.0;
     let mut order = 0.0;
-    for i in 0..t {
-        for j in i + 1..t {
-            antisymmetric += (pair_sum[i][j] - pair_sum[j][i]).powi(2);
-            order += (pair_sum[i][j] + pair_sum[j][i]).powi(2);
+    for (i, row) in pair_sum.iter().enumerate() {
+        for (j, &forward) in row.iter().enumerate().skip(i + 1) {
+            antisymmetric += (forward - pair_sum[j][i]).powi(2);
+            order += (forward + pair_sum[j][i]).powi(2);
         }
     }
     let combination = antisymmetric / (2.0 * nf) - main;

@@ -3,6 +3,7 @@
 
 pub mod distributions;
 pub mod report;
+pub mod response_error;
 pub mod responses;
 pub mod scheffe;
 pub mod studentized;

@@ -20,6 +20,7 @@ pub mod replay;
 pub mod run;
 pub mod scene;
 pub mod soak;
+pub mod study;
 pub mod trace_analyze;
 pub mod trace_cmd;
 pub mod views;

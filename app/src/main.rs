@@ -228,6 +228,25 @@ enum Command {
         #[command(subcommand)]
         command: TraceCommand,
     },
+    /// Paired-comparison studies.
+    Study {
+        #[command(subcommand)]
+        command: StudyCommand,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum StudyCommand {
+    /// Analyse a responses file (participant,trial,first,second,response): forced choices with
+    /// Thurstone's Case V and Mosteller's chi-square, -3..3 ratings with Nakaya's variant of
+    /// Scheffe's method (ANOVA, yardsticks from the studentized range).
+    Analyze {
+        /// The responses file (CSV).
+        responses: PathBuf,
+        /// Write the results as JSON on stdout instead of the tables.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[derive(Subcommand, Debug)]
@@ -535,6 +554,17 @@ fn run(cli: Cli) -> Result<()> {
                     seed,
                 };
                 println!("{}", trace_cmd::synth(&scene, &options, &out)?);
+                Ok(())
+            }
+        },
+        Command::Study { command } => match command {
+            StudyCommand::Analyze { responses, json } => {
+                let analysis = vitreous::study::report::analyze_file(&responses)?;
+                if json {
+                    println!("{}", serde_json::to_string_pretty(&analysis.to_json())?);
+                } else {
+                    print!("{analysis}");
+                }
                 Ok(())
             }
         },

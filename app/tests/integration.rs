@@ -10,5 +10,6 @@ mod interrupted;
 mod scene_errors;
 mod scene_load;
 mod scene_shipped;
+mod study_analyze;
 mod trace_analyze;
 mod trace_import;

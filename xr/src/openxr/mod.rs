@@ -433,6 +433,9 @@ pub struct SessionOptions {
     /// Submit depth with XR_KHR_composition_layer_depth in this format and range, when the
     /// runtime offers the extension and the format (None: no depth submission).
     pub depth: Option<DepthOptions>,
+    /// Set by the application when it is done (e.g. a study's last answer is in): the session
+    /// then ends the way it does at the frame limit, through STOPPING.
+    pub end: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// How depth is submitted (XR_KHR_composition_layer_depth).

@@ -83,6 +83,8 @@ pub enum EndReason {
     FrameLimit,
     /// Ctrl-C (SIGINT).
     Interrupted,
+    /// The application said it is done ([`crate::openxr::SessionOptions::end`]).
+    AppDone,
     /// The runtime asked the session to exit (EXITING after STOPPING), e.g. the user quit.
     RuntimeExit,
     /// The session is being lost (LOSS_PENDING).
@@ -96,6 +98,7 @@ impl fmt::Display for EndReason {
         f.write_str(match self {
             EndReason::FrameLimit => "frame limit reached",
             EndReason::Interrupted => "interrupted (Ctrl-C)",
+            EndReason::AppDone => "the application is done",
             EndReason::RuntimeExit => "the runtime ended the session",
             EndReason::SessionLost => "the session was lost (LOSS_PENDING)",
             EndReason::InstanceLost => "the OpenXR runtime is going away (instance loss pending)",

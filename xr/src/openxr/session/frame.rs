@@ -291,6 +291,14 @@ impl Backend for Session {
             {
                 self.stop(EndReason::FrameLimit)?;
             }
+            if self
+                .options
+                .end
+                .as_ref()
+                .is_some_and(|end| end.load(Ordering::SeqCst))
+            {
+                self.stop(EndReason::AppDone)?;
+            }
             self.poll_events()?;
             if self.quit {
                 tracing::info!(

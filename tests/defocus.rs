@@ -117,6 +117,7 @@ fn refracted_blur_matches_the_literal_convolution() {
             reflection: Reflection::EnvironmentFresnel,
             inducer: false,
             caustics: false,
+            blank: false,
         };
         let gpu = render(&scene, &setup, &input, look);
         let blurred = blur_reference(&grey, pw, ph, k_g);

@@ -246,6 +246,7 @@ const DISPARITY: Look = Look {
     reflection: Reflection::EnvironmentFresnel,
     inducer: false,
     caustics: false,
+    blank: false,
 };
 const BASELINE: Look = Look {
     disparity: false,
@@ -253,6 +254,7 @@ const BASELINE: Look = Look {
     reflection: Reflection::EnvironmentFresnel,
     inducer: false,
     caustics: false,
+    blank: false,
 };
 
 #[test]

@@ -59,6 +59,7 @@ pub fn look(effects: &EffectSet, reflection: Reflection) -> Look {
         },
         inducer: effects.inducer,
         caustics: effects.caustics,
+        blank: false,
     }
 }
 

@@ -111,6 +111,10 @@ pub struct Look {
     /// Add the corrected caustics G L_r (eq. 6) to the floor overlay; needs the scene's
     /// caustic gain map ([`crate::SceneDesc::caustics`]), draws nothing without one.
     pub caustics: bool,
+    /// Draw nothing of the method: the display adds no light (a study's blank between two
+    /// stimuli, or a condition where a real object is shown instead). The real-world photos
+    /// are still drawn behind where the composition needs them.
+    pub blank: bool,
 }
 
 /// Everything the renderer needs to draw one stereo frame.

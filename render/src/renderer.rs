@@ -439,7 +439,11 @@ impl Renderer {
         // framebuffers belong to the render pass they are begun with. The images copied are
         // in TRANSFER_SRC_OPTIMAL (the render pass's final layout, or the transition before).
         unsafe {
-            let (inducer, caustics) = (params.look.inducer, params.look.caustics);
+            let blank = params.look.blank;
+            let (inducer, caustics) = (
+                params.look.inducer && !blank,
+                params.look.caustics && !blank,
+            );
             if inducer || caustics {
                 // Once per scene (and per change of these switches), before the timed part.
                 prepared = self
@@ -464,18 +468,20 @@ impl Renderer {
                     // Added before the glass, which covers it where the object is.
                     self.inducer.record(&self.ctx, cmd, eye, inducer, caustics);
                 }
-                self.glass.record(
-                    &self.ctx,
-                    cmd,
-                    &self.scene,
-                    &EyePush::new(
-                        &params.eyes,
-                        index,
-                        &params.look,
-                        self.scene.stack_slices,
-                        self.scene.stack_steps,
-                    ),
-                );
+                if !blank {
+                    self.glass.record(
+                        &self.ctx,
+                        cmd,
+                        &self.scene,
+                        &EyePush::new(
+                            &params.eyes,
+                            index,
+                            &params.look,
+                            self.scene.stack_slices,
+                            self.scene.stack_steps,
+                        ),
+                    );
+                }
                 d.cmd_end_render_pass(cmd);
             }
             if let Some(pool) = slot.queries.as_ref().map(Owned::raw) {

@@ -233,21 +233,7 @@ enum Command {
     /// Paired-comparison studies.
     Study {
         #[command(subcommand)]
-        command: StudyCommand,
-    },
-}
-
-#[derive(Subcommand, Debug)]
-enum StudyCommand {
-    /// Analyse a responses file (participant,trial,first,second,response): forced choices with
-    /// Thurstone's Case V and Mosteller's chi-square, -3..3 ratings with Nakaya's variant of
-    /// Scheffe's method (ANOVA, yardsticks from the studentized range).
-    Analyze {
-        /// The responses file (CSV).
-        responses: PathBuf,
-        /// Write the results as JSON on stdout instead of the tables.
-        #[arg(long)]
-        json: bool,
+        command: vitreous::study::cli::StudyCommand,
     },
 }
 
@@ -559,17 +545,7 @@ fn run(cli: Cli) -> Result<()> {
                 Ok(())
             }
         },
-        Command::Study { command } => match command {
-            StudyCommand::Analyze { responses, json } => {
-                let analysis = vitreous::study::report::analyze_file(&responses)?;
-                if json {
-                    println!("{}", serde_json::to_string_pretty(&analysis.to_json())?);
-                } else {
-                    print!("{analysis}");
-                }
-                Ok(())
-            }
-        },
+        Command::Study { command } => vitreous::study::cli::run(command),
     }
 }
 

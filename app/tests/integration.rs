@@ -11,5 +11,6 @@ mod scene_errors;
 mod scene_load;
 mod scene_shipped;
 mod study_analyze;
+mod study_run;
 mod trace_analyze;
 mod trace_import;

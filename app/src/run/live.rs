@@ -76,7 +76,14 @@ impl LiveLooks {
         self.gaze
     }
 
-    fn set_gaze(&mut self, gaze: GazeOverride) {
+    /// Shows condition `index` (of those given to [`LiveLooks::new`]).
+    pub fn select(&mut self, index: usize) {
+        assert!(index < self.conditions.len(), "condition {index} exists");
+        self.current = index;
+    }
+
+    /// Forces the gaze image of every condition.
+    pub fn set_gaze(&mut self, gaze: GazeOverride) {
         self.gaze = gaze;
         for (_, planner) in &mut self.conditions {
             planner.set_gaze_override(gaze);

@@ -57,6 +57,7 @@ use crate::look::{GazeSettings, planners_for};
 use crate::output::write_atomic;
 use crate::replay::{Spread, ValidationSummary};
 use crate::scene::load_scene;
+use crate::study::run::StudyStage;
 use crate::views;
 use readback::check_readback;
 use recording::{replay_check, trace_sample};
@@ -118,6 +119,8 @@ struct RunSink {
     recorded: Vec<FrameInput>,
     /// The per-frame log (`frames.csv` with `--out`).
     log: FrameLog,
+    /// A study's trials, deciding each frame's condition (`vitreous study run`).
+    study: Option<StudyStage>,
     /// The first error writing the log, reported when the next frame finishes.
     log_error: Option<anyhow::Error>,
 }
@@ -136,12 +139,17 @@ impl FrameSink for RunSink {
         let read = self.readback_frame == Some(input.index);
         if let Some(rx) = &self.commands {
             for command in rx.try_iter() {
-                if let Some(change) = self.looks.apply(command) {
+                if let Some(study) = &mut self.study {
+                    study.director.command(command);
+                } else if let Some(change) = self.looks.apply(command) {
                     tracing::info!("frame {}: {change}", input.index);
                 }
             }
         }
-        let look = self.looks.plan(input);
+        let look = match &mut self.study {
+            Some(study) => study.plan(&mut self.looks, input),
+            None => self.looks.plan(input),
+        };
         let condition = self.looks.condition().to_string();
         if let Err(e) = self
             .log
@@ -162,6 +170,9 @@ impl FrameSink for RunSink {
         if let Some(e) = self.log_error.take() {
             return Err(e);
         }
+        if let Some(e) = self.study.as_mut().and_then(StudyStage::take_error) {
+            return Err(e);
+        }
         if let Some(rb) = &result.readback {
             self.readback = Some(check_readback(
                 input,
@@ -178,6 +189,22 @@ impl FrameSink for RunSink {
 /// Runs the scene on the OpenXR runtime. Fails with a clear message when there is no runtime,
 /// no Vulkan support, a validation message, or a failed readback check.
 pub fn run(options: &RunOptions) -> Result<RunSummary> {
+    run_with(options, None).map(|(summary, _)| summary)
+}
+
+/// Runs one block of a study's trials on the OpenXR runtime: the stage decides each frame's
+/// condition and gaze image, the controller's buttons answer, and the session ends once the
+/// block is answered. Returns the stage with its director's state.
+pub fn run_study_block(options: &RunOptions, stage: StudyStage) -> Result<StudyStage> {
+    let (_, stage) = run_with(options, Some(stage))?;
+    Ok(stage.expect("the study stage comes back"))
+}
+
+/// [`run`], with a study's stage deciding the looks when given.
+fn run_with(
+    options: &RunOptions,
+    study: Option<StudyStage>,
+) -> Result<(RunSummary, Option<StudyStage>)> {
     let mut scene = load_scene(&options.scene)?;
     let effects = options.effects.unwrap_or(scene.effects);
     effects.ensure_implemented()?;
@@ -192,7 +219,20 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
                 .load_caustics()
                 .map_err(|e| tracing::warn!("caustic conditions not offered live: {e}"))
                 .is_ok());
-    let conditions = live_conditions(effects, caustics_loaded);
+    let conditions = match &study {
+        Some(stage) => {
+            if stage.sets.iter().any(|s| s.caustics) && !caustics_loaded {
+                scene.load_caustics().with_context(|| {
+                    format!(
+                        "a study condition shows caustics in {}",
+                        options.scene.display()
+                    )
+                })?;
+            }
+            stage.sets.clone()
+        }
+        None => live_conditions(effects, caustics_loaded),
+    };
     tracing::info!(
         "effect conditions (menu on the right controller): {}",
         conditions
@@ -267,6 +307,7 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
                 scene_origin: None,
                 viewer_position_m: scene.viewer.head_position_m,
                 handle_ctrl_c: true,
+                end: study.as_ref().map(StudyStage::end_flag),
                 depth: Some(DepthOptions {
                     format: Renderer::DEPTH_FORMAT,
                     near_m: vitreous_render::camera::NEAR_M,
@@ -322,6 +363,7 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         recorded: Vec::new(),
         log,
         log_error: None,
+        study,
     };
     let started = Instant::now();
     let result = frame_loop::run(&mut session, &mut renderer, &mut sink);
@@ -470,7 +512,7 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
             None => bail!("readback check: no frame was read back (the session ended first)"),
         }
     }
-    Ok(summary)
+    Ok((summary, sink.study.take()))
 }
 
 /// `result`, unless it succeeded and `cleanup` (done after it) failed: the first error is the

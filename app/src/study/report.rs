@@ -19,10 +19,59 @@ pub enum Analysis {
     Scheffe(Scheffe),
 }
 
-/// Reads a responses file and runs the analysis its kind of answers calls for.
-pub fn analyze_file(path: &Path) -> Result<Analysis, ResponsesError> {
-    let responses = Responses::read(path)?;
-    Ok(analyze(&responses))
+/// The analyses of a responses file: one per stimulus.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyReport {
+    /// Each stimulus's name ("" for a file without a `stimulus` column) and analysis, by name.
+    pub groups: Vec<(String, Analysis)>,
+}
+
+impl StudyReport {
+    /// The `--json` report: one stimulus's object as [`Analysis::to_json`] gives it (with its
+    /// `stimulus` name when it has one), or `{"stimuli": {name: object}}` for several.
+    pub fn to_json(&self) -> Value {
+        match self.groups.as_slice() {
+            [(name, analysis)] => {
+                let mut value = analysis.to_json();
+                if !name.is_empty() {
+                    value["stimulus"] = Value::String(name.clone());
+                }
+                value
+            }
+            groups => {
+                let map: Map<String, Value> = groups
+                    .iter()
+                    .map(|(name, a)| (name.clone(), a.to_json()))
+                    .collect();
+                json!({ "stimuli": map })
+            }
+        }
+    }
+}
+
+impl fmt::Display for StudyReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, (name, analysis)) in self.groups.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            if !name.is_empty() {
+                writeln!(f, "stimulus {name}:")?;
+            }
+            write!(f, "{analysis}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Reads a responses file and runs, for each stimulus, the analysis its kind of answers calls
+/// for.
+pub fn analyze_file(path: &Path) -> Result<StudyReport, ResponsesError> {
+    let groups = Responses::read_by_stimulus(path)?
+        .into_iter()
+        .map(|(name, responses)| (name, analyze(&responses)))
+        .collect();
+    Ok(StudyReport { groups })
 }
 
 /// Runs the analysis the kind of answers calls for.

@@ -11,6 +11,9 @@ pub use super::response_error::ResponsesError;
 
 /// The columns a responses file must have, in any order.
 pub const COLUMNS: [&str; 5] = ["participant", "trial", "first", "second", "response"];
+/// The optional column naming the stimulus (scene) of each answer; each stimulus is analysed
+/// on its own.
+pub const STIMULUS_COLUMN: &str = "stimulus";
 /// The largest rating magnitude (ratings run from -3 to 3).
 pub const RATING_LIMIT: i8 = 3;
 
@@ -66,6 +69,8 @@ pub struct Response {
     pub second: String,
     /// The answer.
     pub answer: Answer,
+    /// The stimulus (scene) it was given in; empty without a `stimulus` column.
+    pub stimulus: String,
 }
 
 /// A whole responses file, checked line by line.
@@ -93,97 +98,36 @@ impl Responses {
         Self::parse(path, file)
     }
 
-    /// Parses and checks responses from `reader`; `path` names them in messages.
+    /// Parses and checks responses from `reader`; `path` names them in messages. All answers
+    /// are analysed together, whatever their stimulus.
     pub fn parse(path: &Path, reader: impl Read) -> Result<Self, ResponsesError> {
-        let path_buf = path.to_path_buf();
-        let csv_error = |error: csv::Error| ResponsesError::Csv {
-            path: path_buf.clone(),
-            line: error.position().map_or(0, |p| p.line()),
-            message: error.to_string(),
-        };
-        let mut csv = csv::ReaderBuilder::new()
-            .trim(csv::Trim::All)
-            .comment(Some(b'#'))
-            .from_reader(reader);
-        let header = csv.headers().map_err(csv_error)?.clone();
-        let mut index = [0usize; 5];
-        for (slot, column) in index.iter_mut().zip(COLUMNS) {
-            *slot = header
-                .iter()
-                .position(|name| name == column)
-                .ok_or_else(|| ResponsesError::MissingColumn {
-                    path: path.to_path_buf(),
-                    column,
-                })?;
-        }
-        let mut rows: Vec<Response> = Vec::new();
-        let mut trials: BTreeMap<(String, u64), u64> = BTreeMap::new();
-        for record in csv.records() {
-            let record = record.map_err(csv_error)?;
-            let line = record.position().map_or(0, |p| p.line());
-            let field = |i: usize| record.get(index[i]).unwrap_or("");
-            let bad = |name: &'static str, value: &str, expected: &'static str| {
-                ResponsesError::BadField {
-                    path: path.to_path_buf(),
-                    line,
-                    field: name,
-                    value: value.to_string(),
-                    expected,
-                }
-            };
-            let participant = field(0);
-            if participant.is_empty() {
-                return Err(bad("participant", participant, "a participant identifier"));
-            }
-            let trial: u64 = field(1)
-                .parse()
-                .map_err(|_| bad("trial", field(1), "a non-negative integer"))?;
-            let (first, second) = (field(2), field(3));
-            if first.is_empty() {
-                return Err(bad("first", first, "a condition name"));
-            }
-            if second.is_empty() {
-                return Err(bad("second", second, "a condition name"));
-            }
-            if first == second {
-                return Err(ResponsesError::SameCondition {
-                    path: path.to_path_buf(),
-                    line,
-                    condition: first.to_string(),
-                });
-            }
-            let answer = parse_answer(path, line, field(4))?;
-            if let Some(earlier) = rows.first() {
-                let (found, expected) = (kind_of(answer), kind_of(earlier.answer));
-                if found != expected {
-                    return Err(ResponsesError::MixedKinds {
-                        path: path.to_path_buf(),
-                        line,
-                        found: found.name(),
-                        expected: expected.name(),
-                        first_line: earlier.line,
-                    });
-                }
-            }
-            if let Some(&first_line) = trials.get(&(participant.to_string(), trial)) {
-                return Err(ResponsesError::DuplicateTrial {
-                    path: path.to_path_buf(),
-                    line,
-                    participant: participant.to_string(),
-                    trial,
-                    first_line,
-                });
-            }
-            trials.insert((participant.to_string(), trial), line);
-            rows.push(Response {
-                line,
-                participant: participant.to_string(),
-                trial,
-                first: first.to_string(),
-                second: second.to_string(),
-                answer,
-            });
-        }
+        Responses::from_rows(path, parse_rows(path, reader)?)
+    }
+
+    /// Reads a responses file and splits it by stimulus (one group named "" without a
+    /// `stimulus` column), each group checked as a whole study of its own.
+    pub fn read_by_stimulus(path: &Path) -> Result<Vec<(String, Responses)>, ResponsesError> {
+        let file = std::fs::File::open(path).map_err(|source| ResponsesError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let rows = parse_rows(path, file)?;
+        let names: BTreeSet<String> = rows.iter().map(|r| r.stimulus.clone()).collect();
+        names
+            .into_iter()
+            .map(|name| {
+                let group: Vec<Response> = rows
+                    .iter()
+                    .filter(|r| r.stimulus == name)
+                    .cloned()
+                    .collect();
+                Responses::from_rows(path, group).map(|r| (name, r))
+            })
+            .collect()
+    }
+
+    /// Checks answers as one study.
+    fn from_rows(path: &Path, rows: Vec<Response>) -> Result<Self, ResponsesError> {
         let Some(first_row) = rows.first() else {
             return Err(ResponsesError::Empty {
                 path: path.to_path_buf(),
@@ -214,7 +158,108 @@ impl Responses {
         }
         Ok(responses)
     }
+}
 
+/// Parses every line, checking each on its own and against the lines before it (one kind of
+/// answer per file, no trial twice).
+fn parse_rows(path: &Path, reader: impl Read) -> Result<Vec<Response>, ResponsesError> {
+    let path_buf = path.to_path_buf();
+    let csv_error = |error: csv::Error| ResponsesError::Csv {
+        path: path_buf.clone(),
+        line: error.position().map_or(0, |p| p.line()),
+        message: error.to_string(),
+    };
+    let mut csv = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(reader);
+    let header = csv.headers().map_err(csv_error)?.clone();
+    let mut index = [0usize; 5];
+    for (slot, column) in index.iter_mut().zip(COLUMNS) {
+        *slot = header
+            .iter()
+            .position(|name| name == column)
+            .ok_or_else(|| ResponsesError::MissingColumn {
+                path: path.to_path_buf(),
+                column,
+            })?;
+    }
+    let stimulus_index = header.iter().position(|name| name == STIMULUS_COLUMN);
+    let mut rows: Vec<Response> = Vec::new();
+    let mut trials: BTreeMap<(String, u64), u64> = BTreeMap::new();
+    for record in csv.records() {
+        let record = record.map_err(csv_error)?;
+        let line = record.position().map_or(0, |p| p.line());
+        let field = |i: usize| record.get(index[i]).unwrap_or("");
+        let bad =
+            |name: &'static str, value: &str, expected: &'static str| ResponsesError::BadField {
+                path: path.to_path_buf(),
+                line,
+                field: name,
+                value: value.to_string(),
+                expected,
+            };
+        let participant = field(0);
+        if participant.is_empty() {
+            return Err(bad("participant", participant, "a participant identifier"));
+        }
+        let trial: u64 = field(1)
+            .parse()
+            .map_err(|_| bad("trial", field(1), "a non-negative integer"))?;
+        let (first, second) = (field(2), field(3));
+        if first.is_empty() {
+            return Err(bad("first", first, "a condition name"));
+        }
+        if second.is_empty() {
+            return Err(bad("second", second, "a condition name"));
+        }
+        if first == second {
+            return Err(ResponsesError::SameCondition {
+                path: path.to_path_buf(),
+                line,
+                condition: first.to_string(),
+            });
+        }
+        let answer = parse_answer(path, line, field(4))?;
+        if let Some(earlier) = rows.first() {
+            let (found, expected) = (kind_of(answer), kind_of(earlier.answer));
+            if found != expected {
+                return Err(ResponsesError::MixedKinds {
+                    path: path.to_path_buf(),
+                    line,
+                    found: found.name(),
+                    expected: expected.name(),
+                    first_line: earlier.line,
+                });
+            }
+        }
+        if let Some(&first_line) = trials.get(&(participant.to_string(), trial)) {
+            return Err(ResponsesError::DuplicateTrial {
+                path: path.to_path_buf(),
+                line,
+                participant: participant.to_string(),
+                trial,
+                first_line,
+            });
+        }
+        trials.insert((participant.to_string(), trial), line);
+        rows.push(Response {
+            line,
+            participant: participant.to_string(),
+            trial,
+            first: first.to_string(),
+            second: second.to_string(),
+            answer,
+            stimulus: stimulus_index
+                .and_then(|i| record.get(i))
+                .unwrap_or("")
+                .to_string(),
+        });
+    }
+    Ok(rows)
+}
+
+impl Responses {
     /// Index of a condition in [`Responses::conditions`].
     pub fn condition_index(&self, name: &str) -> Option<usize> {
         self.conditions

@@ -81,14 +81,7 @@ pub fn case_v(conditions: Vec<String>, counts: Vec<Vec<u64>>) -> CaseV {
             }
         }
     }
-    let mut scale: Vec<f64> = proportions
-        .iter()
-        .map(|row| row.iter().map(|&p| normal_quantile(p)).sum::<f64>() / k as f64)
-        .collect();
-    let lowest = scale.iter().copied().fold(f64::INFINITY, f64::min);
-    for value in &mut scale {
-        *value -= lowest;
-    }
+    let scale = scale_from_proportions(&proportions);
     let mut chi_square = 0.0;
     for i in 0..k {
         for j in i + 1..k {
@@ -111,6 +104,22 @@ pub fn case_v(conditions: Vec<String>, counts: Vec<Vec<u64>>) -> CaseV {
         scale,
         test: MostellerTest { chi_square, df, p },
     }
+}
+
+/// Case V scale values from a square matrix of proportions, `proportions[i][j]` the share of
+/// judgments preferring `i` to `j` (already clipped away from 0 and 1): the row means of the
+/// normal deviates, shifted so that the lowest is 0.
+pub fn scale_from_proportions(proportions: &[Vec<f64>]) -> Vec<f64> {
+    let k = proportions.len();
+    let mut scale: Vec<f64> = proportions
+        .iter()
+        .map(|row| row.iter().map(|&p| normal_quantile(p)).sum::<f64>() / k as f64)
+        .collect();
+    let lowest = scale.iter().copied().fold(f64::INFINITY, f64::min);
+    for value in &mut scale {
+        *value -= lowest;
+    }
+    scale
 }
 
 /// Case V analysis of forced-choice responses.
@@ -199,6 +208,53 @@ mod tests {
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
         (z ^ (z >> 31)) as f64 / u64::MAX as f64
+    }
+
+    /// Guilford's (1954, Psychometric Methods) preferences among nine vegetables, the classic
+    /// worked example of Case V scaling, as distributed with the R package psychTools (`veg`):
+    /// `VEG[j][i]` is the share preferring vegetable `j` to vegetable `i`. The published scale
+    /// values (psych::thurstone on these data, two decimals, lowest at 0) are turnips 0.00,
+    /// cabbage 0.52, beets 0.65, asparagus 0.98, carrots 1.12, spinach 1.14, string beans 1.40,
+    /// peas 1.44, corn 1.63.
+    #[allow(clippy::approx_constant)] // 0.318 is a measured proportion, not 1/pi
+    const VEG: [[f64; 9]; 9] = [
+        [
+            0.500, 0.182, 0.230, 0.189, 0.122, 0.108, 0.101, 0.108, 0.074,
+        ],
+        [
+            0.818, 0.500, 0.399, 0.277, 0.257, 0.264, 0.189, 0.155, 0.142,
+        ],
+        [
+            0.770, 0.601, 0.500, 0.439, 0.264, 0.324, 0.155, 0.203, 0.182,
+        ],
+        [
+            0.811, 0.723, 0.561, 0.500, 0.439, 0.412, 0.324, 0.399, 0.270,
+        ],
+        [
+            0.878, 0.743, 0.736, 0.561, 0.500, 0.507, 0.426, 0.291, 0.236,
+        ],
+        [
+            0.892, 0.736, 0.676, 0.588, 0.493, 0.500, 0.372, 0.318, 0.372,
+        ],
+        [
+            0.899, 0.811, 0.845, 0.676, 0.574, 0.628, 0.500, 0.473, 0.358,
+        ],
+        [
+            0.892, 0.845, 0.797, 0.601, 0.709, 0.682, 0.527, 0.500, 0.372,
+        ],
+        [
+            0.926, 0.858, 0.818, 0.730, 0.764, 0.628, 0.642, 0.628, 0.500,
+        ],
+    ];
+
+    #[test]
+    fn case_v_reproduces_guilfords_vegetable_scale() {
+        let published = [0.00, 0.52, 0.65, 0.98, 1.12, 1.14, 1.40, 1.44, 1.63];
+        let proportions: Vec<Vec<f64>> = VEG.iter().map(|row| row.to_vec()).collect();
+        let scale = scale_from_proportions(&proportions);
+        for (value, want) in scale.iter().zip(published) {
+            assert!((value - want).abs() <= 0.005 + 1e-9, "{scale:?}");
+        }
     }
 
     #[test]

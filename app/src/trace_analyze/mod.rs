@@ -46,7 +46,7 @@ use crate::gaze::vergence::{VergenceConfig, VergenceEstimator};
 use crate::gaze::{FilterKind, GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances};
 use crate::scene::{gaze_image_of_target, load_scene};
 
-mod plot;
+pub(crate) mod plot;
 mod report;
 
 pub use plot::{FILTER_COLOURS, PlotLayout, plot, plot_trace_file};

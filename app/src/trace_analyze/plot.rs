@@ -49,7 +49,7 @@ const PLOT_SIZE_PX: (u32, u32) = (1400, 800);
 /// plot needs no system fonts.
 static FONT_TTF: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-fn register_font() -> Result<()> {
+pub(crate) fn register_font() -> Result<()> {
     static ONCE: Once = Once::new();
     let mut result = Ok(());
     ONCE.call_once(|| {

@@ -226,21 +226,6 @@ mod tests {
         (0..t).map(|i| format!("c{i}")).collect()
     }
 
-    /// SplitMix64 mapped to (0, 1).
-    fn uniform(state: &mut u64) -> f64 {
-        *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) as f64 + 0.5) / (u64::MAX as f64 + 1.0)
-    }
-
-    /// A standard normal deviate (Box-Muller).
-    fn normal(state: &mut u64) -> f64 {
-        let (u, v) = (uniform(state), uniform(state));
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-
     fn sum_of_squares(result: &Scheffe, source: &str) -> f64 {
         result
             .anova
@@ -288,15 +273,11 @@ mod tests {
     #[test]
     fn sums_of_squares_add_up_and_the_error_is_the_residual() {
         let (t, n) = (4, 5);
-        let mut state = 7;
+        let mut rng = vitreous_xr::synth::SplitMix64(7);
         let ratings: Vec<Vec<Vec<f64>>> = (0..n)
             .map(|_| {
                 (0..t)
-                    .map(|_| {
-                        (0..t)
-                            .map(|_| (uniform(&mut state) * 7.0).floor() - 3.0)
-                            .collect()
-                    })
+                    .map(|_| (0..t).map(|_| (rng.unit() * 7.0).floor() - 3.0).collect())
                     .collect()
             })
             .collect();
@@ -347,13 +328,13 @@ mod tests {
     fn scale_values_are_recovered_from_simulated_ratings() {
         let truth = [-0.6, -0.2, 0.0, 0.3, 0.5];
         let (t, n) = (5, 60);
-        let mut state = 99;
+        let mut rng = vitreous_xr::synth::SplitMix64(99);
         let ratings: Vec<Vec<Vec<f64>>> = (0..n)
             .map(|_| {
                 (0..t)
                     .map(|i| {
                         (0..t)
-                            .map(|j| truth[i] - truth[j] + 0.2 + 0.8 * normal(&mut state))
+                            .map(|j| truth[i] - truth[j] + 0.2 + 0.8 * rng.gaussian())
                             .collect()
                     })
                     .collect()

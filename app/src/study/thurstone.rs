@@ -201,15 +201,6 @@ mod tests {
         assert!(result.test.chi_square < 1e-3);
     }
 
-    /// SplitMix64: a small deterministic generator for simulated judgments.
-    fn uniform(state: &mut u64) -> f64 {
-        *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        (z ^ (z >> 31)) as f64 / u64::MAX as f64
-    }
-
     /// Guilford's (1954, Psychometric Methods) preferences among nine vegetables, the classic
     /// worked example of Case V scaling, as distributed with the R package psychTools (`veg`):
     /// `VEG[j][i]` is the share preferring vegetable `j` to vegetable `i`. The published scale
@@ -260,12 +251,12 @@ mod tests {
     #[test]
     fn scale_values_are_recovered_from_simulated_choices() {
         let truth = [0.0, 0.4, 0.7, 1.2, 1.3];
-        let mut state = 14;
+        let mut rng = vitreous_xr::synth::SplitMix64(14);
         let mut counts = vec![vec![0u64; 5]; 5];
         for i in 0..5 {
             for j in i + 1..5 {
                 for _ in 0..2000 {
-                    if uniform(&mut state) < normal_cdf(truth[i] - truth[j]) {
+                    if rng.unit() < normal_cdf(truth[i] - truth[j]) {
                         counts[i][j] += 1;
                     } else {
                         counts[j][i] += 1;

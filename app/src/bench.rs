@@ -215,15 +215,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             }
         }
     }
-    let v = renderer.context().validation();
-    if v.errors() + v.warnings() > 0 {
-        bail!(
-            "the Vulkan validation layers reported {} errors and {} warnings; first: {}",
-            v.errors(),
-            v.warnings(),
-            v.messages().first().map(String::as_str).unwrap_or("")
-        );
-    }
+    crate::frame_loop::ensure_validation_clean(&renderer)?;
     let spreads: Vec<_> = (0..n)
         .map(|i| {
             (

@@ -156,3 +156,17 @@ fn finish(
     });
     Ok(())
 }
+
+/// Fails when the Vulkan validation layers reported anything to `renderer`'s context.
+pub fn ensure_validation_clean(renderer: &Renderer) -> Result<()> {
+    let v = renderer.context().validation();
+    if v.errors() + v.warnings() > 0 {
+        anyhow::bail!(
+            "the Vulkan validation layers reported {} errors and {} warnings; first: {}",
+            v.errors(),
+            v.warnings(),
+            v.messages().first().map(String::as_str).unwrap_or("")
+        );
+    }
+    Ok(())
+}

@@ -75,6 +75,19 @@ pub fn texture(image: &Image) -> TextureDesc<'_> {
     }
 }
 
+/// The renderer for `scene` (with its defocus stacks when given) at `width` x `height` per eye.
+pub fn renderer_for(
+    ctx: vitreous_render::GpuContext,
+    scene: &Scene,
+    defocus: Option<&DefocusSetup>,
+    width: u32,
+    height: u32,
+) -> anyhow::Result<vitreous_render::Renderer> {
+    use anyhow::Context;
+    vitreous_render::Renderer::new(ctx, &scene_desc(scene, defocus), width, height)
+        .context("preparing the renderer")
+}
+
 /// The renderer's view of a scene, with the blur stacks of `defocus` when defocus is used.
 pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> SceneDesc<'a> {
     let mesh = &scene.object.mesh;

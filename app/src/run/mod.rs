@@ -286,13 +286,7 @@ fn run_with(
             ..GazeSettings::default()
         },
     )?;
-    let mut renderer = Renderer::new(
-        ctx,
-        &views::scene_desc(&scene, defocus.as_ref()),
-        width,
-        height,
-    )
-    .context("preparing the renderer")?;
+    let mut renderer = views::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
     drop(defocus);
     // SAFETY: `handles` are the instance, device and queue this runtime created for the
     // renderer's context (XrDeviceCreator); the renderer owns them and outlives `session`,

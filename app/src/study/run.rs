@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result, bail};
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, GpuContext, Look, Reflection, Renderer};
+use vitreous_render::{ContextOptions, GpuContext, Look, Reflection};
 use vitreous_xr::{FrameInput, NullBackend, NullConfig};
 
 use super::answers::{Keyboard, SimulatedObserver};
@@ -357,13 +357,7 @@ fn dry_run_block(
         Reflection::default(),
         &GazeSettings::default(),
     )?;
-    let mut renderer = Renderer::new(
-        ctx,
-        &views::scene_desc(&scene, defocus.as_ref()),
-        width,
-        height,
-    )
-    .context("preparing the renderer")?;
+    let mut renderer = views::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
     drop(defocus);
     let looks = LiveLooks::new(
         stage.sets.iter().copied().zip(planners).collect(),
@@ -378,15 +372,7 @@ fn dry_run_block(
     if let Some(e) = sink.stage.take_error() {
         return Err(e);
     }
-    let v = renderer.context().validation();
-    if v.errors() + v.warnings() > 0 {
-        bail!(
-            "the Vulkan validation layers reported {} errors and {} warnings, first: {}",
-            v.errors(),
-            v.warnings(),
-            v.messages().first().map(String::as_str).unwrap_or("")
-        );
-    }
+    frame_loop::ensure_validation_clean(&renderer)?;
     if !stage.director.done() && !crate::interrupt::requested() {
         tracing::warn!(
             "the dry run's trace ended before the block's last trial; run again to resume"

@@ -325,6 +325,16 @@ fn study_run_takes_typed_answers_and_repairs_a_cut_off_last_line() {
         (answered[2][1].as_str(), answered[2][4].as_str()),
         ("3", "3")
     );
+    // Typing ends (standard input closed) with answers still due: a clear error, not a wait
+    // until the trace runs out; the answer given is kept.
+    let out = dry_run(&plan_path, &responses, &[], "0\n");
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("trial 5: an answer is due but nothing can give it"),
+        "{stderr}"
+    );
+    assert_eq!(rows(&responses).len(), 4);
 }
 
 #[test]

@@ -145,6 +145,11 @@ impl Keyboard {
         }
     }
 
+    /// Whether standard input has ended (nothing more can be typed).
+    pub fn closed(&self) -> bool {
+        self.closed
+    }
+
     /// The next line typed, if any.
     pub fn poll(&mut self) -> Option<String> {
         if self.closed {

@@ -93,8 +93,10 @@ pub fn draw(report: &StudyReport) -> Result<(Vec<u8>, u32, u32, Vec<Mark>)> {
                 ))
                 .map_err(|e| draw_err(&e))?;
                 if major.abs() < 1e-9 {
+                    // No "-0.0" where rounding leaves a negative zero.
+                    let shown = if tick.abs() < 1e-9 { 0.0 } else { tick };
                     root.draw(&Text::new(
-                        format!("{tick:.1}"),
+                        format!("{shown:.1}"),
                         (x - 10, axis_y + 12),
                         font(12),
                     ))

@@ -249,6 +249,7 @@ pub fn run_study(options: &StudyRunOptions) -> Result<StudyRunSummary> {
             AnswerSources {
                 keyboard: keyboard.take(),
                 simulated: simulated.take(),
+                controller: !options.dry_run,
             },
             responses,
             TimingLog::open(&timing_path)?,

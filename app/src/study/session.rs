@@ -251,6 +251,8 @@ pub struct AnswerSources {
     pub keyboard: Option<Keyboard>,
     /// A simulated participant, answering as soon as each answer is due.
     pub simulated: Option<SimulatedObserver>,
+    /// Whether the controller's buttons can answer (on the OpenXR runtime).
+    pub controller: bool,
 }
 
 /// The trial under way.
@@ -393,6 +395,16 @@ impl StudyDirector {
             self.enter(phase, frame, time_s)?;
             match phase {
                 Phase::Answer => {
+                    let typed_out = self.typed.is_empty()
+                        && self.sources.keyboard.as_ref().is_none_or(Keyboard::closed);
+                    if typed_out && self.sources.simulated.is_none() && !self.sources.controller {
+                        bail!(
+                            "trial {}: an answer is due but nothing can give it: standard input \
+                             is closed (or --no-keyboard) and there is no controller; type the \
+                             answers, or pass --simulate",
+                            self.current.as_ref().expect("trial under way").trial.trial
+                        );
+                    }
                     if let Some(answer) = self.take_answer(&commands) {
                         let cur = self.current.as_mut().expect("trial under way");
                         self.responses.append(&cur.trial, answer)?;

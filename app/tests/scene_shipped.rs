@@ -121,6 +121,40 @@ fn diamond_reproduces_the_shadow_study() {
 }
 
 #[test]
+fn the_study_floors_keep_the_shadow_study_setup() {
+    for (name, ior) in [
+        ("glass-sphere-wood.toml", 1.51),
+        ("glass-sphere-stone.toml", 1.51),
+        ("diamond-wood.toml", 2.42),
+        ("diamond-stone.toml", 2.42),
+    ] {
+        let scene = load(name);
+        check_shadow_study_scene(&scene, ior);
+        // A floor photo of its own: 1024 px across the 1 m table top.
+        assert_eq!(scene.floor.photo.width, 1024, "{name}");
+    }
+}
+
+#[test]
+fn every_shipped_bake_belongs_to_its_scene() {
+    let mut baked = 0;
+    for entry in std::fs::read_dir(scenes_dir()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let mut scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+        if scene.caustics.bake.is_some() {
+            scene
+                .load_caustics()
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            baked += 1;
+        }
+    }
+    assert!(baked >= 6, "{baked} scenes with a bake");
+}
+
+#[test]
 fn visual_effects_keeps_the_papers_distances() {
     let scene = load("visual-effects.toml");
     let object = &scene.object;

@@ -103,15 +103,16 @@ fn study_plan_is_reproducible_and_balanced_across_participants() {
         }
     }
     assert!(positions.values().all(|p| p.len() == 20));
-    // The forced-choice protocol: two scenes in balanced order, six trials in each block.
+    // The forced-choice protocol: four scenes (two objects on two floors) in a balanced order,
+    // six trials in each block.
     plan("shadows-caustics.toml", 4, 3, &a);
     let trials = rows(&a);
-    assert_eq!(trials.len(), 4 * 12);
-    let firsts: BTreeSet<&str> = trials.chunks(12).map(|p| p[0][2].as_str()).collect();
+    assert_eq!(trials.len(), 4 * 24);
+    let firsts: BTreeSet<&str> = trials.chunks(24).map(|p| p[0][2].as_str()).collect();
     assert_eq!(
         firsts.len(),
-        2,
-        "each scene comes first for some participants"
+        4,
+        "each scene comes first for one of four participants"
     );
     for block in trials.chunks(6) {
         let stimuli: BTreeSet<_> = block.iter().map(|r| &r[2]).collect();

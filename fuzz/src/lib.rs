@@ -1,5 +1,6 @@
 //! Fuzz targets for the readers that take files from users: the trace v1 reader, the
-//! SRanipal and Tobii Pro Glasses 3 importers, the scene loader and the glTF model path.
+//! SRanipal and Tobii Pro Glasses 3 importers, the scene loader, the glTF model path and the
+//! study protocol, plan and responses readers.
 //!
 //! Each target is a plain function from bytes to nothing that must not panic on any input.
 //! `fuzz_targets/*.rs` hand them to libFuzzer (`tools/fuzz`, `cargo fuzz`); the corpus test
@@ -18,7 +19,7 @@ use vitreous::scene::{Scene, SceneError, SceneFiles};
 use vitreous_xr::trace::{TraceReader, TraceSample, TraceWriter};
 
 /// Names of the targets, as in `fuzz_targets/` and `corpus/`.
-pub const TARGETS: [&str; 5] = ["trace_v1", "sranipal", "tobii_g3", "scene", "gltf"];
+pub const TARGETS: [&str; 6] = ["trace_v1", "sranipal", "tobii_g3", "scene", "gltf", "study"];
 
 /// Runs the target called `name` (one of [`TARGETS`]) on `data`; `false` for an unknown name.
 pub fn run(name: &str, data: &[u8]) -> bool {
@@ -28,6 +29,7 @@ pub fn run(name: &str, data: &[u8]) -> bool {
         "tobii_g3" => tobii_g3(data),
         "scene" => scene(data),
         "gltf" => gltf(data),
+        "study" => study(data),
         _ => return false,
     }
     true
@@ -47,6 +49,40 @@ pub fn trace_v1(data: &[u8]) {
     let again =
         read_all(&written).unwrap_or_else(|e| panic!("a written trace does not read back: {e}"));
     assert_eq!(samples, again, "writing then reading changed the samples");
+}
+
+/// A study protocol, then (after the first NUL byte) a responses file. The protocol is read as
+/// if it lay in `config/studies/` (its stimuli name the shipped scenes); when it is accepted, a
+/// plan for three participants must write and read back to the same trials. The responses are
+/// parsed and, when accepted, analysed; the report (or the error) must format.
+pub fn study(data: &[u8]) {
+    use vitreous::study::{plan, protocol::Protocol, report, responses::Responses};
+    let split = data.iter().position(|&b| b == 0).unwrap_or(data.len());
+    let (protocol_bytes, responses_bytes) = (&data[..split], data.get(split + 1..).unwrap_or(&[]));
+    let studies = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/studies/fuzz.toml");
+    if let Ok(text) = std::str::from_utf8(protocol_bytes) {
+        match Protocol::parse(&studies, text) {
+            Ok(protocol) => {
+                let seed = data.len() as u64;
+                let trials = plan::plan(&protocol, 3, seed);
+                assert_eq!(trials.len(), 3 * protocol.trials_per_participant());
+                let mut written = Vec::new();
+                plan::write_plan(&mut written, &protocol, seed, &trials).expect("in memory");
+                let again = plan::parse_plan(Path::new("plan.csv"), &written[..], &protocol)
+                    .unwrap_or_else(|e| panic!("a written plan does not read back: {e}"));
+                assert_eq!(trials, again, "writing then reading changed the plan");
+            }
+            Err(e) => assert!(!e.to_string().is_empty()),
+        }
+    }
+    match Responses::parse(Path::new("responses.csv"), responses_bytes) {
+        Ok(responses) => {
+            let analysis = report::analyze(&responses);
+            assert!(!analysis.to_string().is_empty());
+            let _ = analysis.to_json().to_string();
+        }
+        Err(e) => assert!(!e.to_string().is_empty()),
+    }
 }
 
 /// SRanipal CSV text: import it; the samples of a successful import must make a valid trace

@@ -198,10 +198,15 @@ fn gltf_survives_its_corpus() {
 }
 
 #[test]
+fn study_survives_its_corpus() {
+    check("study");
+}
+
+#[test]
 fn every_target_has_a_test_and_a_corpus() {
     assert_eq!(
         vitreous_fuzz::TARGETS,
-        ["trace_v1", "sranipal", "tobii_g3", "scene", "gltf"]
+        ["trace_v1", "sranipal", "tobii_g3", "scene", "gltf", "study"]
     );
     for target in vitreous_fuzz::TARGETS {
         assert!(!corpus(target).is_empty(), "corpus/{target} is empty");

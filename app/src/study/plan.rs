@@ -171,10 +171,19 @@ pub fn read_plan(path: &Path, protocol: &Protocol) -> Result<Vec<PlannedTrial>, 
         path: path.to_path_buf(),
         source,
     })?;
+    parse_plan(path, file, protocol)
+}
+
+/// [`read_plan`] from `reader`; `path` names it in messages.
+pub fn parse_plan(
+    path: &Path,
+    reader: impl std::io::Read,
+    protocol: &Protocol,
+) -> Result<Vec<PlannedTrial>, PlanError> {
     let mut csv = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
-        .from_reader(file);
+        .from_reader(reader);
     let line_error = |line: u64, message: String| PlanError::Line {
         path: path.to_path_buf(),
         line,

@@ -17,6 +17,7 @@ use crate::glass::{EyePush, GlassPass};
 use crate::memory::Buffer;
 use crate::owned::Owned;
 use crate::pipeline;
+use crate::pose::ScenePose;
 use crate::scene::{GpuScene, SceneDesc};
 use crate::target::{self, StereoTarget};
 use crate::world::WorldPass;
@@ -133,6 +134,10 @@ pub struct Renderer {
     scene: GpuScene,
     /// Sequence number of the next frame.
     next_sequence: u64,
+    /// The object's and the light's pose for the next frame.
+    pose: ScenePose,
+    /// The pose the glass pass's uniform block holds once submitted work has run.
+    glass_pose: ScenePose,
     /// The GPU context; dropped last.
     ctx: GpuContext,
 }
@@ -230,6 +235,8 @@ impl Renderer {
             render_pass,
             scene: gpu_scene,
             next_sequence: 0,
+            pose: ScenePose::of(scene),
+            glass_pose: ScenePose::of(scene),
             ctx,
         })
     }
@@ -248,6 +255,20 @@ impl Renderer {
     /// computed first if no submitted frame has. Waits for the GPU; for tests and debugging.
     pub fn inducer_fields(&mut self) -> Result<InducerFields> {
         self.inducer.read_back(&self.ctx, &self.scene)
+    }
+
+    /// Places the object and the light for the next frames. The glass follows at once; the
+    /// shadow inducer's fields are computed again on the next frame that draws them, and only
+    /// when `pose` differs from the last one.
+    pub fn set_pose(&mut self, pose: ScenePose) {
+        self.pose = pose;
+        self.inducer.set_pose(pose);
+    }
+
+    /// How many times the shadow inducer's fields (mask, distance, gain) were computed: once
+    /// for the first frame that drew them, then once per frame after the object or light moved.
+    pub fn inducer_computations(&self) -> u64 {
+        self.inducer.computations()
     }
 
     /// Records and submits a frame. Returns the frame that last used the same slot
@@ -313,6 +334,7 @@ impl Renderer {
         };
         // Only now, with the work on the queue, do later frames rely on what it computes.
         self.inducer.submitted(prepared);
+        self.glass_pose = self.pose;
         self.slots[slot_index].pending = Some(Pending {
             sequence,
             want,
@@ -439,6 +461,9 @@ impl Renderer {
         // framebuffers belong to the render pass they are begun with. The images copied are
         // in TRANSFER_SRC_OPTIMAL (the render pass's final layout, or the transition before).
         unsafe {
+            if self.pose != self.glass_pose {
+                self.glass.record_pose(&self.ctx, cmd, &self.pose);
+            }
             let (inducer, caustics) = (params.look.inducer, params.look.caustics);
             if inducer || caustics {
                 // Once per scene (and per change of these switches), before the timed part.

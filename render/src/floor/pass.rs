@@ -3,7 +3,7 @@
 //! them (progress.rs tracks whether it has really run; readback.rs copies the fields back).
 
 use ash::vk;
-use glam::{Mat4, Vec2};
+use glam::{Mat4, Vec2, Vec3};
 
 use super::fields::{DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY};
 use super::geometry::{
@@ -18,6 +18,7 @@ use crate::error::Result;
 use crate::memory::{Image, upload_texture};
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec};
+use crate::pose::ScenePose;
 use crate::scene::{GpuScene, InducerDesc, SceneDesc};
 use crate::shaders;
 
@@ -30,6 +31,12 @@ pub(crate) struct InducerPass {
     pub(super) texel_m: Vec2,
     /// The floor plane's transform (unit square to world).
     world_from_plane: Mat4,
+    /// The floor's frame.
+    floor: Floor,
+    /// The mesh's vertices, model space (to bound the shadow of each pose).
+    positions: Vec<Vec3>,
+    /// The object's transform and the light the fields are (or are due to be) computed for.
+    pose: ScenePose,
     /// Model space to the mask's clip space; `None` when the light is not above the floor.
     mask_clip_from_model: Option<Mat4>,
     /// Plane-local rectangle the inducer's light covers; `None` when nothing can be lit.
@@ -77,17 +84,8 @@ impl InducerPass {
         let params = desc.inducer;
         let n = params.resolution_px;
         let floor = Floor::new(desc.floor.world_from_plane);
-        let shadow = planar_shadow(floor.center_m, floor.normal, desc.light.position_m);
-        let rect = shadow.and_then(|shadow| {
-            // Ramp width plus two texels (rasterisation and the overlay's bilinear footprint).
-            let margin = Vec2::splat(params.ramp_width_m) / floor.size_m + 2.0 / n as f32;
-            let world = desc
-                .mesh
-                .positions
-                .iter()
-                .map(|p| desc.world_from_model.transform_point3(*p));
-            overlay_rect(world, shadow, floor.plane_from_world, margin)
-        });
+        let pose = ScenePose::of(desc);
+        let (mask_clip_from_model, rect) = shadow_of(&floor, &params, desc.mesh.positions, &pose);
         let field_extent = vk::Extent2D {
             width: n,
             height: n,
@@ -214,8 +212,10 @@ impl InducerPass {
             desc: params,
             texel_m: floor.size_m / n as f32,
             world_from_plane: floor.world_from_plane,
-            mask_clip_from_model: shadow
-                .map(|s| mask_clip_from_model(&floor, s, desc.world_from_model)),
+            floor,
+            positions: desc.mesh.positions.to_vec(),
+            pose,
+            mask_clip_from_model,
             rect,
             caustic_rect,
             index_count: scene.index_count,
@@ -232,6 +232,25 @@ impl InducerPass {
             _caustic: caustic,
             targets,
         })
+    }
+
+    /// Moves the object or the light: when `pose` differs from the current one, the shadow's
+    /// projection and the overlay's rectangle follow at once, and the fields (eq. 1-5,
+    /// unchanged) are computed again by the next frame that draws the overlay.
+    pub fn set_pose(&mut self, pose: ScenePose) {
+        if pose == self.pose {
+            return;
+        }
+        let (clip, rect) = shadow_of(&self.floor, &self.desc, &self.positions, &pose);
+        self.mask_clip_from_model = clip;
+        self.rect = rect;
+        self.pose = pose;
+        self.progress.invalidate();
+    }
+
+    /// How many computations of the fields were submitted since the pass was made.
+    pub fn computations(&self) -> u64 {
+        self.progress.computations
     }
 
     /// The push constants shared by the full-screen passes.
@@ -419,4 +438,27 @@ impl InducerPass {
             };
         }
     }
+}
+
+/// The mask's projection (eq. 1: `None` when the light is not above the floor) and the
+/// plane-local rectangle the inducer's light covers (`None` when nothing can be lit) for the
+/// object and light of `pose`.
+fn shadow_of(
+    floor: &Floor,
+    params: &InducerDesc,
+    positions: &[Vec3],
+    pose: &ScenePose,
+) -> (Option<Mat4>, Option<[f32; 4]>) {
+    let shadow = planar_shadow(floor.center_m, floor.normal, pose.light_position_m);
+    let rect = shadow.and_then(|shadow| {
+        // Ramp width plus two texels (rasterisation and the overlay's bilinear footprint).
+        let margin =
+            Vec2::splat(params.ramp_width_m) / floor.size_m + 2.0 / params.resolution_px as f32;
+        let world = positions
+            .iter()
+            .map(|p| pose.world_from_model.transform_point3(*p));
+        overlay_rect(world, shadow, floor.plane_from_world, margin)
+    });
+    let clip = shadow.map(|s| mask_clip_from_model(floor, s, pose.world_from_model));
+    (clip, rect)
 }

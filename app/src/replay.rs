@@ -10,7 +10,7 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
+use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer, ScenePose};
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{TraceSample, read_trace};
@@ -182,6 +182,11 @@ pub struct ReplaySummary {
     pub gaze_image_switches: u64,
     /// Where A_p came from and the values used (`null` without defocus).
     pub pupil: Option<PupilSummary>,
+    /// Frames whose object or light pose differed from the previous frame's (`[motion]`).
+    pub moved_frames: u64,
+    /// Computations of the shadow inducer's fields (mask, distance, gain) on the GPU: one
+    /// for the first frame drawing them, then one per moved frame, none otherwise.
+    pub inducer_computations: u64,
     /// Every frame's timing.
     pub per_frame: Vec<FrameRecord>,
 }
@@ -225,9 +230,54 @@ struct Saver<'a> {
     condition: String,
     /// The first error writing the log, reported when the next frame finishes.
     log_error: Option<anyhow::Error>,
+    /// How the scene moves, with the time of the first frame once it came.
+    motion: MotionClock<'a>,
+}
+
+/// Turns frame times into the scene's poses (`[motion]`) and counts the frames that moved.
+pub(crate) struct MotionClock<'a> {
+    /// The scene, when it moves.
+    scene: Option<&'a Scene>,
+    /// Time of the first frame, the backend's clock, nanoseconds.
+    start_ns: Option<i64>,
+    /// The previous frame's pose.
+    last: Option<ScenePose>,
+    /// Frames whose pose differed from the previous frame's.
+    pub moved_frames: u64,
+}
+
+impl<'a> MotionClock<'a> {
+    /// A clock for `scene`; it gives poses only when the scene moves.
+    pub fn new(scene: &'a Scene) -> MotionClock<'a> {
+        MotionClock {
+            scene: scene.motion.is_animated().then_some(scene),
+            start_ns: None,
+            last: None,
+            moved_frames: 0,
+        }
+    }
+
+    /// The pose of the frame at `time_ns`, moving the planner's object centre with it;
+    /// `None` for a scene that stands still.
+    pub fn pose(&mut self, time_ns: i64, planner: &mut LookPlanner) -> Option<ScenePose> {
+        let scene = self.scene?;
+        let start = *self.start_ns.get_or_insert(time_ns);
+        let placement = scene.placement_at(views::seconds_since(start, time_ns));
+        planner.set_object_center(placement.object_position_m);
+        let pose = views::scene_pose(scene, &placement);
+        if self.last.is_some_and(|last| last != pose) {
+            self.moved_frames += 1;
+        }
+        self.last = Some(pose);
+        Some(pose)
+    }
 }
 
 impl FrameSink for Saver<'_> {
+    fn pose(&mut self, input: &FrameInput) -> Option<ScenePose> {
+        self.motion.pose(input.time_ns, &mut self.planner)
+    }
+
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         let save = self.save_every > 0 && input.index.is_multiple_of(self.save_every);
         let look = self.planner.plan(input).0;
@@ -398,6 +448,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         log,
         condition: effects.to_string(),
         log_error: None,
+        motion: MotionClock::new(&scene),
     };
     let started = Instant::now();
     let records = match frame_loop::run(&mut backend, &mut renderer, &mut saver) {
@@ -452,6 +503,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         saved: saver.saved,
         gaze_image_switches: saver.log.gaze_image_switches(),
         pupil: saver.log.pupil_summary(saver.planner.pupil_source()),
+        moved_frames: saver.motion.moved_frames,
+        inducer_computations: renderer.inducer_computations(),
         per_frame: records,
     };
     let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;

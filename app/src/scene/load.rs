@@ -63,9 +63,9 @@ pub fn load_scene_from(path: &Path, files: &dyn SceneFiles) -> Result<Scene, Sce
     loader.resolve(raw)
 }
 
-struct Loader<'a> {
+pub(super) struct Loader<'a> {
     files: &'a dyn SceneFiles,
-    src: Source<'a>,
+    pub(super) src: Source<'a>,
     dir: PathBuf,
     hasher: Sha256,
 }
@@ -140,7 +140,7 @@ impl Loader<'_> {
         })
     }
 
-    fn vec3(&self, field: &str, v: &Spanned<Vec<f32>>) -> Result<Vec3, SceneError> {
+    pub(super) fn vec3(&self, field: &str, v: &Spanned<Vec<f32>>) -> Result<Vec3, SceneError> {
         let value = Vec3::from_array(self.array(field, v)?);
         if !value.is_finite() || value.abs().max_element() > MAX_COORD_M {
             return Err(self.src.invalid(
@@ -152,7 +152,11 @@ impl Loader<'_> {
         Ok(value)
     }
 
-    fn rotation(&self, field: &str, v: Option<&Spanned<Vec<f32>>>) -> Result<Quat, SceneError> {
+    pub(super) fn rotation(
+        &self,
+        field: &str,
+        v: Option<&Spanned<Vec<f32>>>,
+    ) -> Result<Quat, SceneError> {
         let Some(v) = v else {
             return Ok(Quat::IDENTITY);
         };
@@ -227,6 +231,7 @@ impl Loader<'_> {
             },
         };
 
+        let motion = self.motion(&raw.motion, raw.light.frame, object.rotation)?;
         let floor = self.plane("floor", &raw.floor)?;
         let background = self.plane("background", &raw.background)?;
 
@@ -374,6 +379,8 @@ impl Loader<'_> {
             inducer,
             gaze,
             caustics,
+            motion,
+            light_in_frame_m: light_offset,
         })
     }
 
@@ -525,6 +532,9 @@ impl Loader<'_> {
             mesh: model.mesh,
             world_from_model,
             center_m: position,
+            rotation,
+            scale,
+            model_center: center_model,
             radius_m: radius_model * scale,
             ior,
             ior_source,

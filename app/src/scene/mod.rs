@@ -20,6 +20,7 @@ mod fixation;
 mod image;
 mod load;
 mod mesh;
+mod motion;
 
 use std::path::PathBuf;
 
@@ -38,6 +39,7 @@ pub use fixation::{
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
 pub use load::{load_scene, load_scene_from};
 pub use mesh::{Mesh, load_mesh};
+pub use motion::{LightKey, MAX_KEYFRAMES, MAX_TIME_S, Motion, ObjectKey, Placement};
 
 /// A fully loaded scene, in the world frame described in the module docs.
 #[derive(Clone, Debug)]
@@ -70,6 +72,11 @@ pub struct Scene {
     /// The caustic bake (eq. 6): where it is and, once [`Scene::load_caustics`] ran, its
     /// gain map.
     pub caustics: Caustics,
+    /// How the object and the light move (`[motion]`; empty: they stand still).
+    pub motion: Motion,
+    /// `[light] position_m` as written: world, or an offset from the object's position when
+    /// [`Motion::light_follows_object`].
+    pub light_in_frame_m: Vec3,
 }
 
 /// `[caustics]`: the scene's caustic gain bake (docs/caustics.md).
@@ -83,10 +90,30 @@ pub struct Caustics {
 }
 
 impl Scene {
+    /// Where `[object]` and `[light]` put the object and the light.
+    pub fn rest_placement(&self) -> Placement {
+        Placement {
+            object_position_m: self.object.center_m,
+            object_rotation: self.object.rotation,
+            light_position_m: self.light.position_m,
+        }
+    }
+
+    /// Where the object and the light are `time_s` seconds after the first frame.
+    pub fn placement_at(&self, time_s: f64) -> Placement {
+        self.motion
+            .placement_at(time_s, self.rest_placement(), self.light_in_frame_m)
+    }
+
     /// Reads the scene's caustic bake into [`Caustics::gain`], checking that it was baked
     /// for this scene (its stored hash equals [`Scene::hash`]). Errors name the file: no bake
-    /// named, missing, corrupt, or made for another scene.
+    /// named, missing, corrupt, or made for another scene; a moving scene is refused.
     pub fn load_caustics(&mut self) -> Result<(), crate::caustics::BakeError> {
+        if self.motion.is_animated() {
+            return Err(crate::caustics::BakeError::MovingScene {
+                scene: self.path.clone(),
+            });
+        }
         let path =
             self.caustics
                 .bake
@@ -153,6 +180,12 @@ pub struct Object {
     pub world_from_model: Mat4,
     /// World centre of the bounding sphere, metres (the object's `position_m`).
     pub center_m: Vec3,
+    /// The object's orientation (`rotation_deg`).
+    pub rotation: Quat,
+    /// Uniform scale from model units to metres.
+    pub scale: f32,
+    /// Centre of the mesh's bounding box, model units (moved to `center_m`).
+    pub model_center: Vec3,
     /// World radius of the bounding sphere about `center_m`, metres.
     pub radius_m: f32,
     /// Refractive index relative to air.
@@ -166,6 +199,15 @@ pub struct Object {
     pub surface_transmittance: f32,
     /// The glTF/GLB file.
     pub model_path: PathBuf,
+}
+
+impl Object {
+    /// Model to world with the bounding-box centre at `position_m` and orientation
+    /// `rotation`: [`Object::world_from_model`] for another placement.
+    pub fn world_from_model_at(&self, position_m: Vec3, rotation: Quat) -> Mat4 {
+        Mat4::from_scale_rotation_translation(Vec3::splat(self.scale), rotation, position_m)
+            * Mat4::from_translation(-self.model_center)
+    }
 }
 
 /// The point light.

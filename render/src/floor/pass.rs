@@ -5,9 +5,9 @@
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 
-use super::fields::{DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY};
+use super::fields::{CLEAR, DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY};
 use super::geometry::{
-    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, union_rect,
+    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect, union_rect,
 };
 use super::jump_flood::{COMBINE, FieldDraw, RAMP, distance_passes};
 use super::overlay::OverlayPass;
@@ -296,7 +296,13 @@ impl InducerPass {
                     0,
                     [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
                 );
-                self.full_screen(ctx, cmd, OVERLAY, COMBINE, self.combine_set, &push);
+                // Nothing is drawn outside the overlay's rectangle: the gain there stays 0.
+                let extent = self.targets[OVERLAY].extent;
+                let scissor = self
+                    .overlay_rect(inducer, caustics)
+                    .map(|r| texel_rect(r, extent.width, extent.height));
+                let set = self.combine_set;
+                self.full_screen(ctx, cmd, OVERLAY, COMBINE, set, &push, scissor);
             }
         }
         prepared
@@ -332,10 +338,15 @@ impl InducerPass {
         scene: &GpuScene,
     ) {
         let d = &ctx.device;
+        let n = self.desc.resolution_px;
+        // Only the part of the floor the inducer can light (the shadow and its ramp) is
+        // computed; the rest keeps the cleared values (lit, beyond the ramp, no gain).
+        let scissor = self.rect.map(|r| texel_rect(r, n, n));
+        let span = scissor.map_or(n, |[x0, y0, x1, y1]| (x1 - x0).max(y1 - y0));
         // SAFETY: the caller's contract: `cmd` records outside a render pass and everything
         // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it.
         unsafe {
-            self.targets[MASK].begin(d, cmd);
+            self.targets[MASK].begin(d, cmd, CLEAR[MASK], scissor);
             if let Some(clip_from_model) = self.mask_clip_from_model {
                 d.cmd_bind_pipeline(
                     cmd,
@@ -360,21 +371,20 @@ impl InducerPass {
                 source: DISTANCE,
                 step: 0,
             };
-            for draw in distance_passes(self.desc.resolution_px)
-                .into_iter()
-                .chain([ramp])
-            {
+            for draw in distance_passes(span).into_iter().chain([ramp]) {
                 let push = self.push(draw.step, [0.0; 2]);
                 let set = self.source_sets[draw.source];
-                self.full_screen(ctx, cmd, draw.target, draw.pipeline, set, &push);
+                self.full_screen(ctx, cmd, draw.target, draw.pipeline, set, &push, scissor);
             }
         }
     }
 
-    /// One full-screen pass of `pipeline` into field `target`.
+    /// One full-screen pass of `pipeline` into field `target`, drawing only inside
+    /// `scissor` (texels; `None`: everywhere) after clearing the whole field.
     ///
     /// # Safety
     /// As [`InducerPass::prepare`]; `set` must be one of this pass's sets.
+    #[allow(clippy::too_many_arguments)]
     unsafe fn full_screen(
         &self,
         ctx: &GpuContext,
@@ -383,12 +393,13 @@ impl InducerPass {
         pipeline: usize,
         set: vk::DescriptorSet,
         push: &FieldPush,
+        scissor: Option<[u32; 4]>,
     ) {
         let d = &ctx.device;
         // SAFETY: the caller's contract; the pipeline, layout, set and target are this
         // pass's.
         unsafe {
-            self.targets[target].begin(d, cmd);
+            self.targets[target].begin(d, cmd, CLEAR[target], scissor);
             d.cmd_bind_pipeline(
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,

@@ -45,7 +45,13 @@ pub struct BenchOptions {
     /// Pupil diameters to sweep for effect sets with defocus, millimetres (empty: the
     /// scene's).
     pub pupils_mm: Vec<f32>,
+    /// Also time each variant with the light moving every frame (alternated with the same
+    /// variant standing still).
+    pub moving: bool,
 }
+
+/// Degrees the light turns about the vertical axis through the object on each moving frame.
+pub const MOVING_LIGHT_STEP_DEG: f32 = 1.0;
 
 /// One variant's figures.
 #[derive(Clone, Debug, Serialize)]
@@ -54,8 +60,13 @@ pub struct VariantResult {
     pub effects: String,
     /// Texture fetches per covered pixel of the glass, by the shader's structure.
     pub fetches_per_pixel: u32,
-    /// GPU milliseconds per stereo frame.
+    /// Whether the light moved on every frame of this variant.
+    pub moving: bool,
+    /// GPU milliseconds per stereo frame (the eye passes).
     pub gpu_ms: Option<Spread>,
+    /// GPU milliseconds per frame of the floor fields' work before the eye passes (the
+    /// shadow inducer's recomputation after a move, the overlay gain's combination).
+    pub prepare_gpu_ms: Option<Spread>,
     /// CPU milliseconds per stereo frame (recording and submission).
     pub cpu_ms: Option<Spread>,
     /// Wall-clock milliseconds per stereo frame, submission to completion.
@@ -66,6 +77,11 @@ pub struct VariantResult {
     pub cpu_ratio: Option<f64>,
     /// Median wall time over the baseline's.
     pub wall_ratio: Option<f64>,
+    /// Moving variants: median GPU time (fields and eye passes) over the same variant's
+    /// standing still.
+    pub gpu_over_static: Option<f64>,
+    /// Moving variants: median wall time over the same variant's standing still.
+    pub wall_over_static: Option<f64>,
 }
 
 /// A benchmark's result.
@@ -192,7 +208,29 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         .context("preparing the renderer")?;
     drop(setup);
 
+    // With --moving every variant runs twice in a row per frame: the light moved, then the
+    // same pose again (nothing moved since the frame before).
+    let (labels, mut planners, moving): (Vec<String>, Vec<LookPlanner>, Vec<bool>) =
+        if options.moving {
+            let mut out = (Vec::new(), Vec::new(), Vec::new());
+            for (label, planner) in labels.into_iter().zip(planners) {
+                out.0.push(format!("{label} moving"));
+                out.1.push(planner.restarted());
+                out.2.push(true);
+                out.0.push(label);
+                out.1.push(planner);
+                out.2.push(false);
+            }
+            out
+        } else {
+            let n = labels.len();
+            (labels, planners, vec![false; n])
+        };
+    let center = scene.object.center_m;
+    let rest = scene.rest_placement();
+    let mut turns = 0u32;
     let n = planners.len();
+    let mut prepare = vec![Vec::new(); n];
     let mut gpu = vec![Vec::new(); n];
     let mut cpu = vec![Vec::new(); n];
     let mut wall = vec![Vec::new(); n];
@@ -202,6 +240,17 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             let started = Instant::now();
             let (look, _) = planner.plan(input);
             looks[v] = look;
+            if moving[v] {
+                turns += 1;
+                let turn = glam::Quat::from_rotation_y(
+                    (turns as f32 * MOVING_LIGHT_STEP_DEG).to_radians(),
+                );
+                let placement = crate::scene::Placement {
+                    light_position_m: center + turn * (rest.light_position_m - center),
+                    ..rest
+                };
+                renderer.set_pose(views::scene_pose(&scene, &placement));
+            }
             let params = views::frame_params(input, look);
             renderer.submit(&params, Want::default())?;
             let result = renderer.flush()?.pop().expect("one frame in flight");
@@ -209,6 +258,9 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             if k >= WARM_UP_FRAMES {
                 if let Some(g) = result.timing.gpu_ms {
                     gpu[v].push(g);
+                }
+                if let Some(p) = result.timing.prepare_gpu_ms {
+                    prepare[v].push(p);
                 }
                 cpu[v].push(result.timing.cpu_submit_ms);
                 wall[v].push(wall_ms);
@@ -233,24 +285,42 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             )
         })
         .collect();
+    // GPU time of a whole frame: the fields' work and the eye passes.
+    let total_gpu: Vec<Option<Spread>> = (0..n)
+        .map(|i| {
+            Spread::of(
+                gpu[i]
+                    .iter()
+                    .zip(prepare[i].iter().chain(std::iter::repeat(&0.0)))
+                    .map(|(g, p)| g + p),
+            )
+        })
+        .collect();
     let ratio = |a: Option<Spread>, b: Option<Spread>| match (a, b) {
         (Some(a), Some(b)) if b.median_ms > 0.0 => Some(a.median_ms / b.median_ms),
         _ => None,
     };
-    let base = spreads[0];
-    let results = labels
-        .iter()
-        .zip(&looks)
-        .zip(&spreads)
-        .map(|((label, look), &(g, c, wl))| VariantResult {
-            effects: label.clone(),
-            fetches_per_pixel: fetches_per_pixel(look),
-            gpu_ms: g,
-            cpu_ms: c,
-            wall_ms: wl,
-            gpu_ratio: ratio(g, base.0),
-            cpu_ratio: ratio(c, base.1),
-            wall_ratio: ratio(wl, base.2),
+    // The baseline standing still (the second variant when the first is its moving twin).
+    let base = spreads[usize::from(options.moving)];
+    let results = (0..n)
+        .map(|i| {
+            let (g, c, wl) = spreads[i];
+            // A moving variant's static twin comes right after it.
+            let twin = (moving[i] && i + 1 < n).then_some(i + 1);
+            VariantResult {
+                effects: labels[i].clone(),
+                fetches_per_pixel: fetches_per_pixel(&looks[i]),
+                moving: moving[i],
+                gpu_ms: g,
+                prepare_gpu_ms: Spread::of(prepare[i].iter().copied()),
+                cpu_ms: c,
+                wall_ms: wl,
+                gpu_ratio: ratio(g, base.0),
+                cpu_ratio: ratio(c, base.1),
+                wall_ratio: ratio(wl, base.2),
+                gpu_over_static: twin.and_then(|t| ratio(total_gpu[i], total_gpu[t])),
+                wall_over_static: twin.and_then(|t| ratio(wl, spreads[t].2)),
+            }
         })
         .collect();
     Ok(BenchReport {
@@ -275,7 +345,7 @@ impl BenchReport {
         );
         let _ = writeln!(
             out,
-            "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7}",
+            "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8}",
             "effects",
             "fetch",
             "GPU ms (p10-p90)",
@@ -283,7 +353,10 @@ impl BenchReport {
             "CPU ms (p10-p90)",
             "ratio",
             "wall ms (p10-p90)",
-            "ratio"
+            "ratio",
+            "fields GPU ms",
+            "GPU/still",
+            "wall/still"
         );
         let cell = |s: Option<Spread>| {
             s.map_or("n/a".to_string(), |s| {
@@ -294,7 +367,7 @@ impl BenchReport {
         for v in &self.variants {
             let _ = writeln!(
                 out,
-                "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7}",
+                "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8}",
                 v.effects,
                 v.fetches_per_pixel,
                 cell(v.gpu_ms),
@@ -302,7 +375,10 @@ impl BenchReport {
                 cell(v.cpu_ms),
                 r(v.cpu_ratio),
                 cell(v.wall_ms),
-                r(v.wall_ratio)
+                r(v.wall_ratio),
+                cell(v.prepare_gpu_ms),
+                r(v.gpu_over_static),
+                r(v.wall_over_static)
             );
         }
         out

@@ -190,6 +190,10 @@ enum Command {
             allow_negative_numbers = true
         )]
         pupils_mm: Vec<f32>,
+        /// Also time each variant with the light turning 1 degree about the object every
+        /// frame, alternated with the same variant standing still.
+        #[arg(long)]
+        moving: bool,
     },
     /// Replay a scene again and again in one process (a new Vulkan device and renderer each
     /// pass, validation on) and check that resident memory stays flat and validation silent.
@@ -454,6 +458,7 @@ fn run(cli: Cli) -> Result<()> {
             validate,
             device,
             pupils_mm,
+            moving,
         } => {
             let report = bench(&BenchOptions {
                 scene,
@@ -464,6 +469,7 @@ fn run(cli: Cli) -> Result<()> {
                 validate,
                 device,
                 pupils_mm,
+                moving,
             })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);

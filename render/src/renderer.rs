@@ -62,6 +62,10 @@ pub struct FrameTiming {
     /// GPU time of the frame's rendering (both eyes, without the readback copy), milliseconds;
     /// `None` when the device cannot write timestamps.
     pub gpu_ms: Option<f64>,
+    /// GPU time of the floor fields' work recorded before the eye passes (the shadow
+    /// inducer's computation after a move, the overlay gain's combination after a switch;
+    /// 0 when none was due), milliseconds; `None` without timestamps.
+    pub prepare_gpu_ms: Option<f64>,
     /// CPU time spent recording and submitting the frame, milliseconds.
     pub cpu_submit_ms: f64,
 }
@@ -95,7 +99,8 @@ struct FrameSlot {
     cmd: vk::CommandBuffer,
     /// Signalled when the slot's last submission finished.
     fence: Owned<vk::Fence>,
-    /// Two timestamps (start, end of rendering), when supported.
+    /// Three timestamps (start of the floor fields' work, start and end of the eye passes),
+    /// when supported.
     queries: Option<Owned<vk::QueryPool>>,
     /// Host-visible copy of both eye layers, then both world layers.
     readback: Buffer,
@@ -199,7 +204,7 @@ impl Renderer {
                 Some(_) => {
                     let info = vk::QueryPoolCreateInfo::default()
                         .query_type(vk::QueryType::TIMESTAMP)
-                        .query_count(2);
+                        .query_count(3);
                     // SAFETY: a valid create info; owned right away.
                     let pool = unsafe { ctx.device.create_query_pool(&info, None) }
                         .vk("vkCreateQueryPool")?;
@@ -375,9 +380,9 @@ impl Renderer {
             return Err(e);
         }
         self.inducer.finished(pending.prepared, true);
-        let gpu_ms = match (&slot.queries, self.ctx.timestamp_period_ns) {
+        let (gpu_ms, prepare_gpu_ms) = match (&slot.queries, self.ctx.timestamp_period_ns) {
             (Some(pool), Some(period)) => {
-                let mut stamps = [0u64; 2];
+                let mut stamps = [0u64; 3];
                 // SAFETY: the frame that wrote both queries finished (its fence signalled
                 // above), so the results are available.
                 unsafe {
@@ -389,9 +394,10 @@ impl Renderer {
                     )
                 }
                 .vk("vkGetQueryPoolResults")?;
-                Some(stamps[1].wrapping_sub(stamps[0]) as f64 * f64::from(period) * 1e-6)
+                let ms = |a: u64, b: u64| Some(b.wrapping_sub(a) as f64 * f64::from(period) * 1e-6);
+                (ms(stamps[1], stamps[2]), ms(stamps[0], stamps[1]))
             }
-            _ => None,
+            _ => (None, None),
         };
         let bytes = if pending.want.eyes {
             Some(slot.readback.mapped()?)
@@ -414,6 +420,7 @@ impl Renderer {
             sequence: pending.sequence,
             timing: FrameTiming {
                 gpu_ms,
+                prepare_gpu_ms,
                 cpu_submit_ms: pending.cpu_submit_ms,
             },
             readback,
@@ -464,16 +471,20 @@ impl Renderer {
             if self.pose != self.glass_pose {
                 self.glass.record_pose(&self.ctx, cmd, &self.pose);
             }
+            let queries = slot.queries.as_ref().map(Owned::raw);
+            if let Some(pool) = queries {
+                d.cmd_reset_query_pool(cmd, pool, 0, 3);
+                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 0);
+            }
             let (inducer, caustics) = (params.look.inducer, params.look.caustics);
             if inducer || caustics {
-                // Once per scene (and per change of these switches), before the timed part.
+                // Once per pose (and per change of these switches), timed on its own.
                 prepared = self
                     .inducer
                     .prepare(&self.ctx, cmd, &self.scene, inducer, caustics);
             }
-            if let Some(pool) = slot.queries.as_ref().map(Owned::raw) {
-                d.cmd_reset_query_pool(cmd, pool, 0, 2);
-                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 0);
+            if let Some(pool) = queries {
+                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 1);
             }
             for (index, eye) in params.eyes.iter().enumerate() {
                 self.begin_pass(
@@ -503,8 +514,8 @@ impl Renderer {
                 );
                 d.cmd_end_render_pass(cmd);
             }
-            if let Some(pool) = slot.queries.as_ref().map(Owned::raw) {
-                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 1);
+            if let Some(pool) = queries {
+                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 2);
             }
             if want.eyes && want.world {
                 for (index, eye) in params.eyes.iter().enumerate() {

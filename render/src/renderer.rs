@@ -23,6 +23,7 @@ use crate::target::{self, StereoTarget};
 use crate::world::WorldPass;
 
 mod composition;
+mod copy;
 mod external;
 
 pub use composition::Composition;
@@ -544,36 +545,7 @@ impl Renderer {
                 if want.world {
                     copies.push((self.world_target.color.image, 2 * layer_bytes));
                 }
-                for (image, offset) in copies {
-                    let region = vk::BufferImageCopy::default()
-                        .buffer_offset(offset)
-                        .image_subresource(vk::ImageSubresourceLayers {
-                            aspect_mask: vk::ImageAspectFlags::COLOR,
-                            mip_level: 0,
-                            base_array_layer: 0,
-                            layer_count: 2,
-                        })
-                        .image_extent(vk::Extent3D {
-                            width: self.extent.width,
-                            height: self.extent.height,
-                            depth: 1,
-                        });
-                    d.cmd_copy_image_to_buffer(
-                        cmd,
-                        image,
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                        slot.readback.buffer,
-                        &[region],
-                    );
-                }
-                let to_host = vk::BufferMemoryBarrier::default()
-                    .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                    .dst_access_mask(vk::AccessFlags::HOST_READ)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(slot.readback.buffer)
-                    .offset(0)
-                    .size(vk::WHOLE_SIZE);
+                copy::record_readback(d, cmd, &copies, self.extent, slot.readback.buffer);
                 if external_image {
                     external::transition(
                         d,
@@ -583,15 +555,6 @@ impl Renderer {
                         vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                     );
                 }
-                d.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::HOST,
-                    vk::DependencyFlags::empty(),
-                    &[],
-                    &[to_host],
-                    &[],
-                );
             }
         }
         prepared

@@ -205,9 +205,15 @@ impl Object {
     /// Model to world with the bounding-box centre at `position_m` and orientation
     /// `rotation`: [`Object::world_from_model`] for another placement.
     pub fn world_from_model_at(&self, position_m: Vec3, rotation: Quat) -> Mat4 {
-        Mat4::from_scale_rotation_translation(Vec3::splat(self.scale), rotation, position_m)
-            * Mat4::from_translation(-self.model_center)
+        model_placement(self.scale, self.model_center, position_m, rotation)
     }
+}
+
+/// Model to world for a mesh scaled by `scale` about its bounding-box centre `model_center`
+/// (model units), turned by `rotation` and moved to `position_m`.
+pub fn model_placement(scale: f32, model_center: Vec3, position_m: Vec3, rotation: Quat) -> Mat4 {
+    Mat4::from_scale_rotation_translation(Vec3::splat(scale), rotation, position_m)
+        * Mat4::from_translation(-model_center)
 }
 
 /// The point light.

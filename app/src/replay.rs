@@ -20,9 +20,11 @@ use crate::frame_log::{FrameLog, PupilSummary};
 use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
 pub use crate::look::GazeSettings;
 use crate::look::LookPlanner;
+use crate::motion_clock::MotionClock;
 use crate::output::{self, write_atomic};
 use crate::reference_view::side_by_side;
 use crate::scene::{Scene, load_scene};
+pub use crate::spread::Spread;
 use crate::trace_cmd::synth_params_for;
 use crate::views;
 
@@ -60,34 +62,6 @@ pub struct ReplayOptions {
     pub reference: bool,
     /// Depth filter and gaze-image override of the gaze pipeline (used with defocus).
     pub gaze: GazeSettings,
-}
-
-/// Median and spread of a timing.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct Spread {
-    /// Median, milliseconds.
-    pub median_ms: f64,
-    /// 10th percentile, milliseconds.
-    pub p10_ms: f64,
-    /// 90th percentile, milliseconds.
-    pub p90_ms: f64,
-}
-
-impl Spread {
-    /// The spread of `values`, or `None` when empty.
-    pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Spread> {
-        let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
-        if v.is_empty() {
-            return None;
-        }
-        v.sort_by(f64::total_cmp);
-        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-        Some(Spread {
-            median_ms: at(0.5),
-            p10_ms: at(0.1),
-            p90_ms: at(0.9),
-        })
-    }
 }
 
 /// Validation layer results.
@@ -231,46 +205,7 @@ struct Saver<'a> {
     /// The first error writing the log, reported when the next frame finishes.
     log_error: Option<anyhow::Error>,
     /// How the scene moves, with the time of the first frame once it came.
-    motion: MotionClock<'a>,
-}
-
-/// Turns frame times into the scene's poses (`[motion]`) and counts the frames that moved.
-pub(crate) struct MotionClock<'a> {
-    /// The scene, when it moves.
-    scene: Option<&'a Scene>,
-    /// Time of the first frame, the backend's clock, nanoseconds.
-    start_ns: Option<i64>,
-    /// The previous frame's pose.
-    last: Option<ScenePose>,
-    /// Frames whose pose differed from the previous frame's.
-    pub moved_frames: u64,
-}
-
-impl<'a> MotionClock<'a> {
-    /// A clock for `scene`; it gives poses only when the scene moves.
-    pub fn new(scene: &'a Scene) -> MotionClock<'a> {
-        MotionClock {
-            scene: scene.motion.is_animated().then_some(scene),
-            start_ns: None,
-            last: None,
-            moved_frames: 0,
-        }
-    }
-
-    /// The pose of the frame at `time_ns`, moving the planner's object centre with it;
-    /// `None` for a scene that stands still.
-    pub fn pose(&mut self, time_ns: i64, planner: &mut LookPlanner) -> Option<ScenePose> {
-        let scene = self.scene?;
-        let start = *self.start_ns.get_or_insert(time_ns);
-        let placement = scene.placement_at(views::seconds_since(start, time_ns));
-        planner.set_object_center(placement.object_position_m);
-        let pose = views::scene_pose(scene, &placement);
-        if self.last.is_some_and(|last| last != pose) {
-            self.moved_frames += 1;
-        }
-        self.last = Some(pose);
-        Some(pose)
-    }
+    motion: MotionClock,
 }
 
 impl FrameSink for Saver<'_> {

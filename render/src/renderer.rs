@@ -271,6 +271,23 @@ impl Renderer {
         self.inducer.set_pose(pose);
     }
 
+    /// Computes the caustics on the GPU for every pose from now on instead of using the
+    /// scene's bake (docs/caustics.md); `scene` must be the description the renderer was
+    /// made with.
+    pub fn enable_live_caustics(
+        &mut self,
+        scene: &SceneDesc,
+        live: crate::floor::LiveCausticsDesc,
+    ) -> Result<()> {
+        self.inducer.enable_live(&self.ctx, scene, live)
+    }
+
+    /// The live caustic gain map of the last finished frame that computed it (call
+    /// [`Renderer::flush`] first); `None` without live caustics.
+    pub fn live_caustic_gain(&self) -> Result<Option<Vec<f32>>> {
+        self.inducer.live_gain()
+    }
+
     /// How many times the shadow inducer's fields (mask, distance, gain) were computed: once
     /// for the first frame that drew them, then once per frame after the object or light moved.
     pub fn inducer_computations(&self) -> u64 {

@@ -10,6 +10,7 @@ use super::geometry::{
     Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect, union_rect,
 };
 use super::jump_flood::{COMBINE, FieldDraw, RAMP, distance_passes};
+use super::live::{LiveCaustics, LiveCausticsDesc};
 use super::overlay::OverlayPass;
 use super::progress::{Prepared, Progress};
 use crate::camera::EyeParams;
@@ -66,7 +67,9 @@ pub(crate) struct InducerPass {
     /// The combine pass's set: the gain and G.
     combine_set: vk::DescriptorSet,
     /// The caustic gain G (R32F, read texel for texel by fs_combine; zeros without a map).
-    _caustic: Image,
+    caustic: Image,
+    /// Caustics computed per pose into `caustic`, once enabled.
+    live: Option<LiveCaustics>,
     /// Mask, seeds (two), distance, gain and overlay gain, in the order of [`FIELDS`].
     pub(super) targets: Vec<FieldTarget>,
 }
@@ -229,7 +232,8 @@ impl InducerPass {
             _field_set_layout: field_set_layout,
             source_sets,
             combine_set,
-            _caustic: caustic,
+            caustic,
+            live: None,
             targets,
         })
     }
@@ -246,6 +250,35 @@ impl InducerPass {
         self.rect = rect;
         self.pose = pose;
         self.progress.invalidate();
+    }
+
+    /// Computes the caustic gain map on the GPU for each pose from now on (with the fields,
+    /// so on the next frame drawing the overlay and after every move), at the map's current
+    /// size (the bake's, or the inducer's resolution without one); the overlay may then
+    /// cover the whole floor.
+    pub fn enable_live(
+        &mut self,
+        ctx: &GpuContext,
+        desc: &SceneDesc,
+        live: LiveCausticsDesc,
+    ) -> Result<()> {
+        let extent = self.targets[OVERLAY].extent;
+        self.live = Some(LiveCaustics::new(
+            ctx,
+            &desc.mesh,
+            desc.ior,
+            self.world_from_plane,
+            [extent.width, extent.height],
+            live,
+        )?);
+        self.caustic_rect = Some([-0.5, -0.5, 0.5, 0.5]);
+        self.progress.invalidate();
+        Ok(())
+    }
+
+    /// The live caustic gain map of the last finished computation, if live caustics are on.
+    pub fn live_gain(&self) -> Result<Option<Vec<f32>>> {
+        self.live.as_ref().map(LiveCaustics::gain).transpose()
     }
 
     /// How many computations of the fields were submitted since the pass was made.
@@ -290,6 +323,9 @@ impl InducerPass {
         unsafe {
             if prepared.fields {
                 self.record_fields(ctx, cmd, scene);
+                if let Some(live) = &self.live {
+                    live.record(ctx, cmd, &self.pose, &self.caustic);
+                }
             }
             if prepared.combined.is_some() {
                 let push = self.push(

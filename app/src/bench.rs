@@ -206,6 +206,12 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     let (w, h) = options.size;
     let mut renderer = Renderer::new(ctx, &views::scene_desc(&scene, setup.as_ref()), w, h)
         .context("preparing the renderer")?;
+    views::enable_live_caustics(
+        &mut renderer,
+        &scene,
+        options.effects.iter().any(|set| set.caustics),
+    )
+    .context("preparing live caustics")?;
     drop(setup);
 
     // With --moving every variant runs twice in a row per frame: the light moved, then the

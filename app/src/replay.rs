@@ -338,6 +338,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         height,
     )
     .context("preparing the renderer")?;
+    views::enable_live_caustics(&mut renderer, &scene, effects.caustics)
+        .context("preparing live caustics")?;
     drop(defocus);
 
     let frames_dir = options.out.join("frames");

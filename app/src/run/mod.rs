@@ -263,6 +263,8 @@ pub fn run(options: &RunOptions) -> Result<RunSummary> {
         height,
     )
     .context("preparing the renderer")?;
+    views::enable_live_caustics(&mut renderer, &scene, caustics_loaded)
+        .context("preparing live caustics")?;
     drop(defocus);
     // SAFETY: `handles` are the instance, device and queue this runtime created for the
     // renderer's context (XrDeviceCreator); the renderer owns them and outlives `session`,

@@ -68,6 +68,9 @@ pub(crate) struct LightKeyToml {
 #[serde(deny_unknown_fields)]
 pub(crate) struct CausticsToml {
     pub bake: Option<Spanned<String>>,
+    pub mode: Option<Spanned<String>>,
+    pub resolution_px: Option<Spanned<i64>>,
+    pub photons_per_side: Option<Spanned<i64>>,
 }
 
 /// `[gaze]`: how the gaze image is chosen for defocus.

@@ -79,14 +79,30 @@ pub struct Scene {
     pub light_in_frame_m: Vec3,
 }
 
-/// `[caustics]`: the scene's caustic gain bake (docs/caustics.md).
+/// How the caustics are made (`[caustics] mode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CausticsMode {
+    /// Read from the scene's bake (offline, one pose).
+    #[default]
+    Baked,
+    /// Computed on the GPU for every pose (photon splatting).
+    Live,
+}
+
+/// `[caustics]`: the scene's caustic gain bake, or live caustics (docs/caustics.md).
 #[derive(Clone, Debug, Default)]
 pub struct Caustics {
     /// The bake file, resolved against the scene's folder; `None` when the scene names none.
     /// Not read (nor hashed) when the scene loads: only when the caustics are asked for.
     pub bake: Option<PathBuf>,
-    /// The gain map, after [`Scene::load_caustics`].
+    /// The gain map, after [`Scene::load_caustics`] (zeros in live mode, filled per pose).
     pub gain: Option<crate::caustics::Bake>,
+    /// Baked or live.
+    pub mode: CausticsMode,
+    /// Side of the live gain map, texels (live mode).
+    pub resolution_px: u32,
+    /// Photons along each side of the live emission grid (live mode).
+    pub photons_per_side: u32,
 }
 
 impl Scene {
@@ -107,8 +123,22 @@ impl Scene {
 
     /// Reads the scene's caustic bake into [`Caustics::gain`], checking that it was baked
     /// for this scene (its stored hash equals [`Scene::hash`]). Errors name the file: no bake
-    /// named, missing, corrupt, or made for another scene; a moving scene is refused.
+    /// named, missing, corrupt, or made for another scene; a moving scene is refused. In live
+    /// mode no file is read: the gain map is zeros of `[caustics] resolution_px`, which the
+    /// renderer fills for each pose ([`crate::views::enable_live_caustics`]).
     pub fn load_caustics(&mut self) -> Result<(), crate::caustics::BakeError> {
+        if self.caustics.mode == CausticsMode::Live {
+            // The map's size; the renderer fills it for every pose.
+            let n = self.caustics.resolution_px;
+            self.caustics.gain = Some(crate::caustics::Bake {
+                width_px: n,
+                height_px: n,
+                gain: vec![0.0; n as usize * n as usize],
+                scene_hash: self.hash.clone(),
+                params: "method=live".into(),
+            });
+            return Ok(());
+        }
         if self.motion.is_animated() {
             return Err(crate::caustics::BakeError::MovingScene {
                 scene: self.path.clone(),

@@ -18,7 +18,7 @@ use crate::gaze::GazeConfig;
 use crate::gaze::blur::check_pupil_diameter_m;
 use crate::look::{DefocusModel, LookPlanner};
 use crate::replay::{Spread, check_size};
-use crate::scene::{load_scene, synth_params_for};
+use crate::scene::{CausticsMode, load_scene, synth_params_for};
 use crate::views;
 
 /// Frames of each variant rendered before timing starts (shaders compile on first use on
@@ -48,6 +48,9 @@ pub struct BenchOptions {
     /// Also time each variant with the light moving every frame (alternated with the same
     /// variant standing still).
     pub moving: bool,
+    /// Also time each variant with caustics computed per pose on the GPU (a second renderer,
+    /// alternated with the scene's baked caustics).
+    pub live_caustics: bool,
 }
 
 /// Degrees the light turns about the vertical axis through the object on each moving frame.
@@ -150,6 +153,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     // gaze pipeline over the same views.
     let mut labels = Vec::new();
     let mut planners = Vec::new();
+    let mut with_caustics = Vec::new();
     for set in &sets {
         let base = views::look(set, options.reflection);
         match (&setup, set.defocus) {
@@ -173,6 +177,24 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 planners.push(LookPlanner::new(base, None));
             }
         }
+        with_caustics.resize(labels.len(), set.caustics);
+    }
+    // With --live-caustics every variant with caustics also runs on a second renderer that
+    // computes them per pose (`<set> live`), right after the same variant with the bake.
+    let mut on_live = vec![false; labels.len()];
+    if options.live_caustics {
+        let mut out = (Vec::new(), Vec::new(), Vec::new());
+        for ((label, planner), caustics) in labels.into_iter().zip(planners).zip(with_caustics) {
+            if caustics {
+                out.0.push(format!("{label} live"));
+                out.1.push(planner.restarted());
+                out.2.push(true);
+            }
+            out.0.push(label);
+            out.1.push(planner);
+            out.2.push(false);
+        }
+        (labels, planners, on_live) = out;
     }
 
     // The same views for every variant: a synthetic trace looking at the object.
@@ -204,34 +226,55 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     .context("setting up the Vulkan device")?;
     let (device, driver) = (ctx.device_name.clone(), ctx.driver.clone());
     let (w, h) = options.size;
+    let any_caustics = options.effects.iter().any(|set| set.caustics);
     let mut renderer = Renderer::new(ctx, &views::scene_desc(&scene, setup.as_ref()), w, h)
         .context("preparing the renderer")?;
-    views::enable_live_caustics(
-        &mut renderer,
-        &scene,
-        options.effects.iter().any(|set| set.caustics),
-    )
-    .context("preparing live caustics")?;
+    views::enable_live_caustics(&mut renderer, &scene, any_caustics)
+        .context("preparing live caustics")?;
+    // The same scene with caustics computed per pose, on a map of the bake's size.
+    let mut live_renderer = match (options.live_caustics, &scene.caustics.gain) {
+        (true, Some(bake)) if scene.caustics.mode == CausticsMode::Baked => {
+            let mut live = scene.clone();
+            live.caustics.mode = CausticsMode::Live;
+            live.caustics.resolution_px = bake.width_px;
+            live.load_caustics()?;
+            let ctx = GpuContext::headless(&ContextOptions {
+                validation: options.validate,
+                device_name: options.device.clone(),
+            })
+            .context("setting up the second Vulkan device")?;
+            let mut r = Renderer::new(ctx, &views::scene_desc(&live, setup.as_ref()), w, h)
+                .context("preparing the live-caustics renderer")?;
+            views::enable_live_caustics(&mut r, &live, true).context("preparing live caustics")?;
+            Some(r)
+        }
+        (true, _) => bail!(
+            "--live-caustics compares with the scene's bake: give a scene with a bake \
+             ([caustics] mode = \"baked\") and an effect set with caustics"
+        ),
+        _ => None,
+    };
     drop(setup);
 
     // With --moving every variant runs twice in a row per frame: the light moved, then the
     // same pose again (nothing moved since the frame before).
-    let (labels, mut planners, moving): (Vec<String>, Vec<LookPlanner>, Vec<bool>) =
-        if options.moving {
-            let mut out = (Vec::new(), Vec::new(), Vec::new());
-            for (label, planner) in labels.into_iter().zip(planners) {
-                out.0.push(format!("{label} moving"));
-                out.1.push(planner.restarted());
-                out.2.push(true);
-                out.0.push(label);
-                out.1.push(planner);
-                out.2.push(false);
-            }
-            out
-        } else {
-            let n = labels.len();
-            (labels, planners, vec![false; n])
-        };
+    let (labels, mut planners, moving, on_live) = if options.moving {
+        let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for ((label, planner), live) in labels.into_iter().zip(planners).zip(on_live) {
+            out.0.push(format!("{label} moving"));
+            out.1.push(planner.restarted());
+            out.2.push(true);
+            out.3.push(live);
+            out.0.push(label);
+            out.1.push(planner);
+            out.2.push(false);
+            out.3.push(live);
+        }
+        out
+    } else {
+        let n = labels.len();
+        (labels, planners, vec![false; n], on_live)
+    };
     let center = scene.object.center_m;
     let rest = scene.rest_placement();
     let mut turns = 0u32;
@@ -243,6 +286,10 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     let mut looks = vec![Look::default(); n];
     for (k, input) in inputs.iter().enumerate() {
         for (v, planner) in planners.iter_mut().enumerate() {
+            let renderer = match &mut live_renderer {
+                Some(live) if on_live[v] => live,
+                _ => &mut renderer,
+            };
             let started = Instant::now();
             let (look, _) = planner.plan(input);
             looks[v] = look;
@@ -273,14 +320,16 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             }
         }
     }
-    let v = renderer.context().validation();
-    if v.errors() + v.warnings() > 0 {
-        bail!(
-            "the Vulkan validation layers reported {} errors and {} warnings; first: {}",
-            v.errors(),
-            v.warnings(),
-            v.messages().first().map(String::as_str).unwrap_or("")
-        );
+    for r in std::iter::once(&renderer).chain(live_renderer.as_ref()) {
+        let v = r.context().validation();
+        if v.errors() + v.warnings() > 0 {
+            bail!(
+                "the Vulkan validation layers reported {} errors and {} warnings; first: {}",
+                v.errors(),
+                v.warnings(),
+                v.messages().first().map(String::as_str).unwrap_or("")
+            );
+        }
     }
     let spreads: Vec<_> = (0..n)
         .map(|i| {

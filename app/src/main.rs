@@ -194,6 +194,10 @@ enum Command {
         /// frame, alternated with the same variant standing still.
         #[arg(long)]
         moving: bool,
+        /// Also time each effect set with caustics on a second renderer that computes them
+        /// per pose on the GPU, alternated with the scene's bake.
+        #[arg(long = "live-caustics")]
+        live_caustics: bool,
     },
     /// Replay a scene again and again in one process (a new Vulkan device and renderer each
     /// pass, validation on) and check that resident memory stays flat and validation silent.
@@ -459,6 +463,7 @@ fn run(cli: Cli) -> Result<()> {
             device,
             pupils_mm,
             moving,
+            live_caustics,
         } => {
             let report = bench(&BenchOptions {
                 scene,
@@ -470,6 +475,7 @@ fn run(cli: Cli) -> Result<()> {
                 device,
                 pupils_mm,
                 moving,
+                live_caustics,
             })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);

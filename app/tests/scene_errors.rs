@@ -540,3 +540,42 @@ fn object_keyframe_rotation_and_repeat_are_checked() {
     let (_dir, _path, result) = load_text(&text);
     assert!(result.unwrap().motion.is_animated());
 }
+
+#[test]
+fn caustics_mode_and_live_sizes_are_checked() {
+    let text = format!("{}\n[caustics]\nmode = \"realtime\"\n", good_text());
+    let msg = expect_error(&text, line_of(&text, "realtime"), "caustics.mode");
+    assert!(msg.contains("baked or live"), "{msg}");
+    let text = format!(
+        "{}\n[caustics]\nmode = \"live\"\nphotons_per_side = 0\n",
+        good_text()
+    );
+    expect_error(
+        &text,
+        line_of(&text, "photons_per_side"),
+        "caustics.photons_per_side",
+    );
+    let text = format!(
+        "{}\n[caustics]\nmode = \"live\"\nresolution_px = 8\n",
+        good_text()
+    );
+    expect_error(
+        &text,
+        line_of(&text, "resolution_px"),
+        "caustics.resolution_px",
+    );
+    // A live scene needs no bake: its map is zeros of the given size until the renderer
+    // fills it.
+    let text = format!(
+        "{}\n[caustics]\nmode = \"live\"\nresolution_px = 64\n",
+        good_text()
+    );
+    let (_dir, _path, result) = load_text(&text);
+    let mut scene = result.unwrap();
+    scene.load_caustics().unwrap();
+    let map = scene.caustics.gain.as_ref().unwrap();
+    assert_eq!(
+        (map.width_px, map.height_px, map.gain.len()),
+        (64, 64, 64 * 64)
+    );
+}

@@ -4,6 +4,8 @@
 mod caustics;
 mod defocus;
 mod inducer;
+mod live_caustics;
+mod motion;
 mod refraction;
 mod render_smoke;
 mod replay;

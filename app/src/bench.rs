@@ -18,7 +18,7 @@ use crate::gaze::GazeConfig;
 use crate::gaze::blur::check_pupil_diameter_m;
 use crate::look::{DefocusModel, LookPlanner};
 use crate::replay::{Spread, check_size};
-use crate::scene::{load_scene, synth_params_for};
+use crate::scene::{CausticsMode, load_scene, synth_params_for};
 use crate::views;
 
 /// Frames of each variant rendered before timing starts (shaders compile on first use on
@@ -45,7 +45,16 @@ pub struct BenchOptions {
     /// Pupil diameters to sweep for effect sets with defocus, millimetres (empty: the
     /// scene's).
     pub pupils_mm: Vec<f32>,
+    /// Also time each variant with the light moving every frame (alternated with the same
+    /// variant standing still).
+    pub moving: bool,
+    /// Also time each variant with caustics computed per pose on the GPU (a second renderer,
+    /// alternated with the scene's baked caustics).
+    pub live_caustics: bool,
 }
+
+/// Degrees the light turns about the vertical axis through the object on each moving frame.
+pub const MOVING_LIGHT_STEP_DEG: f32 = 1.0;
 
 /// One variant's figures.
 #[derive(Clone, Debug, Serialize)]
@@ -54,8 +63,13 @@ pub struct VariantResult {
     pub effects: String,
     /// Texture fetches per covered pixel of the glass, by the shader's structure.
     pub fetches_per_pixel: u32,
-    /// GPU milliseconds per stereo frame.
+    /// Whether the light moved on every frame of this variant.
+    pub moving: bool,
+    /// GPU milliseconds per stereo frame (the eye passes).
     pub gpu_ms: Option<Spread>,
+    /// GPU milliseconds per frame of the floor fields' work before the eye passes (the
+    /// shadow inducer's recomputation after a move, the overlay gain's combination).
+    pub prepare_gpu_ms: Option<Spread>,
     /// CPU milliseconds per stereo frame (recording and submission).
     pub cpu_ms: Option<Spread>,
     /// Wall-clock milliseconds per stereo frame, submission to completion.
@@ -66,6 +80,11 @@ pub struct VariantResult {
     pub cpu_ratio: Option<f64>,
     /// Median wall time over the baseline's.
     pub wall_ratio: Option<f64>,
+    /// Moving variants: median GPU time (fields and eye passes) over the same variant's
+    /// standing still.
+    pub gpu_over_static: Option<f64>,
+    /// Moving variants: median wall time over the same variant's standing still.
+    pub wall_over_static: Option<f64>,
 }
 
 /// A benchmark's result.
@@ -134,6 +153,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     // gaze pipeline over the same views.
     let mut labels = Vec::new();
     let mut planners = Vec::new();
+    let mut with_caustics = Vec::new();
     for set in &sets {
         let base = views::look(set, options.reflection);
         match (&setup, set.defocus) {
@@ -157,6 +177,24 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 planners.push(LookPlanner::new(base, None));
             }
         }
+        with_caustics.resize(labels.len(), set.caustics);
+    }
+    // With --live-caustics every variant with caustics also runs on a second renderer that
+    // computes them per pose (`<set> live`), right after the same variant with the bake.
+    let mut on_live = vec![false; labels.len()];
+    if options.live_caustics {
+        let mut out = (Vec::new(), Vec::new(), Vec::new());
+        for ((label, planner), caustics) in labels.into_iter().zip(planners).zip(with_caustics) {
+            if caustics {
+                out.0.push(format!("{label} live"));
+                out.1.push(planner.restarted());
+                out.2.push(true);
+            }
+            out.0.push(label);
+            out.1.push(planner);
+            out.2.push(false);
+        }
+        (labels, planners, on_live) = out;
     }
 
     // The same views for every variant: a synthetic trace looking at the object.
@@ -188,20 +226,84 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     .context("setting up the Vulkan device")?;
     let (device, driver) = (ctx.device_name.clone(), ctx.driver.clone());
     let (w, h) = options.size;
+    let any_caustics = options.effects.iter().any(|set| set.caustics);
     let mut renderer = Renderer::new(ctx, &views::scene_desc(&scene, setup.as_ref()), w, h)
         .context("preparing the renderer")?;
+    views::enable_live_caustics(&mut renderer, &scene, any_caustics)
+        .context("preparing live caustics")?;
+    // The same scene with caustics computed per pose, on a map of the bake's size.
+    let mut live_renderer = match (options.live_caustics, &scene.caustics.gain) {
+        (true, Some(bake)) if scene.caustics.mode == CausticsMode::Baked => {
+            let mut live = scene.clone();
+            live.caustics.mode = CausticsMode::Live;
+            live.caustics.resolution_px = bake.width_px;
+            live.load_caustics()?;
+            let ctx = GpuContext::headless(&ContextOptions {
+                validation: options.validate,
+                device_name: options.device.clone(),
+            })
+            .context("setting up the second Vulkan device")?;
+            let mut r = Renderer::new(ctx, &views::scene_desc(&live, setup.as_ref()), w, h)
+                .context("preparing the live-caustics renderer")?;
+            views::enable_live_caustics(&mut r, &live, true).context("preparing live caustics")?;
+            Some(r)
+        }
+        (true, _) => bail!(
+            "--live-caustics compares with the scene's bake: give a scene with a bake \
+             ([caustics] mode = \"baked\") and an effect set with caustics"
+        ),
+        _ => None,
+    };
     drop(setup);
 
+    // With --moving every variant runs twice in a row per frame: the light moved, then the
+    // same pose again (nothing moved since the frame before).
+    let (labels, mut planners, moving, on_live) = if options.moving {
+        let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for ((label, planner), live) in labels.into_iter().zip(planners).zip(on_live) {
+            out.0.push(format!("{label} moving"));
+            out.1.push(planner.restarted());
+            out.2.push(true);
+            out.3.push(live);
+            out.0.push(label);
+            out.1.push(planner);
+            out.2.push(false);
+            out.3.push(live);
+        }
+        out
+    } else {
+        let n = labels.len();
+        (labels, planners, vec![false; n], on_live)
+    };
+    let center = scene.object.center_m;
+    let rest = scene.rest_placement();
+    let mut turns = 0u32;
     let n = planners.len();
+    let mut prepare = vec![Vec::new(); n];
     let mut gpu = vec![Vec::new(); n];
     let mut cpu = vec![Vec::new(); n];
     let mut wall = vec![Vec::new(); n];
     let mut looks = vec![Look::default(); n];
     for (k, input) in inputs.iter().enumerate() {
         for (v, planner) in planners.iter_mut().enumerate() {
+            let renderer = match &mut live_renderer {
+                Some(live) if on_live[v] => live,
+                _ => &mut renderer,
+            };
             let started = Instant::now();
             let (look, _) = planner.plan(input);
             looks[v] = look;
+            if moving[v] {
+                turns += 1;
+                let turn = glam::Quat::from_rotation_y(
+                    (turns as f32 * MOVING_LIGHT_STEP_DEG).to_radians(),
+                );
+                let placement = crate::scene::Placement {
+                    light_position_m: center + turn * (rest.light_position_m - center),
+                    ..rest
+                };
+                renderer.set_pose(views::scene_pose(&scene, &placement));
+            }
             let params = views::frame_params(input, look);
             renderer.submit(&params, Want::default())?;
             let result = renderer.flush()?.pop().expect("one frame in flight");
@@ -210,12 +312,17 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 if let Some(g) = result.timing.gpu_ms {
                     gpu[v].push(g);
                 }
+                if let Some(p) = result.timing.prepare_gpu_ms {
+                    prepare[v].push(p);
+                }
                 cpu[v].push(result.timing.cpu_submit_ms);
                 wall[v].push(wall_ms);
             }
         }
     }
-    crate::frame_loop::ensure_validation_clean(&renderer)?;
+    for r in std::iter::once(&renderer).chain(live_renderer.as_ref()) {
+        crate::frame_loop::ensure_validation_clean(r)?;
+    }
     let spreads: Vec<_> = (0..n)
         .map(|i| {
             (
@@ -225,24 +332,42 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             )
         })
         .collect();
+    // GPU time of a whole frame: the fields' work and the eye passes.
+    let total_gpu: Vec<Option<Spread>> = (0..n)
+        .map(|i| {
+            Spread::of(
+                gpu[i]
+                    .iter()
+                    .zip(prepare[i].iter().chain(std::iter::repeat(&0.0)))
+                    .map(|(g, p)| g + p),
+            )
+        })
+        .collect();
     let ratio = |a: Option<Spread>, b: Option<Spread>| match (a, b) {
         (Some(a), Some(b)) if b.median_ms > 0.0 => Some(a.median_ms / b.median_ms),
         _ => None,
     };
-    let base = spreads[0];
-    let results = labels
-        .iter()
-        .zip(&looks)
-        .zip(&spreads)
-        .map(|((label, look), &(g, c, wl))| VariantResult {
-            effects: label.clone(),
-            fetches_per_pixel: fetches_per_pixel(look),
-            gpu_ms: g,
-            cpu_ms: c,
-            wall_ms: wl,
-            gpu_ratio: ratio(g, base.0),
-            cpu_ratio: ratio(c, base.1),
-            wall_ratio: ratio(wl, base.2),
+    // The baseline standing still (the second variant when the first is its moving twin).
+    let base = spreads[usize::from(options.moving)];
+    let results = (0..n)
+        .map(|i| {
+            let (g, c, wl) = spreads[i];
+            // A moving variant's static twin comes right after it.
+            let twin = (moving[i] && i + 1 < n).then_some(i + 1);
+            VariantResult {
+                effects: labels[i].clone(),
+                fetches_per_pixel: fetches_per_pixel(&looks[i]),
+                moving: moving[i],
+                gpu_ms: g,
+                prepare_gpu_ms: Spread::of(prepare[i].iter().copied()),
+                cpu_ms: c,
+                wall_ms: wl,
+                gpu_ratio: ratio(g, base.0),
+                cpu_ratio: ratio(c, base.1),
+                wall_ratio: ratio(wl, base.2),
+                gpu_over_static: twin.and_then(|t| ratio(total_gpu[i], total_gpu[t])),
+                wall_over_static: twin.and_then(|t| ratio(wl, spreads[t].2)),
+            }
         })
         .collect();
     Ok(BenchReport {
@@ -267,7 +392,7 @@ impl BenchReport {
         );
         let _ = writeln!(
             out,
-            "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7}",
+            "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8}",
             "effects",
             "fetch",
             "GPU ms (p10-p90)",
@@ -275,7 +400,10 @@ impl BenchReport {
             "CPU ms (p10-p90)",
             "ratio",
             "wall ms (p10-p90)",
-            "ratio"
+            "ratio",
+            "fields GPU ms",
+            "GPU/still",
+            "wall/still"
         );
         let cell = |s: Option<Spread>| {
             s.map_or("n/a".to_string(), |s| {
@@ -286,7 +414,7 @@ impl BenchReport {
         for v in &self.variants {
             let _ = writeln!(
                 out,
-                "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7}",
+                "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8}",
                 v.effects,
                 v.fetches_per_pixel,
                 cell(v.gpu_ms),
@@ -294,7 +422,10 @@ impl BenchReport {
                 cell(v.cpu_ms),
                 r(v.cpu_ratio),
                 cell(v.wall_ms),
-                r(v.wall_ratio)
+                r(v.wall_ratio),
+                cell(v.prepare_gpu_ms),
+                r(v.gpu_over_static),
+                r(v.wall_over_static)
             );
         }
         out

@@ -109,6 +109,15 @@ pub enum BakeError {
         /// The scene file.
         scene: PathBuf,
     },
+    /// The scene moves (`[motion]`), and a bake holds one pose of the object and the light.
+    #[error(
+        "the scene {scene} moves its object or light ([motion]), and a caustics bake holds only \
+         one pose: render it without caustics (e.g. --effects inducer)"
+    )]
+    MovingScene {
+        /// The scene file.
+        scene: PathBuf,
+    },
     /// Writing failed.
     #[error("cannot write the caustics bake {path}: {reason}")]
     Write {

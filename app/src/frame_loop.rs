@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{Composition, Look, Renderer};
+use vitreous_render::{Composition, Look, Renderer, ScenePose};
 use vitreous_xr::openxr::Blend;
 use vitreous_xr::{Backend, FrameInput, FrameTarget};
 
@@ -28,6 +28,12 @@ pub trait FrameSink {
     /// Sees each frame's input as soon as the backend hands it out (e.g. to record it).
     fn started(&mut self, _input: &FrameInput) -> Result<()> {
         Ok(())
+    }
+
+    /// Where the object and the light are for this frame (called before
+    /// [`FrameSink::plan`]); `None` leaves them where the previous frame had them.
+    fn pose(&mut self, _input: &FrameInput) -> Option<ScenePose> {
+        None
     }
 
     /// How to draw this frame and what to read back of it.
@@ -107,6 +113,9 @@ fn draw<B: Backend>(
 ) -> Result<(f64, FramePlan, Option<FrameResult>)> {
     sink.started(input)?;
     let started = Instant::now();
+    if let Some(pose) = sink.pose(input) {
+        renderer.set_pose(pose);
+    }
     let plan = sink.plan(input);
     let params = views::frame_params(input, plan.look);
     let prepare_ms = started.elapsed().as_secs_f64() * 1e3;

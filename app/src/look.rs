@@ -191,6 +191,13 @@ impl LookPlanner {
             .map(|d| d.pipeline.config().override_image)
     }
 
+    /// Moves the object's centre the image distances are measured to (a moving object).
+    pub fn set_object_center(&mut self, center_m: Vec3) {
+        if let Some(d) = &mut self.defocus {
+            d.model.geometry.center_m = center_m;
+        }
+    }
+
     /// The look of a frame, and the gaze state behind its defocus (when defocus is on). The
     /// image distances are those of the frame's viewing position ([`viewing_position_m`]).
     pub fn plan(&mut self, input: &FrameInput) -> (Look, Option<GazeState>) {

@@ -190,6 +190,14 @@ enum Command {
             allow_negative_numbers = true
         )]
         pupils_mm: Vec<f32>,
+        /// Also time each variant with the light turning 1 degree about the object every
+        /// frame, alternated with the same variant standing still.
+        #[arg(long)]
+        moving: bool,
+        /// Also time each effect set with caustics on a second renderer that computes them
+        /// per pose on the GPU, alternated with the scene's bake.
+        #[arg(long = "live-caustics")]
+        live_caustics: bool,
     },
     /// Replay a scene again and again in one process (a new Vulkan device and renderer each
     /// pass, validation on) and check that resident memory stays flat and validation silent.
@@ -440,6 +448,8 @@ fn run(cli: Cli) -> Result<()> {
             validate,
             device,
             pupils_mm,
+            moving,
+            live_caustics,
         } => {
             let report = bench(&BenchOptions {
                 scene,
@@ -450,6 +460,8 @@ fn run(cli: Cli) -> Result<()> {
                 validate,
                 device,
                 pupils_mm,
+                moving,
+                live_caustics,
             })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);

@@ -10,7 +10,7 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
+use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer, ScenePose};
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{TraceSample, read_trace};
@@ -20,9 +20,11 @@ use crate::frame_log::{FrameLog, PupilSummary};
 use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
 pub use crate::look::GazeSettings;
 use crate::look::LookPlanner;
+use crate::motion_clock::MotionClock;
 use crate::output::{self, write_atomic};
 use crate::reference_view::side_by_side;
 use crate::scene::{Scene, load_scene};
+pub use crate::spread::Spread;
 use crate::trace_cmd::synth_params_for;
 use crate::views;
 
@@ -60,34 +62,6 @@ pub struct ReplayOptions {
     pub reference: bool,
     /// Depth filter and gaze-image override of the gaze pipeline (used with defocus).
     pub gaze: GazeSettings,
-}
-
-/// Median and spread of a timing.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct Spread {
-    /// Median, milliseconds.
-    pub median_ms: f64,
-    /// 10th percentile, milliseconds.
-    pub p10_ms: f64,
-    /// 90th percentile, milliseconds.
-    pub p90_ms: f64,
-}
-
-impl Spread {
-    /// The spread of `values`, or `None` when empty.
-    pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Spread> {
-        let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
-        if v.is_empty() {
-            return None;
-        }
-        v.sort_by(f64::total_cmp);
-        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-        Some(Spread {
-            median_ms: at(0.5),
-            p10_ms: at(0.1),
-            p90_ms: at(0.9),
-        })
-    }
 }
 
 /// Validation layer results.
@@ -182,6 +156,11 @@ pub struct ReplaySummary {
     pub gaze_image_switches: u64,
     /// Where A_p came from and the values used (`null` without defocus).
     pub pupil: Option<PupilSummary>,
+    /// Frames whose object or light pose differed from the previous frame's (`[motion]`).
+    pub moved_frames: u64,
+    /// Computations of the shadow inducer's fields (mask, distance, gain) on the GPU: one
+    /// for the first frame drawing them, then one per moved frame, none otherwise.
+    pub inducer_computations: u64,
     /// Every frame's timing.
     pub per_frame: Vec<FrameRecord>,
 }
@@ -225,9 +204,15 @@ struct Saver<'a> {
     condition: String,
     /// The first error writing the log, reported when the next frame finishes.
     log_error: Option<anyhow::Error>,
+    /// How the scene moves, with the time of the first frame once it came.
+    motion: MotionClock,
 }
 
 impl FrameSink for Saver<'_> {
+    fn pose(&mut self, input: &FrameInput) -> Option<ScenePose> {
+        self.motion.pose(input.time_ns, &mut self.planner)
+    }
+
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         let save = self.save_every > 0 && input.index.is_multiple_of(self.save_every);
         let look = self.planner.plan(input).0;
@@ -353,6 +338,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         height,
     )
     .context("preparing the renderer")?;
+    views::enable_live_caustics(&mut renderer, &scene, effects.caustics)
+        .context("preparing live caustics")?;
     drop(defocus);
 
     let frames_dir = options.out.join("frames");
@@ -398,6 +385,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         log,
         condition: effects.to_string(),
         log_error: None,
+        motion: MotionClock::new(&scene),
     };
     let started = Instant::now();
     let records = match frame_loop::run(&mut backend, &mut renderer, &mut saver) {
@@ -452,6 +440,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         saved: saver.saved,
         gaze_image_switches: saver.log.gaze_image_switches(),
         pupil: saver.log.pupil_summary(saver.planner.pupil_source()),
+        moved_frames: saver.motion.moved_frames,
+        inducer_computations: renderer.inducer_computations(),
         per_frame: records,
     };
     let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;

@@ -4,13 +4,13 @@
 use vitreous_render::camera::{EyeParams, Fov as RenderFov};
 use vitreous_render::{
     CausticsDesc, FrameParams, InducerDesc, LightDesc, Look, MeshRef, PlaneDesc, Reflection,
-    SceneDesc, TexelData, TextureDesc,
+    SceneDesc, ScenePose, TexelData, TextureDesc,
 };
 use vitreous_xr::{EyeView, Fov, FrameInput};
 
 use crate::blur_stack::DefocusSetup;
 use crate::effects::EffectSet;
-use crate::scene::{Image, PixelData, Scene};
+use crate::scene::{CausticsMode, Image, PixelData, Placement, Scene};
 
 /// Scale applied to environment radiance. The shipped HDR maps are in scene-referred units
 /// where 1.0 is a bright diffuse white; they are shown as they are.
@@ -41,6 +41,42 @@ pub fn frame_params(input: &FrameInput, look: Look) -> FrameParams {
         eyes: [eye_params(&input.views[0]), eye_params(&input.views[1])],
         look,
     }
+}
+
+/// The renderer's pose of the object and the light for a placement of `scene`'s object.
+pub fn scene_pose(scene: &Scene, placement: &Placement) -> ScenePose {
+    ScenePose {
+        world_from_model: scene
+            .object
+            .world_from_model_at(placement.object_position_m, placement.object_rotation),
+        light_position_m: placement.light_position_m,
+    }
+}
+
+/// Turns on the caustics computed per pose when the scene asks for them (`[caustics] mode =
+/// "live"`) and `caustics` (the effect) is on; `renderer` must have been made from this
+/// scene's description with its caustics loaded.
+pub fn enable_live_caustics(
+    renderer: &mut vitreous_render::Renderer,
+    scene: &Scene,
+    caustics: bool,
+) -> vitreous_render::Result<()> {
+    if !caustics || scene.caustics.mode != CausticsMode::Live {
+        return Ok(());
+    }
+    renderer.enable_live_caustics(
+        &scene_desc(scene, None),
+        vitreous_render::floor::LiveCausticsDesc {
+            photons_per_side: scene.caustics.photons_per_side,
+            ..Default::default()
+        },
+    )
+}
+
+/// Seconds from `start_ns` to a frame at `time_ns` (the backend's clock): the time
+/// [`Scene::placement_at`] takes.
+pub fn seconds_since(start_ns: i64, time_ns: i64) -> f64 {
+    time_ns.saturating_sub(start_ns) as f64 * 1e-9
 }
 
 /// How an effect set is drawn. The baseline is the conventional method (environment map and

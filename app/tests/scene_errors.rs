@@ -462,3 +462,120 @@ fn gaze_pupil_source_is_read_and_a_bad_one_named() {
     let msg = expect_error(&text, line_of(&text, "pupil ="), "gaze.pupil");
     assert!(msg.contains("paper or measured"), "{msg}");
 }
+
+/// The base scene with `[motion]` light keyframes at `times` (seconds), `position` as written
+/// for the second one.
+fn motion_text(times: [&str; 3], second_position: &str) -> String {
+    format!(
+        "{}\n[motion]\n\n[[motion.light]]\ntime_s = {}\nposition_m = [0.0, 1.0, -1.0]\n\n\
+         [[motion.light]]\ntime_s = {}\nposition_m = {second_position}\n\n\
+         [[motion.light]]\ntime_s = {}\nposition_m = [1.0, 1.0, 0.0]\n",
+        good_text(),
+        times[0],
+        times[1],
+        times[2]
+    )
+}
+
+#[test]
+fn keyframes_out_of_order_are_refused_at_their_time() {
+    let text = motion_text(["0.0", "2.0", "1.0"], "[1.0, 1.0, 0.0]");
+    let msg = expect_error(
+        &text,
+        line_of(&text, "time_s = 1.0"),
+        "motion.light[2].time_s",
+    );
+    assert!(msg.contains("increase strictly"), "{msg}");
+    // Equal times too.
+    let text = motion_text(["0.0", "1.0", "1.0"], "[1.0, 1.0, 0.0]");
+    let lines: Vec<usize> = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.contains("time_s = 1.0"))
+        .map(|(i, _)| i + 1)
+        .collect();
+    expect_error(&text, lines[1], "motion.light[2].time_s");
+}
+
+#[test]
+fn keyframe_nan_and_negative_times_and_wrong_lengths_are_refused() {
+    let text = motion_text(["0.0", "nan", "3.0"], "[1.0, 1.0, 0.0]");
+    let msg = expect_error(&text, line_of(&text, "nan"), "motion.light[1].time_s");
+    assert!(msg.contains("NaN"), "{msg}");
+    let text = motion_text(["-1.0", "1.0", "3.0"], "[1.0, 1.0, 0.0]");
+    expect_error(
+        &text,
+        line_of(&text, "time_s = -1.0"),
+        "motion.light[0].time_s",
+    );
+    let text = motion_text(["0.0", "1.0", "3.0"], "[1.0, 1.0]");
+    let msg = expect_error(
+        &text,
+        line_of(&text, "position_m = [1.0, 1.0]"),
+        "motion.light[1].position_m",
+    );
+    assert!(msg.contains("3 numbers"), "{msg}");
+    let text = motion_text(["0.0", "1.0", "3.0"], "[nan, 1.0, 0.0]");
+    expect_error(&text, line_of(&text, "[nan"), "motion.light[1].position_m");
+}
+
+#[test]
+fn object_keyframe_rotation_and_repeat_are_checked() {
+    let text = format!(
+        "{}\n[motion]\nrepeat_s = 0.5\n\n[[motion.object]]\ntime_s = 0.0\n\
+         position_m = [0.0, -0.26, -1.5]\nrotation_deg = [0.0, 400.0, 0.0]\n\n\
+         [[motion.object]]\ntime_s = 1.0\nposition_m = [0.1, -0.26, -1.5]\n",
+        good_text()
+    );
+    expect_error(
+        &text,
+        line_of(&text, "400.0"),
+        "motion.object[0].rotation_deg",
+    );
+    let text = text.replace("400.0", "40.0");
+    // The period ends before the last keyframe.
+    let msg = expect_error(&text, line_of(&text, "repeat_s"), "motion.repeat_s");
+    assert!(msg.contains("last keyframe"), "{msg}");
+    let text = text.replace("repeat_s = 0.5", "repeat_s = 2.0");
+    let (_dir, _path, result) = load_text(&text);
+    assert!(result.unwrap().motion.is_animated());
+}
+
+#[test]
+fn caustics_mode_and_live_sizes_are_checked() {
+    let text = format!("{}\n[caustics]\nmode = \"realtime\"\n", good_text());
+    let msg = expect_error(&text, line_of(&text, "realtime"), "caustics.mode");
+    assert!(msg.contains("baked or live"), "{msg}");
+    let text = format!(
+        "{}\n[caustics]\nmode = \"live\"\nphotons_per_side = 0\n",
+        good_text()
+    );
+    expect_error(
+        &text,
+        line_of(&text, "photons_per_side"),
+        "caustics.photons_per_side",
+    );
+    let text = format!(
+        "{}\n[caustics]\nmode = \"live\"\nresolution_px = 8\n",
+        good_text()
+    );
+    expect_error(
+        &text,
+        line_of(&text, "resolution_px"),
+        "caustics.resolution_px",
+    );
+    // A live scene needs no bake: its map is zeros of the given size until the renderer
+    // fills it.
+    let text = format!(
+        "{}\n[caustics]\nmode = \"live\"\nresolution_px = 64\n",
+        good_text()
+    );
+    let (_dir, _path, result) = load_text(&text);
+    let mut scene = result.unwrap();
+    scene.load_caustics().unwrap();
+    let map = scene.caustics.gain.as_ref().unwrap();
+    assert_eq!(
+        (map.width_px, map.height_px, map.gain.len()),
+        (64, 64, 64 * 64)
+    );
+}

@@ -118,3 +118,78 @@ fn rotation_and_object_frame_light_are_applied() {
     std::fs::write(&path, format!("{text}\n# comment\n")).unwrap();
     assert_ne!(load_scene(&path).unwrap().hash, first);
 }
+
+#[test]
+fn moving_light_circles_the_sphere_then_holds() {
+    let scene = load_scene(&repo("config/scenes/moving-light.toml")).unwrap();
+    assert!(scene.motion.is_animated());
+    let center = scene.object.center_m;
+    // Starts where [light] puts it: the paper's offset.
+    let start = scene.placement_at(0.0);
+    assert!(
+        start
+            .light_position_m
+            .abs_diff_eq(center + Vec3::new(0.0, 1.0, -1.0), 1e-6)
+    );
+    assert_eq!(start.light_position_m, scene.light.position_m);
+    // A quarter of the circle later (1.5 s) the light is 1 m to the left, 1 m up.
+    let quarter = scene.placement_at(1.5).light_position_m - center;
+    assert!(
+        quarter.abs_diff_eq(Vec3::new(-1.0, 1.0, 0.0), 1e-4),
+        "{quarter}"
+    );
+    // Held from 6 s to 8 s, then it starts again.
+    assert_eq!(scene.placement_at(6.5), scene.placement_at(7.9));
+    assert!(
+        scene
+            .placement_at(8.0 + 1.5)
+            .light_position_m
+            .abs_diff_eq(quarter + center, 1e-4)
+    );
+    // Between keyframes the light stays 1 m above the sphere, about 1 m out.
+    let between = scene.placement_at(0.25).light_position_m - center;
+    assert!((between.y - 1.0).abs() < 1e-6);
+    assert!((between.x.hypot(between.z) - 1.0).abs() < 0.04, "{between}");
+    // The object stays put.
+    assert_eq!(scene.placement_at(3.0).object_position_m, center);
+}
+
+#[test]
+fn rolling_diamond_moves_and_turns_on_the_table() {
+    let scene = load_scene(&repo("config/scenes/rolling-diamond.toml")).unwrap();
+    assert!(scene.motion.is_animated());
+    let half = scene.placement_at(0.5);
+    assert!(
+        half.object_position_m
+            .abs_diff_eq(Vec3::new(-0.15, -0.26, -1.5), 1e-5)
+    );
+    let angle = half.object_rotation.to_axis_angle();
+    assert!((angle.1.to_degrees() - 45.0).abs() < 1e-3, "{angle:?}");
+    // The placement's transform puts the box centre where the keyframe says.
+    let m = scene
+        .object
+        .world_from_model_at(half.object_position_m, half.object_rotation);
+    let centre = m.transform_point3(scene.object.model_center);
+    assert!(centre.abs_diff_eq(half.object_position_m, 1e-5));
+    // At rest on the same spot from 8 s to 10 s; the light stands still throughout.
+    assert_eq!(scene.placement_at(8.5), scene.placement_at(9.5));
+    assert_eq!(
+        scene.placement_at(2.3).light_position_m,
+        scene.light.position_m
+    );
+    // A moving scene's caustic bake is refused: it holds one pose.
+    let mut scene = scene;
+    let err = scene.load_caustics().unwrap_err();
+    assert!(err.to_string().contains("[motion]"), "{err}");
+}
+
+#[test]
+fn static_scenes_keep_their_transform() {
+    let scene = load_scene(&repo("config/scenes/diamond.toml")).unwrap();
+    assert!(!scene.motion.is_animated());
+    let rest = scene.placement_at(3.0);
+    let m = scene
+        .object
+        .world_from_model_at(rest.object_position_m, rest.object_rotation);
+    assert!(m.abs_diff_eq(scene.object.world_from_model, 1e-6));
+}

@@ -11,6 +11,7 @@ use crate::memory::Buffer;
 use crate::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, PipelineSpec};
+use crate::pose::ScenePose;
 use crate::scene::{GpuScene, SceneDesc, VERTEX_STRIDE};
 use crate::shaders;
 
@@ -104,6 +105,16 @@ struct Globals {
     shading: [f32; 4],
 }
 
+impl Globals {
+    /// These globals with the object and light of `pose`.
+    fn posed(mut self, pose: &ScenePose) -> Globals {
+        self.world_from_model = pose.world_from_model.to_cols_array();
+        self.normal_from_model = pose.world_from_model.inverse().transpose().to_cols_array();
+        self.light = pose.light_position_m.extend(1.0).to_array();
+        self
+    }
+}
+
 /// The glass pipeline and its descriptors, freed on drop.
 pub struct GlassPass {
     /// The pipeline.
@@ -117,7 +128,9 @@ pub struct GlassPass {
     /// The descriptor set: globals, environment map, sampler.
     set: vk::DescriptorSet,
     /// The uniform buffer behind `Globals`.
-    _globals: Buffer,
+    globals_buffer: Buffer,
+    /// What the buffer was created with; [`GlassPass::record_pose`] changes only the pose.
+    globals: Globals,
 }
 
 impl GlassPass {
@@ -216,29 +229,29 @@ impl GlassPass {
             ],
         )?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
-        let normal_from_model = desc.world_from_model.inverse().transpose();
         let surface_opacity = if desc.surface.is_some() {
             1.0 - desc.surface_transmittance
         } else {
             0.0
         };
         let globals = Globals {
-            world_from_model: desc.world_from_model.to_cols_array(),
-            normal_from_model: normal_from_model.to_cols_array(),
+            world_from_model: [0.0; 16],
+            normal_from_model: [0.0; 16],
             background_from_world: desc.background.world_from_plane.inverse().to_cols_array(),
             optics: [desc.ior, FRESNEL_BIAS, FRESNEL_SCALE, FRESNEL_POWER],
-            light: desc.light.position_m.extend(1.0).to_array(),
+            light: [0.0; 4],
             light_colour: desc.light.radiance.extend(PHONG_EXPONENT).to_array(),
             shading: Vec4::new(desc.exposure, surface_opacity, PHONG_STRENGTH, 0.0).to_array(),
-        };
-        let globals = Buffer::with_data(
+        }
+        .posed(&ScenePose::of(desc));
+        let globals_buffer = Buffer::with_data(
             ctx,
             "glass globals",
             bytemuck::bytes_of(&globals),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
         )?;
         let buffer_info = [vk::DescriptorBufferInfo {
-            buffer: globals.buffer,
+            buffer: globals_buffer.buffer,
             offset: 0,
             range: vk::WHOLE_SIZE,
         }];
@@ -265,8 +278,67 @@ impl GlassPass {
             _pool: pool,
             _set_layout: set_layout,
             set,
-            _globals: globals,
+            globals_buffer,
+            globals,
         })
+    }
+
+    /// Records the update of the object's transform and the light's position to `pose`, for
+    /// this and later draws: the copy waits for earlier draws' reads of the uniform block
+    /// (also those of frames submitted before), and later draws wait for the copy.
+    ///
+    /// # Safety
+    /// `cmd` must be recording outside any render pass; `self` must outlive its execution.
+    pub unsafe fn record_pose(&self, ctx: &GpuContext, cmd: vk::CommandBuffer, pose: &ScenePose) {
+        let d = &ctx.device;
+        let shaders =
+            vk::PipelineStageFlags::VERTEX_SHADER | vk::PipelineStageFlags::FRAGMENT_SHADER;
+        let barrier = |src, dst| {
+            vk::BufferMemoryBarrier::default()
+                .src_access_mask(src)
+                .dst_access_mask(dst)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(self.globals_buffer.buffer)
+                .offset(0)
+                .size(vk::WHOLE_SIZE)
+        };
+        let globals = self.globals.posed(pose);
+        // SAFETY: the caller's contract (outside a render pass; the buffer outlives the
+        // execution); the data is a multiple of 4 bytes and under 65536, as
+        // vkCmdUpdateBuffer requires, and the buffer was made with TRANSFER_DST.
+        unsafe {
+            d.cmd_pipeline_barrier(
+                cmd,
+                shaders,
+                vk::PipelineStageFlags::TRANSFER,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[barrier(
+                    vk::AccessFlags::UNIFORM_READ,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                )],
+                &[],
+            );
+            d.cmd_update_buffer(
+                cmd,
+                self.globals_buffer.buffer,
+                0,
+                bytemuck::bytes_of(&globals),
+            );
+            d.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::TRANSFER,
+                shaders,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[barrier(
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::AccessFlags::UNIFORM_READ,
+                )],
+                &[],
+            );
+        }
     }
 
     /// Records the draw of the object for one eye, inside that eye's render pass.

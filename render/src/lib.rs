@@ -32,6 +32,7 @@ mod memory;
 pub mod optics;
 mod owned;
 mod pipeline;
+pub mod pose;
 pub mod reference;
 pub mod renderer;
 pub mod scene;
@@ -46,6 +47,7 @@ pub use error::{RenderError, Result};
 /// The floor passes under their earlier name.
 pub use floor as inducer;
 pub use floor::InducerFields;
+pub use pose::ScenePose;
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
     BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData,

@@ -156,6 +156,31 @@ pub fn create(ctx: &GpuContext, spec: &PipelineSpec) -> Result<Owned<vk::Pipelin
     Ok(Owned::new(ctx, pipelines[0]))
 }
 
+/// A compute pipeline of `entry` in `spirv` with `layout`.
+pub fn compute(
+    ctx: &GpuContext,
+    layout: vk::PipelineLayout,
+    spirv: &[u8],
+    entry: &std::ffi::CStr,
+) -> Result<Owned<vk::Pipeline>> {
+    let module = module(ctx, spirv)?;
+    let stage = vk::PipelineShaderStageCreateInfo::default()
+        .stage(vk::ShaderStageFlags::COMPUTE)
+        .module(module.raw())
+        .name(entry);
+    let info = vk::ComputePipelineCreateInfo::default()
+        .stage(stage)
+        .layout(layout);
+    // SAFETY: the module and layout are live for the call; the module is SPIR-V naga wrote.
+    let pipelines = unsafe {
+        ctx.device
+            .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+    }
+    .map_err(|(_, e)| e)
+    .vk("vkCreateComputePipelines")?;
+    Ok(Owned::new(ctx, pipelines[0]))
+}
+
 /// A shader module of SPIR-V compiled by build.rs.
 fn module(ctx: &GpuContext, spirv: &[u8]) -> Result<Owned<vk::ShaderModule>> {
     let words = shaders::words(spirv);

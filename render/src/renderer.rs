@@ -17,11 +17,13 @@ use crate::glass::{EyePush, GlassPass};
 use crate::memory::Buffer;
 use crate::owned::Owned;
 use crate::pipeline;
+use crate::pose::ScenePose;
 use crate::scene::{GpuScene, SceneDesc};
 use crate::target::{self, StereoTarget};
 use crate::world::WorldPass;
 
 mod composition;
+mod copy;
 mod external;
 
 pub use composition::Composition;
@@ -61,6 +63,10 @@ pub struct FrameTiming {
     /// GPU time of the frame's rendering (both eyes, without the readback copy), milliseconds;
     /// `None` when the device cannot write timestamps.
     pub gpu_ms: Option<f64>,
+    /// GPU time of the floor fields' work recorded before the eye passes (the shadow
+    /// inducer's computation after a move, the overlay gain's combination after a switch;
+    /// 0 when none was due), milliseconds; `None` without timestamps.
+    pub prepare_gpu_ms: Option<f64>,
     /// CPU time spent recording and submitting the frame, milliseconds.
     pub cpu_submit_ms: f64,
 }
@@ -94,7 +100,8 @@ struct FrameSlot {
     cmd: vk::CommandBuffer,
     /// Signalled when the slot's last submission finished.
     fence: Owned<vk::Fence>,
-    /// Two timestamps (start, end of rendering), when supported.
+    /// Three timestamps (start of the floor fields' work, start and end of the eye passes),
+    /// when supported.
     queries: Option<Owned<vk::QueryPool>>,
     /// Host-visible copy of both eye layers, then both world layers.
     readback: Buffer,
@@ -133,6 +140,10 @@ pub struct Renderer {
     scene: GpuScene,
     /// Sequence number of the next frame.
     next_sequence: u64,
+    /// The object's and the light's pose for the next frame.
+    pose: ScenePose,
+    /// The pose the glass pass's uniform block holds once submitted work has run.
+    glass_pose: ScenePose,
     /// The GPU context; dropped last.
     ctx: GpuContext,
 }
@@ -194,7 +205,7 @@ impl Renderer {
                 Some(_) => {
                     let info = vk::QueryPoolCreateInfo::default()
                         .query_type(vk::QueryType::TIMESTAMP)
-                        .query_count(2);
+                        .query_count(3);
                     // SAFETY: a valid create info; owned right away.
                     let pool = unsafe { ctx.device.create_query_pool(&info, None) }
                         .vk("vkCreateQueryPool")?;
@@ -230,6 +241,8 @@ impl Renderer {
             render_pass,
             scene: gpu_scene,
             next_sequence: 0,
+            pose: ScenePose::of(scene),
+            glass_pose: ScenePose::of(scene),
             ctx,
         })
     }
@@ -248,6 +261,37 @@ impl Renderer {
     /// computed first if no submitted frame has. Waits for the GPU; for tests and debugging.
     pub fn inducer_fields(&mut self) -> Result<InducerFields> {
         self.inducer.read_back(&self.ctx, &self.scene)
+    }
+
+    /// Places the object and the light for the next frames. The glass follows at once; the
+    /// shadow inducer's fields are computed again on the next frame that draws them, and only
+    /// when `pose` differs from the last one.
+    pub fn set_pose(&mut self, pose: ScenePose) {
+        self.pose = pose;
+        self.inducer.set_pose(pose);
+    }
+
+    /// Computes the caustics on the GPU for every pose from now on instead of using the
+    /// scene's bake (docs/caustics.md); `scene` must be the description the renderer was
+    /// made with.
+    pub fn enable_live_caustics(
+        &mut self,
+        scene: &SceneDesc,
+        live: crate::floor::LiveCausticsDesc,
+    ) -> Result<()> {
+        self.inducer.enable_live(&self.ctx, scene, live)
+    }
+
+    /// The live caustic gain map of the last finished frame that computed it (call
+    /// [`Renderer::flush`] first); `None` without live caustics.
+    pub fn live_caustic_gain(&self) -> Result<Option<Vec<f32>>> {
+        self.inducer.live_gain()
+    }
+
+    /// How many times the shadow inducer's fields (mask, distance, gain) were computed: once
+    /// for the first frame that drew them, then once per frame after the object or light moved.
+    pub fn inducer_computations(&self) -> u64 {
+        self.inducer.computations()
     }
 
     /// Records and submits a frame. Returns the frame that last used the same slot
@@ -313,6 +357,7 @@ impl Renderer {
         };
         // Only now, with the work on the queue, do later frames rely on what it computes.
         self.inducer.submitted(prepared);
+        self.glass_pose = self.pose;
         self.slots[slot_index].pending = Some(Pending {
             sequence,
             want,
@@ -353,9 +398,9 @@ impl Renderer {
             return Err(e);
         }
         self.inducer.finished(pending.prepared, true);
-        let gpu_ms = match (&slot.queries, self.ctx.timestamp_period_ns) {
+        let (gpu_ms, prepare_gpu_ms) = match (&slot.queries, self.ctx.timestamp_period_ns) {
             (Some(pool), Some(period)) => {
-                let mut stamps = [0u64; 2];
+                let mut stamps = [0u64; 3];
                 // SAFETY: the frame that wrote both queries finished (its fence signalled
                 // above), so the results are available.
                 unsafe {
@@ -367,9 +412,10 @@ impl Renderer {
                     )
                 }
                 .vk("vkGetQueryPoolResults")?;
-                Some(stamps[1].wrapping_sub(stamps[0]) as f64 * f64::from(period) * 1e-6)
+                let ms = |a: u64, b: u64| Some(b.wrapping_sub(a) as f64 * f64::from(period) * 1e-6);
+                (ms(stamps[1], stamps[2]), ms(stamps[0], stamps[1]))
             }
-            _ => None,
+            _ => (None, None),
         };
         let bytes = if pending.want.eyes {
             Some(slot.readback.mapped()?)
@@ -392,6 +438,7 @@ impl Renderer {
             sequence: pending.sequence,
             timing: FrameTiming {
                 gpu_ms,
+                prepare_gpu_ms,
                 cpu_submit_ms: pending.cpu_submit_ms,
             },
             readback,
@@ -439,20 +486,27 @@ impl Renderer {
         // framebuffers belong to the render pass they are begun with. The images copied are
         // in TRANSFER_SRC_OPTIMAL (the render pass's final layout, or the transition before).
         unsafe {
+            if self.pose != self.glass_pose {
+                self.glass.record_pose(&self.ctx, cmd, &self.pose);
+            }
+            let queries = slot.queries.as_ref().map(Owned::raw);
+            if let Some(pool) = queries {
+                d.cmd_reset_query_pool(cmd, pool, 0, 3);
+                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 0);
+            }
             let blank = params.look.blank;
             let (inducer, caustics) = (
                 params.look.inducer && !blank,
                 params.look.caustics && !blank,
             );
             if inducer || caustics {
-                // Once per scene (and per change of these switches), before the timed part.
+                // Once per pose (and per change of these switches), timed on its own.
                 prepared = self
                     .inducer
                     .prepare(&self.ctx, cmd, &self.scene, inducer, caustics);
             }
-            if let Some(pool) = slot.queries.as_ref().map(Owned::raw) {
-                d.cmd_reset_query_pool(cmd, pool, 0, 2);
-                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 0);
+            if let Some(pool) = queries {
+                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 1);
             }
             for (index, eye) in params.eyes.iter().enumerate() {
                 self.begin_pass(
@@ -484,8 +538,8 @@ impl Renderer {
                 }
                 d.cmd_end_render_pass(cmd);
             }
-            if let Some(pool) = slot.queries.as_ref().map(Owned::raw) {
-                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 1);
+            if let Some(pool) = queries {
+                d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 2);
             }
             if want.eyes && want.world {
                 for (index, eye) in params.eyes.iter().enumerate() {
@@ -514,36 +568,7 @@ impl Renderer {
                 if want.world {
                     copies.push((self.world_target.color.image, 2 * layer_bytes));
                 }
-                for (image, offset) in copies {
-                    let region = vk::BufferImageCopy::default()
-                        .buffer_offset(offset)
-                        .image_subresource(vk::ImageSubresourceLayers {
-                            aspect_mask: vk::ImageAspectFlags::COLOR,
-                            mip_level: 0,
-                            base_array_layer: 0,
-                            layer_count: 2,
-                        })
-                        .image_extent(vk::Extent3D {
-                            width: self.extent.width,
-                            height: self.extent.height,
-                            depth: 1,
-                        });
-                    d.cmd_copy_image_to_buffer(
-                        cmd,
-                        image,
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                        slot.readback.buffer,
-                        &[region],
-                    );
-                }
-                let to_host = vk::BufferMemoryBarrier::default()
-                    .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                    .dst_access_mask(vk::AccessFlags::HOST_READ)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(slot.readback.buffer)
-                    .offset(0)
-                    .size(vk::WHOLE_SIZE);
+                copy::record_readback(d, cmd, &copies, self.extent, slot.readback.buffer);
                 if external_image {
                     external::transition(
                         d,
@@ -553,15 +578,6 @@ impl Renderer {
                         vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                     );
                 }
-                d.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::HOST,
-                    vk::DependencyFlags::empty(),
-                    &[],
-                    &[to_host],
-                    &[],
-                );
             }
         }
         prepared

@@ -60,6 +60,13 @@ impl LiveLooks {
         self.conditions[self.current].0
     }
 
+    /// Moves the object's centre the image distances are measured to, for every condition.
+    pub fn set_object_center(&mut self, center_m: glam::Vec3) {
+        for (_, planner) in &mut self.conditions {
+            planner.set_object_center(center_m);
+        }
+    }
+
     /// The planner of the condition shown (its newest defocus decision, its pupil source).
     pub fn planner(&self) -> &LookPlanner {
         &self.conditions[self.current].1

@@ -54,6 +54,7 @@ use crate::effects::EffectSet;
 use crate::frame_log::FrameLog;
 use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::look::{GazeSettings, planners_for};
+use crate::motion_clock::MotionClock;
 use crate::output::write_atomic;
 use crate::replay::{Spread, ValidationSummary};
 use crate::scene::load_scene;
@@ -123,9 +124,18 @@ struct RunSink {
     study: Option<StudyStage>,
     /// The first error writing the log, reported when the next frame finishes.
     log_error: Option<anyhow::Error>,
+    /// The scene's motion (`[motion]`), from the session's first frame.
+    motion: MotionClock,
 }
 
 impl FrameSink for RunSink {
+    fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
+        let placement = self.motion.placement(input.time_ns)?;
+        self.looks.set_object_center(placement.object_position_m);
+        self.object_center_m = placement.object_position_m;
+        Some(self.motion.pose_of(&placement))
+    }
+
     fn started(&mut self, input: &FrameInput) -> Result<()> {
         if let Some(w) = &mut self.writer {
             w.write(&trace_sample(input))
@@ -287,6 +297,8 @@ fn run_with(
         },
     )?;
     let mut renderer = views::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
+    views::enable_live_caustics(&mut renderer, &scene, caustics_loaded)
+        .context("preparing live caustics")?;
     drop(defocus);
     // SAFETY: `handles` are the instance, device and queue this runtime created for the
     // renderer's context (XrDeviceCreator); the renderer owns them and outlives `session`,
@@ -350,6 +362,7 @@ fn run_with(
             .readback_check
             .then(|| options.frames.map_or(10, |n| (n / 2).min(10)).max(1) - 1),
         object_center_m: scene.object.center_m,
+        motion: MotionClock::new(&scene),
         object_radius_m: scene.object.radius_m,
         blend: info.blend,
         readback: None,

@@ -31,6 +31,36 @@ pub(crate) struct SceneFile {
     pub gaze: GazeToml,
     #[serde(default)]
     pub caustics: CausticsToml,
+    #[serde(default)]
+    pub motion: MotionToml,
+}
+
+/// `[motion]`: keyframes of the object and the light.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct MotionToml {
+    pub repeat_s: Option<Spanned<f64>>,
+    #[serde(default)]
+    pub object: Vec<ObjectKeyToml>,
+    #[serde(default)]
+    pub light: Vec<LightKeyToml>,
+}
+
+/// `[[motion.object]]`: one keyframe of the object.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ObjectKeyToml {
+    pub time_s: Spanned<f64>,
+    pub position_m: Spanned<Vec<f32>>,
+    pub rotation_deg: Option<Spanned<Vec<f32>>>,
+}
+
+/// `[[motion.light]]`: one keyframe of the light.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct LightKeyToml {
+    pub time_s: Spanned<f64>,
+    pub position_m: Spanned<Vec<f32>>,
 }
 
 /// `[caustics]`: the scene's caustic bake (eq. 6).
@@ -38,6 +68,9 @@ pub(crate) struct SceneFile {
 #[serde(deny_unknown_fields)]
 pub(crate) struct CausticsToml {
     pub bake: Option<Spanned<String>>,
+    pub mode: Option<Spanned<String>>,
+    pub resolution_px: Option<Spanned<i64>>,
+    pub photons_per_side: Option<Spanned<i64>>,
 }
 
 /// `[gaze]`: how the gaze image is chosen for defocus.

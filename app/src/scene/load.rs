@@ -12,8 +12,8 @@ use vitreous_xr::{Fov, Pose};
 use super::error::Source;
 use super::file::{DiskFiles, LightFrame, PlaneToml, SceneFile, SceneFiles};
 use super::{
-    Caustics, Environment, GazeChoice, Image, Inducer, IorSource, Light, Object, Output, RealPlane,
-    Scene, SceneError, Viewer, euler_xyz_deg,
+    Caustics, CausticsMode, Environment, GazeChoice, Image, Inducer, IorSource, Light, Object,
+    Output, RealPlane, Scene, SceneError, Viewer, euler_xyz_deg,
 };
 use super::{file, image, mesh};
 use crate::effects::EffectSet;
@@ -63,9 +63,9 @@ pub fn load_scene_from(path: &Path, files: &dyn SceneFiles) -> Result<Scene, Sce
     loader.resolve(raw)
 }
 
-struct Loader<'a> {
+pub(super) struct Loader<'a> {
     files: &'a dyn SceneFiles,
-    src: Source<'a>,
+    pub(super) src: Source<'a>,
     dir: PathBuf,
     hasher: Sha256,
 }
@@ -140,7 +140,7 @@ impl Loader<'_> {
         })
     }
 
-    fn vec3(&self, field: &str, v: &Spanned<Vec<f32>>) -> Result<Vec3, SceneError> {
+    pub(super) fn vec3(&self, field: &str, v: &Spanned<Vec<f32>>) -> Result<Vec3, SceneError> {
         let value = Vec3::from_array(self.array(field, v)?);
         if !value.is_finite() || value.abs().max_element() > MAX_COORD_M {
             return Err(self.src.invalid(
@@ -152,7 +152,11 @@ impl Loader<'_> {
         Ok(value)
     }
 
-    fn rotation(&self, field: &str, v: Option<&Spanned<Vec<f32>>>) -> Result<Quat, SceneError> {
+    pub(super) fn rotation(
+        &self,
+        field: &str,
+        v: Option<&Spanned<Vec<f32>>>,
+    ) -> Result<Quat, SceneError> {
         let Some(v) = v else {
             return Ok(Quat::IDENTITY);
         };
@@ -227,6 +231,7 @@ impl Loader<'_> {
             },
         };
 
+        let motion = self.motion(&raw.motion, raw.light.frame, object.rotation)?;
         let floor = self.plane("floor", &raw.floor)?;
         let background = self.plane("background", &raw.background)?;
 
@@ -321,6 +326,32 @@ impl Loader<'_> {
                 Some(rel) => Some(normalize(&self.dir.join(rel.get_ref()))),
             },
             gain: None,
+            mode: match &raw.caustics.mode {
+                None => CausticsMode::Baked,
+                Some(m) => match m.get_ref().as_str() {
+                    "baked" => CausticsMode::Baked,
+                    "live" => CausticsMode::Live,
+                    other => {
+                        return Err(self.src.invalid(
+                            m.span(),
+                            "caustics.mode",
+                            format!("expected baked or live, found '{other}'"),
+                        ));
+                    }
+                },
+            },
+            resolution_px: self.count(
+                "caustics.resolution_px",
+                raw.caustics.resolution_px.as_ref(),
+                1980,
+                16..=4096,
+            )?,
+            photons_per_side: self.count(
+                "caustics.photons_per_side",
+                raw.caustics.photons_per_side.as_ref(),
+                128,
+                1..=4096,
+            )?,
         };
         let gaze = GazeChoice {
             filter: match &raw.gaze.filter {
@@ -374,7 +405,35 @@ impl Loader<'_> {
             inducer,
             gaze,
             caustics,
+            motion,
+            light_in_frame_m: light_offset,
         })
+    }
+
+    /// A whole number within `range`, `default` when absent.
+    fn count(
+        &self,
+        field: &str,
+        v: Option<&Spanned<i64>>,
+        default: u32,
+        range: std::ops::RangeInclusive<u32>,
+    ) -> Result<u32, SceneError> {
+        let Some(v) = v else {
+            return Ok(default);
+        };
+        match u32::try_from(*v.get_ref()) {
+            Ok(n) if range.contains(&n) => Ok(n),
+            _ => Err(self.src.invalid(
+                v.span(),
+                field,
+                format!(
+                    "expected a whole number within {}..={}, found {}",
+                    range.start(),
+                    range.end(),
+                    v.get_ref()
+                ),
+            )),
+        }
     }
 
     fn inducer(&self, raw: &file::InducerToml) -> Result<Inducer, SceneError> {
@@ -525,6 +584,9 @@ impl Loader<'_> {
             mesh: model.mesh,
             world_from_model,
             center_m: position,
+            rotation,
+            scale,
+            model_center: center_model,
             radius_m: radius_model * scale,
             ior,
             ior_source,

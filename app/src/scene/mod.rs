@@ -20,6 +20,7 @@ mod fixation;
 mod image;
 mod load;
 mod mesh;
+mod motion;
 
 use std::path::PathBuf;
 
@@ -38,6 +39,7 @@ pub use fixation::{
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
 pub use load::{load_scene, load_scene_from};
 pub use mesh::{Mesh, load_mesh};
+pub use motion::{LightKey, MAX_KEYFRAMES, MAX_TIME_S, Motion, ObjectKey, Placement};
 
 /// A fully loaded scene, in the world frame described in the module docs.
 #[derive(Clone, Debug)]
@@ -70,23 +72,78 @@ pub struct Scene {
     /// The caustic bake (eq. 6): where it is and, once [`Scene::load_caustics`] ran, its
     /// gain map.
     pub caustics: Caustics,
+    /// How the object and the light move (`[motion]`; empty: they stand still).
+    pub motion: Motion,
+    /// `[light] position_m` as written: world, or an offset from the object's position when
+    /// [`Motion::light_follows_object`].
+    pub light_in_frame_m: Vec3,
 }
 
-/// `[caustics]`: the scene's caustic gain bake (docs/caustics.md).
+/// How the caustics are made (`[caustics] mode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CausticsMode {
+    /// Read from the scene's bake (offline, one pose).
+    #[default]
+    Baked,
+    /// Computed on the GPU for every pose (photon splatting).
+    Live,
+}
+
+/// `[caustics]`: the scene's caustic gain bake, or live caustics (docs/caustics.md).
 #[derive(Clone, Debug, Default)]
 pub struct Caustics {
     /// The bake file, resolved against the scene's folder; `None` when the scene names none.
     /// Not read (nor hashed) when the scene loads: only when the caustics are asked for.
     pub bake: Option<PathBuf>,
-    /// The gain map, after [`Scene::load_caustics`].
+    /// The gain map, after [`Scene::load_caustics`] (zeros in live mode, filled per pose).
     pub gain: Option<crate::caustics::Bake>,
+    /// Baked or live.
+    pub mode: CausticsMode,
+    /// Side of the live gain map, texels (live mode).
+    pub resolution_px: u32,
+    /// Photons along each side of the live emission grid (live mode).
+    pub photons_per_side: u32,
 }
 
 impl Scene {
+    /// Where `[object]` and `[light]` put the object and the light.
+    pub fn rest_placement(&self) -> Placement {
+        Placement {
+            object_position_m: self.object.center_m,
+            object_rotation: self.object.rotation,
+            light_position_m: self.light.position_m,
+        }
+    }
+
+    /// Where the object and the light are `time_s` seconds after the first frame.
+    pub fn placement_at(&self, time_s: f64) -> Placement {
+        self.motion
+            .placement_at(time_s, self.rest_placement(), self.light_in_frame_m)
+    }
+
     /// Reads the scene's caustic bake into [`Caustics::gain`], checking that it was baked
     /// for this scene (its stored hash equals [`Scene::hash`]). Errors name the file: no bake
-    /// named, missing, corrupt, or made for another scene.
+    /// named, missing, corrupt, or made for another scene; a moving scene is refused. In live
+    /// mode no file is read: the gain map is zeros of `[caustics] resolution_px`, which the
+    /// renderer fills for each pose ([`crate::views::enable_live_caustics`]).
     pub fn load_caustics(&mut self) -> Result<(), crate::caustics::BakeError> {
+        if self.caustics.mode == CausticsMode::Live {
+            // The map's size; the renderer fills it for every pose.
+            let n = self.caustics.resolution_px;
+            self.caustics.gain = Some(crate::caustics::Bake {
+                width_px: n,
+                height_px: n,
+                gain: vec![0.0; n as usize * n as usize],
+                scene_hash: self.hash.clone(),
+                params: "method=live".into(),
+            });
+            return Ok(());
+        }
+        if self.motion.is_animated() {
+            return Err(crate::caustics::BakeError::MovingScene {
+                scene: self.path.clone(),
+            });
+        }
         let path =
             self.caustics
                 .bake
@@ -153,6 +210,12 @@ pub struct Object {
     pub world_from_model: Mat4,
     /// World centre of the bounding sphere, metres (the object's `position_m`).
     pub center_m: Vec3,
+    /// The object's orientation (`rotation_deg`).
+    pub rotation: Quat,
+    /// Uniform scale from model units to metres.
+    pub scale: f32,
+    /// Centre of the mesh's bounding box, model units (moved to `center_m`).
+    pub model_center: Vec3,
     /// World radius of the bounding sphere about `center_m`, metres.
     pub radius_m: f32,
     /// Refractive index relative to air.
@@ -166,6 +229,21 @@ pub struct Object {
     pub surface_transmittance: f32,
     /// The glTF/GLB file.
     pub model_path: PathBuf,
+}
+
+impl Object {
+    /// Model to world with the bounding-box centre at `position_m` and orientation
+    /// `rotation`: [`Object::world_from_model`] for another placement.
+    pub fn world_from_model_at(&self, position_m: Vec3, rotation: Quat) -> Mat4 {
+        model_placement(self.scale, self.model_center, position_m, rotation)
+    }
+}
+
+/// Model to world for a mesh scaled by `scale` about its bounding-box centre `model_center`
+/// (model units), turned by `rotation` and moved to `position_m`.
+pub fn model_placement(scale: f32, model_center: Vec3, position_m: Vec3, rotation: Quat) -> Mat4 {
+    Mat4::from_scale_rotation_translation(Vec3::splat(scale), rotation, position_m)
+        * Mat4::from_translation(-model_center)
 }
 
 /// The point light.

@@ -23,6 +23,7 @@ use super::session::{AnswerSources, ResponsesFile, StudyDirector, TimingLog, rem
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::look::{GazeSettings, planners_for};
+use crate::motion_clock::MotionClock;
 use crate::run::{LiveLooks, RunOptions};
 use crate::scene::{Scene, load_scene};
 use crate::views;
@@ -359,6 +360,8 @@ fn dry_run_block(
         &GazeSettings::default(),
     )?;
     let mut renderer = views::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
+    views::enable_live_caustics(&mut renderer, &scene, stage.sets.iter().any(|s| s.caustics))
+        .context("preparing live caustics")?;
     drop(defocus);
     let looks = LiveLooks::new(
         stage.sets.iter().copied().zip(planners).collect(),
@@ -368,6 +371,7 @@ fn dry_run_block(
     let mut sink = DryRunSink {
         stage: &mut stage,
         looks,
+        motion: MotionClock::new(&scene),
     };
     frame_loop::run(&mut backend, &mut renderer, &mut sink)?;
     if let Some(e) = sink.stage.take_error() {
@@ -388,9 +392,17 @@ struct DryRunSink<'a> {
     stage: &'a mut StudyStage,
     /// A planner per effect set.
     looks: LiveLooks,
+    /// The scene's motion (`[motion]`), from the first frame.
+    motion: MotionClock,
 }
 
 impl FrameSink for DryRunSink<'_> {
+    fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
+        let placement = self.motion.placement(input.time_ns)?;
+        self.looks.set_object_center(placement.object_position_m);
+        Some(self.motion.pose_of(&placement))
+    }
+
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         FramePlan {
             look: self.stage.plan(&mut self.looks, input),

@@ -30,6 +30,11 @@ pub(crate) const FIELDS: [(&str, vk::Format); 6] = [
     ("overlay gain", vk::Format::R16_SFLOAT),
 ];
 
+/// What each floor-space image holds where its passes do not draw (outside the rectangle
+/// the overlay can light, see [`FieldTarget::begin`]): lit floor, no seed (the shader's
+/// `NO_SEED`), beyond the ramp (the shader's `FAR_M`), no gain.
+pub(crate) const CLEAR: [f32; 6] = [0.0, -1.0e7, -1.0e7, 1.0e9, 0.0, 0.0];
+
 /// One floor-space image with the render pass and framebuffer that write it (dropped in
 /// that order: framebuffer, render pass, image).
 pub(crate) struct FieldTarget {
@@ -71,13 +76,23 @@ impl FieldTarget {
         })
     }
 
-    /// Begins this target's render pass, cleared to zero, with a viewport covering it.
+    /// Begins this target's render pass, cleared to `clear` everywhere, with a viewport
+    /// covering it and draws limited to `scissor` (`[x0, y0, x1, y1]` texels, ends excluded;
+    /// `None`: all of it).
     ///
     /// # Safety
     /// `cmd` must be recording outside any render pass, and execute while `self` lives.
-    pub unsafe fn begin(&self, device: &ash::Device, cmd: vk::CommandBuffer) {
+    pub unsafe fn begin(
+        &self,
+        device: &ash::Device,
+        cmd: vk::CommandBuffer,
+        clear: f32,
+        scissor: Option<[u32; 4]>,
+    ) {
         let clear = [vk::ClearValue {
-            color: vk::ClearColorValue { float32: [0.0; 4] },
+            color: vk::ClearColorValue {
+                float32: [clear; 4],
+            },
         }];
         // SAFETY: the caller's contract; the render pass and framebuffer are this target's.
         unsafe {
@@ -89,6 +104,19 @@ impl FieldTarget {
                 self.extent,
                 &clear,
             );
+            if let Some([x0, y0, x1, y1]) = scissor {
+                let area = vk::Rect2D {
+                    offset: vk::Offset2D {
+                        x: x0 as i32,
+                        y: y0 as i32,
+                    },
+                    extent: vk::Extent2D {
+                        width: x1 - x0,
+                        height: y1 - y0,
+                    },
+                };
+                device.cmd_set_scissor(cmd, 0, &[area]);
+            }
         }
     }
 }
@@ -120,7 +148,8 @@ pub struct InducerFields {
     pub texel_m: Vec2,
     /// 1 where the floor is in the object's shadow, 0 where lit.
     pub mask: Vec<u8>,
-    /// Distance to the shadow edge, metres; -1 inside the shadow, [`super::FAR_M`] without shadow.
+    /// Distance to the shadow edge, metres; -1 inside the shadow, [`super::FAR_M`] without
+    /// shadow and outside the overlay's rectangle (where the floor is farther than D from it).
     pub distance_m: Vec<f32>,
     /// k alpha(d) (eq. 2, 4): the overlay multiplies the floor photo by this.
     pub gain: Vec<f32>,

@@ -122,6 +122,19 @@ pub fn caustic_rect(width: u32, height: u32, gain: &[f32]) -> Option<[f32; 4]> {
     ])
 }
 
+/// The texels `[x0, y0, x1, y1]` (ends excluded) of a `width` x `height` floor-space image
+/// (row 0 at plane-local +y) that a plane-local rectangle touches, clamped to the image.
+pub(crate) fn texel_rect(rect: [f32; 4], width: u32, height: u32) -> [u32; 4] {
+    let (w, h) = (width as f32, height as f32);
+    let clamp = |v: f32, n: u32| (v.max(0.0) as u32).min(n);
+    [
+        clamp(((rect[0] + 0.5) * w).floor(), width),
+        clamp(((0.5 - rect[3]) * h).floor(), height),
+        clamp(((rect[2] + 0.5) * w).ceil(), width),
+        clamp(((0.5 - rect[1]) * h).ceil(), height),
+    ]
+}
+
 /// The smallest rectangle holding both (either may be absent).
 pub(crate) fn union_rect(a: Option<[f32; 4]>, b: Option<[f32; 4]>) -> Option<[f32; 4]> {
     match (a, b) {
@@ -156,6 +169,20 @@ mod tests {
         // A point above the light has no shadow on the floor.
         assert!((m * Vec3::new(0.0, 2.0, 0.0).extend(1.0)).w < 0.0);
         assert!(planar_shadow(Vec3::ZERO, Vec3::Y, Vec3::new(0.0, -1.0, 0.0)).is_none());
+    }
+
+    #[test]
+    fn texel_rect_covers_the_rectangle_with_row_zero_at_the_top() {
+        assert_eq!(
+            texel_rect([-0.5, -0.5, 0.5, 0.5], 512, 256),
+            [0, 0, 512, 256]
+        );
+        // The upper-left quarter, grown to whole texels.
+        assert_eq!(
+            texel_rect([-0.5, 0.001, -0.001, 0.5], 100, 100),
+            [0, 0, 50, 50]
+        );
+        assert_eq!(texel_rect([0.1, -0.3, 0.2, -0.1], 10, 10), [6, 6, 7, 8]);
     }
 
     #[test]

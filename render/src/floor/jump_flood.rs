@@ -30,11 +30,12 @@ pub(crate) struct FieldDraw {
     pub step: i32,
 }
 
-/// The jump of each jump-flooding pass for a `resolution_px` field: halving jumps from half
-/// the next power of two down to 1, then one more of 1.
-pub(crate) fn jumps(resolution_px: u32) -> Vec<i32> {
+/// The jump of each jump-flooding pass over a region `span_px` texels across (the field's
+/// side, or the side of the part of it the passes draw): halving jumps from half the next
+/// power of two down to 1, then one more of 1.
+pub(crate) fn jumps(span_px: u32) -> Vec<i32> {
     let mut jumps = Vec::new();
-    let mut step = resolution_px.next_power_of_two() / 2;
+    let mut step = span_px.max(1).next_power_of_two() / 2;
     while step >= 1 {
         jumps.push(step as i32);
         step /= 2;
@@ -45,8 +46,8 @@ pub(crate) fn jumps(resolution_px: u32) -> Vec<i32> {
 
 /// The passes from the shadow mask to the distance field, in recording order: the seed pass
 /// into [`SEEDS_A`], the jumps ping-ponging between [`SEEDS_A`] and [`SEEDS_B`], and the
-/// distance pass into [`DISTANCE`] reading the last seeds written.
-pub(crate) fn distance_passes(resolution_px: u32) -> Vec<FieldDraw> {
+/// distance pass into [`DISTANCE`] reading the last seeds written; `span_px` as in [`jumps`].
+pub(crate) fn distance_passes(span_px: u32) -> Vec<FieldDraw> {
     let mut draws = vec![FieldDraw {
         target: SEEDS_A,
         pipeline: SEED,
@@ -54,7 +55,7 @@ pub(crate) fn distance_passes(resolution_px: u32) -> Vec<FieldDraw> {
         step: 0,
     }];
     let mut source = SEEDS_A;
-    for step in jumps(resolution_px) {
+    for step in jumps(span_px) {
         let target = if source == SEEDS_A { SEEDS_B } else { SEEDS_A };
         draws.push(FieldDraw {
             target,

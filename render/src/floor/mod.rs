@@ -44,7 +44,9 @@
 //! - `fields`: the floor-space images, the push constants and the fields read back;
 //! - `jump_flood`: the schedule of the distance-field passes;
 //! - `overlay`: the per-eye overlay pipeline;
-//! - `pass`: the pass that builds all of it and records it once per scene;
+//! - `live`: the caustic gain map computed per pose on the GPU (photon splatting), instead of
+//!   a bake;
+//! - `pass`: the pass that builds all of it and records it once per pose;
 //! - `progress`: whether that computation has really run (set only after its fence);
 //! - `readback`: copying the fields back to the CPU.
 //!
@@ -54,6 +56,7 @@
 mod fields;
 mod geometry;
 mod jump_flood;
+mod live;
 mod overlay;
 mod pass;
 mod progress;
@@ -66,6 +69,7 @@ pub use crate::scene::{
 };
 pub use fields::InducerFields;
 pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
+pub use live::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE};
 pub(crate) use pass::InducerPass;
 pub(crate) use progress::Prepared;
 pub use reference::{

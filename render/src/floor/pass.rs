@@ -3,13 +3,14 @@
 //! them (progress.rs tracks whether it has really run; readback.rs copies the fields back).
 
 use ash::vk;
-use glam::{Mat4, Vec2};
+use glam::{Mat4, Vec2, Vec3};
 
-use super::fields::{DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY};
+use super::fields::{CLEAR, DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY};
 use super::geometry::{
-    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, union_rect,
+    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect, union_rect,
 };
 use super::jump_flood::{COMBINE, FieldDraw, RAMP, distance_passes};
+use super::live::{LiveCaustics, LiveCausticsDesc};
 use super::overlay::OverlayPass;
 use super::progress::{Prepared, Progress};
 use crate::camera::EyeParams;
@@ -18,6 +19,7 @@ use crate::error::Result;
 use crate::memory::{Image, upload_texture};
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec};
+use crate::pose::ScenePose;
 use crate::scene::{GpuScene, InducerDesc, SceneDesc};
 use crate::shaders;
 
@@ -30,6 +32,12 @@ pub(crate) struct InducerPass {
     pub(super) texel_m: Vec2,
     /// The floor plane's transform (unit square to world).
     world_from_plane: Mat4,
+    /// The floor's frame.
+    floor: Floor,
+    /// The mesh's vertices, model space (to bound the shadow of each pose).
+    positions: Vec<Vec3>,
+    /// The object's transform and the light the fields are (or are due to be) computed for.
+    pose: ScenePose,
     /// Model space to the mask's clip space; `None` when the light is not above the floor.
     mask_clip_from_model: Option<Mat4>,
     /// Plane-local rectangle the inducer's light covers; `None` when nothing can be lit.
@@ -59,7 +67,9 @@ pub(crate) struct InducerPass {
     /// The combine pass's set: the gain and G.
     combine_set: vk::DescriptorSet,
     /// The caustic gain G (R32F, read texel for texel by fs_combine; zeros without a map).
-    _caustic: Image,
+    caustic: Image,
+    /// Caustics computed per pose into `caustic`, once enabled.
+    live: Option<LiveCaustics>,
     /// Mask, seeds (two), distance, gain and overlay gain, in the order of [`FIELDS`].
     pub(super) targets: Vec<FieldTarget>,
 }
@@ -77,17 +87,8 @@ impl InducerPass {
         let params = desc.inducer;
         let n = params.resolution_px;
         let floor = Floor::new(desc.floor.world_from_plane);
-        let shadow = planar_shadow(floor.center_m, floor.normal, desc.light.position_m);
-        let rect = shadow.and_then(|shadow| {
-            // Ramp width plus two texels (rasterisation and the overlay's bilinear footprint).
-            let margin = Vec2::splat(params.ramp_width_m) / floor.size_m + 2.0 / n as f32;
-            let world = desc
-                .mesh
-                .positions
-                .iter()
-                .map(|p| desc.world_from_model.transform_point3(*p));
-            overlay_rect(world, shadow, floor.plane_from_world, margin)
-        });
+        let pose = ScenePose::of(desc);
+        let (mask_clip_from_model, rect) = shadow_of(&floor, &params, desc.mesh.positions, &pose);
         let field_extent = vk::Extent2D {
             width: n,
             height: n,
@@ -214,8 +215,10 @@ impl InducerPass {
             desc: params,
             texel_m: floor.size_m / n as f32,
             world_from_plane: floor.world_from_plane,
-            mask_clip_from_model: shadow
-                .map(|s| mask_clip_from_model(&floor, s, desc.world_from_model)),
+            floor,
+            positions: desc.mesh.positions.to_vec(),
+            pose,
+            mask_clip_from_model,
             rect,
             caustic_rect,
             index_count: scene.index_count,
@@ -229,9 +232,58 @@ impl InducerPass {
             _field_set_layout: field_set_layout,
             source_sets,
             combine_set,
-            _caustic: caustic,
+            caustic,
+            live: None,
             targets,
         })
+    }
+
+    /// Moves the object or the light: when `pose` differs from the current one, the shadow's
+    /// projection and the overlay's rectangle follow at once, and the fields (eq. 1-5,
+    /// unchanged) are computed again by the next frame that draws the overlay.
+    pub fn set_pose(&mut self, pose: ScenePose) {
+        if pose == self.pose {
+            return;
+        }
+        let (clip, rect) = shadow_of(&self.floor, &self.desc, &self.positions, &pose);
+        self.mask_clip_from_model = clip;
+        self.rect = rect;
+        self.pose = pose;
+        self.progress.invalidate();
+    }
+
+    /// Computes the caustic gain map on the GPU for each pose from now on (with the fields,
+    /// so on the next frame drawing the overlay and after every move), at the map's current
+    /// size (the bake's, or the inducer's resolution without one); the overlay may then
+    /// cover the whole floor.
+    pub fn enable_live(
+        &mut self,
+        ctx: &GpuContext,
+        desc: &SceneDesc,
+        live: LiveCausticsDesc,
+    ) -> Result<()> {
+        let extent = self.targets[OVERLAY].extent;
+        self.live = Some(LiveCaustics::new(
+            ctx,
+            &desc.mesh,
+            desc.ior,
+            self.world_from_plane,
+            [extent.width, extent.height],
+            live,
+        )?);
+        self.caustic_rect = Some([-0.5, -0.5, 0.5, 0.5]);
+        self.progress.invalidate();
+        Ok(())
+    }
+
+    /// The live caustic gain map of the last finished computation, if live caustics are on.
+    pub fn live_gain(&self) -> Result<Option<Vec<f32>>> {
+        self.live.as_ref().map(LiveCaustics::gain).transpose()
+    }
+
+    /// How many computations of the fields were submitted since the pass was made.
+    pub fn computations(&self) -> u64 {
+        self.progress.computations
     }
 
     /// The push constants shared by the full-screen passes.
@@ -271,13 +323,22 @@ impl InducerPass {
         unsafe {
             if prepared.fields {
                 self.record_fields(ctx, cmd, scene);
+                if let Some(live) = &self.live {
+                    live.record(ctx, cmd, &self.pose, &self.caustic);
+                }
             }
             if prepared.combined.is_some() {
                 let push = self.push(
                     0,
                     [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
                 );
-                self.full_screen(ctx, cmd, OVERLAY, COMBINE, self.combine_set, &push);
+                // Nothing is drawn outside the overlay's rectangle: the gain there stays 0.
+                let extent = self.targets[OVERLAY].extent;
+                let scissor = self
+                    .overlay_rect(inducer, caustics)
+                    .map(|r| texel_rect(r, extent.width, extent.height));
+                let set = self.combine_set;
+                self.full_screen(ctx, cmd, OVERLAY, COMBINE, set, &push, scissor);
             }
         }
         prepared
@@ -313,10 +374,15 @@ impl InducerPass {
         scene: &GpuScene,
     ) {
         let d = &ctx.device;
+        let n = self.desc.resolution_px;
+        // Only the part of the floor the inducer can light (the shadow and its ramp) is
+        // computed; the rest keeps the cleared values (lit, beyond the ramp, no gain).
+        let scissor = self.rect.map(|r| texel_rect(r, n, n));
+        let span = scissor.map_or(n, |[x0, y0, x1, y1]| (x1 - x0).max(y1 - y0));
         // SAFETY: the caller's contract: `cmd` records outside a render pass and everything
         // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it.
         unsafe {
-            self.targets[MASK].begin(d, cmd);
+            self.targets[MASK].begin(d, cmd, CLEAR[MASK], scissor);
             if let Some(clip_from_model) = self.mask_clip_from_model {
                 d.cmd_bind_pipeline(
                     cmd,
@@ -341,21 +407,20 @@ impl InducerPass {
                 source: DISTANCE,
                 step: 0,
             };
-            for draw in distance_passes(self.desc.resolution_px)
-                .into_iter()
-                .chain([ramp])
-            {
+            for draw in distance_passes(span).into_iter().chain([ramp]) {
                 let push = self.push(draw.step, [0.0; 2]);
                 let set = self.source_sets[draw.source];
-                self.full_screen(ctx, cmd, draw.target, draw.pipeline, set, &push);
+                self.full_screen(ctx, cmd, draw.target, draw.pipeline, set, &push, scissor);
             }
         }
     }
 
-    /// One full-screen pass of `pipeline` into field `target`.
+    /// One full-screen pass of `pipeline` into field `target`, drawing only inside
+    /// `scissor` (texels; `None`: everywhere) after clearing the whole field.
     ///
     /// # Safety
     /// As [`InducerPass::prepare`]; `set` must be one of this pass's sets.
+    #[allow(clippy::too_many_arguments)]
     unsafe fn full_screen(
         &self,
         ctx: &GpuContext,
@@ -364,12 +429,13 @@ impl InducerPass {
         pipeline: usize,
         set: vk::DescriptorSet,
         push: &FieldPush,
+        scissor: Option<[u32; 4]>,
     ) {
         let d = &ctx.device;
         // SAFETY: the caller's contract; the pipeline, layout, set and target are this
         // pass's.
         unsafe {
-            self.targets[target].begin(d, cmd);
+            self.targets[target].begin(d, cmd, CLEAR[target], scissor);
             d.cmd_bind_pipeline(
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,
@@ -419,4 +485,27 @@ impl InducerPass {
             };
         }
     }
+}
+
+/// The mask's projection (eq. 1: `None` when the light is not above the floor) and the
+/// plane-local rectangle the inducer's light covers (`None` when nothing can be lit) for the
+/// object and light of `pose`.
+fn shadow_of(
+    floor: &Floor,
+    params: &InducerDesc,
+    positions: &[Vec3],
+    pose: &ScenePose,
+) -> (Option<Mat4>, Option<[f32; 4]>) {
+    let shadow = planar_shadow(floor.center_m, floor.normal, pose.light_position_m);
+    let rect = shadow.and_then(|shadow| {
+        // Ramp width plus two texels (rasterisation and the overlay's bilinear footprint).
+        let margin =
+            Vec2::splat(params.ramp_width_m) / floor.size_m + 2.0 / params.resolution_px as f32;
+        let world = positions
+            .iter()
+            .map(|p| pose.world_from_model.transform_point3(*p));
+        overlay_rect(world, shadow, floor.plane_from_world, margin)
+    });
+    let clip = shadow.map(|s| mask_clip_from_model(floor, s, pose.world_from_model));
+    (clip, rect)
 }

@@ -1,7 +1,8 @@
 //! Whether the floor fields have really been computed. The state changes only when the
 //! renderer reports what happened to submitted work (submitted, then finished or failed),
 //! never while commands are being recorded, so a failed submit or a lost frame leaves the
-//! computation due again.
+//! computation due again. A moved object or light starts a new generation: the fields are due
+//! again, and reports about work of an older generation no longer change anything.
 
 /// Where a one-time computation stands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -21,6 +22,8 @@ pub(super) enum Computation {
 /// [`super::InducerPass::finished`] once its fence signalled (or the wait failed).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Prepared {
+    /// The generation (object and light pose) it was recorded for.
+    pub(super) generation: u64,
     /// The fields (mask, distance, gain) were recorded.
     pub(super) fields: bool,
     /// The overlay gain's combination for these switches was recorded.
@@ -31,6 +34,11 @@ pub(crate) struct Prepared {
 /// happened to submitted work, never while recording.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Progress {
+    /// How many times the object or the light moved since the pass was made.
+    generation: u64,
+    /// How many computations of the fields were submitted (of the current generation when
+    /// they were).
+    pub computations: u64,
     /// The mask, distance and gain fields.
     pub fields: Computation,
     /// The switches (bit 0 inducer, bit 1 caustics) of the last overlay gain combination
@@ -42,14 +50,27 @@ impl Progress {
     /// What must be recorded for a frame drawing with `switches`.
     pub fn plan(&self, switches: Option<u8>) -> Prepared {
         Prepared {
+            generation: self.generation,
             fields: self.fields == Computation::Missing,
             combined: switches.filter(|&s| self.combined_for != Some(s)),
         }
     }
 
+    /// The object or the light moved: the fields and the combination are due again, and
+    /// work recorded before is of an older generation.
+    pub fn invalidate(&mut self) {
+        self.generation += 1;
+        self.fields = Computation::Missing;
+        self.combined_for = None;
+    }
+
     /// The work `prepared` was recorded into has been submitted.
     pub fn submitted(&mut self, prepared: Prepared) {
+        if prepared.generation != self.generation {
+            return;
+        }
         if prepared.fields {
+            self.computations += 1;
             self.fields = Computation::Submitted;
         }
         if prepared.combined.is_some() {
@@ -60,6 +81,9 @@ impl Progress {
     /// The work `prepared` was recorded into has finished (`ok`) or can no longer be relied
     /// on (its fence wait failed).
     pub fn finished(&mut self, prepared: Prepared, ok: bool) {
+        if prepared.generation != self.generation {
+            return;
+        }
         if prepared.fields && self.fields == Computation::Submitted {
             self.fields = if ok {
                 Computation::Done
@@ -84,6 +108,7 @@ mod tests {
         assert_eq!(
             first,
             Prepared {
+                generation: 0,
                 fields: true,
                 combined: Some(1)
             }
@@ -100,10 +125,30 @@ mod tests {
         assert_eq!(
             progress.plan(Some(3)),
             Prepared {
+                generation: 0,
                 fields: false,
                 combined: Some(3)
             }
         );
+    }
+
+    #[test]
+    fn a_move_makes_everything_due_and_ignores_older_work() {
+        let mut progress = Progress::default();
+        let first = progress.plan(Some(3));
+        progress.submitted(first);
+        progress.invalidate();
+        let second = progress.plan(Some(3));
+        assert!(second.fields && second.combined == Some(3));
+        progress.submitted(second);
+        // The older frame finishing does not mark the newer computation done ...
+        progress.finished(first, true);
+        assert_eq!(progress.fields, Computation::Submitted);
+        // ... nor does its failure make it due again.
+        progress.finished(first, false);
+        assert!(!progress.plan(Some(3)).fields);
+        progress.finished(second, true);
+        assert_eq!(progress.fields, Computation::Done);
     }
 
     #[test]

@@ -27,8 +27,8 @@ impl InducerPass {
             MemoryLocation::GpuToCpu,
         )?;
         let prepared = Prepared {
-            fields: self.progress.plan(None).fields,
             combined: None,
+            ..self.progress.plan(None)
         };
         let this = &*self;
         let d = &ctx.device;

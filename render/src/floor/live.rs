@@ -1,0 +1,583 @@
+//! Caustics computed on the GPU for each pose of the object and the light (docs/caustics.md,
+//! eq. 6): photon splatting in two compute passes (shaders/caustics_live.wgsl) into the
+//! caustic gain map the overlay combines, in place of a bake. Recorded with the inducer's
+//! fields, so only on frames after a move; lavapipe's timestamps do not cover compute, so the
+//! work shows in wall-clock time.
+
+use ash::vk;
+use glam::{Mat4, Vec3, Vec4};
+use gpu_allocator::MemoryLocation;
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::memory::{Buffer, Image, subresource_range};
+use crate::owned::Owned;
+use crate::pipeline;
+use crate::pose::ScenePose;
+use crate::scene::MeshRef;
+use crate::shaders;
+
+/// How caustics are computed live.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LiveCausticsDesc {
+    /// Photons along each side of the emission grid (its square is the photon count).
+    pub photons_per_side: u32,
+    /// Most reflections and refractions on one light path (the bake's default: 12).
+    pub max_interactions: u32,
+}
+
+impl Default for LiveCausticsDesc {
+    /// 128 x 128 photons (the glass sphere's map within 2 % of its bake), 12 interactions.
+    fn default() -> LiveCausticsDesc {
+        LiveCausticsDesc {
+            photons_per_side: 128,
+            max_interactions: 12,
+        }
+    }
+}
+
+/// Largest photon grid side accepted.
+pub const MAX_PHOTONS_PER_SIDE: u32 = 4096;
+/// Fixed-point units per unit of gain in the sums (integer atomics keep the result the same
+/// whatever order photons land in).
+const FIXED_POINT: f32 = 65536.0;
+/// Paths below this weight end (as in the bake).
+const MIN_WEIGHT: f32 = 1e-4;
+/// Gains below this are stored as 0 (the bake's `MIN_GAIN`).
+const MIN_GAIN: f32 = 0.001;
+
+/// Uniform block matching `Params` in caustics_live.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    model_from_world: [f32; 16],
+    world_from_model: [f32; 16],
+    world_from_plane: [f32; 16],
+    plane_from_world: [f32; 16],
+    light: [f32; 4],
+    axis: [f32; 4],
+    basis_u: [f32; 4],
+    basis_v: [f32; 4],
+    grid_origin: [f32; 4],
+    grid_dims: [u32; 4],
+    map: [u32; 4],
+    misc: [f32; 4],
+}
+
+/// A uniform grid over the mesh's bounding box, model space: the triangles overlapping each
+/// cell (x fastest, then y, then z).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Grid {
+    /// Lower corner, model units.
+    pub origin: Vec3,
+    /// Side of a cell, model units.
+    pub side: f32,
+    /// Cells along x, y, z.
+    pub dims: [u32; 3],
+    /// First entry in `triangles` and count, per cell.
+    pub cells: Vec<[u32; 2]>,
+    /// Triangle indices, cell after cell.
+    pub triangles: Vec<u32>,
+}
+
+impl Grid {
+    /// About one cell per triangle, cubic cells over the bounding box, every triangle listed
+    /// in each cell its bounding box overlaps.
+    pub fn new(positions: &[Vec3], indices: &[u32]) -> Grid {
+        let lo = positions.iter().copied().fold(Vec3::INFINITY, Vec3::min);
+        let hi = positions
+            .iter()
+            .copied()
+            .fold(Vec3::NEG_INFINITY, Vec3::max);
+        let extent = (hi - lo).max(Vec3::splat(1e-6));
+        let count = (indices.len() / 3).max(1) as f32;
+        let per_axis = count.cbrt().ceil().clamp(1.0, 64.0);
+        let side = extent.max_element() / per_axis;
+        let pad = Vec3::splat(side * 1e-3);
+        let origin = lo - pad;
+        let dims = ((extent + 2.0 * pad) / side)
+            .ceil()
+            .max(Vec3::ONE)
+            .as_uvec3()
+            .to_array();
+        let cell_of = |p: Vec3| {
+            ((p - origin) / side)
+                .floor()
+                .max(Vec3::ZERO)
+                .as_uvec3()
+                .min(glam::UVec3::from_array(dims) - 1)
+        };
+        let total = (dims[0] * dims[1] * dims[2]) as usize;
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); total];
+        for (t, tri) in indices.chunks_exact(3).enumerate() {
+            let corners = tri.iter().map(|&i| positions[i as usize]);
+            let tlo = corners.clone().fold(Vec3::INFINITY, Vec3::min) - pad;
+            let thi = corners.fold(Vec3::NEG_INFINITY, Vec3::max) + pad;
+            let (a, b) = (cell_of(tlo), cell_of(thi));
+            for z in a.z..=b.z {
+                for y in a.y..=b.y {
+                    for x in a.x..=b.x {
+                        lists[(x + dims[0] * (y + dims[1] * z)) as usize].push(t as u32);
+                    }
+                }
+            }
+        }
+        let mut cells = Vec::with_capacity(total);
+        let mut triangles = Vec::new();
+        for list in lists {
+            cells.push([triangles.len() as u32, list.len() as u32]);
+            triangles.extend(list);
+        }
+        Grid {
+            origin,
+            side,
+            dims,
+            cells,
+            triangles,
+        }
+    }
+}
+
+/// The compute passes, their buffers and what they need of the mesh; freed on drop.
+pub(crate) struct LiveCaustics {
+    /// Photon tracing and splatting.
+    trace: Owned<vk::Pipeline>,
+    /// Fixed point to gain.
+    resolve: Owned<vk::Pipeline>,
+    /// Layout of both (one set, no push constants).
+    layout: Owned<vk::PipelineLayout>,
+    /// Pool of the set.
+    _pool: Owned<vk::DescriptorPool>,
+    /// Layout of the set.
+    _set_layout: Owned<vk::DescriptorSetLayout>,
+    /// The set: parameters, mesh, grid, sums, gain.
+    set: vk::DescriptorSet,
+    /// `Params`, rewritten before each computation.
+    params: Buffer,
+    /// Mesh and grid buffers, read by the trace pass.
+    _mesh: [Buffer; 5],
+    /// Fixed-point sums per texel.
+    sums: Buffer,
+    /// The resolved gain map, host-visible (for tests).
+    gain: Buffer,
+    /// Map width and height, texels.
+    size: [u32; 2],
+    /// Photons and path length.
+    desc: LiveCausticsDesc,
+    /// The grid's placement, model units.
+    grid_origin: Vec3,
+    /// Its cell side.
+    grid_side: f32,
+    /// Its cells per axis.
+    grid_dims: [u32; 3],
+    /// Centre of the mesh's bounding box, model units.
+    model_center: Vec3,
+    /// Largest distance of a vertex from it, model units.
+    model_radius: f32,
+    /// Floor unit square to world.
+    world_from_plane: Mat4,
+    /// Relative index of refraction.
+    ior: f32,
+}
+
+impl LiveCaustics {
+    /// Prepares the passes for `mesh` (model units, outward normals, closed) over a floor
+    /// mapped by `world_from_plane`, writing a `size` gain map.
+    pub fn new(
+        ctx: &GpuContext,
+        mesh: &MeshRef,
+        ior: f32,
+        world_from_plane: Mat4,
+        size: [u32; 2],
+        desc: LiveCausticsDesc,
+    ) -> Result<LiveCaustics> {
+        if !(1..=MAX_PHOTONS_PER_SIDE).contains(&desc.photons_per_side)
+            || desc.max_interactions == 0
+        {
+            return Err(RenderError::InvalidInput(format!(
+                "live caustics need 1..={MAX_PHOTONS_PER_SIDE} photons per side and at least \
+                 one interaction, got {} and {}",
+                desc.photons_per_side, desc.max_interactions
+            )));
+        }
+        let grid = Grid::new(mesh.positions, mesh.indices);
+        let lo = mesh
+            .positions
+            .iter()
+            .copied()
+            .fold(Vec3::INFINITY, Vec3::min);
+        let hi = mesh
+            .positions
+            .iter()
+            .copied()
+            .fold(Vec3::NEG_INFINITY, Vec3::max);
+        let model_center = (lo + hi) / 2.0;
+        let model_radius = mesh
+            .positions
+            .iter()
+            .map(|p| p.distance(model_center))
+            .fold(0.0f32, f32::max);
+        let vec4s =
+            |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.extend(0.0).to_array()).collect() };
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let cells: Vec<u32> = grid.cells.iter().flatten().copied().collect();
+        let mesh_buffers = [
+            Buffer::with_data(
+                ctx,
+                "caustics positions",
+                bytemuck::cast_slice(&vec4s(mesh.positions)),
+                storage,
+            )?,
+            Buffer::with_data(
+                ctx,
+                "caustics normals",
+                bytemuck::cast_slice(&vec4s(mesh.normals)),
+                storage,
+            )?,
+            Buffer::with_data(
+                ctx,
+                "caustics indices",
+                bytemuck::cast_slice(mesh.indices),
+                storage,
+            )?,
+            Buffer::with_data(
+                ctx,
+                "caustics grid cells",
+                bytemuck::cast_slice(&cells),
+                storage,
+            )?,
+            Buffer::with_data(
+                ctx,
+                "caustics grid triangles",
+                bytemuck::cast_slice(&grid.triangles),
+                storage,
+            )?,
+        ];
+        let texels = u64::from(size[0]) * u64::from(size[1]);
+        let sums = Buffer::new(
+            ctx,
+            "caustics sums",
+            texels * 4,
+            storage | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
+        let gain = Buffer::new(
+            ctx,
+            "caustics gain",
+            texels * 4,
+            storage | vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let params = Buffer::new(
+            ctx,
+            "caustics parameters",
+            size_of::<Params>() as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let mut bindings = vec![(0, vk::DescriptorType::UNIFORM_BUFFER, compute)];
+        bindings.extend((1..=7).map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute)));
+        let set_layout = pipeline::set_layout(ctx, &bindings)?;
+        // A 4-byte push range the shaders never read keeps the shared layout helper.
+        let layout = pipeline::layout(ctx, Some(set_layout.raw()), compute, 4)?;
+        let trace = pipeline::compute(ctx, layout.raw(), shaders::CAUSTICS_TRACE_CS, c"cs_trace")?;
+        let resolve = pipeline::compute(
+            ctx,
+            layout.raw(),
+            shaders::CAUSTICS_RESOLVE_CS,
+            c"cs_resolve",
+        )?;
+        let pool = pipeline::pool(
+            ctx,
+            1,
+            &[
+                (vk::DescriptorType::UNIFORM_BUFFER, 1),
+                (vk::DescriptorType::STORAGE_BUFFER, 7),
+            ],
+        )?;
+        let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+        let mut buffers = vec![params.buffer];
+        buffers.extend(mesh_buffers.iter().map(|b| b.buffer));
+        buffers.extend([sums.buffer, gain.buffer]);
+        let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
+            .iter()
+            .map(|&buffer| {
+                [vk::DescriptorBufferInfo {
+                    buffer,
+                    offset: 0,
+                    range: vk::WHOLE_SIZE,
+                }]
+            })
+            .collect();
+        let writes: Vec<_> = infos
+            .iter()
+            .enumerate()
+            .map(|(binding, info)| {
+                let ty = if binding == 0 {
+                    vk::DescriptorType::UNIFORM_BUFFER
+                } else {
+                    vk::DescriptorType::STORAGE_BUFFER
+                };
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(binding as u32)
+                    .descriptor_type(ty)
+                    .buffer_info(info)
+            })
+            .collect();
+        // SAFETY: the set was just allocated and no GPU work uses it; the buffers are live.
+        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        Ok(LiveCaustics {
+            trace,
+            resolve,
+            layout,
+            _pool: pool,
+            _set_layout: set_layout,
+            set,
+            params,
+            _mesh: mesh_buffers,
+            sums,
+            gain,
+            size,
+            desc,
+            grid_origin: grid.origin,
+            grid_side: grid.side,
+            grid_dims: grid.dims,
+            model_center,
+            model_radius,
+            world_from_plane,
+            ior,
+        })
+    }
+
+    /// The shader's parameters for `pose`.
+    fn params(&self, pose: &ScenePose) -> Params {
+        let m = pose.world_from_model;
+        let center = m.transform_point3(self.model_center);
+        let radius = self.model_radius * m.x_axis.truncate().length();
+        let light = pose.light_position_m;
+        let to_center = center - light;
+        let dist = to_center.length();
+        let axis = if dist > 0.0 {
+            to_center / dist
+        } else {
+            Vec3::NEG_Y
+        };
+        let one_minus_cos = if dist <= radius {
+            2.0
+        } else {
+            2.0 * (0.5 * (radius / dist).asin()).sin().powi(2)
+        };
+        let helper = if axis.x.abs() < 0.6 { Vec3::X } else { Vec3::Y };
+        let u = helper.cross(axis).normalize();
+        let v = axis.cross(u);
+        let n = self.desc.photons_per_side;
+        let solid_angle = 2.0 * std::f32::consts::PI * one_minus_cos / (n as f32 * n as f32);
+        let floor_area = self
+            .world_from_plane
+            .x_axis
+            .truncate()
+            .cross(self.world_from_plane.y_axis.truncate())
+            .length();
+        let texel_area = floor_area / (self.size[0] as f32 * self.size[1] as f32);
+        let [gx, gy, gz] = self.grid_dims;
+        Params {
+            model_from_world: m.inverse().to_cols_array(),
+            world_from_model: m.to_cols_array(),
+            world_from_plane: self.world_from_plane.to_cols_array(),
+            plane_from_world: self.world_from_plane.inverse().to_cols_array(),
+            light: light.extend(solid_angle).to_array(),
+            axis: axis.extend(one_minus_cos).to_array(),
+            basis_u: u.extend(self.ior).to_array(),
+            basis_v: v.extend(texel_area).to_array(),
+            grid_origin: self.grid_origin.extend(self.grid_side).to_array(),
+            grid_dims: [gx, gy, gz, n],
+            map: [self.size[0], self.size[1], self.desc.max_interactions, 0],
+            misc: Vec4::new(self.model_radius * 2e-5, FIXED_POINT, MIN_WEIGHT, MIN_GAIN).to_array(),
+        }
+    }
+
+    /// Records the computation of the gain map for `pose` and its copy into `caustic` (an
+    /// R32F image of the map's size in SHADER_READ_ONLY_OPTIMAL, left there), ordered after
+    /// earlier work's reads of both and before later fragment reads of `caustic`.
+    ///
+    /// # Safety
+    /// `cmd` must be recording outside any render pass; `self` and `caustic` must outlive its
+    /// execution.
+    pub unsafe fn record(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        pose: &ScenePose,
+        caustic: &Image,
+    ) {
+        let d = &ctx.device;
+        let params = self.params(pose);
+        let memory = |src, dst| {
+            [vk::MemoryBarrier::default()
+                .src_access_mask(src)
+                .dst_access_mask(dst)]
+        };
+        let image_barrier = |old, new, src, dst| {
+            [vk::ImageMemoryBarrier::default()
+                .src_access_mask(src)
+                .dst_access_mask(dst)
+                .old_layout(old)
+                .new_layout(new)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(caustic.image)
+                .subresource_range(subresource_range(vk::ImageAspectFlags::COLOR, 0, 1))]
+        };
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        let groups = |n: u32| n.div_ceil(8);
+        // SAFETY: the caller's contract (outside a render pass, everything outlives the
+        // execution); the barriers order every access to the parameters, the sums, the gain
+        // and the image against earlier and later work on the queue; the image is moved from
+        // and back to the layout it is in.
+        unsafe {
+            d.cmd_pipeline_barrier(
+                cmd,
+                compute | transfer | vk::PipelineStageFlags::HOST,
+                transfer,
+                vk::DependencyFlags::empty(),
+                &memory(
+                    vk::AccessFlags::SHADER_READ
+                        | vk::AccessFlags::SHADER_WRITE
+                        | vk::AccessFlags::UNIFORM_READ
+                        | vk::AccessFlags::TRANSFER_READ
+                        | vk::AccessFlags::HOST_READ,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                ),
+                &[],
+                &[],
+            );
+            d.cmd_update_buffer(cmd, self.params.buffer, 0, bytemuck::bytes_of(&params));
+            d.cmd_fill_buffer(cmd, self.sums.buffer, 0, vk::WHOLE_SIZE, 0);
+            d.cmd_pipeline_barrier(
+                cmd,
+                transfer,
+                compute,
+                vk::DependencyFlags::empty(),
+                &memory(
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::AccessFlags::UNIFORM_READ
+                        | vk::AccessFlags::SHADER_READ
+                        | vk::AccessFlags::SHADER_WRITE,
+                ),
+                &[],
+                &[],
+            );
+            let bind = vk::PipelineBindPoint::COMPUTE;
+            d.cmd_bind_descriptor_sets(cmd, bind, self.layout.raw(), 0, &[self.set], &[]);
+            d.cmd_bind_pipeline(cmd, bind, self.trace.raw());
+            let n = self.desc.photons_per_side;
+            d.cmd_dispatch(cmd, groups(n), groups(n), 1);
+            d.cmd_pipeline_barrier(
+                cmd,
+                compute,
+                compute,
+                vk::DependencyFlags::empty(),
+                &memory(
+                    vk::AccessFlags::SHADER_WRITE,
+                    vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+                ),
+                &[],
+                &[],
+            );
+            d.cmd_bind_pipeline(cmd, bind, self.resolve.raw());
+            d.cmd_dispatch(cmd, groups(self.size[0]), groups(self.size[1]), 1);
+            d.cmd_pipeline_barrier(
+                cmd,
+                compute | vk::PipelineStageFlags::FRAGMENT_SHADER,
+                transfer,
+                vk::DependencyFlags::empty(),
+                &memory(
+                    vk::AccessFlags::SHADER_WRITE,
+                    vk::AccessFlags::TRANSFER_READ,
+                ),
+                &[],
+                &image_barrier(
+                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    vk::AccessFlags::SHADER_READ,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                ),
+            );
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D {
+                    width: self.size[0],
+                    height: self.size[1],
+                    depth: 1,
+                });
+            d.cmd_copy_buffer_to_image(
+                cmd,
+                self.gain.buffer,
+                caustic.image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            );
+            d.cmd_pipeline_barrier(
+                cmd,
+                transfer | compute,
+                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::HOST,
+                vk::DependencyFlags::empty(),
+                &memory(vk::AccessFlags::SHADER_WRITE, vk::AccessFlags::HOST_READ),
+                &[],
+                &image_barrier(
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::AccessFlags::SHADER_READ,
+                ),
+            );
+        }
+    }
+
+    /// The gain map of the last computation that finished, row 0 at the photo's top (wait
+    /// for the frame first).
+    pub fn gain(&self) -> Result<Vec<f32>> {
+        Ok(self
+            .gain
+            .mapped()?
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_triangle_is_listed_in_the_cells_around_it() {
+        let positions = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        ];
+        let indices = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
+        let grid = Grid::new(&positions, &indices);
+        // Two cells per side over the unit box, grown by a hair for the padding.
+        assert_eq!(grid.dims, [3, 3, 3]);
+        // Each triangle appears at least once, the one facing the origin's corner in all
+        // cells its box touches.
+        for t in 0..4u32 {
+            assert!(grid.triangles.contains(&t));
+        }
+        let total: u32 = grid.cells.iter().map(|c| c[1]).sum();
+        assert_eq!(total as usize, grid.triangles.len());
+        let corner = grid.cells[0];
+        assert_eq!(corner[1], 4, "every face touches the cell at the origin");
+    }
+}

@@ -1,0 +1,170 @@
+//! Caustics computed on the GPU for the current pose (photon splatting, docs/caustics.md)
+//! against the offline bake of the same scene at the same resolution, on the machine's
+//! Vulkan device with validation on.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::{Quat, Vec2, Vec3};
+use vitreous::scene::{Scene, load_scene};
+use vitreous::views;
+use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_render::floor::LiveCausticsDesc;
+use vitreous_render::renderer::Want;
+use vitreous_render::{ContextOptions, FrameParams, GpuContext, Look, Renderer, ScenePose};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn scene(name: &str) -> Scene {
+    let path = workspace().join("config/scenes").join(name);
+    let mut scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    scene.load_caustics().unwrap_or_else(|e| panic!("{e}"));
+    scene
+}
+
+/// Renders one frame with the caustics on for each light position (`None`: the scene's) and
+/// returns the live gain maps, with the wall-clock milliseconds of each frame.
+fn live_gains(
+    scene: &Scene,
+    photons_per_side: u32,
+    lights: &[Option<Vec3>],
+) -> Vec<(Vec<f32>, f64)> {
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: true,
+        device_name: None,
+    })
+    .expect("Vulkan device with validation");
+    let desc = views::scene_desc(scene, None);
+    let mut renderer = Renderer::new(ctx, &desc, 32, 32).expect("renderer");
+    renderer
+        .enable_live_caustics(
+            &desc,
+            LiveCausticsDesc {
+                photons_per_side,
+                max_interactions: 12,
+            },
+        )
+        .expect("live caustics");
+    let fov = Fov {
+        left_rad: -0.3,
+        right_rad: 0.3,
+        up_rad: 0.3,
+        down_rad: -0.3,
+    };
+    let eye = EyeParams::new(Vec3::ZERO, Quat::IDENTITY, fov);
+    let params = FrameParams {
+        eyes: [eye, eye],
+        look: Look {
+            inducer: true,
+            caustics: true,
+            ..Look::default()
+        },
+    };
+    let mut out = Vec::new();
+    for light in lights {
+        if let Some(light) = light {
+            renderer.set_pose(ScenePose {
+                light_position_m: *light,
+                ..ScenePose::of(&desc)
+            });
+        }
+        let started = Instant::now();
+        renderer.submit(&params, Want::default()).expect("submit");
+        renderer.flush().expect("flush");
+        let wall_ms = started.elapsed().as_secs_f64() * 1e3;
+        let gain = renderer
+            .live_caustic_gain()
+            .expect("read back")
+            .expect("live caustics are on");
+        out.push((gain, wall_ms));
+    }
+    let v = renderer.context().validation();
+    assert_eq!(
+        v.errors() + v.warnings(),
+        0,
+        "validation messages: {:#?}",
+        v.messages()
+    );
+    out
+}
+
+/// docs/caustics.md's quality figure: sqrt(sum (G - G_ref)^2 / sum G_ref^2) over the texels
+/// where the reference is visibly brighter than the bare floor (G_ref > 0.1).
+fn relative_rms(gain: &[f32], reference: &[f32]) -> f64 {
+    let (mut diff, mut norm) = (0.0f64, 0.0f64);
+    for (&g, &r) in gain.iter().zip(reference) {
+        if r > 0.1 {
+            diff += f64::from(g - r).powi(2);
+            norm += f64::from(r).powi(2);
+        }
+    }
+    (diff / norm).sqrt()
+}
+
+/// The texel (column, row) with the largest gain.
+fn peak(gain: &[f32], width: u32) -> (u32, u32) {
+    let i = gain
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(i, _)| i as u32)
+        .unwrap_or(0);
+    (i % width, i / width)
+}
+
+/// The texel (continuous, pixel centres at half-integers) where the line from `light` through
+/// the sphere's centre meets the floor, for a `w` x `h` map.
+fn axis_texel(scene: &Scene, light: Vec3, w: u32, h: u32) -> Vec2 {
+    let center = scene.object.center_m;
+    let floor_y = scene.floor.pose.position.y;
+    let dir = center - light;
+    let axis_point = light + dir * ((floor_y - light.y) / dir.y);
+    let local = scene
+        .floor
+        .world_from_plane()
+        .inverse()
+        .transform_point3(axis_point);
+    Vec2::new((local.x + 0.5) * w as f32, (0.5 - local.y) * h as f32)
+}
+
+#[test]
+fn live_sphere_caustics_match_the_bake_and_focus_on_the_light_axis() {
+    let scene = scene("glass-sphere.toml");
+    let bake = scene.caustics.gain.as_ref().expect("the bake is loaded");
+    let (w, h) = (bake.width_px, bake.height_px);
+    // The shipped pose, then the light turned a quarter round the sphere (to its left).
+    let center = scene.object.center_m;
+    let offset = scene.light.position_m - center;
+    let turned = center + Quat::from_rotation_y(std::f32::consts::FRAC_PI_2) * offset;
+    let frames = live_gains(&scene, 128, &[None, Some(turned)]);
+    let (gain, wall_ms) = &frames[0];
+    assert_eq!(gain.len(), bake.gain.len());
+    let rms = relative_rms(gain, &bake.gain);
+    let (bx, by) = peak(&bake.gain, w);
+    for ((gain, wall_ms), light) in frames.iter().zip([scene.light.position_m, turned]) {
+        let (px, py) = peak(gain, w);
+        let expected = axis_texel(&scene, light, w, h);
+        eprintln!(
+            "live sphere caustics at {w}x{h}, light at {light}: peak G {:.0} at ({px}, {py}), \
+             the light axis meets the floor at ({:.2}, {:.2}); frame with the computation \
+             {wall_ms:.0} ms wall clock",
+            gain[(py * w + px) as usize],
+            expected.x,
+            expected.y
+        );
+        let centre = Vec2::new(px as f32 + 0.5, py as f32 + 0.5);
+        assert!(
+            (centre - expected).abs().max_element() <= 1.0,
+            "peak at {centre}, the axis at {expected}"
+        );
+    }
+    eprintln!(
+        "relative RMS {:.2} % against the bake (peak {:.0} at ({bx}, {by})); first frame \
+         {wall_ms:.0} ms",
+        rms * 100.0,
+        bake.gain[(by * w + bx) as usize]
+    );
+    assert!(rms < 0.05, "relative RMS {rms}");
+}

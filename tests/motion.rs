@@ -1,0 +1,241 @@
+//! A moving scene (`[motion]`) on the machine's Vulkan device with validation on: the glass
+//! follows the object's pose from the frame it is set, the shadow inducer's fields follow the
+//! light (the shadow's centroid against an exact CPU shadow of the sphere), and a replay of
+//! the shipped moving-light scene computes the fields once per frame that moved and never on
+//! frames that did not.
+
+use std::path::{Path, PathBuf};
+
+use glam::{DVec2, Quat, Vec2, Vec3};
+use vitreous::effects::EffectSet;
+use vitreous::replay::{ReplayOptions, replay};
+use vitreous::scene::{Placement, Scene, load_scene};
+use vitreous::views;
+use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_render::floor::InducerFields;
+use vitreous_render::renderer::Want;
+use vitreous_render::{ContextOptions, FrameParams, GpuContext, Look, Renderer};
+use vitreous_tests::{lit_centroid, render_once};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn scene(name: &str) -> Scene {
+    let path = workspace().join("config/scenes").join(name);
+    load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn renderer(scene: &Scene, width: u32, height: u32) -> Renderer {
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: true,
+        device_name: None,
+    })
+    .expect("Vulkan device with validation");
+    Renderer::new(ctx, &views::scene_desc(scene, None), width, height).expect("renderer")
+}
+
+fn assert_silent(renderer: &Renderer) {
+    let v = renderer.context().validation();
+    assert_eq!(
+        v.errors() + v.warnings(),
+        0,
+        "validation messages: {:#?}",
+        v.messages()
+    );
+}
+
+/// Where a floor texel centre lies in the world.
+fn texel_world(scene: &Scene, n: u32, x: u32, y: u32) -> Vec3 {
+    let uv = Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
+    scene
+        .floor
+        .world_from_plane()
+        .transform_point3(Vec3::new(uv.x - 0.5, 0.5 - uv.y, 0.0))
+}
+
+/// Centroid (texels) and count of the texels `inside` says are in shadow.
+fn centroid(n: u32, inside: impl Fn(u32, u32) -> bool) -> (DVec2, usize) {
+    let mut sum = DVec2::ZERO;
+    let mut count = 0;
+    for y in 0..n {
+        for x in 0..n {
+            if inside(x, y) {
+                sum += DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                count += 1;
+            }
+        }
+    }
+    (sum / count.max(1) as f64, count)
+}
+
+/// Whether the segment from a floor point to the light passes through the sphere.
+fn shadowed(point: Vec3, light: Vec3, center: Vec3, radius: f32) -> bool {
+    let d = light - point;
+    let t = ((center - point).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+    (point + d * t).distance(center) < radius
+}
+
+#[test]
+fn inducer_fields_follow_the_circling_light() {
+    let mut scene = scene("moving-light.toml");
+    scene.inducer.resolution_px = 256;
+    let n = scene.inducer.resolution_px;
+    let mut renderer = renderer(&scene, 32, 32);
+    let mut previous: Option<DVec2> = None;
+    // Light beyond, to the left of, in front of and to the right of the sphere; then the
+    // sphere itself moved 10 cm to the right under the last light.
+    let mut placements: Vec<(f64, Placement)> = [0.0, 1.5, 3.0, 4.5]
+        .into_iter()
+        .map(|t| (t, scene.placement_at(t)))
+        .collect();
+    let mut moved = placements[3].1;
+    moved.object_position_m.x += 0.1;
+    placements.push((4.5, moved));
+    for (time_s, placement) in placements {
+        let center = placement.object_position_m;
+        renderer.set_pose(views::scene_pose(&scene, &placement));
+        let fields: InducerFields = renderer.inducer_fields().expect("fields");
+        let light = placement.light_position_m;
+        let (gpu, gpu_count) = centroid(n, |x, y| fields.mask[fields.index(x, y)] == 1);
+        let (cpu, cpu_count) = centroid(n, |x, y| {
+            shadowed(
+                texel_world(&scene, n, x, y),
+                light,
+                center,
+                scene.object.radius_m,
+            )
+        });
+        assert!(
+            cpu_count > 100,
+            "the exact shadow covers {cpu_count} texels"
+        );
+        let area = gpu_count as f64 / cpu_count as f64;
+        eprintln!(
+            "t = {time_s} s: shadow centroid off by {:.2} texels, area {gpu_count} / {cpu_count}",
+            gpu.distance(cpu)
+        );
+        assert!(
+            (0.93..=1.02).contains(&area),
+            "at {time_s} s: {gpu_count} vs {cpu_count} texels"
+        );
+        assert!(
+            gpu.distance(cpu) < 1.0,
+            "at {time_s} s the shadow's centroid is at {gpu}, the exact one at {cpu}"
+        );
+        // The shadow lies on the far side of the sphere from the light: floor-space offset
+        // of the centroid from the sphere's foot against the light's.
+        let foot = texel_uv(&scene, center) * n as f32;
+        let away = (gpu.as_vec2() - foot).normalize();
+        let towards_light = (texel_uv(&scene, light) * n as f32 - foot).normalize();
+        assert!(
+            away.dot(towards_light) < -0.99,
+            "at {time_s} s the shadow points {away}, the light {towards_light}"
+        );
+        if let Some(p) = previous {
+            assert!(
+                p.distance(gpu) > 5.0,
+                "the shadow did not move at {time_s} s"
+            );
+        }
+        previous = Some(gpu);
+    }
+    // One computation per pose.
+    assert_eq!(renderer.inducer_computations(), 5);
+    assert_silent(&renderer);
+}
+
+/// The floor photo's texel coordinate (0..1, v down) under a world point.
+fn texel_uv(scene: &Scene, world: Vec3) -> Vec2 {
+    let local = scene
+        .floor
+        .world_from_plane()
+        .inverse()
+        .transform_point3(world);
+    Vec2::new(local.x + 0.5, 0.5 - local.y)
+}
+
+#[test]
+fn glass_follows_the_object_from_the_frame_its_pose_is_set() {
+    let scene = scene("rolling-diamond.toml");
+    let (w, h) = (128, 96);
+    let mut renderer = renderer(&scene, w, h);
+    let fov = Fov {
+        left_rad: -0.2,
+        right_rad: 0.2,
+        up_rad: 0.0,
+        down_rad: -0.3,
+    };
+    let eye = EyeParams::new(Vec3::ZERO, Quat::IDENTITY, fov);
+    let params = FrameParams {
+        eyes: [eye, eye],
+        look: Look::default(),
+    };
+    for time_s in [0.0, 2.0, 4.0] {
+        let placement = scene.placement_at(time_s);
+        renderer.set_pose(views::scene_pose(&scene, &placement));
+        let frame = render_once(
+            &mut renderer,
+            &params,
+            Want {
+                eyes: true,
+                world: false,
+            },
+        );
+        let (lit, count) = lit_centroid(&frame.eyes[0], w, 8).expect("the diamond is drawn");
+        let expected = eye
+            .project_to_pixel(placement.object_position_m, Vec2::new(w as f32, h as f32))
+            .unwrap();
+        assert!(count > 80, "{count} pixels");
+        assert!(
+            (lit.x - expected.x).abs() < 2.0,
+            "at {time_s} s the diamond is drawn at x = {}, its centre projects to {}",
+            lit.x,
+            expected.x
+        );
+    }
+    assert_silent(&renderer);
+}
+
+#[test]
+fn moving_light_replay_recomputes_the_inducer_only_when_something_moved() {
+    let out = tempfile::tempdir().unwrap();
+    let scene_path = workspace().join("config/scenes/moving-light.toml");
+    let rate_hz = 4.0;
+    let frames = 36u64;
+    let summary = replay(&ReplayOptions {
+        scene: scene_path.clone(),
+        trace: None,
+        out: out.path().to_path_buf(),
+        frames: Some(frames),
+        save_every: 0,
+        size: Some((64, 48)),
+        validate: true,
+        effects: Some(EffectSet::parse("inducer").unwrap()),
+        device: None,
+        frame_rate_hz: rate_hz,
+        at_samples: false,
+        progress: false,
+        reflection: vitreous_render::Reflection::Phong,
+        reference: false,
+        gaze: Default::default(),
+    })
+    .expect("replay");
+    assert_eq!(summary.frames, frames);
+    assert_eq!(summary.validation.errors + summary.validation.warnings, 0);
+    // Frames k / rate seconds apart: the light circles until 6 s, holds until 8 s (where the
+    // circle starts again at the same place), then circles again.
+    let scene = load_scene(&scene_path).unwrap();
+    let moved = (1..frames)
+        .filter(|&k| {
+            let at = |k: u64| scene.placement_at(k as f64 / rate_hz);
+            at(k) != at(k - 1)
+        })
+        .count() as u64;
+    assert_eq!(moved, 24 + 3, "frames 1-24 and 33-35 move");
+    assert_eq!(summary.moved_frames, moved);
+    assert_eq!(summary.inducer_computations, 1 + moved);
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("summary.json")).unwrap()).unwrap();
+    assert_eq!(json["inducer_computations"], 1 + moved);
+}

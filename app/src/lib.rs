@@ -23,4 +23,5 @@ pub mod soak;
 pub mod study;
 pub mod trace_analyze;
 pub mod trace_cmd;
+pub mod view;
 pub mod views;

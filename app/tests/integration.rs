@@ -13,3 +13,4 @@ mod scene_shipped;
 mod study_analyze;
 mod trace_analyze;
 mod trace_import;
+mod view;

@@ -62,8 +62,12 @@ struct Shot {
 
 impl Shot {
     fn read(path: &Path) -> Shot {
+        Shot::read_sized(path, WINDOW)
+    }
+
+    fn read_sized(path: &Path, size: (u32, u32)) -> Shot {
         let img = image::open(path).expect("a PNG screenshot").to_rgba8();
-        assert_eq!(img.dimensions(), WINDOW, "the screenshot is the window");
+        assert_eq!(img.dimensions(), size, "the screenshot is the window");
         Shot {
             width: img.width(),
             pixels: img.into_raw(),
@@ -260,4 +264,109 @@ fn scripted_scene_edits_reload_and_a_broken_edit_keeps_the_last_good_scene() {
     let (inside, _) = regions(&glass_discs(&moved_path));
     let mean = inside.iter().map(|&(x, y)| img.luma(x, y)).sum::<f32>() / inside.len() as f32;
     assert!(mean > 20.0, "the moved glass has mean luma {mean}");
+}
+
+fn summary(out_dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn a_resized_window_gets_a_new_swapchain_and_renderer() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("resize.script"), "2 resize 400 300\n").unwrap();
+    let (shot, out_dir) = (dir.path().join("shot.png"), dir.path().join("out"));
+    view(
+        &xvfb,
+        &scene("glass-sphere.toml"),
+        &[
+            "--frames",
+            "24",
+            "--script",
+            "resize.script",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let s = summary(&out_dir);
+    assert_eq!(s["window_px"], serde_json::json!([400, 300]), "{s:#}");
+    assert!(s["renderers_made"].as_u64().unwrap() >= 2, "{s:#}");
+    let img = Shot::read_sized(&shot, (400, 300));
+    let lit = img.pixels.chunks(4).filter(|p| p[1] > 40).count();
+    assert!(
+        lit > 100,
+        "the glass is drawn after the resize: {lit} px lit"
+    );
+}
+
+#[test]
+fn a_recorded_session_replays_and_the_preview_shows_the_world() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("visual-effects.toml");
+    let (shot, trace) = (
+        dir.path().join("shot.png"),
+        dir.path().join("session.trace"),
+    );
+    view(
+        &xvfb,
+        &scene,
+        &[
+            "--frames",
+            "8",
+            "--effects",
+            "O5",
+            "--preview",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--record",
+            trace.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    // The preview adds the real world's photos: bright everywhere, not black around the glass.
+    let img = Shot::read(&shot);
+    let dark = img
+        .pixels
+        .chunks(4)
+        .filter(|p| p[0].max(p[1]).max(p[2]) < 10)
+        .count();
+    assert!(
+        dark * 100 < img.pixels.len() / 4,
+        "{dark} px black in the preview"
+    );
+    let samples = vitreous_xr::trace::read_trace(&trace).expect("the recording is a trace");
+    assert_eq!(samples.len(), 8);
+    let out = Command::new(env!("CARGO_BIN_EXE_vitreous"))
+        .arg("replay")
+        .arg(&scene)
+        .args([
+            "--trace",
+            trace.to_str().unwrap(),
+            "--at-samples",
+            "--size",
+            "64x48",
+        ])
+        .args([
+            "--effects",
+            "O5",
+            "--save-every",
+            "0",
+            "--quiet",
+            "--validate",
+        ])
+        .arg("--out")
+        .arg(dir.path().join("replay"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = summary(&dir.path().join("replay"));
+    assert_eq!(s["frames"], 8, "one frame per recorded sample: {s:#}");
 }

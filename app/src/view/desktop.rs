@@ -337,6 +337,11 @@ impl Backend for DesktopBackend {
             for step in script.due(self.next_index) {
                 match step {
                     Step::Input(event) => self.apply(event, false),
+                    Step::Resize { width, height } => {
+                        let size = winit::dpi::PhysicalSize::new(width, height);
+                        // None: the request is being carried out; a Resized event follows.
+                        let _ = self.window.window().request_inner_size(size);
+                    }
                     Step::Copy { from, to } => {
                         // A failed copy is the script's error, reported and not fatal.
                         match std::fs::copy(&from, &to) {

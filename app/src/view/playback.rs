@@ -124,7 +124,11 @@ mod tests {
         for _ in 0..7 {
             p.step();
         }
-        assert_eq!(p.advance(0).0.position.x, 1.0, "seven 1/60 s steps: past 0.1 s");
+        assert_eq!(
+            p.advance(0).0.position.x,
+            1.0,
+            "seven 1/60 s steps: past 0.1 s"
+        );
         p.toggle_pause();
         assert_eq!(
             p.advance(60 * NS_PER_S).0.position.x,

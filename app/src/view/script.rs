@@ -9,7 +9,8 @@
 //! - `press BUTTON` / `release BUTTON` / `click BUTTON`: `left`, `right` or `middle`;
 //! - `wheel N`: turn the wheel N notches;
 //! - `copy FROM TO`: copy a file over another (paths relative to the script's folder), e.g. to
-//!   edit the scene and see it reload.
+//!   edit the scene and see it reload;
+//! - `resize W H`: ask for a window of W x H pixels.
 
 use std::path::{Path, PathBuf};
 
@@ -22,6 +23,13 @@ use super::input::InputEvent;
 pub enum Step {
     /// An input event.
     Input(InputEvent),
+    /// Ask for a new window size, pixels.
+    Resize {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+    },
     /// Copy a file over another.
     Copy {
         /// The file copied.
@@ -152,6 +160,17 @@ impl Script {
                         .ok_or_else(|| (i + 1, format!("expected notches, got '{}'", args[0])))?;
                     steps.push((frame, Step::Input(InputEvent::Wheel(n))));
                 }
+                "resize" => {
+                    want(2, "FRAME resize W H")?;
+                    let px = |s: &str| {
+                        s.parse::<u32>()
+                            .ok()
+                            .filter(|v| (64..=8192).contains(v))
+                            .ok_or_else(|| (i + 1, format!("expected 64..8192 pixels, got '{s}'")))
+                    };
+                    let (width, height) = (px(args[0])?, px(args[1])?);
+                    steps.push((frame, Step::Resize { width, height }));
+                }
                 "copy" => {
                     want(2, "FRAME copy FROM TO")?;
                     steps.push((
@@ -167,7 +186,7 @@ impl Script {
                         i + 1,
                         format!(
                             "unknown event '{other}'; expected key, down, up, move, press, \
-                             release, click, wheel or copy"
+                             release, click, wheel, resize or copy"
                         ),
                     ));
                 }
@@ -210,10 +229,16 @@ mod tests {
         assert_eq!(at5[2], Step::Input(InputEvent::Wheel(-1.0)));
         assert_eq!(
             s.due(100),
-            [Step::Copy {
-                from: PathBuf::from("/s/a.toml"),
-                to: PathBuf::from("/s/b.toml"),
-            }]
+            [
+                Step::Copy {
+                    from: PathBuf::from("/s/a.toml"),
+                    to: PathBuf::from("/s/b.toml"),
+                },
+                Step::Resize {
+                    width: 400,
+                    height: 300
+                }
+            ]
         );
     }
 
@@ -225,6 +250,7 @@ mod tests {
             ("1 move 2 0\n", 1, "fraction"),
             ("1 click thumb\n", 1, "left, right or middle"),
             ("1 jump\n", 1, "unknown event 'jump'"),
+            ("1 resize 10 300\n", 1, "64..8192"),
         ] {
             let (l, reason) = Script::parse(text, Path::new(".")).unwrap_err();
             assert_eq!(l, line, "{text}");

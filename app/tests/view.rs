@@ -163,20 +163,26 @@ fn a_scripted_key_changes_the_glass_and_nothing_else() {
     let dir = tempfile::tempdir().unwrap();
     let scene = scene("glass-sphere.toml");
     let script = dir.path().join("o4.script");
-    // Key 3: condition O4 (per-eye refraction to the background plane).
-    std::fs::write(&script, "1 key 3\n").unwrap();
+    // Key 3: condition O4 (per-eye refraction to the background plane); Esc at frame 6
+    // ends the session as --frames 6 does.
+    std::fs::write(&script, "1 key 3\n6 key escape\n").unwrap();
     let (before, after) = (dir.path().join("none.png"), dir.path().join("o4.png"));
-    let common = ["--frames", "6", "--effects", "none", "--screenshot"];
+    let common = ["--effects", "none", "--screenshot"];
     let mut args = common.to_vec();
-    args.push(before.to_str().unwrap());
+    args.extend([before.to_str().unwrap(), "--frames", "6"]);
     view(&xvfb, &scene, &args, dir.path());
+    let out_dir = dir.path().join("out");
     let mut args = common.to_vec();
     args.extend([
         after.to_str().unwrap(),
         "--script",
         script.to_str().unwrap(),
     ]);
+    args.extend(["--frames", "100", "--out", out_dir.to_str().unwrap()]);
     let out = view(&xvfb, &scene, &args, dir.path());
+    let s = summary(&out_dir);
+    assert_eq!(s["frames"], 6, "Esc ended the session: {s:#}");
+    assert_eq!(s["final_condition"], "disparity", "{s:#}");
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("effects now disparity"),
         "{}",

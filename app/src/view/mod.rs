@@ -11,9 +11,10 @@
 //! renderer, and runs the loop again with the same backend and sink.
 //!
 //! Parts: `desktop.rs` (the backend), `window.rs` (winit), `swapchain.rs` (surface, swapchain,
-//! presentation), `input.rs` (events and keys), `script.rs` (`--script`), `looks.rs` (effect
-//! conditions), `picture.rs` (the window's picture and overlay), `reload.rs` (hot reload),
-//! `session.rs` (the sink and what the overlay shows).
+//! presentation), `staging.rs` (its staging buffers), `input.rs` (events and keys),
+//! `script.rs` (`--script`), `looks.rs` (effect conditions), `picture.rs` (the window's picture
+//! and overlay), `reload.rs` (hot reload), `playback.rs` (`--trace`), `session.rs` (the sink
+//! and what the overlay shows), `cli.rs` (the options).
 
 mod cli;
 mod desktop;
@@ -24,6 +25,7 @@ mod playback;
 mod reload;
 mod script;
 mod session;
+mod staging;
 mod swapchain;
 mod window;
 

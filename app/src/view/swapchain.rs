@@ -26,6 +26,8 @@ use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use vitreous_render::GpuContext;
 use winit::window::Window;
 
+use super::staging::Staging;
+
 /// Presentation slots in flight at once.
 pub const FRAMES_IN_FLIGHT: usize = 2;
 
@@ -49,13 +51,7 @@ struct Slot {
     /// The copy's command buffer (freed with the pool).
     cmd: vk::CommandBuffer,
     /// Host-visible staging buffer for one picture.
-    staging: vk::Buffer,
-    /// Its memory, mapped for as long as it lives.
-    memory: vk::DeviceMemory,
-    /// The mapped pointer to `memory`.
-    mapped: *mut u8,
-    /// Bytes in `staging`.
-    capacity: u64,
+    staging: Staging,
 }
 
 /// The swapchain and what belongs to each of its images.
@@ -188,10 +184,7 @@ impl Presenter {
                 fence,
                 acquired: vk::Semaphore::null(),
                 cmd,
-                staging: vk::Buffer::null(),
-                memory: vk::DeviceMemory::null(),
-                mapped: std::ptr::null_mut(),
-                capacity: 0,
+                staging: Staging::EMPTY,
             });
             let slot = self.slots.last_mut().expect("pushed above");
             // SAFETY: a valid create info; stored in the slot (freed in Drop) at once.
@@ -265,16 +258,16 @@ impl Presenter {
             Err(e) => return Err(e).context("vkAcquireNextImageKHR"),
         };
         let bytes = u64::from(extent.width) * u64::from(extent.height) * 4;
-        self.ensure_staging(slot_index, bytes)?;
+        self.slots[slot_index].staging.ensure(&self.ctx, bytes)?;
         let mut picture = vec![0u8; bytes as usize];
         draw(&mut picture, extent.width, extent.height);
         let d = &self.ctx.device;
-        let slot = &self.slots[slot_index];
+        let slot = &mut self.slots[slot_index];
         let chain = self.chain.as_ref().context("a swapchain")?;
         let bgra = matches!(self.format.format, vk::Format::B8G8R8A8_UNORM);
-        // SAFETY: `mapped` points at `capacity` >= `bytes` bytes of host-coherent memory that
-        // no submitted work uses (the slot's fence signalled above).
-        let staging = unsafe { std::slice::from_raw_parts_mut(slot.mapped, bytes as usize) };
+        // SAFETY: the buffer was sized for `bytes` above, and no submitted work uses it (the
+        // slot's fence signalled above).
+        let staging = unsafe { slot.staging.bytes_mut(bytes as usize) };
         if bgra {
             for (out, px) in staging.chunks_exact_mut(4).zip(picture.chunks_exact(4)) {
                 out.copy_from_slice(&[px[2], px[1], px[0], 255]);
@@ -296,7 +289,7 @@ impl Presenter {
                 .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             d.begin_command_buffer(slot.cmd, &begin)
                 .context("vkBeginCommandBuffer")?;
-            record_copy(d, slot.cmd, slot.staging, image, extent);
+            record_copy(d, slot.cmd, slot.staging.buffer, image, extent);
             d.end_command_buffer(slot.cmd)
                 .context("vkEndCommandBuffer")?;
             let waits = [slot.acquired];
@@ -328,56 +321,6 @@ impl Presenter {
         }
         self.last = Some((picture, extent.width, extent.height));
         Ok(Presented::Shown)
-    }
-
-    /// Makes the slot's staging buffer hold at least `bytes`.
-    fn ensure_staging(&mut self, slot_index: usize, bytes: u64) -> Result<()> {
-        if self.slots[slot_index].capacity >= bytes {
-            return Ok(());
-        }
-        let d = &self.ctx.device;
-        let slot = &mut self.slots[slot_index];
-        free_staging(d, slot);
-        let info = vk::BufferCreateInfo::default()
-            .size(bytes)
-            .usage(vk::BufferUsageFlags::TRANSFER_SRC)
-            .sharing_mode(vk::SharingMode::EXCLUSIVE);
-        // SAFETY: a valid create info; the buffer is stored in the slot at once (freed there).
-        slot.staging = unsafe { d.create_buffer(&info, None) }.context("vkCreateBuffer")?;
-        // SAFETY: the buffer is live.
-        let needs = unsafe { d.get_buffer_memory_requirements(slot.staging) };
-        // SAFETY: the physical device belongs to the instance.
-        let props = unsafe {
-            self.ctx
-                .instance
-                .get_physical_device_memory_properties(self.ctx.physical)
-        };
-        let wanted = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
-        let type_index = (0..props.memory_type_count)
-            .find(|&i| {
-                needs.memory_type_bits & (1 << i) != 0
-                    && props.memory_types[i as usize]
-                        .property_flags
-                        .contains(wanted)
-            })
-            .context("no host-visible coherent memory for the window's staging buffer")?;
-        let alloc = vk::MemoryAllocateInfo::default()
-            .allocation_size(needs.size)
-            .memory_type_index(type_index);
-        // SAFETY: a valid allocate info; stored in the slot at once; bound and mapped whole.
-        unsafe {
-            slot.memory = d
-                .allocate_memory(&alloc, None)
-                .context("vkAllocateMemory")?;
-            d.bind_buffer_memory(slot.staging, slot.memory, 0)
-                .context("vkBindBufferMemory")?;
-            slot.mapped = d
-                .map_memory(slot.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty())
-                .context("vkMapMemory")?
-                .cast();
-        }
-        slot.capacity = bytes;
-        Ok(())
     }
 
     /// Makes a swapchain of the window's current size; false when the window has no area.
@@ -500,7 +443,7 @@ impl Drop for Presenter {
         unsafe {
             let _ = d.device_wait_idle();
             for slot in &mut self.slots {
-                free_staging(d, slot);
+                slot.staging.free(d);
                 d.destroy_semaphore(slot.acquired, None);
                 d.destroy_fence(slot.fence, None);
             }
@@ -511,22 +454,6 @@ impl Drop for Presenter {
             self.surface_fn.destroy_surface(self.surface, None);
         }
     }
-}
-
-/// Frees a slot's staging buffer and memory, if any. The slot must not be in flight.
-fn free_staging(d: &ash::Device, slot: &mut Slot) {
-    // SAFETY: the caller's contract (no work uses the buffer); null handles are ignored.
-    unsafe {
-        if slot.memory != vk::DeviceMemory::null() {
-            d.unmap_memory(slot.memory);
-        }
-        d.destroy_buffer(slot.staging, None);
-        d.free_memory(slot.memory, None);
-    }
-    slot.staging = vk::Buffer::null();
-    slot.memory = vk::DeviceMemory::null();
-    slot.mapped = std::ptr::null_mut();
-    slot.capacity = 0;
 }
 
 /// Records the copy of `staging` into the whole `image`, leaving it ready to present.

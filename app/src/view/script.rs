@@ -216,8 +216,8 @@ mod tests {
 
     #[test]
     fn events_come_out_at_their_frame_in_file_order() {
-        let text =
-            "# a comment\n5 key 3\n2 move 0.5 0.25\n5 wheel -1 # back\n9 copy a.toml b.toml\n";
+        let text = "# a comment\n5 key 3\n2 move 0.5 0.25\n5 wheel -1 # back\n\
+                    9 copy a.toml b.toml\n12 resize 400 300\n";
         let mut s = Script::parse(text, Path::new("/s")).unwrap();
         assert!(s.due(1).is_empty());
         assert_eq!(

@@ -376,3 +376,42 @@ fn a_recorded_session_replays_and_the_preview_shows_the_world() {
     let s = summary(&dir.path().join("replay"));
     assert_eq!(s["frames"], 8, "one frame per recorded sample: {s:#}");
 }
+
+#[test]
+fn the_wheel_moves_the_gaze_to_the_refracted_image_through_the_gaze_pipeline() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    // The cursor on the middle of the left eye's image, on the glass; the wheel at frame 4
+    // moves the fixation point from the glass's surface to the background behind it. The
+    // scene's filter (eq. 15's 20-sample mean) then decides the refracted image.
+    std::fs::write(
+        dir.path().join("gaze.script"),
+        "0 move 0.25 0.5\n4 wheel 1\n",
+    )
+    .unwrap();
+    let out_dir = dir.path().join("out");
+    view(
+        &xvfb,
+        &scene("visual-effects.toml"),
+        &[
+            "--frames",
+            "40",
+            "--effects",
+            "O3",
+            "--script",
+            "gaze.script",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let s = summary(&out_dir);
+    let seen: Vec<&str> = s["gaze_images"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|v| v.as_str())
+        .filter(|v| *v != "unknown")
+        .collect();
+    assert_eq!(seen, ["surface", "refracted"], "{s:#}");
+}

@@ -120,6 +120,9 @@ pub struct ViewSummary {
     pub reload_errors: Vec<String>,
     /// The effect condition shown at the end.
     pub final_condition: String,
+    /// The gaze images the gaze pipeline decided (with defocus on), in order, each change
+    /// once.
+    pub gaze_images: Vec<String>,
     /// The screenshot written, if any.
     pub screenshot: Option<String>,
     /// The trace recorded, if any.
@@ -270,6 +273,7 @@ pub fn view(options: &ViewOptions) -> Result<ViewSummary> {
         reloads: sink.reloads(),
         reload_errors: sink.reload_errors().to_vec(),
         final_condition: sink.condition(),
+        gaze_images: sink.gaze_images().to_vec(),
         screenshot,
         recorded: options.record.as_ref().map(|p| p.display().to_string()),
     };

@@ -152,6 +152,8 @@ pub struct ViewSink {
     writer: Option<TraceWriter<AtomicFile>>,
     /// Time of the newest frame recorded, nanoseconds.
     recorded_until_ns: Option<i64>,
+    /// The gaze images the pipeline decided, in order, each change once.
+    gaze_images: Vec<String>,
 }
 
 impl ViewSink {
@@ -183,6 +185,7 @@ impl ViewSink {
         Ok(ViewSink {
             writer,
             recorded_until_ns: None,
+            gaze_images: Vec::new(),
             watcher: Watcher::new(loaded.files.clone()),
             loaded,
             looks,
@@ -327,6 +330,11 @@ impl ViewSink {
     /// Reloads refused, with their errors.
     pub fn reload_errors(&self) -> &[String] {
         &self.reload_errors
+    }
+
+    /// The gaze images decided, in order, each change once.
+    pub fn gaze_images(&self) -> &[String] {
+        &self.gaze_images
     }
 
     /// The condition shown.
@@ -511,8 +519,15 @@ impl FrameSink for ViewSink {
                 self.request = Some(Request::Resize);
             }
         }
+        let look = self.looks.plan(input);
+        if let Some(d) = self.looks.planner().last_defocus() {
+            let image = d.image.to_string();
+            if self.gaze_images.last() != Some(&image) {
+                self.gaze_images.push(image);
+            }
+        }
         FramePlan {
-            look: self.looks.plan(input),
+            look,
             want: Want {
                 eyes: true,
                 world: self.preview,

@@ -415,3 +415,51 @@ fn the_wheel_moves_the_gaze_to_the_refracted_image_through_the_gaze_pipeline() {
         .collect();
     assert_eq!(seen, ["surface", "refracted"], "{s:#}");
 }
+
+#[test]
+fn a_played_trace_pauses_and_steps_and_the_recording_shows_it() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("glass-sphere.toml");
+    let trace = dir.path().join("synth.trace");
+    let synth = Command::new(env!("CARGO_BIN_EXE_vitreous"))
+        .args(["trace", "synth", "--scene"])
+        .arg(&scene)
+        .arg("-o")
+        .arg(&trace)
+        .output()
+        .unwrap();
+    assert!(
+        synth.status.success(),
+        "{}",
+        String::from_utf8_lossy(&synth.stderr)
+    );
+    // K pauses before frame 2 is drawn, L steps 1/60 s before frame 5.
+    std::fs::write(dir.path().join("keys.script"), "2 key k\n5 key l\n").unwrap();
+    let recorded = dir.path().join("rec.trace");
+    view(
+        &xvfb,
+        &scene,
+        &[
+            "--frames",
+            "8",
+            "--trace",
+            trace.to_str().unwrap(),
+            "--script",
+            "keys.script",
+            "--record",
+            recorded.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let samples = vitreous_xr::trace::read_trace(&recorded).unwrap();
+    // Frames 0 and 1 play, 2-4 stand still (not recorded again), 5 is one step on, 6-7 stand.
+    let times: Vec<i64> = samples.iter().map(|s| s.time_ns).collect();
+    assert_eq!(times.len(), 3, "{times:?}");
+    assert_eq!(times[2] - times[1], 1_000_000_000 / 60, "{times:?}");
+    let played = vitreous_xr::trace::read_trace(&trace).unwrap();
+    assert_eq!(
+        samples[0].head, played[0].head,
+        "the trace's first head pose"
+    );
+}

@@ -365,11 +365,11 @@ impl Backend for DesktopBackend {
             .map_or(0.0, |t| now.duration_since(t).as_secs_f32().min(0.1));
         self.last_frame = Some(now);
         if let Some(p) = &mut self.playback {
-            let (head, gaze) = p.advance((dt * 1e9) as i64);
+            let (time_ns, head, gaze) = p.advance((dt * 1e9) as i64);
             let (at, of) = p.position_s();
             let paused = p.paused();
             self.shared.borrow_mut().trace = Some((at, of, paused));
-            let input = self.frame(head, Some(gaze), gaze.sample_time_ns);
+            let input = self.frame(head, Some(gaze), time_ns);
             return Ok(Some(input));
         }
         let orientation = self.orientation();

@@ -71,8 +71,8 @@ impl Playback {
     }
 
     /// Advances the clock by `dt_ns` of wall-clock time (unless paused; it stops at the end)
-    /// and returns the newest sample at or before it: head pose and gaze.
-    pub fn advance(&mut self, dt_ns: i64) -> (Pose, GazeSample) {
+    /// and returns it with the newest sample at or before it: trace time, head pose, gaze.
+    pub fn advance(&mut self, dt_ns: i64) -> (i64, Pose, GazeSample) {
         if !self.paused {
             self.seek_ns(dt_ns);
         }
@@ -81,7 +81,7 @@ impl Playback {
             .partition_point(|s| s.time_ns <= self.time_ns)
             .saturating_sub(1);
         let s = &self.samples[i];
-        (s.head, s.gaze)
+        (self.time_ns, s.head, s.gaze)
     }
 }
 
@@ -113,25 +113,25 @@ mod tests {
     #[test]
     fn playback_follows_the_clock_pauses_steps_and_seeks_within_the_trace() {
         let mut p = Playback::new((0..=20).map(sample).collect());
-        assert_eq!(p.advance(0).0.position.x, 0.0);
-        assert_eq!(p.advance(NS_PER_S / 4).0.position.x, 2.0);
+        assert_eq!(p.advance(0).1.position.x, 0.0);
+        assert_eq!(p.advance(NS_PER_S / 4).1.position.x, 2.0);
         p.toggle_pause();
-        assert_eq!(p.advance(NS_PER_S).0.position.x, 2.0, "paused");
+        assert_eq!(p.advance(NS_PER_S).1.position.x, 2.0, "paused");
         p.seek_ns(NS_PER_S);
-        assert_eq!(p.advance(0).0.position.x, 12.0);
+        assert_eq!(p.advance(0).1.position.x, 12.0);
         p.seek_ns(-10 * NS_PER_S);
-        assert_eq!(p.advance(0).0.position.x, 0.0, "clamped at the start");
+        assert_eq!(p.advance(0).1.position.x, 0.0, "clamped at the start");
         for _ in 0..7 {
             p.step();
         }
         assert_eq!(
-            p.advance(0).0.position.x,
+            p.advance(0).1.position.x,
             1.0,
             "seven 1/60 s steps: past 0.1 s"
         );
         p.toggle_pause();
         assert_eq!(
-            p.advance(60 * NS_PER_S).0.position.x,
+            p.advance(60 * NS_PER_S).1.position.x,
             20.0,
             "held at the end"
         );

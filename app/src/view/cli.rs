@@ -18,6 +18,10 @@ pub struct ViewArgs {
     /// Window size, e.g. 960x540.
     #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "960x540")]
     pub window: (u32, u32),
+    /// Render the eye images at this fraction of their part of the window (0.25-1) and scale
+    /// them up: faster on a CPU device.
+    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    pub render_scale: f32,
     /// End after N frames (default: when the window is closed or Esc is pressed).
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_frame_count)]
     pub frames: Option<u64>,
@@ -71,6 +75,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
     let summary = view(&ViewOptions {
         scene: args.scene,
         window: args.window,
+        render_scale: args.render_scale,
         frames: args.frames,
         screenshot: args.screenshot,
         script: args.script,

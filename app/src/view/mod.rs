@@ -59,6 +59,8 @@ pub struct ViewOptions {
     pub scene: PathBuf,
     /// Window size, pixels.
     pub window: (u32, u32),
+    /// Eye images rendered at this fraction of their part of the window (0.25-1), scaled up.
+    pub render_scale: f32,
     /// End after this many frames (None: when the window is closed or Esc pressed).
     pub frames: Option<u64>,
     /// Write the last picture shown here as PNG when the session ends.
@@ -167,6 +169,12 @@ pub fn view(options: &ViewOptions) -> Result<ViewSummary> {
     let (w, h) = options.window;
     if !(64..=8192).contains(&w) || !(64..=8192).contains(&h) {
         bail!("window size {w}x{h} is outside 64..=8192 pixels per side");
+    }
+    if !(0.25..=1.0).contains(&options.render_scale) {
+        bail!(
+            "--render-scale must be between 0.25 and 1, got {}",
+            options.render_scale
+        );
     }
     let title = format!("vitreous view: {}", options.scene.display());
     let desktop = window::DesktopWindow::open(&title, w, h)?;

@@ -132,6 +132,8 @@ pub struct ViewSink {
     overlay: Overlay,
     /// Eye image size of the current renderer.
     eye_size: (u32, u32),
+    /// Fraction of the window's pixels the eye images are rendered at.
+    render_scale: f32,
     /// A new renderer is needed.
     request: Option<Request>,
     /// The newest message for the overlay (a reload error, a note).
@@ -197,6 +199,7 @@ impl ViewSink {
             see: SeeThrough::new(),
             overlay: Overlay::new()?,
             eye_size: (0, 0),
+            render_scale: options.render_scale,
             request: None,
             status,
             reload_errors: Vec::new(),
@@ -211,7 +214,9 @@ impl ViewSink {
     /// The eye image size the window needs now.
     fn wanted_eye_size(&self) -> (u32, u32) {
         let (w, h) = self.presenter.window_size();
-        self.shared.borrow().eyes.eye_size(w.max(1), h.max(1))
+        let (ew, eh) = self.shared.borrow().eyes.eye_size(w.max(1), h.max(1));
+        let scaled = |v: u32| ((v as f32 * self.render_scale).round() as u32).max(16);
+        (scaled(ew), scaled(eh))
     }
 
     /// A renderer for the window as it is now.

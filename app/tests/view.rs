@@ -35,8 +35,13 @@ fn xvfb_run() -> Option<PathBuf> {
 /// Runs `vitreous view` in a virtual X server with validation on.
 fn view(xvfb: &Path, scene: &Path, args: &[&str], cwd: &Path) -> Output {
     let size = format!("{}x{}", WINDOW.0, WINDOW.1);
+    // Each run starts its search for a free display at its own number: runs started at once
+    // by parallel tests would otherwise race for the same one.
+    static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let first_display = 100 + 10 * RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let out = Command::new(xvfb)
-        .args(["-a", "-s", "-screen 0 640x480x24"])
+        .args(["-a", "-n", &first_display.to_string()])
+        .args(["-s", "-screen 0 640x480x24"])
         .arg(env!("CARGO_BIN_EXE_vitreous"))
         .arg("view")
         .arg(scene)

@@ -25,4 +25,5 @@ pub mod spread;
 pub mod study;
 pub mod trace_analyze;
 pub mod trace_cmd;
+pub mod view;
 pub mod views;

@@ -79,6 +79,9 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Look around a scene in a desktop window: the frame loop and renderer of `run` with
+    /// head and gaze from the mouse and keys (docs/view.md; F1 lists the keys).
+    View(vitreous::view::ViewArgs),
     /// Replay a head/eye trace through the frame loop on a Vulkan device and write per-eye
     /// images, see-through previews and summary.json.
     Replay {
@@ -376,6 +379,7 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", s.report());
             Ok(())
         }
+        Command::View(args) => vitreous::view::run(args),
         Command::Replay {
             scene,
             trace,

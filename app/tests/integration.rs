@@ -14,3 +14,4 @@ mod study_analyze;
 mod study_run;
 mod trace_analyze;
 mod trace_import;
+mod view;

@@ -1,0 +1,303 @@
+//! `vitreous view`: the see-through display simulated in a desktop window.
+//!
+//! The same frame loop as `run` and `replay` ([`crate::frame_loop`]) drives the real renderer
+//! through a third backend, [`desktop::DesktopBackend`], whose head pose comes from the mouse
+//! and keys and whose gaze is synthesised from the cursor. Each finished frame's eye images
+//! are read back and put in the window (left, right or both; the display's light or the
+//! see-through preview) by [`swapchain::Presenter`], on a Vulkan device of its own.
+//!
+//! What needs a new renderer (a new eye image size after a resize or a change of the eyes
+//! shown, a reloaded scene) ends the frame loop with the frames in flight finished, makes the
+//! renderer, and runs the loop again with the same backend and sink.
+//!
+//! Parts: `desktop.rs` (the backend), `window.rs` (winit), `swapchain.rs` (surface, swapchain,
+//! presentation), `staging.rs` (its staging buffers), `input.rs` (events and keys),
+//! `script.rs` (`--script`), `looks.rs` (effect conditions), `picture.rs` (the window's picture
+//! and overlay), `reload.rs` (hot reload), `playback.rs` (`--trace`), `session.rs` (the sink
+//! and what the overlay shows), `cli.rs` (the options).
+
+mod cli;
+mod desktop;
+mod input;
+mod looks;
+mod picture;
+mod playback;
+mod reload;
+mod script;
+mod session;
+mod staging;
+mod swapchain;
+mod window;
+
+use std::cell::RefCell;
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::rc::Rc;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use serde::Serialize;
+use vitreous_render::{ContextOptions, GpuContext, PlainVulkan, Reflection};
+
+pub use cli::{ViewArgs, run};
+pub use desktop::{FixationTarget, fixation_point};
+pub use input::{Action, EyesShown, InputEvent, KEYS};
+pub use script::{Script, ScriptError, Step};
+
+use crate::effects::EffectSet;
+use crate::frame_loop::{self, FrameRecord};
+use crate::gaze::{FilterKind, GazeOverride};
+use crate::output::{encode_png, write_atomic};
+use crate::replay::{Spread, ValidationSummary};
+use desktop::{DesktopBackend, Shared};
+use session::{Loaded, Request, ViewSink};
+
+/// Options of `vitreous view`.
+#[derive(Clone, Debug)]
+pub struct ViewOptions {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// Window size, pixels.
+    pub window: (u32, u32),
+    /// Eye images rendered at this fraction of their part of the window (0.25-1), scaled up.
+    pub render_scale: f32,
+    /// End after this many frames (None: when the window is closed or Esc pressed).
+    pub frames: Option<u64>,
+    /// Write the last picture shown here as PNG when the session ends.
+    pub screenshot: Option<PathBuf>,
+    /// Scripted input.
+    pub script: Option<PathBuf>,
+    /// Effects to start with, overriding the scene's.
+    pub effects: Option<EffectSet>,
+    /// Which eyes the window shows at the start.
+    pub eyes: EyesShown,
+    /// Start with the see-through preview instead of the display's light.
+    pub preview: bool,
+    /// Show the overlay at the start.
+    pub overlay: bool,
+    /// How the reflected image is drawn at the start.
+    pub reflection: Reflection,
+    /// Gaze filter overriding the scene's.
+    pub filter: Option<FilterKind>,
+    /// Turn on the Vulkan validation layers; any message fails the session.
+    pub validate: bool,
+    /// Pick the Vulkan device whose name contains this.
+    pub device: Option<String>,
+    /// Folder for summary.json.
+    pub out: Option<PathBuf>,
+    /// Play this trace instead of taking head and gaze from the user.
+    pub trace: Option<PathBuf>,
+    /// Record each frame's head pose and gaze as a trace (v1) here.
+    pub record: Option<PathBuf>,
+}
+
+/// What `summary.json` of a view session holds.
+#[derive(Clone, Debug, Serialize)]
+pub struct ViewSummary {
+    /// vitreous version.
+    pub vitreous_version: String,
+    /// The scene file.
+    pub scene: String,
+    /// Vulkan device rendering the scene.
+    pub device: String,
+    /// Validation results of every device used.
+    pub validation: ValidationSummary,
+    /// Window size at the end, pixels.
+    pub window_px: (u32, u32),
+    /// Frames rendered.
+    pub frames: u64,
+    /// Frames per second of wall-clock time.
+    pub frames_per_second: f64,
+    /// Wall-clock time of the session, seconds.
+    pub wall_s: f64,
+    /// CPU milliseconds per stereo frame.
+    pub cpu_ms: Option<Spread>,
+    /// GPU milliseconds per stereo frame.
+    pub gpu_ms: Option<Spread>,
+    /// Times the renderer was made anew (resizes, eyes shown, reloads).
+    pub renderers_made: u32,
+    /// Scene reloads that took effect.
+    pub reloads: u32,
+    /// Scene reloads refused (the last good scene kept running), with their errors.
+    pub reload_errors: Vec<String>,
+    /// The effect condition shown at the end.
+    pub final_condition: String,
+    /// The gaze images the gaze pipeline decided (with defocus on), in order, each change
+    /// once.
+    pub gaze_images: Vec<String>,
+    /// The screenshot written, if any.
+    pub screenshot: Option<String>,
+    /// The trace recorded, if any.
+    pub recorded: Option<String>,
+}
+
+impl ViewSummary {
+    /// Frames, rate and timings in one line.
+    pub fn summary_line(&self) -> String {
+        let median =
+            |s: Option<Spread>| s.map_or("n/a".to_string(), |s| format!("{:.2}", s.median_ms));
+        format!(
+            "viewed {} frames in a {}x{} window on {} in {:.1} s ({:.1} frames/s; median GPU {} \
+             ms, CPU {} ms per stereo frame)",
+            self.frames,
+            self.window_px.0,
+            self.window_px.1,
+            self.device,
+            self.wall_s,
+            self.frames_per_second,
+            median(self.gpu_ms),
+            median(self.cpu_ms),
+        )
+    }
+}
+
+/// Runs a view session until the window closes, Esc, or `frames`.
+pub fn view(options: &ViewOptions) -> Result<ViewSummary> {
+    let script = match &options.script {
+        Some(path) => Some(Script::load(path)?),
+        None => None,
+    };
+    let mut inputs = vec![options.scene.as_path()];
+    inputs.extend(options.trace.as_deref());
+    if let Some(shot) = &options.screenshot {
+        crate::output::ensure_not_input(shot, "--screenshot", &inputs)?;
+    }
+    if let Some(record) = &options.record {
+        crate::output::ensure_not_input(record, "--record", &inputs)?;
+    }
+    let loaded = Loaded::load(&options.scene, options.effects)?;
+    let (w, h) = options.window;
+    if !(64..=8192).contains(&w) || !(64..=8192).contains(&h) {
+        bail!("window size {w}x{h} is outside 64..=8192 pixels per side");
+    }
+    if !(0.25..=1.0).contains(&options.render_scale) {
+        bail!(
+            "--render-scale must be between 0.25 and 1, got {}",
+            options.render_scale
+        );
+    }
+    let title = format!("vitreous view: {}", options.scene.display());
+    let desktop = window::DesktopWindow::open(&title, w, h)?;
+    let win = desktop.window();
+    let extensions = swapchain::surface_extensions(&win)?;
+    let context_options = ContextOptions {
+        validation: options.validate,
+        device_name: options.device.clone(),
+    };
+    let present_ctx = GpuContext::new(
+        &context_options,
+        &mut PlainVulkan,
+        &extensions,
+        &[ash::khr::swapchain::NAME],
+    )
+    .context("setting up the Vulkan device for the window")?;
+    let presenter = swapchain::Presenter::new(present_ctx, win)?;
+
+    let shared = Rc::new(RefCell::new(Shared {
+        actions: VecDeque::new(),
+        eyes: options.eyes,
+        eye_aspect: 1.0,
+        fixation: (FixationTarget::Surface, 0.0),
+        resized_at: None,
+        touched: Vec::new(),
+        noise: false,
+        trace: None,
+    }));
+    let mut backend = DesktopBackend::new(
+        desktop,
+        shared.clone(),
+        script,
+        options.frames,
+        &loaded.scene,
+    );
+    if let Some(path) = &options.trace {
+        let samples = vitreous_xr::trace::read_trace(path)
+            .with_context(|| format!("reading trace {}", path.display()))?;
+        if samples.is_empty() {
+            bail!("trace {} has no samples: nothing to play", path.display());
+        }
+        backend.play(playback::Playback::new(samples));
+    }
+    let mut sink = ViewSink::new(
+        options,
+        loaded,
+        presenter,
+        shared,
+        options.filter,
+        GazeOverride::Auto,
+    )?;
+    let mut renderer = sink.make_renderer(&context_options)?;
+
+    let started = Instant::now();
+    let mut records: Vec<FrameRecord> = Vec::new();
+    loop {
+        let part = frame_loop::run(&mut backend, &mut renderer, &mut sink);
+        records.extend(part?);
+        match sink.take_request() {
+            None => break,
+            Some(Request::Resize) => {
+                sink.retire(&renderer);
+                renderer = sink.make_renderer(&context_options)?;
+            }
+            Some(Request::Reload(loaded)) => match sink.adopt(*loaded, &context_options) {
+                Ok(new) => {
+                    sink.retire(&renderer);
+                    renderer = new;
+                    backend.set_scene(sink.scene());
+                }
+                Err(e) => sink.report_reload_error(format!("{e:#}")),
+            },
+        }
+    }
+    let wall_s = started.elapsed().as_secs_f64();
+    sink.finish_recording()?;
+    sink.retire(&renderer);
+    let device = renderer.context().device_name.clone();
+    drop(renderer);
+
+    let screenshot = match &options.screenshot {
+        Some(path) => {
+            let (rgba, sw, sh) = sink
+                .last_shown()
+                .context("--screenshot: no picture was shown (the window never had an area)")?;
+            let png = encode_png(rgba, sw, sh)?;
+            write_atomic(path, &png)?;
+            Some(path.display().to_string())
+        }
+        None => None,
+    };
+    let summary = ViewSummary {
+        vitreous_version: env!("CARGO_PKG_VERSION").into(),
+        scene: options.scene.display().to_string(),
+        device,
+        validation: sink.validation(),
+        window_px: sink.window_size(),
+        frames: records.len() as u64,
+        frames_per_second: records.len() as f64 / wall_s.max(1e-9),
+        wall_s,
+        cpu_ms: Spread::of(records.iter().map(|r| r.cpu_ms)),
+        gpu_ms: Spread::of(records.iter().filter_map(|r| r.gpu_ms)),
+        renderers_made: sink.renderers_made(),
+        reloads: sink.reloads(),
+        reload_errors: sink.reload_errors().to_vec(),
+        final_condition: sink.condition(),
+        gaze_images: sink.gaze_images().to_vec(),
+        screenshot,
+        recorded: options.record.as_ref().map(|p| p.display().to_string()),
+    };
+    if let Some(out) = &options.out {
+        std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+        let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;
+        write_atomic(&out.join("summary.json"), &json)?;
+    }
+    let v = &summary.validation;
+    if v.errors + v.warnings > 0 {
+        bail!(
+            "the Vulkan validation layers reported {} errors and {} warnings, first: {}",
+            v.errors,
+            v.warnings,
+            v.messages.first().map(String::as_str).unwrap_or("")
+        );
+    }
+    Ok(summary)
+}

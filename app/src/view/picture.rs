@@ -1,0 +1,238 @@
+//! The window's picture: the eye images read back from the renderer (the display's light, or
+//! the see-through preview as `replay` writes it), scaled into the window, with the overlay
+//! text on top.
+
+use ab_glyph::{Font, FontRef, PxScale, ScaleFont, point};
+use vitreous_render::Readback;
+
+use super::input::EyesShown;
+use crate::output::{linear_to_srgb, srgb_to_linear};
+
+/// The embedded font (DejaVu Sans, licence in `app/assets/fonts/LICENSE-DejaVu.txt`).
+static FONT_TTF: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+
+/// Height of the overlay's text, pixels.
+const TEXT_PX: f32 = 14.0;
+
+/// Steps of the linear-light table used to encode the preview back to sRGB.
+const LINEAR_STEPS: usize = 4096;
+
+/// Lookup tables for adding the display's light to the world's in linear light.
+pub struct SeeThrough {
+    /// sRGB byte to linear light.
+    to_linear: [f32; 256],
+    /// Linear light 0..1 in [`LINEAR_STEPS`] steps to an sRGB byte.
+    to_srgb: Vec<u8>,
+}
+
+impl SeeThrough {
+    /// The tables.
+    pub fn new() -> SeeThrough {
+        let mut to_linear = [0.0; 256];
+        for (i, v) in to_linear.iter_mut().enumerate() {
+            *v = srgb_to_linear(i as u8);
+        }
+        let to_srgb = (0..=LINEAR_STEPS)
+            .map(|i| linear_to_srgb(i as f32 / LINEAR_STEPS as f32))
+            .collect();
+        SeeThrough { to_linear, to_srgb }
+    }
+
+    /// One channel of display light `eye` added to world light `world` (both sRGB bytes).
+    fn add(&self, eye: u8, world: u8) -> u8 {
+        let sum = (self.to_linear[eye as usize] + self.to_linear[world as usize]).min(1.0);
+        self.to_srgb[(sum * LINEAR_STEPS as f32 + 0.5) as usize]
+    }
+}
+
+impl Default for SeeThrough {
+    fn default() -> Self {
+        SeeThrough::new()
+    }
+}
+
+/// Fills `out` (RGBA8, `width` x `height`) with the eye images of `readback` as `eyes` says,
+/// each scaled (nearest pixel) to its part of the window; with `preview`, the world views are
+/// added in linear light.
+pub fn compose(
+    out: &mut [u8],
+    width: u32,
+    height: u32,
+    readback: &Readback,
+    eyes: EyesShown,
+    preview: Option<&SeeThrough>,
+    world: Option<&[Vec<u8>; 2]>,
+) {
+    let parts: &[(usize, u32, u32)] = match eyes {
+        EyesShown::Both => &[(0, 0, width / 2), (1, width / 2, width - width / 2)],
+        EyesShown::Left => &[(0, 0, width)],
+        EyesShown::Right => &[(1, 0, width)],
+    };
+    let (ew, eh) = (readback.width as usize, readback.height as usize);
+    let see = preview.zip(world);
+    for &(eye, x0, part_w) in parts {
+        if part_w == 0 {
+            continue;
+        }
+        let src = &readback.eyes[eye];
+        let columns: Vec<usize> = (0..part_w as usize)
+            .map(|x| ((x * ew) / part_w as usize).min(ew - 1))
+            .collect();
+        for y in 0..height as usize {
+            let sy = ((y * eh) / height as usize).min(eh - 1);
+            let row = &mut out[(y * width as usize + x0 as usize) * 4..][..part_w as usize * 4];
+            for (px, &sx) in row.chunks_exact_mut(4).zip(&columns) {
+                let i = (sy * ew + sx) * 4;
+                match see {
+                    Some((tables, world)) => {
+                        let w = &world[eye][i..i + 3];
+                        px[0] = tables.add(src[i], w[0]);
+                        px[1] = tables.add(src[i + 1], w[1]);
+                        px[2] = tables.add(src[i + 2], w[2]);
+                    }
+                    None => px[..3].copy_from_slice(&src[i..i + 3]),
+                }
+                px[3] = 255;
+            }
+        }
+    }
+}
+
+/// Draws lines of text in the window's top left corner on a darkened box.
+pub struct Overlay {
+    /// The parsed font.
+    font: FontRef<'static>,
+}
+
+impl Overlay {
+    /// The overlay with the embedded font.
+    pub fn new() -> anyhow::Result<Overlay> {
+        let font = FontRef::try_from_slice(FONT_TTF)
+            .map_err(|_| anyhow::anyhow!("the embedded DejaVu Sans font could not be parsed"))?;
+        Ok(Overlay { font })
+    }
+
+    /// Draws `lines` into `out` (RGBA8, `width` x `height`).
+    pub fn draw(&self, out: &mut [u8], width: u32, height: u32, lines: &[String]) {
+        if lines.is_empty() {
+            return;
+        }
+        let scale = PxScale::from(TEXT_PX);
+        let scaled = self.font.as_scaled(scale);
+        let line_h = scaled.height() + scaled.line_gap();
+        let text_w = lines
+            .iter()
+            .map(|l| {
+                l.chars()
+                    .map(|c| scaled.h_advance(self.font.glyph_id(c)))
+                    .sum::<f32>()
+            })
+            .fold(0.0f32, f32::max);
+        let (box_w, box_h) = (
+            ((text_w + 12.0) as u32).min(width),
+            ((line_h * lines.len() as f32 + 8.0) as u32).min(height),
+        );
+        for y in 0..box_h as usize {
+            for x in 0..box_w as usize {
+                let px = &mut out[(y * width as usize + x) * 4..][..3];
+                for c in px {
+                    *c /= 3;
+                }
+            }
+        }
+        for (n, line) in lines.iter().enumerate() {
+            let mut x = 6.0;
+            let baseline = 4.0 + scaled.ascent() + line_h * n as f32;
+            for c in line.chars() {
+                let id = self.font.glyph_id(c);
+                let glyph = id.with_scale_and_position(scale, point(x, baseline));
+                x += scaled.h_advance(id);
+                let Some(outline) = self.font.outline_glyph(glyph) else {
+                    continue;
+                };
+                let bounds = outline.px_bounds();
+                outline.draw(|gx, gy, coverage| {
+                    let px = bounds.min.x as i64 + i64::from(gx);
+                    let py = bounds.min.y as i64 + i64::from(gy);
+                    if px < 0 || py < 0 || px >= i64::from(width) || py >= i64::from(height) {
+                        return;
+                    }
+                    let i = (py as usize * width as usize + px as usize) * 4;
+                    for c in &mut out[i..i + 3] {
+                        let v = f32::from(*c) + (255.0 - f32::from(*c)) * coverage;
+                        *c = v.min(255.0) as u8;
+                    }
+                });
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn readback(left: u8, right: u8) -> Readback {
+        Readback {
+            width: 2,
+            height: 2,
+            eyes: [vec![left; 16], vec![right; 16]],
+            world: None,
+        }
+    }
+
+    #[test]
+    fn side_by_side_puts_each_eye_in_its_half() {
+        let mut out = vec![0u8; 8 * 2 * 4];
+        compose(
+            &mut out,
+            8,
+            2,
+            &readback(10, 200),
+            EyesShown::Both,
+            None,
+            None,
+        );
+        assert_eq!(out[0], 10);
+        assert_eq!(out[4 * 4], 200);
+        assert_eq!(out[7 * 4 + 3], 255);
+        compose(
+            &mut out,
+            8,
+            2,
+            &readback(10, 200),
+            EyesShown::Right,
+            None,
+            None,
+        );
+        assert!(out.chunks(4).all(|p| p[0] == 200));
+    }
+
+    #[test]
+    fn the_preview_adds_light_as_replay_does() {
+        let tables = SeeThrough::new();
+        for (e, w) in [(0u8, 0u8), (128, 64), (10, 250), (255, 255)] {
+            let replay = crate::output::see_through(&[e, e, e, 255], &[w, w, w, 255]);
+            assert!(
+                i16::from(tables.add(e, w)).abs_diff(i16::from(replay[0])) <= 1,
+                "{e} + {w}"
+            );
+        }
+    }
+
+    #[test]
+    fn overlay_text_lights_pixels_in_the_corner_only() {
+        let (w, h) = (200u32, 100u32);
+        let mut out = vec![90u8; (w * h * 4) as usize];
+        Overlay::new()
+            .unwrap()
+            .draw(&mut out, w, h, &["K_g 3.2 px".into()]);
+        let lit = out.chunks(4).filter(|p| p[0] > 200).count();
+        assert!(lit > 20, "{lit} bright pixels");
+        assert_eq!(
+            out[((h - 1) * w + w - 1) as usize * 4],
+            90,
+            "far corner untouched"
+        );
+    }
+}

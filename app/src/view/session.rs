@@ -1,0 +1,585 @@
+//! The viewer's frame sink: takes the user's actions, plans each frame's look, watches the
+//! scene's files, and puts finished frames in the window with the overlay.
+
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use vitreous_render::renderer::{FrameResult, Want};
+use vitreous_render::{ContextOptions, GpuContext, Renderer};
+use vitreous_xr::trace::{AtomicFile, TraceSample, TraceWriter};
+use vitreous_xr::{FrameInput, GazeRay, GazeSample};
+
+use super::ViewOptions;
+use super::desktop::Shared;
+use super::input::{Action, KEYS};
+use super::looks::Looks;
+use super::picture::{Overlay, SeeThrough, compose};
+use super::reload::{Watcher, load_watched};
+use super::swapchain::Presenter;
+use crate::blur_stack::DefocusSetup;
+use crate::effects::EffectSet;
+use crate::frame_loop::{FramePlan, FrameSink};
+use crate::gaze::{FilterKind, FixationDepth, GazeOverride};
+use crate::replay::ValidationSummary;
+use crate::scene::Scene;
+use crate::views;
+
+/// How long a window keeps its new size before the renderer is made for it.
+const RESIZE_SETTLE: Duration = Duration::from_millis(200);
+
+/// A scene loaded with what its renderer needs.
+pub struct Loaded {
+    /// The scene.
+    pub scene: Scene,
+    /// The files it was read from (watched for reload).
+    files: Vec<PathBuf>,
+    /// The effects to start with.
+    effects: EffectSet,
+    /// Whether the caustic bake is loaded (conditions b and c offered).
+    caustics_loaded: bool,
+    /// Why the scene's caustic bake is not used, when it is not.
+    caustics_note: Option<String>,
+    /// Blur stacks and the eq. 13-14 model, when defocus is implemented.
+    setup: Option<DefocusSetup>,
+}
+
+impl Loaded {
+    /// Loads the scene at `path`; `effects` overrides the scene's starting effects.
+    pub fn load(path: &Path, effects: Option<EffectSet>) -> Result<Loaded> {
+        let (scene, files) = load_watched(path);
+        let mut scene = scene?;
+        let effects = effects.unwrap_or(scene.effects);
+        effects.ensure_implemented()?;
+        let mut caustics_note = None;
+        let caustics_loaded = match &scene.caustics.bake {
+            Some(_) if EffectSet::IMPLEMENTED.caustics => match scene.load_caustics() {
+                Ok(()) => true,
+                Err(e) => {
+                    let note = format!("caustic bake not used (conditions b, c off): {e}");
+                    tracing::warn!("{note}");
+                    caustics_note = Some(note);
+                    false
+                }
+            },
+            _ => false,
+        };
+        if effects.caustics && !caustics_loaded {
+            bail!(
+                "effects {effects} need the scene's caustic bake: {}",
+                caustics_note.as_deref().unwrap_or("the scene names none")
+            );
+        }
+        let setup = EffectSet::IMPLEMENTED.defocus.then(|| {
+            let mut setup = DefocusSetup::new(&scene, scene.viewer.pupil_diameter_m);
+            setup.model.pupil_source = scene.gaze.pupil;
+            setup
+        });
+        Ok(Loaded {
+            scene,
+            files,
+            effects,
+            caustics_loaded,
+            caustics_note,
+            setup,
+        })
+    }
+
+    /// A renderer of this scene with eye images of `size`, on a new device.
+    fn renderer(&self, size: (u32, u32), options: &ContextOptions) -> Result<Renderer> {
+        let ctx = GpuContext::headless(options).context("setting up the Vulkan device")?;
+        Renderer::new(
+            ctx,
+            &views::scene_desc(&self.scene, self.setup.as_ref()),
+            size.0,
+            size.1,
+        )
+        .context("preparing the renderer")
+    }
+}
+
+/// Why the frame loop was ended for a new renderer.
+pub enum Request {
+    /// The eye images need a new size.
+    Resize,
+    /// The scene was loaded anew.
+    Reload(Box<Loaded>),
+}
+
+/// The sink (see the module docs).
+pub struct ViewSink {
+    /// The scene shown.
+    loaded: Loaded,
+    /// Conditions and planners.
+    looks: Looks,
+    /// The scene's files.
+    watcher: Watcher,
+    /// The window's swapchain.
+    presenter: Presenter,
+    /// Shared with the backend.
+    shared: Rc<RefCell<Shared>>,
+    /// Show the see-through preview instead of the display's light.
+    preview: bool,
+    /// Show the overlay.
+    show_overlay: bool,
+    /// List the keys in the overlay.
+    help: bool,
+    /// Tables of the preview.
+    see: SeeThrough,
+    /// The overlay's text drawer.
+    overlay: Overlay,
+    /// Eye image size of the current renderer.
+    eye_size: (u32, u32),
+    /// Fraction of the window's pixels the eye images are rendered at.
+    render_scale: f32,
+    /// A new renderer is needed.
+    request: Option<Request>,
+    /// The newest message for the overlay (a reload error, a note).
+    status: Option<String>,
+    /// Reloads refused.
+    reload_errors: Vec<String>,
+    /// Reloads taken.
+    reloads: u32,
+    /// Renderers made.
+    renderers_made: u32,
+    /// Validation messages of retired renderers' devices: warnings, errors, first texts.
+    validation: (u32, u32, Vec<String>),
+    /// Smoothed CPU and GPU milliseconds per frame, and frames per second.
+    timing: (f64, Option<f64>, f64),
+    /// When the last frame finished.
+    last_finished: Option<Instant>,
+    /// Where each frame's head pose and gaze are recorded.
+    writer: Option<TraceWriter<AtomicFile>>,
+    /// Time of the newest frame recorded, nanoseconds.
+    recorded_until_ns: Option<i64>,
+    /// The gaze images the pipeline decided, in order, each change once.
+    gaze_images: Vec<String>,
+}
+
+impl ViewSink {
+    /// A sink showing `loaded` in `presenter`'s window.
+    pub fn new(
+        options: &ViewOptions,
+        loaded: Loaded,
+        presenter: Presenter,
+        shared: Rc<RefCell<Shared>>,
+        filter: Option<FilterKind>,
+        gaze: GazeOverride,
+    ) -> Result<ViewSink> {
+        let looks = Looks::new(
+            loaded.effects,
+            loaded.caustics_loaded,
+            loaded.setup.as_ref().map(|s| s.model),
+            options.reflection,
+            filter.unwrap_or(loaded.scene.gaze.filter),
+            gaze,
+        );
+        let status = loaded.caustics_note.clone();
+        let writer = match &options.record {
+            Some(path) => Some(
+                TraceWriter::create(path)
+                    .with_context(|| format!("creating {}", path.display()))?,
+            ),
+            None => None,
+        };
+        Ok(ViewSink {
+            writer,
+            recorded_until_ns: None,
+            gaze_images: Vec::new(),
+            watcher: Watcher::new(loaded.files.clone()),
+            loaded,
+            looks,
+            presenter,
+            shared,
+            preview: options.preview,
+            show_overlay: options.overlay,
+            help: false,
+            see: SeeThrough::new(),
+            overlay: Overlay::new()?,
+            eye_size: (0, 0),
+            render_scale: options.render_scale,
+            request: None,
+            status,
+            reload_errors: Vec::new(),
+            reloads: 0,
+            renderers_made: 0,
+            validation: (0, 0, Vec::new()),
+            timing: (0.0, None, 0.0),
+            last_finished: None,
+        })
+    }
+
+    /// The eye image size the window needs now.
+    fn wanted_eye_size(&self) -> (u32, u32) {
+        let (w, h) = self.presenter.window_size();
+        let (ew, eh) = self.shared.borrow().eyes.eye_size(w.max(1), h.max(1));
+        let scaled = |v: u32| ((v as f32 * self.render_scale).round() as u32).max(16);
+        (scaled(ew), scaled(eh))
+    }
+
+    /// A renderer for the window as it is now.
+    pub fn make_renderer(&mut self, options: &ContextOptions) -> Result<Renderer> {
+        let size = self.wanted_eye_size();
+        let renderer = self.loaded.renderer(size, options)?;
+        self.took_renderer(size);
+        Ok(renderer)
+    }
+
+    fn took_renderer(&mut self, size: (u32, u32)) {
+        self.eye_size = size;
+        self.shared.borrow_mut().eye_aspect = size.0 as f32 / size.1 as f32;
+        self.renderers_made += 1;
+        tracing::info!("eye images {}x{}", size.0, size.1);
+    }
+
+    /// Makes a renderer for a reloaded scene and, once it exists, shows that scene.
+    pub fn adopt(&mut self, loaded: Loaded, options: &ContextOptions) -> Result<Renderer> {
+        let size = self.wanted_eye_size();
+        let renderer = loaded.renderer(size, options)?;
+        let (filter, reflection, gaze) = self.looks.settings();
+        let current = self.looks.condition();
+        let start = if loaded.caustics_loaded || !current.caustics {
+            current
+        } else {
+            loaded.effects
+        };
+        self.looks = Looks::new(
+            start,
+            loaded.caustics_loaded,
+            loaded.setup.as_ref().map(|s| s.model),
+            reflection,
+            filter,
+            gaze,
+        );
+        self.watcher = Watcher::new(loaded.files.clone());
+        self.status = Some(match &loaded.caustics_note {
+            Some(note) => format!("reloaded; {note}"),
+            None => "reloaded".into(),
+        });
+        self.loaded = loaded;
+        self.reloads += 1;
+        self.took_renderer(size);
+        tracing::info!("scene reloaded");
+        Ok(renderer)
+    }
+
+    /// Closes the recorded trace, if any.
+    pub fn finish_recording(&mut self) -> Result<()> {
+        if let Some(w) = self.writer.take() {
+            w.finish().context("closing the recorded trace")?;
+        }
+        Ok(())
+    }
+
+    /// The scene shown.
+    pub fn scene(&self) -> &Scene {
+        &self.loaded.scene
+    }
+
+    /// Counts a renderer's validation messages before it goes.
+    pub fn retire(&mut self, renderer: &Renderer) {
+        let v = renderer.context().validation();
+        self.validation.0 += v.warnings();
+        self.validation.1 += v.errors();
+        self.validation.2.extend(v.messages());
+    }
+
+    /// Reports a reload that could not take effect; the last good scene keeps running.
+    pub fn report_reload_error(&mut self, error: String) {
+        tracing::error!("reload refused, the last good scene keeps running: {error}");
+        self.status = Some(format!("reload failed: {error}"));
+        self.reload_errors.push(error);
+    }
+
+    /// Takes the pending request for a new renderer.
+    pub fn take_request(&mut self) -> Option<Request> {
+        self.request.take()
+    }
+
+    /// The last picture shown.
+    pub fn last_shown(&self) -> Option<(&[u8], u32, u32)> {
+        self.presenter.last_shown()
+    }
+
+    /// Validation of every device used (retired renderers and the window's).
+    pub fn validation(&self) -> ValidationSummary {
+        let ctx = self.presenter.context();
+        let v = ctx.validation();
+        let mut messages = self.validation.2.clone();
+        messages.extend(v.messages());
+        ValidationSummary {
+            enabled: ctx.validation_enabled(),
+            warnings: self.validation.0 + v.warnings(),
+            errors: self.validation.1 + v.errors(),
+            messages,
+        }
+    }
+
+    /// The window's size now.
+    pub fn window_size(&self) -> (u32, u32) {
+        self.presenter.window_size()
+    }
+
+    /// Renderers made so far.
+    pub fn renderers_made(&self) -> u32 {
+        self.renderers_made
+    }
+
+    /// Reloads taken.
+    pub fn reloads(&self) -> u32 {
+        self.reloads
+    }
+
+    /// Reloads refused, with their errors.
+    pub fn reload_errors(&self) -> &[String] {
+        &self.reload_errors
+    }
+
+    /// The gaze images decided, in order, each change once.
+    pub fn gaze_images(&self) -> &[String] {
+        &self.gaze_images
+    }
+
+    /// The condition shown.
+    pub fn condition(&self) -> String {
+        self.looks.condition().to_string()
+    }
+
+    /// Applies one action of the user.
+    fn act(&mut self, action: Action) -> Option<String> {
+        Some(match action {
+            Action::Condition(i) => self.looks.choose(i),
+            Action::NextCondition => self.looks.next(),
+            Action::Reflection => self.looks.toggle_reflection(),
+            Action::Filter => match self.looks.next_filter() {
+                Ok(m) => m,
+                Err(e) => format!("{e:#}"),
+            },
+            Action::GazeOverride => self.looks.next_gaze(),
+            Action::Noise => {
+                let mut s = self.shared.borrow_mut();
+                s.noise = !s.noise;
+                format!("gaze noise {}", if s.noise { "on" } else { "off" })
+            }
+            Action::Eyes => {
+                let mut s = self.shared.borrow_mut();
+                s.eyes = s.eyes.next();
+                format!("eyes shown: {}", s.eyes)
+            }
+            Action::Preview => {
+                self.preview = !self.preview;
+                if self.preview {
+                    "see-through preview".into()
+                } else {
+                    "display light alone".into()
+                }
+            }
+            Action::Overlay => {
+                self.show_overlay = !self.show_overlay;
+                return None;
+            }
+            Action::Help => {
+                self.help = !self.help;
+                for (keys, what) in KEYS {
+                    tracing::info!("{keys:>20}  {what}");
+                }
+                return None;
+            }
+            Action::Pause | Action::Step | Action::Seek(_) => {
+                "trace keys act only while a trace plays (--trace)".into()
+            }
+            Action::Recentre | Action::FixationTarget | Action::Quit => return None,
+        })
+    }
+
+    /// Looks for a changed scene file and, when one changed, loads the scene anew.
+    fn check_reload(&mut self) {
+        let touched = !std::mem::take(&mut self.shared.borrow_mut().touched).is_empty();
+        let Some(file) = self.watcher.changed(touched) else {
+            return;
+        };
+        tracing::info!("{} changed: reloading the scene", file.display());
+        match Loaded::load(&self.loaded.scene.path, None) {
+            Ok(loaded) => self.request = Some(Request::Reload(Box::new(loaded))),
+            Err(e) => self.report_reload_error(format!("{e:#}")),
+        }
+    }
+
+    /// The overlay's lines.
+    fn overlay_lines(&self) -> Vec<String> {
+        let depth = |d: FixationDepth| match d {
+            FixationDepth::Known { depth_m, .. } => format!("{depth_m:.3} m"),
+            FixationDepth::Unknown => "-".into(),
+        };
+        let (filter, reflection, forced) = self.looks.settings();
+        let shared = self.shared.borrow();
+        let mut lines = vec![
+            format!(
+                "{}  |  {}  |  eyes {}  |  {}  |  reflection {reflection:?}",
+                self.loaded
+                    .scene
+                    .path
+                    .file_name()
+                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+                self.looks.condition(),
+                shared.eyes,
+                if self.preview {
+                    "see-through preview"
+                } else {
+                    "display light"
+                },
+            ),
+            format!(
+                "cursor fixates the {:?} image at {:.3} m{}",
+                shared.fixation.0,
+                shared.fixation.1,
+                if shared.noise { " (with noise)" } else { "" }
+            ),
+        ];
+        match (self.looks.gaze_state(), self.looks.planner().last_defocus()) {
+            (Some(state), Some(d)) => {
+                lines.push(format!(
+                    "gaze image {} (forced: {forced})  |  depth raw {}, filtered {} ({filter})",
+                    d.image,
+                    depth(state.raw_depth),
+                    depth(state.filtered_depth)
+                ));
+                lines.push(match d.defocus {
+                    Some(k) => format!(
+                        "K_g refracted {:.2} px, surface {:.2} px",
+                        k.refracted_k_g_px, k.surface_k_g_px
+                    ),
+                    None => "K_g: none (gaze image unknown)".into(),
+                });
+            }
+            _ => lines.push("no defocus in this condition (gaze image not used)".into()),
+        }
+        let (cpu, gpu, fps) = self.timing;
+        lines.push(format!(
+            "GPU {} ms  |  CPU {cpu:.1} ms  |  {fps:.1} frames/s  |  F1: keys",
+            gpu.map_or("n/a".into(), |g| format!("{g:.1}"))
+        ));
+        if let Some((at, of, paused)) = shared.trace {
+            lines.push(format!(
+                "trace {at:.2} / {of:.2} s{}  (K pause, L step, J / Shift+L seek)",
+                if paused { ", paused" } else { "" }
+            ));
+        }
+        if let Some(status) = &self.status {
+            lines.push(status.clone());
+        }
+        if self.help {
+            lines.extend(KEYS.iter().map(|(k, w)| format!("{k}: {w}")));
+        }
+        lines
+    }
+}
+
+impl FrameSink for ViewSink {
+    fn started(&mut self, input: &FrameInput) -> Result<()> {
+        // A trace's times increase strictly: a paused or rewound trace is not recorded again.
+        if self.recorded_until_ns.is_some_and(|t| input.time_ns <= t) {
+            return Ok(());
+        }
+        if let Some(w) = &mut self.writer {
+            self.recorded_until_ns = Some(input.time_ns);
+            let gaze = input.gaze.unwrap_or(GazeSample {
+                sample_time_ns: input.time_ns,
+                left: GazeRay::INVALID,
+                right: GazeRay::INVALID,
+                combined: None,
+                fixation: None,
+                pupil_diameter_m: [None, None],
+            });
+            w.write(&TraceSample {
+                time_ns: input.time_ns,
+                head: input.head,
+                gaze,
+            })
+            .context("recording the trace")?;
+        }
+        Ok(())
+    }
+
+    fn plan(&mut self, input: &FrameInput) -> FramePlan {
+        let actions: Vec<Action> = self.shared.borrow_mut().actions.drain(..).collect();
+        for action in actions {
+            if let Some(change) = self.act(action) {
+                tracing::info!("frame {}: {change}", input.index);
+            }
+        }
+        if self.request.is_none() {
+            self.check_reload();
+        }
+        if self.request.is_none() && self.wanted_eye_size() != self.eye_size {
+            let (w, h) = self.presenter.window_size();
+            let settled = self
+                .shared
+                .borrow()
+                .resized_at
+                .is_none_or(|t| t.elapsed() >= RESIZE_SETTLE);
+            if settled && w > 0 && h > 0 {
+                self.request = Some(Request::Resize);
+            }
+        }
+        let look = self.looks.plan(input);
+        if let Some(d) = self.looks.planner().last_defocus() {
+            let image = d.image.to_string();
+            if self.gaze_images.last() != Some(&image) {
+                self.gaze_images.push(image);
+            }
+        }
+        FramePlan {
+            look,
+            want: Want {
+                eyes: true,
+                world: self.preview,
+            },
+        }
+    }
+
+    fn finished(&mut self, _input: &FrameInput, result: &FrameResult) -> Result<()> {
+        let now = Instant::now();
+        let smooth = |old: f64, new: f64| {
+            if old == 0.0 {
+                new
+            } else {
+                old * 0.9 + new * 0.1
+            }
+        };
+        let fps = self
+            .last_finished
+            .map(|t| 1.0 / now.duration_since(t).as_secs_f64().max(1e-6));
+        self.last_finished = Some(now);
+        self.timing = (
+            smooth(self.timing.0, result.timing.cpu_submit_ms),
+            result
+                .timing
+                .gpu_ms
+                .map(|g| smooth(self.timing.1.unwrap_or(0.0), g)),
+            fps.map_or(self.timing.2, |f| smooth(self.timing.2, f)),
+        );
+        let Some(readback) = &result.readback else {
+            return Ok(());
+        };
+        let lines = if self.show_overlay {
+            self.overlay_lines()
+        } else {
+            Vec::new()
+        };
+        let eyes = self.shared.borrow().eyes;
+        let preview = self.preview.then_some(&self.see);
+        let overlay = &self.overlay;
+        self.presenter.present(|out, w, h| {
+            compose(out, w, h, readback, eyes, preview, readback.world.as_ref());
+            overlay.draw(out, w, h, &lines);
+        })?;
+        Ok(())
+    }
+
+    fn stop_requested(&self) -> bool {
+        self.request.is_some() || crate::interrupt::requested()
+    }
+}

@@ -1,0 +1,101 @@
+//! A host-visible buffer a picture is written into before it is copied to the window.
+
+use anyhow::{Context, Result};
+use ash::vk;
+use vitreous_render::GpuContext;
+
+/// A staging buffer, mapped for as long as it lives. Freed with [`Staging::free`] (it holds
+/// no device, so it cannot free itself on drop).
+pub struct Staging {
+    /// The buffer (null until first sized).
+    pub buffer: vk::Buffer,
+    /// Its memory.
+    memory: vk::DeviceMemory,
+    /// The mapped pointer to `memory`.
+    mapped: *mut u8,
+    /// Bytes in the buffer.
+    capacity: u64,
+}
+
+impl Staging {
+    /// No buffer yet.
+    pub const EMPTY: Staging = Staging {
+        buffer: vk::Buffer::null(),
+        memory: vk::DeviceMemory::null(),
+        mapped: std::ptr::null_mut(),
+        capacity: 0,
+    };
+
+    /// Makes the buffer hold at least `bytes`. No submitted work may use it.
+    pub fn ensure(&mut self, ctx: &GpuContext, bytes: u64) -> Result<()> {
+        if self.capacity >= bytes {
+            return Ok(());
+        }
+        let d = &ctx.device;
+        self.free(d);
+        let info = vk::BufferCreateInfo::default()
+            .size(bytes)
+            .usage(vk::BufferUsageFlags::TRANSFER_SRC)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: a valid create info; stored at once, so `free` releases it on a later error.
+        self.buffer = unsafe { d.create_buffer(&info, None) }.context("vkCreateBuffer")?;
+        // SAFETY: the buffer is live.
+        let needs = unsafe { d.get_buffer_memory_requirements(self.buffer) };
+        // SAFETY: the physical device belongs to the context's instance.
+        let props = unsafe {
+            ctx.instance
+                .get_physical_device_memory_properties(ctx.physical)
+        };
+        let wanted = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
+        let type_index = (0..props.memory_type_count)
+            .find(|&i| {
+                needs.memory_type_bits & (1 << i) != 0
+                    && props.memory_types[i as usize]
+                        .property_flags
+                        .contains(wanted)
+            })
+            .context("no host-visible coherent memory for the window's staging buffer")?;
+        let alloc = vk::MemoryAllocateInfo::default()
+            .allocation_size(needs.size)
+            .memory_type_index(type_index);
+        // SAFETY: a valid allocate info; stored at once; bound to the buffer and mapped whole.
+        unsafe {
+            self.memory = d
+                .allocate_memory(&alloc, None)
+                .context("vkAllocateMemory")?;
+            d.bind_buffer_memory(self.buffer, self.memory, 0)
+                .context("vkBindBufferMemory")?;
+            self.mapped = d
+                .map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty())
+                .context("vkMapMemory")?
+                .cast();
+        }
+        self.capacity = bytes;
+        Ok(())
+    }
+
+    /// The first `bytes` bytes of the mapped buffer.
+    ///
+    /// # Safety
+    /// `bytes` must not exceed what [`Staging::ensure`] was last given, and no submitted work
+    /// may read the buffer while the slice lives.
+    pub unsafe fn bytes_mut(&mut self, bytes: usize) -> &mut [u8] {
+        debug_assert!(bytes as u64 <= self.capacity);
+        // SAFETY: the caller's contract: `mapped` points at `capacity` >= `bytes` bytes of
+        // host-coherent memory that nothing else uses meanwhile.
+        unsafe { std::slice::from_raw_parts_mut(self.mapped, bytes) }
+    }
+
+    /// Frees the buffer and its memory, if any; no submitted work may use them.
+    pub fn free(&mut self, d: &ash::Device) {
+        // SAFETY: the contract above; null handles are ignored by the destroy calls.
+        unsafe {
+            if self.memory != vk::DeviceMemory::null() {
+                d.unmap_memory(self.memory);
+            }
+            d.destroy_buffer(self.buffer, None);
+            d.free_memory(self.memory, None);
+        }
+        *self = Staging::EMPTY;
+    }
+}

@@ -1,0 +1,470 @@
+//! `vitreous view` in a virtual X server (xvfb-run) on the machine's Vulkan device (lavapipe
+//! in CI) with validation on: screenshots measured in the glass's projected region and away
+//! from it, a scripted key press, and scripted scene edits (reload, and a broken edit kept
+//! out).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use glam::Vec3;
+
+/// Window size of every test: small, so each run takes a few seconds on a CPU device.
+const WINDOW: (u32, u32) = (320, 240);
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// `xvfb-run`, or None outside CI when it is missing (in CI, a missing one fails the test).
+fn xvfb_run() -> Option<PathBuf> {
+    let found = std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|p| p.join("xvfb-run"))
+            .find(|p| p.is_file())
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "xvfb-run is missing: tools/ensure-vulkan --window installs it (Debian: xvfb, xauth)"
+        );
+        eprintln!("skipped: no xvfb-run here (tools/ensure-vulkan --window installs it)");
+    }
+    found
+}
+
+/// Runs `vitreous view` in a virtual X server with validation on.
+fn view(xvfb: &Path, scene: &Path, args: &[&str], cwd: &Path) -> Output {
+    let size = format!("{}x{}", WINDOW.0, WINDOW.1);
+    // Each run starts its search for a free display at its own number: runs started at once
+    // by parallel tests would otherwise race for the same one.
+    static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let first_display = 100 + 10 * RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let out = Command::new(xvfb)
+        .args(["-a", "-n", &first_display.to_string()])
+        .args(["-s", "-screen 0 640x480x24"])
+        .arg(env!("CARGO_BIN_EXE_vitreous"))
+        .arg("view")
+        .arg(scene)
+        .args(["--window", &size, "--validate", "--no-overlay"])
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("running xvfb-run");
+    assert!(
+        out.status.success(),
+        "vitreous view failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// An RGBA8 screenshot.
+struct Shot {
+    width: u32,
+    pixels: Vec<u8>,
+}
+
+impl Shot {
+    fn read(path: &Path) -> Shot {
+        Shot::read_sized(path, WINDOW)
+    }
+
+    fn read_sized(path: &Path, size: (u32, u32)) -> Shot {
+        let img = image::open(path).expect("a PNG screenshot").to_rgba8();
+        assert_eq!(img.dimensions(), size, "the screenshot is the window");
+        Shot {
+            width: img.width(),
+            pixels: img.into_raw(),
+        }
+    }
+
+    fn luma(&self, x: u32, y: u32) -> f32 {
+        let i = ((y * self.width + x) * 4) as usize;
+        let p = &self.pixels[i..i + 3];
+        0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2])
+    }
+}
+
+/// Where the scene's glass (its bounding sphere) lies in each half of the window, as the
+/// viewer projects it from the starting pose: centre and radius in window pixels.
+fn glass_discs(scene_path: &Path) -> [(f32, f32, f32); 2] {
+    let scene = vitreous::scene::load_scene(scene_path).expect("scene loads");
+    let g = scene.viewing_geometry();
+    let fov = scene.output.fov;
+    let tan_v = ((fov.angle_up_rad - fov.angle_down_rad) / 2.0).tan();
+    let (eye_w, eye_h) = ((WINDOW.0 / 2) as f32, WINDOW.1 as f32);
+    let tan_h = tan_v * eye_w / eye_h;
+    let head = scene.viewer.head_position_m;
+    [-1.0f32, 1.0].map(|side| {
+        let eye = head + Vec3::X * side * scene.viewer.ipd_m / 2.0;
+        let p = g.center_m - eye;
+        let u = 0.5 + p.x / -p.z / (2.0 * tan_h);
+        let v = 0.5 - p.y / -p.z / (2.0 * tan_v);
+        let r = g.radius_m / p.length() / (2.0 * tan_v) * eye_h;
+        let x0 = if side < 0.0 { 0.0 } else { eye_w };
+        (x0 + u * eye_w, v * eye_h, r)
+    })
+}
+
+/// Window pixels, (x, y).
+type Pixels = Vec<(u32, u32)>;
+
+/// Pixels inside 0.7 of the discs and outside 1.6 of them.
+fn regions(discs: &[(f32, f32, f32); 2]) -> (Pixels, Pixels) {
+    let (mut inside, mut outside) = (Vec::new(), Vec::new());
+    for y in 0..WINDOW.1 {
+        for x in 0..WINDOW.0 {
+            let d = |&(cx, cy, r): &(f32, f32, f32)| {
+                ((x as f32 + 0.5 - cx).hypot(y as f32 + 0.5 - cy)) / r
+            };
+            let nearest = discs.iter().map(d).fold(f32::INFINITY, f32::min);
+            if nearest < 0.7 {
+                inside.push((x, y));
+            } else if nearest > 1.6 {
+                outside.push((x, y));
+            }
+        }
+    }
+    (inside, outside)
+}
+
+fn scene(name: &str) -> PathBuf {
+    root().join("config/scenes").join(name)
+}
+
+#[test]
+fn view_shows_the_glass_where_it_projects_and_black_elsewhere() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("glass-sphere.toml");
+    let shot = dir.path().join("shot.png");
+    view(
+        &xvfb,
+        &scene,
+        &["--frames", "6", "--screenshot", shot.to_str().unwrap()],
+        dir.path(),
+    );
+    let img = Shot::read(&shot);
+    let (inside, outside) = regions(&glass_discs(&scene));
+    assert!(inside.len() > 50, "the glass covers {} px", inside.len());
+    let mean =
+        |px: &[(u32, u32)]| px.iter().map(|&(x, y)| img.luma(x, y)).sum::<f32>() / px.len() as f32;
+    let lit_outside = outside
+        .iter()
+        .filter(|&&(x, y)| img.luma(x, y) > 8.0)
+        .count();
+    assert!(mean(&inside) > 20.0, "glass mean luma {}", mean(&inside));
+    assert!(
+        (lit_outside as f32) < 0.01 * outside.len() as f32,
+        "{lit_outside} of {} px lit away from the glass (display light only)",
+        outside.len()
+    );
+}
+
+#[test]
+fn a_scripted_key_changes_the_glass_and_nothing_else() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("glass-sphere.toml");
+    let script = dir.path().join("o4.script");
+    // Key 3: condition O4 (per-eye refraction to the background plane); Esc at frame 6
+    // ends the session as --frames 6 does.
+    std::fs::write(&script, "1 key 3\n6 key escape\n").unwrap();
+    let (before, after) = (dir.path().join("none.png"), dir.path().join("o4.png"));
+    let common = ["--effects", "none", "--screenshot"];
+    let mut args = common.to_vec();
+    args.extend([before.to_str().unwrap(), "--frames", "6"]);
+    view(&xvfb, &scene, &args, dir.path());
+    let out_dir = dir.path().join("out");
+    let mut args = common.to_vec();
+    args.extend([
+        after.to_str().unwrap(),
+        "--script",
+        script.to_str().unwrap(),
+    ]);
+    args.extend(["--frames", "100", "--out", out_dir.to_str().unwrap()]);
+    let out = view(&xvfb, &scene, &args, dir.path());
+    let s = summary(&out_dir);
+    assert_eq!(s["frames"], 6, "Esc ended the session: {s:#}");
+    assert_eq!(s["final_condition"], "disparity", "{s:#}");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("effects now disparity"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (a, b) = (Shot::read(&before), Shot::read(&after));
+    let (inside, outside) = regions(&glass_discs(&scene));
+    let diff = |&(x, y): &(u32, u32)| (a.luma(x, y) - b.luma(x, y)).abs();
+    let inside_diff = inside.iter().map(diff).sum::<f32>() / inside.len() as f32;
+    let changed_outside = outside.iter().filter(|p| diff(p) > 8.0).count();
+    assert!(
+        inside_diff > 3.0,
+        "the glass changed by {inside_diff} on average"
+    );
+    assert!(
+        (changed_outside as f32) < 0.005 * outside.len() as f32,
+        "{changed_outside} of {} px changed away from the glass",
+        outside.len()
+    );
+}
+
+/// A copy of a shipped scene in `dir` with its asset paths made absolute, so edits of the copy
+/// load the same assets.
+fn scene_copy(name: &str, dir: &Path) -> (PathBuf, String) {
+    let text = std::fs::read_to_string(scene(name)).unwrap();
+    let config = root().join("config").canonicalize().unwrap();
+    let text = text.replace("\"../", &format!("\"{}/", config.display()));
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, &text).unwrap();
+    (path, text)
+}
+
+#[test]
+fn scripted_scene_edits_reload_and_a_broken_edit_keeps_the_last_good_scene() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let (path, text) = scene_copy("glass-sphere.toml", dir.path());
+    let moved = text.replace(
+        "position_m = [0.0, -0.26, -1.5]",
+        "position_m = [0.1, -0.26, -1.5]",
+    );
+    assert_ne!(moved, text, "the edit applies");
+    std::fs::write(dir.path().join("moved.toml"), &moved).unwrap();
+    // Line 3 of the broken file has no value.
+    std::fs::write(
+        dir.path().join("broken.toml"),
+        "[object]\nior = 1.5\ndiameter_m =\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("edits.script"),
+        "2 copy moved.toml scene.toml\n6 copy broken.toml scene.toml\n",
+    )
+    .unwrap();
+    let out_dir = dir.path().join("out");
+    let shot = dir.path().join("shot.png");
+    view(
+        &xvfb,
+        &path,
+        &[
+            "--frames",
+            "10",
+            "--script",
+            "edits.script",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["reloads"], 1, "{summary:#}");
+    let errors = summary["reload_errors"].as_array().unwrap();
+    assert_eq!(errors.len(), 1, "{summary:#}");
+    let error = errors[0].as_str().unwrap();
+    assert!(
+        error.contains("scene.toml") && error.contains('3'),
+        "{error}"
+    );
+    // The moved scene kept running: its glass is where the moved sphere projects.
+    let moved_path = dir.path().join("moved.toml");
+    let img = Shot::read(&shot);
+    let (inside, _) = regions(&glass_discs(&moved_path));
+    let mean = inside.iter().map(|&(x, y)| img.luma(x, y)).sum::<f32>() / inside.len() as f32;
+    assert!(mean > 20.0, "the moved glass has mean luma {mean}");
+}
+
+fn summary(out_dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn a_resized_window_gets_a_new_swapchain_and_renderer() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("resize.script"), "2 resize 400 300\n").unwrap();
+    let (shot, out_dir) = (dir.path().join("shot.png"), dir.path().join("out"));
+    view(
+        &xvfb,
+        &scene("glass-sphere.toml"),
+        &[
+            "--frames",
+            "24",
+            "--script",
+            "resize.script",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let s = summary(&out_dir);
+    assert_eq!(s["window_px"], serde_json::json!([400, 300]), "{s:#}");
+    assert!(s["renderers_made"].as_u64().unwrap() >= 2, "{s:#}");
+    let img = Shot::read_sized(&shot, (400, 300));
+    let lit = img.pixels.chunks(4).filter(|p| p[1] > 40).count();
+    assert!(
+        lit > 100,
+        "the glass is drawn after the resize: {lit} px lit"
+    );
+}
+
+#[test]
+fn a_recorded_session_replays_and_the_preview_shows_the_world() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("visual-effects.toml");
+    let (shot, trace) = (
+        dir.path().join("shot.png"),
+        dir.path().join("session.trace"),
+    );
+    view(
+        &xvfb,
+        &scene,
+        &[
+            "--frames",
+            "8",
+            "--effects",
+            "O5",
+            "--preview",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--record",
+            trace.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    // The preview adds the real world's photos: bright everywhere, not black around the glass.
+    let img = Shot::read(&shot);
+    let dark = img
+        .pixels
+        .chunks(4)
+        .filter(|p| p[0].max(p[1]).max(p[2]) < 10)
+        .count();
+    assert!(
+        dark * 100 < img.pixels.len() / 4,
+        "{dark} px black in the preview"
+    );
+    let samples = vitreous_xr::trace::read_trace(&trace).expect("the recording is a trace");
+    assert_eq!(samples.len(), 8);
+    let out = Command::new(env!("CARGO_BIN_EXE_vitreous"))
+        .arg("replay")
+        .arg(&scene)
+        .args([
+            "--trace",
+            trace.to_str().unwrap(),
+            "--at-samples",
+            "--size",
+            "64x48",
+        ])
+        .args([
+            "--effects",
+            "O5",
+            "--save-every",
+            "0",
+            "--quiet",
+            "--validate",
+        ])
+        .arg("--out")
+        .arg(dir.path().join("replay"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = summary(&dir.path().join("replay"));
+    assert_eq!(s["frames"], 8, "one frame per recorded sample: {s:#}");
+}
+
+#[test]
+fn the_wheel_moves_the_gaze_to_the_refracted_image_through_the_gaze_pipeline() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    // The cursor on the middle of the left eye's image, on the glass; the wheel at frame 4
+    // moves the fixation point from the glass's surface to the background behind it. The
+    // scene's filter (eq. 15's 20-sample mean) then decides the refracted image.
+    std::fs::write(
+        dir.path().join("gaze.script"),
+        "0 move 0.25 0.5\n4 wheel 1\n",
+    )
+    .unwrap();
+    let out_dir = dir.path().join("out");
+    view(
+        &xvfb,
+        &scene("visual-effects.toml"),
+        &[
+            "--frames",
+            "40",
+            "--effects",
+            "O3",
+            "--script",
+            "gaze.script",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let s = summary(&out_dir);
+    let seen: Vec<&str> = s["gaze_images"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|v| v.as_str())
+        .filter(|v| *v != "unknown")
+        .collect();
+    assert_eq!(seen, ["surface", "refracted"], "{s:#}");
+}
+
+#[test]
+fn a_played_trace_pauses_and_steps_and_the_recording_shows_it() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("glass-sphere.toml");
+    let trace = dir.path().join("synth.trace");
+    let synth = Command::new(env!("CARGO_BIN_EXE_vitreous"))
+        .args(["trace", "synth", "--scene"])
+        .arg(&scene)
+        .arg("-o")
+        .arg(&trace)
+        .output()
+        .unwrap();
+    assert!(
+        synth.status.success(),
+        "{}",
+        String::from_utf8_lossy(&synth.stderr)
+    );
+    // K pauses before frame 2 is drawn, L steps 1/60 s before frame 5.
+    std::fs::write(dir.path().join("keys.script"), "2 key k\n5 key l\n").unwrap();
+    let recorded = dir.path().join("rec.trace");
+    view(
+        &xvfb,
+        &scene,
+        &[
+            "--frames",
+            "8",
+            "--trace",
+            trace.to_str().unwrap(),
+            "--script",
+            "keys.script",
+            "--record",
+            recorded.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let samples = vitreous_xr::trace::read_trace(&recorded).unwrap();
+    // Frames 0 and 1 play, 2-4 stand still (not recorded again), 5 is one step on, 6-7 stand.
+    let times: Vec<i64> = samples.iter().map(|s| s.time_ns).collect();
+    assert_eq!(times.len(), 3, "{times:?}");
+    assert_eq!(times[2] - times[1], 1_000_000_000 / 60, "{times:?}");
+    let played = vitreous_xr::trace::read_trace(&trace).unwrap();
+    assert_eq!(
+        samples[0].head, played[0].head,
+        "the trace's first head pose"
+    );
+}

@@ -9,6 +9,7 @@ pub mod blur_stack;
 pub mod caustics;
 pub mod cli_values;
 pub mod effects;
+pub mod error_report;
 pub mod frame_log;
 pub mod frame_loop;
 pub mod gaze;

@@ -12,6 +12,7 @@ use vitreous::cli_values::{
     parse_blend, parse_effects, parse_frame_count, parse_frame_count_usize, parse_gaze, parse_size,
 };
 use vitreous::effects::EffectSet;
+use vitreous::error_report::error_text;
 use vitreous::gaze::{FilterKind, GazeOverride, PupilSource};
 use vitreous::output::ensure_not_input;
 use vitreous::replay::{GazeSettings, ReplayOptions, replay};
@@ -594,36 +595,5 @@ fn main() -> ExitCode {
             eprintln!("error: {}", error_text(&e));
             ExitCode::FAILURE
         }
-    }
-}
-
-/// The error and its causes in one line, outermost first, leaving out a cause whose text the
-/// line already ends with (many errors quote their source in their own message).
-fn error_text(error: &anyhow::Error) -> String {
-    let mut text = String::new();
-    for cause in error.chain() {
-        let part = cause.to_string();
-        if text.ends_with(part.as_str()) {
-            continue;
-        }
-        if !text.is_empty() {
-            text.push_str(": ");
-        }
-        text.push_str(&part);
-    }
-    text
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn error_text_leaves_out_causes_already_quoted() {
-        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
-        let e = anyhow::Error::new(io)
-            .context("reading a: no such file")
-            .context("loading b");
-        assert_eq!(error_text(&e), "loading b: reading a: no such file");
     }
 }

@@ -379,3 +379,63 @@ fn study_run_refuses_responses_that_do_not_match_the_plan() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("no trials for participant `p99`"));
 }
+
+/// `study run --view`: the trials in the desktop window (a virtual X server, validation on),
+/// answered by a simulated participant; each answer recorded in plan order. Skipped outside CI
+/// when xvfb-run is missing (in CI a missing one fails).
+#[test]
+fn study_run_shows_the_trials_in_the_desktop_viewer() {
+    let xvfb = std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|p| p.join("xvfb-run"))
+            .find(|p| p.is_file())
+    });
+    let Some(xvfb) = xvfb else {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "xvfb-run is missing: tools/ensure-vulkan --window installs it"
+        );
+        eprintln!("skipped: no xvfb-run here");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (plan_path, responses) = (dir.path().join("plan.csv"), dir.path().join("r.csv"));
+    plan("visual-effects.toml", 1, 9, &plan_path);
+    let out = Command::new(xvfb)
+        .args(["-a", "-n", "300", "-s", "-screen 0 640x480x24"])
+        .arg(env!("CARGO_BIN_EXE_vitreous"))
+        .args(["study", "run"])
+        .arg(protocol("visual-effects.toml"))
+        .arg("--plan")
+        .arg(&plan_path)
+        .args(["--participant", "p01", "--responses"])
+        .arg(&responses)
+        .args([
+            "--view",
+            "--window",
+            "320x240",
+            "--validate",
+            "--time-scale",
+            "0.005",
+        ])
+        .args(["--trials", "2", "--simulate", SCALE])
+        .stdin(Stdio::null())
+        .output()
+        .expect("running xvfb-run");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let planned = rows(&plan_path);
+    let answered = rows(&responses);
+    assert_eq!(answered.len(), 2, "{stderr}");
+    for (a, p) in answered.iter().zip(&planned) {
+        assert_eq!((&a[1], &a[2], &a[3]), (&p[1], &p[3], &p[4]));
+    }
+    let log = std::fs::read_to_string(dir.path().join("r-timing.csv")).unwrap();
+    for event in ["first", "blank", "second", "answer", "answered"] {
+        assert!(
+            log.lines()
+                .any(|l| l.starts_with("p01,2,") && l.contains(&format!(",{event},"))),
+            "no {event} in\n{log}"
+        );
+    }
+}

@@ -52,8 +52,15 @@ pub enum StudyCommand {
         /// runtime, replaying --trace or a synthetic trace of each scene.
         #[arg(long)]
         dry_run: bool,
-        /// The trace a dry run replays.
-        #[arg(long, value_name = "FILE", requires = "dry_run")]
+        /// In a desktop window instead (the `vitreous view` simulator: head and gaze from the
+        /// mouse, or --trace played), answers typed in the terminal.
+        #[arg(long, conflicts_with = "dry_run")]
+        view: bool,
+        /// Window size of --view.
+        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "960x540")]
+        window: (u32, u32),
+        /// The trace a dry run replays, or --view plays.
+        #[arg(long, value_name = "FILE")]
         trace: Option<PathBuf>,
         /// Display rate of a dry run, Hz.
         #[arg(long, value_name = "HZ", default_value_t = 30.0, requires = "dry_run")]
@@ -140,6 +147,8 @@ pub fn run(command: StudyCommand) -> Result<()> {
             participant,
             responses,
             dry_run,
+            view,
+            window,
             trace,
             rate,
             time_scale,
@@ -161,12 +170,18 @@ pub fn run(command: StudyCommand) -> Result<()> {
             if trials == Some(0) {
                 bail!("--trials must be at least 1");
             }
+            if trace.is_some() && !(dry_run || view) {
+                bail!(
+                    "--trace is for --dry-run or --view (on a headset, --gaze-trace replays gaze)"
+                );
+            }
             let summary = run_study(&StudyRunOptions {
                 protocol,
                 plan,
                 participant: participant.clone(),
                 responses: responses.clone(),
                 dry_run,
+                view: view.then_some(window),
                 trace,
                 frame_rate_hz: rate,
                 size,

@@ -22,6 +22,7 @@ use super::protocol::{Protocol, Show};
 use super::session::{AnswerSources, ResponsesFile, StudyDirector, TimingLog, remaining_trials};
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
+use crate::gaze::GazeOverride;
 use crate::look::{GazeSettings, planners_for};
 use crate::motion_clock::MotionClock;
 use crate::run::{LiveLooks, RunOptions};
@@ -44,6 +45,8 @@ pub struct StudyRunOptions {
     pub responses: PathBuf,
     /// Headless on the null backend instead of the OpenXR runtime.
     pub dry_run: bool,
+    /// In a desktop window of this size instead of the OpenXR runtime (`vitreous view`).
+    pub view: Option<(u32, u32)>,
     /// The trace a dry run replays (default: a synthetic one for each scene).
     pub trace: Option<PathBuf>,
     /// Display rate of a dry run, hertz.
@@ -133,8 +136,9 @@ impl StudyStage {
         self.end.load(Ordering::SeqCst)
     }
 
-    /// This frame's look.
-    pub fn plan(&mut self, looks: &mut LiveLooks, input: &FrameInput) -> Look {
+    /// What this frame shows: the effect set (`None`: nothing) and the gaze image cued
+    /// (`None` after an error, which [`StudyStage::take_error`] returns).
+    pub fn next_shown(&mut self, input: &FrameInput) -> (Option<EffectSet>, Option<GazeOverride>) {
         let shown = match self
             .director
             .frame(input.index, input.time_ns as f64 * 1e-9)
@@ -148,17 +152,25 @@ impl StudyStage {
         if self.director.done() || self.error.is_some() {
             self.end.store(true, Ordering::SeqCst);
         }
-        let index = shown.and_then(|s| s.condition.and_then(|c| self.looks_index[c]));
-        if let Some(s) = shown
-            && s.gaze != looks.gaze()
+        let set = shown
+            .and_then(|s| s.condition.and_then(|c| self.looks_index[c]))
+            .map(|i| self.sets[i]);
+        (set, shown.map(|s| s.gaze))
+    }
+
+    /// This frame's look, through `looks` (built for [`StudyStage::sets`], in order).
+    pub fn plan(&mut self, looks: &mut LiveLooks, input: &FrameInput) -> Look {
+        let (set, gaze) = self.next_shown(input);
+        if let Some(g) = gaze
+            && g != looks.gaze()
         {
-            looks.set_gaze(s.gaze);
+            looks.set_gaze(g);
         }
-        if let Some(i) = index {
+        if let Some(i) = set.and_then(|s| self.sets.iter().position(|x| *x == s)) {
             looks.select(i);
         }
         let mut look = looks.plan(input);
-        look.blank = index.is_none();
+        look.blank = set.is_none();
         look
     }
 
@@ -250,7 +262,7 @@ pub fn run_study(options: &StudyRunOptions) -> Result<StudyRunSummary> {
             AnswerSources {
                 keyboard: keyboard.take(),
                 simulated: simulated.take(),
-                controller: !options.dry_run,
+                controller: !options.dry_run && options.view.is_none(),
             },
             responses,
             TimingLog::open(&timing_path)?,
@@ -258,6 +270,29 @@ pub fn run_study(options: &StudyRunOptions) -> Result<StudyRunSummary> {
         let stage = StudyStage::new(&protocol, director);
         let stage = if options.dry_run {
             dry_run_block(options, &protocol, &stimulus.scene, block.len(), stage)?
+        } else if let Some(window) = options.view {
+            crate::view::view_study_block(
+                &crate::view::ViewOptions {
+                    scene: stimulus.scene.clone(),
+                    window,
+                    render_scale: 1.0,
+                    frames: None,
+                    screenshot: None,
+                    script: None,
+                    effects: None,
+                    eyes: Default::default(),
+                    preview: false,
+                    overlay: true,
+                    reflection: Reflection::Phong,
+                    filter: None,
+                    validate: options.validate,
+                    device: None,
+                    out: None,
+                    trace: options.trace.clone(),
+                    record: None,
+                },
+                stage,
+            )?
         } else {
             let mut run = options.run.clone();
             run.scene = stimulus.scene.clone();
@@ -365,7 +400,7 @@ fn dry_run_block(
     drop(defocus);
     let looks = LiveLooks::new(
         stage.sets.iter().copied().zip(planners).collect(),
-        crate::gaze::GazeOverride::Auto,
+        GazeOverride::Auto,
     );
     crate::interrupt::watch();
     let mut sink = DryRunSink {

@@ -171,6 +171,28 @@ impl Looks {
         Ok(format!("gaze filter now {}", self.filter))
     }
 
+    /// Shows the condition with effects `set`; false when the viewer has no such condition
+    /// available.
+    pub fn show_set(&mut self, set: EffectSet) -> bool {
+        match self.conditions.iter().position(|c| *c == Some(set)) {
+            Some(i) => {
+                self.current = i;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Forces the gaze image (auto: the gaze pipeline decides).
+    pub fn set_gaze(&mut self, gaze: GazeOverride) {
+        if gaze != self.gaze {
+            self.gaze = gaze;
+            for p in self.planners.iter_mut().flatten() {
+                p.set_gaze_override(gaze);
+            }
+        }
+    }
+
     /// The next forced gaze image (auto, surface, refracted).
     pub fn next_gaze(&mut self) -> String {
         self.gaze = match self.gaze {

@@ -153,6 +153,25 @@ impl ViewSummary {
 
 /// Runs a view session until the window closes, Esc, or `frames`.
 pub fn view(options: &ViewOptions) -> Result<ViewSummary> {
+    view_with(options, None).map(|(summary, _)| summary)
+}
+
+/// Runs one block of a study's trials in the window (`vitreous study run --view`): the stage
+/// decides each frame's condition and gaze image, and the session ends once the block is
+/// answered (or the window closes). Returns the stage with its director's state.
+pub fn view_study_block(
+    options: &ViewOptions,
+    stage: crate::study::run::StudyStage,
+) -> Result<crate::study::run::StudyStage> {
+    let (_, stage) = view_with(options, Some(stage))?;
+    Ok(stage.expect("the study stage comes back"))
+}
+
+/// [`view`], with a study's stage deciding the looks when given.
+fn view_with(
+    options: &ViewOptions,
+    study: Option<crate::study::run::StudyStage>,
+) -> Result<(ViewSummary, Option<crate::study::run::StudyStage>)> {
     let script = match &options.script {
         Some(path) => Some(Script::load(path)?),
         None => None,
@@ -226,6 +245,9 @@ pub fn view(options: &ViewOptions) -> Result<ViewSummary> {
         options.filter,
         GazeOverride::Auto,
     )?;
+    if let Some(stage) = study {
+        sink.set_study(stage);
+    }
     let mut renderer = sink.make_renderer(&context_options)?;
 
     let started = Instant::now();
@@ -299,5 +321,5 @@ pub fn view(options: &ViewOptions) -> Result<ViewSummary> {
             v.messages.first().map(String::as_str).unwrap_or("")
         );
     }
-    Ok(summary)
+    Ok((summary, sink.take_study()))
 }

@@ -25,6 +25,7 @@ use crate::frame_loop::{FramePlan, FrameSink};
 use crate::gaze::{FilterKind, FixationDepth, GazeOverride};
 use crate::replay::ValidationSummary;
 use crate::scene::Scene;
+use crate::study::run::StudyStage;
 use crate::views;
 
 /// How long a window keeps its new size before the renderer is made for it.
@@ -110,6 +111,9 @@ pub enum Request {
 
 /// The sink (see the module docs).
 pub struct ViewSink {
+    /// A study's trials, deciding each frame's condition and gaze image (`vitreous study run
+    /// --view`).
+    study: Option<StudyStage>,
     /// The scene shown.
     loaded: Loaded,
     /// Conditions and planners.
@@ -185,6 +189,7 @@ impl ViewSink {
             None => None,
         };
         Ok(ViewSink {
+            study: None,
             writer,
             recorded_until_ns: None,
             gaze_images: Vec::new(),
@@ -347,8 +352,26 @@ impl ViewSink {
         self.looks.condition().to_string()
     }
 
+    /// Hands the frames' conditions and gaze images to a study's trials.
+    pub fn set_study(&mut self, stage: StudyStage) {
+        self.study = Some(stage);
+    }
+
+    /// The study's trials, once the session is over.
+    pub fn take_study(&mut self) -> Option<StudyStage> {
+        self.study.take()
+    }
+
     /// Applies one action of the user.
     fn act(&mut self, action: Action) -> Option<String> {
+        if self.study.is_some()
+            && matches!(
+                action,
+                Action::Condition(_) | Action::NextCondition | Action::GazeOverride
+            )
+        {
+            return Some("the study decides the condition and the gaze image".into());
+        }
         Some(match action {
             Action::Condition(i) => self.looks.choose(i),
             Action::NextCondition => self.looks.next(),
@@ -524,7 +547,19 @@ impl FrameSink for ViewSink {
                 self.request = Some(Request::Resize);
             }
         }
-        let look = self.looks.plan(input);
+        let mut blank = false;
+        if let Some(study) = &mut self.study {
+            let (set, gaze) = study.next_shown(input);
+            if let Some(g) = gaze {
+                self.looks.set_gaze(g);
+            }
+            blank = match set {
+                Some(s) => !self.looks.show_set(s),
+                None => true,
+            };
+        }
+        let mut look = self.looks.plan(input);
+        look.blank = blank;
         if let Some(d) = self.looks.planner().last_defocus() {
             let image = d.image.to_string();
             if self.gaze_images.last() != Some(&image) {
@@ -541,6 +576,9 @@ impl FrameSink for ViewSink {
     }
 
     fn finished(&mut self, _input: &FrameInput, result: &FrameResult) -> Result<()> {
+        if let Some(e) = self.study.as_mut().and_then(StudyStage::take_error) {
+            return Err(e);
+        }
         let now = Instant::now();
         let smooth = |old: f64, new: f64| {
             if old == 0.0 {
@@ -580,6 +618,8 @@ impl FrameSink for ViewSink {
     }
 
     fn stop_requested(&self) -> bool {
-        self.request.is_some() || crate::interrupt::requested()
+        self.request.is_some()
+            || crate::interrupt::requested()
+            || self.study.as_ref().is_some_and(StudyStage::ending)
     }
 }

@@ -47,6 +47,7 @@ pub use error::{RenderError, Result};
 /// The floor passes under their earlier name.
 pub use floor as inducer;
 pub use floor::InducerFields;
+pub use memory::color_copy_region;
 pub use pose::ScenePose;
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{

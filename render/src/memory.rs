@@ -364,18 +364,7 @@ pub fn upload_volume(
             &[],
             &[to_dst],
         );
-        let region = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers {
-                aspect_mask: vk::ImageAspectFlags::COLOR,
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            })
-            .image_extent(vk::Extent3D {
-                width: extent.width,
-                height: extent.height,
-                depth,
-            });
+        let region = color_copy_region(0, extent.width, extent.height, depth, 1);
         device.cmd_copy_buffer_to_image(
             cmd,
             staging.buffer,
@@ -438,4 +427,28 @@ pub fn subresource_range(
         base_array_layer: base,
         layer_count: count,
     }
+}
+
+/// The copy region between a buffer (from byte `offset`, tightly packed) and the first `layers`
+/// array layers of mip 0 of a colour image of `width` x `height` x `depth` texels.
+pub fn color_copy_region(
+    offset: u64,
+    width: u32,
+    height: u32,
+    depth: u32,
+    layers: u32,
+) -> vk::BufferImageCopy {
+    vk::BufferImageCopy::default()
+        .buffer_offset(offset)
+        .image_subresource(vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: layers,
+        })
+        .image_extent(vk::Extent3D {
+            width,
+            height,
+            depth,
+        })
 }

@@ -506,18 +506,7 @@ impl LiveCaustics {
                     vk::AccessFlags::TRANSFER_WRITE,
                 ),
             );
-            let region = vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: 0,
-                    base_array_layer: 0,
-                    layer_count: 1,
-                })
-                .image_extent(vk::Extent3D {
-                    width: self.size[0],
-                    height: self.size[1],
-                    depth: 1,
-                });
+            let region = crate::memory::color_copy_region(0, self.size[0], self.size[1], 1, 1);
             d.cmd_copy_buffer_to_image(
                 cmd,
                 self.gain.buffer,

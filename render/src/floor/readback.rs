@@ -129,19 +129,7 @@ impl InducerPass {
                 &to_copy,
             );
             for &(image, offset) in offsets {
-                let region = vk::BufferImageCopy::default()
-                    .buffer_offset(offset)
-                    .image_subresource(vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        mip_level: 0,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    })
-                    .image_extent(vk::Extent3D {
-                        width: n,
-                        height: n,
-                        depth: 1,
-                    });
+                let region = crate::memory::color_copy_region(offset, n, n, 1, 1);
                 d.cmd_copy_image_to_buffer(
                     cmd,
                     self.targets[image].image.image,

@@ -20,19 +20,8 @@ pub(super) unsafe fn record_readback(
     // SAFETY: the caller's contract.
     unsafe {
         for &(image, offset) in copies {
-            let region = vk::BufferImageCopy::default()
-                .buffer_offset(offset)
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: 0,
-                    base_array_layer: 0,
-                    layer_count: 2,
-                })
-                .image_extent(vk::Extent3D {
-                    width: extent.width,
-                    height: extent.height,
-                    depth: 1,
-                });
+            let region =
+                crate::memory::color_copy_region(offset, extent.width, extent.height, 1, 2);
             d.cmd_copy_image_to_buffer(
                 cmd,
                 image,

@@ -1,5 +1,10 @@
 //! The viewer's frame sink: takes the user's actions, plans each frame's look, watches the
 //! scene's files, and puts finished frames in the window with the overlay.
+//!
+//! Just over 600 lines: it is the viewer's one `FrameSink`, and each of its parts (actions,
+//! reload requests, renderer hand-over, overlay lines, presentation) reads and writes the same
+//! session state; the state machines it drives live in `looks.rs`, `reload.rs` and
+//! `swapchain.rs`.
 
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};

@@ -199,10 +199,12 @@ struct Keep {
 
 impl FrameSink for Keep {
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
-        let (look, state) = self.planner.plan(input);
+        let (mut look, state) = self.planner.plan(input);
         self.images
             .insert(input.index, state.map_or(GazeImage::Unknown, |s| s.image));
         let keep = self.frames.contains(&input.index);
+        // Every sample goes through the gaze pipeline; only the frames measured are drawn.
+        look.blank = !keep;
         FramePlan {
             look,
             want: Want {

@@ -11,7 +11,9 @@
 //!
 //! where `f_ν` is the density of `s = sqrt(χ²_ν / ν)`. Both integrals are evaluated by composite
 //! Gauss-Legendre quadrature; for ν = ∞ the estimate is exact (s = 1) and P = W(q). The quantile
-//! inverts the CDF by bisection.
+//! inverts the CDF by the Illinois variant of regula falsi on a bracket (each CDF costs about
+//! 10^5 normal CDFs, and the smooth, monotone CDF converges in a handful of steps where
+//! bisection takes two dozen).
 
 use super::distributions::{ln_gamma, normal_cdf, normal_pdf};
 
@@ -138,15 +140,32 @@ pub fn quantile(alpha: f64, k: usize, df: f64) -> f64 {
             return f64::NAN;
         }
     }
-    while high - low > 1e-7 * high {
-        let middle = 0.5 * (low + high);
-        if cdf(middle, k, df) < target {
-            low = middle;
-        } else {
-            high = middle;
+    // Illinois: the secant of the bracket's ends, halving the value kept at an end that stays
+    // twice in a row so that both ends move; stops when the bracket is below 1e-7 of q.
+    let (mut a, mut b) = (low, high);
+    let (mut fa, mut fb) = (cdf(a, k, df) - target, cdf(b, k, df) - target);
+    for _ in 0..200 {
+        if (b - a).abs() <= 1e-7 * b.abs().max(a.abs()) {
+            break;
         }
+        let mut c = (a * fb - b * fa) / (fb - fa);
+        if !(c.is_finite() && c > a.min(b) && c < a.max(b)) {
+            c = 0.5 * (a + b);
+        }
+        let fc = cdf(c, k, df) - target;
+        if fc == 0.0 {
+            return c;
+        }
+        if (fc < 0.0) == (fb < 0.0) {
+            fa *= 0.5;
+        } else {
+            a = b;
+            fa = fb;
+        }
+        b = c;
+        fb = fc;
     }
-    0.5 * (low + high)
+    0.5 * (a + b)
 }
 
 #[cfg(test)]
@@ -196,6 +215,21 @@ mod tests {
                 (q - table).abs() < 1e-3,
                 "q({alpha}; {k}, {df}) = {q}, table {table}"
             );
+        }
+    }
+
+    #[test]
+    fn quantile_inverts_the_cdf() {
+        for (alpha, k, df) in [(0.05, 2, 4.0), (0.01, 7, 30.0), (0.5, 3, f64::INFINITY)] {
+            let q = quantile(alpha, k, df);
+            let p = cdf(q, k, df);
+            assert!(
+                (p - (1.0 - alpha)).abs() < 1e-7,
+                "P(Q <= {q}; {k}, {df}) = {p}"
+            );
+            // Within 1e-7 of q: moving by 1e-5 q changes the probability visibly.
+            assert!(cdf(q * (1.0 - 1e-5), k, df) < 1.0 - alpha);
+            assert!(cdf(q * (1.0 + 1e-5), k, df) > 1.0 - alpha);
         }
     }
 

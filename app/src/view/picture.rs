@@ -70,29 +70,49 @@ pub fn compose(
     };
     let (ew, eh) = (readback.width as usize, readback.height as usize);
     let see = preview.zip(world);
+    let width = width as usize;
+    // Index loops over whole rows: this runs for every pixel of every frame, and iterator
+    // adapters per pixel cost more than the copy itself in unoptimised builds.
     for &(eye, x0, part_w) in parts {
+        let part_w = part_w as usize;
         if part_w == 0 {
             continue;
         }
         let src = &readback.eyes[eye];
-        let columns: Vec<usize> = (0..part_w as usize)
-            .map(|x| ((x * ew) / part_w as usize).min(ew - 1))
+        // Byte offset in a source row of each column of the part.
+        let columns: Vec<usize> = (0..part_w)
+            .map(|x| ((x * ew) / part_w).min(ew - 1) * 4)
             .collect();
         for y in 0..height as usize {
             let sy = ((y * eh) / height as usize).min(eh - 1);
-            let row = &mut out[(y * width as usize + x0 as usize) * 4..][..part_w as usize * 4];
-            for (px, &sx) in row.chunks_exact_mut(4).zip(&columns) {
-                let i = (sy * ew + sx) * 4;
-                match see {
-                    Some((tables, world)) => {
-                        let w = &world[eye][i..i + 3];
-                        px[0] = tables.add(src[i], w[0]);
-                        px[1] = tables.add(src[i + 1], w[1]);
-                        px[2] = tables.add(src[i + 2], w[2]);
+            let src_row = &src[sy * ew * 4..(sy + 1) * ew * 4];
+            let row = &mut out[(y * width + x0 as usize) * 4..][..part_w * 4];
+            match see {
+                None if part_w == ew => row.copy_from_slice(src_row),
+                None => {
+                    let mut x = 0;
+                    while x < part_w {
+                        let (o, i) = (x * 4, columns[x]);
+                        row[o..o + 3].copy_from_slice(&src_row[i..i + 3]);
+                        x += 1;
                     }
-                    None => px[..3].copy_from_slice(&src[i..i + 3]),
                 }
-                px[3] = 255;
+                Some((tables, world)) => {
+                    let world_row = &world[eye][sy * ew * 4..(sy + 1) * ew * 4];
+                    let mut x = 0;
+                    while x < part_w {
+                        let (o, i) = (x * 4, columns[x]);
+                        row[o] = tables.add(src_row[i], world_row[i]);
+                        row[o + 1] = tables.add(src_row[i + 1], world_row[i + 1]);
+                        row[o + 2] = tables.add(src_row[i + 2], world_row[i + 2]);
+                        x += 1;
+                    }
+                }
+            }
+            let mut a = 3;
+            while a < row.len() {
+                row[a] = 255;
+                a += 4;
             }
         }
     }

@@ -84,9 +84,13 @@ impl MotionClock {
     }
 
     /// The placement of the frame at `time_ns` (seconds from the first frame given), edits
-    /// included; `None` for a scene that stands still and was not edited.
+    /// included; `None` for a scene that stands still and was never moved (once moved, edits
+    /// undone give the resting placement back to the renderer).
     pub fn placement(&mut self, time_ns: i64) -> Option<Placement> {
-        if self.motion.is_none() && !self.edits.moves_object_or_light() {
+        if self.motion.is_none()
+            && !self.edits.moves_object_or_light()
+            && self.last_placement.is_none()
+        {
             return None;
         }
         let base = self.keyed_placement(time_ns);
@@ -206,8 +210,8 @@ impl MotionClock {
             self.stale_reported = true;
             tracing::warn!(
                 "the caustic bake was made for the scene's own placement of the object and \
-                 light; with them moved it would be wrong, so caustics are off from here on \
-                 (use [caustics] mode = \"live\" to see them follow)"
+                 light; with them moved it would be wrong, so caustics are off while they are away \
+                 from it (use [caustics] mode = \"live\" to see them follow)"
             );
         }
         false
@@ -336,6 +340,25 @@ mod tests {
         c.pose(500_000_000, &mut planner);
         assert_eq!(c.moved_frames, 1);
         assert_eq!(c.edit_count, 2);
+    }
+
+    #[test]
+    fn undone_edits_give_the_resting_placement_back() {
+        let mut c = clock(None);
+        let mut planner = LookPlanner::new(vitreous_render::Look::default(), None);
+        c.edit(SceneEdit::MoveObject(Axis::X, 0.01), &input(0))
+            .unwrap();
+        c.pose(0, &mut planner).unwrap();
+        c.edit(SceneEdit::MoveObject(Axis::X, -0.01), &input(1))
+            .unwrap();
+        let p = c
+            .placement(1)
+            .expect("the renderer must hear of the way back");
+        assert!(
+            p.object_position_m
+                .abs_diff_eq(c.rest.object_position_m, 1e-6)
+        );
+        assert!(c.caustics_valid(), "the bake fits again");
     }
 
     #[test]

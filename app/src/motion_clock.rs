@@ -200,6 +200,12 @@ impl MotionClock {
         );
     }
 
+    /// Sets the edit state without counting or logging it (a played trace going back before
+    /// its first edit).
+    pub fn set_edits(&mut self, state: EditState) {
+        self.edits = state;
+    }
+
     /// Whether the caustics may be drawn: not from a bake once the edits moved the object
     /// or the light away from the placement it was made for (reported once).
     pub fn caustics_valid(&mut self) -> bool {

@@ -550,6 +550,26 @@ fn scripted_scene_edits_are_recorded_and_the_replay_ends_where_the_session_did()
     assert_eq!(r["scene_edits"], 6, "{r:#}");
     assert_eq!(r["final_placement"], s["final_placement"], "{r:#}\n{s:#}");
     assert_eq!(r["moved_frames"], s["moved_frames"], "{r:#}\n{s:#}");
+    // The recording played in the window: once its clock reaches the end (it holds there),
+    // the scene is where the session left it.
+    let played_dir = dir.path().join("played");
+    view(
+        &xvfb,
+        &scene,
+        &[
+            "--effects",
+            "c",
+            "--frames",
+            "40",
+            "--trace",
+            trace.to_str().unwrap(),
+            "--out",
+            played_dir.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let p = summary(&played_dir);
+    assert_eq!(p["final_placement"], s["final_placement"], "{p:#}\n{s:#}");
     let placed = &s["final_placement"]["object_position_m"];
     let rest = vitreous::scene::load_scene(&scene).unwrap().object.center_m;
     assert!(

@@ -236,13 +236,15 @@ fn view_with(
         options.frames,
         &loaded.scene,
     );
+    let mut played_edits = Vec::new();
     if let Some(path) = &options.trace {
-        let samples = vitreous_xr::trace::read_trace(path)
+        let (samples, edits) = vitreous_xr::trace::read_trace_with_edits(path)
             .with_context(|| format!("reading trace {}", path.display()))?;
         if samples.is_empty() {
             bail!("trace {} has no samples: nothing to play", path.display());
         }
         backend.play(playback::Playback::new(samples));
+        played_edits = edits;
     }
     let mut sink = ViewSink::new(
         options,
@@ -255,6 +257,7 @@ fn view_with(
     if let Some(stage) = study {
         sink.set_study(stage);
     }
+    sink.play_edits(played_edits);
     let mut renderer = sink.make_renderer(&context_options)?;
 
     let started = Instant::now();

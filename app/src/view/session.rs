@@ -31,7 +31,7 @@ use crate::gaze::{FilterKind, FixationDepth, GazeOverride};
 use crate::motion_clock::MotionClock;
 use crate::replay::ValidationSummary;
 use crate::scene::Scene;
-use crate::scene_edit::SceneEdit;
+use crate::scene_edit::{EditState, SceneEdit};
 use crate::study::run::StudyStage;
 use crate::views;
 
@@ -171,6 +171,8 @@ pub struct ViewSink {
     motion: MotionClock,
     /// The first error recording an edit, reported when the next frame finishes.
     edit_error: Option<anyhow::Error>,
+    /// The scene edits of the trace played (`--trace`), by time.
+    played_edits: Vec<vitreous_xr::trace::EditRecord>,
 }
 
 impl ViewSink {
@@ -202,6 +204,7 @@ impl ViewSink {
         Ok(ViewSink {
             motion: MotionClock::new(&loaded.scene),
             edit_error: None,
+            played_edits: Vec::new(),
             study: None,
             writer,
             recorded_until_ns: None,
@@ -291,6 +294,12 @@ impl ViewSink {
     /// The scene's motion and the keys' edits.
     pub fn motion(&self) -> &MotionClock {
         &self.motion
+    }
+
+    /// Shows the scene edits of the trace played: each frame takes the edit state of the last
+    /// edit at or before its trace time (so pausing, stepping and seeking back show it too).
+    pub fn play_edits(&mut self, edits: Vec<vitreous_xr::trace::EditRecord>) {
+        self.played_edits = edits;
     }
 
     /// Applies a scene edit of the keys to this frame and records it.
@@ -569,6 +578,20 @@ impl FrameSink for ViewSink {
         for edit in edits {
             if let Err(e) = self.edit(edit, input) {
                 self.edit_error.get_or_insert(e);
+            }
+        }
+        if !self.played_edits.is_empty() {
+            let last = self
+                .played_edits
+                .iter()
+                .rev()
+                .find(|e| e.time_ns <= input.time_ns);
+            let state = last.map_or_else(EditState::default, EditState::of_record);
+            if state != self.motion.edits() {
+                match last {
+                    Some(record) => self.motion.replay_edit(record, input.index),
+                    None => self.motion.set_edits(state),
+                }
             }
         }
         let placement = self.motion.placement(input.time_ns)?;

@@ -21,6 +21,7 @@ pub mod reference_view;
 pub mod replay;
 pub mod run;
 pub mod scene;
+pub mod scene_edit;
 pub mod soak;
 pub mod spread;
 pub mod study;

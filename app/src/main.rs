@@ -79,6 +79,11 @@ enum Command {
         /// Folder for summary.json (default: none written).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Read the live controls (`object x 10`, `turn -1`, `place`, `light y 10`,
+        /// `register z -1`, one a line) from standard input also when it is not a terminal (a
+        /// pipe or fifo); in a terminal they are always read.
+        #[arg(long)]
+        stdin_controls: bool,
     },
     /// Look around a scene in a desktop window: the frame loop and renderer of `run` with
     /// head and gaze from the mouse and keys (docs/view.md; F1 lists the keys).
@@ -355,6 +360,7 @@ fn run(cli: Cli) -> Result<()> {
             filter,
             pupil_source,
             out,
+            stdin_controls,
         } => {
             if let Some(record) = &record {
                 let mut inputs = vec![scene.as_path()];
@@ -375,6 +381,7 @@ fn run(cli: Cli) -> Result<()> {
                 filter,
                 pupil_source,
                 out,
+                stdin_controls,
                 ..Default::default()
             })?;
             print!("{}", s.report());

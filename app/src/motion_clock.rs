@@ -1,11 +1,16 @@
-//! Frame times to the scene's poses (`[motion]`): what `replay` and `run` hand the renderer
-//! each frame, with the count of frames that moved.
+//! Frame times to the scene's poses (`[motion]`, offset by the live controls' edits): what
+//! `replay`, `run` and `view` hand the renderer each frame, with the count of frames that
+//! moved.
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
+use serde::Serialize;
 use vitreous_render::ScenePose;
+use vitreous_xr::FrameInput;
+use vitreous_xr::trace::EditRecord;
 
 use crate::look::LookPlanner;
-use crate::scene::{Motion, Placement, Scene, model_placement};
+use crate::scene::{CausticsMode, Motion, Placement, Scene, model_placement};
+use crate::scene_edit::{EditState, SceneEdit, place_ray, ray_meets_plane};
 use crate::views;
 
 /// Turns frame times into the scene's poses and counts the frames that moved. Owns what it
@@ -26,8 +31,34 @@ pub struct MotionClock {
     start_ns: Option<i64>,
     /// The previous frame's pose.
     last: Option<ScenePose>,
+    /// The previous frame's placement (for the logs and summaries).
+    last_placement: Option<Placement>,
     /// Frames whose pose differed from the previous frame's.
     pub moved_frames: u64,
+    /// The light's keyframes are offsets from the object (`[light] frame = "object"`): it
+    /// follows the object's edits too.
+    light_follows_object: bool,
+    /// The registered floor: a point and its unit normal (where the object is placed).
+    floor: (Vec3, Vec3),
+    /// The caustics come from a bake (made for the scene's own placement).
+    baked_caustics: bool,
+    /// A stale bake was reported.
+    stale_reported: bool,
+    /// What the live controls changed so far.
+    edits: EditState,
+    /// Edits made or replayed.
+    pub edit_count: u64,
+}
+
+/// Where the object and the light were at the end, as the summaries report it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FinalPlacement {
+    /// World position of the object's centre, metres.
+    pub object_position_m: [f32; 3],
+    /// The object's orientation, quaternion x, y, z, w.
+    pub object_rotation_xyzw: [f32; 4],
+    /// World position of the light, metres.
+    pub light_position_m: [f32; 3],
 }
 
 impl MotionClock {
@@ -41,20 +72,164 @@ impl MotionClock {
             model_center: scene.object.model_center,
             start_ns: None,
             last: None,
+            last_placement: None,
             moved_frames: 0,
+            light_follows_object: scene.motion.light_follows_object,
+            floor: (scene.floor.pose.position, scene.floor.normal()),
+            baked_caustics: scene.caustics.mode == CausticsMode::Baked,
+            stale_reported: false,
+            edits: EditState::default(),
+            edit_count: 0,
         }
     }
 
-    /// The placement of the frame at `time_ns` (seconds from the first frame given); `None`
-    /// for a scene that stands still.
+    /// The placement of the frame at `time_ns` (seconds from the first frame given), edits
+    /// included; `None` for a scene that stands still and was never moved (once moved, edits
+    /// undone give the resting placement back to the renderer).
     pub fn placement(&mut self, time_ns: i64) -> Option<Placement> {
-        let motion = self.motion.as_ref()?;
+        if self.motion.is_none()
+            && !self.edits.moves_object_or_light()
+            && self.last_placement.is_none()
+        {
+            return None;
+        }
+        let base = self.keyed_placement(time_ns);
+        Some(self.edited(base))
+    }
+
+    /// The scene's own placement at `time_ns`: the keyframes', or the resting one.
+    fn keyed_placement(&mut self, time_ns: i64) -> Placement {
         let start = *self.start_ns.get_or_insert(time_ns);
-        Some(motion.placement_at(
-            views::seconds_since(start, time_ns),
-            self.rest,
-            self.light_in_frame_m,
-        ))
+        match &self.motion {
+            Some(motion) => motion.placement_at(
+                views::seconds_since(start, time_ns),
+                self.rest,
+                self.light_in_frame_m,
+            ),
+            None => self.rest,
+        }
+    }
+
+    /// `base` offset by the edits (the rule in [`crate::scene_edit`]).
+    fn edited(&self, base: Placement) -> Placement {
+        let e = &self.edits;
+        let light_follows = if self.light_follows_object {
+            e.object_offset_m
+        } else {
+            Vec3::ZERO
+        };
+        Placement {
+            object_position_m: base.object_position_m + e.object_offset_m,
+            object_rotation: (e.object_turn * base.object_rotation).normalize(),
+            light_position_m: base.light_position_m + e.light_offset_m + light_follows,
+        }
+    }
+
+    /// What the edits so far change.
+    pub fn edits(&self) -> EditState {
+        self.edits
+    }
+
+    /// Applies a live control to the frame `input` (whose rays place the object); returns
+    /// the trace's edit line for it, or why it was not applied (a place ray missing the
+    /// floor). Logs the new placement.
+    pub fn edit(&mut self, edit: SceneEdit, input: &FrameInput) -> Result<EditRecord, String> {
+        let e = &mut self.edits;
+        match edit {
+            SceneEdit::MoveObject(axis, m) => e.object_offset_m += axis.unit() * m,
+            SceneEdit::TurnObject(deg) => {
+                e.object_turn =
+                    (Quat::from_rotation_y(deg.to_radians()) * e.object_turn).normalize();
+            }
+            SceneEdit::MoveLight(axis, m) => e.light_offset_m += axis.unit() * m,
+            SceneEdit::Register(axis, m) => e.world_offset_m += axis.unit() * m,
+            SceneEdit::PlaceObject => {
+                let (origin, dir) = place_ray(input);
+                let (floor_point, normal) = self.floor;
+                let hit = ray_meets_plane(origin, dir, floor_point, normal).ok_or_else(|| {
+                    format!(
+                        "frame {}: the gaze ray does not meet the floor within {} m; the object \
+                         stays",
+                        input.index,
+                        crate::scene_edit::MAX_PLACE_DISTANCE_M
+                    )
+                })?;
+                let base = self.keyed_placement(input.time_ns);
+                let now = self.edited(base).object_position_m;
+                let height = (now - floor_point).dot(normal);
+                self.edits.object_offset_m += hit + normal * height - now;
+            }
+        }
+        self.edit_count += 1;
+        let base = self.keyed_placement(input.time_ns);
+        let p = self.edited(base);
+        let e = &self.edits;
+        tracing::info!(
+            "frame {}: {edit}: object at ({:.4}, {:.4}, {:.4}) m turned {:+.1} deg, light at \
+             ({:.4}, {:.4}, {:.4}) m, world registered {:+.4} {:+.4} {:+.4} m",
+            input.index,
+            p.object_position_m.x,
+            p.object_position_m.y,
+            p.object_position_m.z,
+            turn_deg(e.object_turn),
+            p.light_position_m.x,
+            p.light_position_m.y,
+            p.light_position_m.z,
+            e.world_offset_m.x,
+            e.world_offset_m.y,
+            e.world_offset_m.z,
+        );
+        Ok(self.edits.record(input.time_ns, edit.action()))
+    }
+
+    /// Takes the edit state of a recorded edit line (`vitreous replay`), logged like the
+    /// live edit.
+    pub fn replay_edit(&mut self, record: &EditRecord, frame: u64) {
+        self.edits = EditState::of_record(record);
+        self.edit_count += 1;
+        let o = self.edits.object_offset_m;
+        tracing::info!(
+            "frame {frame}: recorded edit {} at {} ns: object offset ({:+.4}, {:+.4}, {:+.4}) m \
+             turned {:+.1} deg",
+            record.action,
+            record.time_ns,
+            o.x,
+            o.y,
+            o.z,
+            turn_deg(self.edits.object_turn)
+        );
+    }
+
+    /// Sets the edit state without counting or logging it (a played trace going back before
+    /// its first edit).
+    pub fn set_edits(&mut self, state: EditState) {
+        self.edits = state;
+    }
+
+    /// Whether the caustics may be drawn: not from a bake once the edits moved the object
+    /// or the light away from the placement it was made for (reported once).
+    pub fn caustics_valid(&mut self) -> bool {
+        if !(self.baked_caustics && self.edits.moves_object_or_light()) {
+            return true;
+        }
+        if !self.stale_reported {
+            self.stale_reported = true;
+            tracing::warn!(
+                "the caustic bake was made for the scene's own placement of the object and \
+                 light; with them moved it would be wrong, so caustics are off while they are away \
+                 from it (use [caustics] mode = \"live\" to see them follow)"
+            );
+        }
+        false
+    }
+
+    /// The last placement handed out; `None` when nothing ever moved.
+    pub fn final_placement(&self) -> Option<FinalPlacement> {
+        self.last_placement.map(|p| FinalPlacement {
+            object_position_m: p.object_position_m.to_array(),
+            object_rotation_xyzw: p.object_rotation.to_array(),
+            light_position_m: p.light_position_m.to_array(),
+        })
     }
 
     /// The renderer's pose of the frame at `time_ns`, moving the planner's object centre
@@ -67,6 +242,7 @@ impl MotionClock {
 
     /// The renderer's pose for a placement, counted as this frame's.
     pub fn pose_of(&mut self, placement: &Placement) -> ScenePose {
+        self.last_placement = Some(*placement);
         let pose = ScenePose {
             world_from_model: model_placement(
                 self.scale,
@@ -81,5 +257,153 @@ impl MotionClock {
         }
         self.last = Some(pose);
         pose
+    }
+}
+
+/// The angle of a turn about the vertical, degrees (positive: counter-clockwise from above).
+fn turn_deg(turn: Quat) -> f32 {
+    let (axis, angle) = turn.to_axis_angle();
+    (angle * axis.y.signum()).to_degrees()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene_edit::Axis;
+
+    fn clock(motion: Option<Motion>) -> MotionClock {
+        MotionClock {
+            motion,
+            rest: Placement {
+                object_position_m: Vec3::new(0.3, 0.1, -0.5),
+                object_rotation: Quat::IDENTITY,
+                light_position_m: Vec3::new(0.0, 1.0, -1.0),
+            },
+            light_in_frame_m: Vec3::new(0.0, 1.0, -1.0),
+            scale: 1.0,
+            model_center: Vec3::ZERO,
+            start_ns: None,
+            last: None,
+            last_placement: None,
+            moved_frames: 0,
+            light_follows_object: false,
+            floor: (Vec3::ZERO, Vec3::Y),
+            baked_caustics: true,
+            stale_reported: false,
+            edits: EditState::default(),
+            edit_count: 0,
+        }
+    }
+
+    fn input(time_ns: i64) -> FrameInput {
+        let mut f = crate::run::test_frame();
+        f.time_ns = time_ns;
+        // Head 1 m above the floor at z = 0, looking 45 degrees down ahead.
+        f.head = vitreous_xr::Pose {
+            position: Vec3::new(0.0, 1.0, 0.0),
+            orientation: Quat::from_rotation_x(-std::f32::consts::FRAC_PI_4),
+        };
+        f
+    }
+
+    #[test]
+    fn edits_offset_the_keyframed_pose_and_count_as_moves() {
+        use crate::scene::ObjectKey;
+        let motion = Motion {
+            object: vec![
+                ObjectKey {
+                    time_s: 0.0,
+                    position_m: Vec3::new(0.0, 0.1, -1.0),
+                    rotation: Quat::IDENTITY,
+                },
+                ObjectKey {
+                    time_s: 1.0,
+                    position_m: Vec3::new(1.0, 0.1, -1.0),
+                    rotation: Quat::IDENTITY,
+                },
+            ],
+            ..Motion::default()
+        };
+        let mut c = clock(Some(motion));
+        let mut planner = LookPlanner::new(vitreous_render::Look::default(), None);
+        c.pose(0, &mut planner);
+        c.edit(SceneEdit::MoveObject(Axis::Z, 0.01), &input(0))
+            .unwrap();
+        let record = c.edit(SceneEdit::TurnObject(10.0), &input(0)).unwrap();
+        assert_eq!(record.action, "turn+10");
+        assert!((turn_deg(record.object_turn) - 10.0).abs() < 1e-4);
+        // Half way through the keyframes: the keyframed x, the edited z, the turn.
+        let p = c.placement(500_000_000).unwrap();
+        assert!(
+            p.object_position_m
+                .abs_diff_eq(Vec3::new(0.5, 0.1, -0.99), 1e-5),
+            "{p:?}"
+        );
+        assert!(
+            p.object_rotation
+                .abs_diff_eq(Quat::from_rotation_y(10f32.to_radians()), 1e-5)
+        );
+        c.pose(500_000_000, &mut planner);
+        assert_eq!(c.moved_frames, 1);
+        assert_eq!(c.edit_count, 2);
+    }
+
+    #[test]
+    fn undone_edits_give_the_resting_placement_back() {
+        let mut c = clock(None);
+        let mut planner = LookPlanner::new(vitreous_render::Look::default(), None);
+        c.edit(SceneEdit::MoveObject(Axis::X, 0.01), &input(0))
+            .unwrap();
+        c.pose(0, &mut planner).unwrap();
+        c.edit(SceneEdit::MoveObject(Axis::X, -0.01), &input(1))
+            .unwrap();
+        let p = c
+            .placement(1)
+            .expect("the renderer must hear of the way back");
+        assert!(
+            p.object_position_m
+                .abs_diff_eq(c.rest.object_position_m, 1e-6)
+        );
+        assert!(c.caustics_valid(), "the bake fits again");
+    }
+
+    #[test]
+    fn a_still_scene_moves_only_once_edited_and_the_bake_goes_stale() {
+        let mut c = clock(None);
+        assert_eq!(c.placement(0), None);
+        assert!(c.caustics_valid());
+        // Re-registration moves nothing of the object or light.
+        c.edit(SceneEdit::Register(Axis::X, 0.01), &input(0))
+            .unwrap();
+        assert_eq!(c.placement(0), None);
+        assert!(c.caustics_valid());
+        c.edit(SceneEdit::MoveLight(Axis::Y, -0.001), &input(0))
+            .unwrap();
+        let p = c.placement(0).unwrap();
+        assert!((p.light_position_m.y - 0.999).abs() < 1e-6);
+        assert!(!c.caustics_valid());
+        assert!(c.stale_reported);
+        assert!(!c.caustics_valid(), "stays off");
+    }
+
+    #[test]
+    fn place_puts_the_object_where_the_head_ray_meets_the_floor_at_its_height() {
+        let mut c = clock(None);
+        let record = c.edit(SceneEdit::PlaceObject, &input(0)).unwrap();
+        // The head ray meets the floor 1 m ahead; the centre stays 0.1 m above the floor.
+        let p = c.placement(0).unwrap();
+        assert!(
+            p.object_position_m
+                .abs_diff_eq(Vec3::new(0.0, 0.1, -1.0), 1e-5),
+            "{p:?}"
+        );
+        assert_eq!(record.action, "place");
+        let mut up = input(0);
+        up.head.orientation = Quat::from_rotation_x(0.3);
+        assert!(c.edit(SceneEdit::PlaceObject, &up).is_err());
+        // Replaying the record gives the same state.
+        let mut r = clock(None);
+        r.replay_edit(&record, 0);
+        assert_eq!(r.edits(), c.edits());
     }
 }

@@ -13,14 +13,14 @@ use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer, ScenePose};
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::trace::{TraceSample, read_trace};
+use vitreous_xr::trace::{EditRecord, TraceSample, read_trace_with_edits};
 
 use crate::effects::EffectSet;
 use crate::frame_log::{FrameLog, PupilSummary};
 use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
 pub use crate::look::GazeSettings;
 use crate::look::LookPlanner;
-use crate::motion_clock::MotionClock;
+use crate::motion_clock::{FinalPlacement, MotionClock};
 use crate::output::{self, write_atomic};
 use crate::reference_view::side_by_side;
 use crate::scene::{Scene, load_scene};
@@ -161,6 +161,10 @@ pub struct ReplaySummary {
     /// Computations of the shadow inducer's fields (mask, distance, gain) on the GPU: one
     /// for the first frame drawing them, then one per moved frame, none otherwise.
     pub inducer_computations: u64,
+    /// Scene edits of the trace (version 1.2 edit lines) applied.
+    pub scene_edits: u64,
+    /// Where the object and light were in the last frame (`null` when nothing moved).
+    pub final_placement: Option<FinalPlacement>,
     /// Every frame's timing.
     pub per_frame: Vec<FrameRecord>,
 }
@@ -206,16 +210,26 @@ struct Saver<'a> {
     log_error: Option<anyhow::Error>,
     /// How the scene moves, with the time of the first frame once it came.
     motion: MotionClock,
+    /// The trace's scene edits not yet applied, in time order.
+    edits: std::collections::VecDeque<EditRecord>,
 }
 
 impl FrameSink for Saver<'_> {
     fn pose(&mut self, input: &FrameInput) -> Option<ScenePose> {
+        // Each edit shows from the first frame at or after its time, as in the session.
+        while let Some(edit) = self.edits.front()
+            && edit.time_ns <= input.time_ns
+        {
+            self.motion.replay_edit(edit, input.index);
+            self.edits.pop_front();
+        }
         self.motion.pose(input.time_ns, &mut self.planner)
     }
 
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         let save = self.save_every > 0 && input.index.is_multiple_of(self.save_every);
-        let look = self.planner.plan(input).0;
+        let mut look = self.planner.plan(input).0;
+        look.caustics &= self.motion.caustics_valid();
         if let Err(e) = self
             .log
             .record(input, &self.condition, self.planner.last_defocus())
@@ -264,20 +278,28 @@ pub(crate) fn load_trace(
     scene: &Scene,
     trace: Option<&Path>,
 ) -> Result<(Vec<TraceSample>, String)> {
+    load_trace_with_edits(scene, trace).map(|(samples, _, name)| (samples, name))
+}
+
+/// Loads the trace, with its scene edits, or synthesises one (without edits) for the scene.
+pub(crate) fn load_trace_with_edits(
+    scene: &Scene,
+    trace: Option<&Path>,
+) -> Result<(Vec<TraceSample>, Vec<EditRecord>, String)> {
     match trace {
         Some(path) => {
-            let samples = read_trace(path).context("reading the trace")?;
+            let (samples, edits) = read_trace_with_edits(path).context("reading the trace")?;
             if samples.is_empty() {
                 bail!("trace {} has no samples: nothing to replay", path.display());
             }
-            Ok((samples, path.display().to_string()))
+            Ok((samples, edits, path.display().to_string()))
         }
         None => {
             tracing::info!("no --trace given: replaying a synthetic trace for the scene");
             let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(scene))
                 .context("synthesising a trace for the scene")?
                 .samples;
-            Ok((samples, "synthetic".into()))
+            Ok((samples, Vec::new(), "synthetic".into()))
         }
     }
 }
@@ -300,7 +322,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
             options.frame_rate_hz
         );
     }
-    let (samples, trace_name) = load_trace(&scene, options.trace.as_deref())?;
+    let (samples, edits, trace_name) = load_trace_with_edits(&scene, options.trace.as_deref())?;
     let expected_frames = expected_frames(&samples, options.frame_rate_hz, options.frames);
     if options.frames.is_none() && expected_frames > MAX_FRAMES_WITHOUT_LIMIT {
         bail!(
@@ -386,6 +408,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         condition: effects.to_string(),
         log_error: None,
         motion: MotionClock::new(&scene),
+        edits: edits.into(),
     };
     let started = Instant::now();
     let records = match frame_loop::run(&mut backend, &mut renderer, &mut saver) {
@@ -442,6 +465,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         pupil: saver.log.pupil_summary(saver.planner.pupil_source()),
         moved_frames: saver.motion.moved_frames,
         inducer_computations: renderer.inducer_computations(),
+        scene_edits: saver.motion.edit_count,
+        final_placement: saver.motion.final_placement(),
         per_frame: records,
     };
     let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;

@@ -468,3 +468,112 @@ fn a_played_trace_pauses_and_steps_and_the_recording_shows_it() {
         "the trace's first head pose"
     );
 }
+
+#[test]
+fn scripted_scene_edits_are_recorded_and_the_replay_ends_where_the_session_did() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("glass-sphere.toml");
+    let script = dir.path().join("edits.script");
+    // The object 1 cm right, 1 mm away (Shift) and turned 1 degree (Shift); the light 1 cm
+    // up; the world 1 cm left; then the object placed where the gaze (the cursor, low in the
+    // left eye) meets the floor.
+    std::fs::write(
+        &script,
+        "1 key right\n2 down shift\n2 key up\n2 key t\n2 up shift\n3 key b\n3 key pageup\n\
+         4 key b\n4 key left\n5 move 0.25 0.95\n6 key m\n9 key escape\n",
+    )
+    .unwrap();
+    let (trace, out_dir) = (dir.path().join("edits.trace"), dir.path().join("view"));
+    let out = view(
+        &xvfb,
+        &scene,
+        &[
+            "--effects",
+            "c",
+            "--frames",
+            "100",
+            "--script",
+            script.to_str().unwrap(),
+            "--record",
+            trace.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let s = summary(&out_dir);
+    assert_eq!(s["scene_edits"], 6, "{s:#}\n{stderr}");
+    assert!(
+        stderr.contains("move the object +10.0 mm along x: object at"),
+        "{stderr}"
+    );
+    assert_eq!(
+        stderr.matches("caustics are off").count(),
+        1,
+        "the stale bake is reported once: {stderr}"
+    );
+    let (samples, edits) =
+        vitreous_xr::trace::read_trace_with_edits(&trace).expect("the recording reads");
+    let actions: Vec<&str> = edits.iter().map(|e| e.action.as_str()).collect();
+    assert_eq!(
+        actions,
+        [
+            "object+10mmx",
+            "object-1mmz",
+            "turn+1",
+            "light+10mmy",
+            "register-10mmx",
+            "place"
+        ]
+    );
+    assert_eq!(samples.len(), 9);
+    assert!((edits[4].world_offset_m.x + 0.01).abs() < 1e-6);
+
+    let replay_dir = dir.path().join("replay");
+    let out = Command::new(env!("CARGO_BIN_EXE_vitreous"))
+        .args(["--log", "info", "replay"])
+        .arg(&scene)
+        .args(["--trace", trace.to_str().unwrap(), "--at-samples"])
+        .args(["--size", "64x48", "--effects", "c", "--save-every", "0"])
+        .args(["--quiet", "--validate", "--out"])
+        .arg(&replay_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = summary(&replay_dir);
+    assert_eq!(r["scene_edits"], 6, "{r:#}");
+    assert_eq!(r["final_placement"], s["final_placement"], "{r:#}\n{s:#}");
+    assert_eq!(r["moved_frames"], s["moved_frames"], "{r:#}\n{s:#}");
+    // The recording played in the window: once its clock reaches the end (it holds there),
+    // the scene is where the session left it.
+    let played_dir = dir.path().join("played");
+    view(
+        &xvfb,
+        &scene,
+        &[
+            "--effects",
+            "c",
+            "--frames",
+            "40",
+            "--trace",
+            trace.to_str().unwrap(),
+            "--out",
+            played_dir.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let p = summary(&played_dir);
+    assert_eq!(p["final_placement"], s["final_placement"], "{p:#}\n{s:#}");
+    let placed = &s["final_placement"]["object_position_m"];
+    let rest = vitreous::scene::load_scene(&scene).unwrap().object.center_m;
+    assert!(
+        (placed[2].as_f64().unwrap() - f64::from(rest.z)).abs() > 0.01,
+        "placing moved the object: {placed} from {rest}"
+    );
+}

@@ -97,8 +97,8 @@ impl LiveLooks {
         }
     }
 
-    /// Applies a live command; says what changed (None for commands the session handles:
-    /// Nudge and Rotate). [`GAZE_IMAGE_CYCLE`] steps the forced gaze image,
+    /// Applies a live command; says what changed (None for commands handled elsewhere: the
+    /// session's Nudge and Rotate, the scene edits). [`GAZE_IMAGE_CYCLE`] steps the forced gaze image,
     /// [`CONDITION_CYCLE`] the effect condition.
     pub fn apply(&mut self, command: Command) -> Option<String> {
         match command {
@@ -127,7 +127,11 @@ impl LiveLooks {
                     }
                 ))
             }
-            Command::Nudge(_) | Command::Rotate(_) => None,
+            Command::Nudge(_)
+            | Command::Rotate(_)
+            | Command::MoveObject(_)
+            | Command::TurnObject(_)
+            | Command::PlaceObject => None,
         }
     }
 

@@ -21,6 +21,7 @@
 //! replay check), `summary.rs` (what the run reports); this file sets the session up, runs it
 //! and writes the summary.
 
+mod controls;
 mod device;
 mod live;
 mod readback;
@@ -58,6 +59,7 @@ use crate::motion_clock::MotionClock;
 use crate::output::write_atomic;
 use crate::replay::{Spread, ValidationSummary};
 use crate::scene::load_scene;
+use crate::scene_edit::SceneEdit;
 use crate::study::run::StudyStage;
 use crate::views;
 use readback::check_readback;
@@ -96,6 +98,10 @@ pub struct RunOptions {
     pub pupil_source: Option<crate::gaze::PupilSource>,
     /// Where summary.json goes (None: not written).
     pub out: Option<PathBuf>,
+    /// Read the keyboard's live controls from standard input even when it is not a terminal
+    /// (a pipe or fifo); in a terminal they are always read (not in a study, whose answers
+    /// come from there).
+    pub stdin_controls: bool,
 }
 
 /// Records frames and checks a readback.
@@ -124,12 +130,49 @@ struct RunSink {
     study: Option<StudyStage>,
     /// The first error writing the log, reported when the next frame finishes.
     log_error: Option<anyhow::Error>,
-    /// The scene's motion (`[motion]`), from the session's first frame.
+    /// The scene's motion (`[motion]`), from the session's first frame, with the edits.
     motion: MotionClock,
+    /// The keyboard's live controls, when read.
+    edits: Option<std::sync::mpsc::Receiver<SceneEdit>>,
+    /// Where re-registrations go: the session, which moves the scene's placement.
+    registrar: std::sync::mpsc::Sender<Command>,
+}
+
+impl RunSink {
+    /// Applies a live control to this frame and records it in the trace.
+    fn edit(&mut self, edit: SceneEdit, input: &FrameInput) {
+        match self.motion.edit(edit, input) {
+            Ok(record) => self.record(&record),
+            Err(why) => tracing::warn!("{edit}: {why}"),
+        }
+    }
+
+    /// Writes an edit line into the recording, if any.
+    fn record(&mut self, record: &vitreous_xr::trace::EditRecord) {
+        if let Some(w) = &mut self.writer
+            && let Err(e) = w.write_edit(record)
+        {
+            self.log_error
+                .get_or_insert(anyhow::Error::new(e).context("recording an edit"));
+        }
+    }
 }
 
 impl FrameSink for RunSink {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
+        let typed: Vec<SceneEdit> = match &self.edits {
+            Some(rx) => rx.try_iter().collect(),
+            None => Vec::new(),
+        };
+        for edit in typed {
+            match edit {
+                // The session moves the world at the next frame and says so as a nudge.
+                SceneEdit::Register(axis, m) => {
+                    let _ = self.registrar.send(Command::Nudge(axis.unit() * m));
+                }
+                other => self.edit(other, input),
+            }
+        }
         let placement = self.motion.placement(input.time_ns)?;
         self.looks.set_object_center(placement.object_position_m);
         self.object_center_m = placement.object_position_m;
@@ -147,19 +190,48 @@ impl FrameSink for RunSink {
 
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         let read = self.readback_frame == Some(input.index);
-        if let Some(rx) = &self.commands {
-            for command in rx.try_iter() {
-                if let Some(study) = &mut self.study {
-                    study.director.command(command);
-                } else if let Some(change) = self.looks.apply(command) {
-                    tracing::info!("frame {}: {change}", input.index);
+        let commands: Vec<Command> = match &self.commands {
+            Some(rx) => rx.try_iter().collect(),
+            None => Vec::new(),
+        };
+        for command in commands {
+            // The session has moved the world already: record it (a turn by its name: the
+            // head poses hold it).
+            match command {
+                Command::Nudge(d) => {
+                    for edit in controls::register_edits(d) {
+                        self.edit(edit, input);
+                    }
                 }
+                Command::Rotate(a) => {
+                    let action = format!("register-turn{:+.1}", a.to_degrees());
+                    let record = self.motion.edits().record(input.time_ns, action);
+                    self.record(&record);
+                }
+                Command::MoveObject(d) => {
+                    for edit in controls::object_edits(d) {
+                        self.edit(edit, input);
+                    }
+                }
+                Command::TurnObject(a) => {
+                    // Whole thousandths of a degree: the step, not its rounding error.
+                    let deg = (a.to_degrees() * 1000.0).round() / 1000.0;
+                    self.edit(SceneEdit::TurnObject(deg), input);
+                }
+                Command::PlaceObject => self.edit(SceneEdit::PlaceObject, input),
+                Command::Cycle(_) => {}
+            }
+            if let Some(study) = &mut self.study {
+                study.director.command(command);
+            } else if let Some(change) = self.looks.apply(command) {
+                tracing::info!("frame {}: {change}", input.index);
             }
         }
-        let look = match &mut self.study {
+        let mut look = match &mut self.study {
             Some(study) => study.plan(&mut self.looks, input),
             None => self.looks.plan(input),
         };
+        look.caustics &= self.motion.caustics_valid();
         let condition = self.looks.condition().to_string();
         if let Err(e) = self
             .log
@@ -339,7 +411,8 @@ fn run_with(
 
     let writer = match &options.record {
         Some(path) => Some(
-            TraceWriter::create(path).with_context(|| format!("creating {}", path.display()))?,
+            TraceWriter::create_with_edits(path)
+                .with_context(|| format!("creating {}", path.display()))?,
         ),
         None => None,
     };
@@ -351,7 +424,19 @@ fn run_with(
         None => FrameLog::in_memory(),
     };
     let world_behind = info.blend.needs_world_behind();
+    let edits = {
+        use std::io::IsTerminal;
+        (study.is_none() && (options.stdin_controls || std::io::stdin().is_terminal())).then(|| {
+            tracing::info!(
+                "keyboard controls on standard input, one a line: object x|y|z MM, turn DEG, \
+                 place, light x|y|z MM, register x|y|z MM"
+            );
+            controls::stdin_edits()
+        })
+    };
     let mut sink = RunSink {
+        edits,
+        registrar: session.command_sender(),
         looks: LiveLooks::new(
             conditions.iter().copied().zip(planners).collect(),
             scene.gaze.image,
@@ -390,6 +475,7 @@ fn run_with(
     };
     let records = first_error(first_error(result, detached), closed)?;
     sink.log.finish()?;
+    let inducer_computations = renderer.inducer_computations();
 
     let v = renderer.context().validation();
     let validation = ValidationSummary {
@@ -469,6 +555,10 @@ fn run_with(
         frames_with_depth: report.frames_with_depth,
         gaze_image_switches: sink.log.gaze_image_switches(),
         pupil: sink.log.pupil_summary(sink.looks.pupil_source()),
+        scene_edits: sink.motion.edit_count,
+        moved_frames: sink.motion.moved_frames,
+        inducer_computations,
+        final_placement: sink.motion.final_placement(),
     };
     if let Some(out) = &options.out {
         fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;

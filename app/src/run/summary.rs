@@ -102,6 +102,16 @@ pub struct RunSummary {
     pub gaze_image_switches: u64,
     /// Where A_p came from and the values used (`null` when no condition has defocus).
     pub pupil: Option<PupilSummary>,
+    /// Live-control edits made (keyboard, controllers), re-registrations included.
+    pub scene_edits: u64,
+    /// Frames whose object or light pose differed from the previous frame's (`[motion]` and
+    /// edits).
+    pub moved_frames: u64,
+    /// Computations of the shadow inducer's fields on the GPU (one, then one per moved
+    /// frame that draws them).
+    pub inducer_computations: u64,
+    /// Where the object and light were in the last frame (`null` when nothing moved).
+    pub final_placement: Option<crate::motion_clock::FinalPlacement>,
 }
 
 impl RunSummary {

@@ -20,6 +20,7 @@ use super::playback::Playback;
 use super::script::{Script, Step};
 use super::window::DesktopWindow;
 use crate::scene::ViewingGeometry;
+use crate::scene_edit::SceneEdit;
 
 /// Radians of head turn per window width dragged.
 const DRAG_RAD_PER_WIDTH: f32 = std::f32::consts::PI;
@@ -62,6 +63,21 @@ pub struct Shared {
     pub noise: bool,
     /// Where a played trace is (position and length, seconds; whether paused).
     pub trace: Option<(f64, f64, bool)>,
+    /// The object's centre once an edit or `[motion]` moved it, metres (what lies under the
+    /// cursor follows it).
+    pub object_center_m: Option<Vec3>,
+}
+
+/// What the arrow keys move.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum EditTarget {
+    /// The glass object.
+    #[default]
+    Object,
+    /// The light.
+    Light,
+    /// The registered world (floor, background, object, light) against the head.
+    World,
 }
 
 /// The desktop backend (see the module docs).
@@ -104,6 +120,10 @@ pub struct DesktopBackend {
     rng: u64,
     /// A trace played instead of the user's head and gaze.
     playback: Option<Playback>,
+    /// What the arrow keys move.
+    edit_target: EditTarget,
+    /// How far the registered world was moved against the head, metres (re-registration).
+    world_offset_m: Vec3,
 }
 
 impl DesktopBackend {
@@ -136,6 +156,8 @@ impl DesktopBackend {
             geometry: scene.viewing_geometry(),
             rng: 0x9E37_79B9_7F4A_7C15,
             playback: None,
+            edit_target: EditTarget::Object,
+            world_offset_m: Vec3::ZERO,
         }
     }
 
@@ -155,6 +177,8 @@ impl DesktopBackend {
 
     /// Applies one input event.
     fn apply(&mut self, event: InputEvent, shift: bool) {
+        // A script holds Shift as a key (`down shift`).
+        let shift = shift || self.held.iter().any(|h| h == "shift");
         match event {
             InputEvent::Key { name, pressed } => {
                 self.held.retain(|h| *h != name);
@@ -167,6 +191,38 @@ impl DesktopBackend {
                                 self.pitch_rad = 0.0;
                             }
                             Action::FixationTarget => self.flip_target(),
+                            Action::Nudge(axis, m) => {
+                                let edit = match self.edit_target {
+                                    EditTarget::Object => SceneEdit::MoveObject(axis, m),
+                                    EditTarget::Light => SceneEdit::MoveLight(axis, m),
+                                    EditTarget::World => {
+                                        self.world_offset_m += axis.unit() * m;
+                                        SceneEdit::Register(axis, m)
+                                    }
+                                };
+                                self.shared
+                                    .borrow_mut()
+                                    .actions
+                                    .push_back(Action::Edit(edit));
+                            }
+                            Action::Turn(deg) => self
+                                .shared
+                                .borrow_mut()
+                                .actions
+                                .push_back(Action::Edit(SceneEdit::TurnObject(deg))),
+                            Action::Place => self
+                                .shared
+                                .borrow_mut()
+                                .actions
+                                .push_back(Action::Edit(SceneEdit::PlaceObject)),
+                            Action::EditTarget => {
+                                self.edit_target = match self.edit_target {
+                                    EditTarget::Object => EditTarget::Light,
+                                    EditTarget::Light => EditTarget::World,
+                                    EditTarget::World => EditTarget::Object,
+                                };
+                                tracing::info!("the arrow keys move the {:?}", self.edit_target);
+                            }
                             Action::Pause | Action::Step | Action::Seek(_)
                                 if self.playback.is_some() =>
                             {
@@ -375,10 +431,14 @@ impl Backend for DesktopBackend {
         let orientation = self.orientation();
         let [mx, my, mz] = movement(&self.held);
         self.position_m += orientation * Vec3::new(mx, my, -mz) * SPEED_M_PER_S * dt;
+        // The world moved by the re-registration is the head moved the other way.
         let head = Pose {
-            position: self.position_m,
+            position: self.position_m - self.world_offset_m,
             orientation,
         };
+        if let Some(center) = self.shared.borrow().object_center_m {
+            self.geometry.center_m = center;
+        }
         let (eyes_shown, aspect, target, noise) = {
             let s = self.shared.borrow();
             (s.eyes, s.eye_aspect, s.fixation.0, s.noise)

@@ -2,6 +2,8 @@
 
 use std::fmt;
 
+use crate::scene_edit::{Axis, MOVE_STEPS_M, SceneEdit, TURN_STEPS_DEG};
+
 /// One input event, from the window or from a script.
 #[derive(Clone, Debug, PartialEq)]
 pub enum InputEvent {
@@ -33,7 +35,7 @@ pub enum InputEvent {
 }
 
 /// What the viewer does in answer to a key (movement keys are held, not actions).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Action {
     /// Show the effect condition of this index of [`super::looks::CONDITION_KEYS`].
     Condition(usize),
@@ -67,6 +69,17 @@ pub enum Action {
     Step,
     /// Seek trace playback by this many seconds.
     Seek(i32),
+    /// Move what the arrow keys move (the object, the light or the registered world) along
+    /// a world axis, metres.
+    Nudge(Axis, f32),
+    /// Turn the object about the vertical, degrees.
+    Turn(f32),
+    /// Place the object where the gaze meets the floor.
+    Place,
+    /// The next thing the arrow keys move: object, light, registered world.
+    EditTarget,
+    /// A scene edit, for the sink to apply and record.
+    Edit(SceneEdit),
 }
 
 /// Keys and what they do, as F1 lists them.
@@ -95,6 +108,16 @@ pub const KEYS: &[(&str, &str)] = &[
         "K / L / J",
         "trace: pause, step, back 1 s (Shift+L: forward 1 s)",
     ),
+    (
+        "arrows / PgUp PgDn",
+        "move the object (or light, world) 1 cm along x, z / y (Shift: 1 mm)",
+    ),
+    ("B", "arrows move: object, light, registered world"),
+    (
+        "T / Y",
+        "turn the object 10 deg left / right (Shift: 1 deg)",
+    ),
+    ("M", "place the object where the gaze meets the floor"),
     ("F1", "this list"),
     ("Esc", "quit"),
 ];
@@ -121,6 +144,22 @@ pub fn action_for_key(name: &str, shift: bool) -> Option<Action> {
         "l" if shift => Action::Seek(1),
         "l" => Action::Step,
         "j" => Action::Seek(-1),
+        "left" | "right" | "up" | "down" | "pageup" | "pagedown" => {
+            let step = MOVE_STEPS_M[usize::from(!shift)];
+            match name {
+                "left" => Action::Nudge(Axis::X, -step),
+                "right" => Action::Nudge(Axis::X, step),
+                // Up: away from the viewer at the start (-z).
+                "up" => Action::Nudge(Axis::Z, -step),
+                "down" => Action::Nudge(Axis::Z, step),
+                "pageup" => Action::Nudge(Axis::Y, step),
+                _ => Action::Nudge(Axis::Y, -step),
+            }
+        }
+        "t" => Action::Turn(TURN_STEPS_DEG[usize::from(!shift)]),
+        "y" => Action::Turn(-TURN_STEPS_DEG[usize::from(!shift)]),
+        "m" => Action::Place,
+        "b" => Action::EditTarget,
         _ => return None,
     })
 }
@@ -207,6 +246,25 @@ mod tests {
         assert_eq!(action_for_key("l", false), Some(Action::Step));
         assert_eq!(action_for_key("l", true), Some(Action::Seek(1)));
         assert_eq!(action_for_key("w", false), None, "movement keys are held");
+    }
+
+    #[test]
+    fn arrows_move_a_centimetre_and_shift_a_millimetre() {
+        assert_eq!(
+            action_for_key("left", false),
+            Some(Action::Nudge(Axis::X, -0.01))
+        );
+        assert_eq!(
+            action_for_key("up", true),
+            Some(Action::Nudge(Axis::Z, -0.001))
+        );
+        assert_eq!(
+            action_for_key("pageup", false),
+            Some(Action::Nudge(Axis::Y, 0.01))
+        );
+        assert_eq!(action_for_key("t", false), Some(Action::Turn(10.0)));
+        assert_eq!(action_for_key("y", true), Some(Action::Turn(-1.0)));
+        assert_eq!(action_for_key("m", false), Some(Action::Place));
     }
 
     #[test]

@@ -114,6 +114,13 @@ impl Looks {
             .expect("the current condition has a planner")
     }
 
+    /// Moves the object's centre the image distances are measured to, for every condition.
+    pub fn set_object_center(&mut self, center_m: glam::Vec3) {
+        for planner in self.planners.iter_mut().flatten() {
+            planner.set_object_center(center_m);
+        }
+    }
+
     /// The gaze filter, reflection and forced gaze image, for the overlay.
     pub fn settings(&self) -> (FilterKind, Reflection, GazeOverride) {
         (self.filter, self.reflection, self.gaze)

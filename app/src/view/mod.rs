@@ -129,6 +129,12 @@ pub struct ViewSummary {
     pub screenshot: Option<String>,
     /// The trace recorded, if any.
     pub recorded: Option<String>,
+    /// Scene edits made with the keys (docs/view.md), re-registrations included.
+    pub scene_edits: u64,
+    /// Frames whose object or light pose differed from the previous frame's.
+    pub moved_frames: u64,
+    /// Where the object and light were in the last frame (`null` when nothing moved).
+    pub final_placement: Option<crate::motion_clock::FinalPlacement>,
 }
 
 impl ViewSummary {
@@ -219,6 +225,7 @@ fn view_with(
         fixation: (FixationTarget::Surface, 0.0),
         resized_at: None,
         touched: Vec::new(),
+        object_center_m: None,
         noise: false,
         trace: None,
     }));
@@ -229,13 +236,15 @@ fn view_with(
         options.frames,
         &loaded.scene,
     );
+    let mut played_edits = Vec::new();
     if let Some(path) = &options.trace {
-        let samples = vitreous_xr::trace::read_trace(path)
+        let (samples, edits) = vitreous_xr::trace::read_trace_with_edits(path)
             .with_context(|| format!("reading trace {}", path.display()))?;
         if samples.is_empty() {
             bail!("trace {} has no samples: nothing to play", path.display());
         }
         backend.play(playback::Playback::new(samples));
+        played_edits = edits;
     }
     let mut sink = ViewSink::new(
         options,
@@ -248,6 +257,7 @@ fn view_with(
     if let Some(stage) = study {
         sink.set_study(stage);
     }
+    sink.play_edits(played_edits);
     let mut renderer = sink.make_renderer(&context_options)?;
 
     let started = Instant::now();
@@ -306,6 +316,9 @@ fn view_with(
         gaze_images: sink.gaze_images().to_vec(),
         screenshot,
         recorded: options.record.as_ref().map(|p| p.display().to_string()),
+        scene_edits: sink.motion().edit_count,
+        moved_frames: sink.motion().moved_frames,
+        final_placement: sink.motion().final_placement(),
     };
     if let Some(out) = &options.out {
         std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;

@@ -28,8 +28,10 @@ use crate::blur_stack::DefocusSetup;
 use crate::effects::EffectSet;
 use crate::frame_loop::{FramePlan, FrameSink};
 use crate::gaze::{FilterKind, FixationDepth, GazeOverride};
+use crate::motion_clock::MotionClock;
 use crate::replay::ValidationSummary;
 use crate::scene::Scene;
+use crate::scene_edit::{EditState, SceneEdit};
 use crate::study::run::StudyStage;
 use crate::views;
 
@@ -165,6 +167,12 @@ pub struct ViewSink {
     recorded_until_ns: Option<i64>,
     /// The gaze images the pipeline decided, in order, each change once.
     gaze_images: Vec<String>,
+    /// The scene's motion and the keys' edits.
+    motion: MotionClock,
+    /// The first error recording an edit, reported when the next frame finishes.
+    edit_error: Option<anyhow::Error>,
+    /// The scene edits of the trace played (`--trace`), by time.
+    played_edits: Vec<vitreous_xr::trace::EditRecord>,
 }
 
 impl ViewSink {
@@ -188,12 +196,15 @@ impl ViewSink {
         let status = loaded.caustics_note.clone();
         let writer = match &options.record {
             Some(path) => Some(
-                TraceWriter::create(path)
+                TraceWriter::create_with_edits(path)
                     .with_context(|| format!("creating {}", path.display()))?,
             ),
             None => None,
         };
         Ok(ViewSink {
+            motion: MotionClock::new(&loaded.scene),
+            edit_error: None,
+            played_edits: Vec::new(),
             study: None,
             writer,
             recorded_until_ns: None,
@@ -264,6 +275,11 @@ impl ViewSink {
             gaze,
         );
         self.watcher = Watcher::new(loaded.files.clone());
+        if self.motion.edit_count > 0 {
+            tracing::info!("the reloaded scene starts from its own placement: edits dropped");
+        }
+        self.motion = MotionClock::new(&loaded.scene);
+        self.shared.borrow_mut().object_center_m = None;
         self.status = Some(match &loaded.caustics_note {
             Some(note) => format!("reloaded; {note}"),
             None => "reloaded".into(),
@@ -273,6 +289,39 @@ impl ViewSink {
         self.took_renderer(size);
         tracing::info!("scene reloaded");
         Ok(renderer)
+    }
+
+    /// The scene's motion and the keys' edits.
+    pub fn motion(&self) -> &MotionClock {
+        &self.motion
+    }
+
+    /// Shows the scene edits of the trace played: each frame takes the edit state of the last
+    /// edit at or before its trace time (so pausing, stepping and seeking back show it too).
+    pub fn play_edits(&mut self, edits: Vec<vitreous_xr::trace::EditRecord>) {
+        self.played_edits = edits;
+    }
+
+    /// Applies a scene edit of the keys to this frame and records it.
+    fn edit(&mut self, edit: SceneEdit, input: &FrameInput) -> Result<()> {
+        let record = match self.motion.edit(edit, input) {
+            Ok(record) => record,
+            Err(why) => {
+                tracing::warn!("{edit}: {why}");
+                self.status = Some(why);
+                return Ok(());
+            }
+        };
+        if let Some(w) = &mut self.writer {
+            // A paused or rewound trace goes back in time; the edit follows the last sample.
+            let time_ns = self
+                .recorded_until_ns
+                .map_or(record.time_ns, |t| t.max(record.time_ns));
+            w.write_edit(&vitreous_xr::trace::EditRecord { time_ns, ..record })
+                .context("recording a scene edit")?;
+        }
+        self.status = Some(format!("{edit}"));
+        Ok(())
     }
 
     /// Closes the recorded trace, if any.
@@ -418,7 +467,14 @@ impl ViewSink {
             Action::Pause | Action::Step | Action::Seek(_) => {
                 "trace keys act only while a trace plays (--trace)".into()
             }
-            Action::Recentre | Action::FixationTarget | Action::Quit => return None,
+            Action::Recentre
+            | Action::FixationTarget
+            | Action::Quit
+            | Action::Nudge(..)
+            | Action::Turn(_)
+            | Action::Place
+            | Action::EditTarget
+            | Action::Edit(_) => return None,
         })
     }
 
@@ -506,6 +562,44 @@ impl ViewSink {
 }
 
 impl FrameSink for ViewSink {
+    fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
+        let edits: Vec<SceneEdit> = {
+            let mut shared = self.shared.borrow_mut();
+            let mut edits = Vec::new();
+            shared.actions.retain(|a| match a {
+                Action::Edit(e) => {
+                    edits.push(*e);
+                    false
+                }
+                _ => true,
+            });
+            edits
+        };
+        for edit in edits {
+            if let Err(e) = self.edit(edit, input) {
+                self.edit_error.get_or_insert(e);
+            }
+        }
+        if !self.played_edits.is_empty() {
+            let last = self
+                .played_edits
+                .iter()
+                .rev()
+                .find(|e| e.time_ns <= input.time_ns);
+            let state = last.map_or_else(EditState::default, EditState::of_record);
+            if state != self.motion.edits() {
+                match last {
+                    Some(record) => self.motion.replay_edit(record, input.index),
+                    None => self.motion.set_edits(state),
+                }
+            }
+        }
+        let placement = self.motion.placement(input.time_ns)?;
+        self.looks.set_object_center(placement.object_position_m);
+        self.shared.borrow_mut().object_center_m = Some(placement.object_position_m);
+        Some(self.motion.pose_of(&placement))
+    }
+
     fn started(&mut self, input: &FrameInput) -> Result<()> {
         // A trace's times increase strictly: a paused or rewound trace is not recorded again.
         if self.recorded_until_ns.is_some_and(|t| input.time_ns <= t) {
@@ -565,6 +659,7 @@ impl FrameSink for ViewSink {
         }
         let mut look = self.looks.plan(input);
         look.blank = blank;
+        look.caustics &= self.motion.caustics_valid();
         if let Some(d) = self.looks.planner().last_defocus() {
             let image = d.image.to_string();
             if self.gaze_images.last() != Some(&image) {
@@ -581,6 +676,9 @@ impl FrameSink for ViewSink {
     }
 
     fn finished(&mut self, _input: &FrameInput, result: &FrameResult) -> Result<()> {
+        if let Some(e) = self.edit_error.take() {
+            return Err(e);
+        }
         if let Some(e) = self.study.as_mut().and_then(StudyStage::take_error) {
             return Err(e);
         }

@@ -110,6 +110,12 @@ fn named_key(key: NamedKey) -> Option<&'static str> {
         NamedKey::Space => "space",
         NamedKey::Escape => "escape",
         NamedKey::Shift => "shift",
+        NamedKey::ArrowLeft => "left",
+        NamedKey::ArrowRight => "right",
+        NamedKey::ArrowUp => "up",
+        NamedKey::ArrowDown => "down",
+        NamedKey::PageUp => "pageup",
+        NamedKey::PageDown => "pagedown",
         _ => return None,
     })
 }

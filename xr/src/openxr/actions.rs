@@ -2,15 +2,20 @@
 //! OpenXR action set to whatever the runtime maps (simple controller select/menu, ...), and the
 //! pure mapping from input edges to [`Command`]s.
 //!
-//! Two boolean actions, `select` and `menu`, each with the subaction paths `/user/hand/left`
-//! and `/user/hand/right`, are suggested for these interaction profiles ([`BINDINGS`]):
+//! Three boolean actions, `select`, `menu` and `squeeze`, each with the subaction paths
+//! `/user/hand/left` and `/user/hand/right`, are suggested for these interaction profiles
+//! ([`BINDINGS`]):
 //!
-//! | profile | select | menu |
-//! | --- | --- | --- |
-//! | `/interaction_profiles/khr/simple_controller` | `select/click` | `menu/click` |
-//! | `/interaction_profiles/htc/vive_controller` | `trigger/click` | `menu/click` |
-//! | `/interaction_profiles/oculus/touch_controller` | left `x/click`, right `a/click` | left `y/click`, right `b/click` |
-//! | `/interaction_profiles/valve/index_controller` | `a/click` | `b/click` |
+//! | profile | select | menu | squeeze |
+//! | --- | --- | --- | --- |
+//! | `/interaction_profiles/khr/simple_controller` | `select/click` | `menu/click` | - |
+//! | `/interaction_profiles/htc/vive_controller` | `trigger/click` | `menu/click` | `squeeze/click` |
+//! | `/interaction_profiles/oculus/touch_controller` | left `x/click`, right `a/click` | left `y/click`, right `b/click` | `squeeze/value` |
+//! | `/interaction_profiles/valve/index_controller` | `a/click` | `b/click` | `squeeze/value` |
+//!
+//! With a hand's squeeze held, its select and menu edit the glass object instead (right: move
+//! it 1 cm away or closer, left: turn it 10 degrees left or right), and a press of the right
+//! squeeze alone places the object where the gaze meets the floor.
 //!
 //! [`commands_for`] turns one hand's presses into commands: the right hand steps the
 //! application's two cycles (select: [`Cycle::Primary`], menu: [`Cycle::Secondary`]; what
@@ -29,6 +34,12 @@ pub const NUDGE_STEP_M: f32 = 0.01;
 /// The scene turn per press, radians (2 degrees).
 pub const ROTATE_STEP_RAD: f32 = std::f32::consts::PI / 90.0;
 
+/// The object move per press with the squeeze held, metres.
+pub const OBJECT_STEP_M: f32 = 0.01;
+
+/// The object turn per press with the squeeze held, radians (10 degrees).
+pub const OBJECT_TURN_RAD: f32 = std::f32::consts::PI / 18.0;
+
 /// Something a live action asks for.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Command {
@@ -39,6 +50,13 @@ pub enum Command {
     Rotate(f32),
     /// Step one of the application's cycles to its next value.
     Cycle(Cycle),
+    /// Move the glass object by this offset, scene frame, metres.
+    MoveObject(Vec3),
+    /// Turn the glass object about the vertical through its centre, radians (positive:
+    /// counter-clockwise seen from above).
+    TurnObject(f32),
+    /// Place the glass object where the gaze meets the floor.
+    PlaceObject,
 }
 
 /// The two cycles the right hand steps; the application decides what each goes through.
@@ -61,6 +79,13 @@ impl std::fmt::Display for Command {
             Command::Rotate(a) => write!(f, "turn the scene by {:+.1} deg", a.to_degrees()),
             Command::Cycle(Cycle::Primary) => f.write_str("step the primary cycle"),
             Command::Cycle(Cycle::Secondary) => f.write_str("step the secondary cycle"),
+            Command::MoveObject(d) => write!(
+                f,
+                "move the object by ({:+.3}, {:+.3}, {:+.3}) m",
+                d.x, d.y, d.z
+            ),
+            Command::TurnObject(a) => write!(f, "turn the object by {:+.1} deg", a.to_degrees()),
+            Command::PlaceObject => f.write_str("place the object at the gaze"),
         }
     }
 }
@@ -96,6 +121,10 @@ pub struct Presses {
     pub menu: bool,
     /// Select was held while menu was pressed (or the other way round).
     pub chord: bool,
+    /// The squeeze went down.
+    pub squeeze: bool,
+    /// The squeeze is held: select and menu edit the object.
+    pub editing: bool,
 }
 
 /// One input's state after an xrSyncActions.
@@ -124,11 +153,22 @@ impl ButtonState {
 /// One hand's presses from its two buttons' states: a chord is a press of one button while
 /// the other is held (or both pressed at the same sync).
 pub fn presses(select: ButtonState, menu: ButtonState) -> Presses {
+    presses_with_squeeze(select, menu, ButtonState::default())
+}
+
+/// [`presses`] with the hand's squeeze.
+pub fn presses_with_squeeze(
+    select: ButtonState,
+    menu: ButtonState,
+    squeeze: ButtonState,
+) -> Presses {
     let (s, m) = (select.pressed(), menu.pressed());
     Presses {
         select: s,
         menu: m,
         chord: (s && menu.held()) || (m && select.held()),
+        squeeze: squeeze.pressed(),
+        editing: squeeze.held(),
     }
 }
 
@@ -143,6 +183,30 @@ pub fn commands(p: Presses) -> Vec<Command> {
 /// left, select turns the scene left and menu right by [`ROTATE_STEP_RAD`], both together
 /// nudge it closer by [`NUDGE_STEP_M`].
 pub fn commands_for(hand: Hand, p: Presses) -> Vec<Command> {
+    if p.editing {
+        let mut out = Vec::new();
+        // The squeeze's own press (the right hand's places the object) comes first.
+        if p.squeeze && hand == Hand::Right && !p.select && !p.menu {
+            out.push(Command::PlaceObject);
+        }
+        let (on_select, on_menu) = match hand {
+            Hand::Right => (
+                Command::MoveObject(Vec3::new(0.0, 0.0, -OBJECT_STEP_M)),
+                Command::MoveObject(Vec3::new(0.0, 0.0, OBJECT_STEP_M)),
+            ),
+            Hand::Left => (
+                Command::TurnObject(OBJECT_TURN_RAD),
+                Command::TurnObject(-OBJECT_TURN_RAD),
+            ),
+        };
+        if p.select {
+            out.push(on_select);
+        }
+        if p.menu {
+            out.push(on_menu);
+        }
+        return out;
+    }
     if p.chord {
         let z = match hand {
             Hand::Right => -NUDGE_STEP_M,
@@ -172,38 +236,68 @@ pub fn commands_for(hand: Hand, p: Presses) -> Vec<Command> {
     out
 }
 
-/// One hand's suggested bindings: the hand, then its select and menu input paths relative to
-/// the hand's user path.
-pub type HandBinding = (Hand, &'static str, &'static str);
+/// One hand's suggested bindings: the hand, then its select, menu and (where the profile has
+/// one) squeeze input paths relative to the hand's user path.
+pub type HandBinding = (Hand, &'static str, &'static str, Option<&'static str>);
 
 /// Suggested bindings: interaction profile, then each hand's (left first).
 pub const BINDINGS: &[(&str, [HandBinding; 2])] = &[
     (
         "/interaction_profiles/khr/simple_controller",
         [
-            (Hand::Left, "input/select/click", "input/menu/click"),
-            (Hand::Right, "input/select/click", "input/menu/click"),
+            (Hand::Left, "input/select/click", "input/menu/click", None),
+            (Hand::Right, "input/select/click", "input/menu/click", None),
         ],
     ),
     (
         "/interaction_profiles/htc/vive_controller",
         [
-            (Hand::Left, "input/trigger/click", "input/menu/click"),
-            (Hand::Right, "input/trigger/click", "input/menu/click"),
+            (
+                Hand::Left,
+                "input/trigger/click",
+                "input/menu/click",
+                Some("input/squeeze/click"),
+            ),
+            (
+                Hand::Right,
+                "input/trigger/click",
+                "input/menu/click",
+                Some("input/squeeze/click"),
+            ),
         ],
     ),
     (
         "/interaction_profiles/oculus/touch_controller",
         [
-            (Hand::Left, "input/x/click", "input/y/click"),
-            (Hand::Right, "input/a/click", "input/b/click"),
+            (
+                Hand::Left,
+                "input/x/click",
+                "input/y/click",
+                Some("input/squeeze/value"),
+            ),
+            (
+                Hand::Right,
+                "input/a/click",
+                "input/b/click",
+                Some("input/squeeze/value"),
+            ),
         ],
     ),
     (
         "/interaction_profiles/valve/index_controller",
         [
-            (Hand::Left, "input/a/click", "input/b/click"),
-            (Hand::Right, "input/a/click", "input/b/click"),
+            (
+                Hand::Left,
+                "input/a/click",
+                "input/b/click",
+                Some("input/squeeze/value"),
+            ),
+            (
+                Hand::Right,
+                "input/a/click",
+                "input/b/click",
+                Some("input/squeeze/value"),
+            ),
         ],
     ),
 ];
@@ -216,6 +310,8 @@ pub(super) struct Controls {
     select: xr::Action<bool>,
     /// The menu action.
     menu: xr::Action<bool>,
+    /// The squeeze action.
+    squeeze: xr::Action<bool>,
     /// `/user/hand/left`, `/user/hand/right`.
     hands: [xr::Path; 2],
     /// Profiles whose suggested bindings the runtime accepted.
@@ -243,20 +339,25 @@ impl Controls {
         let menu = set
             .create_action::<bool>("menu", "Menu", &hands)
             .xr("xrCreateAction(menu)")?;
+        let squeeze = set
+            .create_action::<bool>("squeeze", "Squeeze", &hands)
+            .xr("xrCreateAction(squeeze)")?;
         let mut profiles = Vec::new();
         for (profile, hand_bindings) in BINDINGS {
             let made = (|| -> Result<()> {
                 let profile_path = instance.string_to_path(profile).xr("xrStringToPath")?;
                 let mut bindings = Vec::new();
-                for (hand, s, m) in hand_bindings {
-                    let s = instance
-                        .string_to_path(&format!("{}/{s}", hand.path()))
-                        .xr("xrStringToPath")?;
-                    let m = instance
-                        .string_to_path(&format!("{}/{m}", hand.path()))
-                        .xr("xrStringToPath")?;
-                    bindings.push(xr::Binding::new(&select, s));
-                    bindings.push(xr::Binding::new(&menu, m));
+                for (hand, s, m, q) in hand_bindings {
+                    let path = |input: &str| {
+                        instance
+                            .string_to_path(&format!("{}/{input}", hand.path()))
+                            .xr("xrStringToPath")
+                    };
+                    bindings.push(xr::Binding::new(&select, path(s)?));
+                    bindings.push(xr::Binding::new(&menu, path(m)?));
+                    if let Some(q) = q {
+                        bindings.push(xr::Binding::new(&squeeze, path(q)?));
+                    }
                 }
                 instance
                     .suggest_interaction_profile_bindings(profile_path, &bindings)
@@ -271,6 +372,7 @@ impl Controls {
             set,
             select,
             menu,
+            squeeze,
             hands,
             profiles,
         })
@@ -289,7 +391,11 @@ impl Controls {
         };
         let mut out = Vec::new();
         for (hand, path) in Hand::BOTH.into_iter().zip(self.hands) {
-            let p = presses(state(&self.select, path)?, state(&self.menu, path)?);
+            let p = presses_with_squeeze(
+                state(&self.select, path)?,
+                state(&self.menu, path)?,
+                state(&self.squeeze, path)?,
+            );
             out.extend(commands_for(hand, p));
         }
         Ok(out)
@@ -321,6 +427,7 @@ mod tests {
             select: true,
             menu: true,
             chord: true,
+            ..Default::default()
         };
         assert_eq!(
             commands(chord),
@@ -397,6 +504,7 @@ mod tests {
                 select: true,
                 menu: true,
                 chord: true,
+                ..Default::default()
             }
         );
         // An unbound (inactive) input never presses.
@@ -414,5 +522,42 @@ mod tests {
             assert_eq!(hands[0].0, Hand::Left, "{profile}");
             assert_eq!(hands[1].0, Hand::Right, "{profile}");
         }
+    }
+
+    #[test]
+    fn with_the_squeeze_held_select_and_menu_edit_the_object() {
+        let up = ButtonState {
+            active: true,
+            ..Default::default()
+        };
+        let pressed = ButtonState {
+            active: true,
+            down: true,
+            changed: true,
+        };
+        let held = ButtonState {
+            active: true,
+            down: true,
+            changed: false,
+        };
+        // The right squeeze alone places the object; the left one alone does nothing.
+        let place = presses_with_squeeze(up, up, pressed);
+        assert_eq!(commands_for(Hand::Right, place), [Command::PlaceObject]);
+        assert!(commands_for(Hand::Left, place).is_empty());
+        // Held: select and menu move (right) or turn (left) the object, never cycle or nudge.
+        let select = presses_with_squeeze(pressed, up, held);
+        assert_eq!(
+            commands_for(Hand::Right, select),
+            [Command::MoveObject(Vec3::new(0.0, 0.0, -OBJECT_STEP_M))]
+        );
+        assert_eq!(
+            commands_for(Hand::Left, presses_with_squeeze(up, pressed, held)),
+            [Command::TurnObject(-OBJECT_TURN_RAD)]
+        );
+        // Without the squeeze, as before.
+        assert_eq!(
+            commands_for(Hand::Right, presses_with_squeeze(pressed, up, up)),
+            [Command::Cycle(Cycle::Primary)]
+        );
     }
 }

@@ -67,7 +67,7 @@ pub enum TraceError {
     },
     /// The version line names a version this reader does not know.
     #[error(
-        "{file}:{line}: unsupported trace version `{version}`; this reader understands v1 and v1.1"
+        "{file}:{line}: unsupported trace version `{version}`; this reader understands v1, v1.1 and v1.2"
     )]
     UnsupportedVersion {
         /// File name.
@@ -280,5 +280,23 @@ pub enum TraceError {
         group: &'static str,
         /// The first empty column of the group.
         column: &'static str,
+    },
+    /// A scene-edit line (version 1.2) that cannot be replayed.
+    #[error("{file}:{line}: edit line: {reason}")]
+    BadEdit {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// An edit written into a trace whose version has no edit lines.
+    #[error("{file}: a version {version} trace holds no scene edits")]
+    EditsNotInVersion {
+        /// File name.
+        file: String,
+        /// The version being written.
+        version: &'static str,
     },
 }

@@ -1,5 +1,6 @@
-//! The vitreous trace format, version 1 (and its minor version 1.1, which adds the per-eye
-//! pupil diameters): head poses and eye-tracker samples as UTF-8 text.
+//! The vitreous trace format, version 1 (and its minor versions: 1.1 adds the per-eye pupil
+//! diameters, 1.2 the scene-edit lines of live controls): head poses and eye-tracker samples
+//! as UTF-8 text.
 //!
 //! One sample per line, comma-separated, after a version line and a column header line. The
 //! full description (every column, its unit and axes) is in `docs/trace-format.md`; the short
@@ -15,13 +16,16 @@
 //! what trackers really produce: a gaze ray with a NaN/infinite value or a zero direction is
 //! read as an invalid ray of that eye instead of failing the whole trace.
 //!
-//! The reader takes both versions; the writer writes v1.1 (its pupil columns are empty where
-//! a sample has no measurement).
+//! The reader takes all three versions; the writer writes v1.1 (its pupil columns are empty
+//! where a sample has no measurement), or v1.2 when asked for a trace that may hold edits
+//! ([`TraceWriter::create_with_edits`]); edit lines come out of the reader beside the samples
+//! ([`TraceReader::take_edits`], [`read_trace_with_edits`]).
 //!
 //! The writer runs the same checks before writing, so it never produces a file the reader
 //! refuses, and flushes after every sample so a crash loses at most the sample being written.
 //! A trace file ([`TraceWriter::create`]) appears under its name only once finished.
 
+mod edit;
 mod error;
 mod read;
 #[cfg(test)]
@@ -32,8 +36,9 @@ mod write;
 use crate::frame::{GazeSample, Pose};
 
 pub use crate::atomic_file::AtomicFile;
+pub use edit::{EDIT_FIELDS, EDIT_TAG, EditRecord, MAX_ACTION_BYTES, valid_action};
 pub use error::TraceError;
-pub use read::{TraceReader, read_trace};
+pub use read::{TraceReader, read_trace, read_trace_with_edits};
 pub(crate) use validate::check_span;
 pub use validate::clean_ray;
 pub use write::TraceWriter;
@@ -44,6 +49,9 @@ pub const VERSION_LINE: &str = "# vitreous-trace v1";
 /// The first line of a version-1.1 trace (version 1 plus the per-eye pupil diameters); the
 /// writer writes this version.
 pub const VERSION_LINE_V1_1: &str = "# vitreous-trace v1.1";
+
+/// The first line of a version-1.2 trace (version 1.1 plus scene-edit lines).
+pub const VERSION_LINE_V1_2: &str = "# vitreous-trace v1.2";
 
 /// What the version line starts with, whatever the version.
 const VERSION_PREFIX: &str = "# vitreous-trace ";
@@ -106,6 +114,9 @@ pub enum TraceVersion {
     V1,
     /// `# vitreous-trace v1.1`: 35 columns, version 1's and the pupil diameters.
     V1_1,
+    /// `# vitreous-trace v1.2`: version 1.1's columns, and scene-edit lines
+    /// ([`EditRecord`]) between the samples.
+    V1_2,
 }
 
 impl TraceVersion {
@@ -113,7 +124,7 @@ impl TraceVersion {
     pub fn columns(self) -> &'static [&'static str] {
         match self {
             TraceVersion::V1 => &COLUMNS,
-            TraceVersion::V1_1 => &COLUMNS_V1_1,
+            TraceVersion::V1_1 | TraceVersion::V1_2 => &COLUMNS_V1_1,
         }
     }
 
@@ -122,7 +133,13 @@ impl TraceVersion {
         match self {
             TraceVersion::V1 => VERSION_LINE,
             TraceVersion::V1_1 => VERSION_LINE_V1_1,
+            TraceVersion::V1_2 => VERSION_LINE_V1_2,
         }
+    }
+
+    /// Whether lines of this version may be scene edits.
+    pub fn has_edits(self) -> bool {
+        self == TraceVersion::V1_2
     }
 }
 

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use glam::{Quat, Vec3};
 
+use super::edit::{EDIT_TAG, EditRecord, check_edit, parse_edit};
 use super::validate::{Preceding, check_sample};
 use super::{
     COLUMNS, COLUMNS_V1_1, COMBINED, FIXATION, LEFT, PUPILS, RIGHT, TraceError, TraceSample,
@@ -84,7 +85,7 @@ fn parse_record(record: &Record<'_>, version: TraceVersion) -> Result<TraceSampl
     };
     let pupil_diameter_m = match version {
         TraceVersion::V1 => [None, None],
-        TraceVersion::V1_1 => [
+        TraceVersion::V1_1 | TraceVersion::V1_2 => [
             parse_pupil(record, PUPILS)?,
             parse_pupil(record, PUPILS + 1)?,
         ],
@@ -145,6 +146,8 @@ pub struct TraceReader<R: Read> {
     done: bool,
     /// The version named by the first line.
     version: TraceVersion,
+    /// The edit lines read so far (version 1.2), in file order.
+    edits: Vec<EditRecord>,
 }
 
 impl TraceReader<BufReader<File>> {
@@ -170,6 +173,7 @@ impl<R: Read> TraceReader<R> {
             previous: None,
             done: false,
             version: TraceVersion::V1,
+            edits: Vec::new(),
         };
         this.read_headers()?;
         Ok(this)
@@ -178,6 +182,12 @@ impl<R: Read> TraceReader<R> {
     /// The version of the trace, from its first line.
     pub fn version(&self) -> TraceVersion {
         self.version
+    }
+
+    /// The scene edits read so far (the lines among the samples already read; all of them once
+    /// the iterator has ended), taken out of the reader.
+    pub fn take_edits(&mut self) -> Vec<EditRecord> {
+        std::mem::take(&mut self.edits)
     }
 
     /// The file name used in error messages.
@@ -199,6 +209,7 @@ impl<R: Read> TraceReader<R> {
         match text.strip_prefix(VERSION_PREFIX) {
             Some("v1") => self.version = TraceVersion::V1,
             Some("v1.1") => self.version = TraceVersion::V1_1,
+            Some("v1.2") => self.version = TraceVersion::V1_2,
             Some(version) => {
                 return Err(TraceError::UnsupportedVersion {
                     file: name,
@@ -238,10 +249,24 @@ impl<R: Read> TraceReader<R> {
         Ok(())
     }
 
-    /// Reads, parses and checks the next sample.
+    /// Reads, parses and checks the next sample (keeping the edit lines before it).
     fn next_sample(&mut self) -> Result<Option<TraceSample>, TraceError> {
-        let Some(record) = self.records.next_content_record()? else {
-            return Ok(None);
+        let record = loop {
+            let Some(record) = self.records.next_content_record()? else {
+                return Ok(None);
+            };
+            if !(self.version.has_edits() && record.field(0) == EDIT_TAG) {
+                break record;
+            }
+            let raw = parse_edit(&record)?;
+            let edit = check_edit(
+                record.file(),
+                record.line(),
+                &raw,
+                self.previous.map(|p| p.time_ns()),
+                self.edits.last().map(|e| e.time_ns),
+            )?;
+            self.edits.push(edit);
         };
         let raw = parse_record(&record, self.version)?;
         let sample = check_sample(record.file(), record.line(), &raw, self.previous)?;
@@ -273,7 +298,16 @@ impl<R: Read> Iterator for TraceReader<R> {
 
 impl<R: Read> std::iter::FusedIterator for TraceReader<R> {}
 
-/// Reads a whole trace file into memory.
+/// Reads a whole trace file into memory, with its scene edits (none before version 1.2).
+pub fn read_trace_with_edits(
+    path: impl AsRef<Path>,
+) -> Result<(Vec<TraceSample>, Vec<EditRecord>), TraceError> {
+    let mut reader = TraceReader::open(path)?;
+    let samples = reader.by_ref().collect::<Result<Vec<_>, _>>()?;
+    Ok((samples, reader.take_edits()))
+}
+
+/// Reads a whole trace file into memory (the samples; scene edits are skipped).
 pub fn read_trace(path: impl AsRef<Path>) -> Result<Vec<TraceSample>, TraceError> {
     TraceReader::open(path)?.collect()
 }

@@ -21,6 +21,11 @@ pub(super) struct Preceding {
 }
 
 impl Preceding {
+    /// The previous sample's time.
+    pub(super) fn time_ns(self) -> i64 {
+        self.time_ns
+    }
+
     /// What follows a sample accepted after `before`.
     pub(super) fn after(before: Option<Preceding>, sample: &TraceSample) -> Preceding {
         Preceding {

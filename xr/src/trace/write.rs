@@ -3,11 +3,13 @@
 use std::io::{self, Write};
 use std::path::Path;
 
+use super::edit::{EditRecord, check_edit, format_edit};
 use super::validate::{Preceding, check_sample};
-use super::{AtomicFile, COLUMNS_V1_1, TraceError, TraceSample, VERSION_LINE_V1_1};
+use super::{AtomicFile, COLUMNS_V1_1, TraceError, TraceSample, TraceVersion};
 use crate::frame::GazeRay;
 
-/// Writes [`TraceSample`]s as a version-1.1 trace (version 1 and the pupil diameters).
+/// Writes [`TraceSample`]s as a version-1.1 trace (version 1 and the pupil diameters), or as
+/// version 1.2 with scene edits among them ([`TraceWriter::create_with_edits`]).
 ///
 /// Every sample is checked like the reader checks it (finite head pose, unit quaternion,
 /// increasing times, gaze time not after the pose time) and flushed once written.
@@ -20,6 +22,10 @@ pub struct TraceWriter<W: Write> {
     line: usize,
     /// What the ordering checks need of the samples before.
     previous: Option<Preceding>,
+    /// Time of the last edit written.
+    previous_edit_ns: Option<i64>,
+    /// The version written (1.1, or 1.2 when edits may come).
+    version: TraceVersion,
     /// Reused line buffer.
     buf: String,
     /// What [`TraceWriter::finish`] does after flushing: nothing, or commit a file.
@@ -32,14 +38,24 @@ impl TraceWriter<AtomicFile> {
     /// replacing any earlier file, only when [`TraceWriter::finish`] succeeds; see
     /// [`AtomicFile`].
     pub fn create(path: impl AsRef<Path>) -> Result<Self, TraceError> {
-        let path = path.as_ref();
+        TraceWriter::create_version(path.as_ref(), TraceVersion::V1_1)
+    }
+
+    /// [`TraceWriter::create`] for a version-1.2 trace, which may hold scene edits
+    /// ([`TraceWriter::write_edit`]).
+    pub fn create_with_edits(path: impl AsRef<Path>) -> Result<Self, TraceError> {
+        TraceWriter::create_version(path.as_ref(), TraceVersion::V1_2)
+    }
+
+    /// [`TraceWriter::create`] of a version-1.1 or 1.2 trace.
+    fn create_version(path: &Path, version: TraceVersion) -> Result<Self, TraceError> {
         let name = path.display().to_string();
         let file = AtomicFile::create(path).map_err(|source| TraceError::Io {
             file: name.clone(),
             context: "creating trace".to_owned(),
             source,
         })?;
-        let mut this = TraceWriter::with_name(file, name)?;
+        let mut this = TraceWriter::with_version(file, name, version)?;
         this.complete = AtomicFile::commit;
         Ok(this)
     }
@@ -54,15 +70,30 @@ impl<W: Write> TraceWriter<W> {
 
     /// Like [`TraceWriter::new`], with the name to use in error messages.
     pub fn with_name(writer: W, name: impl Into<String>) -> Result<Self, TraceError> {
+        TraceWriter::with_version(writer, name, TraceVersion::V1_1)
+    }
+
+    /// Like [`TraceWriter::with_name`], writing `version` (1.1 or 1.2; 1 is written as 1.1).
+    pub fn with_version(
+        writer: W,
+        name: impl Into<String>,
+        version: TraceVersion,
+    ) -> Result<Self, TraceError> {
+        let version = match version {
+            TraceVersion::V1 => TraceVersion::V1_1,
+            v => v,
+        };
         let mut this = TraceWriter {
             writer,
             name: name.into(),
             line: 3,
             previous: None,
+            previous_edit_ns: None,
+            version,
             buf: String::new(),
             complete: |_| Ok(()),
         };
-        this.buf = format!("{VERSION_LINE_V1_1}\n{}\n", COLUMNS_V1_1.join(","));
+        this.buf = format!("{}\n{}\n", version.version_line(), COLUMNS_V1_1.join(","));
         this.flush_buf("writing header")?;
         Ok(this)
     }
@@ -104,6 +135,29 @@ impl<W: Write> TraceWriter<W> {
         b.push('\n');
         self.flush_buf("writing sample")?;
         self.previous = Some(Preceding::after(self.previous, &s));
+        self.line += 1;
+        Ok(())
+    }
+
+    /// Checks and writes one scene edit (a version-1.2 trace only), then flushes. Its time
+    /// must not be before the sample or edit written before it.
+    pub fn write_edit(&mut self, edit: &EditRecord) -> Result<(), TraceError> {
+        if !self.version.has_edits() {
+            return Err(TraceError::EditsNotInVersion {
+                file: self.name.clone(),
+                version: self.version.version_line(),
+            });
+        }
+        let e = check_edit(
+            &self.name,
+            self.line,
+            edit,
+            self.previous.map(|p| p.time_ns()),
+            self.previous_edit_ns,
+        )?;
+        self.buf = format_edit(&e);
+        self.flush_buf("writing edit")?;
+        self.previous_edit_ns = Some(e.time_ns);
         self.line += 1;
         Ok(())
     }

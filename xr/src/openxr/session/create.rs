@@ -209,6 +209,7 @@ pub(in crate::openxr) unsafe fn start(
         depth_images,
     };
     let (commands_tx, commands_rx) = mpsc::channel();
+    let (injected_tx, injected_rx) = mpsc::channel();
     Ok((
         Session {
             stream,
@@ -219,6 +220,8 @@ pub(in crate::openxr) unsafe fn start(
             action_sets,
             commands_tx,
             commands_rx: Some(commands_rx),
+            injected_tx,
+            injected_rx,
             gaze,
             space,
             space_type,

@@ -123,7 +123,9 @@ impl Session {
         };
         // Live actions (and the eye-gaze action) are synced before the gaze is sampled and
         // before the placement is used, so a nudge shows in this very frame.
-        self.sync_actions(compose(&placed, &head_space).position)?;
+        let head_m = compose(&placed, &head_space).position;
+        self.sync_actions(head_m)?;
+        self.apply_injected(head_m);
         let world_from_space = self.world_from_space.unwrap_or(placed);
         let sampled = self
             .gaze

@@ -115,6 +115,10 @@ pub struct Session {
     commands_tx: mpsc::Sender<Command>,
     /// The app's end, until taken.
     commands_rx: Option<mpsc::Receiver<Command>>,
+    /// Commands the app sends in (keyboard controls), applied at the next frame.
+    injected_tx: mpsc::Sender<Command>,
+    /// Their receiving end, drained each frame.
+    injected_rx: mpsc::Receiver<Command>,
     /// The gaze source (holds spaces/trackers of the session).
     gaze: Gaze,
     /// The app space the scene is placed in (STAGE or LOCAL).
@@ -176,6 +180,20 @@ impl Session {
     /// first call.
     pub fn take_commands(&mut self) -> Option<mpsc::Receiver<Command>> {
         self.commands_rx.take()
+    }
+
+    /// Where the application sends commands to be applied as if a live action gave them, at
+    /// the next frame before its views are located (e.g. a keyboard's re-registration).
+    pub fn command_sender(&self) -> mpsc::Sender<Command> {
+        self.injected_tx.clone()
+    }
+
+    /// Applies the commands sent through [`Session::command_sender`] since the last frame.
+    /// `head_m` is the head's position in the scene frame.
+    pub(super) fn apply_injected(&mut self, head_m: Vec3) {
+        while let Ok(command) = self.injected_rx.try_recv() {
+            self.command(command, head_m);
+        }
     }
 
     /// Applies a command as if a live action gave it (Nudge and Rotate re-register the scene;

@@ -25,7 +25,10 @@ pub(crate) fn re_register(world_from_space: &Pose, command: Command, head_m: Vec
                 orientation: r,
             }
         }
-        Command::Cycle(_) => return *world_from_space,
+        Command::Cycle(_)
+        | Command::MoveObject(_)
+        | Command::TurnObject(_)
+        | Command::PlaceObject => return *world_from_space,
     };
     compose(&change, world_from_space)
 }

@@ -18,6 +18,7 @@
 
 mod cli;
 mod desktop;
+mod edits;
 mod input;
 mod looks;
 mod picture;
@@ -50,7 +51,8 @@ use crate::gaze::{FilterKind, GazeOverride};
 use crate::output::{encode_png, write_atomic};
 use crate::replay::{Spread, ValidationSummary};
 use desktop::{DesktopBackend, Shared};
-use session::{Loaded, Request, ViewSink};
+use reload::Loaded;
+use session::{Request, ViewSink};
 
 /// Options of `vitreous view`.
 #[derive(Clone, Debug)]

@@ -1,12 +1,88 @@
-//! Hot reload: the scene file and every file it reads are watched (modification time and
-//! size, polled), and a change loads the scene anew. A scene that fails to load is reported
-//! and the last good one keeps running.
+//! The scene shown and its hot reload: the scene file and every file it reads are watched
+//! (modification time and size, polled), and a change loads the scene anew. A scene that
+//! fails to load is reported and the last good one keeps running.
 
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime};
 
+use anyhow::{Context, Result, bail};
+use vitreous_render::{ContextOptions, GpuContext, Renderer};
+
+use crate::blur_stack::DefocusSetup;
+use crate::effects::EffectSet;
 use crate::scene::{DiskFiles, Scene, SceneFiles, load_scene_from};
+use crate::views;
+
+/// A scene loaded with what its renderer needs.
+pub struct Loaded {
+    /// The scene.
+    pub scene: Scene,
+    /// The files it was read from (watched for reload).
+    pub(super) files: Vec<PathBuf>,
+    /// The effects to start with.
+    pub(super) effects: EffectSet,
+    /// Whether the caustic bake is loaded (conditions b and c offered).
+    pub(super) caustics_loaded: bool,
+    /// Why the scene's caustic bake is not used, when it is not.
+    pub(super) caustics_note: Option<String>,
+    /// Blur stacks and the eq. 13-14 model, when defocus is implemented.
+    pub(super) setup: Option<DefocusSetup>,
+}
+
+impl Loaded {
+    /// Loads the scene at `path`; `effects` overrides the scene's starting effects.
+    pub fn load(path: &Path, effects: Option<EffectSet>) -> Result<Loaded> {
+        let (scene, files) = load_watched(path);
+        let mut scene = scene?;
+        let effects = effects.unwrap_or(scene.effects);
+        effects.ensure_implemented()?;
+        let mut caustics_note = None;
+        let caustics_loaded = match &scene.caustics.bake {
+            Some(_) if EffectSet::IMPLEMENTED.caustics => match scene.load_caustics() {
+                Ok(()) => true,
+                Err(e) => {
+                    let note = format!("caustic bake not used (conditions b, c off): {e}");
+                    tracing::warn!("{note}");
+                    caustics_note = Some(note);
+                    false
+                }
+            },
+            _ => false,
+        };
+        if effects.caustics && !caustics_loaded {
+            bail!(
+                "effects {effects} need the scene's caustic bake: {}",
+                caustics_note.as_deref().unwrap_or("the scene names none")
+            );
+        }
+        let setup = EffectSet::IMPLEMENTED.defocus.then(|| {
+            let mut setup = DefocusSetup::new(&scene, scene.viewer.pupil_diameter_m);
+            setup.model.pupil_source = scene.gaze.pupil;
+            setup
+        });
+        Ok(Loaded {
+            scene,
+            files,
+            effects,
+            caustics_loaded,
+            caustics_note,
+            setup,
+        })
+    }
+
+    /// A renderer of this scene with eye images of `size`, on a new device.
+    pub(super) fn renderer(&self, size: (u32, u32), options: &ContextOptions) -> Result<Renderer> {
+        let ctx = GpuContext::headless(options).context("setting up the Vulkan device")?;
+        Renderer::new(
+            ctx,
+            &views::scene_desc(&self.scene, self.setup.as_ref()),
+            size.0,
+            size.1,
+        )
+        .context("preparing the renderer")
+    }
+}
 
 /// How often the files are looked at.
 const POLL: Duration = Duration::from_millis(250);

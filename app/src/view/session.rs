@@ -7,106 +7,33 @@
 //! `swapchain.rs`.
 
 use std::cell::RefCell;
-use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, GpuContext, Renderer};
+use vitreous_render::{ContextOptions, Renderer};
 use vitreous_xr::trace::{AtomicFile, TraceSample, TraceWriter};
 use vitreous_xr::{FrameInput, GazeRay, GazeSample};
 
 use super::ViewOptions;
 use super::desktop::Shared;
+use super::edits::ViewEdits;
 use super::input::{Action, KEYS};
 use super::looks::Looks;
 use super::picture::{Overlay, SeeThrough, compose};
-use super::reload::{Watcher, load_watched};
+use super::reload::{Loaded, Watcher};
 use super::swapchain::Presenter;
-use crate::blur_stack::DefocusSetup;
-use crate::effects::EffectSet;
 use crate::frame_loop::{FramePlan, FrameSink};
 use crate::gaze::{FilterKind, FixationDepth, GazeOverride};
 use crate::motion_clock::MotionClock;
 use crate::replay::ValidationSummary;
 use crate::scene::Scene;
-use crate::scene_edit::{EditState, SceneEdit};
+use crate::scene_edit::SceneEdit;
 use crate::study::run::StudyStage;
-use crate::views;
 
 /// How long a window keeps its new size before the renderer is made for it.
 const RESIZE_SETTLE: Duration = Duration::from_millis(200);
-
-/// A scene loaded with what its renderer needs.
-pub struct Loaded {
-    /// The scene.
-    pub scene: Scene,
-    /// The files it was read from (watched for reload).
-    files: Vec<PathBuf>,
-    /// The effects to start with.
-    effects: EffectSet,
-    /// Whether the caustic bake is loaded (conditions b and c offered).
-    caustics_loaded: bool,
-    /// Why the scene's caustic bake is not used, when it is not.
-    caustics_note: Option<String>,
-    /// Blur stacks and the eq. 13-14 model, when defocus is implemented.
-    setup: Option<DefocusSetup>,
-}
-
-impl Loaded {
-    /// Loads the scene at `path`; `effects` overrides the scene's starting effects.
-    pub fn load(path: &Path, effects: Option<EffectSet>) -> Result<Loaded> {
-        let (scene, files) = load_watched(path);
-        let mut scene = scene?;
-        let effects = effects.unwrap_or(scene.effects);
-        effects.ensure_implemented()?;
-        let mut caustics_note = None;
-        let caustics_loaded = match &scene.caustics.bake {
-            Some(_) if EffectSet::IMPLEMENTED.caustics => match scene.load_caustics() {
-                Ok(()) => true,
-                Err(e) => {
-                    let note = format!("caustic bake not used (conditions b, c off): {e}");
-                    tracing::warn!("{note}");
-                    caustics_note = Some(note);
-                    false
-                }
-            },
-            _ => false,
-        };
-        if effects.caustics && !caustics_loaded {
-            bail!(
-                "effects {effects} need the scene's caustic bake: {}",
-                caustics_note.as_deref().unwrap_or("the scene names none")
-            );
-        }
-        let setup = EffectSet::IMPLEMENTED.defocus.then(|| {
-            let mut setup = DefocusSetup::new(&scene, scene.viewer.pupil_diameter_m);
-            setup.model.pupil_source = scene.gaze.pupil;
-            setup
-        });
-        Ok(Loaded {
-            scene,
-            files,
-            effects,
-            caustics_loaded,
-            caustics_note,
-            setup,
-        })
-    }
-
-    /// A renderer of this scene with eye images of `size`, on a new device.
-    fn renderer(&self, size: (u32, u32), options: &ContextOptions) -> Result<Renderer> {
-        let ctx = GpuContext::headless(options).context("setting up the Vulkan device")?;
-        Renderer::new(
-            ctx,
-            &views::scene_desc(&self.scene, self.setup.as_ref()),
-            size.0,
-            size.1,
-        )
-        .context("preparing the renderer")
-    }
-}
 
 /// Why the frame loop was ended for a new renderer.
 pub enum Request {
@@ -167,12 +94,8 @@ pub struct ViewSink {
     recorded_until_ns: Option<i64>,
     /// The gaze images the pipeline decided, in order, each change once.
     gaze_images: Vec<String>,
-    /// The scene's motion and the keys' edits.
-    motion: MotionClock,
-    /// The first error recording an edit, reported when the next frame finishes.
-    edit_error: Option<anyhow::Error>,
-    /// The scene edits of the trace played (`--trace`), by time.
-    played_edits: Vec<vitreous_xr::trace::EditRecord>,
+    /// The scene's motion with the keys' edits and those of a trace played.
+    edits: ViewEdits,
 }
 
 impl ViewSink {
@@ -202,9 +125,7 @@ impl ViewSink {
             None => None,
         };
         Ok(ViewSink {
-            motion: MotionClock::new(&loaded.scene),
-            edit_error: None,
-            played_edits: Vec::new(),
+            edits: ViewEdits::new(&loaded.scene),
             study: None,
             writer,
             recorded_until_ns: None,
@@ -275,10 +196,7 @@ impl ViewSink {
             gaze,
         );
         self.watcher = Watcher::new(loaded.files.clone());
-        if self.motion.edit_count > 0 {
-            tracing::info!("the reloaded scene starts from its own placement: edits dropped");
-        }
-        self.motion = MotionClock::new(&loaded.scene);
+        self.edits.reset(&loaded.scene);
         self.shared.borrow_mut().object_center_m = None;
         self.status = Some(match &loaded.caustics_note {
             Some(note) => format!("reloaded; {note}"),
@@ -293,35 +211,12 @@ impl ViewSink {
 
     /// The scene's motion and the keys' edits.
     pub fn motion(&self) -> &MotionClock {
-        &self.motion
+        self.edits.motion()
     }
 
-    /// Shows the scene edits of the trace played: each frame takes the edit state of the last
-    /// edit at or before its trace time (so pausing, stepping and seeking back show it too).
+    /// Shows the scene edits of the trace played (see [`ViewEdits::play`]).
     pub fn play_edits(&mut self, edits: Vec<vitreous_xr::trace::EditRecord>) {
-        self.played_edits = edits;
-    }
-
-    /// Applies a scene edit of the keys to this frame and records it.
-    fn edit(&mut self, edit: SceneEdit, input: &FrameInput) -> Result<()> {
-        let record = match self.motion.edit(edit, input) {
-            Ok(record) => record,
-            Err(why) => {
-                tracing::warn!("{edit}: {why}");
-                self.status = Some(why);
-                return Ok(());
-            }
-        };
-        if let Some(w) = &mut self.writer {
-            // A paused or rewound trace goes back in time; the edit follows the last sample.
-            let time_ns = self
-                .recorded_until_ns
-                .map_or(record.time_ns, |t| t.max(record.time_ns));
-            w.write_edit(&vitreous_xr::trace::EditRecord { time_ns, ..record })
-                .context("recording a scene edit")?;
-        }
-        self.status = Some(format!("{edit}"));
-        Ok(())
+        self.edits.play(edits);
     }
 
     /// Closes the recorded trace, if any.
@@ -563,41 +458,26 @@ impl ViewSink {
 
 impl FrameSink for ViewSink {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
-        let edits: Vec<SceneEdit> = {
+        let keyed: Vec<SceneEdit> = {
             let mut shared = self.shared.borrow_mut();
-            let mut edits = Vec::new();
+            let mut keyed = Vec::new();
             shared.actions.retain(|a| match a {
                 Action::Edit(e) => {
-                    edits.push(*e);
+                    keyed.push(*e);
                     false
                 }
                 _ => true,
             });
-            edits
+            keyed
         };
-        for edit in edits {
-            if let Err(e) = self.edit(edit, input) {
-                self.edit_error.get_or_insert(e);
-            }
+        let recording = self.writer.as_mut().map(|w| (w, self.recorded_until_ns));
+        if let Some(status) = self.edits.apply(keyed, input, recording) {
+            self.status = Some(status);
         }
-        if !self.played_edits.is_empty() {
-            let last = self
-                .played_edits
-                .iter()
-                .rev()
-                .find(|e| e.time_ns <= input.time_ns);
-            let state = last.map_or_else(EditState::default, EditState::of_record);
-            if state != self.motion.edits() {
-                match last {
-                    Some(record) => self.motion.replay_edit(record, input.index),
-                    None => self.motion.set_edits(state),
-                }
-            }
-        }
-        let placement = self.motion.placement(input.time_ns)?;
-        self.looks.set_object_center(placement.object_position_m);
-        self.shared.borrow_mut().object_center_m = Some(placement.object_position_m);
-        Some(self.motion.pose_of(&placement))
+        let (center_m, pose) = self.edits.pose(input)?;
+        self.looks.set_object_center(center_m);
+        self.shared.borrow_mut().object_center_m = Some(center_m);
+        Some(pose)
     }
 
     fn started(&mut self, input: &FrameInput) -> Result<()> {
@@ -659,7 +539,7 @@ impl FrameSink for ViewSink {
         }
         let mut look = self.looks.plan(input);
         look.blank = blank;
-        look.caustics &= self.motion.caustics_valid();
+        look.caustics &= self.edits.caustics_valid();
         if let Some(d) = self.looks.planner().last_defocus() {
             let image = d.image.to_string();
             if self.gaze_images.last() != Some(&image) {
@@ -676,7 +556,7 @@ impl FrameSink for ViewSink {
     }
 
     fn finished(&mut self, _input: &FrameInput, result: &FrameResult) -> Result<()> {
-        if let Some(e) = self.edit_error.take() {
+        if let Some(e) = self.edits.take_error() {
             return Err(e);
         }
         if let Some(e) = self.study.as_mut().and_then(StudyStage::take_error) {

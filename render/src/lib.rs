@@ -37,6 +37,7 @@ pub mod reference;
 pub mod renderer;
 pub mod scene;
 mod shaders;
+pub mod solid;
 mod target;
 mod validation;
 mod world;

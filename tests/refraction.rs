@@ -120,6 +120,7 @@ fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
             CENTER,
         ),
         ior: IOR,
+        refraction: vitreous_render::Refraction::Paper,
         environment: TextureDesc {
             width: ew,
             height: eh,

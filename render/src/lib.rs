@@ -52,6 +52,6 @@ pub use memory::color_copy_region;
 pub use pose::ScenePose;
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
-    BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData,
-    TextureDesc,
+    BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, Refraction,
+    RefractionParseError, SceneDesc, TexelData, TextureDesc,
 };

@@ -224,6 +224,7 @@ fn reference_scene() -> SphereScene {
         center_m: CENTER,
         radius_m: RADIUS,
         ior: IOR,
+        refraction: vitreous_render::Refraction::Paper,
         background_from_world: background_plane().inverse(),
     }
 }

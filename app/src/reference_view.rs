@@ -19,6 +19,7 @@ pub fn sphere_of(scene: &Scene) -> SphereScene {
         center_m: scene.object.center_m,
         radius_m: scene.object.radius_m,
         ior: scene.object.ior,
+        refraction: scene.object.refraction,
         background_from_world: scene.background.world_from_plane().inverse(),
     }
 }

@@ -39,6 +39,7 @@ pub mod scene;
 mod shaders;
 pub mod solid;
 mod target;
+pub mod two_surface;
 mod validation;
 mod world;
 

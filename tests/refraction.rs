@@ -8,7 +8,7 @@ use vitreous_render::reference::{SphereScene, marker_centroid};
 use vitreous_render::renderer::Want;
 use vitreous_render::{
     ContextOptions, FrameParams, GpuContext, LightDesc, Look, MeshRef, PlaneDesc, Reflection,
-    Renderer, SceneDesc, TexelData, TextureDesc,
+    Refraction, Renderer, SceneDesc, TexelData, TextureDesc,
 };
 use vitreous_tests::{render_once, uv_sphere};
 
@@ -78,6 +78,17 @@ fn environment(marker: bool) -> (u32, u32, Vec<f32>) {
 
 /// Renders both eyes of the sphere with `look` and returns the eye images.
 fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
+    render_with(look, surface_dot, env_marker, Refraction::Paper, eyes())
+}
+
+/// Renders `eyes` of the sphere with `look` and `refraction`, and returns the eye images.
+fn render_with(
+    look: Look,
+    surface_dot: bool,
+    env_marker: bool,
+    refraction: Refraction,
+    eyes: [EyeParams; 2],
+) -> [Vec<u8>; 2] {
     let ctx = GpuContext::headless(&ContextOptions {
         validation: true,
         device_name: None,
@@ -120,7 +131,7 @@ fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
             CENTER,
         ),
         ior: IOR,
-        refraction: vitreous_render::Refraction::Paper,
+        refraction,
         environment: TextureDesc {
             width: ew,
             height: eh,
@@ -159,7 +170,7 @@ fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
         caustics: None,
     };
     let mut renderer = Renderer::new(ctx, &scene, W, H).expect("renderer");
-    let params = FrameParams { eyes: eyes(), look };
+    let params = FrameParams { eyes, look };
     let want = Want {
         eyes: true,
         world: false,
@@ -219,23 +230,27 @@ fn reference_dot(eye: &EyeParams, size: Vec2) -> Vec2 {
     sum / count
 }
 
-fn reference_scene() -> SphereScene {
+fn reference_scene(refraction: Refraction) -> SphereScene {
     SphereScene {
         center_m: CENTER,
         radius_m: RADIUS,
         ior: IOR,
-        refraction: vitreous_render::Refraction::Paper,
+        refraction,
         background_from_world: background_plane().inverse(),
     }
 }
 
 fn reference_marker(eye: &EyeParams) -> Vec2 {
+    reference_marker_with(eye, Refraction::Paper)
+}
+
+fn reference_marker_with(eye: &EyeParams, refraction: Refraction) -> Vec2 {
     let lo = MARKER.0 as f32 / PHOTO as f32;
     let hi = MARKER.1 as f32 / PHOTO as f32;
     marker_centroid(
         eye,
         (W, H),
-        &reference_scene(),
+        &reference_scene(refraction),
         (Vec2::splat(lo), Vec2::splat(hi)),
     )
     .expect("the reference sees the marker")
@@ -311,4 +326,40 @@ fn refracted_image_has_its_own_disparity_only_with_the_effect() {
         "baseline refracted offset {baseline_relative} px should not match the reference \
          {predicted} px"
     );
+}
+
+/// Both eyes of a head at `head_m` turned by `turn` (the eyes `IPD` apart along its x axis).
+fn head_eyes(head_m: Vec3, turn: Quat) -> [EyeParams; 2] {
+    [-IPD / 2.0, IPD / 2.0]
+        .map(|x| EyeParams::new(head_m + turn * Vec3::new(x, 0.0, 0.0), turn, fov()))
+}
+
+/// Two-surface refraction against the CPU ray tracer of the analytic ball that refracts twice:
+/// the marker's image (inverted by the ball lens) lands within `bar_px` in each eye.
+fn two_surface_marker_matches_the_reference(eyes: [EyeParams; 2], bar_px: f32) {
+    let images = render_with(DISPARITY, false, false, Refraction::TwoSurface, eyes);
+    for (i, eye) in eyes.iter().enumerate() {
+        let gpu = bright_centroid(&images[i]);
+        let reference = reference_marker_with(eye, Refraction::TwoSurface);
+        let paper = reference_marker_with(eye, Refraction::Paper);
+        eprintln!(
+            "eye {i}: GPU {gpu}, two-surface reference {reference} ({} px), paper {paper}",
+            (gpu - reference).length()
+        );
+        assert!(
+            (gpu - reference).length() < bar_px,
+            "eye {i}: GPU marker at {gpu}, two-surface reference at {reference}"
+        );
+    }
+}
+
+#[test]
+fn two_surface_marker_matches_the_reference_for_a_neutral_head() {
+    two_surface_marker_matches_the_reference(eyes(), 1.0);
+}
+
+#[test]
+fn two_surface_marker_matches_the_reference_for_a_turned_and_moved_head() {
+    let turn = Quat::from_euler(glam::EulerRot::YXZ, 0.08, -0.05, 0.02);
+    two_surface_marker_matches_the_reference(head_eyes(Vec3::new(0.015, -0.01, 0.02), turn), 2.0);
 }

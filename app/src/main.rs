@@ -202,6 +202,10 @@ enum Command {
         /// per pose on the GPU, alternated with the scene's bake.
         #[arg(long = "live-caustics")]
         live_caustics: bool,
+        /// Also time each variant with two-surface refraction on a second renderer,
+        /// alternated with the same variant under the paper's refraction (ratio GPU/paper).
+        #[arg(long = "two-surface")]
+        two_surface: bool,
     },
     /// Replay a scene again and again in one process (a new Vulkan device and renderer each
     /// pass, validation on) and check that resident memory stays flat and validation silent.
@@ -455,6 +459,7 @@ fn run(cli: Cli) -> Result<()> {
             pupils_mm,
             moving,
             live_caustics,
+            two_surface,
         } => {
             let report = bench(&BenchOptions {
                 scene,
@@ -467,6 +472,7 @@ fn run(cli: Cli) -> Result<()> {
                 pupils_mm,
                 moving,
                 live_caustics,
+                two_surface,
             })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);

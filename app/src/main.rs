@@ -138,8 +138,9 @@ enum Command {
         /// (the paper's choice) or the environment map with a Fresnel term.
         #[arg(long, value_enum, default_value_t = ReflectionArg::Phong)]
         reflection: ReflectionArg,
-        /// Also write each saved eye image beside the CPU ray-traced reference of its
-        /// refraction layer (for sphere scenes: the object's bounding sphere is traced).
+        /// Also write each saved eye image under the paper's and under two-surface refraction
+        /// beside the CPU ray-traced two-surface refraction layer (for sphere scenes: the
+        /// object's bounding sphere is traced).
         #[arg(long)]
         reference: bool,
         /// Gaze image: auto (from the wearer's fixation depth), or forced to surface or

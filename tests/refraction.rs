@@ -81,6 +81,23 @@ fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
     render_with(look, surface_dot, env_marker, Refraction::Paper, eyes())
 }
 
+/// A sphere mesh with the radius of its model.
+type SphereMesh = ((Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<u32>), f32);
+
+/// The test's finely tessellated unit sphere.
+fn fine_sphere() -> SphereMesh {
+    (uv_sphere(128, 64), 1.0)
+}
+
+/// The sphere the visual-effects scene ships (config/models/sphere.glb, radius 0.5).
+fn shipped_sphere() -> SphereMesh {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../config/scenes/visual-effects.toml");
+    let scene = vitreous::scene::load_scene(&path).expect("the visual-effects scene");
+    let m = scene.object.mesh;
+    ((m.positions, m.normals, m.uvs, m.indices), 0.5)
+}
+
 /// Renders `eyes` of the sphere with `look` and `refraction`, and returns the eye images.
 fn render_with(
     look: Look,
@@ -89,12 +106,31 @@ fn render_with(
     refraction: Refraction,
     eyes: [EyeParams; 2],
 ) -> [Vec<u8>; 2] {
+    render_mesh(
+        look,
+        surface_dot,
+        env_marker,
+        refraction,
+        eyes,
+        fine_sphere(),
+    )
+}
+
+/// Renders `eyes` of the sphere `mesh` with `look` and `refraction`.
+fn render_mesh(
+    look: Look,
+    surface_dot: bool,
+    env_marker: bool,
+    refraction: Refraction,
+    eyes: [EyeParams; 2],
+    mesh: SphereMesh,
+) -> [Vec<u8>; 2] {
     let ctx = GpuContext::headless(&ContextOptions {
         validation: true,
         device_name: None,
     })
     .expect("Vulkan device with validation");
-    let (positions, normals, uvs, indices) = uv_sphere(128, 64);
+    let ((positions, normals, uvs, indices), model_radius) = mesh;
     let (ew, eh, env) = environment(env_marker);
     let photo = if surface_dot {
         marker_photo(PHOTO, 0, 0)
@@ -126,7 +162,7 @@ fn render_with(
         },
         // Half a turn about y puts the texture's u = 0.5 towards the viewer.
         world_from_model: Mat4::from_scale_rotation_translation(
-            Vec3::splat(RADIUS),
+            Vec3::splat(RADIUS / model_radius),
             Quat::from_rotation_y(std::f32::consts::PI),
             CENTER,
         ),
@@ -337,18 +373,30 @@ fn head_eyes(head_m: Vec3, turn: Quat) -> [EyeParams; 2] {
 /// Two-surface refraction against the CPU ray tracer of the analytic ball that refracts twice:
 /// the marker's image (inverted by the ball lens) lands within `bar_px` in each eye.
 fn two_surface_marker_matches_the_reference(eyes: [EyeParams; 2], bar_px: f32) {
-    let images = render_with(DISPARITY, false, false, Refraction::TwoSurface, eyes);
+    marker_matches_the_reference(eyes, bar_px, Refraction::TwoSurface, fine_sphere());
+}
+
+/// The marker seen through `mesh` under `refraction` lands within `bar_px` of the CPU ray
+/// tracer's analytic ball in each eye.
+fn marker_matches_the_reference(
+    eyes: [EyeParams; 2],
+    bar_px: f32,
+    refraction: Refraction,
+    mesh: SphereMesh,
+) {
+    let images = render_mesh(DISPARITY, false, false, refraction, eyes, mesh);
     for (i, eye) in eyes.iter().enumerate() {
         let gpu = bright_centroid(&images[i]);
-        let reference = reference_marker_with(eye, Refraction::TwoSurface);
-        let paper = reference_marker_with(eye, Refraction::Paper);
+        let reference = reference_marker_with(eye, refraction);
         eprintln!(
-            "eye {i}: GPU {gpu}, two-surface reference {reference} ({} px), paper {paper}",
+            "{} eye {i}: GPU {gpu}, reference {reference} ({} px)",
+            refraction.name(),
             (gpu - reference).length()
         );
         assert!(
             (gpu - reference).length() < bar_px,
-            "eye {i}: GPU marker at {gpu}, two-surface reference at {reference}"
+            "eye {i}: GPU marker at {gpu}, {} reference at {reference}",
+            refraction.name()
         );
     }
 }
@@ -360,6 +408,19 @@ fn two_surface_marker_matches_the_reference_for_a_neutral_head() {
 
 #[test]
 fn two_surface_marker_matches_the_reference_for_a_turned_and_moved_head() {
+    two_surface_marker_matches_the_reference(turned_head(), 2.0);
+}
+
+/// The turned and moved head of the two-surface tests.
+fn turned_head() -> [EyeParams; 2] {
     let turn = Quat::from_euler(glam::EulerRot::YXZ, 0.08, -0.05, 0.02);
-    two_surface_marker_matches_the_reference(head_eyes(Vec3::new(0.015, -0.01, 0.02), turn), 2.0);
+    head_eyes(Vec3::new(0.015, -0.01, 0.02), turn)
+}
+
+#[test]
+fn the_shipped_sphere_places_the_marker_within_the_bar_in_both_models() {
+    for refraction in [Refraction::Paper, Refraction::TwoSurface] {
+        marker_matches_the_reference(eyes(), 1.0, refraction, shipped_sphere());
+        marker_matches_the_reference(turned_head(), 2.0, refraction, shipped_sphere());
+    }
 }

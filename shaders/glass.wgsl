@@ -21,8 +21,8 @@
 // (then the environment), with exact Fresnel at both interfaces. The exit is found against the
 // object's radial map (render/src/two_surface.rs `radial_map`): the distance from the object's
 // centre to its surface and the normal there, per direction. Starting from the sphere through
-// the entry point, each step intersects the ray with the sphere of the radius the map gives
-// at the last estimate: one fetch for a ball, a few for a faceted stone.
+// the entry point, secant steps on the ray's height above the surface: one fetch for a ball, a
+// few for a faceted stone.
 //
 // Texture fetches per covered pixel: baseline 3 (refracted and reflected environment, surface);
 // with background refraction (disparity and/or defocus) and Phong reflection 2 (background
@@ -165,7 +165,7 @@ fn fresnel_exact(cos_incident: f32, eta: f32) -> f32 {
 
 const MAX_INTERNAL_REFLECTIONS: i32 = 4;
 // Radial-map steps per exit at most; a ball needs one.
-const EXIT_STEPS: i32 = 4;
+const EXIT_STEPS: i32 = 8;
 
 // The surface along model direction d from the map centre: x the radius, yzw the outward
 // unit normal (model frame).
@@ -203,17 +203,30 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
     var d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
     for (var bounce = 0; bounce <= MAX_INTERNAL_REFLECTIONS; bounce++) {
-        // Secant-free fixed point on the radius: exact in one step for a ball.
-        var r = length(p);
-        var t = sphere_exit(p, d, r);
+        // f(t) = |p + t d| - r(p + t d) vanishes at the exit. First the exit of the sphere
+        // through the entry (exact for a ball: one fetch), then secant steps on f, or the
+        // sphere of the last radius where a secant step would go backwards.
+        var t = sphere_exit(p, d, length(p));
         var s = radial_surface(p + d * t);
+        var f = length(p + d * t) - s.x;
+        var t_prev = t;
+        var f_prev = f;
         for (var i = 1; i < EXIT_STEPS; i++) {
-            if abs(s.x - r) <= 1e-4 * r {
+            if abs(f) <= 1e-4 * s.x {
                 break;
             }
-            r = s.x;
-            t = sphere_exit(p, d, r);
+            var t_next = sphere_exit(p, d, s.x);
+            if i > 1 && abs(f - f_prev) > 1e-12 {
+                let secant = t - f * (t - t_prev) / (f - f_prev);
+                if secant > 0.0 {
+                    t_next = secant;
+                }
+            }
+            t_prev = t;
+            f_prev = f;
+            t = t_next;
             s = radial_surface(p + d * t);
+            f = length(p + d * t) - s.x;
         }
         p += d * t;
         let outward = s.yzw;

@@ -15,9 +15,19 @@
 // Gaze-dependent defocus (eq. 9-14): the refracted and surface images are read from blur stacks
 // at the blur the frame asks for; one (trilinear) fetch each, whatever the blur.
 //
+// Two-surface refraction (`[object] refraction = "two-surface"`, beyond the paper,
+// docs/equations.md): the ray refracts in at the front, crosses the glass and refracts out at
+// the back, total internal reflection followed for up to MAX_INTERNAL_REFLECTIONS bounces
+// (then the environment), with exact Fresnel at both interfaces. The exit is found against the
+// object's radial map (render/src/two_surface.rs `radial_map`): the distance from the object's
+// centre to its surface and the normal there, per direction. Starting from the sphere through
+// the entry point, secant steps on the ray's height above the surface: one fetch for a ball, a
+// few for a faceted stone.
+//
 // Texture fetches per covered pixel: baseline 3 (refracted and reflected environment, surface);
 // with background refraction (disparity and/or defocus) and Phong reflection 2 (background
-// stack or environment, surface stack); with environment reflection 3.
+// stack or environment, surface stack); with environment reflection 3. Two-surface adds one
+// radial-map fetch per exit step (one for a ball).
 
 struct Eye {
     clip_from_world: mat4x4<f32>,
@@ -51,8 +61,12 @@ struct Globals {
     // rgb: light colour (linear); w: Phong exponent.
     light_colour: vec4<f32>,
     // x: exposure of environment radiance; y: surface opacity (1 - transmittance, 0 without a
-    // surface texture); z: Phong specular strength.
+    // surface texture); z: Phong specular strength; w: 1 for two-surface refraction, else 0.
     shading: vec4<f32>,
+    // Inverse of world_from_model.
+    model_from_world: mat4x4<f32>,
+    // xyz: centre of the radial map (model units); w: its reference radius.
+    radial: vec4<f32>,
 };
 
 var<push_constant> eye: Eye;
@@ -64,6 +78,9 @@ var<push_constant> eye: Eye;
 @group(0) @binding(3) var background: texture_3d<f32>;
 @group(0) @binding(4) var clamp_sampler: sampler;
 @group(0) @binding(5) var surface: texture_3d<f32>;
+// The object's surface seen from its centre (two-surface refraction; 1 texel otherwise): rgb
+// the outward normal minus the direction, a the radius minus the reference radius.
+@group(0) @binding(6) var radial_map: texture_2d<f32>;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -132,6 +149,101 @@ fn background_uv(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(hit.x + 0.5, 0.5 - hit.y, 1.0);
 }
 
+// Exact Fresnel reflectance for unpolarised light (twin of render/src/optics.rs
+// fresnel_reflectance): cos_i on the incident side, eta = n_incident / n_transmitted.
+fn fresnel_exact(cos_incident: f32, eta: f32) -> f32 {
+    let cos_i = clamp(cos_incident, 0.0, 1.0);
+    let sin_t2 = eta * eta * (1.0 - cos_i * cos_i);
+    if sin_t2 >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = sqrt(1.0 - sin_t2);
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return clamp(0.5 * (rs * rs + rp * rp), 0.0, 1.0);
+}
+
+const MAX_INTERNAL_REFLECTIONS: i32 = 4;
+// Radial-map steps per exit at most; a ball needs one.
+const EXIT_STEPS: i32 = 8;
+
+// The surface along model direction d from the map centre: x the radius, yzw the outward
+// unit normal (model frame).
+fn radial_surface(d: vec3<f32>) -> vec4<f32> {
+    let unit = normalize(d);
+    let texel = textureSampleLevel(radial_map, wrap_sampler, latlong_uv(unit), 0.0);
+    return vec4<f32>(g.radial.w + texel.a, normalize(texel.rgb + unit));
+}
+
+// Far crossing of the ray p + t d (d unit) with the sphere of radius r about the origin.
+fn sphere_exit(p: vec3<f32>, d: vec3<f32>, r: f32) -> f32 {
+    let b = dot(p, d);
+    let c = dot(p, p) - r * r;
+    return -b + sqrt(max(b * b - c, 0.0));
+}
+
+struct Passage {
+    // Where the ray left the object (or was given up), world metres.
+    exit: vec3<f32>,
+    // Unit direction after it, world.
+    direction: vec3<f32>,
+    // Exact Fresnel transmittance of both interfaces.
+    transmission: f32,
+    // 1 when it left the object, 0 when given up inside (environment).
+    escaped: f32,
+};
+
+// Two-surface refraction (twin of render/src/two_surface.rs pass_through): the unit ray
+// `incident` meets the front surface at `entry` (world) with unit normal `normal` facing it.
+fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
+    var out: Passage;
+    out.transmission = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
+    out.escaped = 0.0;
+    let inside_world = refract(incident, normal, 1.0 / ior);
+    var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
+    var d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
+    for (var bounce = 0; bounce <= MAX_INTERNAL_REFLECTIONS; bounce++) {
+        // f(t) = |p + t d| - r(p + t d) vanishes at the exit. First the exit of the sphere
+        // through the entry (exact for a ball: one fetch), then secant steps on f, or the
+        // sphere of the last radius where a secant step would go backwards.
+        var t = sphere_exit(p, d, length(p));
+        var s = radial_surface(p + d * t);
+        var f = length(p + d * t) - s.x;
+        var t_prev = t;
+        var f_prev = f;
+        for (var i = 1; i < EXIT_STEPS; i++) {
+            if abs(f) <= 1e-4 * s.x {
+                break;
+            }
+            var t_next = sphere_exit(p, d, s.x);
+            if i > 1 && abs(f - f_prev) > 1e-12 {
+                let secant = t - f * (t - t_prev) / (f - f_prev);
+                if secant > 0.0 {
+                    t_next = secant;
+                }
+            }
+            t_prev = t;
+            f_prev = f;
+            t = t_next;
+            s = radial_surface(p + d * t);
+            f = length(p + d * t) - s.x;
+        }
+        p += d * t;
+        let outward = s.yzw;
+        let leaving = refract(d, -outward, ior);
+        if dot(leaving, leaving) > 0.0 {
+            out.transmission *= 1.0 - fresnel_exact(dot(d, outward), ior);
+            d = leaving;
+            out.escaped = 1.0;
+            break;
+        }
+        d = reflect(d, outward);
+    }
+    out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
+    out.direction = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);
+    return out;
+}
+
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let incident = normalize(in.world_pos - eye.position.xyz);
@@ -141,12 +253,31 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     }
     let ior = g.optics.x;
     let reflected = reflect(incident, n);
-    let fresnel = clamp(g.optics.y + g.optics.z * pow(1.0 + dot(incident, n), g.optics.w), 0.0, 1.0);
+    var fresnel = clamp(g.optics.y + g.optics.z * pow(1.0 + dot(incident, n), g.optics.w), 0.0, 1.0);
     let flags = eye.flags.x;
 
     // The refracted image C_b.
     var refracted_image: vec3<f32>;
-    if (flags & FLAG_BACKGROUND) != 0u {
+    if g.shading.w > 0.0 {
+        // Two-surface: exact Fresnel at the front for the reflection; the refracted image
+        // carries both interfaces' transmittance (1 - fresnel undoes the blend below).
+        var origin = eye.position.xyz;
+        if (flags & FLAG_BACKGROUND) != 0u {
+            origin = eye.refraction_origin.xyz;
+        }
+        let from_origin = normalize(in.world_pos - origin);
+        let passage = two_surface(in.world_pos, from_origin, n, ior);
+        fresnel = fresnel_exact(-dot(incident, n), 1.0 / ior);
+        var seen = environment(passage.direction);
+        if (flags & FLAG_BACKGROUND) != 0u && passage.escaped > 0.0 {
+            let uv = background_uv(passage.exit, passage.direction);
+            if uv.z > 0.0 {
+                seen = textureSampleLevel(
+                    background, clamp_sampler, vec3<f32>(uv.xy, eye.blur.x), 0.0).rgb;
+            }
+        }
+        refracted_image = seen * passage.transmission / max(1.0 - fresnel, 1e-6);
+    } else if (flags & FLAG_BACKGROUND) != 0u {
         let from_origin = normalize(in.world_pos - eye.refraction_origin.xyz);
         let t = refract_heckbert(from_origin, n, ior);
         if t.w == 0.0 {

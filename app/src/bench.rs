@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use vitreous_render::renderer::Want;
-use vitreous_render::{ContextOptions, GpuContext, Look, Reflection, Renderer};
+use vitreous_render::{ContextOptions, GpuContext, Look, Reflection, Refraction, Renderer};
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::{Backend, FrameInput};
 
@@ -51,6 +51,9 @@ pub struct BenchOptions {
     /// Also time each variant with caustics computed per pose on the GPU (a second renderer,
     /// alternated with the scene's baked caustics).
     pub live_caustics: bool,
+    /// Also time each variant with two-surface refraction (a second renderer, alternated
+    /// with the same variant under the paper's refraction).
+    pub two_surface: bool,
 }
 
 /// Degrees the light turns about the vertical axis through the object on each moving frame.
@@ -85,6 +88,9 @@ pub struct VariantResult {
     pub gpu_over_static: Option<f64>,
     /// Moving variants: median wall time over the same variant's standing still.
     pub wall_over_static: Option<f64>,
+    /// Two-surface variants: median GPU time over the same variant's under the paper's
+    /// refraction.
+    pub gpu_over_paper: Option<f64>,
 }
 
 /// A benchmark's result.
@@ -120,6 +126,13 @@ pub fn fetches_per_pixel(look: &Look) -> u32 {
 /// Runs the benchmark.
 pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     let mut scene = load_scene(&options.scene)?;
+    if options.two_surface && options.live_caustics {
+        bail!("give --two-surface or --live-caustics, not both");
+    }
+    if options.two_surface {
+        // The first renderer refracts as the paper does, the second through both surfaces.
+        scene.object.refraction = Refraction::Paper;
+    }
     for set in &options.effects {
         set.ensure_implemented()?;
     }
@@ -196,6 +209,23 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         }
         (labels, planners, on_live) = out;
     }
+    // With --two-surface every variant also runs on a second renderer that refracts through
+    // both surfaces (`<set> two-surface`), right after the same variant under the paper's.
+    let mut on_two = vec![false; labels.len()];
+    if options.two_surface {
+        let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for ((label, planner), live) in labels.into_iter().zip(planners).zip(on_live) {
+            out.0.push(format!("{label} two-surface"));
+            out.1.push(planner.restarted());
+            out.2.push(live);
+            out.3.push(true);
+            out.0.push(label);
+            out.1.push(planner);
+            out.2.push(live);
+            out.3.push(false);
+        }
+        (labels, planners, on_live, on_two) = out;
+    }
 
     // The same views for every variant: a synthetic trace looking at the object.
     let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(&scene))
@@ -254,26 +284,46 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         ),
         _ => None,
     };
+    let mut two_renderer = if options.two_surface {
+        let mut two = scene.clone();
+        two.object.refraction = Refraction::TwoSurface;
+        let ctx = GpuContext::headless(&ContextOptions {
+            validation: options.validate,
+            device_name: options.device.clone(),
+        })
+        .context("setting up the second Vulkan device")?;
+        let mut r = Renderer::new(ctx, &views::scene_desc(&two, setup.as_ref()), w, h)
+            .context("preparing the two-surface renderer")?;
+        views::enable_live_caustics(&mut r, &two, any_caustics)
+            .context("preparing live caustics")?;
+        Some(r)
+    } else {
+        None
+    };
     drop(setup);
 
     // With --moving every variant runs twice in a row per frame: the light moved, then the
     // same pose again (nothing moved since the frame before).
-    let (labels, mut planners, moving, on_live) = if options.moving {
-        let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for ((label, planner), live) in labels.into_iter().zip(planners).zip(on_live) {
+    let (labels, mut planners, moving, on_live, on_two) = if options.moving {
+        let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for (((label, planner), live), two) in
+            labels.into_iter().zip(planners).zip(on_live).zip(on_two)
+        {
             out.0.push(format!("{label} moving"));
             out.1.push(planner.restarted());
             out.2.push(true);
             out.3.push(live);
+            out.4.push(two);
             out.0.push(label);
             out.1.push(planner);
             out.2.push(false);
             out.3.push(live);
+            out.4.push(two);
         }
         out
     } else {
         let n = labels.len();
-        (labels, planners, vec![false; n], on_live)
+        (labels, planners, vec![false; n], on_live, on_two)
     };
     let center = scene.object.center_m;
     let rest = scene.rest_placement();
@@ -286,8 +336,9 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     let mut looks = vec![Look::default(); n];
     for (k, input) in inputs.iter().enumerate() {
         for (v, planner) in planners.iter_mut().enumerate() {
-            let renderer = match &mut live_renderer {
-                Some(live) if on_live[v] => live,
+            let renderer = match (&mut live_renderer, &mut two_renderer) {
+                (Some(live), _) if on_live[v] => live,
+                (_, Some(two)) if on_two[v] => two,
                 _ => &mut renderer,
             };
             let started = Instant::now();
@@ -320,7 +371,10 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             }
         }
     }
-    for r in std::iter::once(&renderer).chain(live_renderer.as_ref()) {
+    for r in std::iter::once(&renderer)
+        .chain(live_renderer.as_ref())
+        .chain(two_renderer.as_ref())
+    {
         crate::frame_loop::ensure_validation_clean(r)?;
     }
     let spreads: Vec<_> = (0..n)
@@ -347,16 +401,23 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         (Some(a), Some(b)) if b.median_ms > 0.0 => Some(a.median_ms / b.median_ms),
         _ => None,
     };
-    // The baseline standing still (the second variant when the first is its moving twin).
-    let base = spreads[usize::from(options.moving)];
+    // The baseline standing still under the paper's refraction (after its moving and
+    // two-surface twins).
+    let base =
+        spreads[(usize::from(options.moving) + 1) * (usize::from(options.two_surface) + 1) - 1];
     let results = (0..n)
         .map(|i| {
             let (g, c, wl) = spreads[i];
             // A moving variant's static twin comes right after it.
             let twin = (moving[i] && i + 1 < n).then_some(i + 1);
+            // A two-surface variant's paper twin: the same label without the suffix.
+            let paper = labels[i].replace(" two-surface", "");
+            let paper_twin = on_two[i]
+                .then(|| labels.iter().position(|l| *l == paper))
+                .flatten();
             VariantResult {
                 effects: labels[i].clone(),
-                fetches_per_pixel: fetches_per_pixel(&looks[i]),
+                fetches_per_pixel: fetches_per_pixel(&looks[i]) + u32::from(on_two[i]),
                 moving: moving[i],
                 gpu_ms: g,
                 prepare_gpu_ms: Spread::of(prepare[i].iter().copied()),
@@ -367,6 +428,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 wall_ratio: ratio(wl, base.2),
                 gpu_over_static: twin.and_then(|t| ratio(total_gpu[i], total_gpu[t])),
                 wall_over_static: twin.and_then(|t| ratio(wl, spreads[t].2)),
+                gpu_over_paper: paper_twin.and_then(|t| ratio(g, spreads[t].0)),
             }
         })
         .collect();
@@ -392,7 +454,7 @@ impl BenchReport {
         );
         let _ = writeln!(
             out,
-            "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8}",
+            "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8} {:>9}",
             "effects",
             "fetch",
             "GPU ms (p10-p90)",
@@ -403,7 +465,8 @@ impl BenchReport {
             "ratio",
             "fields GPU ms",
             "GPU/still",
-            "wall/still"
+            "wall/still",
+            "GPU/paper"
         );
         let cell = |s: Option<Spread>| {
             s.map_or("n/a".to_string(), |s| {
@@ -414,7 +477,7 @@ impl BenchReport {
         for v in &self.variants {
             let _ = writeln!(
                 out,
-                "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8}",
+                "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8} {:>9}",
                 v.effects,
                 v.fetches_per_pixel,
                 cell(v.gpu_ms),
@@ -425,7 +488,8 @@ impl BenchReport {
                 r(v.wall_ratio),
                 cell(v.prepare_gpu_ms),
                 r(v.gpu_over_static),
-                r(v.wall_over_static)
+                r(v.wall_over_static),
+                r(v.gpu_over_paper)
             );
         }
         out

@@ -143,8 +143,9 @@ enum Command {
         /// (the paper's choice) or the environment map with a Fresnel term.
         #[arg(long, value_enum, default_value_t = ReflectionArg::Phong)]
         reflection: ReflectionArg,
-        /// Also write each saved eye image beside the CPU ray-traced reference of its
-        /// refraction layer (for sphere scenes: the object's bounding sphere is traced).
+        /// Also write each saved eye image under the paper's and under two-surface refraction
+        /// beside the CPU ray-traced two-surface refraction layer (for sphere scenes: the
+        /// object's bounding sphere is traced).
         #[arg(long)]
         reference: bool,
         /// Gaze image: auto (from the wearer's fixation depth), or forced to surface or
@@ -207,6 +208,10 @@ enum Command {
         /// per pose on the GPU, alternated with the scene's bake.
         #[arg(long = "live-caustics")]
         live_caustics: bool,
+        /// Also time each variant with two-surface refraction on a second renderer,
+        /// alternated with the same variant under the paper's refraction (ratio GPU/paper).
+        #[arg(long = "two-surface")]
+        two_surface: bool,
     },
     /// Replay a scene again and again in one process (a new Vulkan device and renderer each
     /// pass, validation on) and check that resident memory stays flat and validation silent.
@@ -462,6 +467,7 @@ fn run(cli: Cli) -> Result<()> {
             pupils_mm,
             moving,
             live_caustics,
+            two_surface,
         } => {
             let report = bench(&BenchOptions {
                 scene,
@@ -474,6 +480,7 @@ fn run(cli: Cli) -> Result<()> {
                 pupils_mm,
                 moving,
                 live_caustics,
+                two_surface,
             })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);

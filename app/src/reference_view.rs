@@ -1,8 +1,10 @@
-//! The debug output of `vitreous replay --reference`: each saved eye image beside the CPU
-//! reference of its refraction layer (render/src/reference.rs), for scenes whose object is a
-//! sphere (the reference traces the analytic sphere of the object's bounding sphere).
+//! The debug output of `vitreous replay --reference`: each saved eye image under the paper's
+//! refraction and under two-surface refraction, beside the CPU ray tracer's two-surface
+//! refraction layer (render/src/reference.rs), for scenes whose object is a sphere (the
+//! reference traces the analytic sphere of the object's bounding sphere).
 
 use glam::Vec2;
+use vitreous_render::Refraction;
 use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sample};
 use vitreous_xr::FrameInput;
 
@@ -19,30 +21,42 @@ pub fn sphere_of(scene: &Scene) -> SphereScene {
         center_m: scene.object.center_m,
         radius_m: scene.object.radius_m,
         ior: scene.object.ior,
+        refraction: scene.object.refraction,
         background_from_world: scene.background.world_from_plane().inverse(),
     }
 }
 
-/// An RGBA8 image twice as wide as an eye image: the GPU's eye image on the left, the CPU
-/// reference of the refraction layer on the right (the background photo's texel at
-/// `(u_c, v_c)`, black off the sphere, grey where the ray misses the photo).
+/// An RGBA8 image as wide as `gpu.len() + 1` eye images: the GPU's eye images left to right
+/// (paper, then two-surface refraction), then the CPU reference of the refraction layer under
+/// `refraction` (the background photo's texel at `(u_c, v_c)`, black off the sphere, grey
+/// where the ray misses the photo).
 pub fn side_by_side(
     scene: &Scene,
     input: &FrameInput,
     eye: usize,
-    gpu: &[u8],
+    gpu: &[&[u8]],
+    refraction: Refraction,
     size: (u32, u32),
 ) -> Vec<u8> {
     let (w, h) = size;
+    let panels = gpu.len() as u32 + 1;
     let camera = eye_params(&input.views[eye]);
-    let sphere = sphere_of(scene);
+    let sphere = SphereScene {
+        refraction,
+        ..sphere_of(scene)
+    };
     let dims = Vec2::new(w as f32, h as f32);
     let photo = &scene.background.photo;
-    let mut out = vec![0u8; (w * 2 * h * 4) as usize];
+    let mut out = vec![0u8; (w * panels * h * 4) as usize];
+    let row_bytes = (w * 4) as usize;
     for y in 0..h {
-        let row = (y * w * 2 * 4) as usize;
+        let row = (y * w * panels * 4) as usize;
         let src = (y * w * 4) as usize;
-        out[row..row + (w * 4) as usize].copy_from_slice(&gpu[src..src + (w * 4) as usize]);
+        for (k, image) in gpu.iter().enumerate() {
+            let at = row + k * row_bytes;
+            out[at..at + row_bytes].copy_from_slice(&image[src..src + row_bytes]);
+        }
+        let cpu_panel = gpu.len() as u32 * w;
         for x in 0..w {
             let pixel = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
             let rgba = match refraction_sample(&camera, pixel, dims, &sphere) {
@@ -52,7 +66,7 @@ pub fn side_by_side(
                     texel(&photo.data, photo.width, photo.height, uv)
                 }
             };
-            let i = row + ((w + x) * 4) as usize;
+            let i = row + ((cpu_panel + x) * 4) as usize;
             out[i..i + 4].copy_from_slice(&rgba);
         }
     }

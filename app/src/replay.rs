@@ -10,7 +10,9 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer, ScenePose};
+use vitreous_render::{
+    ContextOptions, GpuContext, Look, Reflection, Refraction, Renderer, ScenePose,
+};
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{EditRecord, TraceSample, read_trace_with_edits};
@@ -199,6 +201,9 @@ struct Saver<'a> {
     planner: LookPlanner,
     /// The scene, when the CPU reference is written beside each saved eye.
     reference: Option<&'a Scene>,
+    /// With the reference: the scene under the other refraction model, drawn again for each
+    /// saved frame.
+    other: Option<OtherRefraction>,
     save_every: u64,
     saved: Vec<String>,
     progress: ProgressBar,
@@ -214,6 +219,45 @@ struct Saver<'a> {
     edits: std::collections::VecDeque<EditRecord>,
 }
 
+/// A second renderer with the scene under the refraction model the scene does not use, for
+/// `--reference`'s paper / two-surface / ray-traced images.
+struct OtherRefraction {
+    /// The renderer.
+    renderer: Renderer,
+    /// The scene's own model.
+    scene_model: Refraction,
+    /// The object's latest pose, when it moves.
+    pose: Option<ScenePose>,
+    /// Saved frames in flight: index, look, and pose.
+    pending: Vec<(u64, Look, Option<ScenePose>)>,
+}
+
+impl OtherRefraction {
+    /// Draws frame `input` as planned under the other model and returns its eye images.
+    fn draw(&mut self, input: &FrameInput) -> Result<Option<[Vec<u8>; 2]>> {
+        let Some(k) = self.pending.iter().position(|p| p.0 == input.index) else {
+            return Ok(None);
+        };
+        let (_, look, pose) = self.pending.swap_remove(k);
+        if let Some(pose) = pose {
+            self.renderer.set_pose(pose);
+        }
+        let want = Want {
+            eyes: true,
+            world: false,
+        };
+        self.renderer
+            .submit(&views::frame_params(input, look), want)
+            .context("drawing the frame under the other refraction model")?;
+        let results = self.renderer.flush()?;
+        Ok(results
+            .into_iter()
+            .last()
+            .and_then(|r| r.readback)
+            .map(|r| r.eyes))
+    }
+}
+
 impl FrameSink for Saver<'_> {
     fn pose(&mut self, input: &FrameInput) -> Option<ScenePose> {
         // Each edit shows from the first frame at or after its time, as in the session.
@@ -223,13 +267,20 @@ impl FrameSink for Saver<'_> {
             self.motion.replay_edit(edit, input.index);
             self.edits.pop_front();
         }
-        self.motion.pose(input.time_ns, &mut self.planner)
+        let pose = self.motion.pose(input.time_ns, &mut self.planner);
+        if let (Some(other), Some(p)) = (&mut self.other, pose) {
+            other.pose = Some(p);
+        }
+        pose
     }
 
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         let save = self.save_every > 0 && input.index.is_multiple_of(self.save_every);
         let mut look = self.planner.plan(input).0;
         look.caustics &= self.motion.caustics_valid();
+        if save && let Some(other) = &mut self.other {
+            other.pending.push((input.index, look, other.pose));
+        }
         if let Err(e) = self
             .log
             .record(input, &self.condition, self.planner.last_defocus())
@@ -260,9 +311,25 @@ impl FrameSink for Saver<'_> {
                 .extend(names.into_iter().map(|n| format!("frames/{n}")));
             if let Some(scene) = self.reference {
                 let size = (readback.width, readback.height);
+                let other = match &mut self.other {
+                    Some(o) => o.draw(input)?.map(|eyes| (eyes, o.scene_model)),
+                    None => None,
+                };
                 for (eye, name) in output::EYE_NAMES.iter().enumerate() {
-                    let image = side_by_side(scene, input, eye, &readback.eyes[eye], size);
-                    let png = output::encode_png(&image, size.0 * 2, size.1)?;
+                    let own = readback.eyes[eye].as_slice();
+                    // Paper, two-surface, then the ray tracer's two-surface layer.
+                    let gpu: Vec<&[u8]> = match &other {
+                        Some((eyes, Refraction::Paper)) => vec![own, eyes[eye].as_slice()],
+                        Some((eyes, Refraction::TwoSurface)) => vec![eyes[eye].as_slice(), own],
+                        None => vec![own],
+                    };
+                    let traced = if other.is_some() {
+                        Refraction::TwoSurface
+                    } else {
+                        scene.object.refraction
+                    };
+                    let image = side_by_side(scene, input, eye, &gpu, traced, size);
+                    let png = output::encode_png(&image, size.0 * (gpu.len() as u32 + 1), size.1)?;
                     let file = format!("{:06}-{name}-reference.png", input.index);
                     write_atomic(&self.dir.join(&file), &png)?;
                     self.saved.push(format!("frames/{file}"));
@@ -362,6 +429,35 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     .context("preparing the renderer")?;
     views::enable_live_caustics(&mut renderer, &scene, effects.caustics)
         .context("preparing live caustics")?;
+    let other = if options.reference {
+        let mut other_scene = scene.clone();
+        other_scene.object.refraction = match scene.object.refraction {
+            Refraction::Paper => Refraction::TwoSurface,
+            Refraction::TwoSurface => Refraction::Paper,
+        };
+        let ctx = GpuContext::headless(&ContextOptions {
+            validation: options.validate,
+            device_name: options.device.clone(),
+        })
+        .context("setting up the second Vulkan device")?;
+        let mut r = Renderer::new(
+            ctx,
+            &views::scene_desc(&other_scene, defocus.as_ref()),
+            width,
+            height,
+        )
+        .context("preparing the renderer of the other refraction model")?;
+        views::enable_live_caustics(&mut r, &other_scene, effects.caustics)
+            .context("preparing live caustics")?;
+        Some(OtherRefraction {
+            renderer: r,
+            scene_model: scene.object.refraction,
+            pose: None,
+            pending: Vec::new(),
+        })
+    } else {
+        None
+    };
     drop(defocus);
 
     let frames_dir = options.out.join("frames");
@@ -400,6 +496,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     let mut saver = Saver {
         dir: frames_dir,
         reference: options.reference.then_some(&scene),
+        other,
         save_every: options.save_every,
         planner,
         saved: Vec::new(),
@@ -425,6 +522,9 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     };
     let wall_s = started.elapsed().as_secs_f64();
     saver.progress.finish_and_clear();
+    if let Some(other) = &saver.other {
+        frame_loop::ensure_validation_clean(&other.renderer)?;
+    }
     let interrupted = signals && crate::interrupt::requested();
     // The log holds exactly the frames rendered, also when interrupted.
     saver.log.finish()?;

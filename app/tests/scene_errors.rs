@@ -204,6 +204,19 @@ fn out_of_range_value_is_named() {
 }
 
 #[test]
+fn unknown_refraction_model_is_named() {
+    let text = good_text().replace(
+        "diameter_m = 0.08",
+        "diameter_m = 0.08\nrefraction = \"thick\"",
+    );
+    let msg = expect_error(&text, line_of(&text, "refraction"), "object.refraction");
+    assert!(
+        msg.contains("two-surface") && msg.contains("thick"),
+        "{msg}"
+    );
+}
+
+#[test]
 fn non_finite_numbers_are_refused() {
     let text = good_text().replace(
         "position_m = [0.0, -0.26, -1.5]",

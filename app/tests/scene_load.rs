@@ -93,6 +93,28 @@ fn gltf_ior_is_used_when_the_scene_gives_none() {
 }
 
 #[test]
+fn refraction_defaults_to_the_paper_and_reads_two_surface() {
+    let text = std::fs::read_to_string(data("scenes/minimal.toml"))
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", data("scenes/..").display()));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, &text).unwrap();
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.object.refraction, vitreous_render::Refraction::Paper);
+    let two = text.replace(
+        "diameter_m = 0.5",
+        "diameter_m = 0.5\nrefraction = \"two-surface\"",
+    );
+    std::fs::write(&path, &two).unwrap();
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(
+        scene.object.refraction,
+        vitreous_render::Refraction::TwoSurface
+    );
+}
+
+#[test]
 fn rotation_and_object_frame_light_are_applied() {
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(data("scenes/minimal.toml"))

@@ -1,5 +1,6 @@
 //! The glass object pass, baseline method: environment-map reflection and refraction blended
-//! by a Fresnel term (METHOD.md section 6; shaders/glass.wgsl).
+//! by a Fresnel term (METHOD.md section 6; shaders/glass.wgsl); refraction to the background
+//! plane (eq. 7-8), or through both surfaces of the object (two-surface, with its radial map).
 
 use ash::vk;
 use glam::Vec4;
@@ -7,13 +8,14 @@ use glam::Vec4;
 use crate::camera::{EyeParams, Look, Reflection};
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::memory::Buffer;
+use crate::memory::{Buffer, Image, upload_texture};
 use crate::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, PipelineSpec};
 use crate::pose::ScenePose;
-use crate::scene::{GpuScene, SceneDesc, VERTEX_STRIDE};
+use crate::scene::{GpuScene, Refraction, SceneDesc, VERTEX_STRIDE};
 use crate::shaders;
+use crate::two_surface::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, radial_map};
 
 /// Phong exponent of the highlight: a sharp highlight, as on polished glass.
 const PHONG_EXPONENT: f32 = 200.0;
@@ -103,6 +105,8 @@ struct Globals {
     light: [f32; 4],
     light_colour: [f32; 4],
     shading: [f32; 4],
+    model_from_world: [f32; 16],
+    radial: [f32; 4],
 }
 
 impl Globals {
@@ -110,6 +114,7 @@ impl Globals {
     fn posed(mut self, pose: &ScenePose) -> Globals {
         self.world_from_model = pose.world_from_model.to_cols_array();
         self.normal_from_model = pose.world_from_model.inverse().transpose().to_cols_array();
+        self.model_from_world = pose.world_from_model.inverse().to_cols_array();
         self.light = pose.light_position_m.extend(1.0).to_array();
         self
     }
@@ -131,6 +136,8 @@ pub struct GlassPass {
     globals_buffer: Buffer,
     /// What the buffer was created with; [`GlassPass::record_pose`] changes only the pose.
     globals: Globals,
+    /// The object's radial map (two-surface refraction), or one texel.
+    _radial_map: Image,
 }
 
 impl GlassPass {
@@ -168,6 +175,11 @@ impl GlassPass {
                 ),
                 (
                     5,
+                    vk::DescriptorType::SAMPLED_IMAGE,
+                    vk::ShaderStageFlags::FRAGMENT,
+                ),
+                (
+                    6,
                     vk::DescriptorType::SAMPLED_IMAGE,
                     vk::ShaderStageFlags::FRAGMENT,
                 ),
@@ -224,7 +236,7 @@ impl GlassPass {
             1,
             &[
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
-                (vk::DescriptorType::SAMPLED_IMAGE, 3),
+                (vk::DescriptorType::SAMPLED_IMAGE, 4),
                 (vk::DescriptorType::SAMPLER, 2),
             ],
         )?;
@@ -234,6 +246,8 @@ impl GlassPass {
         } else {
             0.0
         };
+        let two_surface = desc.refraction == Refraction::TwoSurface;
+        let (radial_map, radial) = upload_radial_map(ctx, desc)?;
         let globals = Globals {
             world_from_model: [0.0; 16],
             normal_from_model: [0.0; 16],
@@ -241,7 +255,15 @@ impl GlassPass {
             optics: [desc.ior, FRESNEL_BIAS, FRESNEL_SCALE, FRESNEL_POWER],
             light: [0.0; 4],
             light_colour: desc.light.radiance.extend(PHONG_EXPONENT).to_array(),
-            shading: Vec4::new(desc.exposure, surface_opacity, PHONG_STRENGTH, 0.0).to_array(),
+            shading: Vec4::new(
+                desc.exposure,
+                surface_opacity,
+                PHONG_STRENGTH,
+                if two_surface { 1.0 } else { 0.0 },
+            )
+            .to_array(),
+            model_from_world: [0.0; 16],
+            radial,
         }
         .posed(&ScenePose::of(desc));
         let globals_buffer = Buffer::with_data(
@@ -272,6 +294,7 @@ impl GlassPass {
             scene.photo_sampler(),
         );
         pipeline::write_image(ctx, set, 5, scene.surface.view);
+        pipeline::write_image(ctx, set, 6, radial_map.view);
         Ok(GlassPass {
             pipeline,
             layout,
@@ -280,6 +303,7 @@ impl GlassPass {
             set,
             globals_buffer,
             globals,
+            _radial_map: radial_map,
         })
     }
 
@@ -378,4 +402,60 @@ impl GlassPass {
             d.cmd_draw_indexed(cmd, scene.index_count, 1, 0, 0, 0);
         }
     }
+}
+
+/// Uploads the object's radial map (half floats, which filter linearly on every device) for
+/// two-surface refraction, or one zero texel for the paper's model; and the map's centre
+/// (model units) and reference radius as the shader's `radial` vector.
+fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32; 4])> {
+    let m = desc.mesh;
+    let (texels, extent, radial) = if desc.refraction == Refraction::TwoSurface {
+        let map = radial_map(
+            m.positions,
+            m.normals,
+            m.indices,
+            RADIAL_MAP_WIDTH,
+            RADIAL_MAP_HEIGHT,
+        )
+        .map_err(|e| {
+            crate::error::RenderError::InvalidInput(format!(
+                "two-surface refraction needs a closed mesh: {e}"
+            ))
+        })?;
+        if !map.star_shaped {
+            tracing::warn!(
+                "two-surface refraction: the object is not star-shaped about its centre; the \
+                 exit is found on its outermost surface"
+            );
+        }
+        (
+            map.texels,
+            vk::Extent2D {
+                width: map.width,
+                height: map.height,
+            },
+            map.center.extend(map.radius).to_array(),
+        )
+    } else {
+        (
+            vec![0.0; 4],
+            vk::Extent2D {
+                width: 1,
+                height: 1,
+            },
+            [0.0, 0.0, 0.0, 1.0],
+        )
+    };
+    let halves: Vec<u8> = texels
+        .iter()
+        .flat_map(|&f| half::f16::from_f32(f).to_le_bytes())
+        .collect();
+    let image = upload_texture(
+        ctx,
+        "radial map",
+        vk::Format::R16G16B16A16_SFLOAT,
+        extent,
+        &halves,
+    )?;
+    Ok((image, radial))
 }

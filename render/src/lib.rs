@@ -37,7 +37,9 @@ pub mod reference;
 pub mod renderer;
 pub mod scene;
 mod shaders;
+pub mod solid;
 mod target;
+pub mod two_surface;
 mod validation;
 mod world;
 
@@ -51,6 +53,6 @@ pub use memory::color_copy_region;
 pub use pose::ScenePose;
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
-    BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData,
-    TextureDesc,
+    BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, Refraction,
+    RefractionParseError, SceneDesc, TexelData, TextureDesc,
 };

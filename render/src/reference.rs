@@ -1,11 +1,14 @@
-//! CPU reference of the refraction layer (eq. 7-8) for an analytic sphere: what each pixel of
-//! an eye image samples from the registered background photo. Tests compare the GPU against
-//! it; `vitreous replay --reference` writes it beside the GPU image.
+//! CPU reference of the refraction layer for an analytic sphere: what each pixel of an eye
+//! image samples from the registered background photo, under the paper's model (eq. 7-8) or
+//! two-surface refraction (`two_surface.rs`). Tests compare the GPU against it;
+//! `vitreous replay --reference` writes it beside the GPU image.
 
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::camera::EyeParams;
 use crate::optics::{fresnel, plane_uv, ray_sphere, refract_heckbert};
+use crate::scene::Refraction;
+use crate::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, pass_through};
 
 /// An analytic glass sphere in front of a registered background plane.
 #[derive(Clone, Copy, Debug)]
@@ -16,6 +19,8 @@ pub struct SphereScene {
     pub radius_m: f32,
     /// Relative index of refraction.
     pub ior: f32,
+    /// How the view ray is refracted.
+    pub refraction: Refraction,
     /// Inverse of the background plane's `world_from_plane`.
     pub background_from_world: Mat4,
 }
@@ -30,7 +35,9 @@ pub enum RefractionSample {
         /// Where the refracted ray meets the background photo, as texture coordinates (u right,
         /// v down); `None` when it misses it (the environment map is seen instead).
         uv: Option<Vec2>,
-        /// Fraction of the refracted image that reaches the eye: 1 minus the Fresnel factor.
+        /// Fraction of the refracted image that reaches the eye: 1 minus the empirical Fresnel
+        /// factor (paper), or the product of the exact Fresnel transmittances at both
+        /// interfaces (two-surface).
         transmission: f32,
     },
 }
@@ -47,7 +54,9 @@ impl EyeParams {
     }
 }
 
-/// Traces one pixel of one eye: eye ray -> sphere -> first refraction (eq. 7-8) -> background.
+/// Traces one pixel of one eye: eye ray -> sphere -> first refraction (eq. 7-8), or both
+/// refractions with total internal reflection (two-surface) -> background. A two-surface ray
+/// still inside after the reflection limit sees the environment (`uv` is `None`).
 pub fn refraction_sample(
     eye: &EyeParams,
     pixel: Vec2,
@@ -56,6 +65,22 @@ pub fn refraction_sample(
 ) -> RefractionSample {
     let dir = eye.pixel_ray(pixel, size);
     let origin = eye.position_m;
+    if scene.refraction == Refraction::TwoSurface {
+        let ball = Ball {
+            center_m: scene.center_m,
+            radius_m: scene.radius_m,
+        };
+        return match pass_through(&ball, origin, dir, scene.ior, MAX_INTERNAL_REFLECTIONS) {
+            None => RefractionSample::Miss,
+            Some(p) => RefractionSample::Hit {
+                uv: p
+                    .escaped
+                    .then(|| plane_uv(p.exit_m, p.direction, scene.background_from_world))
+                    .flatten(),
+                transmission: p.transmission,
+            },
+        };
+    }
     let Some(t) = ray_sphere(origin, dir, scene.center_m, scene.radius_m) else {
         return RefractionSample::Miss;
     };
@@ -141,6 +166,7 @@ mod tests {
             center_m: Vec3::new(0.0, 0.0, -0.2),
             radius_m: 0.075,
             ior: 1.51,
+            refraction: Refraction::Paper,
             background_from_world: Mat4::from_translation(Vec3::new(0.0, 0.0, -0.4)).inverse(),
         };
         let s = refraction_sample(&eye, Vec2::new(50.0, 40.0), Vec2::new(100.0, 80.0), &scene);

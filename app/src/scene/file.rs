@@ -92,6 +92,7 @@ pub(crate) struct ObjectToml {
     pub position_m: Spanned<Vec<f32>>,
     pub rotation_deg: Option<Spanned<Vec<f32>>>,
     pub ior: Option<Spanned<f32>>,
+    pub refraction: Option<Spanned<String>>,
     pub surface_texture: Option<Spanned<String>>,
     pub surface_transmittance: Option<Spanned<f32>>,
 }

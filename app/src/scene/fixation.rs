@@ -8,6 +8,8 @@
 //! refracted one ([`gaze_image_of_target`]).
 
 use glam::Vec3;
+use vitreous_render::Refraction;
+use vitreous_render::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, pass_through};
 use vitreous_xr::synth::{FixationTarget, SynthParams};
 
 use super::Scene;
@@ -22,6 +24,11 @@ pub const REFRACTED_TARGET: usize = 1;
 /// Distance behind the object's centre where the refracted image is assumed to lie when the
 /// scene's background plane is not in line with the object, metres.
 const FALLBACK_REFRACTED_DEPTH_M: f32 = 0.2;
+
+/// Farthest a two-surface refracted image is placed, as a multiple of the background point's
+/// distance: a virtual image near the ball's focal length runs off to infinity, and eq. 13-14
+/// measure its blur on the background photo, whose blur stack must stay small.
+pub const MAX_IMAGE_OVER_BACKGROUND: f32 = 2.0;
 
 /// The viewer's head and the two points it fixates, world frame, metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,6 +54,11 @@ pub struct ViewingGeometry {
     pub plane_point_m: Vec3,
     /// Unit normal of the background plane.
     pub plane_normal: Vec3,
+    /// The object's relative index of refraction when it refracts through both surfaces
+    /// (`refraction = "two-surface"`): the refracted image is then where the light of the
+    /// background point converges after the object. `None`: the paper's refraction, where the
+    /// refracted image is the background point itself.
+    pub two_surface_ior: Option<f32>,
 }
 
 impl ViewingGeometry {
@@ -70,10 +82,53 @@ impl ViewingGeometry {
         } else {
             behind
         };
+        let refracted_m = match self.two_surface_ior {
+            Some(ior) => self.lens_image(head_m, refracted_m, ior),
+            None => refracted_m,
+        };
         FixationPoints {
             head_m,
             surface_m,
             refracted_m,
+        }
+    }
+
+    /// Where the light of `source_m` (on the line from `head_m` through the centre) converges
+    /// after passing through both surfaces of the object's bounding ball: the point on that
+    /// line where a paraxial ray from the source crosses it (the thick-lens image). A virtual
+    /// image (rays diverging from a point behind the ball) is where they seem to come from, at
+    /// most [`MAX_IMAGE_OVER_BACKGROUND`] times as far as the source. When the light reaches
+    /// the viewer parallel or still converging (the image at or behind them) there is no image
+    /// to focus on, and the source itself stands for it, as in the paper's model.
+    fn lens_image(&self, head_m: Vec3, source_m: Vec3, ior: f32) -> Vec3 {
+        let axis = (head_m - source_m).normalize_or(Vec3::Z);
+        let far_m = head_m.distance(source_m) * MAX_IMAGE_OVER_BACKGROUND;
+        let ball = Ball {
+            center_m: self.center_m,
+            radius_m: self.radius_m,
+        };
+        // A ray 1 % of the radius off the axis: paraxial, so the thick-lens image.
+        let side = axis.any_orthonormal_vector();
+        let aim = self.center_m + side * (0.01 * self.radius_m);
+        let dir = (aim - source_m).normalize();
+        let Some(p) = pass_through(&ball, source_m, dir, ior, MAX_INTERNAL_REFLECTIONS) else {
+            return source_m;
+        };
+        // Where the exit ray meets the axis: its height above the axis falls to zero.
+        let height = (p.exit_m - self.center_m).dot(side);
+        let climb = p.direction.dot(side);
+        if !p.escaped || climb.abs() < 1e-9 {
+            return source_m;
+        }
+        let image = p.exit_m + p.direction * (-height / climb);
+        // Along the axis towards the viewer, from the viewer: positive in front of them.
+        let in_front_m = (head_m - image).dot(axis);
+        if in_front_m <= 0.0 {
+            source_m
+        } else if in_front_m > far_m {
+            head_m - axis * far_m
+        } else {
+            image
         }
     }
 
@@ -94,6 +149,8 @@ impl Scene {
             radius_m: self.object.radius_m,
             plane_point_m: self.background.pose.position,
             plane_normal: self.background.normal(),
+            two_surface_ior: (self.object.refraction == Refraction::TwoSurface)
+                .then_some(self.object.ior),
         }
     }
 
@@ -160,5 +217,49 @@ mod tests {
         let d = scene.image_distances();
         assert!((d.surface_m - p.head_m.distance(p.surface_m)).abs() < 1e-6);
         assert!(d.refracted_m > d.surface_m, "{d:?}");
+    }
+
+    fn ball_geometry(background_z_m: f32) -> ViewingGeometry {
+        ViewingGeometry {
+            center_m: Vec3::new(0.0, 0.0, -0.2),
+            radius_m: 0.075,
+            plane_point_m: Vec3::new(0.0, 0.0, background_z_m),
+            plane_normal: Vec3::Z,
+            two_surface_ior: Some(1.51),
+        }
+    }
+
+    #[test]
+    fn two_surface_refracted_image_is_the_ball_lens_image_of_the_background() {
+        // Background 1 m behind the centre: a real image f s / (s - f) in front of the centre,
+        // 0.125 m from it, 0.075 m in front of the viewer (on the ball's surface plane).
+        let g = ball_geometry(-1.2);
+        let p = g.points_from(Vec3::ZERO);
+        let (image_m, _) = vitreous_render::two_surface::ball_image(1.0, 0.075, 1.51);
+        let expected = Vec3::new(0.0, 0.0, -0.2 + image_m);
+        assert!(
+            p.refracted_m.distance(expected) < 1e-3,
+            "{} vs {expected}",
+            p.refracted_m
+        );
+        let d = g.distances_from(Vec3::ZERO);
+        assert!((d.refracted_m - (0.2 - image_m)).abs() < 1e-3, "{d:?}");
+        // The paper's model puts the refracted image at the background point.
+        let paper = ViewingGeometry {
+            two_surface_ior: None,
+            ..g
+        };
+        assert!((paper.distances_from(Vec3::ZERO).refracted_m - 1.2).abs() < 1e-5);
+    }
+
+    #[test]
+    fn an_image_behind_the_viewer_falls_back_to_the_background_point() {
+        // The visual-effects geometry: the image forms 0.25 m in front of the centre, 0.05 m
+        // behind the viewer; the light reaches the eye converging.
+        let d = ball_geometry(-0.4).distances_from(Vec3::ZERO);
+        assert!((d.refracted_m - 0.4).abs() < 1e-5, "{d:?}");
+        // A virtual image far behind (background just inside the focal length) is capped.
+        let d = ball_geometry(-0.3).distances_from(Vec3::ZERO);
+        assert!((d.refracted_m - 0.6).abs() < 1e-4, "{d:?}");
     }
 }

@@ -562,6 +562,18 @@ impl Loader<'_> {
             (None, None) => (1.5, IorSource::Default),
         };
 
+        let refraction = match &raw.refraction {
+            None => vitreous_render::Refraction::default(),
+            Some(r) => {
+                r.get_ref()
+                    .parse()
+                    .map_err(|e: vitreous_render::RefractionParseError| {
+                        self.src
+                            .invalid(r.span(), "object.refraction", e.to_string())
+                    })?
+            }
+        };
+
         let surface_texture = match &raw.surface_texture {
             Some(rel) => Some(self.photo("object.surface_texture", rel)?),
             None => None,
@@ -594,6 +606,7 @@ impl Loader<'_> {
             radius_m: radius_model * scale,
             ior,
             ior_source,
+            refraction,
             surface_texture,
             surface_transmittance,
             model_path,

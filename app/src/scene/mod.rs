@@ -222,6 +222,9 @@ pub struct Object {
     pub ior: f32,
     /// Where `ior` came from.
     pub ior_source: IorSource,
+    /// How the view ray is refracted through the object (`refraction`; the paper's model by
+    /// default).
+    pub refraction: vitreous_render::Refraction,
     /// Surface texture (sRGB), mapped with the mesh's `TEXCOORD_0`, if any.
     pub surface_texture: Option<Image>,
     /// Fraction of light the surface texture lets through, 0..1 (1 = no visible surface

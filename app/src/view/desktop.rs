@@ -496,6 +496,7 @@ mod tests {
             radius_m: 0.075,
             plane_point_m: Vec3::new(0.0, 0.0, -0.4),
             plane_normal: Vec3::Z,
+            two_surface_ior: None,
         }
     }
 

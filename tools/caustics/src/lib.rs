@@ -22,10 +22,8 @@
 
 pub mod bake;
 pub mod bake_file;
-pub mod bvh;
 pub mod emission;
 pub mod optics;
-pub mod solid;
 mod splat;
 mod trace;
 
@@ -33,6 +31,10 @@ use std::path::PathBuf;
 
 use glam::{Mat4, Vec3};
 use thiserror::Error;
+
+/// The mesh tracer the baker shares with the two-surface refraction reference.
+pub use vitreous_render::solid;
+pub use vitreous_render::solid::bvh;
 
 pub use bake::{BakeOutput, BakeParams, Comparison, FluxLedger, bake, compare, gain};
 pub use bake_file::{Bake, BakeError, read_bake, read_bake_unchecked, write_bake};
@@ -146,4 +148,24 @@ pub enum InputError {
     /// A number is out of range.
     #[error("{0}")]
     BadValue(String),
+}
+
+impl From<solid::SolidError> for InputError {
+    fn from(e: solid::SolidError) -> Self {
+        use solid::SolidError as S;
+        match e {
+            S::EmptyMesh => InputError::EmptyMesh,
+            S::BadMesh(m) => InputError::BadMesh(m),
+            S::OpenMesh {
+                open_edges,
+                example_m,
+            } => InputError::OpenMesh {
+                open_edges,
+                example_m,
+            },
+            S::InconsistentWinding { edges, example_m } => {
+                InputError::InconsistentWinding { edges, example_m }
+            }
+        }
+    }
 }

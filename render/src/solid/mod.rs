@@ -1,3 +1,6 @@
+//! Closed triangle meshes for CPU ray tracing: the caustics baker's light paths and the
+//! two-surface refraction reference both trace through a [`Solid`] with its [`bvh::Bvh`].
+//!
 //! Checks that a triangle mesh bounds a volume (every edge shared by exactly two triangles,
 //! consistently wound), orients it outwards, and splits it into smooth patches.
 //!
@@ -6,13 +9,49 @@
 //! one patch across its UV seam. The wavefront baker only interpolates between light paths
 //! that cross the same patches in the same order.
 
+pub mod bvh;
+
 use std::collections::HashMap;
 
 use glam::Vec3;
+use thiserror::Error;
 
-use crate::InputError;
+/// Why a triangle mesh is not a closed solid.
+#[derive(Debug, Error)]
+pub enum SolidError {
+    /// The mesh has no triangles with area.
+    #[error("the object's mesh has no triangles with non-zero area")]
+    EmptyMesh,
+    /// Indices or positions are malformed.
+    #[error("the object's mesh is malformed: {0}")]
+    BadMesh(String),
+    /// Some edges are not shared by exactly two triangles.
+    #[error(
+        "the object's mesh does not enclose a volume: {open_edges} edge(s) are not shared by \
+         exactly two triangles (one near {example_m} m); close the holes, or join duplicated \
+         vertices"
+    )]
+    OpenMesh {
+        /// Number of welded edges used by one, or more than two, triangles.
+        open_edges: usize,
+        /// Midpoint of one such edge, in the frame of the positions given.
+        example_m: Vec3,
+    },
+    /// Neighbouring triangles disagree about which side is outside.
+    #[error(
+        "the object's mesh is inconsistently wound: {edges} edge(s) are traversed in the same \
+         direction by both triangles (one near {example_m} m); make every face \
+         counter-clockwise seen from outside"
+    )]
+    InconsistentWinding {
+        /// Number of such edges.
+        edges: usize,
+        /// Midpoint of one such edge, in the frame of the positions given.
+        example_m: Vec3,
+    },
+}
 
-/// A closed, outward-wound triangle mesh in the bake's object frame.
+/// A closed, outward-wound triangle mesh.
 #[derive(Clone, Debug)]
 pub struct Solid {
     /// Corner positions of each non-degenerate triangle, metres, counter-clockwise seen
@@ -36,24 +75,24 @@ impl Solid {
         positions_m: &[Vec3],
         normals: &[Vec3],
         indices: &[u32],
-    ) -> Result<Self, InputError> {
+    ) -> Result<Self, SolidError> {
         if indices.is_empty() || positions_m.is_empty() {
-            return Err(InputError::EmptyMesh);
+            return Err(SolidError::EmptyMesh);
         }
         if !indices.len().is_multiple_of(3) {
-            return Err(InputError::BadMesh(format!(
+            return Err(SolidError::BadMesh(format!(
                 "the index list has {} entries, not a multiple of 3",
                 indices.len()
             )));
         }
         if let Some(&i) = indices.iter().find(|&&i| i as usize >= positions_m.len()) {
-            return Err(InputError::BadMesh(format!(
+            return Err(SolidError::BadMesh(format!(
                 "index {i} is out of range for {} vertices",
                 positions_m.len()
             )));
         }
         if let Some(p) = positions_m.iter().find(|p| !p.is_finite()) {
-            return Err(InputError::BadMesh(format!(
+            return Err(SolidError::BadMesh(format!(
                 "vertex position {p} is not finite"
             )));
         }
@@ -82,7 +121,7 @@ impl Solid {
             tris.push([t[0], t[1], t[2]]);
         }
         if tris.is_empty() {
-            return Err(InputError::EmptyMesh);
+            return Err(SolidError::EmptyMesh);
         }
 
         // Every undirected welded edge: (low, high, triangle, runs low->high).
@@ -130,13 +169,13 @@ impl Solid {
             i = j;
         }
         if open_edges > 0 {
-            return Err(InputError::OpenMesh {
+            return Err(SolidError::OpenMesh {
                 open_edges,
                 example_m: example.unwrap_or_default(),
             });
         }
         if misoriented > 0 {
-            return Err(InputError::InconsistentWinding {
+            return Err(SolidError::InconsistentWinding {
                 edges: misoriented,
                 example_m: example.unwrap_or_default(),
             });
@@ -256,7 +295,7 @@ mod tests {
     use super::*;
 
     /// A unit cube with flat normals: 24 vertices, 12 triangles, 6 patches.
-    pub(crate) fn cube() -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
+    fn cube() -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
         let mut p = Vec::new();
         let mut n = Vec::new();
         let mut idx = Vec::new();
@@ -305,7 +344,7 @@ mod tests {
         let (p, n, i) = cube();
         let err = Solid::new(&p, &n, &i[..i.len() - 6]).unwrap_err();
         assert!(
-            matches!(err, InputError::OpenMesh { open_edges: 4, .. }),
+            matches!(err, SolidError::OpenMesh { open_edges: 4, .. }),
             "{err}"
         );
         let mut i2 = i.clone();
@@ -313,7 +352,7 @@ mod tests {
         i2.swap(4, 5);
         let err = Solid::new(&p, &n, &i2).unwrap_err();
         assert!(
-            matches!(err, InputError::InconsistentWinding { .. }),
+            matches!(err, SolidError::InconsistentWinding { .. }),
             "{err}"
         );
     }

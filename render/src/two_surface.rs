@@ -1,0 +1,577 @@
+//! Two-surface refraction on the CPU (`[object] refraction = "two-surface"`): the view ray
+//! refracts in at the front surface, crosses the glass, and refracts out at the back surface;
+//! where the back surface reflects it totally, the reflection is followed for a bounded number
+//! of bounces before the ray is given up to the environment. The reference the GPU's
+//! two-surface mode is tested against, for an analytic ball ([`Ball`]) and for any closed mesh
+//! ([`MeshBody`], the caustics baker's tracer).
+
+use glam::Vec3;
+
+use crate::optics::{fresnel_reflectance, ray_sphere, reflect, refract};
+use crate::solid::bvh::Bvh;
+use crate::solid::{Solid, SolidError};
+
+/// Internal reflections followed at most before a ray still inside is given up to the
+/// environment (a brilliant sends most light out within three).
+pub const MAX_INTERNAL_REFLECTIONS: u32 = 4;
+
+/// Self-intersection offset along a ray leaving a surface point, metres.
+const EPS_M: f32 = 1e-6;
+
+/// A closed glass body a ray can enter and leave.
+pub trait Body {
+    /// Where a ray from outside first meets the body: the distance along the unit `dir` and
+    /// the outward unit (shading) normal there.
+    fn enter(&self, origin_m: Vec3, dir: Vec3) -> Option<(f32, Vec3)>;
+    /// Where a ray inside the body next meets its surface: the distance along the unit `dir`
+    /// and the outward unit (shading) normal there.
+    fn leave(&self, origin_m: Vec3, dir: Vec3) -> Option<(f32, Vec3)>;
+}
+
+/// An analytic glass ball.
+#[derive(Clone, Copy, Debug)]
+pub struct Ball {
+    /// Centre, metres (world).
+    pub center_m: Vec3,
+    /// Radius, metres.
+    pub radius_m: f32,
+}
+
+impl Body for Ball {
+    fn enter(&self, origin_m: Vec3, dir: Vec3) -> Option<(f32, Vec3)> {
+        let t = ray_sphere(origin_m, dir, self.center_m, self.radius_m)?;
+        Some((t, (origin_m + dir * t - self.center_m).normalize()))
+    }
+
+    fn leave(&self, origin_m: Vec3, dir: Vec3) -> Option<(f32, Vec3)> {
+        let oc = origin_m - self.center_m;
+        let b = oc.dot(dir);
+        let c = oc.length_squared() - self.radius_m * self.radius_m;
+        let t = -b + (b * b - c).max(0.0).sqrt();
+        (t > 0.0).then(|| (t, (origin_m + dir * t - self.center_m).normalize()))
+    }
+}
+
+/// A closed triangle mesh in world coordinates, with the shading normals interpolated across
+/// each triangle as the rasteriser does.
+pub struct MeshBody {
+    /// The outward-wound solid.
+    solid: Solid,
+    /// Its bounding-volume hierarchy.
+    bvh: Bvh,
+}
+
+impl MeshBody {
+    /// The body of world-space `positions_m`, unit vertex `normals` (outward) and a triangle
+    /// list; the mesh must enclose a volume.
+    pub fn new(
+        positions_m: &[Vec3],
+        normals: &[Vec3],
+        indices: &[u32],
+    ) -> Result<Self, SolidError> {
+        let solid = Solid::new(positions_m, normals, indices)?;
+        let bvh = Bvh::new(&solid.triangles_m);
+        Ok(MeshBody { solid, bvh })
+    }
+
+    /// The nearest surface point along a ray, with the interpolated outward normal.
+    fn hit(&self, origin_m: Vec3, dir: Vec3) -> Option<(f32, Vec3)> {
+        let hit = self.bvh.closest(origin_m, dir, f32::INFINITY)?;
+        let [n0, n1, n2] = self.solid.corner_normals[hit.triangle as usize];
+        let normal = (n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v).normalize();
+        Some((hit.t_m, normal))
+    }
+}
+
+impl Body for MeshBody {
+    fn enter(&self, origin_m: Vec3, dir: Vec3) -> Option<(f32, Vec3)> {
+        self.hit(origin_m, dir)
+    }
+
+    fn leave(&self, origin_m: Vec3, dir: Vec3) -> Option<(f32, Vec3)> {
+        self.hit(origin_m + dir * EPS_M, dir)
+            .map(|(t, n)| (t + EPS_M, n))
+    }
+}
+
+/// A view ray's way through a body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Passage {
+    /// Where the ray enters (the front surface), metres.
+    pub entry_m: Vec3,
+    /// The outward normal at the entry.
+    pub entry_normal: Vec3,
+    /// Where the ray left the body, or where it was last inside when given up, metres.
+    pub exit_m: Vec3,
+    /// Unit direction after the exit (or inside, when given up).
+    pub direction: Vec3,
+    /// The ray left the body (else it was still reflected inside after
+    /// [`MAX_INTERNAL_REFLECTIONS`] and is given up to the environment along `direction`).
+    pub escaped: bool,
+    /// Total internal reflections on the way.
+    pub internal_reflections: u32,
+    /// Fraction of the light that follows this path: (1 - F) at the entry and at the exit,
+    /// exact Fresnel for unpolarised light (total internal reflection loses nothing).
+    pub transmission: f32,
+    /// Length of the path inside the glass, metres (for Beer-Lambert absorption).
+    pub inside_m: f32,
+}
+
+/// Traces the unit view ray `dir` from `origin_m` through `body` of relative index `ior`:
+/// refraction in (Snell), then at each meeting with the surface from inside either refraction
+/// out or, beyond the critical angle, total internal reflection, at most
+/// `max_internal_reflections` times. `None` when the ray misses the body.
+pub fn pass_through(
+    body: &impl Body,
+    origin_m: Vec3,
+    dir: Vec3,
+    ior: f32,
+    max_internal_reflections: u32,
+) -> Option<Passage> {
+    let (t, entry_normal) = body.enter(origin_m, dir)?;
+    let entry_m = origin_m + dir * t;
+    // A shading normal can face away from a grazing ray: refract about the side it meets.
+    let facing = if dir.dot(entry_normal) < 0.0 {
+        entry_normal
+    } else {
+        -entry_normal
+    };
+    let cos_in = -dir.dot(facing);
+    let mut transmission = 1.0 - fresnel_reflectance(cos_in, 1.0 / ior);
+    let mut inside = refract(dir, facing, 1.0 / ior).unwrap_or(dir);
+    let mut at = entry_m;
+    let mut inside_m = 0.0;
+    let mut internal_reflections = 0;
+    loop {
+        let Some((t, normal)) = body.leave(at, inside) else {
+            // Numerically outside already (a grazing entry): carry on straight.
+            return Some(Passage {
+                entry_m,
+                entry_normal,
+                exit_m: at,
+                direction: inside,
+                escaped: true,
+                internal_reflections,
+                transmission,
+                inside_m,
+            });
+        };
+        at += inside * t;
+        inside_m += t;
+        // The outward normal faces the outside; the ray meets it from inside.
+        let facing = if inside.dot(normal) > 0.0 {
+            -normal
+        } else {
+            normal
+        };
+        let cos_out = -inside.dot(facing);
+        match refract(inside, facing, ior) {
+            Some(out) => {
+                transmission *= 1.0 - fresnel_reflectance(cos_out, ior);
+                return Some(Passage {
+                    entry_m,
+                    entry_normal,
+                    exit_m: at,
+                    direction: out,
+                    escaped: true,
+                    internal_reflections,
+                    transmission,
+                    inside_m,
+                });
+            }
+            None if internal_reflections < max_internal_reflections => {
+                inside = reflect(inside, facing).normalize();
+                internal_reflections += 1;
+            }
+            None => {
+                return Some(Passage {
+                    entry_m,
+                    entry_normal,
+                    exit_m: at,
+                    direction: reflect(inside, facing).normalize(),
+                    escaped: false,
+                    internal_reflections,
+                    transmission,
+                    inside_m,
+                });
+            }
+        }
+    }
+}
+
+/// Width of the radial map, texels (latitude-longitude; 0.7 degrees a texel).
+pub const RADIAL_MAP_WIDTH: u32 = 512;
+/// Height of the radial map, texels.
+pub const RADIAL_MAP_HEIGHT: u32 = 256;
+
+/// The object's surface seen from its centre, for the GPU's two-surface mode
+/// (shaders/glass.wgsl `radial_surface`): for each direction d of a latitude-longitude map
+/// (the environment map's layout), the distance r(d) from the centre to the surface and the
+/// outward shading normal there. Exact for a body star-shaped about its centre (every convex
+/// body is); for other bodies the outermost surface along each direction is kept.
+///
+/// Stored relative to a sphere, so that half floats keep what matters: rgb = normal - d and
+/// a = r - `radius`, both zero for a ball.
+#[derive(Clone, Debug)]
+pub struct RadialMap {
+    /// Centre of the map, model units (the mesh's bounding-box centre).
+    pub center: Vec3,
+    /// Reference radius, model units (the largest vertex distance from the centre).
+    pub radius: f32,
+    /// Texels per row.
+    pub width: u32,
+    /// Rows (row 0 looks up, +y).
+    pub height: u32,
+    /// RGBA texels, row-major.
+    pub texels: Vec<f32>,
+    /// Every direction from the centre meets the surface once (the map is exact).
+    pub star_shaped: bool,
+}
+
+/// The unit direction the centre of texel (`x`, `y`) of a `width` x `height`
+/// latitude-longitude map looks along (inverse of glass.wgsl `latlong_uv`).
+pub fn latlong_direction(x: u32, y: u32, width: u32, height: u32) -> Vec3 {
+    let phi = ((x as f32 + 0.5) / width as f32 - 0.5) * std::f32::consts::TAU;
+    let theta = (y as f32 + 0.5) / height as f32 * std::f32::consts::PI;
+    Vec3::new(
+        theta.sin() * phi.sin(),
+        theta.cos(),
+        -theta.sin() * phi.cos(),
+    )
+}
+
+/// Builds the radial map of a closed mesh (model units), casting one ray from the centre per
+/// texel through the mesh's hierarchy.
+pub fn radial_map(
+    positions: &[Vec3],
+    normals: &[Vec3],
+    indices: &[u32],
+    width: u32,
+    height: u32,
+) -> Result<RadialMap, SolidError> {
+    let (lo, hi) = positions
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
+            (l.min(p), h.max(p))
+        });
+    let center = (lo + hi) / 2.0;
+    let local: Vec<Vec3> = positions.iter().map(|&p| p - center).collect();
+    let body = MeshBody::new(&local, normals, indices)?;
+    let radius = local.iter().map(|p| p.length()).fold(0.0f32, f32::max);
+    let eps = radius * 1e-5;
+    let mut texels = Vec::with_capacity((width * height * 4) as usize);
+    let mut star_shaped = true;
+    for y in 0..height {
+        for x in 0..width {
+            let d = latlong_direction(x, y, width, height);
+            // The outermost crossing: the only one for a star-shaped body.
+            let mut found: Option<(f32, Vec3)> = None;
+            let mut from = 0.0;
+            while let Some((t, n)) = body.hit(d * from, d) {
+                if found.is_some() {
+                    star_shaped = false;
+                }
+                from += t + eps;
+                found = Some((from - eps, n));
+            }
+            let (r, n) = found.unwrap_or_else(|| {
+                star_shaped = false;
+                (radius, d)
+            });
+            texels.extend_from_slice(&[n.x - d.x, n.y - d.y, n.z - d.z, r - radius]);
+        }
+    }
+    Ok(RadialMap {
+        center,
+        radius,
+        width,
+        height,
+        texels,
+        star_shaped,
+    })
+}
+
+/// Effective focal length of a ball lens of radius `radius_m` and index `ior`, measured from
+/// its centre (both principal planes pass through the centre): f = n R / (2 (n - 1)).
+pub fn ball_focal_length_m(radius_m: f32, ior: f32) -> f32 {
+    ior * radius_m / (2.0 * (ior - 1.0))
+}
+
+/// Thick-lens image of a point `object_m` metres from a ball lens's centre (on one side) for
+/// paraxial rays: the distance of the image from the centre on the other side,
+/// s' = f s / (s - f) (negative: a virtual image on the object's side), and the lateral
+/// magnification -s' / s (negative: inverted).
+pub fn ball_image(object_m: f32, radius_m: f32, ior: f32) -> (f32, f32) {
+    let f = ball_focal_length_m(radius_m, ior);
+    let image = f * object_m / (object_m - f);
+    (image, -image / object_m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const GLASS: f32 = 1.51;
+    const DIAMOND: f32 = 2.42;
+
+    fn ball() -> Ball {
+        Ball {
+            center_m: Vec3::new(0.0, 0.0, -0.2),
+            radius_m: 0.075,
+        }
+    }
+
+    /// A cube of side 2 `half` about the origin with flat normals.
+    fn cube(half: f32) -> MeshBody {
+        let mut p = Vec::new();
+        let mut n = Vec::new();
+        let mut idx = Vec::new();
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                let mut normal = Vec3::ZERO;
+                normal[axis] = sign;
+                let u = Vec3::from_array(
+                    [0, 1, 2].map(|k| if k == (axis + 1) % 3 { 1.0 } else { 0.0 }),
+                );
+                let v = normal.cross(u);
+                let base = p.len() as u32;
+                for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    p.push(half * (normal + a * u + b * v));
+                    n.push(normal);
+                }
+                idx.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+            }
+        }
+        MeshBody::new(&p, &n, &idx).expect("a closed cube")
+    }
+
+    /// A finely tessellated sphere mesh of `ball()` (smooth normals).
+    fn sphere_mesh(ball: &Ball, segments: u32, rings: u32) -> MeshBody {
+        let mut p = Vec::new();
+        let mut n = Vec::new();
+        for r in 0..=rings {
+            let theta = std::f32::consts::PI * r as f32 / rings as f32;
+            for s in 0..=segments {
+                let phi = std::f32::consts::TAU * s as f32 / segments as f32;
+                let d = Vec3::new(
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                    theta.sin() * phi.cos(),
+                );
+                p.push(ball.center_m + d * ball.radius_m);
+                n.push(d);
+            }
+        }
+        let mut idx = Vec::new();
+        let row = segments + 1;
+        for r in 0..rings {
+            for s in 0..segments {
+                let a = r * row + s;
+                let (b, c, d) = (a + row, a + row + 1, a + 1);
+                idx.extend([a, b, c, a, c, d]);
+            }
+        }
+        MeshBody::new(&p, &n, &idx).expect("a closed sphere")
+    }
+
+    /// Sine of the angle between a unit direction and a unit normal.
+    fn sin_between(d: Vec3, n: Vec3) -> f32 {
+        d.cross(n).length()
+    }
+
+    proptest! {
+        #[test]
+        fn both_refractions_obey_snell_for_random_rays(
+            x in -0.07f32..0.07, y in -0.07f32..0.07, ior in 1.2f32..1.9,
+        ) {
+            let b = ball();
+            let dir = (Vec3::new(x, y, -0.2) - Vec3::new(0.01, -0.02, 0.0)).normalize();
+            let origin = Vec3::new(0.01, -0.02, 0.0);
+            let Some(p) = pass_through(&b, origin, dir, ior, MAX_INTERNAL_REFLECTIONS) else {
+                return Ok(());
+            };
+            // A ball never reflects totally inside: the chord meets both surfaces at one angle.
+            prop_assert!(p.escaped);
+            prop_assert_eq!(p.internal_reflections, 0);
+            let n_in = (p.entry_m - b.center_m).normalize();
+            let n_out = (p.exit_m - b.center_m).normalize();
+            let inside = (p.exit_m - p.entry_m).normalize();
+            prop_assert!((sin_between(dir, n_in) - ior * sin_between(inside, n_in)).abs() < 1e-4);
+            prop_assert!(
+                (ior * sin_between(inside, n_out) - sin_between(p.direction, n_out)).abs() < 1e-4
+            );
+            // All in the plane of incidence: the ray, the two normals and both directions.
+            let plane = dir.cross(n_in);
+            if plane.length() > 1e-3 {
+                let plane = plane.normalize();
+                prop_assert!(inside.dot(plane).abs() < 1e-4);
+                prop_assert!(p.direction.dot(plane).abs() < 1e-4);
+            }
+            prop_assert!(p.transmission > 0.0 && p.transmission < 1.0);
+            prop_assert!((p.inside_m - p.entry_m.distance(p.exit_m)).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn normal_incidence_passes_straight_through_losing_two_reflections() {
+        let b = ball();
+        let p = pass_through(&b, Vec3::ZERO, Vec3::NEG_Z, GLASS, 4).unwrap();
+        assert!(p.direction.abs_diff_eq(Vec3::NEG_Z, 1e-6));
+        assert!(p.exit_m.abs_diff_eq(Vec3::new(0.0, 0.0, -0.275), 1e-6));
+        let r = ((GLASS - 1.0) / (GLASS + 1.0)).powi(2);
+        assert!((p.transmission - (1.0 - r) * (1.0 - r)).abs() < 1e-5);
+    }
+
+    /// Where paraxial rays from an axial point `s` metres behind the ball converge in front of
+    /// it, measured from the centre (the crossing of a ray at height h with the axis).
+    fn traced_image(b: &Ball, s: f32, h: f32, ior: f32) -> f32 {
+        let source = b.center_m + Vec3::new(0.0, 0.0, -s);
+        let aim = b.center_m + Vec3::new(0.0, h, 0.0);
+        let dir = (aim - source).normalize();
+        let p = pass_through(b, source, dir, ior, 4).unwrap();
+        // Axis crossing: y + t dy = 0.
+        let t = -p.exit_m.y / p.direction.y;
+        (p.exit_m + p.direction * t).z - b.center_m.z
+    }
+
+    #[test]
+    fn a_ball_lens_images_a_point_where_the_thick_lens_formula_says() {
+        let b = ball();
+        let f = ball_focal_length_m(b.radius_m, GLASS);
+        assert!((f - 0.1110).abs() < 1e-3, "{f}");
+        for s in [0.2f32, 0.3, 1.0] {
+            let (expected, m) = ball_image(s, b.radius_m, GLASS);
+            // Paraxial: a ray at 0.2 % of the radius.
+            let traced = traced_image(&b, s, 1.5e-4, GLASS);
+            assert!(
+                (traced - expected).abs() < 2e-3 * expected,
+                "s {s}: traced image {traced} m, thick lens {expected} m"
+            );
+            // Beyond the focal length the image is real and inverted; beyond 2f also shrunk.
+            assert!(m < 0.0);
+            assert_eq!(m.abs() < 1.0, s > 2.0 * f, "s {s}: magnification {m}");
+        }
+    }
+
+    #[test]
+    fn a_distant_point_beyond_the_focal_length_appears_inverted_and_shrunk() {
+        // Chief ray through the centre from a point h above the axis at s; the image point is
+        // where a second (marginal) ray from the same point crosses it.
+        let b = ball();
+        let (s, h) = (1.0f32, 0.05f32);
+        let source = b.center_m + Vec3::new(0.0, h, -s);
+        let trace = |aim_y: f32| {
+            let dir = (b.center_m + Vec3::new(0.0, aim_y, 0.0) - source).normalize();
+            pass_through(&b, source, dir, GLASS, 4).unwrap()
+        };
+        let chief = trace(0.0);
+        let marginal = trace(2e-3);
+        // Intersect the two exit rays in the y-z plane.
+        let (p, d, q, e) = (
+            chief.exit_m,
+            chief.direction,
+            marginal.exit_m,
+            marginal.direction,
+        );
+        let denom = d.y * e.z - d.z * e.y;
+        let t = ((q.y - p.y) * e.z - (q.z - p.z) * e.y) / denom;
+        let image = p + d * t;
+        let (s_img, m) = ball_image(s, b.radius_m, GLASS);
+        assert!(
+            ((image.z - b.center_m.z) - s_img).abs() < 0.01 * s_img,
+            "image at {image}, thick lens {s_img} m from the centre"
+        );
+        assert!(
+            (image.y / h - m).abs() < 0.02,
+            "magnification {} vs {m}",
+            image.y / h
+        );
+        assert!(image.y < 0.0 && image.y.abs() < h);
+    }
+
+    #[test]
+    fn a_fine_sphere_mesh_passes_rays_like_the_ball() {
+        let b = ball();
+        let mesh = sphere_mesh(&b, 256, 128);
+        for (x, y) in [(0.0f32, 0.0f32), (0.03, 0.01), (-0.05, 0.04), (0.06, -0.03)] {
+            let dir = Vec3::new(x, y, -0.2).normalize();
+            let exact = pass_through(&b, Vec3::ZERO, dir, GLASS, 4).unwrap();
+            let traced = pass_through(&mesh, Vec3::ZERO, dir, GLASS, 4).unwrap();
+            assert!(traced.escaped);
+            assert!(
+                traced.direction.angle_between(exact.direction) < 2e-3,
+                "ray ({x}, {y}): mesh {} vs ball {}",
+                traced.direction,
+                exact.direction
+            );
+            assert!(traced.exit_m.distance(exact.exit_m) < 5e-4);
+        }
+    }
+
+    #[test]
+    fn the_radial_map_of_a_sphere_mesh_is_its_radius_and_radial_normals() {
+        let b = Ball {
+            center_m: Vec3::new(0.3, -0.1, 0.2),
+            radius_m: 1.0,
+        };
+        let mesh = sphere_mesh(&b, 96, 48);
+        let positions: Vec<Vec3> = mesh.solid.triangles_m.iter().flatten().copied().collect();
+        let normals: Vec<Vec3> = mesh
+            .solid
+            .corner_normals
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
+        let indices: Vec<u32> = (0..positions.len() as u32).collect();
+        let map = radial_map(&positions, &normals, &indices, 64, 32).unwrap();
+        assert!(map.star_shaped);
+        assert!(map.center.abs_diff_eq(b.center_m, 1e-5));
+        for t in map.texels.chunks_exact(4) {
+            // Flat triangles sag inside the sphere, most at a quad's centre, by about
+            // (pi / 96)^2 / 2 + (pi / 48)^2 / 8, under a thousandth of the radius.
+            assert!(t[3] <= 1e-6 && t[3] > -1e-3, "{t:?}");
+            assert!(Vec3::new(t[0], t[1], t[2]).length() < 0.05, "{t:?}");
+        }
+    }
+
+    #[test]
+    fn total_internal_reflection_is_followed_inside_a_diamond_cube() {
+        // In through the top at 60 degrees; the side face meets the ray at 69 degrees, beyond
+        // the critical angle of diamond (24.4 degrees): it reflects, then leaves through the
+        // bottom, mirrored in x.
+        let cube = cube(0.01);
+        let theta = 60f32.to_radians();
+        let dir = Vec3::new(theta.sin(), -theta.cos(), 0.0);
+        let origin = Vec3::new(0.008, 0.01, 0.0) - dir * 0.05;
+        let p = pass_through(&cube, origin, dir, DIAMOND, 4).unwrap();
+        assert!(p.escaped);
+        assert_eq!(p.internal_reflections, 1);
+        assert!(
+            p.direction
+                .abs_diff_eq(Vec3::new(-theta.sin(), -theta.cos(), 0.0), 1e-4),
+            "{}",
+            p.direction
+        );
+        assert!((p.exit_m.y + 0.01).abs() < 1e-5, "{}", p.exit_m);
+        // Total internal reflection loses nothing: both refractions' losses only.
+        let cos_inside = (1.0 - (theta.sin() / DIAMOND).powi(2)).sqrt();
+        let expected = (1.0 - fresnel_reflectance(theta.cos(), 1.0 / DIAMOND))
+            * (1.0 - fresnel_reflectance(cos_inside, DIAMOND));
+        assert!((p.transmission - expected).abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_ray_trapped_by_reflections_is_given_up_after_the_limit() {
+        // The path of the test above with no reflections allowed: given up at the side face.
+        let cube = cube(0.01);
+        let theta = 60f32.to_radians();
+        let dir = Vec3::new(theta.sin(), -theta.cos(), 0.0);
+        let origin = Vec3::new(0.008, 0.01, 0.0) - dir * 0.05;
+        let p = pass_through(&cube, origin, dir, DIAMOND, 0).unwrap();
+        assert!(!p.escaped);
+        assert_eq!(p.internal_reflections, 0);
+        assert!((p.exit_m.x - 0.01).abs() < 1e-5, "{}", p.exit_m);
+    }
+}

@@ -1,12 +1,17 @@
 //! The keyboard's live controls in `vitreous run`: one command a line on standard input
 //! (`object x 10`, `turn -1`, `place`, `light y 10`, `register z -1`; see
-//! [`SceneEdit::parse`]), read on a thread of their own and handed to the frame loop.
+//! [`SceneEdit::parse`]), read on a thread of their own and handed to the frame loop; and how
+//! the run's sink applies and records them and the controllers' edit commands.
 
 use std::io::BufRead;
 use std::sync::mpsc;
 
 use glam::Vec3;
+use vitreous_xr::FrameInput;
+use vitreous_xr::openxr::Command;
+use vitreous_xr::trace::EditRecord;
 
+use super::RunSink;
 use crate::scene_edit::{Axis, SceneEdit};
 
 /// Starts reading commands from standard input; each valid line arrives on the receiver (a
@@ -36,6 +41,73 @@ pub fn stdin_edits() -> mpsc::Receiver<SceneEdit> {
         tracing::warn!("keyboard controls off: cannot start their thread: {e}");
     }
     rx
+}
+
+impl RunSink {
+    /// Applies the live controls typed since the last frame; a re-registration goes to the
+    /// session, which moves the world at the next frame and says so as a nudge.
+    pub(super) fn apply_typed_controls(&mut self, input: &FrameInput) {
+        let typed: Vec<SceneEdit> = match &self.edits {
+            Some(rx) => rx.try_iter().collect(),
+            None => Vec::new(),
+        };
+        for edit in typed {
+            match edit {
+                SceneEdit::Register(axis, m) => {
+                    let _ = self.registrar.send(Command::Nudge(axis.unit() * m));
+                }
+                other => self.edit(other, input),
+            }
+        }
+    }
+
+    /// Applies and records the scene edit of a session command. The session has moved the
+    /// world already for a nudge or a turn: those are only recorded (a turn by its name: the
+    /// head poses hold it).
+    pub(super) fn record_command(&mut self, command: Command, input: &FrameInput) {
+        match command {
+            Command::Nudge(d) => {
+                for edit in register_edits(d) {
+                    self.edit(edit, input);
+                }
+            }
+            Command::Rotate(a) => {
+                let action = format!("register-turn{:+.1}", a.to_degrees());
+                let record = self.motion.edits().record(input.time_ns, action);
+                self.record(&record);
+            }
+            Command::MoveObject(d) => {
+                for edit in object_edits(d) {
+                    self.edit(edit, input);
+                }
+            }
+            Command::TurnObject(a) => {
+                // Whole thousandths of a degree: the step, not its rounding error.
+                let deg = (a.to_degrees() * 1000.0).round() / 1000.0;
+                self.edit(SceneEdit::TurnObject(deg), input);
+            }
+            Command::PlaceObject => self.edit(SceneEdit::PlaceObject, input),
+            Command::Cycle(_) => {}
+        }
+    }
+
+    /// Applies a live control to this frame and records it in the trace.
+    fn edit(&mut self, edit: SceneEdit, input: &FrameInput) {
+        match self.motion.edit(edit, input) {
+            Ok(record) => self.record(&record),
+            Err(why) => tracing::warn!("{edit}: {why}"),
+        }
+    }
+
+    /// Writes an edit line into the recording, if any.
+    fn record(&mut self, record: &EditRecord) {
+        if let Some(w) = &mut self.writer
+            && let Err(e) = w.write_edit(record)
+        {
+            self.log_error
+                .get_or_insert(anyhow::Error::new(e).context("recording an edit"));
+        }
+    }
 }
 
 /// The re-registration edits of a session's nudge (the world moved by `d`, metres), one per

@@ -138,41 +138,9 @@ struct RunSink {
     registrar: std::sync::mpsc::Sender<Command>,
 }
 
-impl RunSink {
-    /// Applies a live control to this frame and records it in the trace.
-    fn edit(&mut self, edit: SceneEdit, input: &FrameInput) {
-        match self.motion.edit(edit, input) {
-            Ok(record) => self.record(&record),
-            Err(why) => tracing::warn!("{edit}: {why}"),
-        }
-    }
-
-    /// Writes an edit line into the recording, if any.
-    fn record(&mut self, record: &vitreous_xr::trace::EditRecord) {
-        if let Some(w) = &mut self.writer
-            && let Err(e) = w.write_edit(record)
-        {
-            self.log_error
-                .get_or_insert(anyhow::Error::new(e).context("recording an edit"));
-        }
-    }
-}
-
 impl FrameSink for RunSink {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
-        let typed: Vec<SceneEdit> = match &self.edits {
-            Some(rx) => rx.try_iter().collect(),
-            None => Vec::new(),
-        };
-        for edit in typed {
-            match edit {
-                // The session moves the world at the next frame and says so as a nudge.
-                SceneEdit::Register(axis, m) => {
-                    let _ = self.registrar.send(Command::Nudge(axis.unit() * m));
-                }
-                other => self.edit(other, input),
-            }
-        }
+        self.apply_typed_controls(input);
         let placement = self.motion.placement(input.time_ns)?;
         self.looks.set_object_center(placement.object_position_m);
         self.object_center_m = placement.object_position_m;
@@ -195,32 +163,7 @@ impl FrameSink for RunSink {
             None => Vec::new(),
         };
         for command in commands {
-            // The session has moved the world already: record it (a turn by its name: the
-            // head poses hold it).
-            match command {
-                Command::Nudge(d) => {
-                    for edit in controls::register_edits(d) {
-                        self.edit(edit, input);
-                    }
-                }
-                Command::Rotate(a) => {
-                    let action = format!("register-turn{:+.1}", a.to_degrees());
-                    let record = self.motion.edits().record(input.time_ns, action);
-                    self.record(&record);
-                }
-                Command::MoveObject(d) => {
-                    for edit in controls::object_edits(d) {
-                        self.edit(edit, input);
-                    }
-                }
-                Command::TurnObject(a) => {
-                    // Whole thousandths of a degree: the step, not its rounding error.
-                    let deg = (a.to_degrees() * 1000.0).round() / 1000.0;
-                    self.edit(SceneEdit::TurnObject(deg), input);
-                }
-                Command::PlaceObject => self.edit(SceneEdit::PlaceObject, input),
-                Command::Cycle(_) => {}
-            }
+            self.record_command(command, input);
             if let Some(study) = &mut self.study {
                 study.director.command(command);
             } else if let Some(change) = self.looks.apply(command) {

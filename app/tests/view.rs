@@ -551,7 +551,16 @@ fn scripted_scene_edits_are_recorded_and_the_replay_ends_where_the_session_did()
     assert_eq!(r["final_placement"], s["final_placement"], "{r:#}\n{s:#}");
     assert_eq!(r["moved_frames"], s["moved_frames"], "{r:#}\n{s:#}");
     // The recording played in the window: once its clock reaches the end (it holds there),
-    // the scene is where the session left it.
+    // the scene is where the session left it. The clock follows the window's frames (at most
+    // 0.1 s a frame), so a recording made on a loaded machine can outlast a few frames of
+    // playback: Shift+L seeks forward 1 s, eight times, past its end.
+    let seek = dir.path().join("seek.script");
+    let mut seek_steps = String::from("2 down shift\n");
+    for _ in 0..8 {
+        seek_steps.push_str("2 key l\n");
+    }
+    seek_steps.push_str("2 up shift\n");
+    std::fs::write(&seek, seek_steps).unwrap();
     let played_dir = dir.path().join("played");
     view(
         &xvfb,
@@ -560,9 +569,11 @@ fn scripted_scene_edits_are_recorded_and_the_replay_ends_where_the_session_did()
             "--effects",
             "c",
             "--frames",
-            "40",
+            "12",
             "--trace",
             trace.to_str().unwrap(),
+            "--script",
+            seek.to_str().unwrap(),
             "--out",
             played_dir.to_str().unwrap(),
         ],

@@ -415,8 +415,10 @@ fn study_run_shows_the_trials_in_the_desktop_viewer() {
             "--window",
             "320x240",
             "--validate",
+            // The shortest phase (the 10 s blank) lasts 250 ms: longer than a frame of the
+            // window on a loaded machine, so that every phase is shown and logged.
             "--time-scale",
-            "0.005",
+            "0.025",
         ])
         .args(["--trials", "2", "--simulate", SCALE])
         .stdin(Stdio::null())

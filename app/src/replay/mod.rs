@@ -8,7 +8,6 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{
     ContextOptions, GpuContext, Look, Reflection, Refraction, Renderer, ScenePose,
@@ -18,17 +17,21 @@ use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{EditRecord, TraceSample, read_trace_with_edits};
 
 use crate::effects::EffectSet;
-use crate::frame_log::{FrameLog, PupilSummary};
-use crate::frame_loop::{self, FramePlan, FrameRecord, FrameSink};
+use crate::frame_log::FrameLog;
+use crate::frame_loop::{self, FramePlan, FrameSink};
 pub use crate::look::GazeSettings;
 use crate::look::LookPlanner;
-use crate::motion_clock::{FinalPlacement, MotionClock};
+use crate::motion_clock::MotionClock;
 use crate::output::{self, write_atomic};
 use crate::reference_view::side_by_side;
 use crate::scene::{Scene, load_scene};
 pub use crate::spread::Spread;
 use crate::trace_cmd::synth_params_for;
 use crate::views;
+use summary::UnfinishedSummary;
+pub use summary::{ReplaySummary, RunStatus, ValidationSummary};
+
+mod summary;
 
 /// Options of a replay.
 #[derive(Clone, Debug)]
@@ -64,131 +67,6 @@ pub struct ReplayOptions {
     pub reference: bool,
     /// Depth filter and gaze-image override of the gaze pipeline (used with defocus).
     pub gaze: GazeSettings,
-}
-
-/// Validation layer results.
-#[derive(Clone, Debug, Serialize)]
-pub struct ValidationSummary {
-    /// Whether the layers were on.
-    pub enabled: bool,
-    /// Warning messages.
-    pub warnings: u32,
-    /// Error messages.
-    pub errors: u32,
-    /// The first messages' texts.
-    pub messages: Vec<String>,
-}
-
-/// How a replay ended, as `summary.json` says it. Anything but `complete` means the output
-/// folder holds only part of the run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RunStatus {
-    /// Written when the replay starts; still there after a crash, kill -9 or a full disk.
-    Running,
-    /// Every frame was rendered and every file written.
-    Complete,
-    /// Ended early by Ctrl-C or SIGTERM; the frames listed were finished.
-    Interrupted,
-    /// Ended by an error (named in `error`).
-    Failed,
-}
-
-/// The `summary.json` of a replay that has not finished (yet): it replaces any earlier run's
-/// summary before the first frame, so a folder never claims a success it does not hold.
-#[derive(Clone, Debug, Serialize)]
-struct UnfinishedSummary<'a> {
-    /// vitreous version.
-    vitreous_version: &'static str,
-    /// `running` or `failed`.
-    status: RunStatus,
-    /// Always false here.
-    complete: bool,
-    /// The scene file.
-    scene: &'a str,
-    /// The replayed trace file, or "synthetic".
-    trace: &'a str,
-    /// Why the replay failed (`failed` only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    error: Option<String>,
-}
-
-/// What `summary.json` holds.
-#[derive(Clone, Debug, Serialize)]
-pub struct ReplaySummary {
-    /// vitreous version.
-    pub vitreous_version: String,
-    /// `complete`, or `interrupted` when Ctrl-C/SIGTERM ended the replay early.
-    pub status: RunStatus,
-    /// True only when every frame asked for was rendered and saved.
-    pub complete: bool,
-    /// The scene file.
-    pub scene: String,
-    /// Hex SHA-256 of the scene and its assets.
-    pub scene_hash: String,
-    /// The replayed trace file, or "synthetic".
-    pub trace: String,
-    /// Effect set rendered.
-    pub effects: String,
-    /// Vulkan device name.
-    pub device: String,
-    /// Vulkan driver name and version.
-    pub driver: String,
-    /// Validation results.
-    pub validation: ValidationSummary,
-    /// Eye image width, pixels.
-    pub width_px: u32,
-    /// Eye image height, pixels.
-    pub height_px: u32,
-    /// Display frame rate replayed, hertz.
-    pub frame_rate_hz: f64,
-    /// Frames rendered.
-    pub frames: u64,
-    /// Frames rendered per second of wall-clock time, saving included.
-    pub frames_per_second: f64,
-    /// Wall-clock time of the frame loop, seconds.
-    pub wall_s: f64,
-    /// CPU milliseconds per stereo frame.
-    pub cpu_ms: Option<Spread>,
-    /// GPU milliseconds per stereo frame.
-    pub gpu_ms: Option<Spread>,
-    /// Files written, relative to the output folder.
-    pub saved: Vec<String>,
-    /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
-    pub gaze_image_switches: u64,
-    /// Where A_p came from and the values used (`null` without defocus).
-    pub pupil: Option<PupilSummary>,
-    /// Frames whose object or light pose differed from the previous frame's (`[motion]`).
-    pub moved_frames: u64,
-    /// Computations of the shadow inducer's fields (mask, distance, gain) on the GPU: one
-    /// for the first frame drawing them, then one per moved frame, none otherwise.
-    pub inducer_computations: u64,
-    /// Scene edits of the trace (version 1.2 edit lines) applied.
-    pub scene_edits: u64,
-    /// Where the object and light were in the last frame (`null` when nothing moved).
-    pub final_placement: Option<FinalPlacement>,
-    /// Every frame's timing.
-    pub per_frame: Vec<FrameRecord>,
-}
-
-impl ReplaySummary {
-    /// Frames, size, device and timings in one line.
-    pub fn summary_line(&self) -> String {
-        let median =
-            |s: Option<Spread>| s.map_or("n/a".to_string(), |s| format!("{:.2}", s.median_ms));
-        format!(
-            "rendered {} frames of {}x{} per eye on {} in {:.1} s ({:.1} frames/s; median GPU {} \
-             ms, CPU {} ms per stereo frame)",
-            self.frames,
-            self.width_px,
-            self.height_px,
-            self.device,
-            self.wall_s,
-            self.frames_per_second,
-            median(self.gpu_ms),
-            median(self.cpu_ms),
-        )
-    }
 }
 
 /// The largest eye image side accepted, pixels.

@@ -324,25 +324,7 @@ mod tests {
 
     /// A cube of side 2 `half` about the origin with flat normals.
     fn cube(half: f32) -> MeshBody {
-        let mut p = Vec::new();
-        let mut n = Vec::new();
-        let mut idx = Vec::new();
-        for axis in 0..3 {
-            for sign in [-1.0f32, 1.0] {
-                let mut normal = Vec3::ZERO;
-                normal[axis] = sign;
-                let u = Vec3::from_array(
-                    [0, 1, 2].map(|k| if k == (axis + 1) % 3 { 1.0 } else { 0.0 }),
-                );
-                let v = normal.cross(u);
-                let base = p.len() as u32;
-                for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                    p.push(half * (normal + a * u + b * v));
-                    n.push(normal);
-                }
-                idx.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
-            }
-        }
+        let (p, n, idx) = crate::solid::tests::cube_of(half);
         MeshBody::new(&p, &n, &idx).expect("a closed cube")
     }
 

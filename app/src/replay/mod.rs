@@ -407,13 +407,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     // The log holds exactly the frames rendered, also when interrupted.
     saver.log.finish()?;
 
-    let v = renderer.context().validation();
-    let validation = ValidationSummary {
-        enabled: renderer.context().validation_enabled(),
-        warnings: v.warnings(),
-        errors: v.errors(),
-        messages: v.messages(),
-    };
+    let validation = ValidationSummary::of(renderer.context());
     let status = if interrupted {
         RunStatus::Interrupted
     } else {

@@ -2,6 +2,7 @@
 //! after it failed, a short summary that says so.
 
 use serde::Serialize;
+use vitreous_render::GpuContext;
 
 use crate::frame_log::PupilSummary;
 use crate::frame_loop::FrameRecord;
@@ -19,6 +20,19 @@ pub struct ValidationSummary {
     pub errors: u32,
     /// The first messages' texts.
     pub messages: Vec<String>,
+}
+
+impl ValidationSummary {
+    /// What the validation layers reported on `ctx`'s device so far.
+    pub fn of(ctx: &GpuContext) -> ValidationSummary {
+        let v = ctx.validation();
+        ValidationSummary {
+            enabled: ctx.validation_enabled(),
+            warnings: v.warnings(),
+            errors: v.errors(),
+            messages: v.messages(),
+        }
+    }
 }
 
 /// How a replay ended, as `summary.json` says it. Anything but `complete` means the output

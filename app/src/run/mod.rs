@@ -420,13 +420,7 @@ fn run_with(
     sink.log.finish()?;
     let inducer_computations = renderer.inducer_computations();
 
-    let v = renderer.context().validation();
-    let validation = ValidationSummary {
-        enabled: renderer.context().validation_enabled(),
-        warnings: v.warnings(),
-        errors: v.errors(),
-        messages: v.messages(),
-    };
+    let validation = ValidationSummary::of(renderer.context());
     drop(renderer);
     drop(runtime);
 

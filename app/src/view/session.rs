@@ -259,15 +259,14 @@ impl ViewSink {
 
     /// Validation of every device used (retired renderers and the window's).
     pub fn validation(&self) -> ValidationSummary {
-        let ctx = self.presenter.context();
-        let v = ctx.validation();
+        let window = ValidationSummary::of(self.presenter.context());
         let mut messages = self.validation.2.clone();
-        messages.extend(v.messages());
+        messages.extend(window.messages);
         ValidationSummary {
-            enabled: ctx.validation_enabled(),
-            warnings: self.validation.0 + v.warnings(),
-            errors: self.validation.1 + v.errors(),
+            warnings: self.validation.0 + window.warnings,
+            errors: self.validation.1 + window.errors,
             messages,
+            ..window
         }
     }
 

@@ -291,11 +291,12 @@ fn union(parent: &mut [u32], a: u32, b: u32) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    /// A unit cube with flat normals: 24 vertices, 12 triangles, 6 patches.
-    fn cube() -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
+    /// A cube of side 2 `half` about the origin with flat normals: 24 vertices, 12
+    /// triangles, 6 patches (positions, normals, indices; also the two-surface tests' cube).
+    pub(crate) fn cube_of(half: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
         let mut p = Vec::new();
         let mut n = Vec::new();
         let mut idx = Vec::new();
@@ -309,13 +310,18 @@ mod tests {
                 let v = normal.cross(u);
                 let base = p.len() as u32;
                 for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                    p.push(0.5 * (normal + a * u + b * v));
+                    p.push(half * (normal + a * u + b * v));
                     n.push(normal);
                 }
                 idx.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
             }
         }
         (p, n, idx)
+    }
+
+    /// The unit cube.
+    fn cube() -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
+        cube_of(0.5)
     }
 
     #[test]

@@ -164,11 +164,17 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     };
     // One variant per set, and per pupil diameter for sets with defocus; each with its own
     // gaze pipeline over the same views.
-    let mut labels = Vec::new();
-    let mut planners = Vec::new();
-    let mut with_caustics = Vec::new();
+    let mut variants = Vec::new();
     for set in &sets {
         let base = views::look(set, options.reflection);
+        let variant = |label: String, planner: LookPlanner| Variant {
+            label,
+            planner,
+            caustics: set.caustics,
+            live: false,
+            two_surface: false,
+            moving: false,
+        };
         match (&setup, set.defocus) {
             (Some(setup), true) => {
                 for &pupil_m in &pupils_m {
@@ -178,53 +184,24 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                         pupil_source: crate::gaze::PupilSource::Paper,
                         ..setup.model
                     };
-                    labels.push(format!("{set} A_p={:.0}mm", pupil_m * 1000.0));
-                    planners.push(LookPlanner::new(
-                        base,
-                        Some((GazeConfig::new(model.distances), model)),
+                    variants.push(variant(
+                        format!("{set} A_p={:.0}mm", pupil_m * 1000.0),
+                        LookPlanner::new(base, Some((GazeConfig::new(model.distances), model))),
                     ));
                 }
             }
-            _ => {
-                labels.push(set.to_string());
-                planners.push(LookPlanner::new(base, None));
-            }
+            _ => variants.push(variant(set.to_string(), LookPlanner::new(base, None))),
         }
-        with_caustics.resize(labels.len(), set.caustics);
     }
     // With --live-caustics every variant with caustics also runs on a second renderer that
     // computes them per pose (`<set> live`), right after the same variant with the bake.
-    let mut on_live = vec![false; labels.len()];
     if options.live_caustics {
-        let mut out = (Vec::new(), Vec::new(), Vec::new());
-        for ((label, planner), caustics) in labels.into_iter().zip(planners).zip(with_caustics) {
-            if caustics {
-                out.0.push(format!("{label} live"));
-                out.1.push(planner.restarted());
-                out.2.push(true);
-            }
-            out.0.push(label);
-            out.1.push(planner);
-            out.2.push(false);
-        }
-        (labels, planners, on_live) = out;
+        variants = with_twins(variants, |v| v.caustics, "live", |v| v.live = true);
     }
     // With --two-surface every variant also runs on a second renderer that refracts through
     // both surfaces (`<set> two-surface`), right after the same variant under the paper's.
-    let mut on_two = vec![false; labels.len()];
     if options.two_surface {
-        let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for ((label, planner), live) in labels.into_iter().zip(planners).zip(on_live) {
-            out.0.push(format!("{label} two-surface"));
-            out.1.push(planner.restarted());
-            out.2.push(live);
-            out.3.push(true);
-            out.0.push(label);
-            out.1.push(planner);
-            out.2.push(live);
-            out.3.push(false);
-        }
-        (labels, planners, on_live, on_two) = out;
+        variants = with_twins(variants, |_| true, "two-surface", |v| v.two_surface = true);
     }
 
     // The same views for every variant: a synthetic trace looking at the object.
@@ -304,47 +281,29 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
 
     // With --moving every variant runs twice in a row per frame: the light moved, then the
     // same pose again (nothing moved since the frame before).
-    let (labels, mut planners, moving, on_live, on_two) = if options.moving {
-        let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for (((label, planner), live), two) in
-            labels.into_iter().zip(planners).zip(on_live).zip(on_two)
-        {
-            out.0.push(format!("{label} moving"));
-            out.1.push(planner.restarted());
-            out.2.push(true);
-            out.3.push(live);
-            out.4.push(two);
-            out.0.push(label);
-            out.1.push(planner);
-            out.2.push(false);
-            out.3.push(live);
-            out.4.push(two);
-        }
-        out
-    } else {
-        let n = labels.len();
-        (labels, planners, vec![false; n], on_live, on_two)
-    };
+    if options.moving {
+        variants = with_twins(variants, |_| true, "moving", |v| v.moving = true);
+    }
     let center = scene.object.center_m;
     let rest = scene.rest_placement();
     let mut turns = 0u32;
-    let n = planners.len();
+    let n = variants.len();
     let mut prepare = vec![Vec::new(); n];
     let mut gpu = vec![Vec::new(); n];
     let mut cpu = vec![Vec::new(); n];
     let mut wall = vec![Vec::new(); n];
     let mut looks = vec![Look::default(); n];
     for (k, input) in inputs.iter().enumerate() {
-        for (v, planner) in planners.iter_mut().enumerate() {
+        for (v, variant) in variants.iter_mut().enumerate() {
             let renderer = match (&mut live_renderer, &mut two_renderer) {
-                (Some(live), _) if on_live[v] => live,
-                (_, Some(two)) if on_two[v] => two,
+                (Some(live), _) if variant.live => live,
+                (_, Some(two)) if variant.two_surface => two,
                 _ => &mut renderer,
             };
             let started = Instant::now();
-            let (look, _) = planner.plan(input);
+            let (look, _) = variant.planner.plan(input);
             looks[v] = look;
-            if moving[v] {
+            if variant.moving {
                 turns += 1;
                 let turn = glam::Quat::from_rotation_y(
                     (turns as f32 * MOVING_LIGHT_STEP_DEG).to_radians(),
@@ -409,16 +368,18 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         .map(|i| {
             let (g, c, wl) = spreads[i];
             // A moving variant's static twin comes right after it.
-            let twin = (moving[i] && i + 1 < n).then_some(i + 1);
+            let variant = &variants[i];
+            let twin = (variant.moving && i + 1 < n).then_some(i + 1);
             // A two-surface variant's paper twin: the same label without the suffix.
-            let paper = labels[i].replace(" two-surface", "");
-            let paper_twin = on_two[i]
-                .then(|| labels.iter().position(|l| *l == paper))
+            let paper = variant.label.replace(" two-surface", "");
+            let paper_twin = variant
+                .two_surface
+                .then(|| variants.iter().position(|v| v.label == paper))
                 .flatten();
             VariantResult {
-                effects: labels[i].clone(),
-                fetches_per_pixel: fetches_per_pixel(&looks[i]) + u32::from(on_two[i]),
-                moving: moving[i],
+                effects: variant.label.clone(),
+                fetches_per_pixel: fetches_per_pixel(&looks[i]) + u32::from(variant.two_surface),
+                moving: variant.moving,
                 gpu_ms: g,
                 prepare_gpu_ms: Spread::of(prepare[i].iter().copied()),
                 cpu_ms: c,
@@ -441,6 +402,46 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         frames: options.frames,
         variants: results,
     })
+}
+
+/// One timed variant: an effect set (with its pupil) and where and how it is drawn.
+struct Variant {
+    /// The label printed (`<set> [A_p=..] [live] [two-surface] [moving]`).
+    label: String,
+    /// Its own gaze pipeline over the shared views.
+    planner: LookPlanner,
+    /// Whether the set draws caustics.
+    caustics: bool,
+    /// Drawn by the renderer that computes the caustics per pose.
+    live: bool,
+    /// Drawn by the renderer that refracts through both surfaces.
+    two_surface: bool,
+    /// The light is turned before each of its frames.
+    moving: bool,
+}
+
+/// `variants` with, right before each one that `wants` a twin, that twin: the label with
+/// ` suffix`, its own restarted gaze pipeline, changed by `mark`.
+fn with_twins(
+    variants: Vec<Variant>,
+    wants: impl Fn(&Variant) -> bool,
+    suffix: &str,
+    mark: impl Fn(&mut Variant),
+) -> Vec<Variant> {
+    let mut out = Vec::with_capacity(variants.len() * 2);
+    for variant in variants {
+        if wants(&variant) {
+            let mut twin = Variant {
+                label: format!("{} {suffix}", variant.label),
+                planner: variant.planner.restarted(),
+                ..variant
+            };
+            mark(&mut twin);
+            out.push(twin);
+        }
+        out.push(variant);
+    }
+    out
 }
 
 impl BenchReport {

@@ -244,8 +244,21 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     return out;
 }
 
+// The paper's refraction (and the baseline) and two-surface refraction are two entry points of
+// one shading function: the pipeline made for the scene's model has the other model's code
+// folded away, which a runtime branch on a uniform would not do on every device (lavapipe
+// ran both, masked, at twice the paper's cost).
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, false);
+}
+
+@fragment
+fn fs_two_surface(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, true);
+}
+
+fn shade(in: VertexOut, two_surface_model: bool) -> vec4<f32> {
     let incident = normalize(in.world_pos - eye.position.xyz);
     var n = normalize(in.world_normal);
     if dot(n, incident) > 0.0 {
@@ -258,7 +271,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
 
     // The refracted image C_b.
     var refracted_image: vec3<f32>;
-    if g.shading.w > 0.0 {
+    if two_surface_model {
         // Two-surface: exact Fresnel at the front for the reflection; the refracted image
         // carries both interfaces' transmittance (1 - fresnel undoes the blend below).
         var origin = eye.position.xyz;

@@ -223,7 +223,11 @@ impl GlassPass {
                 render_pass,
                 layout: layout.raw(),
                 vertex: (shaders::GLASS_VS, c"vs_main"),
-                fragment: (shaders::GLASS_FS, c"fs_main"),
+                fragment: if desc.refraction == Refraction::TwoSurface {
+                    (shaders::GLASS_TWO_SURFACE_FS, c"fs_two_surface")
+                } else {
+                    (shaders::GLASS_FS, c"fs_main")
+                },
                 bindings: &bindings,
                 attributes: &attributes,
                 cull: vk::CullModeFlags::BACK,

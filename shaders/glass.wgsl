@@ -33,8 +33,6 @@ struct Eye {
     clip_from_world: mat4x4<f32>,
     // xyz: the eye's position in the world (metres); w: eye index (0 left, 1 right).
     position: vec4<f32>,
-    // x: FLAG_* bits.
-    flags: vec4<u32>,
     // xyz: where refraction to the background plane is seen from: this eye (disparity), or
     // the point between the eyes (defocus without disparity).
     refraction_origin: vec4<f32>,
@@ -42,10 +40,6 @@ struct Eye {
     // (background photo), y: the surface image (surface texture).
     blur: vec4<f32>,
 };
-
-// Refract to the registered background plane (disparity or defocus on).
-const FLAG_BACKGROUND: u32 = 1u;
-const FLAG_PHONG: u32 = 2u;
 
 struct Globals {
     world_from_model: mat4x4<f32>,
@@ -244,21 +238,53 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     return out;
 }
 
-// The paper's refraction (and the baseline) and two-surface refraction are two entry points of
-// one shading function: the pipeline made for the scene's model has the other model's code
-// folded away, which a runtime branch on a uniform would not do on every device (lavapipe
-// ran both, masked, at twice the paper's cost).
+// One fragment entry point per pipeline (render/src/glass.rs `GlassVariant`): the refraction
+// model; whether refraction reaches the registered background plane (disparity or defocus on)
+// or the environment; Phong or environment reflection. Each calls `shade` with constants, so
+// its pipeline holds only its own path. A branch on a uniform is not free on every device:
+// lavapipe runs both sides, masked (paper O5 cost twice as much while the two models shared one
+// entry point, and the baseline 1.6x while it shared one with O5).
 @fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    return shade(in, false);
+fn fs_paper_environment_fresnel(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, false, false, false);
 }
 
 @fragment
-fn fs_two_surface(in: VertexOut) -> @location(0) vec4<f32> {
-    return shade(in, true);
+fn fs_paper_environment_phong(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, false, false, true);
 }
 
-fn shade(in: VertexOut, two_surface_model: bool) -> vec4<f32> {
+@fragment
+fn fs_paper_background_fresnel(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, false, true, false);
+}
+
+@fragment
+fn fs_paper_background_phong(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, false, true, true);
+}
+
+@fragment
+fn fs_two_surface_environment_fresnel(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, true, false, false);
+}
+
+@fragment
+fn fs_two_surface_environment_phong(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, true, false, true);
+}
+
+@fragment
+fn fs_two_surface_background_fresnel(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, true, true, false);
+}
+
+@fragment
+fn fs_two_surface_background_phong(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in, true, true, true);
+}
+
+fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool) -> vec4<f32> {
     let incident = normalize(in.world_pos - eye.position.xyz);
     var n = normalize(in.world_normal);
     if dot(n, incident) > 0.0 {
@@ -267,7 +293,6 @@ fn shade(in: VertexOut, two_surface_model: bool) -> vec4<f32> {
     let ior = g.optics.x;
     let reflected = reflect(incident, n);
     var fresnel = clamp(g.optics.y + g.optics.z * pow(1.0 + dot(incident, n), g.optics.w), 0.0, 1.0);
-    let flags = eye.flags.x;
 
     // The refracted image C_b.
     var refracted_image: vec3<f32>;
@@ -275,14 +300,14 @@ fn shade(in: VertexOut, two_surface_model: bool) -> vec4<f32> {
         // Two-surface: exact Fresnel at the front for the reflection; the refracted image
         // carries both interfaces' transmittance (1 - fresnel undoes the blend below).
         var origin = eye.position.xyz;
-        if (flags & FLAG_BACKGROUND) != 0u {
+        if to_background {
             origin = eye.refraction_origin.xyz;
         }
         let from_origin = normalize(in.world_pos - origin);
         let passage = two_surface(in.world_pos, from_origin, n, ior);
         fresnel = fresnel_exact(-dot(incident, n), 1.0 / ior);
         var seen = environment(passage.direction);
-        if (flags & FLAG_BACKGROUND) != 0u && passage.escaped > 0.0 {
+        if to_background && passage.escaped > 0.0 {
             let uv = background_uv(passage.exit, passage.direction);
             if uv.z > 0.0 {
                 seen = textureSampleLevel(
@@ -290,7 +315,7 @@ fn shade(in: VertexOut, two_surface_model: bool) -> vec4<f32> {
             }
         }
         refracted_image = seen * passage.transmission / max(1.0 - fresnel, 1e-6);
-    } else if (flags & FLAG_BACKGROUND) != 0u {
+    } else if to_background {
         let from_origin = normalize(in.world_pos - eye.refraction_origin.xyz);
         let t = refract_heckbert(from_origin, n, ior);
         if t.w == 0.0 {
@@ -314,7 +339,7 @@ fn shade(in: VertexOut, two_surface_model: bool) -> vec4<f32> {
 
     // The reflected image.
     var reflected_image: vec3<f32>;
-    if (flags & FLAG_PHONG) != 0u {
+    if phong {
         let to_light = normalize(g.light.xyz - in.world_pos);
         let mirror = reflect(-to_light, n);
         let specular = pow(max(dot(mirror, -incident), 0.0), g.light_colour.w);

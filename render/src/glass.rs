@@ -22,10 +22,44 @@ const PHONG_EXPONENT: f32 = 200.0;
 /// Strength of the Phong highlight relative to the light's radiance.
 const PHONG_STRENGTH: f32 = 1.0;
 
-/// `flags` bit: refraction to the background plane.
-const FLAG_BACKGROUND: u32 = 1;
-/// `flags` bit: Phong reflection instead of environment + Fresnel.
-const FLAG_PHONG: u32 = 2;
+/// Which of the glass pass's pipelines draws a look. Each is its own fragment entry point
+/// (shaders/glass.wgsl): a switch read from a uniform at run time costs both of its sides on
+/// some devices (lavapipe runs them masked).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GlassVariant {
+    /// Refraction reaches the registered background plane (disparity or defocus on); off,
+    /// it reaches the environment map.
+    pub background: bool,
+    /// Phong reflection instead of environment + Fresnel.
+    pub phong: bool,
+}
+
+impl GlassVariant {
+    /// Every variant, in [`GlassVariant::index`] order.
+    const ALL: [GlassVariant; 4] = [
+        GlassVariant::new(false, false),
+        GlassVariant::new(false, true),
+        GlassVariant::new(true, false),
+        GlassVariant::new(true, true),
+    ];
+
+    const fn new(background: bool, phong: bool) -> GlassVariant {
+        GlassVariant { background, phong }
+    }
+
+    /// The variant that draws `look`.
+    pub fn of(look: &Look) -> GlassVariant {
+        GlassVariant {
+            background: look.disparity || look.defocus.is_some(),
+            phong: look.reflection == Reflection::Phong,
+        }
+    }
+
+    /// Position in [`GlassVariant::ALL`] and in the second index of `shaders::GLASS_FS`.
+    fn index(self) -> usize {
+        usize::from(self.background) * 2 + usize::from(self.phong)
+    }
+}
 
 /// Push constants: one eye.
 #[repr(C)]
@@ -35,8 +69,6 @@ pub struct EyePush {
     pub clip_from_world: [f32; 16],
     /// Eye position (xyz, metres) and eye index (w).
     pub position: [f32; 4],
-    /// x: FLAG_* bits.
-    pub flags: [u32; 4],
     /// Where refraction to the background plane is seen from (xyz, metres).
     pub refraction_origin: [f32; 4],
     /// Blur-stack coordinates of the refracted (x) and surface (y) images.
@@ -54,10 +86,6 @@ impl EyePush {
         k_g_steps: [f32; 2],
     ) -> EyePush {
         let eye = &eyes[index];
-        let mut flags = 0;
-        if look.disparity || look.defocus.is_some() {
-            flags |= FLAG_BACKGROUND;
-        }
         let refraction_origin = if look.disparity {
             eye.position_m
         } else {
@@ -70,13 +98,9 @@ impl EyePush {
             0.0,
             0.0,
         ];
-        if look.reflection == Reflection::Phong {
-            flags |= FLAG_PHONG;
-        }
         EyePush {
             clip_from_world: eye.clip_from_world().to_cols_array(),
             position: eye.position_m.extend(index as f32).to_array(),
-            flags: [flags, 0, 0, 0],
             refraction_origin: refraction_origin.extend(1.0).to_array(),
             blur,
         }
@@ -120,10 +144,11 @@ impl Globals {
     }
 }
 
-/// The glass pipeline and its descriptors, freed on drop.
+/// The glass pipelines and their descriptors, freed on drop.
 pub struct GlassPass {
-    /// The pipeline.
-    pipeline: Owned<vk::Pipeline>,
+    /// One pipeline per variant, in [`GlassVariant::index`] order, for the scene's
+    /// refraction model.
+    pipelines: Vec<Owned<vk::Pipeline>>,
     /// Pipeline layout (set + eye push constants).
     layout: Owned<vk::PipelineLayout>,
     /// Pool the set lives in.
@@ -217,24 +242,26 @@ impl GlassPass {
             stride: VERTEX_STRIDE,
             input_rate: vk::VertexInputRate::VERTEX,
         }];
-        let pipeline = pipeline::create(
-            ctx,
-            &PipelineSpec {
-                render_pass,
-                layout: layout.raw(),
-                vertex: (shaders::GLASS_VS, c"vs_main"),
-                fragment: if desc.refraction == Refraction::TwoSurface {
-                    (shaders::GLASS_TWO_SURFACE_FS, c"fs_two_surface")
-                } else {
-                    (shaders::GLASS_FS, c"fs_main")
-                },
-                bindings: &bindings,
-                attributes: &attributes,
-                cull: vk::CullModeFlags::BACK,
-                depth: true,
-                blend: Blend::ReplaceColor,
-            },
-        )?;
+        let model = usize::from(desc.refraction == Refraction::TwoSurface);
+        let pipelines = GlassVariant::ALL
+            .iter()
+            .map(|variant| {
+                pipeline::create(
+                    ctx,
+                    &PipelineSpec {
+                        render_pass,
+                        layout: layout.raw(),
+                        vertex: (shaders::GLASS_VS, c"vs_main"),
+                        fragment: shaders::GLASS_FS[model][variant.index()],
+                        bindings: &bindings,
+                        attributes: &attributes,
+                        cull: vk::CullModeFlags::BACK,
+                        depth: true,
+                        blend: Blend::ReplaceColor,
+                    },
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
         let pool = pipeline::pool(
             ctx,
             1,
@@ -300,7 +327,7 @@ impl GlassPass {
         pipeline::write_image(ctx, set, 5, scene.surface.view);
         pipeline::write_image(ctx, set, 6, radial_map.view);
         Ok(GlassPass {
-            pipeline,
+            pipelines,
             layout,
             _pool: pool,
             _set_layout: set_layout,
@@ -369,7 +396,8 @@ impl GlassPass {
         }
     }
 
-    /// Records the draw of the object for one eye, inside that eye's render pass.
+    /// Records the draw of the object for one eye with the pipeline of `variant`, inside that
+    /// eye's render pass.
     ///
     /// # Safety
     /// `cmd` must be recording inside a render pass compatible with this pass.
@@ -378,14 +406,16 @@ impl GlassPass {
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
+        variant: GlassVariant,
         push: &EyePush,
     ) {
+        let pipeline = self.pipelines[variant.index()].raw();
         let d = &ctx.device;
         // SAFETY: the caller's contract (recording inside a compatible render pass); the
         // pipeline, set and scene buffers are live for as long as the renderer that records
         // them, which waits for its frames before dropping them.
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw());
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
             d.cmd_bind_descriptor_sets(
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,
@@ -462,4 +492,44 @@ fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32;
         &halves,
     )?;
     Ok((image, radial))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Defocus;
+
+    #[test]
+    fn each_variant_draws_with_the_entry_point_named_for_it() {
+        for (position, variant) in GlassVariant::ALL.iter().enumerate() {
+            assert_eq!(variant.index(), position);
+            for (model, prefix) in [(0, "fs_paper_"), (1, "fs_two_surface_")] {
+                let name = shaders::GLASS_FS[model][position].1.to_str().unwrap();
+                let background = if variant.background {
+                    "background"
+                } else {
+                    "environment"
+                };
+                let reflection = if variant.phong { "phong" } else { "fresnel" };
+                assert_eq!(name, format!("{prefix}{background}_{reflection}"));
+            }
+        }
+    }
+
+    #[test]
+    fn disparity_or_defocus_refracts_to_the_background_plane() {
+        let baseline = Look::default();
+        assert_eq!(GlassVariant::of(&baseline), GlassVariant::new(false, false));
+        let disparity = Look {
+            disparity: true,
+            reflection: Reflection::Phong,
+            ..Look::default()
+        };
+        assert_eq!(GlassVariant::of(&disparity), GlassVariant::new(true, true));
+        let defocus = Look {
+            defocus: Some(Defocus::default()),
+            ..Look::default()
+        };
+        assert_eq!(GlassVariant::of(&defocus), GlassVariant::new(true, false));
+    }
 }

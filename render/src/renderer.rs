@@ -13,7 +13,7 @@ use crate::camera::FrameParams;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
 use crate::floor::{InducerFields, InducerPass, Prepared};
-use crate::glass::{EyePush, GlassPass};
+use crate::glass::{EyePush, GlassPass, GlassVariant};
 use crate::memory::Buffer;
 use crate::owned::Owned;
 use crate::pipeline;
@@ -527,6 +527,7 @@ impl Renderer {
                         &self.ctx,
                         cmd,
                         &self.scene,
+                        GlassVariant::of(&params.look),
                         &EyePush::new(
                             &params.eyes,
                             index,

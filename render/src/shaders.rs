@@ -8,8 +8,46 @@ macro_rules! spirv {
 }
 
 pub const GLASS_VS: &[u8] = spirv!("glass.vs_main");
-pub const GLASS_FS: &[u8] = spirv!("glass.fs_main");
-pub const GLASS_TWO_SURFACE_FS: &[u8] = spirv!("glass.fs_two_surface");
+/// The glass pass's fragment entry points: `[model][variant]`, the model paper (0) or
+/// two-surface (1), the variant as `glass::GlassVariant::index` numbers it.
+pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 2] = [
+    [
+        (
+            spirv!("glass.fs_paper_environment_fresnel"),
+            c"fs_paper_environment_fresnel",
+        ),
+        (
+            spirv!("glass.fs_paper_environment_phong"),
+            c"fs_paper_environment_phong",
+        ),
+        (
+            spirv!("glass.fs_paper_background_fresnel"),
+            c"fs_paper_background_fresnel",
+        ),
+        (
+            spirv!("glass.fs_paper_background_phong"),
+            c"fs_paper_background_phong",
+        ),
+    ],
+    [
+        (
+            spirv!("glass.fs_two_surface_environment_fresnel"),
+            c"fs_two_surface_environment_fresnel",
+        ),
+        (
+            spirv!("glass.fs_two_surface_environment_phong"),
+            c"fs_two_surface_environment_phong",
+        ),
+        (
+            spirv!("glass.fs_two_surface_background_fresnel"),
+            c"fs_two_surface_background_fresnel",
+        ),
+        (
+            spirv!("glass.fs_two_surface_background_phong"),
+            c"fs_two_surface_background_phong",
+        ),
+    ],
+];
 pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
 pub const MASK_VS: &[u8] = spirv!("inducer_mask.vs_main");

@@ -59,8 +59,11 @@ struct Globals {
     shading: vec4<f32>,
     // Inverse of world_from_model.
     model_from_world: mat4x4<f32>,
-    // xyz: centre of the radial map (model units); w: its reference radius.
+    // xyz: the object's centre, its bounding box's (model units), also the radial map's; w: the
+    // radial map's reference radius.
     radial: vec4<f32>,
+    // xyz: the object's centre in the world (metres).
+    center_world: vec4<f32>,
 };
 
 var<push_constant> eye: Eye;
@@ -81,7 +84,15 @@ struct VertexOut {
     @location(0) world_pos: vec3<f32>,
     @location(1) world_normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
+    // x: the vertex's distance from the object's centre (world metres); y: 1 where the vertex
+    // normal points away from the centre (a ball's vertex), else 0. Interpolated: see
+    // `front_surface`.
+    @location(3) curve: vec2<f32>,
 };
+
+// Cosine above which a vertex normal counts as pointing away from the object's centre (twin
+// of render/src/two_surface.rs RADIAL_NORMAL_COS).
+const RADIAL_NORMAL_COS: f32 = 0.9999;
 
 @vertex
 fn vs_main(
@@ -94,6 +105,12 @@ fn vs_main(
     out.world_pos = world.xyz;
     out.world_normal = (g.normal_from_model * vec4<f32>(normal, 0.0)).xyz;
     out.uv = uv;
+    let centred = position - g.radial.xyz;
+    var radial = 0.0;
+    if dot(normal, centred) > RADIAL_NORMAL_COS * length(normal) * length(centred) {
+        radial = 1.0;
+    }
+    out.curve = vec2<f32>(length(world.xyz - g.center_world.xyz), radial);
     out.clip = eye.clip_from_world * world;
     return out;
 }
@@ -238,6 +255,33 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     return out;
 }
 
+// The front surface under a fragment: world position and unit normal (not yet facing the
+// eye). Where the vertex normals point away from the object's centre, as a ball's do, the
+// surface between the vertices is taken as the sphere about the centre through them (radius
+// interpolated) rather than the flat triangle, and the eye's ray is intersected with it: a
+// tessellated ball then refracts as the ball itself (a 96 x 48 sphere's flat triangles
+// misplaced refracted images by pixels near the fold). Elsewhere (faceted stones, general
+// meshes) the triangle and its interpolated normal, blended across triangles that touch both.
+struct Front {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+};
+
+fn front_surface(in: VertexOut) -> Front {
+    // The object's transform is a similarity (uniform scale), so the sphere about its centre is
+    // a sphere in the world too, and the eye's ray meets it without leaving the world frame.
+    let from_centre = eye.position.xyz - g.center_world.xyz;
+    let d = normalize(in.world_pos - eye.position.xyz);
+    let b = dot(from_centre, d);
+    let c = dot(from_centre, from_centre) - in.curve.x * in.curve.x;
+    let on_sphere = from_centre + d * (-b - sqrt(max(b * b - c, 0.0)));
+    let weight = clamp(in.curve.y, 0.0, 1.0);
+    var out: Front;
+    out.position = mix(in.world_pos, on_sphere + g.center_world.xyz, weight);
+    out.normal = normalize(mix(normalize(in.world_normal), on_sphere / in.curve.x, weight));
+    return out;
+}
+
 // One fragment entry point per pipeline (render/src/glass.rs `GlassVariant`): the refraction
 // model; whether refraction reaches the registered background plane (disparity or defocus on)
 // or the environment; Phong or environment reflection. Each calls `shade` with constants, so
@@ -285,8 +329,10 @@ fn fs_two_surface_background_phong(in: VertexOut) -> @location(0) vec4<f32> {
 }
 
 fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool) -> vec4<f32> {
-    let incident = normalize(in.world_pos - eye.position.xyz);
-    var n = normalize(in.world_normal);
+    let front = front_surface(in);
+    let world_pos = front.position;
+    let incident = normalize(world_pos - eye.position.xyz);
+    var n = front.normal;
     if dot(n, incident) > 0.0 {
         n = -n;
     }
@@ -303,8 +349,8 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         if to_background {
             origin = eye.refraction_origin.xyz;
         }
-        let from_origin = normalize(in.world_pos - origin);
-        let passage = two_surface(in.world_pos, from_origin, n, ior);
+        let from_origin = normalize(world_pos - origin);
+        let passage = two_surface(world_pos, from_origin, n, ior);
         fresnel = fresnel_exact(-dot(incident, n), 1.0 / ior);
         var seen = environment(passage.direction);
         if to_background && passage.escaped > 0.0 {
@@ -316,12 +362,12 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         }
         refracted_image = seen * passage.transmission / max(1.0 - fresnel, 1e-6);
     } else if to_background {
-        let from_origin = normalize(in.world_pos - eye.refraction_origin.xyz);
+        let from_origin = normalize(world_pos - eye.refraction_origin.xyz);
         let t = refract_heckbert(from_origin, n, ior);
         if t.w == 0.0 {
             refracted_image = environment(reflected);
         } else {
-            let uv = background_uv(in.world_pos, t.xyz);
+            let uv = background_uv(world_pos, t.xyz);
             if uv.z > 0.0 {
                 refracted_image = textureSampleLevel(
                     background, clamp_sampler, vec3<f32>(uv.xy, eye.blur.x), 0.0).rgb;
@@ -340,7 +386,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
     // The reflected image.
     var reflected_image: vec3<f32>;
     if phong {
-        let to_light = normalize(g.light.xyz - in.world_pos);
+        let to_light = normalize(g.light.xyz - world_pos);
         let mirror = reflect(-to_light, n);
         let specular = pow(max(dot(mirror, -incident), 0.0), g.light_colour.w);
         reflected_image = g.light_colour.rgb * g.light.w * g.shading.z * specular;

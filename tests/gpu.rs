@@ -7,5 +7,6 @@ mod inducer;
 mod live_caustics;
 mod motion;
 mod refraction;
+mod refraction_scene;
 mod render_smoke;
 mod replay;

@@ -14,10 +14,10 @@ use vitreous_tests::{render_once, uv_sphere};
 
 const W: u32 = 640;
 const H: u32 = 480;
-const CENTER: Vec3 = Vec3::new(0.0, 0.0, -0.2);
-const RADIUS: f32 = 0.075;
-const IOR: f32 = 1.51;
-const IPD: f32 = 0.063;
+pub(crate) const CENTER: Vec3 = Vec3::new(0.0, 0.0, -0.2);
+pub(crate) const RADIUS: f32 = 0.075;
+pub(crate) const IOR: f32 = 1.51;
+pub(crate) const IPD: f32 = 0.063;
 /// Side of the background plane, metres.
 const PLANE_M: f32 = 0.6;
 /// Photo resolution and the marker's texel range (a small bright square at the centre).
@@ -37,7 +37,7 @@ fn eyes() -> [EyeParams; 2] {
     [-IPD / 2.0, IPD / 2.0].map(|x| EyeParams::new(Vec3::new(x, 0.0, 0.0), Quat::IDENTITY, fov()))
 }
 
-fn background_plane() -> Mat4 {
+pub(crate) fn background_plane() -> Mat4 {
     Mat4::from_scale_rotation_translation(
         Vec3::new(PLANE_M, PLANE_M, 1.0),
         Quat::IDENTITY,
@@ -82,18 +82,18 @@ fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
 }
 
 /// A mesh: positions, normals, uvs, indices.
-type MeshData = (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<u32>);
+pub(crate) type MeshData = (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<u32>);
 
 /// A mesh and the radius of its model (the render scales it to the test's radius).
-type SphereMesh = (MeshData, f32);
+pub(crate) type SphereMesh = (MeshData, f32);
 
 /// The test's finely tessellated unit sphere.
-fn fine_sphere() -> SphereMesh {
+pub(crate) fn fine_sphere() -> SphereMesh {
     (uv_sphere(128, 64), 1.0)
 }
 
 /// The sphere the visual-effects scene ships (config/models/sphere.glb, radius 0.5).
-fn shipped_sphere() -> SphereMesh {
+pub(crate) fn shipped_sphere() -> SphereMesh {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../config/scenes/visual-effects.toml");
     let scene = vitreous::scene::load_scene(&path).expect("the visual-effects scene");
@@ -152,6 +152,61 @@ fn render_mesh_with(
     mesh: SphereMesh,
     ior: f32,
 ) -> [Vec<u8>; 2] {
+    let photo = if surface_dot {
+        marker_photo(PHOTO, 0, 0)
+    } else {
+        marker_photo(PHOTO, MARKER.0, MARKER.1)
+    };
+    let shot = Shot {
+        look,
+        surface_dot,
+        env_marker,
+        refraction,
+        eyes,
+        ior,
+        size: (W, H),
+        photo: &photo,
+        photo_texels: PHOTO,
+    };
+    render_shot(&shot, mesh)
+}
+
+/// One render of the test's geometry.
+pub(crate) struct Shot<'a> {
+    /// Which layers are drawn.
+    pub look: Look,
+    /// An opaque surface texture, black with a white dot; otherwise none.
+    pub surface_dot: bool,
+    /// A bright square straight ahead in the environment; otherwise black.
+    pub env_marker: bool,
+    /// The refraction model.
+    pub refraction: Refraction,
+    /// Both eyes.
+    pub eyes: [EyeParams; 2],
+    /// Index of refraction.
+    pub ior: f32,
+    /// Eye image size, pixels.
+    pub size: (u32, u32),
+    /// The background photo: RGBA8 texels, sRGB, square.
+    pub photo: &'a [u8],
+    /// Texels per side of `photo`.
+    pub photo_texels: u32,
+}
+
+/// Renders `shot` of `mesh` (scaled by RADIUS / its radius, turned half a turn about y, at
+/// the centre) and returns the eye images.
+pub(crate) fn render_shot(shot: &Shot, mesh: SphereMesh) -> [Vec<u8>; 2] {
+    let &Shot {
+        look,
+        surface_dot,
+        env_marker,
+        refraction,
+        eyes,
+        ior,
+        size,
+        photo,
+        photo_texels,
+    } = shot;
     let ctx = GpuContext::headless(&ContextOptions {
         validation: true,
         device_name: None,
@@ -159,11 +214,6 @@ fn render_mesh_with(
     .expect("Vulkan device with validation");
     let ((positions, normals, uvs, indices), model_radius) = mesh;
     let (ew, eh, env) = environment(env_marker);
-    let photo = if surface_dot {
-        marker_photo(PHOTO, 0, 0)
-    } else {
-        marker_photo(PHOTO, MARKER.0, MARKER.1)
-    };
     // A black surface texture with a white dot at uv (0.5, 0.5), opaque (transmittance 0).
     let dot = {
         let (w, h) = (256u32, 128u32);
@@ -211,9 +261,9 @@ fn render_mesh_with(
         background: PlaneDesc {
             world_from_plane: background_plane(),
             photo: TextureDesc {
-                width: PHOTO,
-                height: PHOTO,
-                data: TexelData::Srgb8(&photo),
+                width: photo_texels,
+                height: photo_texels,
+                data: TexelData::Srgb8(photo),
             },
         },
         exposure: 1.0,
@@ -232,7 +282,7 @@ fn render_mesh_with(
         inducer: vitreous_render::InducerDesc::PAPER,
         caustics: None,
     };
-    let mut renderer = Renderer::new(ctx, &scene, W, H).expect("renderer");
+    let mut renderer = Renderer::new(ctx, &scene, size.0, size.1).expect("renderer");
     let params = FrameParams { eyes, look };
     let want = Want {
         eyes: true,
@@ -293,7 +343,7 @@ fn reference_dot(eye: &EyeParams, size: Vec2) -> Vec2 {
     sum / count
 }
 
-fn reference_scene(refraction: Refraction) -> SphereScene {
+pub(crate) fn reference_scene(refraction: Refraction) -> SphereScene {
     SphereScene {
         center_m: CENTER,
         radius_m: RADIUS,
@@ -320,7 +370,7 @@ fn reference_marker_with(eye: &EyeParams, refraction: Refraction) -> Vec2 {
     .0
 }
 
-const DISPARITY: Look = Look {
+pub(crate) const DISPARITY: Look = Look {
     disparity: true,
     defocus: None,
     reflection: Reflection::EnvironmentFresnel,
@@ -392,7 +442,7 @@ fn refracted_image_has_its_own_disparity_only_with_the_effect() {
 }
 
 /// Both eyes of a head at `head_m` turned by `turn` (the eyes `IPD` apart along its x axis).
-fn head_eyes(head_m: Vec3, turn: Quat) -> [EyeParams; 2] {
+pub(crate) fn head_eyes(head_m: Vec3, turn: Quat) -> [EyeParams; 2] {
     [-IPD / 2.0, IPD / 2.0]
         .map(|x| EyeParams::new(head_m + turn * Vec3::new(x, 0.0, 0.0), turn, fov()))
 }
@@ -439,7 +489,7 @@ fn two_surface_marker_matches_the_reference_for_a_turned_and_moved_head() {
 }
 
 /// The turned and moved head of the two-surface tests.
-fn turned_head() -> [EyeParams; 2] {
+pub(crate) fn turned_head() -> [EyeParams; 2] {
     let turn = Quat::from_euler(glam::EulerRot::YXZ, 0.08, -0.05, 0.02);
     head_eyes(Vec3::new(0.015, -0.01, 0.02), turn)
 }

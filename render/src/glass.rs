@@ -15,7 +15,7 @@ use crate::pipeline::{self, Blend, PipelineSpec};
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, Refraction, SceneDesc, VERTEX_STRIDE};
 use crate::shaders;
-use crate::two_surface::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, radial_map};
+use crate::two_surface::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, mesh_center, radial_map};
 
 /// Phong exponent of the highlight: a sharp highlight, as on polished glass.
 const PHONG_EXPONENT: f32 = 200.0;
@@ -131,6 +131,7 @@ struct Globals {
     shading: [f32; 4],
     model_from_world: [f32; 16],
     radial: [f32; 4],
+    center_world: [f32; 4],
 }
 
 impl Globals {
@@ -139,6 +140,12 @@ impl Globals {
         self.world_from_model = pose.world_from_model.to_cols_array();
         self.normal_from_model = pose.world_from_model.inverse().transpose().to_cols_array();
         self.model_from_world = pose.world_from_model.inverse().to_cols_array();
+        let center = glam::Vec3::new(self.radial[0], self.radial[1], self.radial[2]);
+        self.center_world = pose
+            .world_from_model
+            .transform_point3(center)
+            .extend(1.0)
+            .to_array();
         self.light = pose.light_position_m.extend(1.0).to_array();
         self
     }
@@ -295,6 +302,7 @@ impl GlassPass {
             .to_array(),
             model_from_world: [0.0; 16],
             radial,
+            center_world: [0.0; 4],
         }
         .posed(&ScenePose::of(desc));
         let globals_buffer = Buffer::with_data(
@@ -477,7 +485,7 @@ fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32;
                 width: 1,
                 height: 1,
             },
-            [0.0, 0.0, 0.0, 1.0],
+            mesh_center(m.positions).extend(1.0).to_array(),
         )
     };
     let halves: Vec<u8> = texels

@@ -94,7 +94,9 @@ impl std::str::FromStr for Refraction {
 pub struct SceneDesc<'a> {
     /// The glass object's mesh.
     pub mesh: MeshRef<'a>,
-    /// Model to world transform of the object.
+    /// Model to world transform of the object: a similarity (rotation, translation and a
+    /// uniform scale; the glass pass takes a ball's surface between its vertices as a sphere
+    /// in the world).
     pub world_from_model: Mat4,
     /// Relative index of refraction of the object.
     pub ior: f32,

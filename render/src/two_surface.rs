@@ -76,10 +76,71 @@ impl MeshBody {
 
     /// The nearest surface point along a ray, with the interpolated outward normal.
     fn hit(&self, origin_m: Vec3, dir: Vec3) -> Option<(f32, Vec3)> {
+        self.hit_with_curve(origin_m, dir)
+            .map(|h| (h.t_m, h.normal))
+    }
+
+    /// The nearest triangle along a ray, with what the glass shader interpolates across it
+    /// (`front_surface` in shaders/glass.wgsl): the distance from the origin of coordinates
+    /// (the object's centre, for a body built centred) and the weight of the corners whose
+    /// normals point away from it.
+    fn hit_with_curve(&self, origin_m: Vec3, dir: Vec3) -> Option<CurvedHit> {
         let hit = self.bvh.closest(origin_m, dir, f32::INFINITY)?;
-        let [n0, n1, n2] = self.solid.corner_normals[hit.triangle as usize];
-        let normal = (n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v).normalize();
-        Some((hit.t_m, normal))
+        let corners = self.solid.triangles_m[hit.triangle as usize];
+        let normals = self.solid.corner_normals[hit.triangle as usize];
+        let weights = [1.0 - hit.u - hit.v, hit.u, hit.v];
+        let mut normal = Vec3::ZERO;
+        let (mut curved_radius, mut curved) = (0.0, 0.0);
+        for k in 0..3 {
+            normal += normals[k] * weights[k];
+            curved_radius += corners[k].length() * weights[k];
+            if radial_normal(corners[k], normals[k]) {
+                curved += weights[k];
+            }
+        }
+        Some(CurvedHit {
+            t_m: hit.t_m,
+            normal: normal.normalize(),
+            curved_radius,
+            curved,
+        })
+    }
+}
+
+/// A ray's hit on a mesh triangle ([`MeshBody::hit_with_curve`]).
+struct CurvedHit {
+    /// Ray parameter of the flat triangle's point.
+    t_m: f32,
+    /// Interpolated outward unit normal.
+    normal: Vec3,
+    /// The corners' distances from the origin, interpolated.
+    curved_radius: f32,
+    /// The weight of the corners whose normals point away from the origin (0..1).
+    curved: f32,
+}
+
+/// Cosine above which a vertex normal counts as pointing away from the object's centre, so
+/// that the surface around the vertex is taken as the sphere about the centre through it (twin
+/// of shaders/glass.wgsl RADIAL_NORMAL_COS).
+pub const RADIAL_NORMAL_COS: f32 = 0.9999;
+
+/// Whether the unit `normal` at `corner` (relative to the object's centre) points away from
+/// the centre.
+fn radial_normal(corner: Vec3, normal: Vec3) -> bool {
+    normal.dot(corner) > RADIAL_NORMAL_COS * corner.length()
+}
+
+/// The object's centre: the middle of its bounding box (model units).
+pub fn mesh_center(positions: &[Vec3]) -> Vec3 {
+    let (lo, hi) = positions
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
+            (l.min(p), h.max(p))
+        });
+    if lo.is_finite() && hi.is_finite() {
+        (lo + hi) / 2.0
+    } else {
+        Vec3::ZERO
     }
 }
 
@@ -249,12 +310,7 @@ pub fn radial_map(
     width: u32,
     height: u32,
 ) -> Result<RadialMap, SolidError> {
-    let (lo, hi) = positions
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
-            (l.min(p), h.max(p))
-        });
-    let center = (lo + hi) / 2.0;
+    let center = mesh_center(positions);
     let local: Vec<Vec3> = positions.iter().map(|&p| p - center).collect();
     let body = MeshBody::new(&local, normals, indices)?;
     let radius = local.iter().map(|p| p.length()).fold(0.0f32, f32::max);
@@ -267,12 +323,15 @@ pub fn radial_map(
             // The outermost crossing: the only one for a star-shaped body.
             let mut found: Option<(f32, Vec3)> = None;
             let mut from = 0.0;
-            while let Some((t, n)) = body.hit(d * from, d) {
+            while let Some(hit) = body.hit_with_curve(d * from, d) {
                 if found.is_some() {
                     star_shaped = false;
                 }
-                from += t + eps;
-                found = Some((from - eps, n));
+                from += hit.t_m + eps;
+                // From the centre along d: the flat triangle at `from - eps`, the sphere
+                // about the centre through radial-normal corners at the interpolated radius.
+                let flat = from - eps;
+                found = Some((flat + (hit.curved_radius - flat) * hit.curved, hit.normal));
             }
             let (r, n) = found.unwrap_or_else(|| {
                 star_shaped = false;
@@ -511,10 +570,33 @@ mod tests {
         assert!(map.star_shaped);
         assert!(map.center.abs_diff_eq(b.center_m, 1e-5));
         for t in map.texels.chunks_exact(4) {
-            // Flat triangles sag inside the sphere, most at a quad's centre, by about
-            // (pi / 96)^2 / 2 + (pi / 48)^2 / 8, under a thousandth of the radius.
-            assert!(t[3] <= 1e-6 && t[3] > -1e-3, "{t:?}");
+            // The vertex normals point away from the centre, so the surface between the
+            // vertices is the sphere through them, not the flat triangles (which sag inside by
+            // up to (pi / 96)^2 / 2 + (pi / 48)^2 / 8, about 7e-4 of the radius).
+            assert!(t[3].abs() < 2e-6, "{t:?}");
             assert!(Vec3::new(t[0], t[1], t[2]).length() < 0.05, "{t:?}");
+        }
+    }
+
+    #[test]
+    fn the_radial_map_of_a_cube_keeps_its_flat_faces() {
+        // Face normals do not point away from the centre (except at the face centres, which
+        // are no vertices): the faces stay flat.
+        let (positions, normals, indices) = crate::solid::tests::cube_of(0.5);
+        let (width, height) = (64, 32);
+        let map = radial_map(&positions, &normals, &indices, width, height).unwrap();
+        assert!(map.star_shaped);
+        for y in 0..height {
+            for x in 0..width {
+                let d = latlong_direction(x, y, width, height);
+                let t = &map.texels[((y * width + x) * 4) as usize..][..4];
+                let flat = 0.5 / d.abs().max_element();
+                assert!(
+                    (map.radius + t[3] - flat).abs() < 1e-3 * flat,
+                    "direction {d}: radius {} against the face's {flat}",
+                    map.radius + t[3]
+                );
+            }
         }
     }
 

@@ -1,12 +1,17 @@
 // Distance to the shadow edge and the inducer's gain, in floor space (METHOD.md section 1,
-// eq. 2-4; render/src/inducer.rs). Full-screen passes over the floor-space textures:
+// eq. 2-4; render/src/floor/). Full-screen passes over the floor-space textures, drawn only
+// inside the region that can change (render/src/floor/jump_flood.rs):
 //
-// 1. fs_seed: every shadow texel is its own nearest shadow texel; lit texels have none yet.
-// 2. fs_jump (jump flooding, log2(N) passes with halving steps, then one more of step 1):
-//    each texel keeps, of the seeds stored at itself and at its 8 neighbours `step` texels
-//    away, the one nearest in metres.
+// 1. fs_seed_jump: the first jump of the flood straight from the mask: each texel keeps, of
+//    the shadow texels at itself and at its 8 neighbours `step` texels away, the one nearest
+//    in metres (every shadow texel is its own nearest seed; the same as a seed pass followed
+//    by a jump).
+// 2. fs_jump (jump flooding, halving steps down to 1, then one more of step 1): each texel
+//    keeps, of the seeds stored at itself and at its 8 neighbours `step` texels away, the one
+//    nearest in metres. Neighbours outside `region` count as none: the passes draw nothing
+//    there.
 // 3. fs_distance: d, the distance from a lit texel to the shadow edge in metres; -1 inside
-//    the shadow.
+//    the shadow; FAR_M outside `region` (the pass also draws where the region was before).
 // 4. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain.
 // 5. fs_combine (caustics, eq. 6): the floor overlay's gain at the caustic map's resolution,
 //    k alpha(d) (if the inducer is on) + G (if the caustics are on), what the floor overlay
@@ -27,10 +32,13 @@ struct Field {
     k: f32,
     // fs_combine: weights of the inducer's gain and of the caustic gain G (1 on, 0 off).
     switches: vec2<f32>,
+    // The texels the fields are computed in: x0, y0, x1, y1 (ends excluded).
+    region: vec4<i32>,
 };
 
 var<push_constant> field: Field;
-// The pass's input: the mask (fs_seed), seeds (fs_jump, fs_distance) or distances (fs_ramp).
+// The pass's input: the mask (fs_seed_jump), seeds (fs_jump, fs_distance) or distances
+// (fs_ramp).
 @group(0) @binding(0) var source: texture_2d<f32>;
 // The shadow mask, for fs_distance; the caustic gain G (R32F), for fs_combine.
 @group(0) @binding(1) var shadow_mask: texture_2d<f32>;
@@ -47,19 +55,40 @@ fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
     return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
 }
 
-@fragment
-fn fs_seed(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(frag.xy);
-    if textureLoad(source, p, 0).r > 0.5 {
-        return vec4<f32>(vec2<f32>(p), 0.0, 0.0);
-    }
-    return vec4<f32>(NO_SEED, NO_SEED, 0.0, 0.0);
+// Whether texel q lies in the region the fields are computed in.
+fn in_region(q: vec2<i32>) -> bool {
+    return all(q >= field.region.xy) && all(q < field.region.zw);
 }
 
 // Squared distance in metres between texel centres.
 fn distance2_m(seed: vec2<f32>, p: vec2<f32>) -> f32 {
     let v = (seed - p) * field.texel_m;
     return dot(v, v);
+}
+
+@fragment
+fn fs_seed_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let p = vec2<i32>(frag.xy);
+    let pf = vec2<f32>(p);
+    var best = vec2<f32>(NO_SEED);
+    if textureLoad(source, p, 0).r > 0.5 {
+        best = pf;
+    }
+    var best_d = distance2_m(best, pf);
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = p + vec2<i32>(dx, dy) * field.step;
+            if (dx != 0 || dy != 0) && in_region(q) && textureLoad(source, q, 0).r > 0.5 {
+                let seed = vec2<f32>(q);
+                let d = distance2_m(seed, pf);
+                if d < best_d {
+                    best = seed;
+                    best_d = d;
+                }
+            }
+        }
+    }
+    return vec4<f32>(best, 0.0, 0.0);
 }
 
 @fragment
@@ -71,8 +100,7 @@ fn fs_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
             let q = p + vec2<i32>(dx, dy) * field.step;
-            let inside = all(q >= vec2<i32>(0)) && all(q < vec2<i32>(field.size));
-            if (dx != 0 || dy != 0) && inside {
+            if (dx != 0 || dy != 0) && in_region(q) {
                 let seed = textureLoad(source, q, 0).xy;
                 let d = distance2_m(seed, pf);
                 if d < best_d {
@@ -97,6 +125,9 @@ fn edge_distance_m(offset: vec2<f32>) -> f32 {
 @fragment
 fn fs_distance(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let p = vec2<i32>(frag.xy);
+    if !in_region(p) {
+        return vec4<f32>(FAR_M, 0.0, 0.0, 0.0);
+    }
     if textureLoad(shadow_mask, p, 0).r > 0.5 {
         return vec4<f32>(-1.0, 0.0, 0.0, 0.0);
     }

@@ -266,19 +266,52 @@ pub fn eye_render_pass(
     render_pass(ctx, &attachments, &subpasses, &dependencies)
 }
 
-/// A render pass with one colour attachment of `format`, cleared, left for fragment shaders
-/// to read (a floor-space field). Its dependencies order it after earlier reads and writes of
-/// the image (by fragment shaders, attachments or transfers) and make its writes visible to
-/// later fragment shaders and transfers.
-pub fn field_render_pass(ctx: &GpuContext, format: vk::Format) -> Result<Owned<vk::RenderPass>> {
+/// How a floor-space field's render pass treats what the image held before. Only the render
+/// area is cleared or drawn, so the `Keep` kinds cost nothing outside it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FieldStart {
+    /// The image may be in any layout and its texels outside the render area are lost;
+    /// every texel of the render area is drawn, so none is cleared.
+    Discard,
+    /// As `Discard`, but the render area is cleared first.
+    Clear,
+    /// The image is in SHADER_READ_ONLY_OPTIMAL and keeps its texels outside the render
+    /// area; inside it they are cleared.
+    KeepClear,
+    /// As `KeepClear`, but every texel of the render area is drawn, so none is cleared.
+    KeepDraw,
+}
+
+/// A render pass with one colour attachment of `format`, starting as `start` says, left for
+/// fragment shaders to read (a floor-space field). Its dependencies order it after earlier
+/// reads and writes of the image (by fragment shaders, attachments or transfers) and make its
+/// writes visible to later fragment shaders and transfers. The three kinds are compatible:
+/// one framebuffer and one pipeline serve them all.
+pub fn field_render_pass(
+    ctx: &GpuContext,
+    format: vk::Format,
+    start: FieldStart,
+) -> Result<Owned<vk::RenderPass>> {
+    let (load, initial) = match start {
+        FieldStart::Discard => (vk::AttachmentLoadOp::DONT_CARE, vk::ImageLayout::UNDEFINED),
+        FieldStart::Clear => (vk::AttachmentLoadOp::CLEAR, vk::ImageLayout::UNDEFINED),
+        FieldStart::KeepClear => (
+            vk::AttachmentLoadOp::CLEAR,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        ),
+        FieldStart::KeepDraw => (
+            vk::AttachmentLoadOp::DONT_CARE,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        ),
+    };
     let attachments = [vk::AttachmentDescription::default()
         .format(format)
         .samples(vk::SampleCountFlags::TYPE_1)
-        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .load_op(load)
         .store_op(vk::AttachmentStoreOp::STORE)
         .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
         .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-        .initial_layout(vk::ImageLayout::UNDEFINED)
+        .initial_layout(initial)
         .final_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)];
     let color_ref = [vk::AttachmentReference {
         attachment: 0,

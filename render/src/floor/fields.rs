@@ -8,7 +8,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::Image;
 use crate::owned::Owned;
-use crate::pipeline;
+use crate::pipeline::{self, FieldStart};
 
 /// Indices into the pass's field targets.
 pub(crate) const MASK: usize = 0;
@@ -31,17 +31,29 @@ pub(crate) const FIELDS: [(&str, vk::Format); 6] = [
 ];
 
 /// What each floor-space image holds where its passes do not draw (outside the rectangle
-/// the overlay can light, see [`FieldTarget::begin`]): lit floor, no seed (the shader's
-/// `NO_SEED`), beyond the ramp (the shader's `FAR_M`), no gain.
+/// the overlay can light): lit floor, no seed (the shader's `NO_SEED`), beyond the ramp (the
+/// shader's `FAR_M`), no gain.
 pub(crate) const CLEAR: [f32; 6] = [0.0, -1.0e7, -1.0e7, 1.0e9, 0.0, 0.0];
 
-/// One floor-space image with the render pass and framebuffer that write it (dropped in
-/// that order: framebuffer, render pass, image).
+/// The ways a field's render pass may start, in the order of [`FieldTarget`]'s render passes.
+const STARTS: [FieldStart; 4] = [
+    FieldStart::Discard,
+    FieldStart::Clear,
+    FieldStart::KeepClear,
+    FieldStart::KeepDraw,
+];
+
+/// A rectangle of texels `[x0, y0, x1, y1]`, ends excluded.
+pub(crate) type TexelRect = [u32; 4];
+
+/// One floor-space image with the render passes and framebuffer that write it (dropped in
+/// that order: framebuffer, render passes, image).
 pub(crate) struct FieldTarget {
     /// The framebuffer over the image.
     pub framebuffer: Owned<vk::Framebuffer>,
-    /// A single-attachment render pass ending in SHADER_READ_ONLY_OPTIMAL.
-    pub render_pass: Owned<vk::RenderPass>,
+    /// Single-attachment render passes ending in SHADER_READ_ONLY_OPTIMAL, one per
+    /// [`FieldStart`] in the order of [`STARTS`] (compatible with each other).
+    render_passes: Vec<Owned<vk::RenderPass>>,
     /// The image.
     pub image: Image,
     /// Its size.
@@ -66,58 +78,102 @@ impl FieldTarget {
                 | vk::ImageUsageFlags::SAMPLED
                 | vk::ImageUsageFlags::TRANSFER_SRC,
         )?;
-        let render_pass = pipeline::field_render_pass(ctx, format)?;
-        let framebuffer = pipeline::framebuffer(ctx, render_pass.raw(), &[image.view], extent)?;
+        let mut render_passes = Vec::with_capacity(STARTS.len());
+        for start in STARTS {
+            render_passes.push(pipeline::field_render_pass(ctx, format, start)?);
+        }
+        let framebuffer =
+            pipeline::framebuffer(ctx, render_passes[0].raw(), &[image.view], extent)?;
         Ok(FieldTarget {
             framebuffer,
-            render_pass,
+            render_passes,
             image,
             extent,
         })
     }
 
-    /// Begins this target's render pass, cleared to `clear` everywhere, with a viewport
-    /// covering it and draws limited to `scissor` (`[x0, y0, x1, y1]` texels, ends excluded;
-    /// `None`: all of it).
+    /// A render pass of this target, for making pipelines (all of them are compatible).
+    pub fn render_pass(&self) -> vk::RenderPass {
+        self.render_passes[0].raw()
+    }
+
+    /// The whole image as a rectangle of texels.
+    pub fn full(&self) -> TexelRect {
+        [0, 0, self.extent.width, self.extent.height]
+    }
+
+    /// Begins this target's render pass starting as `start` says over `area` (cleared to
+    /// `clear` if `start` clears), with a viewport covering the whole image (so that
+    /// fragment coordinates are texel coordinates) and draws limited to `scissor`, which
+    /// must lie in `area`.
     ///
     /// # Safety
-    /// `cmd` must be recording outside any render pass, and execute while `self` lives.
+    /// `cmd` must be recording outside any render pass, and execute while `self` lives; for
+    /// the `Keep` starts the image must be in SHADER_READ_ONLY_OPTIMAL when it executes.
     pub unsafe fn begin(
         &self,
         device: &ash::Device,
         cmd: vk::CommandBuffer,
+        start: FieldStart,
+        area: TexelRect,
         clear: f32,
-        scissor: Option<[u32; 4]>,
+        scissor: TexelRect,
     ) {
         let clear = [vk::ClearValue {
             color: vk::ClearColorValue {
                 float32: [clear; 4],
             },
         }];
-        // SAFETY: the caller's contract; the render pass and framebuffer are this target's.
+        let rect = |[x0, y0, x1, y1]: TexelRect| vk::Rect2D {
+            offset: vk::Offset2D {
+                x: x0 as i32,
+                y: y0 as i32,
+            },
+            extent: vk::Extent2D {
+                width: x1 - x0,
+                height: y1 - y0,
+            },
+        };
+        let index = match start {
+            FieldStart::Discard => 0,
+            FieldStart::Clear => 1,
+            FieldStart::KeepClear => 2,
+            FieldStart::KeepDraw => 3,
+        };
+        let begin = vk::RenderPassBeginInfo::default()
+            .render_pass(self.render_passes[index].raw())
+            .framebuffer(self.framebuffer.raw())
+            .render_area(rect(area))
+            .clear_values(&clear);
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: self.extent.width as f32,
+            height: self.extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        // SAFETY: the caller's contract; the render pass and framebuffer are this target's
+        // and compatible; the pipelines bound inside set viewport and scissor dynamically.
         unsafe {
-            pipeline::begin_render_pass(
-                device,
-                cmd,
-                self.render_pass.raw(),
-                self.framebuffer.raw(),
-                self.extent,
-                &clear,
-            );
-            if let Some([x0, y0, x1, y1]) = scissor {
-                let area = vk::Rect2D {
-                    offset: vk::Offset2D {
-                        x: x0 as i32,
-                        y: y0 as i32,
-                    },
-                    extent: vk::Extent2D {
-                        width: x1 - x0,
-                        height: y1 - y0,
-                    },
-                };
-                device.cmd_set_scissor(cmd, 0, &[area]);
-            }
+            device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+            device.cmd_set_viewport(cmd, 0, &[viewport]);
+            device.cmd_set_scissor(cmd, 0, &[rect(scissor)]);
         }
+    }
+}
+
+/// The smallest rectangle holding both (either may be absent).
+pub(crate) fn bounding(a: Option<TexelRect>, b: Option<TexelRect>) -> Option<TexelRect> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some([
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ]),
+        (a, None) => a,
+        (None, b) => b,
     }
 }
 
@@ -137,6 +193,9 @@ pub(crate) struct FieldPush {
     pub k: f32,
     /// fs_combine: weights of k alpha(d) and of the caustic gain G (1 on, 0 off).
     pub switches: [f32; 2],
+    /// The texels the fields are computed in (`[x0, y0, x1, y1]`, ends excluded): jump
+    /// flooding reads no seed outside, the distance pass writes "beyond the ramp" there.
+    pub region: [i32; 4],
 }
 
 /// The floor-space fields read back from the GPU, row-major from the photo's top-left.

@@ -5,20 +5,25 @@
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 
-use super::fields::{CLEAR, DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY};
+use super::fields::{
+    CLEAR, DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY, SEEDS_A, SEEDS_B,
+    TexelRect, bounding,
+};
 use super::geometry::{
     Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect, union_rect,
 };
-use super::jump_flood::{COMBINE, FieldDraw, RAMP, distance_passes};
+use super::jump_flood::{COMBINE, DIST, FieldDraw, RAMP, distance_passes, flood_span};
 use super::live::{LiveCaustics, LiveCausticsDesc};
 use super::overlay::OverlayPass;
-use super::progress::{Prepared, Progress};
+use super::progress::{Prepared, Progress, Written};
 use crate::camera::EyeParams;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::{Image, upload_texture};
 use crate::owned::Owned;
-use crate::pipeline::{self, Blend, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec};
+use crate::pipeline::{
+    self, Blend, FieldStart, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec,
+};
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, InducerDesc, SceneDesc};
 use crate::shaders;
@@ -54,7 +59,7 @@ pub(crate) struct InducerPass {
     mask_pipeline: Owned<vk::Pipeline>,
     /// Layout of the mask pass (push constants only).
     mask_layout: Owned<vk::PipelineLayout>,
-    /// Seed, jump, distance, ramp and combine pipelines (`SEED` ..= `COMBINE`).
+    /// Seed-and-jump, jump, distance, ramp and combine pipelines (`SEED_JUMP` ..= `COMBINE`).
     field_pipelines: Vec<Owned<vk::Pipeline>>,
     /// Their pipeline layout.
     field_layout: Owned<vk::PipelineLayout>,
@@ -127,7 +132,7 @@ impl InducerPass {
         let mask_pipeline = pipeline::create(
             ctx,
             &PipelineSpec {
-                render_pass: targets[MASK].render_pass.raw(),
+                render_pass: targets[MASK].render_pass(),
                 layout: mask_layout.raw(),
                 vertex: (shaders::MASK_VS, c"vs_main"),
                 fragment: (shaders::MASK_FS, c"fs_main"),
@@ -152,10 +157,10 @@ impl InducerPass {
             fragment,
             size_of::<FieldPush>() as u32,
         )?;
-        // In the order SEED, JUMP, DIST, RAMP, COMBINE, with the field each writes.
+        // In the order SEED_JUMP, JUMP, DIST, RAMP, COMBINE, with the field each writes.
         let field_stages = [
-            (shaders::SEED_FS, c"fs_seed", super::fields::SEEDS_A),
-            (shaders::JUMP_FS, c"fs_jump", super::fields::SEEDS_A),
+            (shaders::SEED_JUMP_FS, c"fs_seed_jump", SEEDS_A),
+            (shaders::JUMP_FS, c"fs_jump", SEEDS_A),
             (shaders::DISTANCE_FS, c"fs_distance", DISTANCE),
             (shaders::RAMP_FS, c"fs_ramp", GAIN),
             (shaders::COMBINE_FS, c"fs_combine", OVERLAY),
@@ -165,7 +170,7 @@ impl InducerPass {
             field_pipelines.push(pipeline::create(
                 ctx,
                 &PipelineSpec {
-                    render_pass: targets[target].render_pass.raw(),
+                    render_pass: targets[target].render_pass(),
                     layout: field_layout.raw(),
                     vertex: (shaders::FIELD_VS, c"vs_main"),
                     fragment: (spirv, entry),
@@ -185,12 +190,7 @@ impl InducerPass {
             caustic_extent,
             bytemuck::cast_slice(caustic_gain),
         )?;
-        let sources = [
-            MASK,
-            super::fields::SEEDS_A,
-            super::fields::SEEDS_B,
-            DISTANCE,
-        ];
+        let sources = [MASK, SEEDS_A, SEEDS_B, DISTANCE];
         let pool = pipeline::pool(
             ctx,
             sources.len() as u32 + 1,
@@ -287,7 +287,7 @@ impl InducerPass {
     }
 
     /// The push constants shared by the full-screen passes.
-    fn push(&self, step: i32, switches: [f32; 2]) -> FieldPush {
+    fn push(&self, step: i32, switches: [f32; 2], region: Option<TexelRect>) -> FieldPush {
         FieldPush {
             texel_m: self.texel_m.to_array(),
             step,
@@ -295,7 +295,16 @@ impl InducerPass {
             ramp_width_m: self.desc.ramp_width_m,
             k: self.desc.k,
             switches,
+            region: region.map_or([0; 4], |r| r.map(|v| v as i32)),
         }
+    }
+
+    /// The farthest (texels along x or y) a lit texel with d < D can be from the centre of
+    /// its nearest shadow texel: D plus the half texel the edge lies short of that centre,
+    /// over the smaller texel side.
+    fn ramp_reach_px(&self) -> u32 {
+        let t = self.texel_m;
+        ((self.desc.ramp_width_m + t.max_element()) / t.min_element()).ceil() as u32
     }
 
     /// Records what a frame drawing the overlay with these switches still needs: the fields'
@@ -317,31 +326,67 @@ impl InducerPass {
         caustics: bool,
     ) -> Prepared {
         let switches = u8::from(inducer) | (u8::from(caustics) << 1);
-        let prepared = self.progress.plan(Some(switches));
+        let mut prepared = self.progress.plan(Some(switches));
         // SAFETY: the caller's contract covers both recordings (outside a render pass, the
         // objects outlive the execution).
         unsafe {
             if prepared.fields {
-                self.record_fields(ctx, cmd, scene);
+                prepared.fields_within = self.record_fields(ctx, cmd, scene);
                 if let Some(live) = &self.live {
                     live.record(ctx, cmd, &self.pose, &self.caustic);
                 }
             }
-            if prepared.combined.is_some() {
-                let push = self.push(
-                    0,
-                    [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
-                );
-                // Nothing is drawn outside the overlay's rectangle: the gain there stays 0.
-                let extent = self.targets[OVERLAY].extent;
-                let scissor = self
-                    .overlay_rect(inducer, caustics)
-                    .map(|r| texel_rect(r, extent.width, extent.height));
-                let set = self.combine_set;
-                self.full_screen(ctx, cmd, OVERLAY, COMBINE, set, &push, scissor);
+            if let Some(switches) = prepared.combined {
+                let caustics_moved = prepared.fields && self.live.is_some();
+                (prepared.overlay_within, prepared.overlay_inducer) =
+                    self.record_combine(ctx, cmd, switches, caustics_moved);
             }
         }
         prepared
+    }
+
+    /// Records the overlay gain's combination for `switches` (bit 0 inducer, bit 1
+    /// caustics) over the texels whose value can have changed since the last combination
+    /// submitted: where the inducer's rectangle was and is when only the fields moved (the
+    /// same switches, the caustic gain unchanged unless `caustics_moved`), else where the
+    /// overlay may be non-zero before or after. Every texel drawn gets its value, so nothing
+    /// is cleared. Returns the texels that may be non-zero afterwards and the inducer's part
+    /// of them.
+    ///
+    /// # Safety
+    /// As [`InducerPass::prepare`], after the fields' recording (if any).
+    unsafe fn record_combine(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        switches: u8,
+        caustics_moved: bool,
+    ) -> (Option<TexelRect>, Option<TexelRect>) {
+        let (inducer, caustics) = (switches & 1 != 0, switches & 2 != 0);
+        let target = &self.targets[OVERLAY];
+        let (w, h) = (target.extent.width, target.extent.height);
+        let inducer_part = self.rect.filter(|_| inducer).map(|r| texel_rect(r, w, h));
+        let within = self
+            .overlay_rect(inducer, caustics)
+            .map(|r| texel_rect(r, w, h));
+        let (start, area) = match (self.progress.overlay_written, self.progress.last_combined) {
+            (Written::Anywhere, _) => (FieldStart::Discard, Some(target.full())),
+            (Written::Within(_), Some((last, before))) if last == switches && !caustics_moved => {
+                (FieldStart::KeepDraw, bounding(before, inducer_part))
+            }
+            (Written::Within(before), _) => (FieldStart::KeepDraw, bounding(before, within)),
+        };
+        if let Some(area) = area {
+            let push = self.push(
+                0,
+                [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
+                None,
+            );
+            let set = self.combine_set;
+            // SAFETY: the caller's contract; `Keep` only once submitted work drew the image.
+            unsafe { self.full_screen(ctx, cmd, OVERLAY, COMBINE, start, area, set, &push) };
+        }
+        (within, inducer_part)
     }
 
     /// The command buffer `prepared` was recorded into has been submitted.
@@ -363,7 +408,13 @@ impl InducerPass {
         )
     }
 
-    /// Records the mask, jump-flooding, distance and ramp passes.
+    /// Records the mask, jump-flooding, distance and ramp passes; returns the texels that
+    /// may differ from the cleared values once they ran (the overlay's rectangle).
+    ///
+    /// Only that rectangle is computed (the shadow and its ramp); the rest of each field
+    /// keeps its cleared value (lit, beyond the ramp, no gain). So only the rectangle and
+    /// where the last submitted computation drew are cleared or drawn; the jump-flood images
+    /// only in the rectangle, as nothing reads them elsewhere.
     ///
     /// # Safety
     /// As [`InducerPass::prepare`].
@@ -372,18 +423,48 @@ impl InducerPass {
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
-    ) {
+    ) -> Option<TexelRect> {
         let d = &ctx.device;
         let n = self.desc.resolution_px;
-        // Only the part of the floor the inducer can light (the shadow and its ramp) is
-        // computed; the rest keeps the cleared values (lit, beyond the ramp, no gain).
-        let scissor = self.rect.map(|r| texel_rect(r, n, n));
-        let span = scissor.map_or(n, |[x0, y0, x1, y1]| (x1 - x0).max(y1 - y0));
+        let region = self.rect.map(|r| texel_rect(r, n, n));
+        let (before, clear_start, draw_start) = match self.progress.fields_written {
+            Written::Anywhere => (Some([0, 0, n, n]), FieldStart::Clear, FieldStart::Discard),
+            Written::Within(before) => (before, FieldStart::KeepClear, FieldStart::KeepDraw),
+        };
+        // Nothing drawn before nor now: every field already holds its cleared value.
+        let area = bounding(before, region)?;
+        let ramp = FieldDraw {
+            target: GAIN,
+            pipeline: RAMP,
+            source: DISTANCE,
+            step: 0,
+        };
+        let draws = match region {
+            Some([x0, y0, x1, y1]) => {
+                distance_passes(flood_span((x1 - x0).max(y1 - y0), self.ramp_reach_px()))
+            }
+            // No shadow: the distance pass only writes "beyond the ramp", reading no seeds.
+            None => vec![FieldDraw {
+                target: DISTANCE,
+                pipeline: DIST,
+                source: MASK,
+                step: 0,
+            }],
+        };
         // SAFETY: the caller's contract: `cmd` records outside a render pass and everything
-        // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it.
+        // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it;
+        // the `Keep` starts are used only once submitted work drew the images.
         unsafe {
-            self.targets[MASK].begin(d, cmd, CLEAR[MASK], scissor);
-            if let Some(clip_from_model) = self.mask_clip_from_model {
+            let mask = &self.targets[MASK];
+            mask.begin(
+                d,
+                cmd,
+                clear_start,
+                area,
+                CLEAR[MASK],
+                region.unwrap_or(area),
+            );
+            if let (Some(_), Some(clip_from_model)) = (region, self.mask_clip_from_model) {
                 d.cmd_bind_pipeline(
                     cmd,
                     vk::PipelineBindPoint::GRAPHICS,
@@ -401,25 +482,35 @@ impl InducerPass {
                 d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
             }
             d.cmd_end_render_pass(cmd);
-            let ramp = FieldDraw {
-                target: GAIN,
-                pipeline: RAMP,
-                source: DISTANCE,
-                step: 0,
-            };
-            for draw in distance_passes(span).into_iter().chain([ramp]) {
-                let push = self.push(draw.step, [0.0; 2]);
+            for draw in draws.into_iter().chain([ramp]) {
+                let push = self.push(draw.step, [0.0; 2], region);
                 let set = self.source_sets[draw.source];
-                self.full_screen(ctx, cmd, draw.target, draw.pipeline, set, &push, scissor);
+                // The jump-flood images are drawn (and read) only inside the region.
+                let (start, drawn) = match (draw.target, region) {
+                    (SEEDS_A | SEEDS_B, Some(region)) => (FieldStart::Discard, region),
+                    _ => (draw_start, area),
+                };
+                self.full_screen(
+                    ctx,
+                    cmd,
+                    draw.target,
+                    draw.pipeline,
+                    start,
+                    drawn,
+                    set,
+                    &push,
+                );
             }
         }
+        region
     }
 
-    /// One full-screen pass of `pipeline` into field `target`, drawing only inside
-    /// `scissor` (texels; `None`: everywhere) after clearing the whole field.
+    /// One full-screen pass of `pipeline` into field `target` starting as `start` says,
+    /// drawing every texel of `area` and nothing else.
     ///
     /// # Safety
-    /// As [`InducerPass::prepare`]; `set` must be one of this pass's sets.
+    /// As [`InducerPass::prepare`]; `set` must be one of this pass's sets; for the `Keep`
+    /// starts the target must be in SHADER_READ_ONLY_OPTIMAL.
     #[allow(clippy::too_many_arguments)]
     unsafe fn full_screen(
         &self,
@@ -427,15 +518,16 @@ impl InducerPass {
         cmd: vk::CommandBuffer,
         target: usize,
         pipeline: usize,
+        start: FieldStart,
+        area: TexelRect,
         set: vk::DescriptorSet,
         push: &FieldPush,
-        scissor: Option<[u32; 4]>,
     ) {
         let d = &ctx.device;
         // SAFETY: the caller's contract; the pipeline, layout, set and target are this
         // pass's.
         unsafe {
-            self.targets[target].begin(d, cmd, CLEAR[target], scissor);
+            self.targets[target].begin(d, cmd, start, area, CLEAR[target], area);
             d.cmd_bind_pipeline(
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,

@@ -10,7 +10,8 @@ use super::fields::{
     TexelRect, bounding,
 };
 use super::geometry::{
-    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect, union_rect,
+    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect,
+    texels_plane_rect, union_rect,
 };
 use super::jump_flood::{COMBINE, DIST, FieldDraw, RAMP, distance_passes, flood_span};
 use super::live::{LiveCaustics, LiveCausticsDesc};
@@ -47,7 +48,8 @@ pub(crate) struct InducerPass {
     mask_clip_from_model: Option<Mat4>,
     /// Plane-local rectangle the inducer's light covers; `None` when nothing can be lit.
     pub(super) rect: Option<[f32; 4]>,
-    /// Plane-local rectangle of the caustics' non-zero extent; `None` without caustics.
+    /// Plane-local rectangle of the caustics' non-zero extent; `None` without caustics (the
+    /// whole floor while a live map is being computed).
     caustic_rect: Option<[f32; 4]>,
     /// Triangle indices of the mesh.
     index_count: u32,
@@ -249,13 +251,17 @@ impl InducerPass {
         self.mask_clip_from_model = clip;
         self.rect = rect;
         self.pose = pose;
+        if self.live.is_some() {
+            // Anywhere, until the new map's computation has finished.
+            self.caustic_rect = Some(WHOLE_FLOOR);
+        }
         self.progress.invalidate();
     }
 
     /// Computes the caustic gain map on the GPU for each pose from now on (with the fields,
     /// so on the next frame drawing the overlay and after every move), at the map's current
-    /// size (the bake's, or the inducer's resolution without one); the overlay may then
-    /// cover the whole floor.
+    /// size (the bake's, or the inducer's resolution without one); the overlay covers the
+    /// whole floor on the frames that compute it, then only the box of its non-zero texels.
     pub fn enable_live(
         &mut self,
         ctx: &GpuContext,
@@ -271,7 +277,7 @@ impl InducerPass {
             [extent.width, extent.height],
             live,
         )?);
-        self.caustic_rect = Some([-0.5, -0.5, 0.5, 0.5]);
+        self.caustic_rect = Some(WHOLE_FLOOR);
         self.progress.invalidate();
         Ok(())
     }
@@ -395,9 +401,20 @@ impl InducerPass {
     }
 
     /// The command buffer `prepared` was recorded into has finished (`ok`: its fence
-    /// signalled) or failed to (its wait failed), so its results cannot be relied on.
+    /// signalled) or failed to (its wait failed), so its results cannot be relied on. When it
+    /// computed the live caustic map of the current pose, the overlay covers from now on
+    /// only the box of its non-zero texels.
     pub fn finished(&mut self, prepared: Prepared, ok: bool) {
+        let live_map = ok && prepared.fields && self.progress.is_current(prepared);
         self.progress.finished(prepared, ok);
+        if let Some(live) = self.live.as_ref().filter(|_| live_map) {
+            let extent = self.targets[OVERLAY].extent;
+            self.caustic_rect = match live.bounds() {
+                Ok(bounds) => bounds.map(|b| texels_plane_rect(b, extent.width, extent.height)),
+                // Unreadable (never on a host-visible buffer): the whole floor stays.
+                Err(_) => Some(WHOLE_FLOOR),
+            };
+        }
     }
 
     /// The plane-local rectangle the overlay draws for these switches, if any.
@@ -578,6 +595,9 @@ impl InducerPass {
         }
     }
 }
+
+/// The floor's whole unit square, plane-local.
+const WHOLE_FLOOR: [f32; 4] = [-0.5, -0.5, 0.5, 0.5];
 
 /// The mask's projection (eq. 1: `None` when the light is not above the floor) and the
 /// plane-local rectangle the inducer's light covers (`None` when nothing can be lit) for the

@@ -90,6 +90,11 @@ impl Progress {
         }
     }
 
+    /// Whether `prepared` was recorded for the current pose.
+    pub fn is_current(&self, prepared: Prepared) -> bool {
+        prepared.generation == self.generation
+    }
+
     /// The object or the light moved: the fields and the combination are due again, and
     /// work recorded before is of an older generation.
     pub fn invalidate(&mut self) {

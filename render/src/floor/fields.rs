@@ -274,3 +274,92 @@ impl InducerFields {
         }
     }
 }
+
+/// Timestamps the floor passes write after each of their stages, in this order: the mask, the
+/// jump flood, the distance, the ramp, the live caustics, the overlay gain's combination.
+pub const FIELD_STAMPS: u32 = 6;
+
+/// GPU milliseconds of each stage of the floor passes in one frame (0 for a stage that did
+/// not run: nothing moved, or no live caustics).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FieldPassesMs {
+    /// The shadow mask (eq. 1).
+    pub mask_ms: f64,
+    /// All jump-flooding passes.
+    pub jump_flood_ms: f64,
+    /// The distance to the shadow edge.
+    pub distance_ms: f64,
+    /// The gain k alpha(d) (eq. 2, 4).
+    pub ramp_ms: f64,
+    /// The live caustic map (photon tracing, resolving, copying).
+    pub live_caustics_ms: f64,
+    /// The overlay gain's combination.
+    pub combine_ms: f64,
+}
+
+impl FieldPassesMs {
+    /// The stages' times from the timestamp written before them (`start`) and the
+    /// [`FIELD_STAMPS`] written after each, with `period_ns` nanoseconds per tick.
+    pub fn from_stamps(start: u64, stamps: [u64; FIELD_STAMPS as usize], period_ns: f32) -> Self {
+        let mut previous = start;
+        let ms = stamps.map(|stamp| {
+            let ms = stamp.wrapping_sub(previous) as f64 * f64::from(period_ns) * 1e-6;
+            previous = stamp;
+            ms
+        });
+        FieldPassesMs {
+            mask_ms: ms[0],
+            jump_flood_ms: ms[1],
+            distance_ms: ms[2],
+            ramp_ms: ms[3],
+            live_caustics_ms: ms[4],
+            combine_ms: ms[5],
+        }
+    }
+
+    /// Their sum.
+    pub fn total_ms(&self) -> f64 {
+        self.mask_ms
+            + self.jump_flood_ms
+            + self.distance_ms
+            + self.ramp_ms
+            + self.live_caustics_ms
+            + self.combine_ms
+    }
+}
+
+/// Where a frame's floor passes write their [`FIELD_STAMPS`] timestamps: a pool and the
+/// first query.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Stamps {
+    /// The frame's timestamp pool (reset before).
+    pub pool: vk::QueryPool,
+    /// The query of the first stamp.
+    pub first: u32,
+}
+
+impl Stamps {
+    /// Writes stamps `range` (indices from 0 to [`FIELD_STAMPS`]), once all earlier work is
+    /// done.
+    ///
+    /// # Safety
+    /// `cmd` must be recording, outside a render pass, and the pool must hold the queries.
+    pub unsafe fn write(
+        &self,
+        device: &ash::Device,
+        cmd: vk::CommandBuffer,
+        range: std::ops::Range<u32>,
+    ) {
+        for i in range {
+            // SAFETY: the caller's contract.
+            unsafe {
+                device.cmd_write_timestamp(
+                    cmd,
+                    vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                    self.pool,
+                    self.first + i,
+                )
+            };
+        }
+    }
+}

@@ -67,7 +67,8 @@ pub use crate::scene::{
     MAX_CAUSTIC_GAIN, MAX_K, MAX_RAMP_WIDTH_M, MAX_RESOLUTION_PX, MIN_RESOLUTION_PX,
     validate_caustics, validate_inducer as validate,
 };
-pub use fields::InducerFields;
+pub(crate) use fields::Stamps;
+pub use fields::{FIELD_STAMPS, FieldPassesMs, InducerFields};
 pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
 pub use live::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE};
 pub(crate) use pass::InducerPass;

@@ -6,8 +6,8 @@ use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 
 use super::fields::{
-    CLEAR, DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY, SEEDS_A, SEEDS_B,
-    TexelRect, bounding,
+    CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY, SEEDS_A,
+    SEEDS_B, Stamps, TexelRect, bounding,
 };
 use super::geometry::{
     Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect,
@@ -317,12 +317,14 @@ impl InducerPass {
     /// computation when no submitted work holds it, and the overlay gain's combination
     /// (k alpha(d) if `inducer`, + G if `caustics`) when the last one submitted was for
     /// other switches. Returns what was recorded, for [`InducerPass::submitted`] and
-    /// [`InducerPass::finished`]; records nothing (the scene is static) otherwise.
+    /// [`InducerPass::finished`]; records nothing (the scene is static) otherwise. With
+    /// `stamps`, writes all [`FIELD_STAMPS`] timestamps, one after each stage.
     ///
     /// # Safety
     /// `cmd` must be recording outside any render pass, and be submitted before any command
     /// buffer recorded later that draws the overlay; `scene` must be the scene the pass was
-    /// made for, and `self` and `scene` must outlive the command buffer's execution.
+    /// made for, and `self` and `scene` must outlive the command buffer's execution; the
+    /// stamps' pool must hold their queries, reset.
     pub unsafe fn prepare(
         &self,
         ctx: &GpuContext,
@@ -330,23 +332,36 @@ impl InducerPass {
         scene: &GpuScene,
         inducer: bool,
         caustics: bool,
+        stamps: Option<Stamps>,
     ) -> Prepared {
+        let d = &ctx.device;
         let switches = u8::from(inducer) | (u8::from(caustics) << 1);
         let mut prepared = self.progress.plan(Some(switches));
+        let stamp = |range| {
+            if let Some(stamps) = stamps {
+                // SAFETY: the caller's contract (recording outside a render pass, queries
+                // reset).
+                unsafe { stamps.write(d, cmd, range) };
+            }
+        };
         // SAFETY: the caller's contract covers both recordings (outside a render pass, the
         // objects outlive the execution).
         unsafe {
             if prepared.fields {
-                prepared.fields_within = self.record_fields(ctx, cmd, scene);
+                prepared.fields_within = self.record_fields(ctx, cmd, scene, stamps);
                 if let Some(live) = &self.live {
                     live.record(ctx, cmd, &self.pose, &self.caustic);
                 }
+            } else {
+                stamp(0..4);
             }
+            stamp(4..5);
             if let Some(switches) = prepared.combined {
                 let caustics_moved = prepared.fields && self.live.is_some();
                 (prepared.overlay_within, prepared.overlay_inducer) =
                     self.record_combine(ctx, cmd, switches, caustics_moved);
             }
+            stamp(5..FIELD_STAMPS);
         }
         prepared
     }
@@ -425,8 +440,9 @@ impl InducerPass {
         )
     }
 
-    /// Records the mask, jump-flooding, distance and ramp passes; returns the texels that
-    /// may differ from the cleared values once they ran (the overlay's rectangle).
+    /// Records the mask, jump-flooding, distance and ramp passes, each stage followed by its
+    /// stamp (the first four of `stamps`); returns the texels that may differ from the
+    /// cleared values once they ran (the overlay's rectangle).
     ///
     /// Only that rectangle is computed (the shadow and its ramp); the rest of each field
     /// keeps its cleared value (lit, beyond the ramp, no gain). So only the rectangle and
@@ -440,8 +456,16 @@ impl InducerPass {
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
+        stamps: Option<Stamps>,
     ) -> Option<TexelRect> {
         let d = &ctx.device;
+        let stamp = |range| {
+            if let Some(stamps) = stamps {
+                // SAFETY: the caller's contract (recording outside a render pass, queries
+                // reset).
+                unsafe { stamps.write(d, cmd, range) };
+            }
+        };
         let n = self.desc.resolution_px;
         let region = self.rect.map(|r| texel_rect(r, n, n));
         let (before, clear_start, draw_start) = match self.progress.fields_written {
@@ -449,7 +473,10 @@ impl InducerPass {
             Written::Within(before) => (before, FieldStart::KeepClear, FieldStart::KeepDraw),
         };
         // Nothing drawn before nor now: every field already holds its cleared value.
-        let area = bounding(before, region)?;
+        let Some(area) = bounding(before, region) else {
+            stamp(0..4);
+            return None;
+        };
         let ramp = FieldDraw {
             target: GAIN,
             pipeline: RAMP,
@@ -499,7 +526,12 @@ impl InducerPass {
                 d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
             }
             d.cmd_end_render_pass(cmd);
+            stamp(0..1);
             for draw in draws.into_iter().chain([ramp]) {
+                if draw.pipeline == DIST {
+                    // The flood (if any) is done.
+                    stamp(1..2);
+                }
                 let push = self.push(draw.step, [0.0; 2], region);
                 let set = self.source_sets[draw.source];
                 // The jump-flood images are drawn (and read) only inside the region.
@@ -517,6 +549,11 @@ impl InducerPass {
                     set,
                     &push,
                 );
+                match draw.pipeline {
+                    DIST => stamp(2..3),
+                    RAMP => stamp(3..4),
+                    _ => {}
+                }
             }
         }
         region

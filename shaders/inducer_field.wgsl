@@ -17,7 +17,7 @@
 //    k alpha(d) (if the inducer is on) + G (if the caustics are on), what the floor overlay
 //    multiplies the floor photo by. Rerun when those switches change.
 //
-// Every fetch is a textureLoad of one texel: no filtering, no sampler.
+// Every fetch is a textureLoad of one texel, except fs_combine's bilinear read of the gain.
 
 struct Field {
     // Floor metres per texel along the texture's x (u) and y (v).
@@ -42,6 +42,8 @@ var<push_constant> field: Field;
 @group(0) @binding(0) var source: texture_2d<f32>;
 // The shadow mask, for fs_distance; the caustic gain G (R32F), for fs_combine.
 @group(0) @binding(1) var shadow_mask: texture_2d<f32>;
+// fs_combine: bilinear between texel centres, clamped at the edges (the overlay's sampler).
+@group(0) @binding(2) var clamp_sampler: sampler;
 
 // Coordinate of "no seed found yet": far from every texel, so any real seed is nearer.
 const NO_SEED: f32 = -1.0e7;
@@ -153,22 +155,6 @@ fn fs_ramp(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     return vec4<f32>(field.k * ramp(d_m, field.ramp_width_m), 0.0, 0.0, 0.0);
 }
 
-// k alpha(d) at floor uv (0..1, v down), bilinear between texel centres and clamped at the
-// edges like the overlay's sampler (four loads: this pass runs once per switch change).
-fn inducer_gain_bilinear(uv: vec2<f32>) -> f32 {
-    let n = field.size;
-    let t = uv * f32(n) - 0.5;
-    let base = floor(t);
-    let f = t - base;
-    let b = vec2<i32>(base);
-    let hi = vec2<i32>(n - 1);
-    let g00 = textureLoad(source, clamp(b, vec2<i32>(0), hi), 0).r;
-    let g10 = textureLoad(source, clamp(b + vec2<i32>(1, 0), vec2<i32>(0), hi), 0).r;
-    let g01 = textureLoad(source, clamp(b + vec2<i32>(0, 1), vec2<i32>(0), hi), 0).r;
-    let g11 = textureLoad(source, clamp(b + vec2<i32>(1, 1), vec2<i32>(0), hi), 0).r;
-    return mix(mix(g00, g10, f.x), mix(g01, g11, f.x), f.y);
-}
-
 @fragment
 fn fs_combine(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     // The target has the caustic map's size, texel for texel.
@@ -176,7 +162,8 @@ fn fs_combine(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let uv = frag.xy / vec2<f32>(textureDimensions(shadow_mask));
     var gain = 0.0;
     if field.switches.x > 0.0 {
-        gain += field.switches.x * inducer_gain_bilinear(uv);
+        // k alpha(d) at the texel's floor point, bilinear as the overlay samples it.
+        gain += field.switches.x * textureSampleLevel(source, clamp_sampler, uv, 0.0).r;
     }
     if field.switches.y > 0.0 {
         // eq. 6: L'_c = max(0, L_c - L_r) = G L_r; G >= 0 is checked on loading.

@@ -67,11 +67,12 @@ pub(crate) struct InducerPass {
     field_layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets below.
     _pool: Owned<vk::DescriptorPool>,
-    /// Set layout of the full-screen passes: source and mask (or gain and G) textures.
+    /// Set layout of the full-screen passes: source and mask (or gain and G) textures, and
+    /// the sampler of the gain (fs_combine only).
     _field_set_layout: Owned<vk::DescriptorSetLayout>,
     /// The set reading each field image as the source (null for images never read so).
     source_sets: [vk::DescriptorSet; FIELDS.len()],
-    /// The combine pass's set: the gain and G.
+    /// The combine pass's set: the gain (with the photos' clamped bilinear sampler) and G.
     combine_set: vk::DescriptorSet,
     /// The caustic gain G (R32F, read texel for texel by fs_combine; zeros without a map).
     caustic: Image,
@@ -151,6 +152,7 @@ impl InducerPass {
             &[
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+                (2, vk::DescriptorType::SAMPLER, fragment),
             ],
         )?;
         let field_layout = pipeline::layout(
@@ -193,23 +195,34 @@ impl InducerPass {
             bytemuck::cast_slice(caustic_gain),
         )?;
         let sources = [MASK, SEEDS_A, SEEDS_B, DISTANCE];
+        let sets = sources.len() as u32 + 1;
         let pool = pipeline::pool(
             ctx,
-            sources.len() as u32 + 1,
-            &[(
-                vk::DescriptorType::SAMPLED_IMAGE,
-                2 * (sources.len() as u32 + 1),
-            )],
+            sets,
+            &[
+                (vk::DescriptorType::SAMPLED_IMAGE, 2 * sets),
+                (vk::DescriptorType::SAMPLER, sets),
+            ],
         )?;
         let mut source_sets = [vk::DescriptorSet::null(); FIELDS.len()];
         for source in sources {
             let set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
-            pipeline::write_image(ctx, set, 0, targets[source].image.view);
+            // The sampler too, though only fs_combine reads it: lavapipe reads every binding
+            // of a bound set.
+            let (view, sampler) = (targets[source].image.view, scene.photo_sampler());
+            pipeline::write_texture(ctx, set, 0, 2, view, sampler);
             pipeline::write_image(ctx, set, 1, targets[MASK].image.view);
             source_sets[source] = set;
         }
         let combine_set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
-        pipeline::write_image(ctx, combine_set, 0, targets[GAIN].image.view);
+        pipeline::write_texture(
+            ctx,
+            combine_set,
+            0,
+            2,
+            targets[GAIN].image.view,
+            scene.photo_sampler(),
+        );
         pipeline::write_image(ctx, combine_set, 1, caustic.view);
         let overlay = OverlayPass::new(ctx, eye_render_pass, scene, targets[OVERLAY].image.view)?;
 

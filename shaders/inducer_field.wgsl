@@ -37,16 +37,20 @@ struct Field {
 };
 
 var<push_constant> field: Field;
-// The pass's input: the mask (fs_seed_jump), seeds (fs_jump, fs_distance) or distances
-// (fs_ramp).
+// The pass's input: the mask (fs_seed_jump), the distances (fs_ramp) or the gain
+// (fs_combine).
 @group(0) @binding(0) var source: texture_2d<f32>;
 // The shadow mask, for fs_distance; the caustic gain G (R32F), for fs_combine.
 @group(0) @binding(1) var shadow_mask: texture_2d<f32>;
 // fs_combine: bilinear between texel centres, clamped at the edges (the overlay's sampler).
 @group(0) @binding(2) var clamp_sampler: sampler;
+// The seeds (fs_jump, fs_distance): each texel's nearest shadow texel found so far, packed as
+// x | y << 16 (one 32-bit fetch per neighbour), NO_SEED where none is yet.
+@group(0) @binding(3) var seeds: texture_2d<u32>;
 
-// Coordinate of "no seed found yet": far from every texel, so any real seed is nearer.
-const NO_SEED: f32 = -1.0e7;
+// "No seed found yet": it unpacks to (65535, 65535), farther from every texel (fields are at
+// most 4096 texels across) than any real seed.
+const NO_SEED: u32 = 0xffffffffu;
 // Distance written where the floor has no shadow at all, metres.
 const FAR_M: f32 = 1.0e9;
 
@@ -62,6 +66,14 @@ fn in_region(q: vec2<i32>) -> bool {
     return all(q >= field.region.xy) && all(q < field.region.zw);
 }
 
+fn pack(q: vec2<i32>) -> u32 {
+    return u32(q.x) | (u32(q.y) << 16u);
+}
+
+fn unpack(seed: u32) -> vec2<f32> {
+    return vec2<f32>(f32(seed & 0xffffu), f32(seed >> 16u));
+}
+
 // Squared distance in metres between texel centres.
 fn distance2_m(seed: vec2<f32>, p: vec2<f32>) -> f32 {
     let v = (seed - p) * field.texel_m;
@@ -69,42 +81,41 @@ fn distance2_m(seed: vec2<f32>, p: vec2<f32>) -> f32 {
 }
 
 @fragment
-fn fs_seed_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+fn fs_seed_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<u32> {
     let p = vec2<i32>(frag.xy);
     let pf = vec2<f32>(p);
-    var best = vec2<f32>(NO_SEED);
+    var best = NO_SEED;
     if textureLoad(source, p, 0).r > 0.5 {
-        best = pf;
+        best = pack(p);
     }
-    var best_d = distance2_m(best, pf);
+    var best_d = distance2_m(unpack(best), pf);
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
             let q = p + vec2<i32>(dx, dy) * field.step;
             if (dx != 0 || dy != 0) && in_region(q) && textureLoad(source, q, 0).r > 0.5 {
-                let seed = vec2<f32>(q);
-                let d = distance2_m(seed, pf);
+                let d = distance2_m(vec2<f32>(q), pf);
                 if d < best_d {
-                    best = seed;
+                    best = pack(q);
                     best_d = d;
                 }
             }
         }
     }
-    return vec4<f32>(best, 0.0, 0.0);
+    return vec4<u32>(best, 0u, 0u, 0u);
 }
 
 @fragment
-fn fs_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+fn fs_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<u32> {
     let p = vec2<i32>(frag.xy);
     let pf = vec2<f32>(p);
-    var best = textureLoad(source, p, 0).xy;
-    var best_d = distance2_m(best, pf);
+    var best = textureLoad(seeds, p, 0).r;
+    var best_d = distance2_m(unpack(best), pf);
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
             let q = p + vec2<i32>(dx, dy) * field.step;
             if (dx != 0 || dy != 0) && in_region(q) {
-                let seed = textureLoad(source, q, 0).xy;
-                let d = distance2_m(seed, pf);
+                let seed = textureLoad(seeds, q, 0).r;
+                let d = distance2_m(unpack(seed), pf);
                 if d < best_d {
                     best = seed;
                     best_d = d;
@@ -112,7 +123,7 @@ fn fs_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
             }
         }
     }
-    return vec4<f32>(best, 0.0, 0.0);
+    return vec4<u32>(best, 0u, 0u, 0u);
 }
 
 // Distance from a lit texel to the shadow edge, metres, given the offset (texels) to its
@@ -133,11 +144,11 @@ fn fs_distance(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if textureLoad(shadow_mask, p, 0).r > 0.5 {
         return vec4<f32>(-1.0, 0.0, 0.0, 0.0);
     }
-    let seed = textureLoad(source, p, 0).xy;
-    if seed.x < 0.5 * NO_SEED {
+    let seed = textureLoad(seeds, p, 0).r;
+    if seed == NO_SEED {
         return vec4<f32>(FAR_M, 0.0, 0.0, 0.0);
     }
-    return vec4<f32>(edge_distance_m(seed - vec2<f32>(p)), 0.0, 0.0, 0.0);
+    return vec4<f32>(edge_distance_m(unpack(seed) - vec2<f32>(p)), 0.0, 0.0, 0.0);
 }
 
 // eq. 2: alpha(d) = (D - d) / D for 0 <= d < D, 0 beyond D and inside the shadow (d < 0).

@@ -22,8 +22,9 @@ pub(crate) const OVERLAY: usize = 5;
 /// Name and format of each floor-space image, in the order of the indices above.
 pub(crate) const FIELDS: [(&str, vk::Format); 6] = [
     ("shadow mask", vk::Format::R8_UNORM),
-    ("jump flood A", vk::Format::R32G32_SFLOAT),
-    ("jump flood B", vk::Format::R32G32_SFLOAT),
+    // Nearest shadow texel x | y << 16: one 32-bit fetch per neighbour in the flood.
+    ("jump flood A", vk::Format::R32_UINT),
+    ("jump flood B", vk::Format::R32_UINT),
     ("edge distance", vk::Format::R32_SFLOAT),
     // Half floats filter linearly on every device: the overlay samples it bilinearly.
     ("gain", vk::Format::R16_SFLOAT),
@@ -31,9 +32,9 @@ pub(crate) const FIELDS: [(&str, vk::Format); 6] = [
 ];
 
 /// What each floor-space image holds where its passes do not draw (outside the rectangle
-/// the overlay can light): lit floor, no seed (the shader's `NO_SEED`), beyond the ramp (the
-/// shader's `FAR_M`), no gain.
-pub(crate) const CLEAR: [f32; 6] = [0.0, -1.0e7, -1.0e7, 1.0e9, 0.0, 0.0];
+/// the overlay can light): lit floor, beyond the ramp (the shader's `FAR_M`), no gain. The
+/// jump-flood images are never cleared (only read where they were just drawn).
+pub(crate) const CLEAR: [f32; 6] = [0.0, 0.0, 0.0, 1.0e9, 0.0, 0.0];
 
 /// The ways a field's render pass may start, in the order of [`FieldTarget`]'s render passes.
 const STARTS: [FieldStart; 4] = [

@@ -1,7 +1,7 @@
 //! The distance field by jump flooding (shaders/inducer_field.wgsl `fs_seed_jump`,
 //! `fs_jump`, `fs_distance`): passes with halving jumps plus one more of jump 1 (JFA+1, which
-//! mends most of plain jump flooding's rare misses) ping-pong two RG32F images of
-//! nearest-shadow-texel coordinates (nearest in metres), the first taking its seeds straight
+//! mends most of plain jump flooding's rare misses) ping-pong two R32_UINT images of
+//! nearest-shadow-texel coordinates (x | y << 16, nearest in metres), the first taking its seeds straight
 //! from the shadow mask (every shadow texel is its own seed), and a last pass turns them into
 //! the distance d to the shadow edge in metres for every lit texel, -1 inside the shadow
 //! (`edge_distance_m` in [`super::reference`] on the CPU).

@@ -153,6 +153,7 @@ impl InducerPass {
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (2, vk::DescriptorType::SAMPLER, fragment),
+                (3, vk::DescriptorType::SAMPLED_IMAGE, fragment),
             ],
         )?;
         let field_layout = pipeline::layout(
@@ -200,18 +201,25 @@ impl InducerPass {
             ctx,
             sets,
             &[
-                (vk::DescriptorType::SAMPLED_IMAGE, 2 * sets),
+                (vk::DescriptorType::SAMPLED_IMAGE, 3 * sets),
                 (vk::DescriptorType::SAMPLER, sets),
             ],
         )?;
         let mut source_sets = [vk::DescriptorSet::null(); FIELDS.len()];
+        // Every binding of every set is written, though each pass reads only some: lavapipe
+        // reads every binding of a bound set. The seeds are binding 3 (unsigned), the other
+        // sources binding 0.
+        let mask_view = targets[MASK].image.view;
         for source in sources {
             let set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
-            // The sampler too, though only fs_combine reads it: lavapipe reads every binding
-            // of a bound set.
-            let (view, sampler) = (targets[source].image.view, scene.photo_sampler());
-            pipeline::write_texture(ctx, set, 0, 2, view, sampler);
-            pipeline::write_image(ctx, set, 1, targets[MASK].image.view);
+            let view = targets[source].image.view;
+            let (float, unsigned) = match source {
+                SEEDS_A | SEEDS_B => (mask_view, view),
+                _ => (view, mask_view),
+            };
+            pipeline::write_texture(ctx, set, 0, 2, float, scene.photo_sampler());
+            pipeline::write_image(ctx, set, 1, mask_view);
+            pipeline::write_image(ctx, set, 3, unsigned);
             source_sets[source] = set;
         }
         let combine_set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
@@ -223,6 +231,7 @@ impl InducerPass {
             targets[GAIN].image.view,
             scene.photo_sampler(),
         );
+        pipeline::write_image(ctx, combine_set, 3, mask_view);
         pipeline::write_image(ctx, combine_set, 1, caustic.view);
         let overlay = OverlayPass::new(ctx, eye_render_pass, scene, targets[OVERLAY].image.view)?;
 
@@ -500,13 +509,7 @@ impl InducerPass {
             Some([x0, y0, x1, y1]) => {
                 distance_passes(flood_span((x1 - x0).max(y1 - y0), self.ramp_reach_px()))
             }
-            // No shadow: the distance pass only writes "beyond the ramp", reading no seeds.
-            None => vec![FieldDraw {
-                target: DISTANCE,
-                pipeline: DIST,
-                source: MASK,
-                step: 0,
-            }],
+            None => Vec::new(),
         };
         // SAFETY: the caller's contract: `cmd` records outside a render pass and everything
         // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it;
@@ -540,6 +543,16 @@ impl InducerPass {
             }
             d.cmd_end_render_pass(cmd);
             stamp(0..1);
+            if region.is_none() {
+                // No shadow: no light either; only where the last computation drew is cleared.
+                stamp(1..2);
+                for (target, k) in [(DISTANCE, 2), (GAIN, 3)] {
+                    self.targets[target].begin(d, cmd, clear_start, area, CLEAR[target], area);
+                    d.cmd_end_render_pass(cmd);
+                    stamp(k..k + 1);
+                }
+                return None;
+            }
             for draw in draws.into_iter().chain([ramp]) {
                 if draw.pipeline == DIST {
                     // The flood (if any) is done.

@@ -1,8 +1,8 @@
 //! Caustics computed on the GPU for each pose of the object and the light (docs/caustics.md,
 //! eq. 6): photon splatting in two compute passes (shaders/caustics_live.wgsl) into the
 //! caustic gain map the overlay combines, in place of a bake. Recorded with the inducer's
-//! fields, so only on frames after a move; lavapipe's timestamps do not cover compute, so the
-//! work shows in wall-clock time.
+//! fields, so only on frames after a move; timed as the floor's `live caustics` stage
+//! ([`super::FieldPassesMs`]) and in wall-clock time.
 
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};

@@ -6,19 +6,20 @@
 //!
 //! Everything below lives in floor space: square textures of `resolution_px` texels over the
 //! floor photo's area (the unit square of [`crate::PlaneDesc::world_from_plane`], texel
-//! (0, 0) at the photo's top-left, so texture uv equals photo uv). Once per scene (on the
-//! first frame that asks for the inducer, or on [`crate::Renderer::inducer_fields`]) four
-//! kinds of fragment passes run (no compute: lavapipe's timestamps do not see compute work,
-//! and these passes are cheap):
+//! (0, 0) at the photo's top-left, so texture uv equals photo uv). Once per pose of the object
+//! and the light (on the first frame that asks for the inducer after a move, or on
+//! [`crate::Renderer::inducer_fields`]) four kinds of fragment passes run, each drawing only
+//! the region that can change (the overlay's rectangle, and where the last computation drew):
 //!
 //! 1. **Shadow mask** (eq. 1, shaders/inducer_mask.wgsl): the mesh projected from the point
 //!    light onto the floor plane by a homogeneous planar projection ([`planar_shadow`] in
 //!    geometry.rs) and rasterised straight into floor space; covered texels are in shadow.
 //!    For an opaque occluder this equals a conventional shadow-map lookup at each floor
 //!    texel, without the map's resolution and depth-bias artefacts.
-//! 2. **Jump flooding** (jump_flood.rs; shaders/inducer_field.wgsl `fs_seed`, `fs_jump`):
-//!    ceil(log2 N) passes with halving jumps plus one of jump 1, ping-ponging two RG32F
-//!    textures of nearest-shadow-texel coordinates, nearest in metres.
+//! 2. **Jump flooding** (jump_flood.rs; shaders/inducer_field.wgsl `fs_seed_jump`,
+//!    `fs_jump`): passes with halving jumps from what the rectangle (or D) needs, plus one of
+//!    jump 1, ping-ponging two textures of packed nearest-shadow-texel coordinates, nearest
+//!    in metres; the first seeds itself from the mask.
 //! 3. **Distance to the edge** (`fs_distance`, [`edge_distance_m`]): d in metres for every
 //!    lit texel, -1 inside the shadow.
 //! 4. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the precombined

@@ -1,19 +1,12 @@
 // Distance to the shadow edge and the inducer's gain, in floor space (METHOD.md section 1,
 // eq. 2-4; render/src/floor/). Full-screen passes over the floor-space textures, drawn only
-// inside the region that can change (render/src/floor/jump_flood.rs):
+// where the fields can change (render/src/floor/pass.rs):
 //
-// 1. fs_seed_jump: the first jump of the flood straight from the mask: each texel keeps, of
-//    the shadow texels at itself and at its 8 neighbours `step` texels away, the one nearest
-//    in metres (every shadow texel is its own nearest seed; the same as a seed pass followed
-//    by a jump).
-// 2. fs_jump (jump flooding, halving steps down to 1, then one more of step 1): each texel
-//    keeps, of the seeds stored at itself and at its 8 neighbours `step` texels away, the one
-//    nearest in metres. Neighbours outside `region` count as none: the passes draw nothing
-//    there.
-// 3. fs_distance: d, the distance from a lit texel to the shadow edge in metres; -1 inside
+// 1. (shaders/inducer_distance.wgsl) every texel of the region gets its nearest shadow texel.
+// 2. fs_distance: d, the distance from a lit texel to the shadow edge in metres; -1 inside
 //    the shadow; FAR_M outside `region` (the pass also draws where the region was before).
-// 4. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain.
-// 5. fs_combine (caustics, eq. 6): the floor overlay's gain at the caustic map's resolution,
+// 3. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain.
+// 4. fs_combine (caustics, eq. 6): the floor overlay's gain at the caustic map's resolution,
 //    k alpha(d) (if the inducer is on) + G (if the caustics are on), what the floor overlay
 //    multiplies the floor photo by. Rerun when those switches change.
 //
@@ -22,8 +15,6 @@
 struct Field {
     // Floor metres per texel along the texture's x (u) and y (v).
     texel_m: vec2<f32>,
-    // fs_jump: the jump of this pass, texels.
-    step: i32,
     // Side of the floor-space textures, texels.
     size: i32,
     // D of eq. 2, metres.
@@ -37,19 +28,16 @@ struct Field {
 };
 
 var<push_constant> field: Field;
-// The pass's input: the mask (fs_seed_jump), the distances (fs_ramp) or the gain
-// (fs_combine).
+// The pass's input: the distances (fs_ramp) or the gain (fs_combine).
 @group(0) @binding(0) var source: texture_2d<f32>;
 // The shadow mask, for fs_distance; the caustic gain G (R32F), for fs_combine.
 @group(0) @binding(1) var shadow_mask: texture_2d<f32>;
 // fs_combine: bilinear between texel centres, clamped at the edges (the overlay's sampler).
 @group(0) @binding(2) var clamp_sampler: sampler;
-// The seeds (fs_jump, fs_distance): each texel's nearest shadow texel found so far, packed as
-// x | y << 16 (one 32-bit fetch per neighbour), NO_SEED where none is yet.
-@group(0) @binding(3) var seeds: texture_2d<u32>;
+// fs_distance: each texel's nearest shadow texel, packed as x | y << 16, NO_SEED if none.
+@group(0) @binding(3) var<storage, read> nearest: array<u32>;
 
-// "No seed found yet": it unpacks to (65535, 65535), farther from every texel (fields are at
-// most 4096 texels across) than any real seed.
+// No shadow texel in the region.
 const NO_SEED: u32 = 0xffffffffu;
 // Distance written where the floor has no shadow at all, metres.
 const FAR_M: f32 = 1.0e9;
@@ -66,64 +54,8 @@ fn in_region(q: vec2<i32>) -> bool {
     return all(q >= field.region.xy) && all(q < field.region.zw);
 }
 
-fn pack(q: vec2<i32>) -> u32 {
-    return u32(q.x) | (u32(q.y) << 16u);
-}
-
 fn unpack(seed: u32) -> vec2<f32> {
     return vec2<f32>(f32(seed & 0xffffu), f32(seed >> 16u));
-}
-
-// Squared distance in metres between texel centres.
-fn distance2_m(seed: vec2<f32>, p: vec2<f32>) -> f32 {
-    let v = (seed - p) * field.texel_m;
-    return dot(v, v);
-}
-
-@fragment
-fn fs_seed_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<u32> {
-    let p = vec2<i32>(frag.xy);
-    let pf = vec2<f32>(p);
-    var best = NO_SEED;
-    if textureLoad(source, p, 0).r > 0.5 {
-        best = pack(p);
-    }
-    var best_d = distance2_m(unpack(best), pf);
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let q = p + vec2<i32>(dx, dy) * field.step;
-            if (dx != 0 || dy != 0) && in_region(q) && textureLoad(source, q, 0).r > 0.5 {
-                let d = distance2_m(vec2<f32>(q), pf);
-                if d < best_d {
-                    best = pack(q);
-                    best_d = d;
-                }
-            }
-        }
-    }
-    return vec4<u32>(best, 0u, 0u, 0u);
-}
-
-@fragment
-fn fs_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<u32> {
-    let p = vec2<i32>(frag.xy);
-    let pf = vec2<f32>(p);
-    var best = textureLoad(seeds, p, 0).r;
-    var best_d = distance2_m(unpack(best), pf);
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let q = p + vec2<i32>(dx, dy) * field.step;
-            if (dx != 0 || dy != 0) && in_region(q) {
-                let seed = textureLoad(seeds, q, 0).r;
-                let d = distance2_m(unpack(seed), pf);
-                if d < best_d {
-                    best = seed;
-                    best_d = d;
-                }
-            }
-        }
-    }
-    return vec4<u32>(best, 0u, 0u, 0u);
 }
 
 // Distance from a lit texel to the shadow edge, metres, given the offset (texels) to its
@@ -144,7 +76,7 @@ fn fs_distance(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if textureLoad(shadow_mask, p, 0).r > 0.5 {
         return vec4<f32>(-1.0, 0.0, 0.0, 0.0);
     }
-    let seed = textureLoad(seeds, p, 0).r;
+    let seed = nearest[p.y * field.size + p.x];
     if seed == NO_SEED {
         return vec4<f32>(FAR_M, 0.0, 0.0, 0.0);
     }

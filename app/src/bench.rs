@@ -102,8 +102,8 @@ pub struct VariantResult {
 pub struct FieldPassesMedians {
     /// The shadow mask.
     pub mask_ms: f64,
-    /// All jump-flooding passes.
-    pub jump_flood_ms: f64,
+    /// The nearest shadow texel of every texel (distance transform).
+    pub nearest_ms: f64,
     /// The distance to the shadow edge.
     pub distance_ms: f64,
     /// The inducer's gain (ramp).
@@ -122,7 +122,7 @@ impl FieldPassesMedians {
         };
         (!frames.is_empty()).then(|| FieldPassesMedians {
             mask_ms: median(|f| f.mask_ms),
-            jump_flood_ms: median(|f| f.jump_flood_ms),
+            nearest_ms: median(|f| f.nearest_ms),
             distance_ms: median(|f| f.distance_ms),
             ramp_ms: median(|f| f.ramp_ms),
             live_caustics_ms: median(|f| f.live_caustics_ms),
@@ -550,14 +550,9 @@ impl BenchReport {
         for (effects, f) in stages {
             let _ = writeln!(
                 out,
-                "  {effects:<24} mask {:.2}, jump flood {:.2}, distance {:.2}, ramp {:.2}, \
+                "  {effects:<24} mask {:.2}, nearest {:.2}, distance {:.2}, ramp {:.2}, \
                  live caustics {:.2}, combine {:.2}",
-                f.mask_ms,
-                f.jump_flood_ms,
-                f.distance_ms,
-                f.ramp_ms,
-                f.live_caustics_ms,
-                f.combine_ms
+                f.mask_ms, f.nearest_ms, f.distance_ms, f.ramp_ms, f.live_caustics_ms, f.combine_ms
             );
         }
         out

@@ -326,6 +326,7 @@ pub fn field_render_pass(
             .dst_subpass(0)
             .src_stage_mask(
                 vk::PipelineStageFlags::FRAGMENT_SHADER
+                    | vk::PipelineStageFlags::COMPUTE_SHADER
                     | vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
                     | vk::PipelineStageFlags::TRANSFER,
             )
@@ -340,7 +341,9 @@ pub fn field_render_pass(
             .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
             .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
             .dst_stage_mask(
-                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER,
+                vk::PipelineStageFlags::FRAGMENT_SHADER
+                    | vk::PipelineStageFlags::COMPUTE_SHADER
+                    | vk::PipelineStageFlags::TRANSFER,
             )
             .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::TRANSFER_READ),
     ];
@@ -537,6 +540,27 @@ pub fn write_texture(
     ];
     // SAFETY: the set is not in use by pending GPU work (it is written while its pass is
     // built), and the view and sampler are live.
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+}
+
+/// Points a storage-buffer binding of `set` at the whole of `buffer`.
+pub fn write_storage_buffer(
+    ctx: &GpuContext,
+    set: vk::DescriptorSet,
+    binding: u32,
+    buffer: vk::Buffer,
+) {
+    let info = [vk::DescriptorBufferInfo {
+        buffer,
+        offset: 0,
+        range: vk::WHOLE_SIZE,
+    }];
+    let writes = [vk::WriteDescriptorSet::default()
+        .dst_set(set)
+        .dst_binding(binding)
+        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+        .buffer_info(&info)];
+    // SAFETY: as in `write_texture`: the set is idle and the buffer live.
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
 

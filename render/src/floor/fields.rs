@@ -12,19 +12,14 @@ use crate::pipeline::{self, FieldStart};
 
 /// Indices into the pass's field targets.
 pub(crate) const MASK: usize = 0;
-pub(crate) const SEEDS_A: usize = 1;
-pub(crate) const SEEDS_B: usize = 2;
-pub(crate) const DISTANCE: usize = 3;
-pub(crate) const GAIN: usize = 4;
+pub(crate) const DISTANCE: usize = 1;
+pub(crate) const GAIN: usize = 2;
 /// The overlay's gain, k alpha(d) + G as switched on, at the caustic map's resolution.
-pub(crate) const OVERLAY: usize = 5;
+pub(crate) const OVERLAY: usize = 3;
 
 /// Name and format of each floor-space image, in the order of the indices above.
-pub(crate) const FIELDS: [(&str, vk::Format); 6] = [
+pub(crate) const FIELDS: [(&str, vk::Format); 4] = [
     ("shadow mask", vk::Format::R8_UNORM),
-    // Nearest shadow texel x | y << 16: one 32-bit fetch per neighbour in the flood.
-    ("jump flood A", vk::Format::R32_UINT),
-    ("jump flood B", vk::Format::R32_UINT),
     ("edge distance", vk::Format::R32_SFLOAT),
     // Half floats filter linearly on every device: the overlay samples it bilinearly.
     ("gain", vk::Format::R16_SFLOAT),
@@ -32,9 +27,8 @@ pub(crate) const FIELDS: [(&str, vk::Format); 6] = [
 ];
 
 /// What each floor-space image holds where its passes do not draw (outside the rectangle
-/// the overlay can light): lit floor, beyond the ramp (the shader's `FAR_M`), no gain. The
-/// jump-flood images are never cleared (only read where they were just drawn).
-pub(crate) const CLEAR: [f32; 6] = [0.0, 0.0, 0.0, 1.0e9, 0.0, 0.0];
+/// the overlay can light): lit floor, beyond the ramp (the shader's `FAR_M`), no gain.
+pub(crate) const CLEAR: [f32; 4] = [0.0, 1.0e9, 0.0, 0.0];
 
 /// The ways a field's render pass may start, in the order of [`FieldTarget`]'s render passes.
 const STARTS: [FieldStart; 4] = [
@@ -184,18 +178,18 @@ pub(crate) fn bounding(a: Option<TexelRect>, b: Option<TexelRect>) -> Option<Tex
 pub(crate) struct FieldPush {
     /// Floor metres per texel along x and y.
     pub texel_m: [f32; 2],
-    /// The jump of a jump-flooding pass, texels.
-    pub step: i32,
     /// Side of the fields, texels.
     pub size: i32,
     /// D of eq. 2, metres.
     pub ramp_width_m: f32,
     /// k of eq. 4.
     pub k: f32,
+    /// Padding (the switches are 8-byte aligned).
+    pub _pad: f32,
     /// fs_combine: weights of k alpha(d) and of the caustic gain G (1 on, 0 off).
     pub switches: [f32; 2],
-    /// The texels the fields are computed in (`[x0, y0, x1, y1]`, ends excluded): jump
-    /// flooding reads no seed outside, the distance pass writes "beyond the ramp" there.
+    /// The texels the fields are computed in (`[x0, y0, x1, y1]`, ends excluded): the
+    /// distance pass writes "beyond the ramp" outside.
     pub region: [i32; 4],
 }
 
@@ -277,7 +271,7 @@ impl InducerFields {
 }
 
 /// Timestamps the floor passes write after each of their stages, in this order: the mask, the
-/// jump flood, the distance, the ramp, the live caustics, the overlay gain's combination.
+/// nearest shadow texels, the distance, the ramp, the live caustics, the overlay gain's combination.
 pub const FIELD_STAMPS: u32 = 6;
 
 /// GPU milliseconds of each stage of the floor passes in one frame (0 for a stage that did
@@ -286,8 +280,8 @@ pub const FIELD_STAMPS: u32 = 6;
 pub struct FieldPassesMs {
     /// The shadow mask (eq. 1).
     pub mask_ms: f64,
-    /// All jump-flooding passes.
-    pub jump_flood_ms: f64,
+    /// The nearest shadow texel of every texel (the distance transform's compute passes).
+    pub nearest_ms: f64,
     /// The distance to the shadow edge.
     pub distance_ms: f64,
     /// The gain k alpha(d) (eq. 2, 4).
@@ -310,7 +304,7 @@ impl FieldPassesMs {
         });
         FieldPassesMs {
             mask_ms: ms[0],
-            jump_flood_ms: ms[1],
+            nearest_ms: ms[1],
             distance_ms: ms[2],
             ramp_ms: ms[3],
             live_caustics_ms: ms[4],
@@ -321,7 +315,7 @@ impl FieldPassesMs {
     /// Their sum.
     pub fn total_ms(&self) -> f64 {
         self.mask_ms
-            + self.jump_flood_ms
+            + self.nearest_ms
             + self.distance_ms
             + self.ramp_ms
             + self.live_caustics_ms

@@ -16,10 +16,9 @@
 //!    geometry.rs) and rasterised straight into floor space; covered texels are in shadow.
 //!    For an opaque occluder this equals a conventional shadow-map lookup at each floor
 //!    texel, without the map's resolution and depth-bias artefacts.
-//! 2. **Jump flooding** (jump_flood.rs; shaders/inducer_field.wgsl `fs_seed_jump`,
-//!    `fs_jump`): passes with halving jumps from what the rectangle (or D) needs, plus one of
-//!    jump 1, ping-ponging two textures of packed nearest-shadow-texel coordinates, nearest
-//!    in metres; the first seeds itself from the mask.
+//! 2. **Nearest shadow texel** (distance_transform.rs; shaders/inducer_distance.wgsl): an
+//!    exact Euclidean distance transform of the mask in two compute passes (per column, then
+//!    per row), nearest in metres.
 //! 3. **Distance to the edge** (`fs_distance`, [`edge_distance_m`]): d in metres for every
 //!    lit texel, -1 inside the shadow.
 //! 4. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the precombined
@@ -43,7 +42,7 @@
 //! - `geometry`: the floor's frame, the shadow projection (eq. 1) and the overlay's rectangles;
 //! - `reference`: eq. 2-5 and the exact distance field on the CPU;
 //! - `fields`: the floor-space images, the push constants and the fields read back;
-//! - `jump_flood`: the schedule of the distance-field passes;
+//! - `distance_transform`: the nearest shadow texel of every texel (compute);
 //! - `overlay`: the per-eye overlay pipeline;
 //! - `live`: the caustic gain map computed per pose on the GPU (photon splatting), instead of
 //!   a bake;
@@ -54,9 +53,9 @@
 //! The scene limits checked before any of this is built (`validate_inducer`,
 //! `validate_caustics`) live with the descriptions they check, in [`crate::scene`].
 
+mod distance_transform;
 mod fields;
 mod geometry;
-mod jump_flood;
 mod live;
 mod overlay;
 mod pass;

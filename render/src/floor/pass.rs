@@ -1,19 +1,19 @@
 //! The floor pass: builds the floor-space fields' pipelines once per scene and records their
-//! computation (mask, jump flooding, distance, ramp, combination) when a frame first needs
+//! computation (mask, distance transform, distance, ramp, combination) when a frame first needs
 //! them (progress.rs tracks whether it has really run; readback.rs copies the fields back).
 
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 
+use super::distance_transform::{COMBINE, DIST, DistanceTransform, RAMP};
 use super::fields::{
-    CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY, SEEDS_A,
-    SEEDS_B, Stamps, TexelRect, bounding,
+    CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY, Stamps,
+    TexelRect, bounding,
 };
 use super::geometry::{
     Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect,
     texels_plane_rect, union_rect,
 };
-use super::jump_flood::{COMBINE, DIST, FieldDraw, RAMP, distance_passes, flood_span};
 use super::live::{LiveCaustics, LiveCausticsDesc};
 use super::overlay::OverlayPass;
 use super::progress::{Prepared, Progress, Written};
@@ -61,14 +61,14 @@ pub(crate) struct InducerPass {
     mask_pipeline: Owned<vk::Pipeline>,
     /// Layout of the mask pass (push constants only).
     mask_layout: Owned<vk::PipelineLayout>,
-    /// Seed-and-jump, jump, distance, ramp and combine pipelines (`SEED_JUMP` ..= `COMBINE`).
+    /// Distance, ramp and combine pipelines (`DIST` ..= `COMBINE`).
     field_pipelines: Vec<Owned<vk::Pipeline>>,
     /// Their pipeline layout.
     field_layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets below.
     _pool: Owned<vk::DescriptorPool>,
-    /// Set layout of the full-screen passes: source and mask (or gain and G) textures, and
-    /// the sampler of the gain (fs_combine only).
+    /// Set layout of the full-screen passes: source and mask (or gain and G) textures, the
+    /// sampler of the gain (fs_combine only) and the nearest shadow texels (fs_distance).
     _field_set_layout: Owned<vk::DescriptorSetLayout>,
     /// The set reading each field image as the source (null for images never read so).
     source_sets: [vk::DescriptorSet; FIELDS.len()],
@@ -78,6 +78,8 @@ pub(crate) struct InducerPass {
     caustic: Image,
     /// Caustics computed per pose into `caustic`, once enabled.
     live: Option<LiveCaustics>,
+    /// The nearest shadow texel of every texel (read by the distance pass).
+    transform: DistanceTransform,
     /// Mask, seeds (two), distance, gain and overlay gain, in the order of [`FIELDS`].
     pub(super) targets: Vec<FieldTarget>,
 }
@@ -153,7 +155,7 @@ impl InducerPass {
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (2, vk::DescriptorType::SAMPLER, fragment),
-                (3, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+                (3, vk::DescriptorType::STORAGE_BUFFER, fragment),
             ],
         )?;
         let field_layout = pipeline::layout(
@@ -162,10 +164,8 @@ impl InducerPass {
             fragment,
             size_of::<FieldPush>() as u32,
         )?;
-        // In the order SEED_JUMP, JUMP, DIST, RAMP, COMBINE, with the field each writes.
+        // In the order DIST, RAMP, COMBINE, with the field each writes.
         let field_stages = [
-            (shaders::SEED_JUMP_FS, c"fs_seed_jump", SEEDS_A),
-            (shaders::JUMP_FS, c"fs_jump", SEEDS_A),
             (shaders::DISTANCE_FS, c"fs_distance", DISTANCE),
             (shaders::RAMP_FS, c"fs_ramp", GAIN),
             (shaders::COMBINE_FS, c"fs_combine", OVERLAY),
@@ -195,31 +195,29 @@ impl InducerPass {
             caustic_extent,
             bytemuck::cast_slice(caustic_gain),
         )?;
-        let sources = [MASK, SEEDS_A, SEEDS_B, DISTANCE];
+        let mask_view = targets[MASK].image.view;
+        let transform = DistanceTransform::new(ctx, mask_view, n, floor.size_m / n as f32)?;
+        let sources = [MASK, DISTANCE];
         let sets = sources.len() as u32 + 1;
         let pool = pipeline::pool(
             ctx,
             sets,
             &[
-                (vk::DescriptorType::SAMPLED_IMAGE, 3 * sets),
+                (vk::DescriptorType::SAMPLED_IMAGE, 2 * sets),
                 (vk::DescriptorType::SAMPLER, sets),
+                (vk::DescriptorType::STORAGE_BUFFER, sets),
             ],
         )?;
         let mut source_sets = [vk::DescriptorSet::null(); FIELDS.len()];
         // Every binding of every set is written, though each pass reads only some: lavapipe
-        // reads every binding of a bound set. The seeds are binding 3 (unsigned), the other
-        // sources binding 0.
-        let mask_view = targets[MASK].image.view;
+        // reads every binding of a bound set.
+        let nearest = transform.nearest.buffer;
         for source in sources {
             let set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
             let view = targets[source].image.view;
-            let (float, unsigned) = match source {
-                SEEDS_A | SEEDS_B => (mask_view, view),
-                _ => (view, mask_view),
-            };
-            pipeline::write_texture(ctx, set, 0, 2, float, scene.photo_sampler());
+            pipeline::write_texture(ctx, set, 0, 2, view, scene.photo_sampler());
             pipeline::write_image(ctx, set, 1, mask_view);
-            pipeline::write_image(ctx, set, 3, unsigned);
+            pipeline::write_storage_buffer(ctx, set, 3, nearest);
             source_sets[source] = set;
         }
         let combine_set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
@@ -231,8 +229,8 @@ impl InducerPass {
             targets[GAIN].image.view,
             scene.photo_sampler(),
         );
-        pipeline::write_image(ctx, combine_set, 3, mask_view);
         pipeline::write_image(ctx, combine_set, 1, caustic.view);
+        pipeline::write_storage_buffer(ctx, combine_set, 3, nearest);
         let overlay = OverlayPass::new(ctx, eye_render_pass, scene, targets[OVERLAY].image.view)?;
 
         Ok(InducerPass {
@@ -257,6 +255,7 @@ impl InducerPass {
             source_sets,
             combine_set,
             caustic,
+            transform,
             live: None,
             targets,
         })
@@ -315,24 +314,16 @@ impl InducerPass {
     }
 
     /// The push constants shared by the full-screen passes.
-    fn push(&self, step: i32, switches: [f32; 2], region: Option<TexelRect>) -> FieldPush {
+    fn push(&self, switches: [f32; 2], region: Option<TexelRect>) -> FieldPush {
         FieldPush {
             texel_m: self.texel_m.to_array(),
-            step,
             size: self.desc.resolution_px as i32,
             ramp_width_m: self.desc.ramp_width_m,
             k: self.desc.k,
+            _pad: 0.0,
             switches,
             region: region.map_or([0; 4], |r| r.map(|v| v as i32)),
         }
-    }
-
-    /// The farthest (texels along x or y) a lit texel with d < D can be from the centre of
-    /// its nearest shadow texel: D plus the half texel the edge lies short of that centre,
-    /// over the smaller texel side.
-    fn ramp_reach_px(&self) -> u32 {
-        let t = self.texel_m;
-        ((self.desc.ramp_width_m + t.max_element()) / t.min_element()).ceil() as u32
     }
 
     /// Records what a frame drawing the overlay with these switches still needs: the fields'
@@ -421,7 +412,6 @@ impl InducerPass {
         };
         if let Some(area) = area {
             let push = self.push(
-                0,
                 [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
                 None,
             );
@@ -462,14 +452,14 @@ impl InducerPass {
         )
     }
 
-    /// Records the mask, jump-flooding, distance and ramp passes, each stage followed by its
-    /// stamp (the first four of `stamps`); returns the texels that may differ from the
-    /// cleared values once they ran (the overlay's rectangle).
+    /// Records the mask, the distance transform and the distance and ramp passes, each stage
+    /// followed by its stamp (the first four of `stamps`); returns the texels that may differ
+    /// from the cleared values once they ran (the overlay's rectangle).
     ///
     /// Only that rectangle is computed (the shadow and its ramp); the rest of each field
     /// keeps its cleared value (lit, beyond the ramp, no gain). So only the rectangle and
-    /// where the last submitted computation drew are cleared or drawn; the jump-flood images
-    /// only in the rectangle, as nothing reads them elsewhere.
+    /// where the last submitted computation drew are cleared or drawn; the distance transform
+    /// only runs in the rectangle, as nothing reads it elsewhere.
     ///
     /// # Safety
     /// As [`InducerPass::prepare`].
@@ -498,18 +488,6 @@ impl InducerPass {
         let Some(area) = bounding(before, region) else {
             stamp(0..4);
             return None;
-        };
-        let ramp = FieldDraw {
-            target: GAIN,
-            pipeline: RAMP,
-            source: DISTANCE,
-            step: 0,
-        };
-        let draws = match region {
-            Some([x0, y0, x1, y1]) => {
-                distance_passes(flood_span((x1 - x0).max(y1 - y0), self.ramp_reach_px()))
-            }
-            None => Vec::new(),
         };
         // SAFETY: the caller's contract: `cmd` records outside a render pass and everything
         // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it;
@@ -543,7 +521,7 @@ impl InducerPass {
             }
             d.cmd_end_render_pass(cmd);
             stamp(0..1);
-            if region.is_none() {
+            let Some(region) = region else {
                 // No shadow: no light either; only where the last computation drew is cleared.
                 stamp(1..2);
                 for (target, k) in [(DISTANCE, 2), (GAIN, 3)] {
@@ -552,34 +530,16 @@ impl InducerPass {
                     stamp(k..k + 1);
                 }
                 return None;
-            }
-            for draw in draws.into_iter().chain([ramp]) {
-                if draw.pipeline == DIST {
-                    // The flood (if any) is done.
-                    stamp(1..2);
-                }
-                let push = self.push(draw.step, [0.0; 2], region);
-                let set = self.source_sets[draw.source];
-                // The jump-flood images are drawn (and read) only inside the region.
-                let (start, drawn) = match (draw.target, region) {
-                    (SEEDS_A | SEEDS_B, Some(region)) => (FieldStart::Discard, region),
-                    _ => (draw_start, area),
-                };
-                self.full_screen(
-                    ctx,
-                    cmd,
-                    draw.target,
-                    draw.pipeline,
-                    start,
-                    drawn,
-                    set,
-                    &push,
-                );
-                match draw.pipeline {
-                    DIST => stamp(2..3),
-                    RAMP => stamp(3..4),
-                    _ => {}
-                }
+            };
+            self.transform.record(ctx, cmd, region);
+            stamp(1..2);
+            let push = self.push([0.0; 2], Some(region));
+            for (target, pipeline, source, k) in
+                [(DISTANCE, DIST, MASK, 2), (GAIN, RAMP, DISTANCE, 3)]
+            {
+                let set = self.source_sets[source];
+                self.full_screen(ctx, cmd, target, pipeline, draw_start, area, set, &push);
+                stamp(k..k + 1);
             }
         }
         region

@@ -231,7 +231,8 @@ impl InducerPass {
         );
         pipeline::write_image(ctx, combine_set, 1, caustic.view);
         pipeline::write_storage_buffer(ctx, combine_set, 3, nearest);
-        let overlay = OverlayPass::new(ctx, eye_render_pass, scene, targets[OVERLAY].image.view)?;
+        let gains = [targets[GAIN].image.view, targets[OVERLAY].image.view];
+        let overlay = OverlayPass::new(ctx, eye_render_pass, scene, &gains)?;
 
         Ok(InducerPass {
             desc: params,
@@ -327,9 +328,9 @@ impl InducerPass {
     }
 
     /// Records what a frame drawing the overlay with these switches still needs: the fields'
-    /// computation when no submitted work holds it, and the overlay gain's combination
-    /// (k alpha(d) if `inducer`, + G if `caustics`) when the last one submitted was for
-    /// other switches. Returns what was recorded, for [`InducerPass::submitted`] and
+    /// computation when no submitted work holds it, and, with `caustics`, the overlay gain's
+    /// combination (k alpha(d) if `inducer`, + G) when the last one submitted was for other
+    /// switches or the fields moved since. Returns what was recorded, for [`InducerPass::submitted`] and
     /// [`InducerPass::finished`]; records nothing (the scene is static) otherwise. With
     /// `stamps`, writes all [`FIELD_STAMPS`] timestamps, one after each stage.
     ///
@@ -349,7 +350,8 @@ impl InducerPass {
     ) -> Prepared {
         let d = &ctx.device;
         let switches = u8::from(inducer) | (u8::from(caustics) << 1);
-        let mut prepared = self.progress.plan(Some(switches));
+        // Without caustics the overlay draws the inducer's gain itself: nothing to combine.
+        let mut prepared = self.progress.plan(caustics.then_some(switches));
         let stamp = |range| {
             if let Some(stamps) = stamps {
                 // SAFETY: the caller's contract (recording outside a render pass, queries
@@ -609,15 +611,25 @@ impl InducerPass {
         inducer: bool,
         caustics: bool,
     ) {
+        // The precombined gain with the caustics, the inducer's own without.
+        let gain = if caustics {
+            COMBINED_GAIN
+        } else {
+            INDUCER_GAIN
+        };
         if let Some(rect) = self.overlay_rect(inducer, caustics) {
             // SAFETY: the caller's contract, which is the overlay's.
             unsafe {
                 self.overlay
-                    .record(ctx, cmd, eye, self.world_from_plane, rect)
+                    .record(ctx, cmd, eye, self.world_from_plane, gain, rect)
             };
         }
     }
 }
+
+/// The overlay's gains: the inducer's k alpha(d), the combined k alpha(d) + G.
+const INDUCER_GAIN: usize = 0;
+const COMBINED_GAIN: usize = 1;
 
 /// The floor's whole unit square, plane-local.
 const WHOLE_FLOOR: [f32; 4] = [-0.5, -0.5, 0.5, 0.5];

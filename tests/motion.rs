@@ -240,6 +240,46 @@ fn region_limited_fields_match_a_fresh_computation_as_the_object_crosses_the_flo
 }
 
 #[test]
+fn fields_are_clear_while_the_light_is_below_the_floor_and_come_back_after() {
+    let mut scene = scene("moving-light.toml");
+    scene.inducer.resolution_px = 128;
+    let mut renderer = renderer(&scene, 32, 32);
+    let rest = scene.rest_placement();
+    let lit = renderer.inducer_fields().expect("fields");
+    assert!(
+        lit.gain.iter().any(|&g| g > 0.0),
+        "no inducer light at rest"
+    );
+    let below = Placement {
+        light_position_m: rest.light_position_m - Vec3::Y * 2.0,
+        ..rest
+    };
+    assert!(below.light_position_m.y < scene.floor.pose.position.y);
+    renderer.set_pose(views::scene_pose(&scene, &below));
+    let dark = renderer.inducer_fields().expect("fields");
+    assert!(dark.rect.is_none(), "{:?}", dark.rect);
+    assert!(
+        dark.mask.iter().all(|&m| m == 0),
+        "a shadow from below the floor"
+    );
+    assert!(
+        dark.gain.iter().all(|&g| g == 0.0),
+        "light from below the floor"
+    );
+    assert!(
+        dark.distance_m
+            .iter()
+            .all(|&d| d == vitreous_render::floor::FAR_M),
+        "distances without a shadow"
+    );
+    renderer.set_pose(views::scene_pose(&scene, &rest));
+    let back = renderer.inducer_fields().expect("fields");
+    assert!(back.mask == lit.mask && back.distance_m == lit.distance_m && back.gain == lit.gain);
+    assert_eq!(renderer.inducer_computations(), 3);
+    assert_silent(&renderer);
+}
+
+#[test]
 fn glass_follows_the_object_from_the_frame_its_pose_is_set() {
     let scene = scene("rolling-diamond.toml");
     let (w, h) = (128, 96);

@@ -4,7 +4,8 @@
 // exact Fresnel weights, both branches followed) and adds its share of the relative gain G to
 // the four floor texels around where it lands; a photon that meets the object also takes its
 // straight continuation away (the shadow, E_blocked). `cs_resolve` turns the fixed-point sums
-// into G = max(0, sum) (gains below MIN_GAIN become 0, as in the bake).
+// into G = max(0, sum) (gains below MIN_GAIN become 0, as in the bake) and bounds the
+// non-zero texels, so that the overlay covers only them once the map is known.
 //
 // Geometry is traced in the object's model space (the mesh never moves there); a uniform grid
 // of triangle lists, built once on the CPU, finds the surfaces.
@@ -49,6 +50,9 @@ struct Params {
 @group(0) @binding(6) var<storage, read_write> sums: array<atomic<i32>>;
 // The resolved gain map.
 @group(0) @binding(7) var<storage, read_write> gain: array<f32>;
+// The box of the non-zero gains: smallest x, smallest y, largest x, largest y (texels; the
+// CPU sets it to an empty box before each computation).
+@group(0) @binding(8) var<storage, read_write> bounds: array<atomic<u32>, 4>;
 
 const NONE: u32 = 0xffffffffu;
 const PI: f32 = 3.14159265358979;
@@ -337,5 +341,12 @@ fn cs_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let index = id.y * p.map.x + id.x;
     let g = max(f32(atomicLoad(&sums[index])) / p.misc.y, 0.0);
-    gain[index] = select(g, 0.0, g < p.misc.w);
+    let kept = g >= p.misc.w;
+    gain[index] = select(0.0, g, kept);
+    if kept {
+        atomicMin(&bounds[0], id.x);
+        atomicMin(&bounds[1], id.y);
+        atomicMax(&bounds[2], id.x);
+        atomicMax(&bounds[3], id.y);
+    }
 }

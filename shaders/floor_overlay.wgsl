@@ -14,8 +14,8 @@ struct Overlay {
 };
 
 var<push_constant> overlay: Overlay;
-// k alpha(d) + G over the floor's unit square, each term as switched on (fs_combine of
-// inducer_field.wgsl).
+// k alpha(d) (fs_ramp of inducer_field.wgsl) when the caustics are off, k alpha(d) + G
+// (fs_combine) when they are on, over the floor's unit square.
 @group(0) @binding(0) var gain: texture_2d<f32>;
 // The registered photo of the real floor: L_r, decoded to linear light by the sRGB format.
 @group(0) @binding(1) var floor_photo: texture_2d<f32>;

@@ -1,24 +1,20 @@
 // Distance to the shadow edge and the inducer's gain, in floor space (METHOD.md section 1,
-// eq. 2-4; render/src/inducer.rs). Full-screen passes over the floor-space textures:
+// eq. 2-4; render/src/floor/). Full-screen passes over the floor-space textures, drawn only
+// where the fields can change (render/src/floor/pass.rs):
 //
-// 1. fs_seed: every shadow texel is its own nearest shadow texel; lit texels have none yet.
-// 2. fs_jump (jump flooding, log2(N) passes with halving steps, then one more of step 1):
-//    each texel keeps, of the seeds stored at itself and at its 8 neighbours `step` texels
-//    away, the one nearest in metres.
-// 3. fs_distance: d, the distance from a lit texel to the shadow edge in metres; -1 inside
-//    the shadow.
-// 4. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain.
-// 5. fs_combine (caustics, eq. 6): the floor overlay's gain at the caustic map's resolution,
+// 1. (shaders/inducer_distance.wgsl) every texel of the region gets its nearest shadow texel.
+// 2. fs_distance: d, the distance from a lit texel to the shadow edge in metres; -1 inside
+//    the shadow; FAR_M outside `region` (the pass also draws where the region was before).
+// 3. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain.
+// 4. fs_combine (caustics, eq. 6): the floor overlay's gain at the caustic map's resolution,
 //    k alpha(d) (if the inducer is on) + G (if the caustics are on), what the floor overlay
 //    multiplies the floor photo by. Rerun when those switches change.
 //
-// Every fetch is a textureLoad of one texel: no filtering, no sampler.
+// Every fetch is a textureLoad of one texel, except fs_combine's bilinear read of the gain.
 
 struct Field {
     // Floor metres per texel along the texture's x (u) and y (v).
     texel_m: vec2<f32>,
-    // fs_jump: the jump of this pass, texels.
-    step: i32,
     // Side of the floor-space textures, texels.
     size: i32,
     // D of eq. 2, metres.
@@ -27,16 +23,22 @@ struct Field {
     k: f32,
     // fs_combine: weights of the inducer's gain and of the caustic gain G (1 on, 0 off).
     switches: vec2<f32>,
+    // The texels the fields are computed in: x0, y0, x1, y1 (ends excluded).
+    region: vec4<i32>,
 };
 
 var<push_constant> field: Field;
-// The pass's input: the mask (fs_seed), seeds (fs_jump, fs_distance) or distances (fs_ramp).
+// The pass's input: the distances (fs_ramp) or the gain (fs_combine).
 @group(0) @binding(0) var source: texture_2d<f32>;
 // The shadow mask, for fs_distance; the caustic gain G (R32F), for fs_combine.
 @group(0) @binding(1) var shadow_mask: texture_2d<f32>;
+// fs_combine: bilinear between texel centres, clamped at the edges (the overlay's sampler).
+@group(0) @binding(2) var clamp_sampler: sampler;
+// fs_distance: each texel's nearest shadow texel, packed as x | y << 16, NO_SEED if none.
+@group(0) @binding(3) var<storage, read> nearest: array<u32>;
 
-// Coordinate of "no seed found yet": far from every texel, so any real seed is nearer.
-const NO_SEED: f32 = -1.0e7;
+// No shadow texel in the region.
+const NO_SEED: u32 = 0xffffffffu;
 // Distance written where the floor has no shadow at all, metres.
 const FAR_M: f32 = 1.0e9;
 
@@ -47,42 +49,13 @@ fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
     return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
 }
 
-@fragment
-fn fs_seed(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(frag.xy);
-    if textureLoad(source, p, 0).r > 0.5 {
-        return vec4<f32>(vec2<f32>(p), 0.0, 0.0);
-    }
-    return vec4<f32>(NO_SEED, NO_SEED, 0.0, 0.0);
+// Whether texel q lies in the region the fields are computed in.
+fn in_region(q: vec2<i32>) -> bool {
+    return all(q >= field.region.xy) && all(q < field.region.zw);
 }
 
-// Squared distance in metres between texel centres.
-fn distance2_m(seed: vec2<f32>, p: vec2<f32>) -> f32 {
-    let v = (seed - p) * field.texel_m;
-    return dot(v, v);
-}
-
-@fragment
-fn fs_jump(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(frag.xy);
-    let pf = vec2<f32>(p);
-    var best = textureLoad(source, p, 0).xy;
-    var best_d = distance2_m(best, pf);
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let q = p + vec2<i32>(dx, dy) * field.step;
-            let inside = all(q >= vec2<i32>(0)) && all(q < vec2<i32>(field.size));
-            if (dx != 0 || dy != 0) && inside {
-                let seed = textureLoad(source, q, 0).xy;
-                let d = distance2_m(seed, pf);
-                if d < best_d {
-                    best = seed;
-                    best_d = d;
-                }
-            }
-        }
-    }
-    return vec4<f32>(best, 0.0, 0.0);
+fn unpack(seed: u32) -> vec2<f32> {
+    return vec2<f32>(f32(seed & 0xffffu), f32(seed >> 16u));
 }
 
 // Distance from a lit texel to the shadow edge, metres, given the offset (texels) to its
@@ -97,14 +70,17 @@ fn edge_distance_m(offset: vec2<f32>) -> f32 {
 @fragment
 fn fs_distance(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let p = vec2<i32>(frag.xy);
+    if !in_region(p) {
+        return vec4<f32>(FAR_M, 0.0, 0.0, 0.0);
+    }
     if textureLoad(shadow_mask, p, 0).r > 0.5 {
         return vec4<f32>(-1.0, 0.0, 0.0, 0.0);
     }
-    let seed = textureLoad(source, p, 0).xy;
-    if seed.x < 0.5 * NO_SEED {
+    let seed = nearest[p.y * field.size + p.x];
+    if seed == NO_SEED {
         return vec4<f32>(FAR_M, 0.0, 0.0, 0.0);
     }
-    return vec4<f32>(edge_distance_m(seed - vec2<f32>(p)), 0.0, 0.0, 0.0);
+    return vec4<f32>(edge_distance_m(unpack(seed) - vec2<f32>(p)), 0.0, 0.0, 0.0);
 }
 
 // eq. 2: alpha(d) = (D - d) / D for 0 <= d < D, 0 beyond D and inside the shadow (d < 0).
@@ -122,22 +98,6 @@ fn fs_ramp(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     return vec4<f32>(field.k * ramp(d_m, field.ramp_width_m), 0.0, 0.0, 0.0);
 }
 
-// k alpha(d) at floor uv (0..1, v down), bilinear between texel centres and clamped at the
-// edges like the overlay's sampler (four loads: this pass runs once per switch change).
-fn inducer_gain_bilinear(uv: vec2<f32>) -> f32 {
-    let n = field.size;
-    let t = uv * f32(n) - 0.5;
-    let base = floor(t);
-    let f = t - base;
-    let b = vec2<i32>(base);
-    let hi = vec2<i32>(n - 1);
-    let g00 = textureLoad(source, clamp(b, vec2<i32>(0), hi), 0).r;
-    let g10 = textureLoad(source, clamp(b + vec2<i32>(1, 0), vec2<i32>(0), hi), 0).r;
-    let g01 = textureLoad(source, clamp(b + vec2<i32>(0, 1), vec2<i32>(0), hi), 0).r;
-    let g11 = textureLoad(source, clamp(b + vec2<i32>(1, 1), vec2<i32>(0), hi), 0).r;
-    return mix(mix(g00, g10, f.x), mix(g01, g11, f.x), f.y);
-}
-
 @fragment
 fn fs_combine(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     // The target has the caustic map's size, texel for texel.
@@ -145,7 +105,8 @@ fn fs_combine(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let uv = frag.xy / vec2<f32>(textureDimensions(shadow_mask));
     var gain = 0.0;
     if field.switches.x > 0.0 {
-        gain += field.switches.x * inducer_gain_bilinear(uv);
+        // k alpha(d) at the texel's floor point, bilinear as the overlay samples it.
+        gain += field.switches.x * textureSampleLevel(source, clamp_sampler, uv, 0.0).r;
     }
     if field.switches.y > 0.0 {
         // eq. 6: L'_c = max(0, L_c - L_r) = G L_r; G >= 0 is checked on loading.

@@ -106,7 +106,7 @@ fn shadow_ends_z(scene: &Scene) -> (f32, f32) {
 /// Checks the GPU distance field against the exact CPU transform of the same mask: within one
 /// texel wherever the exact distance is within D of the edge, -1 in the shadow. Returns the
 /// largest error in texels.
-fn check_distance_field(fields: &InducerFields, ramp_width_m: f32) -> f32 {
+pub(crate) fn check_distance_field(fields: &InducerFields, ramp_width_m: f32) -> f32 {
     let n = fields.resolution_px;
     let exact = floor::exact_edge_distances(&fields.mask, n, fields.texel_m);
     let texel = fields.texel_m.max_element();
@@ -137,7 +137,7 @@ fn check_distance_field(fields: &InducerFields, ramp_width_m: f32) -> f32 {
 
 /// Checks the gain field against eq. 2 and 4 everywhere (f16 storage) and exactly zero in
 /// the shadow and beyond D.
-fn check_gain_follows_distance(fields: &InducerFields, k: f32, d_m: f32) {
+pub(crate) fn check_gain_follows_distance(fields: &InducerFields, k: f32, d_m: f32) {
     for i in 0..fields.gain.len() {
         let g = fields.gain[i];
         let d = fields.distance_m[i];

@@ -155,6 +155,130 @@ fn texel_uv(scene: &Scene, world: Vec3) -> Vec2 {
     Vec2::new(local.x + 0.5, 0.5 - local.y)
 }
 
+/// The fields and the eye images of `renderer` after moving the object to `position`: the
+/// fields read back before or after drawing a frame of condition c (the inducer and the
+/// baked caustics) seen from 1 m above the floor's centre.
+fn fields_and_eyes(
+    scene: &Scene,
+    renderer: &mut Renderer,
+    position: Vec3,
+    read_first: bool,
+) -> (InducerFields, Vec<u8>) {
+    let placement = Placement {
+        object_position_m: position,
+        ..scene.rest_placement()
+    };
+    renderer.set_pose(views::scene_pose(scene, &placement));
+    let above = scene.floor.pose.position + Vec3::Y;
+    let fov = Fov {
+        left_rad: -0.55,
+        right_rad: 0.55,
+        up_rad: 0.55,
+        down_rad: -0.55,
+    };
+    let down = Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2);
+    let eye = EyeParams::new(above, down, fov);
+    let params = FrameParams {
+        eyes: [eye, eye],
+        look: Look {
+            inducer: true,
+            caustics: true,
+            ..Look::default()
+        },
+    };
+    let want = Want {
+        eyes: true,
+        world: false,
+    };
+    let first = read_first.then(|| renderer.inducer_fields().expect("fields"));
+    let frame = render_once(renderer, &params, want);
+    let fields = first.unwrap_or_else(|| renderer.inducer_fields().expect("fields"));
+    let [left, _] = frame.eyes;
+    (fields, left)
+}
+
+#[test]
+fn region_limited_fields_match_a_fresh_computation_as_the_object_crosses_the_floor() {
+    let mut scene = scene("glass-sphere.toml");
+    scene.inducer.resolution_px = 256;
+    scene.load_caustics().expect("the sphere's bake");
+    let (k, d_m) = (scene.inducer.k, scene.inducer.ramp_width_m);
+    let (w, h) = (96, 96);
+    let mut moving = renderer(&scene, w, h);
+    let y = scene.object.center_m.y;
+    let z = scene.floor.pose.position.z;
+    // From the rest pose across the floor, to its right edge with the shadow leaving it at
+    // the front, to the back left corner and back (the floor is 1 m square).
+    let positions = [
+        scene.object.center_m,
+        Vec3::new(0.25, y, z),
+        Vec3::new(0.46, y, z + 0.42),
+        Vec3::new(-0.46, y, z - 0.46),
+        scene.object.center_m,
+    ];
+    for (i, position) in positions.into_iter().enumerate() {
+        let read_first = i % 2 == 1;
+        let (fields, eyes) = fields_and_eyes(&scene, &mut moving, position, read_first);
+        let mut fresh = renderer(&scene, w, h);
+        let (full, full_eyes) = fields_and_eyes(&scene, &mut fresh, position, read_first);
+        assert_silent(&fresh);
+        let shadow = fields.mask.iter().filter(|&&m| m == 1).count();
+        eprintln!("object at {position}: {shadow} shadow texels");
+        assert!(shadow > 50, "at {position}: {shadow} shadow texels");
+        assert!(fields.mask == full.mask, "at {position}: masks differ");
+        assert!(
+            fields.distance_m == full.distance_m,
+            "at {position}: distances differ"
+        );
+        assert!(fields.gain == full.gain, "at {position}: gains differ");
+        assert!(eyes == full_eyes, "at {position}: eye images differ");
+        crate::inducer::check_distance_field(&fields, d_m);
+        crate::inducer::check_gain_follows_distance(&fields, k, d_m);
+    }
+    assert_eq!(moving.inducer_computations(), positions.len() as u64);
+    assert_silent(&moving);
+}
+
+#[test]
+fn fields_are_clear_while_the_light_is_below_the_floor_and_come_back_after() {
+    let mut scene = scene("moving-light.toml");
+    scene.inducer.resolution_px = 128;
+    let mut renderer = renderer(&scene, 32, 32);
+    let rest = scene.rest_placement();
+    let lit = renderer.inducer_fields().expect("fields");
+    assert!(
+        lit.gain.iter().any(|&g| g > 0.0),
+        "no inducer light at rest"
+    );
+    let below = Placement {
+        light_position_m: rest.light_position_m - Vec3::Y * 2.0,
+        ..rest
+    };
+    assert!(below.light_position_m.y < scene.floor.pose.position.y);
+    renderer.set_pose(views::scene_pose(&scene, &below));
+    let dark = renderer.inducer_fields().expect("fields");
+    assert!(dark.rect.is_none(), "{:?}", dark.rect);
+    assert!(
+        dark.mask.iter().all(|&m| m == 0),
+        "a shadow from below the floor"
+    );
+    assert!(
+        dark.gain.iter().all(|&g| g == 0.0),
+        "light from below the floor"
+    );
+    assert!(
+        dark.distance_m
+            .iter()
+            .all(|&d| d == vitreous_render::floor::FAR_M),
+        "distances without a shadow"
+    );
+    renderer.set_pose(views::scene_pose(&scene, &rest));
+    let back = renderer.inducer_fields().expect("fields");
+    assert!(back.mask == lit.mask && back.distance_m == lit.distance_m && back.gain == lit.gain);
+    assert_eq!(renderer.inducer_computations(), 3);
+    assert_silent(&renderer);
+}
+
 #[test]
 fn glass_follows_the_object_from_the_frame_its_pose_is_set() {
     let scene = scene("rolling-diamond.toml");

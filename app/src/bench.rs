@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
+use vitreous_render::floor::FieldPassesMs;
 use vitreous_render::renderer::Want;
 use vitreous_render::{ContextOptions, GpuContext, Look, Reflection, Refraction, Renderer};
 use vitreous_xr::null::{NullBackend, NullConfig};
@@ -73,6 +74,8 @@ pub struct VariantResult {
     /// GPU milliseconds per frame of the floor fields' work before the eye passes (the
     /// shadow inducer's recomputation after a move, the overlay gain's combination).
     pub prepare_gpu_ms: Option<Spread>,
+    /// Median GPU milliseconds per frame of each stage of that work.
+    pub field_passes_gpu_ms: Option<FieldPassesMedians>,
     /// CPU milliseconds per stereo frame (recording and submission).
     pub cpu_ms: Option<Spread>,
     /// Wall-clock milliseconds per stereo frame, submission to completion.
@@ -91,6 +94,41 @@ pub struct VariantResult {
     /// Two-surface variants: median GPU time over the same variant's under the paper's
     /// refraction.
     pub gpu_over_paper: Option<f64>,
+}
+
+/// Median GPU milliseconds per frame of each stage of the floor fields' work (0 where it
+/// did not run on most frames).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct FieldPassesMedians {
+    /// The shadow mask.
+    pub mask_ms: f64,
+    /// The nearest shadow texel of every texel (distance transform).
+    pub nearest_ms: f64,
+    /// The distance to the shadow edge.
+    pub distance_ms: f64,
+    /// The inducer's gain (ramp).
+    pub ramp_ms: f64,
+    /// The live caustic map.
+    pub live_caustics_ms: f64,
+    /// The overlay gain's combination.
+    pub combine_ms: f64,
+}
+
+impl FieldPassesMedians {
+    /// The medians of `frames`' stages, or `None` without frames.
+    fn of(frames: &[FieldPassesMs]) -> Option<FieldPassesMedians> {
+        let median = |stage: fn(&FieldPassesMs) -> f64| {
+            Spread::of(frames.iter().map(stage)).map_or(0.0, |s| s.median_ms)
+        };
+        (!frames.is_empty()).then(|| FieldPassesMedians {
+            mask_ms: median(|f| f.mask_ms),
+            nearest_ms: median(|f| f.nearest_ms),
+            distance_ms: median(|f| f.distance_ms),
+            ramp_ms: median(|f| f.ramp_ms),
+            live_caustics_ms: median(|f| f.live_caustics_ms),
+            combine_ms: median(|f| f.combine_ms),
+        })
+    }
 }
 
 /// A benchmark's result.
@@ -289,6 +327,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     let mut turns = 0u32;
     let n = variants.len();
     let mut prepare = vec![Vec::new(); n];
+    let mut field_passes = vec![Vec::new(); n];
     let mut gpu = vec![Vec::new(); n];
     let mut cpu = vec![Vec::new(); n];
     let mut wall = vec![Vec::new(); n];
@@ -324,6 +363,9 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 }
                 if let Some(p) = result.timing.prepare_gpu_ms {
                     prepare[v].push(p);
+                }
+                if let Some(f) = result.timing.field_passes {
+                    field_passes[v].push(f);
                 }
                 cpu[v].push(result.timing.cpu_submit_ms);
                 wall[v].push(wall_ms);
@@ -382,6 +424,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 moving: variant.moving,
                 gpu_ms: g,
                 prepare_gpu_ms: Spread::of(prepare[i].iter().copied()),
+                field_passes_gpu_ms: FieldPassesMedians::of(&field_passes[i]),
                 cpu_ms: c,
                 wall_ms: wl,
                 gpu_ratio: ratio(g, base.0),
@@ -491,6 +534,25 @@ impl BenchReport {
                 r(v.gpu_over_static),
                 r(v.wall_over_static),
                 r(v.gpu_over_paper)
+            );
+        }
+        // The variants whose frames have floor work (a still frame's stamps alone take a few
+        // hundredths of a millisecond each on lavapipe).
+        let stages: Vec<_> = self
+            .variants
+            .iter()
+            .filter(|v| v.prepare_gpu_ms.is_some_and(|p| p.median_ms > 0.5))
+            .filter_map(|v| v.field_passes_gpu_ms.map(|f| (&v.effects, f)))
+            .collect();
+        if !stages.is_empty() {
+            let _ = writeln!(out, "fields GPU ms per stage (medians):");
+        }
+        for (effects, f) in stages {
+            let _ = writeln!(
+                out,
+                "  {effects:<24} mask {:.2}, nearest {:.2}, distance {:.2}, ramp {:.2}, \
+                 live caustics {:.2}, combine {:.2}",
+                f.mask_ms, f.nearest_ms, f.distance_ms, f.ramp_ms, f.live_caustics_ms, f.combine_ms
             );
         }
         out

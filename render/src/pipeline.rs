@@ -266,19 +266,52 @@ pub fn eye_render_pass(
     render_pass(ctx, &attachments, &subpasses, &dependencies)
 }
 
-/// A render pass with one colour attachment of `format`, cleared, left for fragment shaders
-/// to read (a floor-space field). Its dependencies order it after earlier reads and writes of
-/// the image (by fragment shaders, attachments or transfers) and make its writes visible to
-/// later fragment shaders and transfers.
-pub fn field_render_pass(ctx: &GpuContext, format: vk::Format) -> Result<Owned<vk::RenderPass>> {
+/// How a floor-space field's render pass treats what the image held before. Only the render
+/// area is cleared or drawn, so the `Keep` kinds cost nothing outside it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FieldStart {
+    /// The image may be in any layout and its texels outside the render area are lost;
+    /// every texel of the render area is drawn, so none is cleared.
+    Discard,
+    /// As `Discard`, but the render area is cleared first.
+    Clear,
+    /// The image is in SHADER_READ_ONLY_OPTIMAL and keeps its texels outside the render
+    /// area; inside it they are cleared.
+    KeepClear,
+    /// As `KeepClear`, but every texel of the render area is drawn, so none is cleared.
+    KeepDraw,
+}
+
+/// A render pass with one colour attachment of `format`, starting as `start` says, left for
+/// fragment shaders to read (a floor-space field). Its dependencies order it after earlier
+/// reads and writes of the image (by fragment shaders, attachments or transfers) and make its
+/// writes visible to later fragment shaders and transfers. The three kinds are compatible:
+/// one framebuffer and one pipeline serve them all.
+pub fn field_render_pass(
+    ctx: &GpuContext,
+    format: vk::Format,
+    start: FieldStart,
+) -> Result<Owned<vk::RenderPass>> {
+    let (load, initial) = match start {
+        FieldStart::Discard => (vk::AttachmentLoadOp::DONT_CARE, vk::ImageLayout::UNDEFINED),
+        FieldStart::Clear => (vk::AttachmentLoadOp::CLEAR, vk::ImageLayout::UNDEFINED),
+        FieldStart::KeepClear => (
+            vk::AttachmentLoadOp::CLEAR,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        ),
+        FieldStart::KeepDraw => (
+            vk::AttachmentLoadOp::DONT_CARE,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        ),
+    };
     let attachments = [vk::AttachmentDescription::default()
         .format(format)
         .samples(vk::SampleCountFlags::TYPE_1)
-        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .load_op(load)
         .store_op(vk::AttachmentStoreOp::STORE)
         .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
         .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-        .initial_layout(vk::ImageLayout::UNDEFINED)
+        .initial_layout(initial)
         .final_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)];
     let color_ref = [vk::AttachmentReference {
         attachment: 0,
@@ -293,6 +326,7 @@ pub fn field_render_pass(ctx: &GpuContext, format: vk::Format) -> Result<Owned<v
             .dst_subpass(0)
             .src_stage_mask(
                 vk::PipelineStageFlags::FRAGMENT_SHADER
+                    | vk::PipelineStageFlags::COMPUTE_SHADER
                     | vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
                     | vk::PipelineStageFlags::TRANSFER,
             )
@@ -307,7 +341,9 @@ pub fn field_render_pass(ctx: &GpuContext, format: vk::Format) -> Result<Owned<v
             .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
             .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
             .dst_stage_mask(
-                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::TRANSFER,
+                vk::PipelineStageFlags::FRAGMENT_SHADER
+                    | vk::PipelineStageFlags::COMPUTE_SHADER
+                    | vk::PipelineStageFlags::TRANSFER,
             )
             .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::TRANSFER_READ),
     ];
@@ -504,6 +540,27 @@ pub fn write_texture(
     ];
     // SAFETY: the set is not in use by pending GPU work (it is written while its pass is
     // built), and the view and sampler are live.
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+}
+
+/// Points a storage-buffer binding of `set` at the whole of `buffer`.
+pub fn write_storage_buffer(
+    ctx: &GpuContext,
+    set: vk::DescriptorSet,
+    binding: u32,
+    buffer: vk::Buffer,
+) {
+    let info = [vk::DescriptorBufferInfo {
+        buffer,
+        offset: 0,
+        range: vk::WHOLE_SIZE,
+    }];
+    let writes = [vk::WriteDescriptorSet::default()
+        .dst_set(set)
+        .dst_binding(binding)
+        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+        .buffer_info(&info)];
+    // SAFETY: as in `write_texture`: the set is idle and the buffer live.
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
 

@@ -12,7 +12,7 @@ use gpu_allocator::MemoryLocation;
 use crate::camera::FrameParams;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
-use crate::floor::{InducerFields, InducerPass, Prepared};
+use crate::floor::{FIELD_STAMPS, FieldPassesMs, InducerFields, InducerPass, Prepared, Stamps};
 use crate::glass::{EyePush, GlassPass, GlassVariant};
 use crate::memory::Buffer;
 use crate::owned::Owned;
@@ -33,6 +33,10 @@ pub const PIPELINE_DEPTH: usize = 2;
 
 /// Largest eye image side the renderer accepts, in pixels.
 pub const MAX_EXTENT: u32 = 8192;
+
+/// Timestamps per frame: the start of the floor fields' work, the start and the end of the
+/// eye passes, then the floor passes' own.
+const QUERIES: u32 = 3 + FIELD_STAMPS;
 
 /// What to read back from a frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -67,6 +71,8 @@ pub struct FrameTiming {
     /// inducer's computation after a move, the overlay gain's combination after a switch;
     /// 0 when none was due), milliseconds; `None` without timestamps.
     pub prepare_gpu_ms: Option<f64>,
+    /// That work stage by stage (the parts of `prepare_gpu_ms`); `None` without timestamps.
+    pub field_passes: Option<FieldPassesMs>,
     /// CPU time spent recording and submitting the frame, milliseconds.
     pub cpu_submit_ms: f64,
 }
@@ -100,8 +106,8 @@ struct FrameSlot {
     cmd: vk::CommandBuffer,
     /// Signalled when the slot's last submission finished.
     fence: Owned<vk::Fence>,
-    /// Three timestamps (start of the floor fields' work, start and end of the eye passes),
-    /// when supported.
+    /// Timestamps (start of the floor fields' work, start and end of the eye passes, then
+    /// the floor passes' [`FIELD_STAMPS`]), when supported.
     queries: Option<Owned<vk::QueryPool>>,
     /// Host-visible copy of both eye layers, then both world layers.
     readback: Buffer,
@@ -205,7 +211,7 @@ impl Renderer {
                 Some(_) => {
                     let info = vk::QueryPoolCreateInfo::default()
                         .query_type(vk::QueryType::TIMESTAMP)
-                        .query_count(3);
+                        .query_count(QUERIES);
                     // SAFETY: a valid create info; owned right away.
                     let pool = unsafe { ctx.device.create_query_pool(&info, None) }
                         .vk("vkCreateQueryPool")?;
@@ -398,25 +404,33 @@ impl Renderer {
             return Err(e);
         }
         self.inducer.finished(pending.prepared, true);
-        let (gpu_ms, prepare_gpu_ms) = match (&slot.queries, self.ctx.timestamp_period_ns) {
-            (Some(pool), Some(period)) => {
-                let mut stamps = [0u64; 3];
-                // SAFETY: the frame that wrote both queries finished (its fence signalled
-                // above), so the results are available.
-                unsafe {
-                    d.get_query_pool_results(
-                        pool.raw(),
-                        0,
-                        &mut stamps,
-                        vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+        let (gpu_ms, prepare_gpu_ms, field_passes) =
+            match (&slot.queries, self.ctx.timestamp_period_ns) {
+                (Some(pool), Some(period)) => {
+                    let mut stamps = [0u64; QUERIES as usize];
+                    // SAFETY: the frame that wrote both queries finished (its fence signalled
+                    // above), so the results are available.
+                    unsafe {
+                        d.get_query_pool_results(
+                            pool.raw(),
+                            0,
+                            &mut stamps,
+                            vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                        )
+                    }
+                    .vk("vkGetQueryPoolResults")?;
+                    let ms =
+                        |a: u64, b: u64| Some(b.wrapping_sub(a) as f64 * f64::from(period) * 1e-6);
+                    let mut field = [0u64; FIELD_STAMPS as usize];
+                    field.copy_from_slice(&stamps[3..]);
+                    (
+                        ms(stamps[1], stamps[2]),
+                        ms(stamps[0], stamps[1]),
+                        Some(FieldPassesMs::from_stamps(stamps[0], field, period)),
                     )
                 }
-                .vk("vkGetQueryPoolResults")?;
-                let ms = |a: u64, b: u64| Some(b.wrapping_sub(a) as f64 * f64::from(period) * 1e-6);
-                (ms(stamps[1], stamps[2]), ms(stamps[0], stamps[1]))
-            }
-            _ => (None, None),
-        };
+                _ => (None, None, None),
+            };
         let bytes = if pending.want.eyes {
             Some(slot.readback.mapped()?)
         } else {
@@ -439,6 +453,7 @@ impl Renderer {
             timing: FrameTiming {
                 gpu_ms,
                 prepare_gpu_ms,
+                field_passes,
                 cpu_submit_ms: pending.cpu_submit_ms,
             },
             readback,
@@ -491,7 +506,7 @@ impl Renderer {
             }
             let queries = slot.queries.as_ref().map(Owned::raw);
             if let Some(pool) = queries {
-                d.cmd_reset_query_pool(cmd, pool, 0, 3);
+                d.cmd_reset_query_pool(cmd, pool, 0, QUERIES);
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 0);
             }
             let blank = params.look.blank;
@@ -499,11 +514,14 @@ impl Renderer {
                 params.look.inducer && !blank,
                 params.look.caustics && !blank,
             );
+            let stamps = queries.map(|pool| Stamps { pool, first: 3 });
             if inducer || caustics {
                 // Once per pose (and per change of these switches), timed on its own.
-                prepared = self
-                    .inducer
-                    .prepare(&self.ctx, cmd, &self.scene, inducer, caustics);
+                prepared =
+                    self.inducer
+                        .prepare(&self.ctx, cmd, &self.scene, inducer, caustics, stamps);
+            } else if let Some(stamps) = stamps {
+                stamps.write(d, cmd, 0..FIELD_STAMPS);
             }
             if let Some(pool) = queries {
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 1);

@@ -8,22 +8,18 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::Image;
 use crate::owned::Owned;
-use crate::pipeline;
+use crate::pipeline::{self, FieldStart};
 
 /// Indices into the pass's field targets.
 pub(crate) const MASK: usize = 0;
-pub(crate) const SEEDS_A: usize = 1;
-pub(crate) const SEEDS_B: usize = 2;
-pub(crate) const DISTANCE: usize = 3;
-pub(crate) const GAIN: usize = 4;
+pub(crate) const DISTANCE: usize = 1;
+pub(crate) const GAIN: usize = 2;
 /// The overlay's gain, k alpha(d) + G as switched on, at the caustic map's resolution.
-pub(crate) const OVERLAY: usize = 5;
+pub(crate) const OVERLAY: usize = 3;
 
 /// Name and format of each floor-space image, in the order of the indices above.
-pub(crate) const FIELDS: [(&str, vk::Format); 6] = [
+pub(crate) const FIELDS: [(&str, vk::Format); 4] = [
     ("shadow mask", vk::Format::R8_UNORM),
-    ("jump flood A", vk::Format::R32G32_SFLOAT),
-    ("jump flood B", vk::Format::R32G32_SFLOAT),
     ("edge distance", vk::Format::R32_SFLOAT),
     // Half floats filter linearly on every device: the overlay samples it bilinearly.
     ("gain", vk::Format::R16_SFLOAT),
@@ -31,17 +27,28 @@ pub(crate) const FIELDS: [(&str, vk::Format); 6] = [
 ];
 
 /// What each floor-space image holds where its passes do not draw (outside the rectangle
-/// the overlay can light, see [`FieldTarget::begin`]): lit floor, no seed (the shader's
-/// `NO_SEED`), beyond the ramp (the shader's `FAR_M`), no gain.
-pub(crate) const CLEAR: [f32; 6] = [0.0, -1.0e7, -1.0e7, 1.0e9, 0.0, 0.0];
+/// the overlay can light): lit floor, beyond the ramp (the shader's `FAR_M`), no gain.
+pub(crate) const CLEAR: [f32; 4] = [0.0, 1.0e9, 0.0, 0.0];
 
-/// One floor-space image with the render pass and framebuffer that write it (dropped in
-/// that order: framebuffer, render pass, image).
+/// The ways a field's render pass may start, in the order of [`FieldTarget`]'s render passes.
+const STARTS: [FieldStart; 4] = [
+    FieldStart::Discard,
+    FieldStart::Clear,
+    FieldStart::KeepClear,
+    FieldStart::KeepDraw,
+];
+
+/// A rectangle of texels `[x0, y0, x1, y1]`, ends excluded.
+pub(crate) type TexelRect = [u32; 4];
+
+/// One floor-space image with the render passes and framebuffer that write it (dropped in
+/// that order: framebuffer, render passes, image).
 pub(crate) struct FieldTarget {
     /// The framebuffer over the image.
     pub framebuffer: Owned<vk::Framebuffer>,
-    /// A single-attachment render pass ending in SHADER_READ_ONLY_OPTIMAL.
-    pub render_pass: Owned<vk::RenderPass>,
+    /// Single-attachment render passes ending in SHADER_READ_ONLY_OPTIMAL, one per
+    /// [`FieldStart`] in the order of [`STARTS`] (compatible with each other).
+    render_passes: Vec<Owned<vk::RenderPass>>,
     /// The image.
     pub image: Image,
     /// Its size.
@@ -66,58 +73,102 @@ impl FieldTarget {
                 | vk::ImageUsageFlags::SAMPLED
                 | vk::ImageUsageFlags::TRANSFER_SRC,
         )?;
-        let render_pass = pipeline::field_render_pass(ctx, format)?;
-        let framebuffer = pipeline::framebuffer(ctx, render_pass.raw(), &[image.view], extent)?;
+        let mut render_passes = Vec::with_capacity(STARTS.len());
+        for start in STARTS {
+            render_passes.push(pipeline::field_render_pass(ctx, format, start)?);
+        }
+        let framebuffer =
+            pipeline::framebuffer(ctx, render_passes[0].raw(), &[image.view], extent)?;
         Ok(FieldTarget {
             framebuffer,
-            render_pass,
+            render_passes,
             image,
             extent,
         })
     }
 
-    /// Begins this target's render pass, cleared to `clear` everywhere, with a viewport
-    /// covering it and draws limited to `scissor` (`[x0, y0, x1, y1]` texels, ends excluded;
-    /// `None`: all of it).
+    /// A render pass of this target, for making pipelines (all of them are compatible).
+    pub fn render_pass(&self) -> vk::RenderPass {
+        self.render_passes[0].raw()
+    }
+
+    /// The whole image as a rectangle of texels.
+    pub fn full(&self) -> TexelRect {
+        [0, 0, self.extent.width, self.extent.height]
+    }
+
+    /// Begins this target's render pass starting as `start` says over `area` (cleared to
+    /// `clear` if `start` clears), with a viewport covering the whole image (so that
+    /// fragment coordinates are texel coordinates) and draws limited to `scissor`, which
+    /// must lie in `area`.
     ///
     /// # Safety
-    /// `cmd` must be recording outside any render pass, and execute while `self` lives.
+    /// `cmd` must be recording outside any render pass, and execute while `self` lives; for
+    /// the `Keep` starts the image must be in SHADER_READ_ONLY_OPTIMAL when it executes.
     pub unsafe fn begin(
         &self,
         device: &ash::Device,
         cmd: vk::CommandBuffer,
+        start: FieldStart,
+        area: TexelRect,
         clear: f32,
-        scissor: Option<[u32; 4]>,
+        scissor: TexelRect,
     ) {
         let clear = [vk::ClearValue {
             color: vk::ClearColorValue {
                 float32: [clear; 4],
             },
         }];
-        // SAFETY: the caller's contract; the render pass and framebuffer are this target's.
+        let rect = |[x0, y0, x1, y1]: TexelRect| vk::Rect2D {
+            offset: vk::Offset2D {
+                x: x0 as i32,
+                y: y0 as i32,
+            },
+            extent: vk::Extent2D {
+                width: x1 - x0,
+                height: y1 - y0,
+            },
+        };
+        let index = match start {
+            FieldStart::Discard => 0,
+            FieldStart::Clear => 1,
+            FieldStart::KeepClear => 2,
+            FieldStart::KeepDraw => 3,
+        };
+        let begin = vk::RenderPassBeginInfo::default()
+            .render_pass(self.render_passes[index].raw())
+            .framebuffer(self.framebuffer.raw())
+            .render_area(rect(area))
+            .clear_values(&clear);
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: self.extent.width as f32,
+            height: self.extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        // SAFETY: the caller's contract; the render pass and framebuffer are this target's
+        // and compatible; the pipelines bound inside set viewport and scissor dynamically.
         unsafe {
-            pipeline::begin_render_pass(
-                device,
-                cmd,
-                self.render_pass.raw(),
-                self.framebuffer.raw(),
-                self.extent,
-                &clear,
-            );
-            if let Some([x0, y0, x1, y1]) = scissor {
-                let area = vk::Rect2D {
-                    offset: vk::Offset2D {
-                        x: x0 as i32,
-                        y: y0 as i32,
-                    },
-                    extent: vk::Extent2D {
-                        width: x1 - x0,
-                        height: y1 - y0,
-                    },
-                };
-                device.cmd_set_scissor(cmd, 0, &[area]);
-            }
+            device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+            device.cmd_set_viewport(cmd, 0, &[viewport]);
+            device.cmd_set_scissor(cmd, 0, &[rect(scissor)]);
         }
+    }
+}
+
+/// The smallest rectangle holding both (either may be absent).
+pub(crate) fn bounding(a: Option<TexelRect>, b: Option<TexelRect>) -> Option<TexelRect> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some([
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ]),
+        (a, None) => a,
+        (None, b) => b,
     }
 }
 
@@ -127,16 +178,19 @@ impl FieldTarget {
 pub(crate) struct FieldPush {
     /// Floor metres per texel along x and y.
     pub texel_m: [f32; 2],
-    /// The jump of a jump-flooding pass, texels.
-    pub step: i32,
     /// Side of the fields, texels.
     pub size: i32,
     /// D of eq. 2, metres.
     pub ramp_width_m: f32,
     /// k of eq. 4.
     pub k: f32,
+    /// Padding (the switches are 8-byte aligned).
+    pub _pad: f32,
     /// fs_combine: weights of k alpha(d) and of the caustic gain G (1 on, 0 off).
     pub switches: [f32; 2],
+    /// The texels the fields are computed in (`[x0, y0, x1, y1]`, ends excluded): the
+    /// distance pass writes "beyond the ramp" outside.
+    pub region: [i32; 4],
 }
 
 /// The floor-space fields read back from the GPU, row-major from the photo's top-left.
@@ -212,6 +266,95 @@ impl InducerFields {
                 .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
                 .collect(),
             rect,
+        }
+    }
+}
+
+/// Timestamps the floor passes write after each of their stages, in this order: the mask, the
+/// nearest shadow texels, the distance, the ramp, the live caustics, the overlay gain's combination.
+pub const FIELD_STAMPS: u32 = 6;
+
+/// GPU milliseconds of each stage of the floor passes in one frame (0 for a stage that did
+/// not run: nothing moved, or no live caustics).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FieldPassesMs {
+    /// The shadow mask (eq. 1).
+    pub mask_ms: f64,
+    /// The nearest shadow texel of every texel (the distance transform's compute passes).
+    pub nearest_ms: f64,
+    /// The distance to the shadow edge.
+    pub distance_ms: f64,
+    /// The gain k alpha(d) (eq. 2, 4).
+    pub ramp_ms: f64,
+    /// The live caustic map (photon tracing, resolving, copying).
+    pub live_caustics_ms: f64,
+    /// The overlay gain's combination.
+    pub combine_ms: f64,
+}
+
+impl FieldPassesMs {
+    /// The stages' times from the timestamp written before them (`start`) and the
+    /// [`FIELD_STAMPS`] written after each, with `period_ns` nanoseconds per tick.
+    pub fn from_stamps(start: u64, stamps: [u64; FIELD_STAMPS as usize], period_ns: f32) -> Self {
+        let mut previous = start;
+        let ms = stamps.map(|stamp| {
+            let ms = stamp.wrapping_sub(previous) as f64 * f64::from(period_ns) * 1e-6;
+            previous = stamp;
+            ms
+        });
+        FieldPassesMs {
+            mask_ms: ms[0],
+            nearest_ms: ms[1],
+            distance_ms: ms[2],
+            ramp_ms: ms[3],
+            live_caustics_ms: ms[4],
+            combine_ms: ms[5],
+        }
+    }
+
+    /// Their sum.
+    pub fn total_ms(&self) -> f64 {
+        self.mask_ms
+            + self.nearest_ms
+            + self.distance_ms
+            + self.ramp_ms
+            + self.live_caustics_ms
+            + self.combine_ms
+    }
+}
+
+/// Where a frame's floor passes write their [`FIELD_STAMPS`] timestamps: a pool and the
+/// first query.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Stamps {
+    /// The frame's timestamp pool (reset before).
+    pub pool: vk::QueryPool,
+    /// The query of the first stamp.
+    pub first: u32,
+}
+
+impl Stamps {
+    /// Writes stamps `range` (indices from 0 to [`FIELD_STAMPS`]), once all earlier work is
+    /// done.
+    ///
+    /// # Safety
+    /// `cmd` must be recording, outside a render pass, and the pool must hold the queries.
+    pub unsafe fn write(
+        &self,
+        device: &ash::Device,
+        cmd: vk::CommandBuffer,
+        range: std::ops::Range<u32>,
+    ) {
+        for i in range {
+            // SAFETY: the caller's contract.
+            unsafe {
+                device.cmd_write_timestamp(
+                    cmd,
+                    vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                    self.pool,
+                    self.first + i,
+                )
+            };
         }
     }
 }

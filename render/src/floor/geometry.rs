@@ -110,16 +110,23 @@ pub fn caustic_rect(width: u32, height: u32, gain: &[f32]) -> Option<[f32; 4]> {
     if x0 == u32::MAX {
         return None;
     }
+    Some(texels_plane_rect([x0, y0, x1 + 1, y1 + 1], width, height))
+}
+
+/// The plane-local rectangle (min x, min y, max x, max y) of the texels `[x0, y0, x1, y1]`
+/// (ends excluded) of a `width` x `height` floor-space image (row 0 at plane-local +y), grown
+/// by one texel for the bilinear footprint and clamped to the unit square.
+pub(crate) fn texels_plane_rect([x0, y0, x1, y1]: [u32; 4], width: u32, height: u32) -> [f32; 4] {
     let u_lo = (x0 as f32 - 1.0) / width as f32;
-    let u_hi = (x1 as f32 + 2.0) / width as f32;
+    let u_hi = (x1 as f32 + 1.0) / width as f32;
     let v_lo = (y0 as f32 - 1.0) / height as f32;
-    let v_hi = (y1 as f32 + 2.0) / height as f32;
-    Some([
+    let v_hi = (y1 as f32 + 1.0) / height as f32;
+    [
         (u_lo - 0.5).max(-0.5),
         (0.5 - v_hi).max(-0.5),
         (u_hi - 0.5).min(0.5),
         (0.5 - v_lo).min(0.5),
-    ])
+    ]
 }
 
 /// The texels `[x0, y0, x1, y1]` (ends excluded) of a `width` x `height` floor-space image

@@ -1,8 +1,8 @@
 //! Caustics computed on the GPU for each pose of the object and the light (docs/caustics.md,
 //! eq. 6): photon splatting in two compute passes (shaders/caustics_live.wgsl) into the
 //! caustic gain map the overlay combines, in place of a bake. Recorded with the inducer's
-//! fields, so only on frames after a move; lavapipe's timestamps do not cover compute, so the
-//! work shows in wall-clock time.
+//! fields, so only on frames after a move; timed as the floor's `live caustics` stage
+//! ([`super::FieldPassesMs`]) and in wall-clock time.
 
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
@@ -160,6 +160,9 @@ pub(crate) struct LiveCaustics {
     sums: Buffer,
     /// The resolved gain map, host-visible (for tests).
     gain: Buffer,
+    /// The box of the non-zero gains (`[x0, y0, x1, y1]`, ends included; empty when
+    /// x0 > x1), host-visible.
+    bounds: Buffer,
     /// Map width and height, texels.
     size: [u32; 2],
     /// Photons and path length.
@@ -268,6 +271,13 @@ impl LiveCaustics {
             storage | vk::BufferUsageFlags::TRANSFER_SRC,
             MemoryLocation::GpuToCpu,
         )?;
+        let bounds = Buffer::new(
+            ctx,
+            "caustics bounds",
+            size_of::<[u32; 4]>() as u64,
+            storage | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
         let params = Buffer::new(
             ctx,
             "caustics parameters",
@@ -277,7 +287,7 @@ impl LiveCaustics {
         )?;
         let compute = vk::ShaderStageFlags::COMPUTE;
         let mut bindings = vec![(0, vk::DescriptorType::UNIFORM_BUFFER, compute)];
-        bindings.extend((1..=7).map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute)));
+        bindings.extend((1..=8).map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute)));
         let set_layout = pipeline::set_layout(ctx, &bindings)?;
         // A 4-byte push range the shaders never read keeps the shared layout helper.
         let layout = pipeline::layout(ctx, Some(set_layout.raw()), compute, 4)?;
@@ -293,13 +303,13 @@ impl LiveCaustics {
             1,
             &[
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
-                (vk::DescriptorType::STORAGE_BUFFER, 7),
+                (vk::DescriptorType::STORAGE_BUFFER, 8),
             ],
         )?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
         buffers.extend(mesh_buffers.iter().map(|b| b.buffer));
-        buffers.extend([sums.buffer, gain.buffer]);
+        buffers.extend([sums.buffer, gain.buffer, bounds.buffer]);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|&buffer| {
@@ -339,6 +349,7 @@ impl LiveCaustics {
             _mesh: mesh_buffers,
             sums,
             gain,
+            bounds,
             size,
             desc,
             grid_origin: grid.origin,
@@ -456,6 +467,8 @@ impl LiveCaustics {
             );
             d.cmd_update_buffer(cmd, self.params.buffer, 0, bytemuck::bytes_of(&params));
             d.cmd_fill_buffer(cmd, self.sums.buffer, 0, vk::WHOLE_SIZE, 0);
+            let empty: [u32; 4] = [u32::MAX, u32::MAX, 0, 0];
+            d.cmd_update_buffer(cmd, self.bounds.buffer, 0, bytemuck::bytes_of(&empty));
             d.cmd_pipeline_barrier(
                 cmd,
                 transfer,
@@ -529,6 +542,18 @@ impl LiveCaustics {
                 ),
             );
         }
+    }
+
+    /// The texels `[x0, y0, x1, y1]` (ends excluded) holding every non-zero gain of the last
+    /// computation that finished (wait for the frame first); `None` when all are 0.
+    pub fn bounds(&self) -> Result<Option<[u32; 4]>> {
+        let b: Vec<u32> = self
+            .bounds
+            .mapped()?
+            .chunks_exact(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        Ok((b[0] <= b[2] && b[1] <= b[3]).then(|| [b[0], b[1], b[2] + 1, b[3] + 1]))
     }
 
     /// The gain map of the last computation that finished, row 0 at the photo's top (wait

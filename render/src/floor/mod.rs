@@ -6,19 +6,19 @@
 //!
 //! Everything below lives in floor space: square textures of `resolution_px` texels over the
 //! floor photo's area (the unit square of [`crate::PlaneDesc::world_from_plane`], texel
-//! (0, 0) at the photo's top-left, so texture uv equals photo uv). Once per scene (on the
-//! first frame that asks for the inducer, or on [`crate::Renderer::inducer_fields`]) four
-//! kinds of fragment passes run (no compute: lavapipe's timestamps do not see compute work,
-//! and these passes are cheap):
+//! (0, 0) at the photo's top-left, so texture uv equals photo uv). Once per pose of the object
+//! and the light (on the first frame that asks for the inducer after a move, or on
+//! [`crate::Renderer::inducer_fields`]) four kinds of fragment passes run, each drawing only
+//! the region that can change (the overlay's rectangle, and where the last computation drew):
 //!
 //! 1. **Shadow mask** (eq. 1, shaders/inducer_mask.wgsl): the mesh projected from the point
 //!    light onto the floor plane by a homogeneous planar projection ([`planar_shadow`] in
 //!    geometry.rs) and rasterised straight into floor space; covered texels are in shadow.
 //!    For an opaque occluder this equals a conventional shadow-map lookup at each floor
 //!    texel, without the map's resolution and depth-bias artefacts.
-//! 2. **Jump flooding** (jump_flood.rs; shaders/inducer_field.wgsl `fs_seed`, `fs_jump`):
-//!    ceil(log2 N) passes with halving jumps plus one of jump 1, ping-ponging two RG32F
-//!    textures of nearest-shadow-texel coordinates, nearest in metres.
+//! 2. **Nearest shadow texel** (distance_transform.rs; shaders/inducer_distance.wgsl): an
+//!    exact Euclidean distance transform of the mask in two compute passes (per column, then
+//!    per row), nearest in metres.
 //! 3. **Distance to the edge** (`fs_distance`, [`edge_distance_m`]): d in metres for every
 //!    lit texel, -1 inside the shadow.
 //! 4. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the precombined
@@ -42,7 +42,7 @@
 //! - `geometry`: the floor's frame, the shadow projection (eq. 1) and the overlay's rectangles;
 //! - `reference`: eq. 2-5 and the exact distance field on the CPU;
 //! - `fields`: the floor-space images, the push constants and the fields read back;
-//! - `jump_flood`: the schedule of the distance-field passes;
+//! - `distance_transform`: the nearest shadow texel of every texel (compute);
 //! - `overlay`: the per-eye overlay pipeline;
 //! - `live`: the caustic gain map computed per pose on the GPU (photon splatting), instead of
 //!   a bake;
@@ -53,9 +53,9 @@
 //! The scene limits checked before any of this is built (`validate_inducer`,
 //! `validate_caustics`) live with the descriptions they check, in [`crate::scene`].
 
+mod distance_transform;
 mod fields;
 mod geometry;
-mod jump_flood;
 mod live;
 mod overlay;
 mod pass;
@@ -67,7 +67,8 @@ pub use crate::scene::{
     MAX_CAUSTIC_GAIN, MAX_K, MAX_RAMP_WIDTH_M, MAX_RESOLUTION_PX, MIN_RESOLUTION_PX,
     validate_caustics, validate_inducer as validate,
 };
-pub use fields::InducerFields;
+pub(crate) use fields::Stamps;
+pub use fields::{FIELD_STAMPS, FieldPassesMs, InducerFields};
 pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
 pub use live::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE};
 pub(crate) use pass::InducerPass;

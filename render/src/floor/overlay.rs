@@ -1,6 +1,7 @@
 //! The floor overlay (shaders/floor_overlay.wgsl): per eye, a world-anchored rectangle on the
-//! floor plane that adds the precombined gain times the floor photo, L_s = k alpha(d) L_r
-//! (eq. 3) plus the corrected caustics G L_r, with blend (ONE, ONE).
+//! floor plane that adds a gain times the floor photo, L_s = k alpha(d) L_r (eq. 3) plus the
+//! corrected caustics G L_r, with blend (ONE, ONE): the inducer's own gain when the caustics
+//! are off, the precombined one when they are on.
 
 use ash::vk;
 use glam::Mat4;
@@ -29,22 +30,22 @@ pub(crate) struct OverlayPass {
     pipeline: Owned<vk::Pipeline>,
     /// Its layout.
     layout: Owned<vk::PipelineLayout>,
-    /// Pool of the set.
+    /// Pool of the sets.
     _pool: Owned<vk::DescriptorPool>,
-    /// Layout of the set: gain, floor photo, sampler.
+    /// Layout of the sets: gain, floor photo, sampler.
     _set_layout: Owned<vk::DescriptorSetLayout>,
-    /// The set.
-    set: vk::DescriptorSet,
+    /// One set per gain image.
+    sets: Vec<vk::DescriptorSet>,
 }
 
 impl OverlayPass {
-    /// The overlay drawing in `eye_render_pass`, reading the gain `gain_view` and the scene's
-    /// floor photo.
+    /// The overlay drawing in `eye_render_pass`, reading one of the gains `gain_views` (R16F,
+    /// filtered) and the scene's floor photo.
     pub fn new(
         ctx: &GpuContext,
         eye_render_pass: vk::RenderPass,
         scene: &GpuScene,
-        gain_view: vk::ImageView,
+        gain_views: &[vk::ImageView],
     ) -> Result<OverlayPass> {
         let fragment = vk::ShaderStageFlags::FRAGMENT;
         let set_layout = pipeline::set_layout(
@@ -78,27 +79,33 @@ impl OverlayPass {
                 blend: Blend::Add,
             },
         )?;
+        let count = gain_views.len() as u32;
         let pool = pipeline::pool(
             ctx,
-            1,
+            count,
             &[
-                (vk::DescriptorType::SAMPLED_IMAGE, 2),
-                (vk::DescriptorType::SAMPLER, 1),
+                (vk::DescriptorType::SAMPLED_IMAGE, 2 * count),
+                (vk::DescriptorType::SAMPLER, count),
             ],
         )?;
-        let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
-        pipeline::write_image(ctx, set, 0, gain_view);
-        pipeline::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
+        let mut sets = Vec::with_capacity(gain_views.len());
+        for &view in gain_views {
+            let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+            pipeline::write_image(ctx, set, 0, view);
+            pipeline::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
+            sets.push(set);
+        }
         Ok(OverlayPass {
             pipeline,
             layout,
             _pool: pool,
             _set_layout: set_layout,
-            set,
+            sets,
         })
     }
 
-    /// Records the overlay's rectangle `rect` (plane-local) for one eye.
+    /// Records the rectangle `rect` (plane-local) of gain `gain` (an index of the views given
+    /// to [`OverlayPass::new`]) for one eye.
     ///
     /// # Safety
     /// `cmd` must be recording inside a render pass compatible with the one given to
@@ -110,6 +117,7 @@ impl OverlayPass {
         cmd: vk::CommandBuffer,
         eye: &EyeParams,
         world_from_plane: Mat4,
+        gain: usize,
         rect: [f32; 4],
     ) {
         let d = &ctx.device;
@@ -126,7 +134,7 @@ impl OverlayPass {
                 vk::PipelineBindPoint::GRAPHICS,
                 self.layout.raw(),
                 0,
-                &[self.set],
+                &[self.sets[gain]],
                 &[],
             );
             d.cmd_push_constants(

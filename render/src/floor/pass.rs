@@ -1,24 +1,30 @@
 //! The floor pass: builds the floor-space fields' pipelines once per scene and records their
-//! computation (mask, jump flooding, distance, ramp, combination) when a frame first needs
+//! computation (mask, distance transform, distance, ramp, combination) when a frame first needs
 //! them (progress.rs tracks whether it has really run; readback.rs copies the fields back).
 
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 
-use super::fields::{CLEAR, DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY};
-use super::geometry::{
-    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect, union_rect,
+use super::distance_transform::{COMBINE, DIST, DistanceTransform, RAMP};
+use super::fields::{
+    CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY, Stamps,
+    TexelRect, bounding,
 };
-use super::jump_flood::{COMBINE, FieldDraw, RAMP, distance_passes};
+use super::geometry::{
+    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect,
+    texels_plane_rect, union_rect,
+};
 use super::live::{LiveCaustics, LiveCausticsDesc};
 use super::overlay::OverlayPass;
-use super::progress::{Prepared, Progress};
+use super::progress::{Prepared, Progress, Written};
 use crate::camera::EyeParams;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::{Image, upload_texture};
 use crate::owned::Owned;
-use crate::pipeline::{self, Blend, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec};
+use crate::pipeline::{
+    self, Blend, FieldStart, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec,
+};
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, InducerDesc, SceneDesc};
 use crate::shaders;
@@ -42,7 +48,8 @@ pub(crate) struct InducerPass {
     mask_clip_from_model: Option<Mat4>,
     /// Plane-local rectangle the inducer's light covers; `None` when nothing can be lit.
     pub(super) rect: Option<[f32; 4]>,
-    /// Plane-local rectangle of the caustics' non-zero extent; `None` without caustics.
+    /// Plane-local rectangle of the caustics' non-zero extent; `None` without caustics (the
+    /// whole floor while a live map is being computed).
     caustic_rect: Option<[f32; 4]>,
     /// Triangle indices of the mesh.
     index_count: u32,
@@ -54,22 +61,25 @@ pub(crate) struct InducerPass {
     mask_pipeline: Owned<vk::Pipeline>,
     /// Layout of the mask pass (push constants only).
     mask_layout: Owned<vk::PipelineLayout>,
-    /// Seed, jump, distance, ramp and combine pipelines (`SEED` ..= `COMBINE`).
+    /// Distance, ramp and combine pipelines (`DIST` ..= `COMBINE`).
     field_pipelines: Vec<Owned<vk::Pipeline>>,
     /// Their pipeline layout.
     field_layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets below.
     _pool: Owned<vk::DescriptorPool>,
-    /// Set layout of the full-screen passes: source and mask (or gain and G) textures.
+    /// Set layout of the full-screen passes: source and mask (or gain and G) textures, the
+    /// sampler of the gain (fs_combine only) and the nearest shadow texels (fs_distance).
     _field_set_layout: Owned<vk::DescriptorSetLayout>,
     /// The set reading each field image as the source (null for images never read so).
     source_sets: [vk::DescriptorSet; FIELDS.len()],
-    /// The combine pass's set: the gain and G.
+    /// The combine pass's set: the gain (with the photos' clamped bilinear sampler) and G.
     combine_set: vk::DescriptorSet,
     /// The caustic gain G (R32F, read texel for texel by fs_combine; zeros without a map).
     caustic: Image,
     /// Caustics computed per pose into `caustic`, once enabled.
     live: Option<LiveCaustics>,
+    /// The nearest shadow texel of every texel (read by the distance pass).
+    transform: DistanceTransform,
     /// Mask, seeds (two), distance, gain and overlay gain, in the order of [`FIELDS`].
     pub(super) targets: Vec<FieldTarget>,
 }
@@ -127,7 +137,7 @@ impl InducerPass {
         let mask_pipeline = pipeline::create(
             ctx,
             &PipelineSpec {
-                render_pass: targets[MASK].render_pass.raw(),
+                render_pass: targets[MASK].render_pass(),
                 layout: mask_layout.raw(),
                 vertex: (shaders::MASK_VS, c"vs_main"),
                 fragment: (shaders::MASK_FS, c"fs_main"),
@@ -144,6 +154,8 @@ impl InducerPass {
             &[
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+                (2, vk::DescriptorType::SAMPLER, fragment),
+                (3, vk::DescriptorType::STORAGE_BUFFER, fragment),
             ],
         )?;
         let field_layout = pipeline::layout(
@@ -152,10 +164,8 @@ impl InducerPass {
             fragment,
             size_of::<FieldPush>() as u32,
         )?;
-        // In the order SEED, JUMP, DIST, RAMP, COMBINE, with the field each writes.
+        // In the order DIST, RAMP, COMBINE, with the field each writes.
         let field_stages = [
-            (shaders::SEED_FS, c"fs_seed", super::fields::SEEDS_A),
-            (shaders::JUMP_FS, c"fs_jump", super::fields::SEEDS_A),
             (shaders::DISTANCE_FS, c"fs_distance", DISTANCE),
             (shaders::RAMP_FS, c"fs_ramp", GAIN),
             (shaders::COMBINE_FS, c"fs_combine", OVERLAY),
@@ -165,7 +175,7 @@ impl InducerPass {
             field_pipelines.push(pipeline::create(
                 ctx,
                 &PipelineSpec {
-                    render_pass: targets[target].render_pass.raw(),
+                    render_pass: targets[target].render_pass(),
                     layout: field_layout.raw(),
                     vertex: (shaders::FIELD_VS, c"vs_main"),
                     fragment: (spirv, entry),
@@ -185,31 +195,44 @@ impl InducerPass {
             caustic_extent,
             bytemuck::cast_slice(caustic_gain),
         )?;
-        let sources = [
-            MASK,
-            super::fields::SEEDS_A,
-            super::fields::SEEDS_B,
-            DISTANCE,
-        ];
+        let mask_view = targets[MASK].image.view;
+        let transform = DistanceTransform::new(ctx, mask_view, n, floor.size_m / n as f32)?;
+        let sources = [MASK, DISTANCE];
+        let sets = sources.len() as u32 + 1;
         let pool = pipeline::pool(
             ctx,
-            sources.len() as u32 + 1,
-            &[(
-                vk::DescriptorType::SAMPLED_IMAGE,
-                2 * (sources.len() as u32 + 1),
-            )],
+            sets,
+            &[
+                (vk::DescriptorType::SAMPLED_IMAGE, 2 * sets),
+                (vk::DescriptorType::SAMPLER, sets),
+                (vk::DescriptorType::STORAGE_BUFFER, sets),
+            ],
         )?;
         let mut source_sets = [vk::DescriptorSet::null(); FIELDS.len()];
+        // Every binding of every set is written, though each pass reads only some: lavapipe
+        // reads every binding of a bound set.
+        let nearest = transform.nearest.buffer;
         for source in sources {
             let set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
-            pipeline::write_image(ctx, set, 0, targets[source].image.view);
-            pipeline::write_image(ctx, set, 1, targets[MASK].image.view);
+            let view = targets[source].image.view;
+            pipeline::write_texture(ctx, set, 0, 2, view, scene.photo_sampler());
+            pipeline::write_image(ctx, set, 1, mask_view);
+            pipeline::write_storage_buffer(ctx, set, 3, nearest);
             source_sets[source] = set;
         }
         let combine_set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
-        pipeline::write_image(ctx, combine_set, 0, targets[GAIN].image.view);
+        pipeline::write_texture(
+            ctx,
+            combine_set,
+            0,
+            2,
+            targets[GAIN].image.view,
+            scene.photo_sampler(),
+        );
         pipeline::write_image(ctx, combine_set, 1, caustic.view);
-        let overlay = OverlayPass::new(ctx, eye_render_pass, scene, targets[OVERLAY].image.view)?;
+        pipeline::write_storage_buffer(ctx, combine_set, 3, nearest);
+        let gains = [targets[GAIN].image.view, targets[OVERLAY].image.view];
+        let overlay = OverlayPass::new(ctx, eye_render_pass, scene, &gains)?;
 
         Ok(InducerPass {
             desc: params,
@@ -233,6 +256,7 @@ impl InducerPass {
             source_sets,
             combine_set,
             caustic,
+            transform,
             live: None,
             targets,
         })
@@ -249,13 +273,17 @@ impl InducerPass {
         self.mask_clip_from_model = clip;
         self.rect = rect;
         self.pose = pose;
+        if self.live.is_some() {
+            // Anywhere, until the new map's computation has finished.
+            self.caustic_rect = Some(WHOLE_FLOOR);
+        }
         self.progress.invalidate();
     }
 
     /// Computes the caustic gain map on the GPU for each pose from now on (with the fields,
     /// so on the next frame drawing the overlay and after every move), at the map's current
-    /// size (the bake's, or the inducer's resolution without one); the overlay may then
-    /// cover the whole floor.
+    /// size (the bake's, or the inducer's resolution without one); the overlay covers the
+    /// whole floor on the frames that compute it, then only the box of its non-zero texels.
     pub fn enable_live(
         &mut self,
         ctx: &GpuContext,
@@ -271,7 +299,7 @@ impl InducerPass {
             [extent.width, extent.height],
             live,
         )?);
-        self.caustic_rect = Some([-0.5, -0.5, 0.5, 0.5]);
+        self.caustic_rect = Some(WHOLE_FLOOR);
         self.progress.invalidate();
         Ok(())
     }
@@ -287,27 +315,30 @@ impl InducerPass {
     }
 
     /// The push constants shared by the full-screen passes.
-    fn push(&self, step: i32, switches: [f32; 2]) -> FieldPush {
+    fn push(&self, switches: [f32; 2], region: Option<TexelRect>) -> FieldPush {
         FieldPush {
             texel_m: self.texel_m.to_array(),
-            step,
             size: self.desc.resolution_px as i32,
             ramp_width_m: self.desc.ramp_width_m,
             k: self.desc.k,
+            _pad: 0.0,
             switches,
+            region: region.map_or([0; 4], |r| r.map(|v| v as i32)),
         }
     }
 
     /// Records what a frame drawing the overlay with these switches still needs: the fields'
-    /// computation when no submitted work holds it, and the overlay gain's combination
-    /// (k alpha(d) if `inducer`, + G if `caustics`) when the last one submitted was for
-    /// other switches. Returns what was recorded, for [`InducerPass::submitted`] and
-    /// [`InducerPass::finished`]; records nothing (the scene is static) otherwise.
+    /// computation when no submitted work holds it, and, with `caustics`, the overlay gain's
+    /// combination (k alpha(d) if `inducer`, + G) when the last one submitted was for other
+    /// switches or the fields moved since. Returns what was recorded, for [`InducerPass::submitted`] and
+    /// [`InducerPass::finished`]; records nothing (the scene is static) otherwise. With
+    /// `stamps`, writes all [`FIELD_STAMPS`] timestamps, one after each stage.
     ///
     /// # Safety
     /// `cmd` must be recording outside any render pass, and be submitted before any command
     /// buffer recorded later that draws the overlay; `scene` must be the scene the pass was
-    /// made for, and `self` and `scene` must outlive the command buffer's execution.
+    /// made for, and `self` and `scene` must outlive the command buffer's execution; the
+    /// stamps' pool must hold their queries, reset.
     pub unsafe fn prepare(
         &self,
         ctx: &GpuContext,
@@ -315,33 +346,82 @@ impl InducerPass {
         scene: &GpuScene,
         inducer: bool,
         caustics: bool,
+        stamps: Option<Stamps>,
     ) -> Prepared {
+        let d = &ctx.device;
         let switches = u8::from(inducer) | (u8::from(caustics) << 1);
-        let prepared = self.progress.plan(Some(switches));
+        // Without caustics the overlay draws the inducer's gain itself: nothing to combine.
+        let mut prepared = self.progress.plan(caustics.then_some(switches));
+        let stamp = |range| {
+            if let Some(stamps) = stamps {
+                // SAFETY: the caller's contract (recording outside a render pass, queries
+                // reset).
+                unsafe { stamps.write(d, cmd, range) };
+            }
+        };
         // SAFETY: the caller's contract covers both recordings (outside a render pass, the
         // objects outlive the execution).
         unsafe {
             if prepared.fields {
-                self.record_fields(ctx, cmd, scene);
+                prepared.fields_within = self.record_fields(ctx, cmd, scene, stamps);
                 if let Some(live) = &self.live {
                     live.record(ctx, cmd, &self.pose, &self.caustic);
                 }
+            } else {
+                stamp(0..4);
             }
-            if prepared.combined.is_some() {
-                let push = self.push(
-                    0,
-                    [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
-                );
-                // Nothing is drawn outside the overlay's rectangle: the gain there stays 0.
-                let extent = self.targets[OVERLAY].extent;
-                let scissor = self
-                    .overlay_rect(inducer, caustics)
-                    .map(|r| texel_rect(r, extent.width, extent.height));
-                let set = self.combine_set;
-                self.full_screen(ctx, cmd, OVERLAY, COMBINE, set, &push, scissor);
+            stamp(4..5);
+            if let Some(switches) = prepared.combined {
+                let caustics_moved = prepared.fields && self.live.is_some();
+                (prepared.overlay_within, prepared.overlay_inducer) =
+                    self.record_combine(ctx, cmd, switches, caustics_moved);
             }
+            stamp(5..FIELD_STAMPS);
         }
         prepared
+    }
+
+    /// Records the overlay gain's combination for `switches` (bit 0 inducer, bit 1
+    /// caustics) over the texels whose value can have changed since the last combination
+    /// submitted: where the inducer's rectangle was and is when only the fields moved (the
+    /// same switches, the caustic gain unchanged unless `caustics_moved`), else where the
+    /// overlay may be non-zero before or after. Every texel drawn gets its value, so nothing
+    /// is cleared. Returns the texels that may be non-zero afterwards and the inducer's part
+    /// of them.
+    ///
+    /// # Safety
+    /// As [`InducerPass::prepare`], after the fields' recording (if any).
+    unsafe fn record_combine(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        switches: u8,
+        caustics_moved: bool,
+    ) -> (Option<TexelRect>, Option<TexelRect>) {
+        let (inducer, caustics) = (switches & 1 != 0, switches & 2 != 0);
+        let target = &self.targets[OVERLAY];
+        let (w, h) = (target.extent.width, target.extent.height);
+        let inducer_part = self.rect.filter(|_| inducer).map(|r| texel_rect(r, w, h));
+        let within = self
+            .overlay_rect(inducer, caustics)
+            .map(|r| texel_rect(r, w, h));
+        let (start, area) = match (self.progress.overlay_written, self.progress.last_combined) {
+            (Written::Anywhere, _) => (FieldStart::Discard, Some(target.full())),
+            (Written::Within(_), Some((last, before))) if last == switches && !caustics_moved => {
+                (FieldStart::KeepDraw, bounding(before, inducer_part))
+            }
+            (Written::Within(before), _) => (FieldStart::KeepDraw, bounding(before, within)),
+        };
+        if let Some(area) = area {
+            let push = self.push(
+                [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
+                None,
+            );
+            let set = self.combine_set;
+            // SAFETY: the caller's contract; `Keep` only once submitted work drew the image.
+            unsafe { self.full_screen(ctx, cmd, OVERLAY, COMBINE, start, area, set, &push) };
+        }
+        (within, inducer_part)
     }
 
     /// The command buffer `prepared` was recorded into has been submitted.
@@ -350,9 +430,20 @@ impl InducerPass {
     }
 
     /// The command buffer `prepared` was recorded into has finished (`ok`: its fence
-    /// signalled) or failed to (its wait failed), so its results cannot be relied on.
+    /// signalled) or failed to (its wait failed), so its results cannot be relied on. When it
+    /// computed the live caustic map of the current pose, the overlay covers from now on
+    /// only the box of its non-zero texels.
     pub fn finished(&mut self, prepared: Prepared, ok: bool) {
+        let live_map = ok && prepared.fields && self.progress.is_current(prepared);
         self.progress.finished(prepared, ok);
+        if let Some(live) = self.live.as_ref().filter(|_| live_map) {
+            let extent = self.targets[OVERLAY].extent;
+            self.caustic_rect = match live.bounds() {
+                Ok(bounds) => bounds.map(|b| texels_plane_rect(b, extent.width, extent.height)),
+                // Unreadable (never on a host-visible buffer): the whole floor stays.
+                Err(_) => Some(WHOLE_FLOOR),
+            };
+        }
     }
 
     /// The plane-local rectangle the overlay draws for these switches, if any.
@@ -363,7 +454,14 @@ impl InducerPass {
         )
     }
 
-    /// Records the mask, jump-flooding, distance and ramp passes.
+    /// Records the mask, the distance transform and the distance and ramp passes, each stage
+    /// followed by its stamp (the first four of `stamps`); returns the texels that may differ
+    /// from the cleared values once they ran (the overlay's rectangle).
+    ///
+    /// Only that rectangle is computed (the shadow and its ramp); the rest of each field
+    /// keeps its cleared value (lit, beyond the ramp, no gain). So only the rectangle and
+    /// where the last submitted computation drew are cleared or drawn; the distance transform
+    /// only runs in the rectangle, as nothing reads it elsewhere.
     ///
     /// # Safety
     /// As [`InducerPass::prepare`].
@@ -372,18 +470,41 @@ impl InducerPass {
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
-    ) {
+        stamps: Option<Stamps>,
+    ) -> Option<TexelRect> {
         let d = &ctx.device;
+        let stamp = |range| {
+            if let Some(stamps) = stamps {
+                // SAFETY: the caller's contract (recording outside a render pass, queries
+                // reset).
+                unsafe { stamps.write(d, cmd, range) };
+            }
+        };
         let n = self.desc.resolution_px;
-        // Only the part of the floor the inducer can light (the shadow and its ramp) is
-        // computed; the rest keeps the cleared values (lit, beyond the ramp, no gain).
-        let scissor = self.rect.map(|r| texel_rect(r, n, n));
-        let span = scissor.map_or(n, |[x0, y0, x1, y1]| (x1 - x0).max(y1 - y0));
+        let region = self.rect.map(|r| texel_rect(r, n, n));
+        let (before, clear_start, draw_start) = match self.progress.fields_written {
+            Written::Anywhere => (Some([0, 0, n, n]), FieldStart::Clear, FieldStart::Discard),
+            Written::Within(before) => (before, FieldStart::KeepClear, FieldStart::KeepDraw),
+        };
+        // Nothing drawn before nor now: every field already holds its cleared value.
+        let Some(area) = bounding(before, region) else {
+            stamp(0..4);
+            return None;
+        };
         // SAFETY: the caller's contract: `cmd` records outside a render pass and everything
-        // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it.
+        // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it;
+        // the `Keep` starts are used only once submitted work drew the images.
         unsafe {
-            self.targets[MASK].begin(d, cmd, CLEAR[MASK], scissor);
-            if let Some(clip_from_model) = self.mask_clip_from_model {
+            let mask = &self.targets[MASK];
+            mask.begin(
+                d,
+                cmd,
+                clear_start,
+                area,
+                CLEAR[MASK],
+                region.unwrap_or(area),
+            );
+            if let (Some(_), Some(clip_from_model)) = (region, self.mask_clip_from_model) {
                 d.cmd_bind_pipeline(
                     cmd,
                     vk::PipelineBindPoint::GRAPHICS,
@@ -401,25 +522,37 @@ impl InducerPass {
                 d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
             }
             d.cmd_end_render_pass(cmd);
-            let ramp = FieldDraw {
-                target: GAIN,
-                pipeline: RAMP,
-                source: DISTANCE,
-                step: 0,
+            stamp(0..1);
+            let Some(region) = region else {
+                // No shadow: no light either; only where the last computation drew is cleared.
+                stamp(1..2);
+                for (target, k) in [(DISTANCE, 2), (GAIN, 3)] {
+                    self.targets[target].begin(d, cmd, clear_start, area, CLEAR[target], area);
+                    d.cmd_end_render_pass(cmd);
+                    stamp(k..k + 1);
+                }
+                return None;
             };
-            for draw in distance_passes(span).into_iter().chain([ramp]) {
-                let push = self.push(draw.step, [0.0; 2]);
-                let set = self.source_sets[draw.source];
-                self.full_screen(ctx, cmd, draw.target, draw.pipeline, set, &push, scissor);
+            self.transform.record(ctx, cmd, region);
+            stamp(1..2);
+            let push = self.push([0.0; 2], Some(region));
+            for (target, pipeline, source, k) in
+                [(DISTANCE, DIST, MASK, 2), (GAIN, RAMP, DISTANCE, 3)]
+            {
+                let set = self.source_sets[source];
+                self.full_screen(ctx, cmd, target, pipeline, draw_start, area, set, &push);
+                stamp(k..k + 1);
             }
         }
+        region
     }
 
-    /// One full-screen pass of `pipeline` into field `target`, drawing only inside
-    /// `scissor` (texels; `None`: everywhere) after clearing the whole field.
+    /// One full-screen pass of `pipeline` into field `target` starting as `start` says,
+    /// drawing every texel of `area` and nothing else.
     ///
     /// # Safety
-    /// As [`InducerPass::prepare`]; `set` must be one of this pass's sets.
+    /// As [`InducerPass::prepare`]; `set` must be one of this pass's sets; for the `Keep`
+    /// starts the target must be in SHADER_READ_ONLY_OPTIMAL.
     #[allow(clippy::too_many_arguments)]
     unsafe fn full_screen(
         &self,
@@ -427,15 +560,16 @@ impl InducerPass {
         cmd: vk::CommandBuffer,
         target: usize,
         pipeline: usize,
+        start: FieldStart,
+        area: TexelRect,
         set: vk::DescriptorSet,
         push: &FieldPush,
-        scissor: Option<[u32; 4]>,
     ) {
         let d = &ctx.device;
         // SAFETY: the caller's contract; the pipeline, layout, set and target are this
         // pass's.
         unsafe {
-            self.targets[target].begin(d, cmd, CLEAR[target], scissor);
+            self.targets[target].begin(d, cmd, start, area, CLEAR[target], area);
             d.cmd_bind_pipeline(
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,
@@ -477,15 +611,28 @@ impl InducerPass {
         inducer: bool,
         caustics: bool,
     ) {
+        // The precombined gain with the caustics, the inducer's own without.
+        let gain = if caustics {
+            COMBINED_GAIN
+        } else {
+            INDUCER_GAIN
+        };
         if let Some(rect) = self.overlay_rect(inducer, caustics) {
             // SAFETY: the caller's contract, which is the overlay's.
             unsafe {
                 self.overlay
-                    .record(ctx, cmd, eye, self.world_from_plane, rect)
+                    .record(ctx, cmd, eye, self.world_from_plane, gain, rect)
             };
         }
     }
 }
+
+/// The overlay's gains: the inducer's k alpha(d), the combined k alpha(d) + G.
+const INDUCER_GAIN: usize = 0;
+const COMBINED_GAIN: usize = 1;
+
+/// The floor's whole unit square, plane-local.
+const WHOLE_FLOOR: [f32; 4] = [-0.5, -0.5, 0.5, 0.5];
 
 /// The mask's projection (eq. 1: `None` when the light is not above the floor) and the
 /// plane-local rectangle the inducer's light covers (`None` when nothing can be lit) for the

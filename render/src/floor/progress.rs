@@ -3,6 +3,12 @@
 //! never while commands are being recorded, so a failed submit or a lost frame leaves the
 //! computation due again. A moved object or light starts a new generation: the fields are due
 //! again, and reports about work of an older generation no longer change anything.
+//!
+//! It also knows where each persistent image may differ from its cleared value, so that a
+//! computation clears and draws only the texels that can change: where the last submitted
+//! work drew and where the new one draws.
+
+use super::fields::TexelRect;
 
 /// Where a one-time computation stands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -17,6 +23,17 @@ pub(super) enum Computation {
     Done,
 }
 
+/// Which texels of a floor-space image may differ from its cleared value.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) enum Written {
+    /// Any of them: never drawn, or the work that drew it failed (its layout is unknown
+    /// too, so the next pass treats the whole image as undefined).
+    #[default]
+    Anywhere,
+    /// Only these (`None`: none); the image is in SHADER_READ_ONLY_OPTIMAL.
+    Within(Option<TexelRect>),
+}
+
 /// What [`super::InducerPass::prepare`] recorded into a command buffer; handed back to
 /// [`super::InducerPass::submitted`] once the command buffer was submitted and to
 /// [`super::InducerPass::finished`] once its fence signalled (or the wait failed).
@@ -28,6 +45,14 @@ pub(crate) struct Prepared {
     pub(super) fields: bool,
     /// The overlay gain's combination for these switches was recorded.
     pub(super) combined: Option<u8>,
+    /// With `fields`: the texels of the mask, distance and gain that may differ from their
+    /// cleared values once it ran.
+    pub(super) fields_within: Option<TexelRect>,
+    /// With `combined`: the texels of the overlay gain that may be non-zero once it ran,
+    /// and the inducer's share of them.
+    pub(super) overlay_within: Option<TexelRect>,
+    /// With `combined`: the overlay texels of the inducer's rectangle it was drawn for.
+    pub(super) overlay_inducer: Option<TexelRect>,
 }
 
 /// Progress of the floor fields' computation: changes only when the renderer reports what
@@ -44,6 +69,14 @@ pub(super) struct Progress {
     /// The switches (bit 0 inducer, bit 1 caustics) of the last overlay gain combination
     /// submitted, while it is submitted or done.
     combined_for: Option<u8>,
+    /// Where the mask, distance and gain may differ from their cleared values after the
+    /// work submitted so far.
+    pub fields_written: Written,
+    /// Where the overlay gain may be non-zero after the work submitted so far.
+    pub overlay_written: Written,
+    /// The last combination submitted (of any generation): its switches and the overlay
+    /// texels of the inducer's rectangle it was drawn for.
+    pub last_combined: Option<(u8, Option<TexelRect>)>,
 }
 
 impl Progress {
@@ -53,7 +86,13 @@ impl Progress {
             generation: self.generation,
             fields: self.fields == Computation::Missing,
             combined: switches.filter(|&s| self.combined_for != Some(s)),
+            ..Prepared::default()
         }
+    }
+
+    /// Whether `prepared` was recorded for the current pose.
+    pub fn is_current(&self, prepared: Prepared) -> bool {
+        prepared.generation == self.generation
     }
 
     /// The object or the light moved: the fields and the combination are due again, and
@@ -66,6 +105,14 @@ impl Progress {
 
     /// The work `prepared` was recorded into has been submitted.
     pub fn submitted(&mut self, prepared: Prepared) {
+        // The images change whatever generation the work was recorded for.
+        if prepared.fields {
+            self.fields_written = Written::Within(prepared.fields_within);
+        }
+        if let Some(switches) = prepared.combined {
+            self.overlay_written = Written::Within(prepared.overlay_within);
+            self.last_combined = Some((switches, prepared.overlay_inducer));
+        }
         if prepared.generation != self.generation {
             return;
         }
@@ -81,6 +128,13 @@ impl Progress {
     /// The work `prepared` was recorded into has finished (`ok`) or can no longer be relied
     /// on (its fence wait failed).
     pub fn finished(&mut self, prepared: Prepared, ok: bool) {
+        if !ok && prepared.fields {
+            self.fields_written = Written::Anywhere;
+        }
+        if !ok && prepared.combined.is_some() {
+            self.overlay_written = Written::Anywhere;
+            self.last_combined = None;
+        }
         if prepared.generation != self.generation {
             return;
         }
@@ -110,7 +164,8 @@ mod tests {
             Prepared {
                 generation: 0,
                 fields: true,
-                combined: Some(1)
+                combined: Some(1),
+                ..Prepared::default()
             }
         );
         // Recording alone changes nothing: a failed submit leaves everything to redo.
@@ -127,7 +182,8 @@ mod tests {
             Prepared {
                 generation: 0,
                 fields: false,
-                combined: Some(3)
+                combined: Some(3),
+                ..Prepared::default()
             }
         );
     }
@@ -158,5 +214,41 @@ mod tests {
         progress.submitted(first);
         progress.finished(first, false);
         assert_eq!(progress.plan(Some(2)), first);
+    }
+
+    #[test]
+    fn images_are_known_written_only_where_submitted_work_drew() {
+        let mut progress = Progress::default();
+        assert_eq!(progress.fields_written, Written::Anywhere);
+        let first = Prepared {
+            fields_within: Some([1, 2, 3, 4]),
+            overlay_within: Some([0, 0, 8, 8]),
+            overlay_inducer: Some([2, 4, 6, 8]),
+            ..progress.plan(Some(1))
+        };
+        // Recorded but not submitted: nothing drawn.
+        assert_eq!(progress.fields_written, Written::Anywhere);
+        progress.submitted(first);
+        assert_eq!(progress.fields_written, Written::Within(Some([1, 2, 3, 4])));
+        assert_eq!(
+            progress.overlay_written,
+            Written::Within(Some([0, 0, 8, 8]))
+        );
+        assert_eq!(progress.last_combined, Some((1, Some([2, 4, 6, 8]))));
+        progress.finished(first, true);
+        assert_eq!(progress.fields_written, Written::Within(Some([1, 2, 3, 4])));
+        // Work that failed leaves the images unknown, whatever its generation.
+        progress.invalidate();
+        let second = Prepared {
+            fields_within: None,
+            ..progress.plan(Some(1))
+        };
+        progress.submitted(second);
+        assert_eq!(progress.fields_written, Written::Within(None));
+        progress.invalidate();
+        progress.finished(second, false);
+        assert_eq!(progress.fields_written, Written::Anywhere);
+        assert_eq!(progress.overlay_written, Written::Anywhere);
+        assert_eq!(progress.last_combined, None);
     }
 }

@@ -26,7 +26,7 @@ impl InducerPass {
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        let prepared = Prepared {
+        let mut prepared = Prepared {
             combined: None,
             ..self.progress.plan(None)
         };
@@ -37,7 +37,7 @@ impl InducerPass {
         // render passes (or the fields' recording just before), and are put back there.
         let result = ctx.one_shot(|cmd| unsafe {
             if prepared.fields {
-                this.record_fields(ctx, cmd, scene);
+                prepared.fields_within = this.record_fields(ctx, cmd, scene, None);
             }
             this.record_copies(d, cmd, &offsets, &buffer);
         });

@@ -299,6 +299,7 @@ fn reference_scene(refraction: Refraction) -> SphereScene {
         radius_m: RADIUS,
         ior: IOR,
         refraction,
+        attenuation: vitreous_render::Attenuation::NONE,
         background_from_world: background_plane().inverse(),
     }
 }

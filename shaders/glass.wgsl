@@ -18,7 +18,8 @@
 // Two-surface refraction (`[object] refraction = "two-surface"`, beyond the paper,
 // docs/equations.md): the ray refracts in at the front, crosses the glass and refracts out at
 // the back, total internal reflection followed for up to MAX_INTERNAL_REFLECTIONS bounces
-// (then the environment), with exact Fresnel at both interfaces. The exit is found against the
+// (then the environment), with exact Fresnel at both interfaces and Beer-Lambert absorption
+// over the path inside (glTF KHR_materials_volume). The exit is found against the
 // object's radial map (render/src/two_surface.rs `radial_map`): the distance from the object's
 // centre to its surface and the normal there, per direction. Starting from the sphere through
 // the entry point, secant steps on the ray's height above the surface: one fetch for a ball, a
@@ -67,6 +68,9 @@ struct Globals {
     model_from_world: mat4x4<f32>,
     // xyz: centre of the radial map (model units); w: its reference radius.
     radial: vec4<f32>,
+    // rgb: absorption coefficient inside the glass per world metre (Beer-Lambert; 0 for clear
+    // glass, where e^0 = 1 leaves the image exactly as it was).
+    absorption: vec4<f32>,
 };
 
 var<push_constant> eye: Eye;
@@ -187,8 +191,9 @@ struct Passage {
     exit: vec3<f32>,
     // Unit direction after it, world.
     direction: vec3<f32>,
-    // Exact Fresnel transmittance of both interfaces.
-    transmission: f32,
+    // Exact Fresnel transmittance of both interfaces times the Beer-Lambert transmittance of
+    // the path inside, per linear RGB channel.
+    transmission: vec3<f32>,
     // 1 when it left the object, 0 when given up inside (environment).
     escaped: f32,
 };
@@ -197,7 +202,9 @@ struct Passage {
 // `incident` meets the front surface at `entry` (world) with unit normal `normal` facing it.
 fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
     var out: Passage;
-    out.transmission = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
+    var fresnel_transmission = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
+    // Length of the path inside, world metres, internal reflections included.
+    var inside_m = 0.0;
     out.escaped = 0.0;
     let inside_world = refract(incident, normal, 1.0 / ior);
     var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
@@ -229,16 +236,18 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
             f = length(p + d * t) - s.x;
         }
         p += d * t;
+        inside_m += length((g.world_from_model * vec4<f32>(d * t, 0.0)).xyz);
         let outward = s.yzw;
         let leaving = refract(d, -outward, ior);
         if dot(leaving, leaving) > 0.0 {
-            out.transmission *= 1.0 - fresnel_exact(dot(d, outward), ior);
+            fresnel_transmission *= 1.0 - fresnel_exact(dot(d, outward), ior);
             d = leaving;
             out.escaped = 1.0;
             break;
         }
         d = reflect(d, outward);
     }
+    out.transmission = fresnel_transmission * exp(-g.absorption.rgb * inside_m);
     out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
     out.direction = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);
     return out;

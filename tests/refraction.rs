@@ -195,6 +195,7 @@ fn render_mesh_with(
         ),
         ior,
         refraction,
+        attenuation: vitreous_render::Attenuation::NONE,
         environment: TextureDesc {
             width: ew,
             height: eh,

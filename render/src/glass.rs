@@ -107,6 +107,9 @@ struct Globals {
     shading: [f32; 4],
     model_from_world: [f32; 16],
     radial: [f32; 4],
+    /// rgb: absorption coefficient inside the glass per world metre (Beer-Lambert, two-surface
+    /// refraction; 0 for clear glass); w unused.
+    absorption: [f32; 4],
 }
 
 impl Globals {
@@ -268,6 +271,7 @@ impl GlassPass {
             .to_array(),
             model_from_world: [0.0; 16],
             radial,
+            absorption: desc.attenuation.coefficient_per_m().extend(0.0).to_array(),
         }
         .posed(&ScenePose::of(desc));
         let globals_buffer = Buffer::with_data(

@@ -68,8 +68,9 @@ struct Globals {
     model_from_world: mat4x4<f32>,
     // xyz: centre of the radial map (model units); w: its reference radius.
     radial: vec4<f32>,
-    // rgb: absorption coefficient inside the glass per world metre (Beer-Lambert; 0 for clear
-    // glass, where e^0 = 1 leaves the image exactly as it was).
+    // rgb: absorption coefficient inside the glass per model unit (Beer-Lambert: per world
+    // metre times the model's scale; 0 for clear glass, where e^0 = 1 leaves the image exactly
+    // as it was).
     absorption: vec4<f32>,
 };
 
@@ -203,8 +204,8 @@ struct Passage {
 fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
     var out: Passage;
     var fresnel_transmission = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
-    // Length of the path inside, world metres, internal reflections included.
-    var inside_m = 0.0;
+    // Length of the path inside, model units, internal reflections included.
+    var inside = 0.0;
     out.escaped = 0.0;
     let inside_world = refract(incident, normal, 1.0 / ior);
     var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
@@ -236,7 +237,7 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
             f = length(p + d * t) - s.x;
         }
         p += d * t;
-        inside_m += length((g.world_from_model * vec4<f32>(d * t, 0.0)).xyz);
+        inside += t;
         let outward = s.yzw;
         let leaving = refract(d, -outward, ior);
         if dot(leaving, leaving) > 0.0 {
@@ -247,7 +248,7 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
         }
         d = reflect(d, outward);
     }
-    out.transmission = fresnel_transmission * exp(-g.absorption.rgb * inside_m);
+    out.transmission = fresnel_transmission * exp(-g.absorption.rgb * inside);
     out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
     out.direction = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);
     return out;

@@ -107,8 +107,9 @@ struct Globals {
     shading: [f32; 4],
     model_from_world: [f32; 16],
     radial: [f32; 4],
-    /// rgb: absorption coefficient inside the glass per world metre (Beer-Lambert, two-surface
-    /// refraction; 0 for clear glass); w unused.
+    /// rgb: absorption coefficient inside the glass per model unit (Beer-Lambert, two-surface
+    /// refraction: per world metre times the model's uniform scale; 0 for clear glass); w
+    /// unused.
     absorption: [f32; 4],
 }
 
@@ -271,7 +272,9 @@ impl GlassPass {
             .to_array(),
             model_from_world: [0.0; 16],
             radial,
-            absorption: desc.attenuation.coefficient_per_m().extend(0.0).to_array(),
+            absorption: (desc.attenuation.coefficient_per_m() * metres_per_model_unit(desc))
+                .extend(0.0)
+                .to_array(),
         }
         .posed(&ScenePose::of(desc));
         let globals_buffer = Buffer::with_data(
@@ -410,6 +413,15 @@ impl GlassPass {
             d.cmd_draw_indexed(cmd, scene.index_count, 1, 0, 0, 0);
         }
     }
+}
+
+/// World metres per model unit of the object's uniform scale (the shader measures the path
+/// inside in model units).
+fn metres_per_model_unit(desc: &SceneDesc) -> f32 {
+    glam::Mat3::from_mat4(desc.world_from_model)
+        .determinant()
+        .abs()
+        .cbrt()
 }
 
 /// Uploads the object's radial map (half floats, which filter linearly on every device) for

@@ -68,11 +68,16 @@ struct Globals {
     model_from_world: mat4x4<f32>,
     // xyz: centre of the radial map (model units); w: its reference radius.
     radial: vec4<f32>,
-    // rgb: absorption coefficient inside the glass per model unit (Beer-Lambert: per world
-    // metre times the model's scale; 0 for clear glass, where e^0 = 1 leaves the image exactly
-    // as it was).
+    // rgb: absorption inside the glass, halvings per model unit (Beer-Lambert, 2^(-rgb L):
+    // the coefficient per world metre times the model's scale over ln 2; 0 in a channel that
+    // absorbs nothing, where 2^0 = 1 leaves it exactly as it was).
     absorption: vec4<f32>,
 };
+
+// The object absorbs (Beer-Lambert, two-surface refraction): a pipeline constant, so that the
+// pipeline of clear glass, the usual case, has the exponentials folded away (render/build.rs
+// compiles fs_two_surface with it set too).
+override ABSORBING: bool = false;
 
 var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -248,7 +253,10 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
         }
         d = reflect(d, outward);
     }
-    out.transmission = fresnel_transmission * exp(-g.absorption.rgb * inside);
+    out.transmission = vec3<f32>(fresnel_transmission);
+    if ABSORBING {
+        out.transmission *= exp2(-g.absorption.rgb * inside);
+    }
     out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
     out.direction = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);
     return out;

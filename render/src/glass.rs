@@ -107,9 +107,9 @@ struct Globals {
     shading: [f32; 4],
     model_from_world: [f32; 16],
     radial: [f32; 4],
-    /// rgb: absorption coefficient inside the glass per model unit (Beer-Lambert, two-surface
-    /// refraction: per world metre times the model's uniform scale; 0 for clear glass); w
-    /// unused.
+    /// rgb: absorption inside the glass in halvings per model unit (Beer-Lambert, two-surface
+    /// refraction: the coefficient per world metre times the model's uniform scale over ln 2,
+    /// for the shader's exp2; 0 for clear glass); w unused.
     absorption: [f32; 4],
 }
 
@@ -227,7 +227,12 @@ impl GlassPass {
                 render_pass,
                 layout: layout.raw(),
                 vertex: (shaders::GLASS_VS, c"vs_main"),
-                fragment: if desc.refraction == Refraction::TwoSurface {
+                // Clear glass gets the pipeline without the absorption's exponentials.
+                fragment: if desc.refraction == Refraction::TwoSurface
+                    && !desc.attenuation.is_clear()
+                {
+                    (shaders::GLASS_TWO_SURFACE_ABSORBING_FS, c"fs_two_surface")
+                } else if desc.refraction == Refraction::TwoSurface {
                     (shaders::GLASS_TWO_SURFACE_FS, c"fs_two_surface")
                 } else {
                     (shaders::GLASS_FS, c"fs_main")
@@ -272,7 +277,8 @@ impl GlassPass {
             .to_array(),
             model_from_world: [0.0; 16],
             radial,
-            absorption: (desc.attenuation.coefficient_per_m() * metres_per_model_unit(desc))
+            absorption: (desc.attenuation.coefficient_per_m()
+                * (metres_per_model_unit(desc) * std::f32::consts::LOG2_E))
                 .extend(0.0)
                 .to_array(),
         }

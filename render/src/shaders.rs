@@ -10,6 +10,8 @@ macro_rules! spirv {
 pub const GLASS_VS: &[u8] = spirv!("glass.vs_main");
 pub const GLASS_FS: &[u8] = spirv!("glass.fs_main");
 pub const GLASS_TWO_SURFACE_FS: &[u8] = spirv!("glass.fs_two_surface");
+/// `fs_two_surface` with `ABSORBING` set: the glass absorbs (Beer-Lambert).
+pub const GLASS_TWO_SURFACE_ABSORBING_FS: &[u8] = spirv!("glass.fs_two_surface.absorbing");
 pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
 pub const MASK_VS: &[u8] = spirv!("inducer_mask.vs_main");

@@ -1,7 +1,14 @@
 //! Compiles every WGSL shader in `../shaders` to SPIR-V with naga, validating it on the way.
-//! Nothing is checked in as SPIR-V and no external shader tool is needed.
+//! Nothing is checked in as SPIR-V and no external shader tool is needed. Pipeline-overridable
+//! constants take their defaults, and the entry points of [`VARIANTS`] are compiled once more
+//! with one set, for the pipelines that need the code it guards.
 
 use std::{env, fs, path::PathBuf};
+
+/// Entry points compiled a second time with a pipeline-overridable constant set, written as
+/// `<file>.<entry>.<suffix>.spv`: file stem, entry-point name prefix, constant, value, suffix.
+const VARIANTS: &[(&str, &str, &str, f64, &str)] =
+    &[("glass", "fs_two_surface_", "ABSORBING", 1.0, "absorbing")];
 
 fn main() {
     let shader_dir = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap()).join("../shaders");
@@ -35,21 +42,45 @@ fn main() {
                 e.emit_to_string_with_path(&source, path.to_str().unwrap())
             )
         });
-        for entry in &module.entry_points {
-            let options = naga::back::spv::Options {
-                lang_version: (1, 0),
-                flags: naga::back::spv::WriterFlags::empty(),
-                ..Default::default()
-            };
-            let pipeline_options = naga::back::spv::PipelineOptions {
-                shader_stage: entry.stage,
-                entry_point: entry.name.clone(),
-            };
-            let words =
-                naga::back::spv::write_vec(&module, &info, &options, Some(&pipeline_options))
-                    .unwrap_or_else(|e| panic!("{}: {}: {e}", path.display(), entry.name));
-            let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
-            fs::write(out_dir.join(format!("{name}.{}.spv", entry.name)), bytes).unwrap();
+        let mut outputs = vec![(
+            naga::back::PipelineConstants::default(),
+            String::new(),
+            None,
+        )];
+        for &(file, entry, constant, value, suffix) in VARIANTS {
+            if file == name {
+                let mut constants = naga::back::PipelineConstants::default();
+                constants.insert(constant.to_owned(), value);
+                outputs.push((constants, format!(".{suffix}"), Some(entry)));
+            }
+        }
+        for (constants, suffix, only) in outputs {
+            let (module, info) =
+                naga::back::pipeline_constants::process_overrides(&module, &info, None, &constants)
+                    .unwrap_or_else(|e| panic!("{}{suffix}: {e}", path.display()));
+            for entry in &module.entry_points {
+                if only.is_some_and(|prefix| !entry.name.starts_with(prefix)) {
+                    continue;
+                }
+                let options = naga::back::spv::Options {
+                    lang_version: (1, 0),
+                    flags: naga::back::spv::WriterFlags::empty(),
+                    ..Default::default()
+                };
+                let pipeline_options = naga::back::spv::PipelineOptions {
+                    shader_stage: entry.stage,
+                    entry_point: entry.name.clone(),
+                };
+                let words =
+                    naga::back::spv::write_vec(&module, &info, &options, Some(&pipeline_options))
+                        .unwrap_or_else(|e| panic!("{}: {}: {e}", path.display(), entry.name));
+                let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+                fs::write(
+                    out_dir.join(format!("{name}.{}{suffix}.spv", entry.name)),
+                    bytes,
+                )
+                .unwrap();
+            }
         }
     }
 }

@@ -18,7 +18,8 @@
 // Two-surface refraction (`[object] refraction = "two-surface"`, beyond the paper,
 // docs/equations.md): the ray refracts in at the front, crosses the glass and refracts out at
 // the back, total internal reflection followed for up to MAX_INTERNAL_REFLECTIONS bounces
-// (then the environment), with exact Fresnel at both interfaces. The exit is found against the
+// (then the environment), with exact Fresnel at both interfaces and Beer-Lambert absorption
+// over the path inside (glTF KHR_materials_volume). The exit is found against the
 // object's radial map (render/src/two_surface.rs `radial_map`): the distance from the object's
 // centre to its surface and the normal there, per direction. Starting from the sphere through
 // the entry point, secant steps on the ray's height above the surface: one fetch for a ball, a
@@ -64,7 +65,16 @@ struct Globals {
     radial: vec4<f32>,
     // xyz: the object's centre in the world (metres).
     center_world: vec4<f32>,
+    // rgb: absorption inside the glass, halvings per model unit (Beer-Lambert, 2^(-rgb L):
+    // the coefficient per world metre times the model's scale over ln 2; 0 in a channel that
+    // absorbs nothing, where 2^0 = 1 leaves it exactly as it was).
+    absorption: vec4<f32>,
 };
+
+// The object absorbs (Beer-Lambert, two-surface refraction): a pipeline constant, so that the
+// pipeline of clear glass, the usual case, has the exponentials folded away (render/build.rs
+// compiles the fs_two_surface_* entry points with it set too).
+override ABSORBING: bool = false;
 
 var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -198,8 +208,9 @@ struct Passage {
     exit: vec3<f32>,
     // Unit direction after it, world.
     direction: vec3<f32>,
-    // Exact Fresnel transmittance of both interfaces.
-    transmission: f32,
+    // Exact Fresnel transmittance of both interfaces times the Beer-Lambert transmittance of
+    // the path inside, per linear RGB channel.
+    transmission: vec3<f32>,
     // 1 when it left the object, 0 when given up inside (environment).
     escaped: f32,
 };
@@ -208,7 +219,9 @@ struct Passage {
 // `incident` meets the front surface at `entry` (world) with unit normal `normal` facing it.
 fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
     var out: Passage;
-    out.transmission = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
+    var fresnel_transmission = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
+    // Length of the path inside, model units, internal reflections included.
+    var inside = 0.0;
     out.escaped = 0.0;
     let inside_world = refract(incident, normal, 1.0 / ior);
     var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
@@ -240,15 +253,20 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
             f = length(p + d * t) - s.x;
         }
         p += d * t;
+        inside += t;
         let outward = s.yzw;
         let leaving = refract(d, -outward, ior);
         if dot(leaving, leaving) > 0.0 {
-            out.transmission *= 1.0 - fresnel_exact(dot(d, outward), ior);
+            fresnel_transmission *= 1.0 - fresnel_exact(dot(d, outward), ior);
             d = leaving;
             out.escaped = 1.0;
             break;
         }
         d = reflect(d, outward);
+    }
+    out.transmission = vec3<f32>(fresnel_transmission);
+    if ABSORBING {
+        out.transmission *= exp2(-g.absorption.rgb * inside);
     }
     out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
     out.direction = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);

@@ -137,6 +137,7 @@ fn refracted_blur_matches_the_literal_convolution() {
                 let RefractionSample::Hit {
                     uv: Some(uv),
                     transmission,
+                    ..
                 } = refraction_sample(&camera, p, size, &sphere)
                 else {
                     continue;

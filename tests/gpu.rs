@@ -1,6 +1,7 @@
 //! The end-to-end GPU tests, in one binary: each module is one subject (on lavapipe in CI,
 //! Vulkan validation on in every test).
 
+mod absorption;
 mod caustics;
 mod defocus;
 mod inducer;

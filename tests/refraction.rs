@@ -262,6 +262,7 @@ pub(crate) fn render_shot(shot: &Shot, mesh: SphereMesh) -> [Vec<u8>; 2] {
         ),
         ior,
         refraction,
+        attenuation: vitreous_render::Attenuation::NONE,
         environment: TextureDesc {
             width: ew,
             height: eh,
@@ -366,6 +367,7 @@ pub(crate) fn reference_scene(refraction: Refraction) -> SphereScene {
         radius_m: RADIUS,
         ior: IOR,
         refraction,
+        attenuation: vitreous_render::Attenuation::NONE,
         background_from_world: background_plane().inverse(),
     }
 }

@@ -127,6 +127,7 @@ fn reference_markers(eye: &EyeParams, refraction: Refraction) -> (Vec<MarkerImag
                 RefractionSample::Hit {
                     uv: Some(uv),
                     transmission,
+                    ..
                 } => seen[i] = marker_seen(uv).map(|(k, value)| (k, transmission * value)),
                 RefractionSample::Hit { uv: None, .. } => {}
             }

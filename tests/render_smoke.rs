@@ -37,6 +37,7 @@ fn sphere_centroid_matches_projection_in_both_eyes_with_validation_silent() {
         world_from_model: place(center, radius),
         ior: 1.51,
         refraction: vitreous_render::Refraction::Paper,
+        attenuation: vitreous_render::Attenuation::NONE,
         environment: TextureDesc {
             width: 64,
             height: 32,
@@ -169,6 +170,7 @@ fn failed_construction_unwinds_without_leaks_at_every_step() {
         world_from_model: place(Vec3::new(0.0, -0.2, -0.5), 0.05),
         ior: 1.5,
         refraction: vitreous_render::Refraction::Paper,
+        attenuation: vitreous_render::Attenuation::NONE,
         environment: TextureDesc {
             width: 8,
             height: 4,
@@ -282,6 +284,7 @@ fn each_composition_draws_the_object_over_what_its_display_needs() {
         world_from_model: place(Vec3::new(0.0, 0.0, -0.5), 0.05),
         ior: 1.5,
         refraction: vitreous_render::Refraction::Paper,
+        attenuation: vitreous_render::Attenuation::NONE,
         environment: TextureDesc {
             width: 16,
             height: 8,

@@ -1,13 +1,15 @@
 //! The debug output of `vitreous replay --reference`: each saved eye image under the paper's
 //! refraction and under two-surface refraction, beside the CPU ray tracer's two-surface
 //! refraction layer (render/src/reference.rs), for scenes whose object is a sphere (the
-//! reference traces the analytic sphere of the object's bounding sphere).
+//! reference traces the analytic sphere of the object's bounding sphere), tinted by the
+//! glass's absorption along each ray's path inside.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use vitreous_render::Refraction;
 use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sample};
 use vitreous_xr::FrameInput;
 
+use crate::output::{linear_to_srgb, srgb_to_linear};
 use crate::scene::{PixelData, Scene};
 use crate::views::eye_params;
 
@@ -22,14 +24,15 @@ pub fn sphere_of(scene: &Scene) -> SphereScene {
         radius_m: scene.object.radius_m,
         ior: scene.object.ior,
         refraction: scene.object.refraction,
+        attenuation: scene.object.attenuation,
         background_from_world: scene.background.world_from_plane().inverse(),
     }
 }
 
 /// An RGBA8 image as wide as `gpu.len() + 1` eye images: the GPU's eye images left to right
 /// (paper, then two-surface refraction), then the CPU reference of the refraction layer under
-/// `refraction` (the background photo's texel at `(u_c, v_c)`, black off the sphere, grey
-/// where the ray misses the photo).
+/// `refraction` (the background photo's texel at `(u_c, v_c)` times the absorption along the
+/// path inside, black off the sphere, grey where the ray misses the photo).
 pub fn side_by_side(
     scene: &Scene,
     input: &FrameInput,
@@ -62,15 +65,32 @@ pub fn side_by_side(
             let rgba = match refraction_sample(&camera, pixel, dims, &sphere) {
                 RefractionSample::Miss => [0, 0, 0, 255],
                 RefractionSample::Hit { uv: None, .. } => [MISS_GREY, MISS_GREY, MISS_GREY, 255],
-                RefractionSample::Hit { uv: Some(uv), .. } => {
-                    texel(&photo.data, photo.width, photo.height, uv)
-                }
+                RefractionSample::Hit {
+                    uv: Some(uv),
+                    absorption,
+                    ..
+                } => absorbed(
+                    texel(&photo.data, photo.width, photo.height, uv),
+                    absorption,
+                ),
             };
             let i = row + ((cpu_panel + x) * 4) as usize;
             out[i..i + 4].copy_from_slice(&rgba);
         }
     }
     out
+}
+
+/// An sRGB texel seen through glass that leaves `absorption` of each linear channel (sRGB
+/// bytes round-trip exactly, so clear glass leaves the texel as it is).
+fn absorbed(rgba: [u8; 4], absorption: Vec3) -> [u8; 4] {
+    let through = |byte: u8, t: f32| linear_to_srgb(srgb_to_linear(byte) * t);
+    [
+        through(rgba[0], absorption.x),
+        through(rgba[1], absorption.y),
+        through(rgba[2], absorption.z),
+        rgba[3],
+    ]
 }
 
 /// The nearest texel of an sRGB photo at texture coordinates `uv`.

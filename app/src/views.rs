@@ -137,6 +137,7 @@ pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> Sc
         world_from_model: scene.object.world_from_model,
         ior: scene.object.ior,
         refraction: scene.object.refraction,
+        attenuation: scene.object.attenuation,
         environment: texture(&scene.environment.latlong),
         floor: PlaneDesc {
             world_from_plane: scene.floor.world_from_plane(),

@@ -391,6 +391,62 @@ fn bad_value_in_an_unused_extension_is_ignored() {
 }
 
 #[test]
+fn bad_gltf_volume_attenuation_names_the_file_and_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    for (volume, field) in [
+        (r#"{"attenuationDistance":0}"#, "attenuationDistance"),
+        (r#"{"attenuationDistance":-2}"#, "attenuationDistance"),
+        (
+            r#"{"attenuationDistance":1,"attenuationColor":[0.5,1.25,0]}"#,
+            "attenuationColor",
+        ),
+        (r#"{"attenuationColor":[-0.5,1,1]}"#, "attenuationColor"),
+    ] {
+        let model = crate::scene_load::tetrahedron_with_volume(dir.path(), volume);
+        let msg = expect_model_error(&model);
+        assert!(
+            msg.contains(&format!(
+                "materials[0].extensions.KHR_materials_volume.{field}"
+            )),
+            "{volume}: {msg}"
+        );
+    }
+}
+
+#[test]
+fn bad_scene_attenuation_is_named() {
+    let text = good_text().replace(
+        "diameter_m = 0.08",
+        "diameter_m = 0.08\nattenuation_distance_m = 0",
+    );
+    expect_error(
+        &text,
+        line_of(&text, "attenuation_distance_m"),
+        "object.attenuation_distance_m",
+    );
+    let text = good_text().replace(
+        "diameter_m = 0.08",
+        "diameter_m = 0.08\nattenuation_distance_m = 0.1\nattenuation_color = [0.5, 2, 0]",
+    );
+    expect_error(
+        &text,
+        line_of(&text, "attenuation_color"),
+        "object.attenuation_color",
+    );
+    // A colour needs a distance: the model gives none.
+    let text = good_text().replace(
+        "diameter_m = 0.08",
+        "diameter_m = 0.08\nattenuation_color = [0.5, 0.5, 0.5]",
+    );
+    let msg = expect_error(
+        &text,
+        line_of(&text, "attenuation_color"),
+        "object.attenuation_color",
+    );
+    assert!(msg.contains("attenuation_distance_m"), "{msg}");
+}
+
+#[test]
 fn model_that_is_not_gltf_is_refused() {
     let msg = expect_model_error(&repo().join("config/textures/brick.png"));
     assert!(msg.contains("invalid glTF"), "{msg}");

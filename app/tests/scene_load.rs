@@ -215,3 +215,98 @@ fn static_scenes_keep_their_transform() {
         .world_from_model_at(rest.object_position_m, rest.object_rotation);
     assert!(m.abs_diff_eq(scene.object.world_from_model, 1e-6));
 }
+
+/// Writes `tetrahedron.gltf` (one unit across, closed, its buffer in `tetrahedron.bin` beside
+/// it) into `dir`, its material carrying `KHR_materials_volume` = `volume` (JSON), and returns
+/// its path.
+pub(crate) fn tetrahedron_with_volume(dir: &Path, volume: &str) -> PathBuf {
+    let mut bytes = Vec::new();
+    for p in [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ] {
+        bytes.extend(p.iter().flat_map(|c| c.to_le_bytes()));
+    }
+    // Counter-clockwise seen from outside.
+    for i in [0u16, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3] {
+        bytes.extend(i.to_le_bytes());
+    }
+    std::fs::write(dir.join("tetrahedron.bin"), &bytes).unwrap();
+    let gltf = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+        "nodes":[{{"mesh":0}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,"material":0}}]}}],
+        "extensionsUsed":["KHR_materials_volume"],
+        "materials":[{{"extensions":{{"KHR_materials_volume":{volume}}}}}],
+        "buffers":[{{"byteLength":72,"uri":"tetrahedron.bin"}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":48}},
+                       {{"buffer":0,"byteOffset":48,"byteLength":24}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3",
+                       "min":[0,0,0],"max":[1,1,1]}},
+                     {{"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}}]}}"#
+    );
+    let path = dir.join("tetrahedron.gltf");
+    std::fs::write(&path, gltf).unwrap();
+    path
+}
+
+#[test]
+fn gltf_volume_attenuation_scales_with_the_object_and_the_scene_overrides_it() {
+    use vitreous_render::Attenuation;
+
+    let dir = tempfile::tempdir().unwrap();
+    let model = tetrahedron_with_volume(
+        dir.path(),
+        r#"{"thicknessFactor":0.5,"attenuationDistance":0.2,"attenuationColor":[0.9,0.5,0.25]}"#,
+    );
+    let minimal = std::fs::read_to_string(data("scenes/minimal.toml"))
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", data("scenes/..").display()));
+    let text = minimal.replace(
+        &format!(
+            "\"{}/models/TransmissionTest.glb\"",
+            data("scenes/..").display()
+        ),
+        &format!("'{}'", model.display()),
+    );
+    assert_ne!(text, minimal);
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, &text).unwrap();
+    // One unit across at diameter 0.5 m: 0.2 units inside are 0.1 m.
+    let scene = load_scene(&path).unwrap();
+    let attenuation = scene.object.attenuation;
+    assert_eq!(attenuation.color, Vec3::new(0.9, 0.5, 0.25));
+    assert!(
+        (attenuation.distance_m - 0.1).abs() < 1e-7,
+        "{attenuation:?}"
+    );
+
+    // Each part of the scene's own attenuation replaces the model's.
+    let overridden = text.replace(
+        "diameter_m = 0.5",
+        "diameter_m = 0.5\nattenuation_distance_m = 0.3",
+    );
+    std::fs::write(&path, &overridden).unwrap();
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(
+        scene.object.attenuation,
+        Attenuation {
+            color: Vec3::new(0.9, 0.5, 0.25),
+            distance_m: 0.3,
+        }
+    );
+    let overridden = overridden.replace(
+        "attenuation_distance_m = 0.3",
+        "attenuation_distance_m = 0.3\nattenuation_color = [1, 0.75, 0.5]",
+    );
+    std::fs::write(&path, &overridden).unwrap();
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.object.attenuation.color, Vec3::new(1.0, 0.75, 0.5));
+
+    // A model without the extension is clear glass.
+    let scene = load_scene(&data("scenes/minimal.toml")).unwrap();
+    assert_eq!(scene.object.attenuation, Attenuation::NONE);
+    assert!(scene.object.attenuation.is_clear());
+}

@@ -132,6 +132,10 @@ struct Globals {
     model_from_world: [f32; 16],
     radial: [f32; 4],
     center_world: [f32; 4],
+    /// rgb: absorption inside the glass in halvings per model unit (Beer-Lambert, two-surface
+    /// refraction: the coefficient per world metre times the model's uniform scale over ln 2,
+    /// for the shader's exp2; 0 for clear glass); w unused.
+    absorption: [f32; 4],
 }
 
 impl Globals {
@@ -249,7 +253,12 @@ impl GlassPass {
             stride: VERTEX_STRIDE,
             input_rate: vk::VertexInputRate::VERTEX,
         }];
-        let model = usize::from(desc.refraction == Refraction::TwoSurface);
+        // Clear glass gets the two-surface pipelines without the absorption's exponentials.
+        let model = match desc.refraction {
+            Refraction::Paper => 0,
+            Refraction::TwoSurface if desc.attenuation.is_clear() => 1,
+            Refraction::TwoSurface => 2,
+        };
         let pipelines = GlassVariant::ALL
             .iter()
             .map(|variant| {
@@ -303,6 +312,10 @@ impl GlassPass {
             model_from_world: [0.0; 16],
             radial,
             center_world: [0.0; 4],
+            absorption: (desc.attenuation.coefficient_per_m()
+                * (metres_per_model_unit(desc) * std::f32::consts::LOG2_E))
+                .extend(0.0)
+                .to_array(),
         }
         .posed(&ScenePose::of(desc));
         let globals_buffer = Buffer::with_data(
@@ -446,6 +459,15 @@ impl GlassPass {
     }
 }
 
+/// World metres per model unit of the object's uniform scale (the shader measures the path
+/// inside in model units).
+fn metres_per_model_unit(desc: &SceneDesc) -> f32 {
+    glam::Mat3::from_mat4(desc.world_from_model)
+        .determinant()
+        .abs()
+        .cbrt()
+}
+
 /// Uploads the object's radial map (half floats, which filter linearly on every device) for
 /// two-surface refraction, or one zero texel for the paper's model; and the map's centre
 /// (model units) and reference radius as the shader's `radial` vector.
@@ -511,7 +533,11 @@ mod tests {
     fn each_variant_draws_with_the_entry_point_named_for_it() {
         for (position, variant) in GlassVariant::ALL.iter().enumerate() {
             assert_eq!(variant.index(), position);
-            for (model, prefix) in [(0, "fs_paper_"), (1, "fs_two_surface_")] {
+            for (model, prefix) in [
+                (0, "fs_paper_"),
+                (1, "fs_two_surface_"),
+                (2, "fs_two_surface_"),
+            ] {
                 let name = shaders::GLASS_FS[model][position].1.to_str().unwrap();
                 let background = if variant.background {
                     "background"

@@ -23,6 +23,7 @@
 //!
 //! Knows nothing about OpenXR: device creation is an injected step ([`context::DeviceCreator`]).
 
+pub mod absorption;
 pub mod camera;
 pub mod context;
 pub mod error;
@@ -43,6 +44,7 @@ pub mod two_surface;
 mod validation;
 mod world;
 
+pub use absorption::Attenuation;
 pub use camera::{Defocus, EyeParams, FrameParams, Look, Reflection};
 pub use context::{ContextOptions, DeviceCreator, GpuContext, PlainVulkan};
 pub use error::{RenderError, Result};

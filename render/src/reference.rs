@@ -1,10 +1,11 @@
 //! CPU reference of the refraction layer for an analytic sphere: what each pixel of an eye
 //! image samples from the registered background photo, under the paper's model (eq. 7-8) or
-//! two-surface refraction (`two_surface.rs`). Tests compare the GPU against it;
+//! two-surface refraction (`two_surface.rs`, with the absorption of a tinted glass). Tests compare the GPU against it;
 //! `vitreous replay --reference` writes it beside the GPU image.
 
 use glam::{Mat4, Vec2, Vec3};
 
+use crate::absorption::Attenuation;
 use crate::camera::EyeParams;
 use crate::optics::{fresnel, plane_uv, ray_sphere, refract_heckbert};
 use crate::scene::Refraction;
@@ -21,6 +22,9 @@ pub struct SphereScene {
     pub ior: f32,
     /// How the view ray is refracted.
     pub refraction: Refraction,
+    /// Absorption inside the glass (two-surface refraction only: the paper's model has no path
+    /// inside).
+    pub attenuation: Attenuation,
     /// Inverse of the background plane's `world_from_plane`.
     pub background_from_world: Mat4,
 }
@@ -39,6 +43,10 @@ pub enum RefractionSample {
         /// factor (paper), or the product of the exact Fresnel transmittances at both
         /// interfaces (two-surface).
         transmission: f32,
+        /// Fraction of each linear RGB channel left by absorption inside the glass
+        /// (Beer-Lambert over the path inside; exactly 1 under the paper's model and for clear
+        /// glass).
+        absorption: Vec3,
     },
 }
 
@@ -78,6 +86,7 @@ pub fn refraction_sample(
                     .then(|| plane_uv(p.exit_m, p.direction, scene.background_from_world))
                     .flatten(),
                 transmission: p.transmission,
+                absorption: scene.attenuation.transmittance(p.inside_m),
             },
         };
     }
@@ -90,12 +99,14 @@ pub fn refraction_sample(
         uv: refract_heckbert(dir, normal, scene.ior)
             .and_then(|refracted| plane_uv(hit, refracted, scene.background_from_world)),
         transmission: 1.0 - fresnel(dir, normal),
+        absorption: Vec3::ONE,
     }
 }
 
 /// Centroid (pixels) of the refracted image of a bright `marker` (a rectangle of photo texture
 /// coordinates: min, max) on a black photo, each pixel weighted by the light it shows
-/// (its transmission), and the number of pixels that see the marker.
+/// (its Fresnel transmission: the tests' marker is seen through clear glass), and the number
+/// of pixels that see the marker.
 pub fn marker_centroid(
     eye: &EyeParams,
     size: (u32, u32),
@@ -112,6 +123,7 @@ pub fn marker_centroid(
             if let RefractionSample::Hit {
                 uv: Some(uv),
                 transmission,
+                ..
             } = refraction_sample(eye, p, dims, scene)
                 && uv.cmpge(marker.0).all()
                 && uv.cmple(marker.1).all()
@@ -167,6 +179,10 @@ mod tests {
             radius_m: 0.075,
             ior: 1.51,
             refraction: Refraction::Paper,
+            attenuation: Attenuation {
+                color: Vec3::splat(0.5),
+                distance_m: 0.1,
+            },
             background_from_world: Mat4::from_translation(Vec3::new(0.0, 0.0, -0.4)).inverse(),
         };
         let s = refraction_sample(&eye, Vec2::new(50.0, 40.0), Vec2::new(100.0, 80.0), &scene);
@@ -174,9 +190,27 @@ mod tests {
             RefractionSample::Hit {
                 uv: Some(uv),
                 transmission,
+                absorption,
             } => {
                 assert!(uv.abs_diff_eq(Vec2::splat(0.5), 1e-3));
                 assert!((transmission - 0.96).abs() < 1e-3);
+                // The paper's model has no path inside the glass.
+                assert_eq!(absorption, Vec3::ONE);
+            }
+            other => panic!("{other:?}"),
+        }
+        // Two-surface: straight through the centre, 2 R = 0.15 m inside.
+        let two = SphereScene {
+            refraction: Refraction::TwoSurface,
+            ..scene
+        };
+        match refraction_sample(&eye, Vec2::new(50.0, 40.0), Vec2::new(100.0, 80.0), &two) {
+            RefractionSample::Hit { absorption, uv, .. } => {
+                assert!(uv.is_some());
+                assert!(
+                    absorption.abs_diff_eq(Vec3::splat(0.5f32.powf(1.5)), 1e-5),
+                    "{absorption}"
+                );
             }
             other => panic!("{other:?}"),
         }

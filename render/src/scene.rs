@@ -3,6 +3,7 @@
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 
+use crate::absorption::Attenuation;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
 use crate::memory::{Buffer, Image, upload_texture, upload_volume};
@@ -102,6 +103,9 @@ pub struct SceneDesc<'a> {
     pub ior: f32,
     /// How the view ray is refracted through the object.
     pub refraction: Refraction,
+    /// Absorption inside the object (Beer-Lambert; two-surface refraction only, the paper's
+    /// model has no path inside). [`Attenuation::NONE`] for clear glass.
+    pub attenuation: Attenuation,
     /// Latitude-longitude environment map (radiance).
     pub environment: TextureDesc<'a>,
     /// The real floor.

@@ -8,9 +8,10 @@ macro_rules! spirv {
 }
 
 pub const GLASS_VS: &[u8] = spirv!("glass.vs_main");
-/// The glass pass's fragment entry points: `[model][variant]`, the model paper (0) or
-/// two-surface (1), the variant as `glass::GlassVariant::index` numbers it.
-pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 2] = [
+/// The glass pass's fragment entry points: `[model][variant]`, the model paper (0),
+/// two-surface (1) or two-surface through absorbing glass (2: compiled with `ABSORBING` set),
+/// the variant as `glass::GlassVariant::index` numbers it.
+pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 3] = [
     [
         (
             spirv!("glass.fs_paper_environment_fresnel"),
@@ -44,6 +45,24 @@ pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 2] = [
         ),
         (
             spirv!("glass.fs_two_surface_background_phong"),
+            c"fs_two_surface_background_phong",
+        ),
+    ],
+    [
+        (
+            spirv!("glass.fs_two_surface_environment_fresnel.absorbing"),
+            c"fs_two_surface_environment_fresnel",
+        ),
+        (
+            spirv!("glass.fs_two_surface_environment_phong.absorbing"),
+            c"fs_two_surface_environment_phong",
+        ),
+        (
+            spirv!("glass.fs_two_surface_background_fresnel.absorbing"),
+            c"fs_two_surface_background_fresnel",
+        ),
+        (
+            spirv!("glass.fs_two_surface_background_phong.absorbing"),
             c"fs_two_surface_background_phong",
         ),
     ],

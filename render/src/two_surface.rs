@@ -3,10 +3,12 @@
 //! where the back surface reflects it totally, the reflection is followed for a bounded number
 //! of bounces before the ray is given up to the environment. The reference the GPU's
 //! two-surface mode is tested against, for an analytic ball ([`Ball`]) and for any closed mesh
-//! ([`MeshBody`], the caustics baker's tracer).
+//! ([`MeshBody`], the caustics baker's tracer). The path's length inside gives the absorption
+//! of a tinted glass ([`Passage::transmittance`]).
 
 use glam::Vec3;
 
+use crate::absorption::Attenuation;
 use crate::optics::{fresnel_reflectance, ray_sphere, reflect, refract};
 use crate::solid::bvh::Bvh;
 use crate::solid::{Solid, SolidError};
@@ -174,8 +176,18 @@ pub struct Passage {
     /// Fraction of the light that follows this path: (1 - F) at the entry and at the exit,
     /// exact Fresnel for unpolarised light (total internal reflection loses nothing).
     pub transmission: f32,
-    /// Length of the path inside the glass, metres (for Beer-Lambert absorption).
+    /// Length of the path inside the glass, metres (for Beer-Lambert absorption): the sum of
+    /// its segments, internal reflections included.
     pub inside_m: f32,
+}
+
+impl Passage {
+    /// Fraction of each linear RGB channel that follows this path through glass of
+    /// `attenuation`: both interfaces' Fresnel transmission times the Beer-Lambert
+    /// transmittance of the path inside, `color^(inside_m / distance_m)`.
+    pub fn transmittance(&self, attenuation: &Attenuation) -> Vec3 {
+        self.transmission * attenuation.transmittance(self.inside_m)
+    }
 }
 
 /// Traces the unit view ray `dir` from `origin_m` through `body` of relative index `ior`:
@@ -624,6 +636,70 @@ mod tests {
         let expected = (1.0 - fresnel_reflectance(theta.cos(), 1.0 / DIAMOND))
             * (1.0 - fresnel_reflectance(cos_inside, DIAMOND));
         assert!((p.transmission - expected).abs() < 1e-5);
+    }
+
+    #[test]
+    fn absorption_follows_the_chord_snells_law_gives_a_ray_at_each_height() {
+        // A ray parallel to the axis at height h meets the surface at sin(i) = h / R and
+        // crosses the ball along a chord at sin(t) = h / (n R) from the centre: length
+        // 2 sqrt(R^2 - (h / n)^2), 2 R through the centre.
+        let b = ball();
+        let tint = Attenuation {
+            color: Vec3::new(0.25, 0.5, 0.8),
+            distance_m: 0.1,
+        };
+        for h_over_r in [0.0f32, 0.3, 0.6, 0.9] {
+            let h = h_over_r * b.radius_m;
+            let origin = b.center_m + Vec3::new(0.0, h, 0.5);
+            let p = pass_through(&b, origin, Vec3::NEG_Z, GLASS, 4).unwrap();
+            let chord = 2.0 * (b.radius_m.powi(2) - (h / GLASS).powi(2)).sqrt();
+            assert!(
+                (p.inside_m - chord).abs() < 1e-6,
+                "h {h_over_r} R: path {} m, chord {chord} m",
+                p.inside_m
+            );
+            let expected = Vec3::new(
+                tint.color.x.powf(chord / tint.distance_m),
+                tint.color.y.powf(chord / tint.distance_m),
+                tint.color.z.powf(chord / tint.distance_m),
+            ) * p.transmission;
+            let t = p.transmittance(&tint);
+            assert!(
+                t.abs_diff_eq(expected, 1e-5),
+                "h {h_over_r} R: {t} vs {expected}"
+            );
+            assert_eq!(
+                p.transmittance(&Attenuation::NONE),
+                Vec3::splat(p.transmission)
+            );
+        }
+        let centre = pass_through(&b, b.center_m + Vec3::Z, Vec3::NEG_Z, GLASS, 4).unwrap();
+        assert!((centre.inside_m - 2.0 * b.radius_m).abs() < 1e-6);
+    }
+
+    #[test]
+    fn absorption_counts_the_path_of_internal_reflections() {
+        // The diamond cube's path above: the reflection off the side keeps the vertical
+        // component of the direction, so the whole path crosses the cube's height
+        // 2 half at cos(t): length 2 half / cos(t), the reflected segment included.
+        let half = 0.01;
+        let cube = cube(half);
+        let theta = 60f32.to_radians();
+        let dir = Vec3::new(theta.sin(), -theta.cos(), 0.0);
+        let origin = Vec3::new(0.008, 0.01, 0.0) - dir * 0.05;
+        let p = pass_through(&cube, origin, dir, DIAMOND, 4).unwrap();
+        assert_eq!(p.internal_reflections, 1);
+        let cos_inside = (1.0 - (theta.sin() / DIAMOND).powi(2)).sqrt();
+        let path = 2.0 * half / cos_inside;
+        assert!((p.inside_m - path).abs() < 1e-5, "{} vs {path}", p.inside_m);
+        let grey = Attenuation {
+            color: Vec3::splat(0.5),
+            distance_m: path,
+        };
+        assert!(
+            p.transmittance(&grey)
+                .abs_diff_eq(Vec3::splat(0.5 * p.transmission), 1e-4)
+        );
     }
 
     #[test]

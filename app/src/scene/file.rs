@@ -95,6 +95,8 @@ pub(crate) struct ObjectToml {
     pub refraction: Option<Spanned<String>>,
     pub surface_texture: Option<Spanned<String>>,
     pub surface_transmittance: Option<Spanned<f32>>,
+    pub attenuation_distance_m: Option<Spanned<f32>>,
+    pub attenuation_color: Option<Spanned<Vec<f32>>>,
 }
 
 /// Which frame `[light] position_m` is given in.

@@ -11,10 +11,12 @@ use std::path::{Component, Path, PathBuf};
 use glam::{Mat4, Quat, Vec2, Vec3};
 use sha2::{Digest, Sha256};
 use toml::Spanned;
+use vitreous_render::Attenuation;
 use vitreous_xr::{Fov, Pose};
 
 use super::error::Source;
 use super::file::{DiskFiles, LightFrame, PlaneToml, SceneFile, SceneFiles};
+use super::mesh::VolumeAttenuation;
 use super::{
     Caustics, CausticsMode, Environment, GazeChoice, Image, Inducer, IorSource, Light, Object,
     Output, RealPlane, Scene, SceneError, Viewer, euler_xyz_deg,
@@ -562,6 +564,8 @@ impl Loader<'_> {
             (None, None) => (1.5, IorSource::Default),
         };
 
+        let attenuation = self.attenuation(raw, model.volume, scale)?;
+
         let refraction = match &raw.refraction {
             None => vitreous_render::Refraction::default(),
             Some(r) => {
@@ -607,10 +611,58 @@ impl Loader<'_> {
             ior,
             ior_source,
             refraction,
+            attenuation,
             surface_texture,
             surface_transmittance,
             model_path,
         })
+    }
+
+    /// The object's absorption: the model's volume attenuation, its distance scaled from model
+    /// units to metres with the object, each part overridden by the scene's.
+    fn attenuation(
+        &self,
+        raw: &file::ObjectToml,
+        volume: Option<VolumeAttenuation>,
+        scale: f32,
+    ) -> Result<Attenuation, SceneError> {
+        let model = volume.map_or(Attenuation::NONE, |v| Attenuation {
+            color: v.color,
+            distance_m: v.distance * scale,
+        });
+        let distance_m = match &raw.attenuation_distance_m {
+            Some(d) => self.number(
+                "object.attenuation_distance_m",
+                Some(d),
+                0.0,
+                (0.0, 1.0e6),
+                (true, false),
+            )?,
+            None => model.distance_m,
+        };
+        let color = match &raw.attenuation_color {
+            None => model.color,
+            Some(c) => {
+                let v = Vec3::from_array(self.array("object.attenuation_color", c)?);
+                if !v.cmpge(Vec3::ZERO).all() || !v.cmple(Vec3::ONE).all() {
+                    return Err(self.src.invalid(
+                        c.span(),
+                        "object.attenuation_color",
+                        format!("expected linear RGB components in 0..=1, found {v}"),
+                    ));
+                }
+                if distance_m.is_infinite() {
+                    return Err(self.src.invalid(
+                        c.span(),
+                        "object.attenuation_color",
+                        "needs `object.attenuation_distance_m` (the model gives no \
+                         attenuationDistance)",
+                    ));
+                }
+                v
+            }
+        };
+        Ok(Attenuation { color, distance_m })
     }
 
     fn plane(&mut self, table: &str, raw: &PlaneToml) -> Result<RealPlane, SceneError> {

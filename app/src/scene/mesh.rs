@@ -51,12 +51,24 @@ impl Mesh {
     }
 }
 
-/// A loaded model: the mesh, the first KHR_materials_ior found, and the buffer bytes (for
-/// the scene hash).
+/// A loaded model: the mesh, the first KHR_materials_ior and KHR_materials_volume found, and
+/// the buffer bytes (for the scene hash).
 pub(crate) struct LoadedModel {
     pub mesh: Mesh,
     pub ior: Option<f32>,
+    pub volume: Option<VolumeAttenuation>,
     pub buffers: Vec<Vec<u8>>,
+}
+
+/// A material's `KHR_materials_volume` attenuation, checked: white light travelling
+/// `distance` inside turns into `color`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct VolumeAttenuation {
+    /// `attenuationColor`: linear RGB, each in 0..=1.
+    pub color: Vec3,
+    /// `attenuationDistance`: model units after the node transforms (glTF's metres), > 0;
+    /// infinite (the extension's default) absorbs nothing.
+    pub distance: f32,
 }
 
 /// Largest vertex coordinate accepted, model units: far beyond any real model in metres,
@@ -141,6 +153,7 @@ fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
         buffers: &buffers,
         mesh: Mesh::default(),
         ior: None,
+        volume: None,
         visits: 0,
     };
     let mut ancestors = Vec::new();
@@ -153,6 +166,7 @@ fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
     Ok(LoadedModel {
         mesh: out.mesh,
         ior: out.ior,
+        volume: out.volume,
         buffers,
     })
 }
@@ -245,6 +259,35 @@ fn check_position_accessors(root: &gltf::json::Root) -> Result<(), String> {
     Ok(())
 }
 
+/// The checked `KHR_materials_volume` attenuation of `material`, if it has the extension
+/// (its `thicknessFactor` is not used: the renderer follows the ray through the mesh itself).
+fn volume_attenuation(material: &gltf::Material) -> Result<Option<VolumeAttenuation>, String> {
+    let Some(volume) = material.volume() else {
+        return Ok(None);
+    };
+    let field = |name: &str| {
+        format!(
+            "materials[{}].extensions.KHR_materials_volume.{name}",
+            material.index().map_or("default".into(), |i| i.to_string())
+        )
+    };
+    let distance = volume.attenuation_distance();
+    if distance.is_nan() || distance <= 0.0 {
+        return Err(format!(
+            "{}: expected a distance > 0 (model units), found {distance}",
+            field("attenuationDistance")
+        ));
+    }
+    let color = Vec3::from_array(volume.attenuation_color());
+    if !color.cmpge(Vec3::ZERO).all() || !color.cmple(Vec3::ONE).all() {
+        return Err(format!(
+            "{}: expected linear RGB components in 0..=1, found {color}",
+            field("attenuationColor")
+        ));
+    }
+    Ok(Some(VolumeAttenuation { color, distance }))
+}
+
 fn describe(e: &gltf::Error) -> String {
     match e {
         gltf::Error::Io(io) if io.kind() == std::io::ErrorKind::NotFound => {
@@ -258,6 +301,7 @@ struct Builder<'a> {
     buffers: &'a [Vec<u8>],
     mesh: Mesh,
     ior: Option<f32>,
+    volume: Option<VolumeAttenuation>,
     visits: usize,
 }
 
@@ -317,6 +361,9 @@ impl Builder<'_> {
         }
         if self.ior.is_none() {
             self.ior = primitive.material().ior();
+        }
+        if self.volume.is_none() {
+            self.volume = volume_attenuation(&primitive.material())?;
         }
         let position_acc = primitive
             .get(&gltf::Semantic::Positions)
@@ -567,6 +614,66 @@ mod tests {
             .unwrap();
         assert!(err.contains("buffers[0].uri"), "{err}");
         assert_eq!(percent_decode("a%20b%zz%4"), b"a b%zz%4");
+    }
+
+    /// The triangle with a material carrying `KHR_materials_volume` = `volume` (JSON).
+    fn triangle_with_volume(volume: &str) -> String {
+        triangle_gltf("0,1,2", "")
+            .replace(r#""indices":1}"#, r#""indices":1,"material":0}"#)
+            .replace(
+                r#""buffers""#,
+                &format!(
+                    r#""extensionsUsed":["KHR_materials_volume"],
+                    "materials":[{{"extensions":{{"KHR_materials_volume":{volume}}}}}],
+                    "buffers""#
+                ),
+            )
+    }
+
+    #[test]
+    fn volume_attenuation_is_read_from_the_material() {
+        let gltf = triangle_with_volume(
+            r#"{"thicknessFactor":0.3,"attenuationDistance":0.2,
+                "attenuationColor":[0.9,0.5,0.25]}"#,
+        );
+        let model = load_gltf(gltf.as_bytes(), Path::new(".")).unwrap();
+        assert_eq!(
+            model.volume,
+            Some(VolumeAttenuation {
+                color: Vec3::new(0.9, 0.5, 0.25),
+                distance: 0.2,
+            })
+        );
+        // The extension's defaults: white at an infinite distance (nothing absorbed).
+        let model = load_gltf(triangle_with_volume("{}").as_bytes(), Path::new(".")).unwrap();
+        let volume = model.volume.unwrap();
+        assert_eq!(volume.color, Vec3::ONE);
+        assert_eq!(volume.distance, f32::INFINITY);
+        let plain = load_gltf(triangle_gltf("0,1,2", "").as_bytes(), Path::new(".")).unwrap();
+        assert_eq!(plain.volume, None);
+    }
+
+    #[test]
+    fn bad_volume_attenuation_names_the_field() {
+        for (volume, field) in [
+            (r#"{"attenuationDistance":0}"#, "attenuationDistance"),
+            (r#"{"attenuationDistance":-0.5}"#, "attenuationDistance"),
+            (
+                r#"{"attenuationDistance":1,"attenuationColor":[1.5,0,0]}"#,
+                "attenuationColor",
+            ),
+            (r#"{"attenuationColor":[0.5,-0.1,0]}"#, "attenuationColor"),
+        ] {
+            let err = load_gltf(triangle_with_volume(volume).as_bytes(), Path::new("."))
+                .err()
+                .unwrap_or_else(|| panic!("{volume} should be refused"));
+            assert!(
+                err.contains(&format!(
+                    "materials[0].extensions.KHR_materials_volume.{field}"
+                )),
+                "{volume}: {err}"
+            );
+        }
     }
 
     #[test]

@@ -225,6 +225,10 @@ pub struct Object {
     /// How the view ray is refracted through the object (`refraction`; the paper's model by
     /// default).
     pub refraction: vitreous_render::Refraction,
+    /// Absorption inside the object, world metres: the model's `KHR_materials_volume`
+    /// (its distance scaled with the object), each part overridden by `attenuation_distance_m`
+    /// and `attenuation_color`; clear glass ([`vitreous_render::Attenuation::NONE`]) without.
+    pub attenuation: vitreous_render::Attenuation,
     /// Surface texture (sRGB), mapped with the mesh's `TEXCOORD_0`, if any.
     pub surface_texture: Option<Image>,
     /// Fraction of light the surface texture lets through, 0..1 (1 = no visible surface

@@ -370,13 +370,17 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         let from_origin = normalize(world_pos - origin);
         let passage = two_surface(world_pos, from_origin, n, ior);
         fresnel = fresnel_exact(-dot(incident, n), 1.0 / ior);
-        var seen = environment(passage.direction);
+        // The background where the ray reaches it, else the environment (fetched only there).
+        var uv = vec3<f32>(0.0);
         if to_background && passage.escaped > 0.0 {
-            let uv = background_uv(passage.exit, passage.direction);
-            if uv.z > 0.0 {
-                seen = textureSampleLevel(
-                    background, clamp_sampler, vec3<f32>(uv.xy, eye.blur.x), 0.0).rgb;
-            }
+            uv = background_uv(passage.exit, passage.direction);
+        }
+        var seen: vec3<f32>;
+        if uv.z > 0.0 {
+            seen = textureSampleLevel(
+                background, clamp_sampler, vec3<f32>(uv.xy, eye.blur.x), 0.0).rgb;
+        } else {
+            seen = environment(passage.direction);
         }
         refracted_image = seen * passage.transmission / max(1.0 - fresnel, 1e-6);
     } else if to_background {

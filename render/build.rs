@@ -1,14 +1,34 @@
 //! Compiles every WGSL shader in `../shaders` to SPIR-V with naga, validating it on the way.
 //! Nothing is checked in as SPIR-V and no external shader tool is needed. Pipeline-overridable
-//! constants take their defaults, and the entry points of [`VARIANTS`] are compiled once more
-//! with one set, for the pipelines that need the code it guards.
+//! constants take their defaults, and the entry points of [`VARIANTS`] are compiled again with
+//! some set, for the pipelines that need (or can skip) the code they guard.
 
 use std::{env, fs, path::PathBuf};
 
-/// Entry points compiled a second time with a pipeline-overridable constant set, written as
-/// `<file>.<entry>.<suffix>.spv`: file stem, entry-point name prefix, constant, value, suffix.
-const VARIANTS: &[(&str, &str, &str, f64, &str)] =
-    &[("glass", "fs_two_surface_", "ABSORBING", 1.0, "absorbing")];
+/// Entry points compiled again with pipeline-overridable constants set, written as
+/// `<file>.<entry>.<suffix>.spv`: file stem, entry-point name prefix, constants and their
+/// values, suffix.
+type Variant = (
+    &'static str,
+    &'static str,
+    &'static [(&'static str, f64)],
+    &'static str,
+);
+const VARIANTS: &[Variant] = &[
+    (
+        "glass",
+        "fs_two_surface_",
+        &[("ABSORBING", 1.0)],
+        "absorbing",
+    ),
+    ("glass", "fs_two_surface_", &[("BALL", 1.0)], "ball"),
+    (
+        "glass",
+        "fs_two_surface_",
+        &[("ABSORBING", 1.0), ("BALL", 1.0)],
+        "absorbing.ball",
+    ),
+];
 
 fn main() {
     let shader_dir = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap()).join("../shaders");
@@ -47,10 +67,12 @@ fn main() {
             String::new(),
             None,
         )];
-        for &(file, entry, constant, value, suffix) in VARIANTS {
+        for &(file, entry, set, suffix) in VARIANTS {
             if file == name {
                 let mut constants = naga::back::PipelineConstants::default();
-                constants.insert(constant.to_owned(), value);
+                for &(constant, value) in set {
+                    constants.insert(constant.to_owned(), value);
+                }
                 outputs.push((constants, format!(".{suffix}"), Some(entry)));
             }
         }

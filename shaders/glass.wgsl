@@ -76,6 +76,11 @@ struct Globals {
 // compiles the fs_two_surface_* entry points with it set too).
 override ABSORBING: bool = false;
 
+// The object is a ball about the radial map's centre (its map is the sphere of radius
+// `g.radial.w` with radial normals, render/src/two_surface.rs `RadialMap::ball`): a pipeline
+// constant, so that a ball's pipeline finds its surface without the map's fetch.
+override BALL: bool = false;
+
 var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(0) @binding(1) var env_map: texture_2d<f32>;
@@ -192,6 +197,9 @@ const EXIT_STEPS: i32 = 8;
 // unit normal (model frame).
 fn radial_surface(d: vec3<f32>) -> vec4<f32> {
     let unit = normalize(d);
+    if BALL {
+        return vec4<f32>(g.radial.w, unit);
+    }
     let texel = textureSampleLevel(radial_map, wrap_sampler, latlong_uv(unit), 0.0);
     return vec4<f32>(g.radial.w + texel.a, normalize(texel.rgb + unit));
 }

@@ -253,11 +253,15 @@ impl GlassPass {
             stride: VERTEX_STRIDE,
             input_rate: vk::VertexInputRate::VERTEX,
         }];
-        // Clear glass gets the two-surface pipelines without the absorption's exponentials.
-        let model = match desc.refraction {
-            Refraction::Paper => 0,
-            Refraction::TwoSurface if desc.attenuation.is_clear() => 1,
-            Refraction::TwoSurface => 2,
+        let (radial_map, radial, ball) = upload_radial_map(ctx, desc)?;
+        // Clear glass gets the two-surface pipelines without the absorption's exponentials, a
+        // ball the ones without the radial map's fetch.
+        let model = match (desc.refraction, desc.attenuation.is_clear(), ball) {
+            (Refraction::Paper, ..) => 0,
+            (Refraction::TwoSurface, true, false) => 1,
+            (Refraction::TwoSurface, false, false) => 2,
+            (Refraction::TwoSurface, true, true) => 3,
+            (Refraction::TwoSurface, false, true) => 4,
         };
         let pipelines = GlassVariant::ALL
             .iter()
@@ -294,7 +298,6 @@ impl GlassPass {
             0.0
         };
         let two_surface = desc.refraction == Refraction::TwoSurface;
-        let (radial_map, radial) = upload_radial_map(ctx, desc)?;
         let globals = Globals {
             world_from_model: [0.0; 16],
             normal_from_model: [0.0; 16],
@@ -470,10 +473,11 @@ fn metres_per_model_unit(desc: &SceneDesc) -> f32 {
 
 /// Uploads the object's radial map (half floats, which filter linearly on every device) for
 /// two-surface refraction, or one zero texel for the paper's model; and the map's centre
-/// (model units) and reference radius as the shader's `radial` vector.
-fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32; 4])> {
+/// (model units) and reference radius as the shader's `radial` vector, and whether the map is a
+/// ball's.
+fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32; 4], bool)> {
     let m = desc.mesh;
-    let (texels, extent, radial) = if desc.refraction == Refraction::TwoSurface {
+    let (texels, extent, radial, ball) = if desc.refraction == Refraction::TwoSurface {
         let map = radial_map(
             m.positions,
             m.normals,
@@ -492,6 +496,7 @@ fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32;
                  exit is found on its outermost surface"
             );
         }
+        let ball = map.ball();
         (
             map.texels,
             vk::Extent2D {
@@ -499,6 +504,7 @@ fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32;
                 height: map.height,
             },
             map.center.extend(map.radius).to_array(),
+            ball,
         )
     } else {
         (
@@ -508,6 +514,7 @@ fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32;
                 height: 1,
             },
             mesh_center(m.positions).extend(1.0).to_array(),
+            false,
         )
     };
     let halves: Vec<u8> = texels
@@ -521,7 +528,7 @@ fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32;
         extent,
         &halves,
     )?;
-    Ok((image, radial))
+    Ok((image, radial, ball))
 }
 
 #[cfg(test)]

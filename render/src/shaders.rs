@@ -9,9 +9,10 @@ macro_rules! spirv {
 
 pub const GLASS_VS: &[u8] = spirv!("glass.vs_main");
 /// The glass pass's fragment entry points: `[model][variant]`, the model paper (0),
-/// two-surface (1) or two-surface through absorbing glass (2: compiled with `ABSORBING` set),
-/// the variant as `glass::GlassVariant::index` numbers it.
-pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 3] = [
+/// two-surface (1), two-surface through absorbing glass (2: compiled with `ABSORBING` set),
+/// two-surface through a ball (3: `BALL`, no radial-map fetch) and through an absorbing ball
+/// (4: both), the variant as `glass::GlassVariant::index` numbers it.
+pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 5] = [
     [
         (
             spirv!("glass.fs_paper_environment_fresnel"),
@@ -63,6 +64,42 @@ pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 3] = [
         ),
         (
             spirv!("glass.fs_two_surface_background_phong.absorbing"),
+            c"fs_two_surface_background_phong",
+        ),
+    ],
+    [
+        (
+            spirv!("glass.fs_two_surface_environment_fresnel.ball"),
+            c"fs_two_surface_environment_fresnel",
+        ),
+        (
+            spirv!("glass.fs_two_surface_environment_phong.ball"),
+            c"fs_two_surface_environment_phong",
+        ),
+        (
+            spirv!("glass.fs_two_surface_background_fresnel.ball"),
+            c"fs_two_surface_background_fresnel",
+        ),
+        (
+            spirv!("glass.fs_two_surface_background_phong.ball"),
+            c"fs_two_surface_background_phong",
+        ),
+    ],
+    [
+        (
+            spirv!("glass.fs_two_surface_environment_fresnel.absorbing.ball"),
+            c"fs_two_surface_environment_fresnel",
+        ),
+        (
+            spirv!("glass.fs_two_surface_environment_phong.absorbing.ball"),
+            c"fs_two_surface_environment_phong",
+        ),
+        (
+            spirv!("glass.fs_two_surface_background_fresnel.absorbing.ball"),
+            c"fs_two_surface_background_fresnel",
+        ),
+        (
+            spirv!("glass.fs_two_surface_background_phong.absorbing.ball"),
             c"fs_two_surface_background_phong",
         ),
     ],

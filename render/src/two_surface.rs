@@ -301,6 +301,17 @@ pub struct RadialMap {
     pub star_shaped: bool,
 }
 
+impl RadialMap {
+    /// Whether the map is a ball's: every texel at the reference radius (within 1e-5 of it)
+    /// with the normal along its direction (within 1e-4), so that the sphere can stand for it.
+    pub fn ball(&self) -> bool {
+        self.star_shaped
+            && self.texels.chunks_exact(4).all(|t| {
+                t[3].abs() <= 1e-5 * self.radius && Vec3::new(t[0], t[1], t[2]).length() <= 1e-4
+            })
+    }
+}
+
 /// The unit direction the centre of texel (`x`, `y`) of a `width` x `height`
 /// latitude-longitude map looks along (inverse of glass.wgsl `latlong_uv`).
 pub fn latlong_direction(x: u32, y: u32, width: u32, height: u32) -> Vec3 {
@@ -580,6 +591,7 @@ mod tests {
         let indices: Vec<u32> = (0..positions.len() as u32).collect();
         let map = radial_map(&positions, &normals, &indices, 64, 32).unwrap();
         assert!(map.star_shaped);
+        assert!(map.ball());
         assert!(map.center.abs_diff_eq(b.center_m, 1e-5));
         for t in map.texels.chunks_exact(4) {
             // The vertex normals point away from the centre, so the surface between the
@@ -598,6 +610,7 @@ mod tests {
         let (width, height) = (64, 32);
         let map = radial_map(&positions, &normals, &indices, width, height).unwrap();
         assert!(map.star_shaped);
+        assert!(!map.ball());
         for y in 0..height {
             for x in 0..width {
                 let d = latlong_direction(x, y, width, height);

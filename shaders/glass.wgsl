@@ -20,7 +20,7 @@
 // the back, total internal reflection followed for up to MAX_INTERNAL_REFLECTIONS bounces
 // (then the environment), with exact Fresnel at both interfaces and Beer-Lambert absorption
 // over the path inside (glTF KHR_materials_volume). The exit is found against the
-// object's radial map (render/src/two_surface.rs `radial_map`): the distance from the object's
+// object's radial map (render/src/radial_map.rs `radial_map`): the distance from the object's
 // centre to its surface and the normal there, per direction. Starting from the sphere through
 // the entry point, secant steps on the ray's height above the surface: one fetch for a ball, a
 // few for a faceted stone.
@@ -77,7 +77,7 @@ struct Globals {
 override ABSORBING: bool = false;
 
 // The object is a ball about the radial map's centre (its map is the sphere of radius
-// `g.radial.w` with radial normals, render/src/two_surface.rs `RadialMap::ball`): a pipeline
+// `g.radial.w` with radial normals, render/src/radial_map.rs `RadialMap::ball`): a pipeline
 // constant, so that a ball's pipeline finds its surface without the map's fetch.
 override BALL: bool = false;
 
@@ -106,7 +106,7 @@ struct VertexOut {
 };
 
 // Cosine above which a vertex normal counts as pointing away from the object's centre (twin
-// of render/src/two_surface.rs RADIAL_NORMAL_COS).
+// of render/src/radial_map.rs RADIAL_NORMAL_COS).
 const RADIAL_NORMAL_COS: f32 = 0.9999;
 
 @vertex

@@ -13,9 +13,9 @@ use crate::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, PipelineSpec};
 use crate::pose::ScenePose;
+use crate::radial_map::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, mesh_center, radial_map};
 use crate::scene::{GpuScene, Refraction, SceneDesc, VERTEX_STRIDE};
 use crate::shaders;
-use crate::two_surface::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, mesh_center, radial_map};
 
 /// Phong exponent of the highlight: a sharp highlight, as on polished glass.
 const PHONG_EXPONENT: f32 = 200.0;

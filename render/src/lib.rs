@@ -34,6 +34,7 @@ pub mod optics;
 mod owned;
 mod pipeline;
 pub mod pose;
+pub mod radial_map;
 pub mod reference;
 pub mod renderer;
 pub mod scene;

@@ -1,5 +1,8 @@
 //! glTF 2.0 (`.gltf` + buffers, or `.glb`) to one flat triangle mesh, checking every
 //! accessor against its buffer so that broken files become errors, not panics.
+//!
+//! Over 600 lines only with its tests (about 500 without): the reading and the checks of one
+//! file format belong together.
 
 use std::collections::HashSet;
 use std::path::Path;

@@ -34,6 +34,11 @@ const NOISE_RAD: f32 = 0.5 * std::f32::consts::PI / 180.0;
 /// Fixation distance when nothing lies under the cursor, metres.
 const FAR_FIXATION_M: f32 = 2.0;
 
+/// How long a frame waits for the windowing system to ask for its picture before it is not
+/// shown: a few display refreshes, so a shown window is never skipped and a hidden one costs
+/// at most this per frame.
+const REDRAW_WAIT: Duration = Duration::from_millis(50);
+
 /// Which image under the cursor is fixated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FixationTarget {
@@ -61,6 +66,11 @@ pub struct Shared {
     pub touched: Vec<std::path::PathBuf>,
     /// Whether noise is added to the gaze rays.
     pub noise: bool,
+    /// The window can take a picture now without waiting (see
+    /// [`DesktopWindow::redraw_due`]); set by the backend before each frame.
+    pub window_ready: bool,
+    /// The sink presented a picture this frame.
+    pub presented: bool,
     /// Where a played trace is (position and length, seconds; whether paused).
     pub trace: Option<(f64, f64, bool)>,
     /// The object's centre once an edit or `[motion]` moved it, metres (what lies under the
@@ -367,8 +377,11 @@ impl Backend for DesktopBackend {
         if self.max_frames.is_some_and(|n| self.next_index >= n) {
             return Ok(None);
         }
+        if std::mem::take(&mut self.shared.borrow_mut().presented) {
+            self.window.picture_presented();
+        }
         let mut wait = Duration::ZERO;
-        let pumped = loop {
+        let mut pumped = loop {
             let pumped = self.window.pump(wait);
             let size = self.window.window().inner_size();
             // Minimised (no area): nothing to draw; wait for events instead of spinning.
@@ -380,6 +393,18 @@ impl Backend for DesktopBackend {
             }
             wait = Duration::from_millis(50);
         };
+        // Wait a little for the windowing system to ask for the next picture; a window that
+        // does not ask (hidden, minimised on Wayland) gets none this frame rather than a
+        // present that would block the loop (and its close button) until it is shown.
+        let deadline = Instant::now() + REDRAW_WAIT;
+        while !self.window.redraw_due() && !pumped.closed {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                break;
+            }
+            pumped.merge(self.window.pump(left));
+        }
+        self.shared.borrow_mut().window_ready = self.window.redraw_due();
         if pumped.closed {
             return Ok(None);
         }
@@ -398,6 +423,7 @@ impl Backend for DesktopBackend {
                         // None: the request is being carried out; a Resized event follows.
                         let _ = self.window.window().request_inner_size(size);
                     }
+                    Step::Minimise(on) => self.window.window().set_minimized(on),
                     Step::Copy { from, to } => {
                         // A failed copy is the script's error, reported and not fatal.
                         match std::fs::copy(&from, &to) {

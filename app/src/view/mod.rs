@@ -11,8 +11,8 @@
 //! renderer, and runs the loop again with the same backend and sink.
 //!
 //! Parts: `desktop.rs` (the backend), `window.rs` (winit), `swapchain.rs` (surface, swapchain,
-//! presentation), `staging.rs` (its staging buffers), `input.rs` (events and keys),
-//! `script.rs` (`--script`), `looks.rs` (effect conditions), `picture.rs` (the window's picture
+//! presentation), `staging.rs` (its staging buffers and their copy to the screen), `input.rs`
+//! (events and keys), `script.rs` (`--script`), `looks.rs` (effect conditions), `picture.rs` (the window's picture
 //! and overlay), `reload.rs` (hot reload), `playback.rs` (`--trace`), `session.rs` (the sink
 //! and what the overlay shows), `cli.rs` (the options).
 
@@ -116,6 +116,9 @@ pub struct ViewSummary {
     pub cpu_ms: Option<Spread>,
     /// GPU milliseconds per stereo frame.
     pub gpu_ms: Option<Spread>,
+    /// Frames whose picture was not put on screen: the window did not ask for one (hidden or
+    /// minimised), had no area, or its swapchain was out of date.
+    pub frames_not_shown: u64,
     /// Times the renderer was made anew (resizes, eyes shown, reloads).
     pub renderers_made: u32,
     /// Scene reloads that took effect.
@@ -230,6 +233,8 @@ fn view_with(
         object_center_m: None,
         noise: false,
         trace: None,
+        window_ready: true,
+        presented: false,
     }));
     let mut backend = DesktopBackend::new(
         desktop,
@@ -311,6 +316,7 @@ fn view_with(
         wall_s,
         cpu_ms: Spread::of(records.iter().map(|r| r.cpu_ms)),
         gpu_ms: Spread::of(records.iter().filter_map(|r| r.gpu_ms)),
+        frames_not_shown: sink.frames_not_shown(),
         renderers_made: sink.renderers_made(),
         reloads: sink.reloads(),
         reload_errors: sink.reload_errors().to_vec(),

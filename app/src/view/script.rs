@@ -10,7 +10,9 @@
 //! - `wheel N`: turn the wheel N notches;
 //! - `copy FROM TO`: copy a file over another (paths relative to the script's folder), e.g. to
 //!   edit the scene and see it reload;
-//! - `resize W H`: ask for a window of W x H pixels.
+//! - `resize W H`: ask for a window of W x H pixels;
+//! - `minimise` / `restore`: ask the window manager or compositor to minimise the window and
+//!   to bring it back (a Wayland client cannot bring back a window itself).
 
 use std::path::{Path, PathBuf};
 
@@ -30,6 +32,8 @@ pub enum Step {
         /// Height.
         height: u32,
     },
+    /// Ask for the window to be minimised (true) or brought back (false).
+    Minimise(bool),
     /// Copy a file over another.
     Copy {
         /// The file copied.
@@ -171,6 +175,10 @@ impl Script {
                     let (width, height) = (px(args[0])?, px(args[1])?);
                     steps.push((frame, Step::Resize { width, height }));
                 }
+                "minimise" | "restore" => {
+                    want(0, "FRAME minimise (or restore)")?;
+                    steps.push((frame, Step::Minimise(event == "minimise")));
+                }
                 "copy" => {
                     want(2, "FRAME copy FROM TO")?;
                     steps.push((
@@ -186,7 +194,7 @@ impl Script {
                         i + 1,
                         format!(
                             "unknown event '{other}'; expected key, down, up, move, press, \
-                             release, click, wheel, resize or copy"
+                             release, click, wheel, resize, minimise, restore or copy"
                         ),
                     ));
                 }
@@ -217,7 +225,7 @@ mod tests {
     #[test]
     fn events_come_out_at_their_frame_in_file_order() {
         let text = "# a comment\n5 key 3\n2 move 0.5 0.25\n5 wheel -1 # back\n\
-                    9 copy a.toml b.toml\n12 resize 400 300\n";
+                    9 copy a.toml b.toml\n12 resize 400 300\n13 minimise\n14 restore\n";
         let mut s = Script::parse(text, Path::new("/s")).unwrap();
         assert!(s.due(1).is_empty());
         assert_eq!(
@@ -237,7 +245,9 @@ mod tests {
                 Step::Resize {
                     width: 400,
                     height: 300
-                }
+                },
+                Step::Minimise(true),
+                Step::Minimise(false),
             ]
         );
     }
@@ -250,6 +260,7 @@ mod tests {
             ("1 move 2 0\n", 1, "fraction"),
             ("1 click thumb\n", 1, "left, right or middle"),
             ("1 jump\n", 1, "unknown event 'jump'"),
+            ("1 minimise now\n", 1, "FRAME minimise"),
             ("1 resize 10 300\n", 1, "64..8192"),
         ] {
             let (l, reason) = Script::parse(text, Path::new(".")).unwrap_err();

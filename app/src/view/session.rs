@@ -23,7 +23,7 @@ use super::input::{Action, KEYS};
 use super::looks::Looks;
 use super::picture::{Overlay, SeeThrough, compose};
 use super::reload::{Loaded, Watcher};
-use super::swapchain::Presenter;
+use super::swapchain::{Presented, Presenter};
 use crate::frame_loop::{FramePlan, FrameSink};
 use crate::gaze::{FilterKind, FixationDepth, GazeOverride};
 use crate::motion_clock::MotionClock;
@@ -273,6 +273,11 @@ impl ViewSink {
     /// The window's size now.
     pub fn window_size(&self) -> (u32, u32) {
         self.presenter.window_size()
+    }
+
+    /// Frames whose picture was not shown.
+    pub fn frames_not_shown(&self) -> u64 {
+        self.presenter.frames_not_shown()
     }
 
     /// Renderers made so far.
@@ -592,10 +597,12 @@ impl FrameSink for ViewSink {
         let eyes = self.shared.borrow().eyes;
         let preview = self.preview.then_some(&self.see);
         let overlay = &self.overlay;
-        self.presenter.present(|out, w, h| {
+        let ready = self.shared.borrow().window_ready;
+        let shown = self.presenter.present(ready, |out, w, h| {
             compose(out, w, h, readback, eyes, preview, readback.world.as_ref());
             overlay.draw(out, w, h, &lines);
         })?;
+        self.shared.borrow_mut().presented = shown == Presented::Shown;
         Ok(())
     }
 

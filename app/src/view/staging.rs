@@ -1,4 +1,4 @@
-//! A host-visible buffer a picture is written into before it is copied to the window.
+//! A host-visible buffer a picture is written into, and its copy into the window's image.
 
 use anyhow::{Context, Result};
 use ash::vk;
@@ -97,5 +97,75 @@ impl Staging {
             d.free_memory(self.memory, None);
         }
         *self = Staging::EMPTY;
+    }
+}
+
+/// Records the copy of `staging` into the whole `image`, leaving it ready to present.
+///
+/// # Safety
+/// `cmd` must be recording outside a render pass; buffer and image must hold `extent` and
+/// outlive the command buffer's execution.
+pub unsafe fn record_copy(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    staging: vk::Buffer,
+    image: vk::Image,
+    extent: vk::Extent2D,
+) {
+    let range = vk::ImageSubresourceRange {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    let to_dst = vk::ImageMemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::empty())
+        .dst_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+        .old_layout(vk::ImageLayout::UNDEFINED)
+        .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(range);
+    let region = vitreous_render::color_copy_region(0, extent.width, extent.height, 1, 1);
+    let to_present = vk::ImageMemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+        .dst_access_mask(vk::AccessFlags::empty())
+        .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+        .new_layout(vk::ImageLayout::PRESENT_SRC_KHR)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(range);
+    // SAFETY: the caller's contract.
+    unsafe {
+        // The acquire semaphore is waited for at TRANSFER, so the layout change happens after
+        // the image is available.
+        d.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::DependencyFlags::empty(),
+            &[],
+            &[],
+            &[to_dst],
+        );
+        d.cmd_copy_buffer_to_image(
+            cmd,
+            staging,
+            image,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &[region],
+        );
+        d.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+            vk::DependencyFlags::empty(),
+            &[],
+            &[],
+            &[to_present],
+        );
     }
 }

@@ -26,7 +26,7 @@ use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use vitreous_render::GpuContext;
 use winit::window::Window;
 
-use super::staging::Staging;
+use super::staging::{Staging, record_copy};
 
 /// Presentation slots in flight at once.
 pub const FRAMES_IN_FLIGHT: usize = 2;
@@ -40,6 +40,8 @@ pub enum Presented {
     Hidden,
     /// The swapchain was out of date: it is recreated, the picture was dropped.
     Recreated,
+    /// The window did not ask for a picture (hidden): nothing was presented.
+    NotAsked,
 }
 
 /// One presentation slot.
@@ -91,6 +93,8 @@ pub struct Presenter {
     swapchain_fn: ash::khr::swapchain::Device,
     /// The last picture shown (RGBA8, rows from the top) and its size.
     last: Option<(Vec<u8>, u32, u32)>,
+    /// Pictures handed to [`Presenter::present`] that were not shown.
+    not_shown: u64,
     /// The Vulkan device the window's images live on; dropped after everything above.
     ctx: GpuContext,
     /// The window; dropped after its surface.
@@ -130,6 +134,7 @@ impl Presenter {
             surface_fn,
             swapchain_fn,
             last: None,
+            not_shown: 0,
             ctx,
             window,
         };
@@ -211,9 +216,36 @@ impl Presenter {
         self.last.as_ref().map(|(p, w, h)| (p.as_slice(), *w, *h))
     }
 
-    /// Puts a picture on screen. `draw` fills an RGBA8 buffer of the given width and height
-    /// (the swapchain's size, rows from the top); it is not called when nothing is presented.
-    pub fn present(&mut self, draw: impl FnOnce(&mut [u8], u32, u32)) -> Result<Presented> {
+    /// Pictures handed to [`Presenter::present`] that were not shown.
+    pub fn frames_not_shown(&self) -> u64 {
+        self.not_shown
+    }
+
+    /// Puts a picture on screen if the window asked for one (`asked`: its `RedrawRequested`
+    /// came since the last picture, see [`super::window::DesktopWindow::redraw_due`]). `draw`
+    /// fills an RGBA8 buffer of the given width and height (the swapchain's size, rows from
+    /// the top); it is not called when nothing is presented.
+    pub fn present(
+        &mut self,
+        asked: bool,
+        draw: impl FnOnce(&mut [u8], u32, u32),
+    ) -> Result<Presented> {
+        let shown = self.present_asked(asked, draw)?;
+        if shown != Presented::Shown {
+            self.not_shown += 1;
+        }
+        Ok(shown)
+    }
+
+    /// [`Presenter::present`] without the count.
+    fn present_asked(
+        &mut self,
+        asked: bool,
+        draw: impl FnOnce(&mut [u8], u32, u32),
+    ) -> Result<Presented> {
+        if !asked {
+            return Ok(Presented::NotAsked);
+        }
         let (w, h) = self.window_size();
         if w == 0 || h == 0 {
             return Ok(Presented::Hidden);
@@ -316,9 +348,14 @@ impl Presenter {
             .wait_semaphores(&waits)
             .swapchains(&swapchains)
             .image_indices(&indices);
+        // The windowing system is told a picture follows (Wayland: a frame callback for it),
+        // and asked for the next one, which `RedrawRequested` brings once this one is taken.
+        self.window.pre_present_notify();
         // SAFETY: the image was acquired from this swapchain and the submission above signals
         // the semaphore presentation waits for.
-        match unsafe { self.swapchain_fn.queue_present(self.ctx.queue, &info) } {
+        let result = unsafe { self.swapchain_fn.queue_present(self.ctx.queue, &info) };
+        self.window.request_redraw();
+        match result {
             Ok(suboptimal) => self.stale |= suboptimal,
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => self.stale = true,
             Err(e) => return Err(e).context("vkQueuePresentKHR"),
@@ -457,76 +494,6 @@ impl Drop for Presenter {
             d.destroy_command_pool(self.pool, None);
             self.surface_fn.destroy_surface(self.surface, None);
         }
-    }
-}
-
-/// Records the copy of `staging` into the whole `image`, leaving it ready to present.
-///
-/// # Safety
-/// `cmd` must be recording outside a render pass; buffer and image must hold `extent` and
-/// outlive the command buffer's execution.
-unsafe fn record_copy(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    staging: vk::Buffer,
-    image: vk::Image,
-    extent: vk::Extent2D,
-) {
-    let range = vk::ImageSubresourceRange {
-        aspect_mask: vk::ImageAspectFlags::COLOR,
-        base_mip_level: 0,
-        level_count: 1,
-        base_array_layer: 0,
-        layer_count: 1,
-    };
-    let to_dst = vk::ImageMemoryBarrier::default()
-        .src_access_mask(vk::AccessFlags::empty())
-        .dst_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-        .old_layout(vk::ImageLayout::UNDEFINED)
-        .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(range);
-    let region = vitreous_render::color_copy_region(0, extent.width, extent.height, 1, 1);
-    let to_present = vk::ImageMemoryBarrier::default()
-        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-        .dst_access_mask(vk::AccessFlags::empty())
-        .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-        .new_layout(vk::ImageLayout::PRESENT_SRC_KHR)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(range);
-    // SAFETY: the caller's contract.
-    unsafe {
-        // The acquire semaphore is waited for at TRANSFER, so the layout change happens after
-        // the image is available.
-        d.cmd_pipeline_barrier(
-            cmd,
-            vk::PipelineStageFlags::TRANSFER,
-            vk::PipelineStageFlags::TRANSFER,
-            vk::DependencyFlags::empty(),
-            &[],
-            &[],
-            &[to_dst],
-        );
-        d.cmd_copy_buffer_to_image(
-            cmd,
-            staging,
-            image,
-            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            &[region],
-        );
-        d.cmd_pipeline_barrier(
-            cmd,
-            vk::PipelineStageFlags::TRANSFER,
-            vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-            vk::DependencyFlags::empty(),
-            &[],
-            &[],
-            &[to_present],
-        );
     }
 }
 

@@ -31,6 +31,9 @@ struct Handler {
     resized: bool,
     /// Shift is held.
     shift: bool,
+    /// The windowing system asked for a picture (`RedrawRequested`) since the last one was
+    /// presented: presenting now does not wait for it.
+    redraw_due: bool,
 }
 
 impl ApplicationHandler for Handler {
@@ -49,6 +52,7 @@ impl ApplicationHandler for Handler {
             WindowEvent::Resized(_) | WindowEvent::ScaleFactorChanged { .. } => {
                 self.resized = true;
             }
+            WindowEvent::RedrawRequested => self.redraw_due = true,
             WindowEvent::ModifiersChanged(m) => self.shift = m.state().shift_key(),
             WindowEvent::KeyboardInput { event, .. } => {
                 if event.repeat {
@@ -121,6 +125,7 @@ fn named_key(key: NamedKey) -> Option<&'static str> {
 }
 
 /// What one pump of the event loop brought.
+#[derive(Default)]
 pub struct Pumped {
     /// Input events, in order.
     pub events: Vec<InputEvent>,
@@ -130,6 +135,16 @@ pub struct Pumped {
     pub closed: bool,
     /// The window changed size.
     pub resized: bool,
+}
+
+impl Pumped {
+    /// Adds what a later pump brought.
+    pub fn merge(&mut self, later: Pumped) {
+        self.events.extend(later.events);
+        self.shift = later.shift;
+        self.closed |= later.closed;
+        self.resized |= later.resized;
+    }
 }
 
 /// The window and its event loop.
@@ -157,6 +172,7 @@ impl DesktopWindow {
             close_requested: false,
             resized: false,
             shift: false,
+            redraw_due: true,
         };
         let mut this_loop = event_loop;
         for _ in 0..200 {
@@ -180,6 +196,20 @@ impl DesktopWindow {
     /// The window.
     pub fn window(&self) -> Arc<Window> {
         self.handler.window.clone().expect("made in open")
+    }
+
+    /// Whether the windowing system is ready for the next picture: it asked for one since
+    /// [`DesktopWindow::picture_presented`]. On Wayland this is the frame callback of the last
+    /// picture: a hidden or minimised window gets none, and presenting to it with FIFO would
+    /// block until it is shown again.
+    pub fn redraw_due(&self) -> bool {
+        self.handler.redraw_due
+    }
+
+    /// A picture was presented (after `pre_present_notify`, followed by `request_redraw`):
+    /// the next waits for the windowing system to ask again.
+    pub fn picture_presented(&mut self) {
+        self.handler.redraw_due = false;
     }
 
     /// Handles the events waiting (waiting up to `wait` for one) and returns them.

@@ -1,4 +1,4 @@
-//! `vitreous view` in a virtual X server (xvfb-run) on the machine's Vulkan device (lavapipe
+//! `vitreous view` in a virtual X server (xvfb-run; `wayland.rs`: in a headless weston) on the machine's Vulkan device (lavapipe
 //! in CI) with validation on: screenshots measured in the glass's projected region and away
 //! from it, a scripted key press, and scripted scene edits (reload, and a broken edit kept
 //! out).
@@ -6,14 +6,11 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use glam::Vec3;
+mod shots;
+#[cfg(feature = "wayland")]
+mod wayland;
 
-/// Window size of every test: small, so each run takes a few seconds on a CPU device.
-const WINDOW: (u32, u32) = (320, 240);
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+use shots::{Shot, WINDOW, assert_glass_shown_alone, glass_discs, regions, root, scene};
 
 /// `xvfb-run`, or None outside CI when it is missing (in CI, a missing one fails the test).
 fn xvfb_run() -> Option<PathBuf> {
@@ -59,80 +56,6 @@ fn view(xvfb: &Path, scene: &Path, args: &[&str], cwd: &Path) -> Output {
     out
 }
 
-/// An RGBA8 screenshot.
-struct Shot {
-    width: u32,
-    pixels: Vec<u8>,
-}
-
-impl Shot {
-    fn read(path: &Path) -> Shot {
-        Shot::read_sized(path, WINDOW)
-    }
-
-    fn read_sized(path: &Path, size: (u32, u32)) -> Shot {
-        let img = image::open(path).expect("a PNG screenshot").to_rgba8();
-        assert_eq!(img.dimensions(), size, "the screenshot is the window");
-        Shot {
-            width: img.width(),
-            pixels: img.into_raw(),
-        }
-    }
-
-    fn luma(&self, x: u32, y: u32) -> f32 {
-        let i = ((y * self.width + x) * 4) as usize;
-        let p = &self.pixels[i..i + 3];
-        0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2])
-    }
-}
-
-/// Where the scene's glass (its bounding sphere) lies in each half of the window, as the
-/// viewer projects it from the starting pose: centre and radius in window pixels.
-fn glass_discs(scene_path: &Path) -> [(f32, f32, f32); 2] {
-    let scene = vitreous::scene::load_scene(scene_path).expect("scene loads");
-    let g = scene.viewing_geometry();
-    let fov = scene.output.fov;
-    let tan_v = ((fov.angle_up_rad - fov.angle_down_rad) / 2.0).tan();
-    let (eye_w, eye_h) = ((WINDOW.0 / 2) as f32, WINDOW.1 as f32);
-    let tan_h = tan_v * eye_w / eye_h;
-    let head = scene.viewer.head_position_m;
-    [-1.0f32, 1.0].map(|side| {
-        let eye = head + Vec3::X * side * scene.viewer.ipd_m / 2.0;
-        let p = g.center_m - eye;
-        let u = 0.5 + p.x / -p.z / (2.0 * tan_h);
-        let v = 0.5 - p.y / -p.z / (2.0 * tan_v);
-        let r = g.radius_m / p.length() / (2.0 * tan_v) * eye_h;
-        let x0 = if side < 0.0 { 0.0 } else { eye_w };
-        (x0 + u * eye_w, v * eye_h, r)
-    })
-}
-
-/// Window pixels, (x, y).
-type Pixels = Vec<(u32, u32)>;
-
-/// Pixels inside 0.7 of the discs and outside 1.6 of them.
-fn regions(discs: &[(f32, f32, f32); 2]) -> (Pixels, Pixels) {
-    let (mut inside, mut outside) = (Vec::new(), Vec::new());
-    for y in 0..WINDOW.1 {
-        for x in 0..WINDOW.0 {
-            let d = |&(cx, cy, r): &(f32, f32, f32)| {
-                ((x as f32 + 0.5 - cx).hypot(y as f32 + 0.5 - cy)) / r
-            };
-            let nearest = discs.iter().map(d).fold(f32::INFINITY, f32::min);
-            if nearest < 0.7 {
-                inside.push((x, y));
-            } else if nearest > 1.6 {
-                outside.push((x, y));
-            }
-        }
-    }
-    (inside, outside)
-}
-
-fn scene(name: &str) -> PathBuf {
-    root().join("config/scenes").join(name)
-}
-
 #[test]
 fn view_shows_the_glass_where_it_projects_and_black_elsewhere() {
     let Some(xvfb) = xvfb_run() else { return };
@@ -145,21 +68,7 @@ fn view_shows_the_glass_where_it_projects_and_black_elsewhere() {
         &["--frames", "6", "--screenshot", shot.to_str().unwrap()],
         dir.path(),
     );
-    let img = Shot::read(&shot);
-    let (inside, outside) = regions(&glass_discs(&scene));
-    assert!(inside.len() > 50, "the glass covers {} px", inside.len());
-    let mean =
-        |px: &[(u32, u32)]| px.iter().map(|&(x, y)| img.luma(x, y)).sum::<f32>() / px.len() as f32;
-    let lit_outside = outside
-        .iter()
-        .filter(|&&(x, y)| img.luma(x, y) > 8.0)
-        .count();
-    assert!(mean(&inside) > 20.0, "glass mean luma {}", mean(&inside));
-    assert!(
-        (lit_outside as f32) < 0.01 * outside.len() as f32,
-        "{lit_outside} of {} px lit away from the glass (display light only)",
-        outside.len()
-    );
+    assert_glass_shown_alone(&shot, &scene);
 }
 
 #[test]
@@ -277,40 +186,50 @@ fn scripted_scene_edits_reload_and_a_broken_edit_keeps_the_last_good_scene() {
     assert!(mean > 20.0, "the moved glass has mean luma {mean}");
 }
 
-fn summary(out_dir: &Path) -> serde_json::Value {
+pub(crate) fn summary(out_dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap()
+}
+
+/// Writes a script into `dir` that asks for a 400 x 300 window at frame 2, and returns the
+/// arguments of a 24-frame session that runs it and leaves `shot.png` and `out/` in `dir`.
+pub(crate) fn resize_session(dir: &Path) -> Vec<String> {
+    std::fs::write(dir.join("resize.script"), "2 resize 400 300\n").unwrap();
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    [
+        "--frames",
+        "24",
+        "--script",
+        "resize.script",
+        "--screenshot",
+    ]
+    .map(String::from)
+    .into_iter()
+    .chain([path("shot.png"), "--out".into(), path("out")])
+    .collect()
+}
+
+/// Checks what [`resize_session`]'s session left: a 400 x 300 window, a renderer made for
+/// it, and the glass drawn in it.
+pub(crate) fn assert_resized(dir: &Path) {
+    let s = summary(&dir.join("out"));
+    assert_eq!(s["window_px"], serde_json::json!([400, 300]), "{s:#}");
+    assert!(s["renderers_made"].as_u64().unwrap() >= 2, "{s:#}");
+    let img = Shot::read_sized(&dir.join("shot.png"), (400, 300));
+    let lit = img.pixels.chunks(4).filter(|p| p[1] > 40).count();
+    assert!(
+        lit > 100,
+        "the glass is drawn after the resize: {lit} px lit"
+    );
 }
 
 #[test]
 fn a_resized_window_gets_a_new_swapchain_and_renderer() {
     let Some(xvfb) = xvfb_run() else { return };
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("resize.script"), "2 resize 400 300\n").unwrap();
-    let (shot, out_dir) = (dir.path().join("shot.png"), dir.path().join("out"));
-    view(
-        &xvfb,
-        &scene("glass-sphere.toml"),
-        &[
-            "--frames",
-            "24",
-            "--script",
-            "resize.script",
-            "--screenshot",
-            shot.to_str().unwrap(),
-            "--out",
-            out_dir.to_str().unwrap(),
-        ],
-        dir.path(),
-    );
-    let s = summary(&out_dir);
-    assert_eq!(s["window_px"], serde_json::json!([400, 300]), "{s:#}");
-    assert!(s["renderers_made"].as_u64().unwrap() >= 2, "{s:#}");
-    let img = Shot::read_sized(&shot, (400, 300));
-    let lit = img.pixels.chunks(4).filter(|p| p[1] > 40).count();
-    assert!(
-        lit > 100,
-        "the glass is drawn after the resize: {lit} px lit"
-    );
+    let args = resize_session(dir.path());
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    view(&xvfb, &scene("glass-sphere.toml"), &args, dir.path());
+    assert_resized(dir.path());
 }
 
 #[test]

@@ -28,6 +28,13 @@ const VARIANTS: &[Variant] = &[
         &[("ABSORBING", 1.0), ("BALL", 1.0)],
         "absorbing.ball",
     ),
+    ("glass", "fs_two_surface_", &[("CONVEX", 1.0)], "convex"),
+    (
+        "glass",
+        "fs_two_surface_",
+        &[("ABSORBING", 1.0), ("CONVEX", 1.0)],
+        "absorbing.convex",
+    ),
 ];
 
 fn main() {

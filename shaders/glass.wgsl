@@ -81,6 +81,12 @@ override ABSORBING: bool = false;
 // constant, so that a ball's pipeline finds its surface without the map's fetch.
 override BALL: bool = false;
 
+// The object is a flat-shaded convex polyhedron (a cut gem) whose facet planes are `planes`
+// (render/src/convex.rs `facet_planes`): a pipeline constant, so that its pipeline finds
+// where a ray leaves exactly, without the radial map (whose filtered texels round every
+// facet edge).
+override CONVEX: bool = false;
+
 var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(0) @binding(1) var env_map: texture_2d<f32>;
@@ -93,6 +99,9 @@ var<push_constant> eye: Eye;
 // The object's surface seen from its centre (two-surface refraction; 1 texel otherwise): rgb
 // the outward normal minus the direction, a the radius minus the reference radius.
 @group(0) @binding(6) var radial_map: texture_2d<f32>;
+// The facet planes of a convex object (model frame, about the radial map's centre): xyz the
+// outward unit normal, w the plane's distance from the centre. One unused plane otherwise.
+@group(0) @binding(7) var<storage, read> planes: array<vec4<f32>>;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -211,6 +220,24 @@ fn sphere_exit(p: vec3<f32>, d: vec3<f32>, r: f32) -> f32 {
     return -b + sqrt(max(b * b - c, 0.0));
 }
 
+// Where the ray p + t d (from inside, d unit) leaves the convex object of `planes`: x the
+// distance t, yzw the outward unit normal (twin of render/src/convex.rs convex_exit).
+fn convex_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
+    var exit = vec4<f32>(3.0e38, 0.0, 0.0, 0.0);
+    let count = arrayLength(&planes);
+    for (var i = 0u; i < count; i++) {
+        let plane = planes[i];
+        let along = dot(plane.xyz, d);
+        if along > 1e-7 {
+            let t = max((plane.w - dot(plane.xyz, p)) / along, 0.0);
+            if t < exit.x {
+                exit = vec4<f32>(t, plane.xyz);
+            }
+        }
+    }
+    return exit;
+}
+
 struct Passage {
     // Where the ray left the object (or was given up), world metres.
     exit: vec3<f32>,
@@ -222,6 +249,41 @@ struct Passage {
     // 1 when it left the object, 0 when given up inside (environment).
     escaped: f32,
 };
+
+// Where the ray p + t d (from inside, d unit; model frame about the radial map's centre)
+// leaves the object: x the distance t, yzw the outward unit normal there. Exact for a convex
+// polyhedron (`CONVEX`, its planes) and a ball; otherwise found on the radial map.
+fn find_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
+    if CONVEX {
+        return convex_exit(p, d);
+    }
+    // f(t) = |p + t d| - r(p + t d) vanishes at the exit. First the exit of the sphere
+    // through the entry (exact for a ball: one fetch), then secant steps on f, or the
+    // sphere of the last radius where a secant step would go backwards.
+    var t = sphere_exit(p, d, length(p));
+    var s = radial_surface(p + d * t);
+    var f = length(p + d * t) - s.x;
+    var t_prev = t;
+    var f_prev = f;
+    for (var i = 1; i < EXIT_STEPS; i++) {
+        if abs(f) <= 1e-4 * s.x {
+            break;
+        }
+        var t_next = sphere_exit(p, d, s.x);
+        if i > 1 && abs(f - f_prev) > 1e-12 {
+            let secant = t - f * (t - t_prev) / (f - f_prev);
+            if secant > 0.0 {
+                t_next = secant;
+            }
+        }
+        t_prev = t;
+        f_prev = f;
+        t = t_next;
+        s = radial_surface(p + d * t);
+        f = length(p + d * t) - s.x;
+    }
+    return vec4<f32>(t, s.yzw);
+}
 
 // Two-surface refraction (twin of render/src/two_surface.rs pass_through): the unit ray
 // `incident` meets the front surface at `entry` (world) with unit normal `normal` facing it.
@@ -235,34 +297,10 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
     var d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
     for (var bounce = 0; bounce <= MAX_INTERNAL_REFLECTIONS; bounce++) {
-        // f(t) = |p + t d| - r(p + t d) vanishes at the exit. First the exit of the sphere
-        // through the entry (exact for a ball: one fetch), then secant steps on f, or the
-        // sphere of the last radius where a secant step would go backwards.
-        var t = sphere_exit(p, d, length(p));
-        var s = radial_surface(p + d * t);
-        var f = length(p + d * t) - s.x;
-        var t_prev = t;
-        var f_prev = f;
-        for (var i = 1; i < EXIT_STEPS; i++) {
-            if abs(f) <= 1e-4 * s.x {
-                break;
-            }
-            var t_next = sphere_exit(p, d, s.x);
-            if i > 1 && abs(f - f_prev) > 1e-12 {
-                let secant = t - f * (t - t_prev) / (f - f_prev);
-                if secant > 0.0 {
-                    t_next = secant;
-                }
-            }
-            t_prev = t;
-            f_prev = f;
-            t = t_next;
-            s = radial_surface(p + d * t);
-            f = length(p + d * t) - s.x;
-        }
-        p += d * t;
-        inside += t;
-        let outward = s.yzw;
+        let exit = find_exit(p, d);
+        p += d * exit.x;
+        inside += exit.x;
+        let outward = exit.yzw;
         let leaving = refract(d, -outward, ior);
         if dot(leaving, leaving) > 0.0 {
             fresnel_transmission *= 1.0 - fresnel_exact(dot(d, outward), ior);

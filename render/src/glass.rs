@@ -7,6 +7,7 @@ use glam::Vec4;
 
 use crate::camera::{EyeParams, Look, Reflection};
 use crate::context::GpuContext;
+use crate::convex;
 use crate::error::Result;
 use crate::memory::{Buffer, Image, upload_texture};
 use crate::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
@@ -174,6 +175,8 @@ pub struct GlassPass {
     globals: Globals,
     /// The object's radial map (two-surface refraction), or one texel.
     _radial_map: Image,
+    /// The facet planes of a convex faceted object (two-surface refraction), or one plane.
+    _planes: Buffer,
 }
 
 impl GlassPass {
@@ -185,40 +188,22 @@ impl GlassPass {
         desc: &SceneDesc,
     ) -> Result<GlassPass> {
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+        let fragment = vk::ShaderStageFlags::FRAGMENT;
+        let (image, sampler) = (
+            vk::DescriptorType::SAMPLED_IMAGE,
+            vk::DescriptorType::SAMPLER,
+        );
         let set_layout = pipeline::set_layout(
             ctx,
             &[
                 (0, vk::DescriptorType::UNIFORM_BUFFER, stages),
-                (
-                    1,
-                    vk::DescriptorType::SAMPLED_IMAGE,
-                    vk::ShaderStageFlags::FRAGMENT,
-                ),
-                (
-                    2,
-                    vk::DescriptorType::SAMPLER,
-                    vk::ShaderStageFlags::FRAGMENT,
-                ),
-                (
-                    3,
-                    vk::DescriptorType::SAMPLED_IMAGE,
-                    vk::ShaderStageFlags::FRAGMENT,
-                ),
-                (
-                    4,
-                    vk::DescriptorType::SAMPLER,
-                    vk::ShaderStageFlags::FRAGMENT,
-                ),
-                (
-                    5,
-                    vk::DescriptorType::SAMPLED_IMAGE,
-                    vk::ShaderStageFlags::FRAGMENT,
-                ),
-                (
-                    6,
-                    vk::DescriptorType::SAMPLED_IMAGE,
-                    vk::ShaderStageFlags::FRAGMENT,
-                ),
+                (1, image, fragment),
+                (2, sampler, fragment),
+                (3, image, fragment),
+                (4, sampler, fragment),
+                (5, image, fragment),
+                (6, image, fragment),
+                (7, vk::DescriptorType::STORAGE_BUFFER, fragment),
             ],
         )?;
         let layout = pipeline::layout(
@@ -254,14 +239,16 @@ impl GlassPass {
             input_rate: vk::VertexInputRate::VERTEX,
         }];
         let (radial_map, radial, ball) = upload_radial_map(ctx, desc)?;
+        let (planes, convex) = upload_facet_planes(ctx, desc, radial)?;
         // Clear glass gets the two-surface pipelines without the absorption's exponentials, a
-        // ball the ones without the radial map's fetch.
-        let model = match (desc.refraction, desc.attenuation.is_clear(), ball) {
+        // ball the ones without the radial map's fetch, a convex faceted object the ones that
+        // leave it through its facet planes.
+        let clear = desc.attenuation.is_clear();
+        let model = match (desc.refraction, ball, convex) {
             (Refraction::Paper, ..) => 0,
-            (Refraction::TwoSurface, true, false) => 1,
-            (Refraction::TwoSurface, false, false) => 2,
-            (Refraction::TwoSurface, true, true) => 3,
-            (Refraction::TwoSurface, false, true) => 4,
+            (Refraction::TwoSurface, true, _) => 4 - usize::from(clear),
+            (Refraction::TwoSurface, false, true) => 6 - usize::from(clear),
+            (Refraction::TwoSurface, false, false) => 2 - usize::from(clear),
         };
         let pipelines = GlassVariant::ALL
             .iter()
@@ -289,6 +276,7 @@ impl GlassPass {
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
                 (vk::DescriptorType::SAMPLED_IMAGE, 4),
                 (vk::DescriptorType::SAMPLER, 2),
+                (vk::DescriptorType::STORAGE_BUFFER, 1),
             ],
         )?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
@@ -350,6 +338,7 @@ impl GlassPass {
         );
         pipeline::write_image(ctx, set, 5, scene.surface.view);
         pipeline::write_image(ctx, set, 6, radial_map.view);
+        pipeline::write_storage_buffer(ctx, set, 7, planes.buffer);
         Ok(GlassPass {
             pipelines,
             layout,
@@ -359,6 +348,7 @@ impl GlassPass {
             globals_buffer,
             globals,
             _radial_map: radial_map,
+            _planes: planes,
         })
     }
 
@@ -531,6 +521,36 @@ fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32;
     Ok((image, radial, ball))
 }
 
+/// Uploads the facet planes of a flat-shaded convex object about the radial map's centre
+/// (`radial`'s xyz) for two-surface refraction, and whether there are any: otherwise one
+/// plane that no pipeline reads.
+fn upload_facet_planes(
+    ctx: &GpuContext,
+    desc: &SceneDesc,
+    radial: [f32; 4],
+) -> Result<(Buffer, bool)> {
+    let m = desc.mesh;
+    let center = glam::Vec3::new(radial[0], radial[1], radial[2]);
+    let planes = (desc.refraction == Refraction::TwoSurface)
+        .then(|| convex::facet_planes(m.positions, m.normals, m.indices, center))
+        .flatten();
+    if let Some(p) = &planes {
+        tracing::debug!(
+            "two-surface refraction: a convex object of {} facet planes",
+            p.len()
+        );
+    }
+    let convex = planes.is_some();
+    let planes = planes.unwrap_or_else(|| vec![Vec4::ZERO]);
+    let buffer = Buffer::with_data(
+        ctx,
+        "facet planes",
+        bytemuck::cast_slice(&planes),
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+    )?;
+    Ok((buffer, convex))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -540,11 +560,12 @@ mod tests {
     fn each_variant_draws_with_the_entry_point_named_for_it() {
         for (position, variant) in GlassVariant::ALL.iter().enumerate() {
             assert_eq!(variant.index(), position);
-            for (model, prefix) in [
-                (0, "fs_paper_"),
-                (1, "fs_two_surface_"),
-                (2, "fs_two_surface_"),
-            ] {
+            for model in 0..shaders::GLASS_FS.len() {
+                let prefix = if model == 0 {
+                    "fs_paper_"
+                } else {
+                    "fs_two_surface_"
+                };
                 let name = shaders::GLASS_FS[model][position].1.to_str().unwrap();
                 let background = if variant.background {
                     "background"

@@ -26,6 +26,7 @@
 pub mod absorption;
 pub mod camera;
 pub mod context;
+pub mod convex;
 pub mod error;
 pub mod floor;
 mod glass;

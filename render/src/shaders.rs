@@ -2,8 +2,37 @@
 
 /// SPIR-V bytes of one entry point, named `<file>.<entry>`.
 macro_rules! spirv {
-    ($name:literal) => {
+    ($name:expr) => {
         include_bytes!(concat!(env!("OUT_DIR"), "/", $name, ".spv"))
+    };
+}
+
+/// The glass pass's four fragment entry points (`glass::GlassVariant::index` order) of one
+/// model, `fs_<model>_*` compiled with the pipeline constants that `<suffix>` names
+/// (build.rs `VARIANTS`).
+macro_rules! glass_row {
+    ($model:literal, $suffix:literal) => {
+        [
+            glass_entry!($model, "environment_fresnel", $suffix),
+            glass_entry!($model, "environment_phong", $suffix),
+            glass_entry!($model, "background_fresnel", $suffix),
+            glass_entry!($model, "background_phong", $suffix),
+        ]
+    };
+}
+
+/// One glass fragment entry point: its SPIR-V and its name.
+macro_rules! glass_entry {
+    ($model:literal, $look:literal, $suffix:literal) => {
+        (
+            spirv!(concat!("glass.fs_", $model, "_", $look, $suffix)),
+            match std::ffi::CStr::from_bytes_with_nul(
+                concat!("fs_", $model, "_", $look, "\0").as_bytes(),
+            ) {
+                Ok(name) => name,
+                Err(_) => panic!("an entry point name without NUL inside"),
+            },
+        )
     };
 }
 
@@ -11,98 +40,17 @@ pub const GLASS_VS: &[u8] = spirv!("glass.vs_main");
 /// The glass pass's fragment entry points: `[model][variant]`, the model paper (0),
 /// two-surface (1), two-surface through absorbing glass (2: compiled with `ABSORBING` set),
 /// two-surface through a ball (3: `BALL`, no radial-map fetch) and through an absorbing ball
-/// (4: both), the variant as `glass::GlassVariant::index` numbers it.
-pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 5] = [
-    [
-        (
-            spirv!("glass.fs_paper_environment_fresnel"),
-            c"fs_paper_environment_fresnel",
-        ),
-        (
-            spirv!("glass.fs_paper_environment_phong"),
-            c"fs_paper_environment_phong",
-        ),
-        (
-            spirv!("glass.fs_paper_background_fresnel"),
-            c"fs_paper_background_fresnel",
-        ),
-        (
-            spirv!("glass.fs_paper_background_phong"),
-            c"fs_paper_background_phong",
-        ),
-    ],
-    [
-        (
-            spirv!("glass.fs_two_surface_environment_fresnel"),
-            c"fs_two_surface_environment_fresnel",
-        ),
-        (
-            spirv!("glass.fs_two_surface_environment_phong"),
-            c"fs_two_surface_environment_phong",
-        ),
-        (
-            spirv!("glass.fs_two_surface_background_fresnel"),
-            c"fs_two_surface_background_fresnel",
-        ),
-        (
-            spirv!("glass.fs_two_surface_background_phong"),
-            c"fs_two_surface_background_phong",
-        ),
-    ],
-    [
-        (
-            spirv!("glass.fs_two_surface_environment_fresnel.absorbing"),
-            c"fs_two_surface_environment_fresnel",
-        ),
-        (
-            spirv!("glass.fs_two_surface_environment_phong.absorbing"),
-            c"fs_two_surface_environment_phong",
-        ),
-        (
-            spirv!("glass.fs_two_surface_background_fresnel.absorbing"),
-            c"fs_two_surface_background_fresnel",
-        ),
-        (
-            spirv!("glass.fs_two_surface_background_phong.absorbing"),
-            c"fs_two_surface_background_phong",
-        ),
-    ],
-    [
-        (
-            spirv!("glass.fs_two_surface_environment_fresnel.ball"),
-            c"fs_two_surface_environment_fresnel",
-        ),
-        (
-            spirv!("glass.fs_two_surface_environment_phong.ball"),
-            c"fs_two_surface_environment_phong",
-        ),
-        (
-            spirv!("glass.fs_two_surface_background_fresnel.ball"),
-            c"fs_two_surface_background_fresnel",
-        ),
-        (
-            spirv!("glass.fs_two_surface_background_phong.ball"),
-            c"fs_two_surface_background_phong",
-        ),
-    ],
-    [
-        (
-            spirv!("glass.fs_two_surface_environment_fresnel.absorbing.ball"),
-            c"fs_two_surface_environment_fresnel",
-        ),
-        (
-            spirv!("glass.fs_two_surface_environment_phong.absorbing.ball"),
-            c"fs_two_surface_environment_phong",
-        ),
-        (
-            spirv!("glass.fs_two_surface_background_fresnel.absorbing.ball"),
-            c"fs_two_surface_background_fresnel",
-        ),
-        (
-            spirv!("glass.fs_two_surface_background_phong.absorbing.ball"),
-            c"fs_two_surface_background_phong",
-        ),
-    ],
+/// (4: both), through a convex faceted object (5: `CONVEX`, the exit from its facet planes)
+/// and through an absorbing one (6: both), the variant as `glass::GlassVariant::index`
+/// numbers it.
+pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 7] = [
+    glass_row!("paper", ""),
+    glass_row!("two_surface", ""),
+    glass_row!("two_surface", ".absorbing"),
+    glass_row!("two_surface", ".ball"),
+    glass_row!("two_surface", ".absorbing.ball"),
+    glass_row!("two_surface", ".convex"),
+    glass_row!("two_surface", ".absorbing.convex"),
 ];
 pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const WORLD_FS: &[u8] = spirv!("world.fs_main");

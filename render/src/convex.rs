@@ -1,0 +1,149 @@
+//! Faceted convex objects (a cut gem): the planes of their facets, so that the glass shader
+//! finds where a ray inside leaves them exactly (shaders/glass.wgsl `convex_exit`), without
+//! the radial map, whose filtered texels round every facet edge over a texel.
+
+use glam::{Vec3, Vec4};
+
+/// Most facet planes a convex object may have for the exact exit (a round brilliant has 73
+/// with its girdle band): each internal reflection tests every plane once.
+pub const MAX_FACET_PLANES: usize = 256;
+
+/// Cosine above which a vertex normal counts as its triangle's face normal (flat shading).
+const FLAT_NORMAL_COS: f32 = 0.9999;
+
+/// The facet planes of a flat-shaded convex mesh, about `center` (model units): per plane,
+/// xyz its outward unit normal and w its distance from `center`. None when the mesh is not
+/// flat-shaded (a vertex normal differs from its triangle's face normal: the shader would
+/// then bend rays by other normals than the planes'), not convex (a vertex lies outside a
+/// facet's plane), degenerate, or has more than [`MAX_FACET_PLANES`] distinct planes.
+///
+/// Triangles of one facet give one plane: planes within 1e-5 in normal and 1e-5 of the
+/// object's size in distance are merged.
+pub fn facet_planes(
+    positions: &[Vec3],
+    normals: &[Vec3],
+    indices: &[u32],
+    center: Vec3,
+) -> Option<Vec<Vec4>> {
+    let size = positions
+        .iter()
+        .map(|&p| (p - center).length())
+        .fold(0.0f32, f32::max);
+    let usable = size.is_finite() && size > 0.0;
+    if !usable || !indices.len().is_multiple_of(3) || indices.is_empty() {
+        return None;
+    }
+    let tolerance = 1e-5 * size;
+    let mut planes: Vec<Vec4> = Vec::new();
+    for tri in indices.chunks_exact(3) {
+        let corner = |k: usize| positions.get(tri[k] as usize).copied();
+        let (a, b, c) = (corner(0)?, corner(1)?, corner(2)?);
+        let cross = (b - a).cross(c - a);
+        if cross.length() <= 1e-12 * size * size {
+            // A sliver adds no surface; its corners are checked against the other planes.
+            continue;
+        }
+        let normal = cross.normalize();
+        let flat = tri.iter().all(|&i| {
+            normals
+                .get(i as usize)
+                .is_some_and(|n| n.normalize_or_zero().dot(normal) >= FLAT_NORMAL_COS)
+        });
+        if !flat {
+            return None;
+        }
+        let plane = normal.extend(normal.dot(a - center));
+        let known = planes
+            .iter()
+            .any(|q| q.truncate().dot(normal) >= 1.0 - 1e-5 && (q.w - plane.w).abs() <= tolerance);
+        if !known {
+            if planes.len() == MAX_FACET_PLANES {
+                return None;
+            }
+            planes.push(plane);
+        }
+    }
+    let inside = |p: Vec3| {
+        planes
+            .iter()
+            .all(|q| q.truncate().dot(p - center) <= q.w + tolerance)
+    };
+    // Convex: every vertex behind every facet's plane; and the centre inside, so that every
+    // plane's distance is positive and a ray from inside leaves through exactly one of them.
+    (!planes.is_empty() && positions.iter().all(|&p| inside(p)) && planes.iter().all(|q| q.w > 0.0))
+        .then_some(planes)
+}
+
+/// Where the ray `p + t d` (from inside, `d` unit) leaves the convex body of `planes`: the
+/// distance t and the outward normal there. The CPU twin of glass.wgsl `convex_exit`.
+pub fn convex_exit(planes: &[Vec4], p: Vec3, d: Vec3) -> Option<(f32, Vec3)> {
+    planes
+        .iter()
+        .filter_map(|q| {
+            let along = q.truncate().dot(d);
+            (along > 1e-7).then(|| (((q.w - q.truncate().dot(p)) / along).max(0.0), q.truncate()))
+        })
+        .min_by(|x, y| x.0.total_cmp(&y.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cube of half-size `h` about the origin, flat-shaded: 24 vertices, 12 triangles.
+    fn cube(h: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
+        let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                let mut n = Vec3::ZERO;
+                n[axis] = sign;
+                let (u, mut v) = n.any_orthonormal_pair();
+                if u.cross(v).dot(n) < 0.0 {
+                    v = -v;
+                }
+                let base = positions.len() as u32;
+                for (su, sv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    positions.push((n + u * su + v * sv) * h);
+                    normals.push(n);
+                }
+                // Counter-clockwise seen from outside (u x v = n).
+                indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+            }
+        }
+        (positions, normals, indices)
+    }
+
+    #[test]
+    fn a_cube_has_six_outward_planes_and_rays_leave_it_where_geometry_says() {
+        let (p, n, i) = cube(0.5);
+        let planes = facet_planes(&p, &n, &i, Vec3::ZERO).expect("a convex faceted cube");
+        assert_eq!(planes.len(), 6);
+        for q in &planes {
+            assert!((q.w - 0.5).abs() < 1e-6, "{q}");
+        }
+        // From the centre along a diagonal-ish direction: leaves through x = 0.5.
+        let d = Vec3::new(1.0, 0.5, 0.25).normalize();
+        let (t, normal) = convex_exit(&planes, Vec3::ZERO, d).unwrap();
+        assert!((t * d.x - 0.5).abs() < 1e-6, "t {t}");
+        assert_eq!(normal, Vec3::X);
+        // From a point on the -y face going up: leaves through +y, 1 away.
+        let (t, normal) = convex_exit(&planes, Vec3::new(0.1, -0.5, 0.2), Vec3::Y).unwrap();
+        assert!((t - 1.0).abs() < 1e-6 && normal == Vec3::Y, "{t} {normal}");
+    }
+
+    #[test]
+    fn smooth_or_concave_meshes_have_no_facet_planes() {
+        let (p, n, i) = cube(0.5);
+        // Smooth normals (pointing from the centre) are not the faces'.
+        let smooth: Vec<Vec3> = p.iter().map(|v| v.normalize()).collect();
+        assert!(facet_planes(&p, &smooth, &i, Vec3::ZERO).is_none());
+        // The -x face pushed in past the centre: the faces around it then reach outside its plane.
+        let mut dented = p.clone();
+        for v in dented.iter_mut().take(4) {
+            v.x = 0.3;
+        }
+        assert!(facet_planes(&dented, &n, &i, Vec3::ZERO).is_none());
+        // No mesh at all.
+        assert!(facet_planes(&[], &[], &[], Vec3::ZERO).is_none());
+    }
+}

@@ -220,7 +220,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                     let model = DefocusModel {
                         pupil_m,
                         pupil_source: crate::gaze::PupilSource::Paper,
-                        ..setup.model
+                        ..setup.model.clone()
                     };
                     variants.push(variant(
                         format!("{set} A_p={:.0}mm", pupil_m * 1000.0),

@@ -63,7 +63,7 @@ impl DefocusSetup {
         // The deepest blur of each image: the other image in focus, at the largest pupil.
         let deepest = DefocusModel {
             pupil_m: PUPIL_MAX_MM / 1000.0,
-            ..model
+            ..model.clone()
         };
         let max_background_k = deepest
             .defocus(GazeImage::Surface)

@@ -28,7 +28,7 @@ use crate::views;
 
 /// The numbers eq. 13-14 need of a scene: where the images lie, pixels per metre of each
 /// image's photo, and the pupil.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct DefocusModel {
     /// Distances of the surface and refracted images from the scene's fixed viewing position,
     /// metres (what the blur stacks are sized for; frames use [`DefocusModel::distances_from`]).
@@ -139,8 +139,8 @@ impl DefocusPlan {
     fn new(config: GazeConfig, model: DefocusModel) -> DefocusPlan {
         DefocusPlan {
             pipeline: GazePipeline::new(config),
-            model,
             pupil: PupilFilter::new(model.pupil_source, model.pupil_m),
+            model,
             last: None,
         }
     }
@@ -172,7 +172,7 @@ impl LookPlanner {
             defocus: self
                 .defocus
                 .as_ref()
-                .map(|d| DefocusPlan::new(*d.pipeline.config(), d.model)),
+                .map(|d| DefocusPlan::new(*d.pipeline.config(), d.model.clone())),
         }
     }
 
@@ -191,10 +191,12 @@ impl LookPlanner {
             .map(|d| d.pipeline.config().override_image)
     }
 
-    /// Moves the object's centre the image distances are measured to (a moving object).
-    pub fn set_object_center(&mut self, center_m: Vec3) {
+    /// Moves the object the image distances are measured to (a moving object): its centre and
+    /// its model-to-world transform.
+    pub fn set_object_pose(&mut self, center_m: Vec3, world_from_model: glam::Mat4) {
         if let Some(d) = &mut self.defocus {
             d.model.geometry.center_m = center_m;
+            d.model.geometry.world_from_model = world_from_model;
         }
     }
 
@@ -305,7 +307,7 @@ pub fn planners_for(
                     let mut config = GazeConfig::new(setup.model.distances);
                     config.filter = gaze.filter.unwrap_or(scene.gaze.filter);
                     config.override_image = gaze.image.unwrap_or(scene.gaze.image);
-                    Some((config, setup.model))
+                    Some((config, setup.model.clone()))
                 }
                 _ => None,
             };

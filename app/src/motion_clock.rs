@@ -236,8 +236,9 @@ impl MotionClock {
     /// with it; `None` for a scene that stands still.
     pub fn pose(&mut self, time_ns: i64, planner: &mut LookPlanner) -> Option<ScenePose> {
         let placement = self.placement(time_ns)?;
-        planner.set_object_center(placement.object_position_m);
-        Some(self.pose_of(&placement))
+        let pose = self.pose_of(&placement);
+        planner.set_object_pose(placement.object_position_m, pose.world_from_model);
+        Some(pose)
     }
 
     /// The renderer's pose for a placement, counted as this frame's.

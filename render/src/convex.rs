@@ -89,29 +89,7 @@ pub fn convex_exit(planes: &[Vec4], p: Vec3, d: Vec3) -> Option<(f32, Vec3)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A cube of half-size `h` about the origin, flat-shaded: 24 vertices, 12 triangles.
-    fn cube(h: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
-        let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
-        for axis in 0..3 {
-            for sign in [-1.0f32, 1.0] {
-                let mut n = Vec3::ZERO;
-                n[axis] = sign;
-                let (u, mut v) = n.any_orthonormal_pair();
-                if u.cross(v).dot(n) < 0.0 {
-                    v = -v;
-                }
-                let base = positions.len() as u32;
-                for (su, sv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                    positions.push((n + u * su + v * sv) * h);
-                    normals.push(n);
-                }
-                // Counter-clockwise seen from outside (u x v = n).
-                indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
-            }
-        }
-        (positions, normals, indices)
-    }
+    use crate::solid::flat_cube as cube;
 
     #[test]
     fn a_cube_has_six_outward_planes_and_rays_leave_it_where_geometry_says() {

@@ -172,7 +172,7 @@ mod tests {
     fn the_radial_map_of_a_cube_keeps_its_flat_faces() {
         // Face normals do not point away from the centre (except at the face centres, which
         // are no vertices): the faces stay flat.
-        let (positions, normals, indices) = crate::solid::tests::cube_of(0.5);
+        let (positions, normals, indices) = crate::solid::flat_cube(0.5);
         let (width, height) = (64, 32);
         let map = radial_map(&positions, &normals, &indices, width, height).unwrap();
         assert!(map.star_shaped);

@@ -281,7 +281,7 @@ pub(crate) mod tests {
 
     /// A cube of side 2 `half` about the origin with flat normals.
     fn cube(half: f32) -> MeshBody {
-        let (p, n, idx) = crate::solid::tests::cube_of(half);
+        let (p, n, idx) = crate::solid::flat_cube(half);
         MeshBody::new(&p, &n, &idx).expect("a closed cube")
     }
 

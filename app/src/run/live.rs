@@ -60,10 +60,11 @@ impl LiveLooks {
         self.conditions[self.current].0
     }
 
-    /// Moves the object's centre the image distances are measured to, for every condition.
-    pub fn set_object_center(&mut self, center_m: glam::Vec3) {
+    /// Moves the object the image distances are measured to (its centre and model-to-world
+    /// transform), for every condition.
+    pub fn set_object_pose(&mut self, center_m: glam::Vec3, world_from_model: glam::Mat4) {
         for (_, planner) in &mut self.conditions {
-            planner.set_object_center(center_m);
+            planner.set_object_pose(center_m, world_from_model);
         }
     }
 

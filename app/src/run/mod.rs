@@ -142,9 +142,11 @@ impl FrameSink for RunSink {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
         self.apply_typed_controls(input);
         let placement = self.motion.placement(input.time_ns)?;
-        self.looks.set_object_center(placement.object_position_m);
+        let pose = self.motion.pose_of(&placement);
+        self.looks
+            .set_object_pose(placement.object_position_m, pose.world_from_model);
         self.object_center_m = placement.object_position_m;
-        Some(self.motion.pose_of(&placement))
+        Some(pose)
     }
 
     fn started(&mut self, input: &FrameInput) -> Result<()> {

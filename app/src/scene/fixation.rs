@@ -7,12 +7,15 @@
 //! their meaning: target [`SURFACE_TARGET`] is the surface point, [`REFRACTED_TARGET`] the
 //! refracted one ([`gaze_image_of_target`]).
 
-use glam::Vec3;
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
 use vitreous_render::Refraction;
-use vitreous_render::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, pass_through};
+use vitreous_render::radial_map::RADIAL_NORMAL_COS;
+use vitreous_render::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, MeshBody, pass_through};
 use vitreous_xr::synth::{FixationTarget, SynthParams};
 
-use super::Scene;
+use super::{Object, Scene};
 use crate::gaze::{GazeImage, ImageDistances};
 
 /// Index of the surface point among the targets of [`synth_params_for`] (fixated first).
@@ -30,6 +33,60 @@ const FALLBACK_REFRACTED_DEPTH_M: f32 = 0.2;
 /// measure its blur on the background photo, whose blur stack must stay small.
 pub const MAX_IMAGE_OVER_BACKGROUND: f32 = 2.0;
 
+/// Largest distance, as a fraction of the bundle's offset from the axis, between the image
+/// point and any ray of the bundle that forms it: beyond it the rays (split between facets, or
+/// by a reflection inside) form no single image.
+const MAX_BUNDLE_SPREAD: f32 = 0.25;
+
+/// The closed mesh of an object that is not a ball (model units), through which the
+/// two-surface refracted image is found by tracing a bundle of rays
+/// ([`ViewingGeometry::points_from`]).
+pub struct MeshLens {
+    /// The mesh tracer of the object, in model units.
+    body: MeshBody,
+}
+
+impl std::fmt::Debug for MeshLens {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("MeshLens")
+    }
+}
+
+impl PartialEq for MeshLens {
+    /// The same lens: one is made per loaded object.
+    fn eq(&self, other: &MeshLens) -> bool {
+        std::ptr::eq(self, other)
+    }
+}
+
+impl MeshLens {
+    /// The lens of `object` under two-surface refraction; None for the paper's refraction, for
+    /// a ball (every vertex at one distance from the centre, within 1e-4, with a normal
+    /// pointing away from it: the thick ball lens stands for it exactly) and for a mesh that
+    /// does not close (which two-surface refraction refuses when the renderer is made).
+    pub fn of(object: &Object) -> Option<Arc<MeshLens>> {
+        if object.refraction != Refraction::TwoSurface {
+            return None;
+        }
+        let m = &object.mesh;
+        let c = object.model_center;
+        let radius = m
+            .positions
+            .iter()
+            .map(|&p| p.distance(c))
+            .fold(0.0, f32::max);
+        let ball = m.positions.iter().zip(&m.normals).all(|(&p, &n)| {
+            (p.distance(c) - radius).abs() <= 1e-4 * radius
+                && n.normalize_or_zero().dot(p - c) > RADIAL_NORMAL_COS * p.distance(c)
+        });
+        if ball {
+            return None;
+        }
+        let body = MeshBody::new(&m.positions, &m.normals, &m.indices).ok()?;
+        Some(Arc::new(MeshLens { body }))
+    }
+}
+
 /// The viewer's head and the two points it fixates, world frame, metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FixationPoints {
@@ -44,7 +101,7 @@ pub struct FixationPoints {
 
 /// What the fixation points depend on besides where the viewer is: the object's centre and
 /// radius and the background plane, in the scene (world) frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ViewingGeometry {
     /// Centre of the object, metres.
     pub center_m: Vec3,
@@ -59,6 +116,12 @@ pub struct ViewingGeometry {
     /// background point converges after the object. `None`: the paper's refraction, where the
     /// refracted image is the background point itself.
     pub two_surface_ior: Option<f32>,
+    /// The object's mesh when it is not a ball (two-surface refraction): the refracted image is
+    /// then found through it, placed by `world_from_model`. None: the bounding ball stands for
+    /// the object.
+    pub lens: Option<Arc<MeshLens>>,
+    /// Model to world of the object now (a similarity), for `lens`.
+    pub world_from_model: Mat4,
 }
 
 impl ViewingGeometry {
@@ -94,33 +157,24 @@ impl ViewingGeometry {
     }
 
     /// Where the light of `source_m` (on the line from `head_m` through the centre) converges
-    /// after passing through both surfaces of the object's bounding ball: the point on that
-    /// line where a paraxial ray from the source crosses it (the thick-lens image). A virtual
-    /// image (rays diverging from a point behind the ball) is where they seem to come from, at
-    /// most [`MAX_IMAGE_OVER_BACKGROUND`] times as far as the source. When the light reaches
-    /// the viewer parallel or still converging (the image at or behind them) there is no image
-    /// to focus on, and the source itself stands for it, as in the paper's model.
+    /// after passing through both surfaces of the object: for a ball, the point on that line
+    /// where a paraxial ray from the source crosses it (the thick-lens image); for another
+    /// mesh, the point nearest to a bundle of paraxial rays from the source traced through it
+    /// ([`ViewingGeometry::mesh_image`]). A virtual image (rays diverging from a point behind
+    /// the object) is where they seem to come from, at most [`MAX_IMAGE_OVER_BACKGROUND`]
+    /// times as far as the source. When the light reaches the viewer parallel or still
+    /// converging (the image at or behind them), or forms no single image, there is nothing to
+    /// focus on, and the source itself stands for it, as in the paper's model.
     fn lens_image(&self, head_m: Vec3, source_m: Vec3, ior: f32) -> Vec3 {
         let axis = (head_m - source_m).normalize_or(Vec3::Z);
         let far_m = head_m.distance(source_m) * MAX_IMAGE_OVER_BACKGROUND;
-        let ball = Ball {
-            center_m: self.center_m,
-            radius_m: self.radius_m,
+        let image = match &self.lens {
+            Some(lens) => self.mesh_image(lens, axis, source_m, ior),
+            None => self.ball_image(axis, source_m, ior),
         };
-        // A ray 1 % of the radius off the axis: paraxial, so the thick-lens image.
-        let side = axis.any_orthonormal_vector();
-        let aim = self.center_m + side * (0.01 * self.radius_m);
-        let dir = (aim - source_m).normalize();
-        let Some(p) = pass_through(&ball, source_m, dir, ior, MAX_INTERNAL_REFLECTIONS) else {
+        let Some(image) = image else {
             return source_m;
         };
-        // Where the exit ray meets the axis: its height above the axis falls to zero.
-        let height = (p.exit_m - self.center_m).dot(side);
-        let climb = p.direction.dot(side);
-        if !p.escaped || climb.abs() < 1e-9 {
-            return source_m;
-        }
-        let image = p.exit_m + p.direction * (-height / climb);
         // Along the axis towards the viewer, from the viewer: positive in front of them.
         let in_front_m = (head_m - image).dot(axis);
         if in_front_m <= 0.0 {
@@ -130,6 +184,80 @@ impl ViewingGeometry {
         } else {
             image
         }
+    }
+
+    /// The thick-lens image of `source_m` through the bounding ball, on the `axis` from the
+    /// source through the centre; None when the light leaves parallel to the axis.
+    fn ball_image(&self, axis: Vec3, source_m: Vec3, ior: f32) -> Option<Vec3> {
+        let ball = Ball {
+            center_m: self.center_m,
+            radius_m: self.radius_m,
+        };
+        // A ray 1 % of the radius off the axis: paraxial, so the thick-lens image.
+        let side = axis.any_orthonormal_vector();
+        let aim = self.center_m + side * (0.01 * self.radius_m);
+        let dir = (aim - source_m).normalize();
+        let p = pass_through(&ball, source_m, dir, ior, MAX_INTERNAL_REFLECTIONS)?;
+        // Where the exit ray meets the axis: its height above the axis falls to zero.
+        let height = (p.exit_m - self.center_m).dot(side);
+        let climb = p.direction.dot(side);
+        if !p.escaped || climb.abs() < 1e-9 {
+            return None;
+        }
+        Some(p.exit_m + p.direction * (-height / climb))
+    }
+
+    /// Where a bundle of four paraxial rays from `source_m`, aimed 1 % of the radius to each
+    /// side of the object's centre, converges after passing through `lens`: the point nearest
+    /// to the four exit rays along their mean ray (least squares). None when a ray stays
+    /// inside or misses the object, when they leave parallel (no finite image), or when they
+    /// pass farther than [`MAX_BUNDLE_SPREAD`] of their offset from that point (no single
+    /// image: a facet edge or a reflection inside splits them).
+    fn mesh_image(&self, lens: &MeshLens, axis: Vec3, source_m: Vec3, ior: f32) -> Option<Vec3> {
+        let offset = 0.01 * self.radius_m;
+        let (u, v) = axis.any_orthonormal_pair();
+        let model_from_world = self.world_from_model.inverse();
+        let mut rays = Vec::with_capacity(4);
+        for side in [u, -u, v, -v] {
+            let dir = (self.center_m + side * offset - source_m).normalize();
+            let p = pass_through(
+                &lens.body,
+                model_from_world.transform_point3(source_m),
+                model_from_world.transform_vector3(dir).normalize(),
+                ior,
+                MAX_INTERNAL_REFLECTIONS,
+            )?;
+            if !p.escaped {
+                return None;
+            }
+            rays.push((
+                self.world_from_model.transform_point3(p.exit_m),
+                self.world_from_model
+                    .transform_vector3(p.direction)
+                    .normalize(),
+            ));
+        }
+        // x(t) = mean exit + t mean direction; minimise the summed squared distances of x(t)
+        // from the rays: |P_i (x - e_i)|^2 with P_i the projection across ray i.
+        let n = rays.len() as f32;
+        let mean_exit = rays.iter().map(|r| r.0).sum::<Vec3>() / n;
+        let mean_dir = (rays.iter().map(|r| r.1).sum::<Vec3>() / n).normalize_or_zero();
+        let across = |d: Vec3, w: Vec3| w - d * w.dot(d);
+        let (mut num, mut den) = (0.0f32, 0.0f32);
+        for &(e, d) in &rays {
+            let a = across(d, mean_dir);
+            num += a.dot(across(d, mean_exit - e));
+            den += a.dot(a);
+        }
+        if den < 1e-12 {
+            return None;
+        }
+        let image = mean_exit - mean_dir * (num / den);
+        let spread = rays
+            .iter()
+            .map(|&(e, d)| across(d, image - e).length())
+            .fold(0.0f32, f32::max);
+        (spread <= MAX_BUNDLE_SPREAD * offset).then_some(image)
     }
 
     /// The distances of the surface and refracted images from a viewer at `head_m`, to the
@@ -151,6 +279,8 @@ impl Scene {
             plane_normal: self.background.normal(),
             two_surface_ior: (self.object.refraction == Refraction::TwoSurface)
                 .then_some(self.object.ior),
+            lens: self.object.lens.clone(),
+            world_from_model: self.object.world_from_model,
         }
     }
 
@@ -226,6 +356,8 @@ mod tests {
             plane_point_m: Vec3::new(0.0, 0.0, background_z_m),
             plane_normal: Vec3::Z,
             two_surface_ior: Some(1.51),
+            lens: None,
+            world_from_model: Mat4::IDENTITY,
         }
     }
 
@@ -252,6 +384,17 @@ mod tests {
         assert!((paper.distances_from(Vec3::ZERO).refracted_m - 1.2).abs() < 1e-5);
     }
 
+    impl ViewingGeometry {
+        /// The same geometry under the paper's refraction.
+        fn paper(self) -> ViewingGeometry {
+            ViewingGeometry {
+                two_surface_ior: None,
+                lens: None,
+                ..self
+            }
+        }
+    }
+
     #[test]
     fn an_image_behind_the_viewer_falls_back_to_the_background_point() {
         // The visual-effects geometry: the image forms 0.25 m in front of the centre, 0.05 m
@@ -261,5 +404,95 @@ mod tests {
         // A virtual image far behind (background just inside the focal length) is capped.
         let d = ball_geometry(-0.3).distances_from(Vec3::ZERO);
         assert!((d.refracted_m - 0.6).abs() < 1e-4, "{d:?}");
+    }
+
+    #[test]
+    fn through_a_glass_slab_the_background_comes_nearer_by_its_thickness_times_1_minus_1_over_n() {
+        // A flat-shaded glass cube 10 cm thick, face on, 0.5 m ahead; the background 1.5 m
+        // ahead. Paraxially a plate of thickness T shows a point behind it T (1 - 1/n) nearer:
+        // a virtual image 1.5 - 0.1 (1 - 1/1.5) = 1.4667 m away.
+        let (positions, normals, indices) = vitreous_render::solid::flat_cube(0.05);
+        let lens = MeshLens {
+            body: MeshBody::new(&positions, &normals, &indices).expect("a closed cube"),
+        };
+        let center = Vec3::new(0.0, 0.0, -0.5);
+        let g = ViewingGeometry {
+            center_m: center,
+            radius_m: 0.05 * 3f32.sqrt(),
+            plane_point_m: Vec3::new(0.0, 0.0, -1.5),
+            plane_normal: Vec3::Z,
+            two_surface_ior: Some(1.5),
+            lens: Some(Arc::new(lens)),
+            world_from_model: Mat4::from_translation(center),
+        };
+        let expected = 1.5 - 0.1 * (1.0 - 1.0 / 1.5);
+        let d = g.distances_from(Vec3::ZERO);
+        assert!(
+            (d.refracted_m - expected).abs() < 1e-4,
+            "{d:?}, expected {expected}"
+        );
+        // Turned a quarter round its vertical axis, the cube is the same slab.
+        let turned = ViewingGeometry {
+            world_from_model: Mat4::from_translation(center)
+                * Mat4::from_rotation_y(std::f32::consts::FRAC_PI_2),
+            ..g.clone()
+        };
+        let d = turned.distances_from(Vec3::ZERO);
+        assert!(
+            (d.refracted_m - expected).abs() < 1e-4,
+            "{d:?}, expected {expected}"
+        );
+        // Seen from 0.3 m to the side, the point behind it on the line through the centre is
+        // still T / cos nearer along that line, less the sideways part: only check it is
+        // nearer than the background point and farther than the cube.
+        let side = Vec3::new(0.3, 0.0, 0.0);
+        let p = g.points_from(side);
+        let background = side.distance(g.clone().paper().points_from(side).refracted_m);
+        let image = side.distance(p.refracted_m);
+        assert!(
+            image < background && image > side.distance(center),
+            "{image} {background}"
+        );
+    }
+
+    #[test]
+    fn a_ball_uses_the_ball_lens_and_a_faceted_object_its_mesh() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes");
+        let mut sphere =
+            crate::scene::load_scene(&root.join("glass-sphere.toml")).expect("shipped scene");
+        let mut diamond =
+            crate::scene::load_scene(&root.join("diamond.toml")).expect("shipped scene");
+        for scene in [&mut sphere, &mut diamond] {
+            scene.object.refraction = Refraction::TwoSurface;
+        }
+        assert!(
+            MeshLens::of(&sphere.object).is_none(),
+            "the sphere is a ball"
+        );
+        assert!(
+            MeshLens::of(&diamond.object).is_some(),
+            "the diamond is not"
+        );
+        diamond.object.lens = MeshLens::of(&diamond.object);
+        eprintln!(
+            "DIAMOND two-surface {:?} paper-bg {:?}",
+            diamond.image_distances(),
+            diamond
+                .viewing_geometry()
+                .paper()
+                .distances_from(diamond.viewer.head_position_m)
+        );
+        for dx in [-0.1f32, -0.05, 0.0, 0.02, 0.05, 0.1] {
+            let h = diamond.viewer.head_position_m + Vec3::new(dx, 0.0, 0.0);
+            eprintln!(
+                "  head dx {dx}: {:?}",
+                diamond.viewing_geometry().distances_from(h)
+            );
+        }
+        diamond.object.refraction = Refraction::Paper;
+        assert!(
+            MeshLens::of(&diamond.object).is_none(),
+            "the paper's model needs none"
+        );
     }
 }

@@ -18,8 +18,8 @@ use super::error::Source;
 use super::file::{DiskFiles, LightFrame, PlaneToml, SceneFile, SceneFiles};
 use super::mesh::VolumeAttenuation;
 use super::{
-    Caustics, CausticsMode, Environment, GazeChoice, Image, Inducer, IorSource, Light, Object,
-    Output, RealPlane, Scene, SceneError, Viewer, euler_xyz_deg,
+    Caustics, CausticsMode, Environment, GazeChoice, Image, Inducer, IorSource, Light, MeshLens,
+    Object, Output, RealPlane, Scene, SceneError, Viewer, euler_xyz_deg,
 };
 use super::{file, image, mesh};
 use crate::effects::EffectSet;
@@ -600,7 +600,7 @@ impl Loader<'_> {
             CLOSED,
         )?;
 
-        Ok(Object {
+        let mut object = Object {
             mesh: model.mesh,
             world_from_model,
             center_m: position,
@@ -615,7 +615,10 @@ impl Loader<'_> {
             surface_texture,
             surface_transmittance,
             model_path,
-        })
+            lens: None,
+        };
+        object.lens = MeshLens::of(&object);
+        Ok(object)
     }
 
     /// The object's absorption: the model's volume attenuation, its distance scaled from model

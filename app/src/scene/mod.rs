@@ -33,8 +33,8 @@ use crate::gaze::{FilterKind, GazeOverride, PupilSource};
 pub use error::{Location, SceneError};
 pub use file::{DiskFiles, SceneFiles};
 pub use fixation::{
-    FixationPoints, REFRACTED_TARGET, SURFACE_TARGET, ViewingGeometry, gaze_image_of_target,
-    synth_params_for,
+    FixationPoints, MeshLens, REFRACTED_TARGET, SURFACE_TARGET, ViewingGeometry,
+    gaze_image_of_target, synth_params_for,
 };
 pub use image::{Image, ImageError, MAX_IMAGE_SIZE_PX, PixelData};
 pub use load::{load_scene, load_scene_from};
@@ -236,6 +236,9 @@ pub struct Object {
     pub surface_transmittance: f32,
     /// The glTF/GLB file.
     pub model_path: PathBuf,
+    /// The mesh through which the two-surface refracted image is found, when the object is
+    /// not a ball ([`MeshLens::of`]).
+    pub lens: Option<std::sync::Arc<MeshLens>>,
 }
 
 impl Object {

@@ -434,8 +434,10 @@ struct DryRunSink<'a> {
 impl FrameSink for DryRunSink<'_> {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
         let placement = self.motion.placement(input.time_ns)?;
-        self.looks.set_object_center(placement.object_position_m);
-        Some(self.motion.pose_of(&placement))
+        let pose = self.motion.pose_of(&placement);
+        self.looks
+            .set_object_pose(placement.object_position_m, pose.world_from_model);
+        Some(pose)
     }
 
     fn plan(&mut self, input: &FrameInput) -> FramePlan {

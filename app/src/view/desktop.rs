@@ -523,6 +523,8 @@ mod tests {
             plane_point_m: Vec3::new(0.0, 0.0, -0.4),
             plane_normal: Vec3::Z,
             two_surface_ior: None,
+            lens: None,
+            world_from_model: glam::Mat4::IDENTITY,
         }
     }
 

@@ -87,12 +87,12 @@ impl Looks {
             .iter()
             .map(|c| {
                 c.map(|set| {
-                    let defocus = match (set.defocus, self.model) {
+                    let defocus = match (set.defocus, &self.model) {
                         (true, Some(model)) => {
                             let mut config = GazeConfig::new(model.distances);
                             config.filter = self.filter;
                             config.override_image = self.gaze;
-                            Some((config, model))
+                            Some((config, model.clone()))
                         }
                         _ => None,
                     };
@@ -114,10 +114,11 @@ impl Looks {
             .expect("the current condition has a planner")
     }
 
-    /// Moves the object's centre the image distances are measured to, for every condition.
-    pub fn set_object_center(&mut self, center_m: glam::Vec3) {
+    /// Moves the object the image distances are measured to (its centre and model-to-world
+    /// transform), for every condition.
+    pub fn set_object_pose(&mut self, center_m: glam::Vec3, world_from_model: glam::Mat4) {
         for planner in self.planners.iter_mut().flatten() {
-            planner.set_object_center(center_m);
+            planner.set_object_pose(center_m, world_from_model);
         }
     }
 

@@ -111,7 +111,7 @@ impl ViewSink {
         let looks = Looks::new(
             loaded.effects,
             loaded.caustics_loaded,
-            loaded.setup.as_ref().map(|s| s.model),
+            loaded.setup.as_ref().map(|s| s.model.clone()),
             options.reflection,
             filter.unwrap_or(loaded.scene.gaze.filter),
             gaze,
@@ -190,7 +190,7 @@ impl ViewSink {
         self.looks = Looks::new(
             start,
             loaded.caustics_loaded,
-            loaded.setup.as_ref().map(|s| s.model),
+            loaded.setup.as_ref().map(|s| s.model.clone()),
             reflection,
             filter,
             gaze,
@@ -479,7 +479,7 @@ impl FrameSink for ViewSink {
             self.status = Some(status);
         }
         let (center_m, pose) = self.edits.pose(input)?;
-        self.looks.set_object_center(center_m);
+        self.looks.set_object_pose(center_m, pose.world_from_model);
         self.shared.borrow_mut().object_center_m = Some(center_m);
         Some(pose)
     }

@@ -290,38 +290,38 @@ fn union(parent: &mut [u32], a: u32, b: u32) {
     }
 }
 
+/// A cube of side 2 `half` about the origin with flat normals: 24 vertices, 12 triangles,
+/// 6 patches (positions, normals, indices). The tests' reference solid: closed, convex, and
+/// with paths through it known in closed form.
+pub fn flat_cube(half: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
+    let mut p = Vec::new();
+    let mut n = Vec::new();
+    let mut idx = Vec::new();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut normal = Vec3::ZERO;
+            normal[axis] = sign;
+            let u =
+                Vec3::from_array([0, 1, 2].map(|k| if k == (axis + 1) % 3 { 1.0 } else { 0.0 }));
+            let v = normal.cross(u);
+            let base = p.len() as u32;
+            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                p.push(half * (normal + a * u + b * v));
+                n.push(normal);
+            }
+            idx.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+    }
+    (p, n, idx)
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
 
-    /// A cube of side 2 `half` about the origin with flat normals: 24 vertices, 12
-    /// triangles, 6 patches (positions, normals, indices; also the two-surface tests' cube).
-    pub(crate) fn cube_of(half: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
-        let mut p = Vec::new();
-        let mut n = Vec::new();
-        let mut idx = Vec::new();
-        for axis in 0..3 {
-            for sign in [-1.0f32, 1.0] {
-                let mut normal = Vec3::ZERO;
-                normal[axis] = sign;
-                let u = Vec3::from_array(
-                    [0, 1, 2].map(|k| if k == (axis + 1) % 3 { 1.0 } else { 0.0 }),
-                );
-                let v = normal.cross(u);
-                let base = p.len() as u32;
-                for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                    p.push(half * (normal + a * u + b * v));
-                    n.push(normal);
-                }
-                idx.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
-            }
-        }
-        (p, n, idx)
-    }
-
     /// The unit cube.
     fn cube() -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
-        cube_of(0.5)
+        flat_cube(0.5)
     }
 
     #[test]

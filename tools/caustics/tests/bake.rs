@@ -290,25 +290,8 @@ fn every_unit_of_flux_is_accounted_for() {
 
 /// A flat-shaded cube, `size_m` across, centred at `center_m`.
 fn cube(center_m: Vec3, size_m: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
-    let mut p = Vec::new();
-    let mut n = Vec::new();
-    let mut idx = Vec::new();
-    for axis in 0..3 {
-        for sign in [-1.0f32, 1.0] {
-            let mut normal = Vec3::ZERO;
-            normal[axis] = sign;
-            let mut u = Vec3::ZERO;
-            u[(axis + 1) % 3] = 1.0;
-            let v = normal.cross(u);
-            let base = p.len() as u32;
-            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                p.push(center_m + 0.5 * size_m * (normal + a * u + b * v));
-                n.push(normal);
-            }
-            idx.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
-        }
-    }
-    (p, n, idx)
+    let (p, n, idx) = vitreous_render::solid::flat_cube(0.5 * size_m);
+    (p.into_iter().map(|v| v + center_m).collect(), n, idx)
 }
 
 // ---------------------------------------------------------------------------------------

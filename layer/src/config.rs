@@ -7,6 +7,7 @@
 //! - `VITREOUS_SIM_BLEND`: comma list of `additive`, `alpha_blend` (default both, in that
 //!   order; `none` for none): the blend modes listed before the runtime's own.
 //! - `VITREOUS_SIM_SUBMITTED`: a CSV file that gets one line per submitted frame.
+//! - `VITREOUS_SIM_BUTTONS`: a script of controller button presses (`crate::controller`).
 
 use std::ffi::CStr;
 use std::fmt;
@@ -22,6 +23,8 @@ pub const GAZE_VAR: &str = "VITREOUS_SIM_GAZE";
 pub const BLEND_VAR: &str = "VITREOUS_SIM_BLEND";
 /// Environment variable naming the submitted-frames CSV.
 pub const SUBMITTED_VAR: &str = "VITREOUS_SIM_SUBMITTED";
+/// Environment variable naming the controller button script.
+pub const BUTTONS_VAR: &str = "VITREOUS_SIM_BUTTONS";
 
 /// An eye-tracking extension the layer can provide.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -103,6 +106,8 @@ pub struct Config {
     pub trace: Option<PathBuf>,
     /// The submitted-frames CSV.
     pub submitted: Option<PathBuf>,
+    /// The controller button script.
+    pub buttons: Option<PathBuf>,
 }
 
 impl Config {
@@ -120,6 +125,7 @@ impl Config {
             blend: parse_blend(get(BLEND_VAR).as_deref())?,
             trace: get(TRACE_VAR).map(PathBuf::from),
             submitted: get(SUBMITTED_VAR).map(PathBuf::from),
+            buttons: get(BUTTONS_VAR).map(PathBuf::from),
         })
     }
 

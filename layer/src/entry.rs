@@ -1,7 +1,7 @@
 //! The loader interface: `xrNegotiateLoaderApiLayerInterface` (the library's one exported
 //! symbol), `xrCreateApiLayerInstance` and the layer's `xrGetInstanceProcAddr`.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::{Arc, Mutex};
@@ -11,7 +11,8 @@ use vitreous_xr::openxr::ml_eye_tracker as ml;
 
 use crate::bindings::{self, GazePaths};
 use crate::calls;
-use crate::config::{Config, GazeExtension, TRACE_VAR};
+use crate::config::{BUTTONS_VAR, Config, GazeExtension, TRACE_VAR};
+use crate::controller::{ButtonScript, Buttons, HANDS};
 use crate::extensions;
 use crate::next::NextTable;
 use crate::registry::{InstanceState, registry};
@@ -104,6 +105,8 @@ struct Prepared {
     timeline: Option<GazeTimeline>,
     /// The submitted-frames CSV.
     submitted: Option<SubmittedLog>,
+    /// The controller button script.
+    buttons: Option<ButtonScript>,
 }
 
 /// Reads the configuration, the trace and opens the CSV.
@@ -134,10 +137,22 @@ fn prepare() -> Result<Prepared, String> {
             )
         })?),
     };
+    let buttons = match &config.buttons {
+        None => None,
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| format!("{BUTTONS_VAR}: reading {}: {e}", path.display()))?;
+            Some(
+                ButtonScript::parse(&text)
+                    .map_err(|e| format!("{BUTTONS_VAR}: {}: {e}", path.display()))?,
+            )
+        }
+    };
     Ok(Prepared {
         config,
         timeline,
         submitted,
+        buttons,
     })
 }
 
@@ -237,6 +252,16 @@ unsafe extern "system" fn create_api_layer_instance(
         } else {
             None
         };
+        let buttons = match prepared.buttons.map(|s| buttons(&next, created, s)) {
+            None => None,
+            Some(Ok(b)) => Some(Arc::new(b)),
+            Some(Err(message)) => {
+                report(message);
+                // SAFETY: `created` is live and not used afterwards.
+                unsafe { (next.destroy_instance)(created) };
+                return sys::Result::ERROR_INITIALIZATION_FAILED;
+            }
+        };
         let state = InstanceState {
             next: Arc::new(next),
             config: Arc::new(prepared.config),
@@ -245,6 +270,8 @@ unsafe extern "system" fn create_api_layer_instance(
             gaze_paths,
             gaze_actions: HashSet::new(),
             submitted: prepared.submitted.map(|s| Arc::new(Mutex::new(s))),
+            buttons,
+            button_actions: HashMap::new(),
         };
         registry()
             .instances
@@ -268,21 +295,50 @@ unsafe fn lookup_destroy(
     f.map(|f| unsafe { std::mem::transmute::<pfn::VoidFunction, pfn::DestroyInstance>(f) })
 }
 
+/// `s` as a path of `instance`.
+fn string_to_path(
+    next: &NextTable,
+    instance: sys::Instance,
+    s: &CStr,
+) -> Result<sys::Path, sys::Result> {
+    let mut p = sys::Path::NULL;
+    // SAFETY: `instance` is live; `s` is NUL-terminated; `p` is writable.
+    let r = unsafe { (next.string_to_path)(instance, s.as_ptr(), &mut p) };
+    if r == sys::Result::SUCCESS {
+        Ok(p)
+    } else {
+        Err(r)
+    }
+}
+
 /// The eye-gaze profile's paths in a new instance.
 fn gaze_paths(next: &NextTable, instance: sys::Instance) -> Result<GazePaths, sys::Result> {
-    let path = |s: &CStr| {
-        let mut p = sys::Path::NULL;
-        // SAFETY: `instance` is live; `s` is NUL-terminated; `p` is writable.
-        let r = unsafe { (next.string_to_path)(instance, s.as_ptr(), &mut p) };
-        if r == sys::Result::SUCCESS {
-            Ok(p)
-        } else {
-            Err(r)
-        }
-    };
     Ok(GazePaths {
-        profile: path(bindings::PROFILE)?,
-        pose: path(bindings::POSE)?,
+        profile: string_to_path(next, instance, bindings::PROFILE)?,
+        pose: string_to_path(next, instance, bindings::POSE)?,
+    })
+}
+
+/// The button script's paths in a new instance.
+fn buttons(
+    next: &NextTable,
+    instance: sys::Instance,
+    script: ButtonScript,
+) -> Result<Buttons, String> {
+    let path = |s: &str| {
+        let c = std::ffi::CString::new(s).map_err(|_| format!("{BUTTONS_VAR}: a NUL in {s:?}"))?;
+        string_to_path(next, instance, &c)
+            .map_err(|r| format!("{BUTTONS_VAR}: xrStringToPath({s:?}) failed: {r:?}"))
+    };
+    Ok(Buttons {
+        profile: path(&script.profile)?,
+        inputs: script
+            .inputs
+            .iter()
+            .map(|s| path(s))
+            .collect::<Result<_, _>>()?,
+        hands: [path(HANDS[0])?, path(HANDS[1])?],
+        script,
     })
 }
 
@@ -359,6 +415,17 @@ fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::VoidF
         b"xrDestroySpace" => (
             None,
             entry!(calls::session::destroy_space, pfn::DestroySpace),
+        ),
+        b"xrSyncActions" => (
+            None,
+            entry!(calls::controller::sync_actions, pfn::SyncActions),
+        ),
+        b"xrGetActionStateBoolean" => (
+            None,
+            entry!(
+                calls::controller::get_action_state_boolean,
+                pfn::GetActionStateBoolean
+            ),
         ),
         b"xrGetActionStatePose" => (
             None,

@@ -16,6 +16,7 @@ pub mod bindings;
 pub mod blend;
 pub mod calls;
 pub mod config;
+pub mod controller;
 pub mod entry;
 pub mod extensions;
 pub mod eye_geometry;

@@ -40,6 +40,10 @@ pub struct NextTable {
     pub suggest_interaction_profile_bindings: pfn::SuggestInteractionProfileBindings,
     /// `xrGetActionStatePose`.
     pub get_action_state_pose: pfn::GetActionStatePose,
+    /// `xrGetActionStateBoolean`.
+    pub get_action_state_boolean: pfn::GetActionStateBoolean,
+    /// `xrSyncActions`.
+    pub sync_actions: pfn::SyncActions,
 }
 
 /// Looks up one function through `gipa`.
@@ -131,6 +135,13 @@ impl NextTable {
                 c"xrGetActionStatePose",
                 pfn::GetActionStatePose
             ),
+            get_action_state_boolean: load!(
+                gipa,
+                instance,
+                c"xrGetActionStateBoolean",
+                pfn::GetActionStateBoolean
+            ),
+            sync_actions: load!(gipa, instance, c"xrSyncActions", pfn::SyncActions),
         })
     }
 

@@ -10,6 +10,7 @@ use vitreous_xr::Pose;
 
 use crate::bindings::GazePaths;
 use crate::config::{Config, GazeExtension};
+use crate::controller::Buttons;
 use crate::next::NextTable;
 use crate::submitted::SubmittedLog;
 use crate::timeline::GazeTimeline;
@@ -30,6 +31,10 @@ pub struct InstanceState {
     pub gaze_actions: HashSet<u64>,
     /// The submitted-frames CSV.
     pub submitted: Option<Arc<Mutex<SubmittedLog>>>,
+    /// The simulated controller buttons (`VITREOUS_SIM_BUTTONS`).
+    pub buttons: Option<Arc<Buttons>>,
+    /// Actions bound to scripted inputs: the inputs of each (indices into the script's).
+    pub button_actions: HashMap<u64, Vec<usize>>,
 }
 
 impl InstanceState {
@@ -54,6 +59,8 @@ pub struct SessionState {
     pub latest_display_ns: Option<i64>,
     /// How many frames the app has ended.
     pub frames_ended: u64,
+    /// The newest predicted display time at the last two `xrSyncActions` (older, newer).
+    pub syncs_ns: (Option<i64>, Option<i64>),
     /// The runtime's blend modes for the session's view configuration (known after
     /// `xrBeginSession`).
     pub runtime_blend: Option<Vec<sys::EnvironmentBlendMode>>,

@@ -73,6 +73,13 @@ impl RunSink {
             }
             Command::Rotate(a) => {
                 let action = format!("register-turn{:+.1}", a.to_degrees());
+                // An edit like the others, as the replay of its line counts it.
+                self.motion.edit_count += 1;
+                tracing::info!(
+                    "frame {}: turn the world {:+.1} deg about the head",
+                    input.index,
+                    a.to_degrees()
+                );
                 let record = self.motion.edits().record(input.time_ns, action);
                 self.record(&record);
             }

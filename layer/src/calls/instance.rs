@@ -175,10 +175,10 @@ pub unsafe extern "system" fn suggest_interaction_profile_bindings(
     suggested: *const sys::InteractionProfileSuggestedBinding,
 ) -> sys::Result {
     guard("xrSuggestInteractionProfileBindings", || {
-        let Some((next, paths)) = registry()
+        let Some((next, paths, buttons)) = registry()
             .instances
             .get(&instance.into_raw())
-            .map(|i| (i.next.clone(), i.gaze_paths))
+            .map(|i| (i.next.clone(), i.gaze_paths, i.buttons.clone()))
         else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
@@ -186,9 +186,9 @@ pub unsafe extern "system" fn suggest_interaction_profile_bindings(
             // SAFETY: the next layer's function with the app's arguments.
             unsafe { (next.suggest_interaction_profile_bindings)(instance, suggested) }
         };
-        let Some(paths) = paths else {
+        if paths.is_none() && buttons.is_none() {
             return forward();
-        };
+        }
         // SAFETY: the app's structure, null or valid.
         let Some(s) = (unsafe { suggested.as_ref() }) else {
             return sys::Result::ERROR_VALIDATION_FAILURE;
@@ -203,6 +203,22 @@ pub unsafe extern "system" fn suggest_interaction_profile_bindings(
                     s.count_suggested_bindings as usize,
                 )
             }
+        };
+        // Scripted inputs: their actions are answered by the layer; the suggestion still goes
+        // on, so the runtime knows the actions.
+        if let Some(b) = &buttons {
+            let bound = b.bound(s.interaction_profile, list);
+            if let Some(i) = registry().instances.get_mut(&instance.into_raw()) {
+                for (action, input) in bound {
+                    i.button_actions
+                        .entry(action.into_raw())
+                        .or_default()
+                        .push(input);
+                }
+            }
+        }
+        let Some(paths) = paths else {
+            return forward();
         };
         match bindings::plan(&paths, s.interaction_profile, list) {
             Plan::Forward => forward(),

@@ -4,6 +4,7 @@
 //! Every entry point runs its body in [`guard`](crate::entry::guard), takes what it needs
 //! from the registry under the lock, and calls down the chain without it.
 
+pub mod controller;
 pub mod fb;
 pub mod instance;
 pub mod ml;

@@ -59,6 +59,7 @@ pub unsafe extern "system" fn create_session(
                 first_display_ns: None,
                 latest_display_ns: None,
                 frames_ended: 0,
+                syncs_ns: (None, None),
                 runtime_blend: None,
             },
         );

@@ -251,7 +251,7 @@ fn sharpness_by_gaze(scene: &Scene) -> Vec<(GazeImage, f64)> {
         ..GazeConfig::new(setup.model.distances)
     };
     let mut sink = Keep {
-        planner: LookPlanner::new(look, Some((config, setup.model))),
+        planner: LookPlanner::new(look, Some((config, setup.model.clone()))),
         frames: frames.clone(),
         kept: Vec::new(),
         images: Default::default(),

@@ -3,9 +3,13 @@
 // the cone from the light around the object, traces it through the mesh (Snell refraction,
 // exact Fresnel weights, both branches followed) and adds its share of the relative gain G to
 // the four floor texels around where it lands; a photon that meets the object also takes its
-// straight continuation away (the shadow, E_blocked). `cs_resolve` turns the fixed-point sums
-// into G = max(0, sum) (gains below MIN_GAIN become 0, as in the bake) and bounds the
-// non-zero texels, so that the overlay covers only them once the map is known.
+// straight continuation away (the shadow, E_blocked). `cs_resolve` turns the fixed-point
+// sums into G = max(0, sum) per texel, as the bake stores it, and `cs_smooth_rows` and
+// `cs_smooth_columns` smooth G with a truncated Gaussian, one axis each (density estimation: a
+// lone photon's share spreads over the kernel, as a beam's does in the bake); the second also
+// zeroes gains below MIN_GAIN (as in the bake) and bounds the non-zero texels, so that the
+// overlay covers only them once the map is known. Without smoothing the kernel is the single
+// centre texel.
 //
 // Geometry is traced in the object's model space (the mesh never moves there); a uniform grid
 // of triangle lists, built once on the CPU, finds the surfaces.
@@ -30,7 +34,8 @@ struct Params {
     grid_origin: vec4<f32>,
     // xyz: cells along each axis; w: photons along each side of the emission grid.
     grid_dims: vec4<u32>,
-    // x, y: the gain map's width and height, texels; z: most interactions on one path.
+    // x, y: the gain map's width and height, texels; z: most interactions on one path;
+    // w: the smoothing kernel's radius, texels (0: no smoothing).
     map: vec4<u32>,
     // x: self-intersection offset, model units; y: fixed-point units per unit of G;
     // z: paths below this weight end; w: gains below this are stored as 0.
@@ -53,6 +58,11 @@ struct Params {
 // The box of the non-zero gains: smallest x, smallest y, largest x, largest y (texels; the
 // CPU sets it to an empty box before each computation).
 @group(0) @binding(8) var<storage, read_write> bounds: array<atomic<u32>, 4>;
+// The clamped gains smoothed along rows only (between the two smoothing passes).
+@group(0) @binding(9) var<storage, read_write> rows: array<f32>;
+// The smoothing kernel's weights from the centre out (radius + 1 of them; [1.0] without
+// smoothing), normalised so that the whole kernel sums to 1 along each axis.
+@group(0) @binding(10) var<storage, read> weights: array<f32>;
 
 const NONE: u32 = 0xffffffffu;
 const PI: f32 = 3.14159265358979;
@@ -340,9 +350,52 @@ fn cs_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let index = id.y * p.map.x + id.x;
-    let g = max(f32(atomicLoad(&sums[index])) / p.misc.y, 0.0);
-    let kept = g >= p.misc.w;
-    gain[index] = select(0.0, g, kept);
+    gain[index] = max(f32(atomicLoad(&sums[index])) / p.misc.y, 0.0);
+}
+
+// Along rows: the kernel over the clamped gains (texels beyond the map's edge count as 0:
+// their light is lost, as off the floor).
+@compute @workgroup_size(8, 8, 1)
+fn cs_smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    let width = p.map.x;
+    if id.x >= width || id.y >= p.map.y {
+        return;
+    }
+    let row = id.y * width;
+    var sum = weights[0] * gain[row + id.x];
+    for (var k = 1u; k <= p.map.w; k++) {
+        var pair = 0.0;
+        if k <= id.x {
+            pair = gain[row + id.x - k];
+        }
+        if id.x + k < width {
+            pair += gain[row + id.x + k];
+        }
+        sum += weights[k] * pair;
+    }
+    rows[row + id.x] = sum;
+}
+
+// Along columns; then gains below MIN_GAIN become 0 and the non-zero texels are bounded.
+@compute @workgroup_size(8, 8, 1)
+fn cs_smooth_columns(@builtin(global_invocation_id) id: vec3<u32>) {
+    let width = p.map.x;
+    if id.x >= width || id.y >= p.map.y {
+        return;
+    }
+    var sum = weights[0] * rows[id.y * width + id.x];
+    for (var k = 1u; k <= p.map.w; k++) {
+        var pair = 0.0;
+        if k <= id.y {
+            pair = rows[(id.y - k) * width + id.x];
+        }
+        if id.y + k < p.map.y {
+            pair += rows[(id.y + k) * width + id.x];
+        }
+        sum += weights[k] * pair;
+    }
+    let kept = sum >= p.misc.w;
+    gain[id.y * width + id.x] = select(0.0, sum, kept);
     if kept {
         atomicMin(&bounds[0], id.x);
         atomicMin(&bounds[1], id.y);

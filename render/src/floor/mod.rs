@@ -70,7 +70,7 @@ pub use crate::scene::{
 pub(crate) use fields::Stamps;
 pub use fields::{FIELD_STAMPS, FieldPassesMs, InducerFields};
 pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
-pub use live::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE};
+pub use live::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE, MAX_SMOOTHING_PX};
 pub(crate) use pass::InducerPass;
 pub(crate) use progress::Prepared;
 pub use reference::{

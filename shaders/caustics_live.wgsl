@@ -3,13 +3,13 @@
 // the cone from the light around the object, traces it through the mesh (Snell refraction,
 // exact Fresnel weights, both branches followed) and adds its share of the relative gain G to
 // the four floor texels around where it lands; a photon that meets the object also takes its
-// straight continuation away (the shadow, E_blocked). `cs_resolve` turns the fixed-point
-// sums into G = max(0, sum) per texel, as the bake stores it, and `cs_smooth_rows` and
-// `cs_smooth_columns` smooth G with a truncated Gaussian, one axis each (density estimation: a
-// lone photon's share spreads over the kernel, as a beam's does in the bake); the second also
-// zeroes gains below MIN_GAIN (as in the bake) and bounds the non-zero texels, so that the
-// overlay covers only them once the map is known. Without smoothing the kernel is the single
-// centre texel.
+// straight continuation away (the shadow, E_blocked). `cs_smooth` then takes G = max(0, sum)
+// per texel, as the bake stores it, and smooths it (density estimation: a lone photon's share
+// spreads over the kernel, as a beam's does in the bake) with a box filter run three times
+// along the rows and three times along the columns, one dispatch each; the last one zeroes
+// gains below MIN_GAIN (as in the bake) and bounds the non-zero texels, so that the overlay
+// covers only them once the map is known. Without smoothing a single dispatch of a one-texel
+// box does only the latter.
 //
 // Geometry is traced in the object's model space (the mesh never moves there); a uniform grid
 // of triangle lists, built once on the CPU, finds the surfaces.
@@ -35,7 +35,7 @@ struct Params {
     // xyz: cells along each axis; w: photons along each side of the emission grid.
     grid_dims: vec4<u32>,
     // x, y: the gain map's width and height, texels; z: most interactions on one path;
-    // w: the smoothing kernel's radius, texels (0: no smoothing).
+    // w: the smoothing box's radius, texels (0: no smoothing).
     map: vec4<u32>,
     // x: self-intersection offset, model units; y: fixed-point units per unit of G;
     // z: paths below this weight end; w: gains below this are stored as 0.
@@ -58,11 +58,8 @@ struct Params {
 // The box of the non-zero gains: smallest x, smallest y, largest x, largest y (texels; the
 // CPU sets it to an empty box before each computation).
 @group(0) @binding(8) var<storage, read_write> bounds: array<atomic<u32>, 4>;
-// The clamped gains smoothed along rows only (between the two smoothing passes).
-@group(0) @binding(9) var<storage, read_write> rows: array<f32>;
-// The smoothing kernel's weights from the centre out (radius + 1 of them; [1.0] without
-// smoothing), normalised so that the whole kernel sums to 1 along each axis.
-@group(0) @binding(10) var<storage, read> weights: array<f32>;
+// Two maps of fixed-point gains, one after the other, between the smoothing steps.
+@group(0) @binding(9) var<storage, read_write> scratch: array<u32>;
 
 const NONE: u32 = 0xffffffffu;
 const PI: f32 = 3.14159265358979;
@@ -344,62 +341,87 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn cs_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= p.map.x || id.y >= p.map.y {
-        return;
+// Which smoothing step a dispatch runs (`smooth_steps` in live.rs): bits 0-7 the step, 0-2
+// along rows and 3-5 along columns (the box applied for the first, second and third time);
+// bit 8 set on the last step, which writes the gain map.
+struct SmoothStep {
+    bits: u32,
+};
+var<push_constant> smooth_step: SmoothStep;
+
+const LAST_STEP: u32 = 0x100u;
+
+// Input of `step` at texel `index`, fixed point: the clamped sums (G = max(0, sum), as the bake
+// stores it) for the first step, else what the step before wrote.
+fn step_input(step: u32, index: u32) -> u32 {
+    if step == 0u {
+        return u32(max(atomicLoad(&sums[index]), 0));
     }
-    let index = id.y * p.map.x + id.x;
-    gain[index] = max(f32(atomicLoad(&sums[index])) / p.misc.y, 0.0);
+    return scratch[((step - 1u) % 2u) * p.map.x * p.map.y + index];
 }
 
-// Along rows: the kernel over the clamped gains (texels beyond the map's edge count as 0:
-// their light is lost, as off the floor).
-@compute @workgroup_size(8, 8, 1)
-fn cs_smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+// One box pass of the smoothing, one line (a row or a column) per invocation: each texel
+// becomes the mean of the 2 radius + 1 texels around it on its line (texels beyond the map's
+// edge count as 0: their light is lost, as off the floor), from a running sum kept exactly in
+// 64 bits (low and high words), so that nothing drifts along the line. The last step also
+// zeroes gains below MIN_GAIN and bounds the non-zero texels.
+@compute @workgroup_size(64, 1, 1)
+fn cs_smooth(@builtin(global_invocation_id) id: vec3<u32>) {
+    let step = smooth_step.bits & 0xffu;
+    let last = (smooth_step.bits & LAST_STEP) != 0u;
+    let columns = step >= 3u;
     let width = p.map.x;
-    if id.x >= width || id.y >= p.map.y {
+    let lines = select(p.map.y, width, columns);
+    let length = select(width, p.map.y, columns);
+    if id.x >= lines {
         return;
     }
-    let row = id.y * width;
-    var sum = weights[0] * gain[row + id.x];
-    for (var k = 1u; k <= p.map.w; k++) {
-        var pair = 0.0;
-        if k <= id.x {
-            pair = gain[row + id.x - k];
-        }
-        if id.x + k < width {
-            pair += gain[row + id.x + k];
-        }
-        sum += weights[k] * pair;
+    let stride = select(1u, width, columns);
+    let start = select(id.x * width, id.x, columns);
+    let radius = p.map.w;
+    let scale = 1.0 / f32(2u * radius + 1u);
+    let destination = (step % 2u) * width * p.map.y;
+    var low = 0u;
+    var high = 0u;
+    for (var j = 0u; j < min(radius, length); j++) {
+        let v = step_input(step, start + j * stride);
+        low += v;
+        high += select(0u, 1u, low < v);
     }
-    rows[row + id.x] = sum;
-}
-
-// Along columns; then gains below MIN_GAIN become 0 and the non-zero texels are bounded.
-@compute @workgroup_size(8, 8, 1)
-fn cs_smooth_columns(@builtin(global_invocation_id) id: vec3<u32>) {
-    let width = p.map.x;
-    if id.x >= width || id.y >= p.map.y {
-        return;
-    }
-    var sum = weights[0] * rows[id.y * width + id.x];
-    for (var k = 1u; k <= p.map.w; k++) {
-        var pair = 0.0;
-        if k <= id.y {
-            pair = rows[(id.y - k) * width + id.x];
+    var first = NONE;
+    var final_texel = 0u;
+    for (var i = 0u; i < length; i++) {
+        if i + radius < length {
+            let v = step_input(step, start + (i + radius) * stride);
+            low += v;
+            high += select(0u, 1u, low < v);
         }
-        if id.y + k < p.map.y {
-            pair += rows[(id.y + k) * width + id.x];
+        let mean = (f32(high) * 4294967296.0 + f32(low)) * scale;
+        let index = start + i * stride;
+        if last {
+            let g = mean / p.misc.y;
+            let kept = g >= p.misc.w;
+            gain[index] = select(0.0, g, kept);
+            if kept {
+                first = min(first, i);
+                final_texel = i;
+            }
+        } else {
+            scratch[destination + index] = u32(round(mean));
         }
-        sum += weights[k] * pair;
+        if i >= radius {
+            let v = step_input(step, start + (i - radius) * stride);
+            high -= select(0u, 1u, low < v);
+            low -= v;
+        }
     }
-    let kept = sum >= p.misc.w;
-    gain[id.y * width + id.x] = select(0.0, sum, kept);
-    if kept {
-        atomicMin(&bounds[0], id.x);
-        atomicMin(&bounds[1], id.y);
-        atomicMax(&bounds[2], id.x);
-        atomicMax(&bounds[3], id.y);
+    if first != NONE {
+        // Along the line from `first` to `final_texel`; across it, the line itself.
+        let lo = select(vec2<u32>(first, id.x), vec2<u32>(id.x, first), columns);
+        let hi = select(vec2<u32>(final_texel, id.x), vec2<u32>(id.x, final_texel), columns);
+        atomicMin(&bounds[0], lo.x);
+        atomicMin(&bounds[1], lo.y);
+        atomicMax(&bounds[2], hi.x);
+        atomicMax(&bounds[3], hi.y);
     }
 }

@@ -360,12 +360,11 @@ impl Loader<'_> {
                 live_default.photons_per_side,
                 1..=MAX_PHOTONS_PER_SIDE,
             )?,
-            smoothing_px: self.number(
+            smoothing_px: self.count(
                 "caustics.smoothing_px",
                 raw.caustics.smoothing_px.as_ref(),
                 live_default.smoothing_px,
-                (0.0, MAX_SMOOTHING_PX),
-                CLOSED,
+                0..=MAX_SMOOTHING_PX,
             )?,
         };
         let gaze = GazeChoice {

@@ -1,6 +1,6 @@
 //! Caustics computed on the GPU for each pose of the object and the light (docs/caustics.md,
-//! eq. 6): photon splatting, then a separable Gaussian smoothing, in four compute passes
-//! (shaders/caustics_live.wgsl) into the caustic gain map the overlay combines, in place of a
+//! eq. 6): photon splatting, then a smoothing by a box filter run three times along each
+//! axis, in compute passes (shaders/caustics_live.wgsl) into the caustic gain map the overlay combines, in place of a
 //! bake. Recorded with the inducer's fields, so only on frames after a move; timed as the floor's `live caustics` stage
 //! ([`super::FieldPassesMs`]) and in wall-clock time.
 
@@ -18,56 +18,52 @@ use crate::scene::MeshRef;
 use crate::shaders;
 
 /// How caustics are computed live.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LiveCausticsDesc {
     /// Photons along each side of the emission grid (its square is the photon count).
     pub photons_per_side: u32,
     /// Most reflections and refractions on one light path (the bake's default: 12).
     pub max_interactions: u32,
-    /// Standard deviation of the Gaussian the map is smoothed with, texels of the map (0: not
-    /// smoothed); the kernel is cut at [`smoothing_radius_px`].
-    pub smoothing_px: f32,
+    /// Radius of the box the map is smoothed with, texels of the map (0: not smoothed): each
+    /// texel becomes the mean of the 2 r + 1 texels around it, three times along the rows,
+    /// then three times along the columns, a kernel close to a Gaussian of standard deviation
+    /// sqrt(r (r + 1)) texels, 6r + 1 texels wide.
+    pub smoothing_px: u32,
 }
 
 impl Default for LiveCausticsDesc {
-    /// 128 x 128 photons, 12 interactions, smoothed with a Gaussian of 6 texels (at the
-    /// bakes' 1980 x 1980, the glass sphere's map within 1.6 % of its bake and the diamond's
-    /// within 2.5 %, both bakes smoothed alike; docs/caustics.md).
+    /// 128 x 128 photons, 12 interactions, a smoothing box of radius 5 texels (at the bakes'
+    /// 1980 x 1980, the glass sphere's map within 1.5 % of its bake and the diamond's within
+    /// 2.7 %, both bakes smoothed alike; docs/caustics.md).
     fn default() -> LiveCausticsDesc {
         LiveCausticsDesc {
             photons_per_side: 128,
             max_interactions: 12,
-            smoothing_px: 6.0,
+            smoothing_px: 5,
         }
     }
 }
 
 /// Largest photon grid side accepted.
 pub const MAX_PHOTONS_PER_SIDE: u32 = 4096;
-/// Largest smoothing standard deviation accepted, texels.
-pub const MAX_SMOOTHING_PX: f32 = 64.0;
+/// Largest smoothing box radius accepted, texels.
+pub const MAX_SMOOTHING_PX: u32 = 64;
+/// Invocations per workgroup of the smoothing (`cs_smooth`), one line each.
+const SMOOTH_GROUP: u32 = 64;
+/// Flag of the last smoothing step (`LAST_STEP` in caustics_live.wgsl).
+const LAST_STEP: u32 = 0x100;
 
-/// Radius at which the smoothing kernel of standard deviation `sigma_px` is cut, texels:
-/// ceil(3 sigma) (0 without smoothing).
-pub(crate) fn smoothing_radius_px(sigma_px: f32) -> u32 {
-    (3.0 * sigma_px).ceil().max(0.0) as u32
+/// The push constants of the smoothing's dispatches, in order, for a box of `radius` texels:
+/// the box three times along the rows (steps 0-2), three times along the columns (3-5), the
+/// last flagged; a single step without smoothing (step 0, which only clamps, zeroes and
+/// bounds).
+fn smooth_steps(radius: u32) -> Vec<u32> {
+    let count = if radius == 0 { 1 } else { 6 };
+    (0..count)
+        .map(|k| if k + 1 == count { k | LAST_STEP } else { k })
+        .collect()
 }
 
-/// The smoothing kernel along one axis, from the centre out (radius + 1 weights): a Gaussian of
-/// standard deviation `sigma_px` texels cut at [`smoothing_radius_px`] and normalised so that
-/// the whole cut kernel sums to 1; `[1.0]` without smoothing.
-fn smoothing_weights(sigma_px: f32) -> Vec<f32> {
-    let radius = smoothing_radius_px(sigma_px);
-    if radius == 0 {
-        return vec![1.0];
-    }
-    let two_var = 2.0 * f64::from(sigma_px).powi(2);
-    let half: Vec<f64> = (0..=radius)
-        .map(|k| (-f64::from(k * k) / two_var).exp())
-        .collect();
-    let total = 2.0 * half.iter().sum::<f64>() - half[0];
-    half.iter().map(|w| (w / total) as f32).collect()
-}
 /// Fixed-point units per unit of gain in the sums (integer atomics keep the result the same
 /// whatever order photons land in).
 const FIXED_POINT: f32 = 65536.0;
@@ -172,13 +168,9 @@ impl Grid {
 pub(crate) struct LiveCaustics {
     /// Photon tracing and splatting.
     trace: Owned<vk::Pipeline>,
-    /// Fixed point to gain.
-    resolve: Owned<vk::Pipeline>,
-    /// Smoothed along rows.
-    smooth_rows: Owned<vk::Pipeline>,
-    /// Smoothed along columns, clamped and bounded.
-    smooth_columns: Owned<vk::Pipeline>,
-    /// Layout of all four (one set, no push constants).
+    /// One step of the smoothing (which also clamps, zeroes small gains and bounds).
+    smooth: Owned<vk::Pipeline>,
+    /// Layout of both (one set; the smoothing step as push constant).
     layout: Owned<vk::PipelineLayout>,
     /// Pool of the set.
     _pool: Owned<vk::DescriptorPool>,
@@ -190,12 +182,10 @@ pub(crate) struct LiveCaustics {
     params: Buffer,
     /// Mesh and grid buffers, read by the trace pass.
     _mesh: [Buffer; 5],
-    /// The smoothing kernel's weights, centre out.
-    _weights: Buffer,
     /// Fixed-point sums per texel.
     sums: Buffer,
-    /// The signed gains smoothed along rows only.
-    _rows: Buffer,
+    /// Two fixed-point maps between the smoothing steps.
+    _scratch: Buffer,
     /// The resolved gain map, host-visible (for tests).
     gain: Buffer,
     /// The box of the non-zero gains (`[x0, y0, x1, y1]`, ends included; empty when
@@ -234,7 +224,7 @@ impl LiveCaustics {
     ) -> Result<LiveCaustics> {
         if !(1..=MAX_PHOTONS_PER_SIDE).contains(&desc.photons_per_side)
             || desc.max_interactions == 0
-            || !(0.0..=MAX_SMOOTHING_PX).contains(&desc.smoothing_px)
+            || desc.smoothing_px > MAX_SMOOTHING_PX
         {
             return Err(RenderError::InvalidInput(format!(
                 "live caustics need 1..={MAX_PHOTONS_PER_SIDE} photons per side, at least \
@@ -304,16 +294,10 @@ impl LiveCaustics {
             storage | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuOnly,
         )?;
-        let weights = Buffer::with_data(
+        let scratch = Buffer::new(
             ctx,
-            "caustics smoothing weights",
-            bytemuck::cast_slice(&smoothing_weights(desc.smoothing_px)),
-            storage,
-        )?;
-        let rows = Buffer::new(
-            ctx,
-            "caustics rows",
-            texels * 4,
+            "caustics smoothing",
+            2 * texels * 4,
             storage,
             MemoryLocation::GpuOnly,
         )?;
@@ -340,47 +324,25 @@ impl LiveCaustics {
         )?;
         let compute = vk::ShaderStageFlags::COMPUTE;
         let mut bindings = vec![(0, vk::DescriptorType::UNIFORM_BUFFER, compute)];
-        bindings.extend((1..=10).map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute)));
+        bindings.extend((1..=9).map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute)));
         let set_layout = pipeline::set_layout(ctx, &bindings)?;
-        // A 4-byte push range the shaders never read keeps the shared layout helper.
+        // The smoothing step; the trace pass reads none.
         let layout = pipeline::layout(ctx, Some(set_layout.raw()), compute, 4)?;
         let trace = pipeline::compute(ctx, layout.raw(), shaders::CAUSTICS_TRACE_CS, c"cs_trace")?;
-        let resolve = pipeline::compute(
-            ctx,
-            layout.raw(),
-            shaders::CAUSTICS_RESOLVE_CS,
-            c"cs_resolve",
-        )?;
-        let smooth_rows = pipeline::compute(
-            ctx,
-            layout.raw(),
-            shaders::CAUSTICS_SMOOTH_ROWS_CS,
-            c"cs_smooth_rows",
-        )?;
-        let smooth_columns = pipeline::compute(
-            ctx,
-            layout.raw(),
-            shaders::CAUSTICS_SMOOTH_COLUMNS_CS,
-            c"cs_smooth_columns",
-        )?;
+        let smooth =
+            pipeline::compute(ctx, layout.raw(), shaders::CAUSTICS_SMOOTH_CS, c"cs_smooth")?;
         let pool = pipeline::pool(
             ctx,
             1,
             &[
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
-                (vk::DescriptorType::STORAGE_BUFFER, 10),
+                (vk::DescriptorType::STORAGE_BUFFER, 9),
             ],
         )?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
         buffers.extend(mesh_buffers.iter().map(|b| b.buffer));
-        buffers.extend([
-            sums.buffer,
-            gain.buffer,
-            bounds.buffer,
-            rows.buffer,
-            weights.buffer,
-        ]);
+        buffers.extend([sums.buffer, gain.buffer, bounds.buffer, scratch.buffer]);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|&buffer| {
@@ -411,18 +373,15 @@ impl LiveCaustics {
         unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
         Ok(LiveCaustics {
             trace,
-            resolve,
-            smooth_rows,
-            smooth_columns,
+            smooth,
             layout,
             _pool: pool,
             _set_layout: set_layout,
             set,
             params,
             _mesh: mesh_buffers,
-            _weights: weights,
             sums,
-            _rows: rows,
+            _scratch: scratch,
             gain,
             bounds,
             size,
@@ -468,7 +427,6 @@ impl LiveCaustics {
             .length();
         let texel_area = floor_area / (self.size[0] as f32 * self.size[1] as f32);
         let [gx, gy, gz] = self.grid_dims;
-        let radius = smoothing_radius_px(self.desc.smoothing_px);
         Params {
             model_from_world: m.inverse().to_cols_array(),
             world_from_model: m.to_cols_array(),
@@ -484,7 +442,7 @@ impl LiveCaustics {
                 self.size[0],
                 self.size[1],
                 self.desc.max_interactions,
-                radius,
+                self.desc.smoothing_px,
             ],
             misc: Vec4::new(self.model_radius * 2e-5, FIXED_POINT, MIN_WEIGHT, MIN_GAIN).to_array(),
         }
@@ -568,30 +526,33 @@ impl LiveCaustics {
             d.cmd_bind_descriptor_sets(cmd, bind, self.layout.raw(), 0, &[self.set], &[]);
             let n = self.desc.photons_per_side;
             let [w, h] = self.size;
-            let passes = [
-                (&self.trace, n, n),
-                (&self.resolve, w, h),
-                (&self.smooth_rows, w, h),
-                (&self.smooth_columns, w, h),
-            ];
-            for (i, (pass, x, y)) in passes.into_iter().enumerate() {
-                if i > 0 {
-                    // Each pass reads what the one before wrote.
-                    d.cmd_pipeline_barrier(
-                        cmd,
-                        compute,
-                        compute,
-                        vk::DependencyFlags::empty(),
-                        &memory(
-                            vk::AccessFlags::SHADER_WRITE,
-                            vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
-                        ),
-                        &[],
-                        &[],
-                    );
-                }
-                d.cmd_bind_pipeline(cmd, bind, pass.raw());
-                d.cmd_dispatch(cmd, groups(x), groups(y), 1);
+            d.cmd_bind_pipeline(cmd, bind, self.trace.raw());
+            d.cmd_dispatch(cmd, groups(n), groups(n), 1);
+            d.cmd_bind_pipeline(cmd, bind, self.smooth.raw());
+            for step in smooth_steps(self.desc.smoothing_px) {
+                // Each step reads what the one before wrote (the first, the photons' sums).
+                d.cmd_pipeline_barrier(
+                    cmd,
+                    compute,
+                    compute,
+                    vk::DependencyFlags::empty(),
+                    &memory(
+                        vk::AccessFlags::SHADER_WRITE,
+                        vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+                    ),
+                    &[],
+                    &[],
+                );
+                let columns = step & 0xff >= 3;
+                let lines = if columns { w } else { h };
+                d.cmd_push_constants(
+                    cmd,
+                    self.layout.raw(),
+                    vk::ShaderStageFlags::COMPUTE,
+                    0,
+                    &step.to_le_bytes(),
+                );
+                d.cmd_dispatch(cmd, lines.div_ceil(SMOOTH_GROUP), 1, 1);
             }
             d.cmd_pipeline_barrier(
                 cmd,
@@ -664,18 +625,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn smoothing_weights_are_a_normalised_gaussian_cut_at_three_sigma() {
-        assert_eq!(smoothing_weights(0.0), vec![1.0]);
-        let sigma = 2.5f32;
-        let w = smoothing_weights(sigma);
-        assert_eq!(w.len(), 9, "ceil(7.5) + 1 weights");
-        let total: f32 = w[0] + 2.0 * w[1..].iter().sum::<f32>();
-        assert!((total - 1.0).abs() < 1e-6, "{total}");
-        for (k, pair) in w.windows(2).enumerate() {
-            let ratio = f64::from(pair[1] / pair[0]);
-            let expected = (-(2.0 * k as f64 + 1.0) / (2.0 * f64::from(sigma).powi(2))).exp();
-            assert!((ratio - expected).abs() < 1e-5, "{k}: {ratio} {expected}");
-        }
+    fn smoothing_runs_six_box_steps_or_one_without_a_box() {
+        assert_eq!(smooth_steps(0), vec![LAST_STEP]);
+        assert_eq!(smooth_steps(5), vec![0, 1, 2, 3, 4, 5 | LAST_STEP]);
     }
 
     #[test]

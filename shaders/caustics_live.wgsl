@@ -6,7 +6,7 @@
 // straight continuation away (the shadow, E_blocked). `cs_smooth` then takes G = max(0, sum)
 // per texel, as the bake stores it, and smooths it (density estimation: a lone photon's share
 // spreads over the kernel, as a beam's does in the bake) with a box filter run three times
-// along the rows and three times along the columns, one dispatch each; the last one zeroes
+// along the rows, then three times along the columns, one dispatch each way; the last zeroes
 // gains below MIN_GAIN (as in the bake) and bounds the non-zero texels, so that the overlay
 // covers only them once the map is known. Without smoothing a single dispatch of a one-texel
 // box does only the latter.
@@ -58,7 +58,7 @@ struct Params {
 // The box of the non-zero gains: smallest x, smallest y, largest x, largest y (texels; the
 // CPU sets it to an empty box before each computation).
 @group(0) @binding(8) var<storage, read_write> bounds: array<atomic<u32>, 4>;
-// Two maps of fixed-point gains, one after the other, between the smoothing steps.
+// The fixed-point gains smoothed along the rows (between the two smoothing passes).
 @group(0) @binding(9) var<storage, read_write> scratch: array<u32>;
 
 const NONE: u32 = 0xffffffffu;
@@ -341,35 +341,52 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// Which smoothing step a dispatch runs (`smooth_steps` in live.rs): bits 0-7 the step, 0-2
-// along rows and 3-5 along columns (the box applied for the first, second and third time);
-// bit 8 set on the last step, which writes the gain map.
+// Which smoothing pass a dispatch runs (`smooth_steps` in live.rs): bit 0 clear along the
+// rows (reading the photons' sums), set along the columns (reading the rows' result); bit 8
+// set on the last pass, which writes the gain map.
 struct SmoothStep {
     bits: u32,
 };
 var<push_constant> smooth_step: SmoothStep;
 
 const LAST_STEP: u32 = 0x100u;
+// Most texels in one box: 2 x 64 + 1 (`MAX_SMOOTHING_PX` in live.rs).
+const MAX_BOX: u32 = 129u;
 
-// Input of `step` at texel `index`, fixed point: the clamped sums (G = max(0, sum), as the bake
-// stores it) for the first step, else what the step before wrote.
-fn step_input(step: u32, index: u32) -> u32 {
-    if step == 0u {
-        return u32(max(atomicLoad(&sums[index]), 0));
-    }
-    return scratch[((step - 1u) % 2u) * p.map.x * p.map.y + index];
+// A box mean over a stream of texels: the last 2 radius + 1 inputs and their sum, exactly in
+// 64 bits (low and high words), so that nothing drifts along a line.
+struct RunningBox {
+    ring: array<u32, MAX_BOX>,
+    low: u32,
+    high: u32,
+    count: u32,
+};
+
+// Feeds the next input `v` of the stream to `b` (the inputs before the first count as 0);
+// returns the mean of the 2 radius + 1 inputs centred `radius` inputs back.
+fn box_feed(b: ptr<function, RunningBox>, v: u32, radius: u32) -> f32 {
+    let span = 2u * radius + 1u;
+    let slot = (*b).count % span;
+    let old = (*b).ring[slot];
+    (*b).ring[slot] = v;
+    (*b).count += 1u;
+    (*b).low += v;
+    (*b).high += select(0u, 1u, (*b).low < v);
+    (*b).high -= select(0u, 1u, (*b).low < old);
+    (*b).low -= old;
+    return (f32((*b).high) * 4294967296.0 + f32((*b).low)) / f32(span);
 }
 
-// One box pass of the smoothing, one line (a row or a column) per invocation: each texel
-// becomes the mean of the 2 radius + 1 texels around it on its line (texels beyond the map's
-// edge count as 0: their light is lost, as off the floor), from a running sum kept exactly in
-// 64 bits (low and high words), so that nothing drifts along the line. The last step also
-// zeroes gains below MIN_GAIN and bounds the non-zero texels.
+// The smoothing along one line (a row or a column) per invocation: the box of 2 radius + 1
+// texels three times over, streamed (each box's means feed the next, rounded to fixed point,
+// and texels beyond the map's edge count as 0 at every box: their light is lost, as off the
+// floor). Along the rows it reads G = max(0, sum) of the photons' sums (eq. 6's clamp, per
+// texel as the bake stores it). The last pass also zeroes gains below MIN_GAIN and bounds
+// the non-zero texels.
 @compute @workgroup_size(64, 1, 1)
 fn cs_smooth(@builtin(global_invocation_id) id: vec3<u32>) {
-    let step = smooth_step.bits & 0xffu;
+    let columns = (smooth_step.bits & 1u) != 0u;
     let last = (smooth_step.bits & LAST_STEP) != 0u;
-    let columns = step >= 3u;
     let width = p.map.x;
     let lines = select(p.map.y, width, columns);
     let length = select(width, p.map.y, columns);
@@ -379,40 +396,49 @@ fn cs_smooth(@builtin(global_invocation_id) id: vec3<u32>) {
     let stride = select(1u, width, columns);
     let start = select(id.x * width, id.x, columns);
     let radius = p.map.w;
-    let scale = 1.0 / f32(2u * radius + 1u);
-    let destination = (step % 2u) * width * p.map.y;
-    var low = 0u;
-    var high = 0u;
-    for (var j = 0u; j < min(radius, length); j++) {
-        let v = step_input(step, start + j * stride);
-        low += v;
-        high += select(0u, 1u, low < v);
-    }
+    var box1: RunningBox;
+    var box2: RunningBox;
+    var box3: RunningBox;
     var first = NONE;
     var final_texel = 0u;
-    for (var i = 0u; i < length; i++) {
-        if i + radius < length {
-            let v = step_input(step, start + (i + radius) * stride);
-            low += v;
-            high += select(0u, 1u, low < v);
+    // Texel n of the line enters the first box; each box's mean for a texel comes out radius
+    // inputs after the texel entered it, so the third's for texel i at input i + 3 radius.
+    for (var n = 0u; n < length + 3u * radius; n++) {
+        var v = 0u;
+        if n < length {
+            let index = start + n * stride;
+            if columns {
+                v = scratch[index];
+            } else {
+                v = u32(max(atomicLoad(&sums[index]), 0));
+            }
         }
-        let mean = (f32(high) * 4294967296.0 + f32(low)) * scale;
-        let index = start + i * stride;
+        let mean1 = box_feed(&box1, v, radius);
+        if n < radius {
+            continue;
+        }
+        let at1 = n - radius;
+        let mean2 = box_feed(&box2, select(0u, u32(round(mean1)), at1 < length), radius);
+        if at1 < radius {
+            continue;
+        }
+        let at2 = at1 - radius;
+        let mean = box_feed(&box3, select(0u, u32(round(mean2)), at2 < length), radius);
+        if at2 < radius {
+            continue;
+        }
+        let at = at2 - radius;
+        let index = start + at * stride;
         if last {
             let g = mean / p.misc.y;
             let kept = g >= p.misc.w;
             gain[index] = select(0.0, g, kept);
             if kept {
-                first = min(first, i);
-                final_texel = i;
+                first = min(first, at);
+                final_texel = at;
             }
         } else {
-            scratch[destination + index] = u32(round(mean));
-        }
-        if i >= radius {
-            let v = step_input(step, start + (i - radius) * stride);
-            high -= select(0u, 1u, low < v);
-            low -= v;
+            scratch[index] = u32(round(mean));
         }
     }
     if first != NONE {

@@ -54,14 +54,14 @@ const SMOOTH_GROUP: u32 = 64;
 const LAST_STEP: u32 = 0x100;
 
 /// The push constants of the smoothing's dispatches, in order, for a box of `radius` texels:
-/// the box three times along the rows (steps 0-2), three times along the columns (3-5), the
-/// last flagged; a single step without smoothing (step 0, which only clamps, zeroes and
-/// bounds).
+/// along the rows (0), then along the columns (1), the last flagged; only along the rows
+/// without smoothing (where the three boxes of one texel only clamp, zero and bound).
 fn smooth_steps(radius: u32) -> Vec<u32> {
-    let count = if radius == 0 { 1 } else { 6 };
-    (0..count)
-        .map(|k| if k + 1 == count { k | LAST_STEP } else { k })
-        .collect()
+    if radius == 0 {
+        vec![LAST_STEP]
+    } else {
+        vec![0, 1 | LAST_STEP]
+    }
 }
 
 /// Fixed-point units per unit of gain in the sums (integer atomics keep the result the same
@@ -184,7 +184,7 @@ pub(crate) struct LiveCaustics {
     _mesh: [Buffer; 5],
     /// Fixed-point sums per texel.
     sums: Buffer,
-    /// Two fixed-point maps between the smoothing steps.
+    /// The fixed-point map smoothed along the rows.
     _scratch: Buffer,
     /// The resolved gain map, host-visible (for tests).
     gain: Buffer,
@@ -297,7 +297,7 @@ impl LiveCaustics {
         let scratch = Buffer::new(
             ctx,
             "caustics smoothing",
-            2 * texels * 4,
+            texels * 4,
             storage,
             MemoryLocation::GpuOnly,
         )?;
@@ -543,7 +543,7 @@ impl LiveCaustics {
                     &[],
                     &[],
                 );
-                let columns = step & 0xff >= 3;
+                let columns = step & 1 != 0;
                 let lines = if columns { w } else { h };
                 d.cmd_push_constants(
                     cmd,
@@ -625,9 +625,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn smoothing_runs_six_box_steps_or_one_without_a_box() {
+    fn smoothing_runs_along_rows_then_columns_or_rows_alone_without_a_box() {
         assert_eq!(smooth_steps(0), vec![LAST_STEP]);
-        assert_eq!(smooth_steps(5), vec![0, 1, 2, 3, 4, 5 | LAST_STEP]);
+        assert_eq!(smooth_steps(5), vec![0, 1 | LAST_STEP]);
     }
 
     #[test]

@@ -53,7 +53,7 @@ struct Params {
 @group(0) @binding(5) var<storage, read> cell_tris: array<u32>;
 // Fixed-point sums of G per texel (row 0 at the photo's top).
 @group(0) @binding(6) var<storage, read_write> sums: array<atomic<i32>>;
-// The resolved gain map.
+// The smoothed gain map.
 @group(0) @binding(7) var<storage, read_write> gain: array<f32>;
 // The box of the non-zero gains: smallest x, smallest y, largest x, largest y (texels; the
 // CPU sets it to an empty box before each computation).

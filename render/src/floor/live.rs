@@ -1,8 +1,9 @@
 //! Caustics computed on the GPU for each pose of the object and the light (docs/caustics.md,
 //! eq. 6): photon splatting, then a smoothing by a box filter run three times along each
-//! axis, in compute passes (shaders/caustics_live.wgsl) into the caustic gain map the overlay combines, in place of a
-//! bake. Recorded with the inducer's fields, so only on frames after a move; timed as the floor's `live caustics` stage
-//! ([`super::FieldPassesMs`]) and in wall-clock time.
+//! axis, in compute passes (shaders/caustics_live.wgsl) into the caustic gain map the overlay
+//! combines, in place of a bake. Recorded with the inducer's fields, so only on frames after
+//! a move; timed as the floor's `live caustics` stage ([`super::FieldPassesMs`]) and in
+//! wall-clock time.
 
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
@@ -168,7 +169,8 @@ impl Grid {
 pub(crate) struct LiveCaustics {
     /// Photon tracing and splatting.
     trace: Owned<vk::Pipeline>,
-    /// One step of the smoothing (which also clamps, zeroes small gains and bounds).
+    /// One pass of the smoothing (the first also clamps, the last zeroes small gains and
+    /// bounds).
     smooth: Owned<vk::Pipeline>,
     /// Layout of both (one set; the smoothing step as push constant).
     layout: Owned<vk::PipelineLayout>,
@@ -186,7 +188,7 @@ pub(crate) struct LiveCaustics {
     sums: Buffer,
     /// The fixed-point map smoothed along the rows.
     _scratch: Buffer,
-    /// The resolved gain map, host-visible (for tests).
+    /// The smoothed gain map, host-visible (for tests).
     gain: Buffer,
     /// The box of the non-zero gains (`[x0, y0, x1, y1]`, ends included; empty when
     /// x0 > x1), host-visible.
@@ -530,7 +532,7 @@ impl LiveCaustics {
             d.cmd_dispatch(cmd, groups(n), groups(n), 1);
             d.cmd_bind_pipeline(cmd, bind, self.smooth.raw());
             for step in smooth_steps(self.desc.smoothing_px) {
-                // Each step reads what the one before wrote (the first, the photons' sums).
+                // Each pass reads what the one before wrote (the first, the photons' sums).
                 d.cmd_pipeline_barrier(
                     cmd,
                     compute,

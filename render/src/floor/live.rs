@@ -68,6 +68,10 @@ fn smooth_steps(radius: u32) -> Vec<u32> {
 /// Fixed-point units per unit of gain in the sums (integer atomics keep the result the same
 /// whatever order photons land in).
 const FIXED_POINT: f32 = 65536.0;
+/// Grid cells per triangle of the mesh: smaller cells hold fewer triangles to test, more
+/// cells take more steps; on the glass sphere (9024 triangles) 4 cut the `live caustics`
+/// stage by about 7 % against 1 (155-156 ms against 164-172 ms on lavapipe; 8 as 4).
+const CELLS_PER_TRIANGLE: f32 = 4.0;
 /// Paths below this weight end (as in the bake).
 const MIN_WEIGHT: f32 = 1e-4;
 /// Gains below this are stored as 0 (the bake's `MIN_GAIN`).
@@ -108,8 +112,8 @@ pub(crate) struct Grid {
 }
 
 impl Grid {
-    /// About one cell per triangle, cubic cells over the bounding box, every triangle listed
-    /// in each cell its bounding box overlaps.
+    /// About [`CELLS_PER_TRIANGLE`] cells per triangle, cubic cells over the bounding box,
+    /// every triangle listed in each cell its bounding box overlaps.
     pub fn new(positions: &[Vec3], indices: &[u32]) -> Grid {
         let lo = positions.iter().copied().fold(Vec3::INFINITY, Vec3::min);
         let hi = positions
@@ -118,7 +122,7 @@ impl Grid {
             .fold(Vec3::NEG_INFINITY, Vec3::max);
         let extent = (hi - lo).max(Vec3::splat(1e-6));
         let count = (indices.len() / 3).max(1) as f32;
-        let per_axis = count.cbrt().ceil().clamp(1.0, 64.0);
+        let per_axis = (count * CELLS_PER_TRIANGLE).cbrt().ceil().clamp(1.0, 64.0);
         let side = extent.max_element() / per_axis;
         let pad = Vec3::splat(side * 1e-3);
         let origin = lo - pad;
@@ -642,8 +646,9 @@ mod tests {
         ];
         let indices = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
         let grid = Grid::new(&positions, &indices);
-        // Two cells per side over the unit box, grown by a hair for the padding.
-        assert_eq!(grid.dims, [3, 3, 3]);
+        // Three cells per side over the unit box (cbrt(4 x 4) rounded up), grown by a hair
+        // for the padding.
+        assert_eq!(grid.dims, [4, 4, 4]);
         // Each triangle appears at least once, the one facing the origin's corner in all
         // cells its box touches.
         for t in 0..4u32 {

@@ -3,9 +3,13 @@
 // the cone from the light around the object, traces it through the mesh (Snell refraction,
 // exact Fresnel weights, both branches followed) and adds its share of the relative gain G to
 // the four floor texels around where it lands; a photon that meets the object also takes its
-// straight continuation away (the shadow, E_blocked). `cs_resolve` turns the fixed-point sums
-// into G = max(0, sum) (gains below MIN_GAIN become 0, as in the bake) and bounds the
-// non-zero texels, so that the overlay covers only them once the map is known.
+// straight continuation away (the shadow, E_blocked). `cs_smooth` then takes G = max(0, sum)
+// per texel, as the bake stores it, and smooths it (density estimation: a lone photon's share
+// spreads over the kernel, as a beam's does in the bake) with a box filter run three times
+// along the rows, then three times along the columns, one dispatch each way; the last zeroes
+// gains below MIN_GAIN (as in the bake) and bounds the non-zero texels, so that the overlay
+// covers only them once the map is known. Without smoothing a single dispatch of a one-texel
+// box does only the latter.
 //
 // Geometry is traced in the object's model space (the mesh never moves there); a uniform grid
 // of triangle lists, built once on the CPU, finds the surfaces.
@@ -30,7 +34,8 @@ struct Params {
     grid_origin: vec4<f32>,
     // xyz: cells along each axis; w: photons along each side of the emission grid.
     grid_dims: vec4<u32>,
-    // x, y: the gain map's width and height, texels; z: most interactions on one path.
+    // x, y: the gain map's width and height, texels; z: most interactions on one path;
+    // w: the smoothing box's radius, texels (0: no smoothing).
     map: vec4<u32>,
     // x: self-intersection offset, model units; y: fixed-point units per unit of G;
     // z: paths below this weight end; w: gains below this are stored as 0.
@@ -48,11 +53,13 @@ struct Params {
 @group(0) @binding(5) var<storage, read> cell_tris: array<u32>;
 // Fixed-point sums of G per texel (row 0 at the photo's top).
 @group(0) @binding(6) var<storage, read_write> sums: array<atomic<i32>>;
-// The resolved gain map.
+// The smoothed gain map.
 @group(0) @binding(7) var<storage, read_write> gain: array<f32>;
 // The box of the non-zero gains: smallest x, smallest y, largest x, largest y (texels; the
 // CPU sets it to an empty box before each computation).
 @group(0) @binding(8) var<storage, read_write> bounds: array<atomic<u32>, 4>;
+// The fixed-point gains smoothed along the rows (between the two smoothing passes).
+@group(0) @binding(9) var<storage, read_write> scratch: array<u32>;
 
 const NONE: u32 = 0xffffffffu;
 const PI: f32 = 3.14159265358979;
@@ -334,19 +341,113 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn cs_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= p.map.x || id.y >= p.map.y {
+// Which smoothing pass a dispatch runs (`smooth_steps` in live.rs): bit 0 clear along the
+// rows (reading the photons' sums), set along the columns (reading the rows' result); bit 8
+// set on the last pass, which writes the gain map.
+struct SmoothStep {
+    bits: u32,
+};
+var<push_constant> smooth_step: SmoothStep;
+
+const LAST_STEP: u32 = 0x100u;
+// Most texels in one box: 2 x 64 + 1 (`MAX_SMOOTHING_PX` in live.rs).
+const MAX_BOX: u32 = 129u;
+
+// A box mean over a stream of texels: the last 2 radius + 1 inputs and their sum, exactly in
+// 64 bits (low and high words), so that nothing drifts along a line.
+struct RunningBox {
+    ring: array<u32, MAX_BOX>,
+    low: u32,
+    high: u32,
+    count: u32,
+};
+
+// Feeds the next input `v` of the stream to `b` (the inputs before the first count as 0);
+// returns the mean of the 2 radius + 1 inputs centred `radius` inputs back.
+fn box_feed(b: ptr<function, RunningBox>, v: u32, radius: u32) -> f32 {
+    let span = 2u * radius + 1u;
+    let slot = (*b).count % span;
+    let old = (*b).ring[slot];
+    (*b).ring[slot] = v;
+    (*b).count += 1u;
+    (*b).low += v;
+    (*b).high += select(0u, 1u, (*b).low < v);
+    (*b).high -= select(0u, 1u, (*b).low < old);
+    (*b).low -= old;
+    return (f32((*b).high) * 4294967296.0 + f32((*b).low)) / f32(span);
+}
+
+// The smoothing along one line (a row or a column) per invocation: the box of 2 radius + 1
+// texels three times over, streamed (each box's means feed the next, rounded to fixed point,
+// and texels beyond the map's edge count as 0 at every box: their light is lost, as off the
+// floor). Along the rows it reads G = max(0, sum) of the photons' sums (eq. 6's clamp, per
+// texel as the bake stores it). The last pass also zeroes gains below MIN_GAIN and bounds
+// the non-zero texels.
+@compute @workgroup_size(64, 1, 1)
+fn cs_smooth(@builtin(global_invocation_id) id: vec3<u32>) {
+    let columns = (smooth_step.bits & 1u) != 0u;
+    let last = (smooth_step.bits & LAST_STEP) != 0u;
+    let width = p.map.x;
+    let lines = select(p.map.y, width, columns);
+    let length = select(width, p.map.y, columns);
+    if id.x >= lines {
         return;
     }
-    let index = id.y * p.map.x + id.x;
-    let g = max(f32(atomicLoad(&sums[index])) / p.misc.y, 0.0);
-    let kept = g >= p.misc.w;
-    gain[index] = select(0.0, g, kept);
-    if kept {
-        atomicMin(&bounds[0], id.x);
-        atomicMin(&bounds[1], id.y);
-        atomicMax(&bounds[2], id.x);
-        atomicMax(&bounds[3], id.y);
+    let stride = select(1u, width, columns);
+    let start = select(id.x * width, id.x, columns);
+    let radius = p.map.w;
+    var box1: RunningBox;
+    var box2: RunningBox;
+    var box3: RunningBox;
+    var first = NONE;
+    var final_texel = 0u;
+    // Texel n of the line enters the first box; each box's mean for a texel comes out radius
+    // inputs after the texel entered it, so the third's for texel i at input i + 3 radius.
+    for (var n = 0u; n < length + 3u * radius; n++) {
+        var v = 0u;
+        if n < length {
+            let index = start + n * stride;
+            if columns {
+                v = scratch[index];
+            } else {
+                v = u32(max(atomicLoad(&sums[index]), 0));
+            }
+        }
+        let mean1 = box_feed(&box1, v, radius);
+        if n < radius {
+            continue;
+        }
+        let at1 = n - radius;
+        let mean2 = box_feed(&box2, select(0u, u32(round(mean1)), at1 < length), radius);
+        if at1 < radius {
+            continue;
+        }
+        let at2 = at1 - radius;
+        let mean = box_feed(&box3, select(0u, u32(round(mean2)), at2 < length), radius);
+        if at2 < radius {
+            continue;
+        }
+        let at = at2 - radius;
+        let index = start + at * stride;
+        if last {
+            let g = mean / p.misc.y;
+            let kept = g >= p.misc.w;
+            gain[index] = select(0.0, g, kept);
+            if kept {
+                first = min(first, at);
+                final_texel = at;
+            }
+        } else {
+            scratch[index] = u32(round(mean));
+        }
+    }
+    if first != NONE {
+        // Along the line from `first` to `final_texel`; across it, the line itself.
+        let lo = select(vec2<u32>(first, id.x), vec2<u32>(id.x, first), columns);
+        let hi = select(vec2<u32>(final_texel, id.x), vec2<u32>(id.x, final_texel), columns);
+        atomicMin(&bounds[0], lo.x);
+        atomicMin(&bounds[1], lo.y);
+        atomicMax(&bounds[2], hi.x);
+        atomicMax(&bounds[3], hi.y);
     }
 }

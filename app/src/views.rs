@@ -68,6 +68,7 @@ pub fn enable_live_caustics(
         &scene_desc(scene, None),
         vitreous_render::floor::LiveCausticsDesc {
             photons_per_side: scene.caustics.photons_per_side,
+            smoothing_px: scene.caustics.smoothing_px,
             ..Default::default()
         },
     )

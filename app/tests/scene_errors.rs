@@ -625,6 +625,18 @@ fn caustics_mode_and_live_sizes_are_checked() {
         "caustics.photons_per_side",
     );
     let text = format!(
+        "{}\n[caustics]\nmode = \"live\"\nsmoothing_px = -1\n",
+        good_text()
+    );
+    expect_error(
+        &text,
+        line_of(&text, "smoothing_px"),
+        "caustics.smoothing_px",
+    );
+    let text = text.replace("-1", "3");
+    let (_dir, _path, result) = load_text(&text);
+    assert_eq!(result.unwrap().caustics.smoothing_px, 3);
+    let text = format!(
         "{}\n[caustics]\nmode = \"live\"\nresolution_px = 8\n",
         good_text()
     );

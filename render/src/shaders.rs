@@ -65,7 +65,7 @@ pub const COMBINE_FS: &[u8] = spirv!("inducer_field.fs_combine");
 pub const OVERLAY_VS: &[u8] = spirv!("floor_overlay.vs_main");
 pub const OVERLAY_FS: &[u8] = spirv!("floor_overlay.fs_main");
 pub const CAUSTICS_TRACE_CS: &[u8] = spirv!("caustics_live.cs_trace");
-pub const CAUSTICS_RESOLVE_CS: &[u8] = spirv!("caustics_live.cs_resolve");
+pub const CAUSTICS_SMOOTH_CS: &[u8] = spirv!("caustics_live.cs_smooth");
 
 /// Reinterprets SPIR-V bytes as words (include_bytes gives no alignment guarantee).
 pub fn words(bytes: &[u8]) -> Vec<u32> {

@@ -71,6 +71,7 @@ pub(crate) struct CausticsToml {
     pub mode: Option<Spanned<String>>,
     pub resolution_px: Option<Spanned<i64>>,
     pub photons_per_side: Option<Spanned<i64>>,
+    pub smoothing_px: Option<Spanned<i64>>,
 }
 
 /// `[gaze]`: how the gaze image is chosen for defocus.

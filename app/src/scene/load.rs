@@ -12,6 +12,7 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 use sha2::{Digest, Sha256};
 use toml::Spanned;
 use vitreous_render::Attenuation;
+use vitreous_render::floor::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE, MAX_SMOOTHING_PX};
 use vitreous_xr::{Fov, Pose};
 
 use super::error::Source;
@@ -319,6 +320,7 @@ impl Loader<'_> {
         };
 
         let inducer = self.inducer(&raw.inducer)?;
+        let live_default = LiveCausticsDesc::default();
         let caustics = Caustics {
             bake: match &raw.caustics.bake {
                 None => None,
@@ -355,8 +357,14 @@ impl Loader<'_> {
             photons_per_side: self.count(
                 "caustics.photons_per_side",
                 raw.caustics.photons_per_side.as_ref(),
-                128,
-                1..=4096,
+                live_default.photons_per_side,
+                1..=MAX_PHOTONS_PER_SIDE,
+            )?,
+            smoothing_px: self.count(
+                "caustics.smoothing_px",
+                raw.caustics.smoothing_px.as_ref(),
+                live_default.smoothing_px,
+                0..=MAX_SMOOTHING_PX,
             )?,
         };
         let gaze = GazeChoice {

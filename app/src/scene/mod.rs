@@ -103,6 +103,8 @@ pub struct Caustics {
     pub resolution_px: u32,
     /// Photons along each side of the live emission grid (live mode).
     pub photons_per_side: u32,
+    /// Radius of the box the live map is smoothed with, texels (live mode; 0: none).
+    pub smoothing_px: u32,
 }
 
 impl Scene {

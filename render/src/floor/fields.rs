@@ -286,7 +286,7 @@ pub struct FieldPassesMs {
     pub distance_ms: f64,
     /// The gain k alpha(d) (eq. 2, 4).
     pub ramp_ms: f64,
-    /// The live caustic map (photon tracing, resolving, copying).
+    /// The live caustic map (photon tracing, smoothing, copying).
     pub live_caustics_ms: f64,
     /// The overlay gain's combination.
     pub combine_ms: f64,

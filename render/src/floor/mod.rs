@@ -44,8 +44,8 @@
 //! - `fields`: the floor-space images, the push constants and the fields read back;
 //! - `distance_transform`: the nearest shadow texel of every texel (compute);
 //! - `overlay`: the per-eye overlay pipeline;
-//! - `live`: the caustic gain map computed per pose on the GPU (photon splatting), instead of
-//!   a bake;
+//! - `live`: the caustic gain map computed per pose on the GPU (photon splatting, then
+//!   smoothing), instead of a bake;
 //! - `pass`: the pass that builds all of it and records it once per pose;
 //! - `progress`: whether that computation has really run (set only after its fence);
 //! - `readback`: copying the fields back to the CPU.
@@ -70,7 +70,7 @@ pub use crate::scene::{
 pub(crate) use fields::Stamps;
 pub use fields::{FIELD_STAMPS, FieldPassesMs, InducerFields};
 pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
-pub use live::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE};
+pub use live::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE, MAX_SMOOTHING_PX};
 pub(crate) use pass::InducerPass;
 pub(crate) use progress::Prepared;
 pub use reference::{

@@ -210,6 +210,7 @@ impl ButtonScript {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
     const SCRIPT: &str = "# a chord\nprofile /interaction_profiles/htc/vive_controller\n\
                           1.0 /user/hand/left/input/squeeze/click down\n\
@@ -269,6 +270,39 @@ mod tests {
         ] {
             let e = ButtonScript::parse(&format!("{profile}{body}")).unwrap_err();
             assert!(e.line >= 2 && e.message.contains(says), "{body:?}: {e}");
+        }
+    }
+
+    proptest! {
+        /// Any text is parsed or refused with a line in it, never a panic; what is parsed
+        /// keeps each input's events in time order and answers any time.
+        #[test]
+        fn any_text_is_parsed_or_refused_with_a_line(
+            lines in proptest::collection::vec(
+                prop_oneof![
+                    Just("profile /interaction_profiles/htc/vive_controller".to_string()),
+                    (0.0f64..10.0, 0usize..3, any::<bool>()).prop_map(|(t, k, d)| format!(
+                        "{t} /user/hand/{}/input/b{k}/click {}",
+                        if k == 0 { "left" } else { "right" },
+                        if d { "down" } else { "up" }
+                    )),
+                    "[ -~]{0,40}",
+                ],
+                0..12,
+            ),
+            at in 0.0f64..12.0,
+        ) {
+            let text = lines.join("\n");
+            match ButtonScript::parse(&text) {
+                Ok(s) => {
+                    for (k, events) in s.events.iter().enumerate() {
+                        prop_assert!(events.windows(2).all(|w| w[0].0 <= w[1].0));
+                        let (_, since) = s.state_at(k, at);
+                        prop_assert!(since.is_none_or(|t| t <= at));
+                    }
+                }
+                Err(e) => prop_assert!(e.line >= 1 && e.line <= lines.len().max(1)),
+            }
         }
     }
 }

@@ -1,11 +1,12 @@
-//! `vitreous view` in a virtual X server (xvfb-run; `wayland.rs`: in a headless weston) on the machine's Vulkan device (lavapipe
-//! in CI) with validation on: screenshots measured in the glass's projected region and away
-//! from it, a scripted key press, and scripted scene edits (reload, and a broken edit kept
-//! out).
+//! `vitreous view` in a virtual X server (xvfb-run; `wayland.rs`: in a headless weston) on the
+//! machine's Vulkan device (lavapipe in CI) with validation on: screenshots measured in the
+//! glass's projected region and away from it, a scripted key press, scripted scene edits
+//! (reload, and a broken edit kept out), and the window closed (`close.rs`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+mod close;
 mod shots;
 #[cfg(feature = "wayland")]
 mod wayland;
@@ -14,19 +15,10 @@ use shots::{Shot, WINDOW, assert_glass_shown_alone, glass_discs, regions, root, 
 
 /// `xvfb-run`, or None outside CI when it is missing (in CI, a missing one fails the test).
 fn xvfb_run() -> Option<PathBuf> {
-    let found = std::env::var_os("PATH").and_then(|paths| {
-        std::env::split_paths(&paths)
-            .map(|p| p.join("xvfb-run"))
-            .find(|p| p.is_file())
-    });
-    if found.is_none() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "xvfb-run is missing: tools/ensure-vulkan --window installs it (Debian: xvfb, xauth)"
-        );
-        eprintln!("skipped: no xvfb-run here (tools/ensure-vulkan --window installs it)");
-    }
-    found
+    shots::program(
+        "xvfb-run",
+        "tools/ensure-vulkan --window (Debian: xvfb, xauth)",
+    )
 }
 
 /// Runs `vitreous view` in a virtual X server with validation on.

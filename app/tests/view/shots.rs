@@ -5,6 +5,24 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
+/// The program `name` on PATH; None outside CI when it is missing (in CI a missing one fails
+/// the test), with `install` saying what installs it.
+pub fn program(name: &str, install: &str) -> Option<PathBuf> {
+    let found = std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|p| p.join(name))
+            .find(|p| p.is_file())
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "{name} is missing: {install} installs it"
+        );
+        eprintln!("skipped: no {name} here ({install} installs it)");
+    }
+    found
+}
+
 /// Window size of every test: small, so each run takes a few seconds on a CPU device.
 pub const WINDOW: (u32, u32) = (320, 240);
 

@@ -27,19 +27,8 @@ impl Weston {
     /// Starts weston's headless backend; None outside CI when weston is missing (in CI a
     /// missing one fails the test: `tools/ensure-vulkan --wayland` installs it).
     fn start() -> Option<Weston> {
-        let found = std::env::var_os("PATH").and_then(|paths| {
-            std::env::split_paths(&paths)
-                .map(|p| p.join("weston"))
-                .find(|p| p.is_file())
-        });
-        let Some(weston) = found else {
-            assert!(
-                std::env::var_os("CI").is_none(),
-                "weston is missing: tools/ensure-vulkan --wayland installs it (Debian: weston)"
-            );
-            eprintln!("skipped: no weston here (tools/ensure-vulkan --wayland installs it)");
-            return None;
-        };
+        let weston =
+            super::shots::program("weston", "tools/ensure-vulkan --wayland (Debian: weston)")?;
         // A private runtime folder (mode 0700, as Wayland requires) per compositor, so tests
         // running at once never share a socket.
         let runtime = tempfile::tempdir().expect("a runtime folder");

@@ -45,7 +45,8 @@
 //! - `distance_transform`: the nearest shadow texel of every texel (compute);
 //! - `overlay`: the per-eye overlay pipeline;
 //! - `live`: the caustic gain map computed per pose on the GPU (photon splatting, then
-//!   smoothing), instead of a bake;
+//!   smoothing), instead of a bake; `triangle_grid`: the grid of triangle lists its photons
+//!   walk;
 //! - `pass`: the pass that builds all of it and records it once per pose;
 //! - `progress`: whether that computation has really run (set only after its fence);
 //! - `readback`: copying the fields back to the CPU.
@@ -62,6 +63,7 @@ mod pass;
 mod progress;
 mod readback;
 mod reference;
+mod triangle_grid;
 
 pub use crate::scene::{
     MAX_CAUSTIC_GAIN, MAX_K, MAX_RAMP_WIDTH_M, MAX_RESOLUTION_PX, MIN_RESOLUTION_PX,

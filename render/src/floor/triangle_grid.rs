@@ -1,0 +1,113 @@
+//! A uniform grid of triangle lists over a mesh, model space: how the live caustics' photons
+//! (shaders/caustics_live.wgsl) find the few triangles a segment can meet among the sphere's
+//! 9024, built once on the CPU when live caustics are enabled.
+
+use glam::Vec3;
+
+/// Grid cells per triangle of the mesh: smaller cells hold fewer triangles to test, more
+/// cells take more steps; on the glass sphere (9024 triangles) 4 cut the `live caustics`
+/// stage by about 7 % against 1 (155-156 ms against 164-172 ms on lavapipe; 8 as 4).
+const CELLS_PER_TRIANGLE: f32 = 4.0;
+
+/// A uniform grid over the mesh's bounding box, model space: the triangles overlapping each
+/// cell (x fastest, then y, then z).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Grid {
+    /// Lower corner, model units.
+    pub origin: Vec3,
+    /// Side of a cell, model units.
+    pub side: f32,
+    /// Cells along x, y, z.
+    pub dims: [u32; 3],
+    /// First entry in `triangles` and count, per cell.
+    pub cells: Vec<[u32; 2]>,
+    /// Triangle indices, cell after cell.
+    pub triangles: Vec<u32>,
+}
+
+impl Grid {
+    /// About [`CELLS_PER_TRIANGLE`] cells per triangle, cubic cells over the bounding box,
+    /// every triangle listed in each cell its bounding box overlaps.
+    pub fn new(positions: &[Vec3], indices: &[u32]) -> Grid {
+        let lo = positions.iter().copied().fold(Vec3::INFINITY, Vec3::min);
+        let hi = positions
+            .iter()
+            .copied()
+            .fold(Vec3::NEG_INFINITY, Vec3::max);
+        let extent = (hi - lo).max(Vec3::splat(1e-6));
+        let count = (indices.len() / 3).max(1) as f32;
+        let per_axis = (count * CELLS_PER_TRIANGLE).cbrt().ceil().clamp(1.0, 64.0);
+        let side = extent.max_element() / per_axis;
+        let pad = Vec3::splat(side * 1e-3);
+        let origin = lo - pad;
+        let dims = ((extent + 2.0 * pad) / side)
+            .ceil()
+            .max(Vec3::ONE)
+            .as_uvec3()
+            .to_array();
+        let cell_of = |p: Vec3| {
+            ((p - origin) / side)
+                .floor()
+                .max(Vec3::ZERO)
+                .as_uvec3()
+                .min(glam::UVec3::from_array(dims) - 1)
+        };
+        let total = (dims[0] * dims[1] * dims[2]) as usize;
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); total];
+        for (t, tri) in indices.chunks_exact(3).enumerate() {
+            let corners = tri.iter().map(|&i| positions[i as usize]);
+            let tlo = corners.clone().fold(Vec3::INFINITY, Vec3::min) - pad;
+            let thi = corners.fold(Vec3::NEG_INFINITY, Vec3::max) + pad;
+            let (a, b) = (cell_of(tlo), cell_of(thi));
+            for z in a.z..=b.z {
+                for y in a.y..=b.y {
+                    for x in a.x..=b.x {
+                        lists[(x + dims[0] * (y + dims[1] * z)) as usize].push(t as u32);
+                    }
+                }
+            }
+        }
+        let mut cells = Vec::with_capacity(total);
+        let mut triangles = Vec::new();
+        for list in lists {
+            cells.push([triangles.len() as u32, list.len() as u32]);
+            triangles.extend(list);
+        }
+        Grid {
+            origin,
+            side,
+            dims,
+            cells,
+            triangles,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_triangle_is_listed_in_the_cells_around_it() {
+        let positions = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        ];
+        let indices = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
+        let grid = Grid::new(&positions, &indices);
+        // Three cells per side over the unit box (cbrt(4 x 4) rounded up), grown by a hair
+        // for the padding.
+        assert_eq!(grid.dims, [4, 4, 4]);
+        // Each triangle appears at least once, the one facing the origin's corner in all
+        // cells its box touches.
+        for t in 0..4u32 {
+            assert!(grid.triangles.contains(&t));
+        }
+        let total: u32 = grid.cells.iter().map(|c| c[1]).sum();
+        assert_eq!(total as usize, grid.triangles.len());
+        let corner = grid.cells[0];
+        assert_eq!(corner[1], 4, "every face touches the cell at the origin");
+    }
+}

@@ -56,7 +56,8 @@ struct Globals {
     // rgb: light colour (linear); w: Phong exponent.
     light_colour: vec4<f32>,
     // x: exposure of environment radiance; y: surface opacity (1 - transmittance, 0 without a
-    // surface texture); z: Phong specular strength; w: 1 for two-surface refraction, else 0.
+    // surface texture); z: Phong specular strength; w: unused (the refraction model is the
+    // pipeline's entry point).
     shading: vec4<f32>,
     // Inverse of world_from_model.
     model_from_world: mat4x4<f32>,

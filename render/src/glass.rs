@@ -285,7 +285,6 @@ impl GlassPass {
         } else {
             0.0
         };
-        let two_surface = desc.refraction == Refraction::TwoSurface;
         let globals = Globals {
             world_from_model: [0.0; 16],
             normal_from_model: [0.0; 16],
@@ -293,13 +292,7 @@ impl GlassPass {
             optics: [desc.ior, FRESNEL_BIAS, FRESNEL_SCALE, FRESNEL_POWER],
             light: [0.0; 4],
             light_colour: desc.light.radiance.extend(PHONG_EXPONENT).to_array(),
-            shading: Vec4::new(
-                desc.exposure,
-                surface_opacity,
-                PHONG_STRENGTH,
-                if two_surface { 1.0 } else { 0.0 },
-            )
-            .to_array(),
+            shading: Vec4::new(desc.exposure, surface_opacity, PHONG_STRENGTH, 0.0).to_array(),
             model_from_world: [0.0; 16],
             radial,
             center_world: [0.0; 4],

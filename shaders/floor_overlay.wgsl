@@ -1,25 +1,30 @@
-// The floor overlay layer (METHOD.md section 1, eq. 3 and 5; render/src/inducer.rs): a
+// The floor overlay layer (METHOD.md section 1, eq. 3, 5 and 6; render/src/floor/overlay.rs): a
 // world-anchored rectangle on the floor plane, added to the eye image (blend ONE, ONE), that
-// carries the shadow inducer's light L_s = k alpha(d) L_r. What the wearer then sees on the
-// floor is L_o = L_r + L_s = (1 + k alpha(d)) L_r (eq. 5); the shadow keeps L_r.
+// carries the shadow inducer's light L_s = k alpha(d) L_r and the corrected caustics
+// L'_c = G L_r. What the wearer then sees on the floor is
+// L_o = L_r + L_s + L'_c = (1 + k alpha(d) + G) L_r (eq. 5); the shadow keeps L_r (+ L'_c).
 //
-// Only the rectangle around the shadow plus the ramp's width (and the caustics' extent) is drawn (computed on the CPU),
-// and texels with no inducer light are discarded before the photo is read: at most two
-// texture fetches per covered pixel (the precomputed gain, the floor photo).
+// Only the rectangle around the shadow plus the ramp's width (and the caustics' extent) is
+// drawn (computed on the CPU). Each pixel sums the two gains itself, each only when switched
+// on: k alpha(d) filtered from the inducer's field, G filtered from the caustic map; texels
+// with no light are discarded before the photo is read.
 
 struct Overlay {
     clip_from_plane: mat4x4<f32>,
     // The drawn part of the floor's unit square: min x, min y, max x, max y (plane-local).
     rect: vec4<f32>,
+    // Weights of the inducer's gain and of the caustic gain G (1 on, 0 off).
+    switches: vec2<f32>,
 };
 
 var<push_constant> overlay: Overlay;
-// k alpha(d) (fs_ramp of inducer_field.wgsl) when the caustics are off, k alpha(d) + G
-// (fs_combine) when they are on, over the floor's unit square.
+// k alpha(d) (fs_ramp of inducer_field.wgsl, R16F) over the floor's unit square.
 @group(0) @binding(0) var gain: texture_2d<f32>;
 // The registered photo of the real floor: L_r, decoded to linear light by the sRGB format.
 @group(0) @binding(1) var floor_photo: texture_2d<f32>;
 @group(0) @binding(2) var clamp_sampler: sampler;
+// The caustic gain G (R32F, the bake's or the live map's size) over the floor's unit square.
+@group(0) @binding(3) var caustic: texture_2d<f32>;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -41,9 +46,33 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VertexOut {
     return out;
 }
 
+// G at uv, bilinear between texel centres and clamped at the edges, as the sampler would
+// filter it; computed from four loads because linear filtering of R32_SFLOAT is optional in
+// Vulkan. Same formula as Bake::sample on the CPU.
+fn caustic_gain(uv: vec2<f32>) -> f32 {
+    let size = vec2<i32>(textureDimensions(caustic));
+    let last = vec2<f32>(size - 1);
+    let t = clamp(uv * vec2<f32>(size) - 0.5, vec2<f32>(0.0), last);
+    let base = floor(t);
+    let f = t - base;
+    let p = vec2<i32>(base);
+    let q = min(p + 1, size - 1);
+    let top = mix(textureLoad(caustic, p, 0).r, textureLoad(caustic, vec2<i32>(q.x, p.y), 0).r, f.x);
+    let bottom = mix(textureLoad(caustic, vec2<i32>(p.x, q.y), 0).r, textureLoad(caustic, q, 0).r, f.x);
+    return mix(top, bottom, f.y);
+}
+
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    let overlay_gain = textureSampleLevel(gain, clamp_sampler, in.uv, 0.0).r;
+    var overlay_gain = 0.0;
+    if overlay.switches.x > 0.0 {
+        // eq. 4: alpha'(d) = k alpha(d).
+        overlay_gain += overlay.switches.x * textureSampleLevel(gain, clamp_sampler, in.uv, 0.0).r;
+    }
+    if overlay.switches.y > 0.0 {
+        // eq. 6: L'_c = max(0, L_c - L_r) = G L_r; G >= 0 is checked on loading.
+        overlay_gain += overlay.switches.y * caustic_gain(in.uv);
+    }
     if overlay_gain <= 0.0 {
         discard;
     }

@@ -5,12 +5,10 @@
 // 1. (shaders/inducer_distance.wgsl) every texel of the region gets its nearest shadow texel.
 // 2. fs_distance: d, the distance from a lit texel to the shadow edge in metres; -1 inside
 //    the shadow; FAR_M outside `region` (the pass also draws where the region was before).
-// 3. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain.
-// 4. fs_combine (caustics, eq. 6): the floor overlay's gain at the caustic map's resolution,
-//    k alpha(d) (if the inducer is on) + G (if the caustics are on), what the floor overlay
-//    multiplies the floor photo by. Rerun when those switches change.
+// 3. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain, which the floor overlay
+//    (shaders/floor_overlay.wgsl) filters and adds to the caustic gain G.
 //
-// Every fetch is a textureLoad of one texel, except fs_combine's bilinear read of the gain.
+// Every fetch is a textureLoad of one texel.
 
 struct Field {
     // Floor metres per texel along the texture's x (u) and y (v).
@@ -21,21 +19,17 @@ struct Field {
     ramp_width_m: f32,
     // k of eq. 4.
     k: f32,
-    // fs_combine: weights of the inducer's gain and of the caustic gain G (1 on, 0 off).
-    switches: vec2<f32>,
     // The texels the fields are computed in: x0, y0, x1, y1 (ends excluded).
     region: vec4<i32>,
 };
 
 var<push_constant> field: Field;
-// The pass's input: the distances (fs_ramp) or the gain (fs_combine).
+// The pass's input: the distances (fs_ramp).
 @group(0) @binding(0) var source: texture_2d<f32>;
-// The shadow mask, for fs_distance; the caustic gain G (R32F), for fs_combine.
+// The shadow mask, for fs_distance.
 @group(0) @binding(1) var shadow_mask: texture_2d<f32>;
-// fs_combine: bilinear between texel centres, clamped at the edges (the overlay's sampler).
-@group(0) @binding(2) var clamp_sampler: sampler;
 // fs_distance: each texel's nearest shadow texel, packed as x | y << 16, NO_SEED if none.
-@group(0) @binding(3) var<storage, read> nearest: array<u32>;
+@group(0) @binding(2) var<storage, read> nearest: array<u32>;
 
 // No shadow texel in the region.
 const NO_SEED: u32 = 0xffffffffu;
@@ -96,21 +90,4 @@ fn fs_ramp(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let d_m = textureLoad(source, vec2<i32>(frag.xy), 0).r;
     // eq. 4: alpha'(d) = k alpha(d).
     return vec4<f32>(field.k * ramp(d_m, field.ramp_width_m), 0.0, 0.0, 0.0);
-}
-
-@fragment
-fn fs_combine(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    // The target has the caustic map's size, texel for texel.
-    let p = vec2<i32>(frag.xy);
-    let uv = frag.xy / vec2<f32>(textureDimensions(shadow_mask));
-    var gain = 0.0;
-    if field.switches.x > 0.0 {
-        // k alpha(d) at the texel's floor point, bilinear as the overlay samples it.
-        gain += field.switches.x * textureSampleLevel(source, clamp_sampler, uv, 0.0).r;
-    }
-    if field.switches.y > 0.0 {
-        // eq. 6: L'_c = max(0, L_c - L_r) = G L_r; G >= 0 is checked on loading.
-        gain += field.switches.y * textureLoad(shadow_mask, p, 0).r;
-    }
-    return vec4<f32>(gain, 0.0, 0.0, 0.0);
 }

@@ -72,7 +72,7 @@ pub struct VariantResult {
     /// GPU milliseconds per stereo frame (the eye passes).
     pub gpu_ms: Option<Spread>,
     /// GPU milliseconds per frame of the floor fields' work before the eye passes (the
-    /// shadow inducer's recomputation after a move, the overlay gain's combination).
+    /// shadow inducer's recomputation after a move, with the live caustic map's).
     pub prepare_gpu_ms: Option<Spread>,
     /// Median GPU milliseconds per frame of each stage of that work.
     pub field_passes_gpu_ms: Option<FieldPassesMedians>,
@@ -110,8 +110,6 @@ pub struct FieldPassesMedians {
     pub ramp_ms: f64,
     /// The live caustic map.
     pub live_caustics_ms: f64,
-    /// The overlay gain's combination.
-    pub combine_ms: f64,
 }
 
 impl FieldPassesMedians {
@@ -126,7 +124,6 @@ impl FieldPassesMedians {
             distance_ms: median(|f| f.distance_ms),
             ramp_ms: median(|f| f.ramp_ms),
             live_caustics_ms: median(|f| f.live_caustics_ms),
-            combine_ms: median(|f| f.combine_ms),
         })
     }
 }
@@ -551,8 +548,8 @@ impl BenchReport {
             let _ = writeln!(
                 out,
                 "  {effects:<24} mask {:.2}, nearest {:.2}, distance {:.2}, ramp {:.2}, \
-                 live caustics {:.2}, combine {:.2}",
-                f.mask_ms, f.nearest_ms, f.distance_ms, f.ramp_ms, f.live_caustics_ms, f.combine_ms
+                 live caustics {:.2}",
+                f.mask_ms, f.nearest_ms, f.distance_ms, f.ramp_ms, f.live_caustics_ms
             );
         }
         out

@@ -68,8 +68,8 @@ pub struct FrameTiming {
     /// `None` when the device cannot write timestamps.
     pub gpu_ms: Option<f64>,
     /// GPU time of the floor fields' work recorded before the eye passes (the shadow
-    /// inducer's computation after a move, the overlay gain's combination after a switch;
-    /// 0 when none was due), milliseconds; `None` without timestamps.
+    /// inducer's computation after a move, with the live caustic map's; 0 when none was
+    /// due), milliseconds; `None` without timestamps.
     pub prepare_gpu_ms: Option<f64>,
     /// That work stage by stage (the parts of `prepare_gpu_ms`); `None` without timestamps.
     pub field_passes: Option<FieldPassesMs>,
@@ -516,10 +516,8 @@ impl Renderer {
             );
             let stamps = queries.map(|pool| Stamps { pool, first: 3 });
             if inducer || caustics {
-                // Once per pose (and per change of these switches), timed on its own.
-                prepared =
-                    self.inducer
-                        .prepare(&self.ctx, cmd, &self.scene, inducer, caustics, stamps);
+                // Once per pose, timed on its own.
+                prepared = self.inducer.prepare(&self.ctx, cmd, &self.scene, stamps);
             } else if let Some(stamps) = stamps {
                 stamps.write(d, cmd, 0..FIELD_STAMPS);
             }

@@ -61,7 +61,6 @@ pub const COLUMNS_CS: &[u8] = spirv!("inducer_distance.cs_columns");
 pub const ROWS_CS: &[u8] = spirv!("inducer_distance.cs_rows");
 pub const DISTANCE_FS: &[u8] = spirv!("inducer_field.fs_distance");
 pub const RAMP_FS: &[u8] = spirv!("inducer_field.fs_ramp");
-pub const COMBINE_FS: &[u8] = spirv!("inducer_field.fs_combine");
 pub const OVERLAY_VS: &[u8] = spirv!("floor_overlay.vs_main");
 pub const OVERLAY_FS: &[u8] = spirv!("floor_overlay.fs_main");
 pub const CAUSTICS_TRACE_CS: &[u8] = spirv!("caustics_live.cs_trace");

@@ -21,7 +21,6 @@ use crate::shaders;
 /// Indices into the floor pass's full-screen pipelines.
 pub(crate) const DIST: usize = 0;
 pub(crate) const RAMP: usize = 1;
-pub(crate) const COMBINE: usize = 2;
 
 /// Push constants of the two passes, as `Transform` in inducer_distance.wgsl.
 #[repr(C)]

@@ -14,21 +14,18 @@ use crate::pipeline::{self, FieldStart};
 pub(crate) const MASK: usize = 0;
 pub(crate) const DISTANCE: usize = 1;
 pub(crate) const GAIN: usize = 2;
-/// The overlay's gain, k alpha(d) + G as switched on, at the caustic map's resolution.
-pub(crate) const OVERLAY: usize = 3;
 
 /// Name and format of each floor-space image, in the order of the indices above.
-pub(crate) const FIELDS: [(&str, vk::Format); 4] = [
+pub(crate) const FIELDS: [(&str, vk::Format); 3] = [
     ("shadow mask", vk::Format::R8_UNORM),
     ("edge distance", vk::Format::R32_SFLOAT),
     // Half floats filter linearly on every device: the overlay samples it bilinearly.
     ("gain", vk::Format::R16_SFLOAT),
-    ("overlay gain", vk::Format::R16_SFLOAT),
 ];
 
 /// What each floor-space image holds where its passes do not draw (outside the rectangle
 /// the overlay can light): lit floor, beyond the ramp (the shader's `FAR_M`), no gain.
-pub(crate) const CLEAR: [f32; 4] = [0.0, 1.0e9, 0.0, 0.0];
+pub(crate) const CLEAR: [f32; 3] = [0.0, 1.0e9, 0.0];
 
 /// The ways a field's render pass may start, in the order of [`FieldTarget`]'s render passes.
 const STARTS: [FieldStart; 4] = [
@@ -90,11 +87,6 @@ impl FieldTarget {
     /// A render pass of this target, for making pipelines (all of them are compatible).
     pub fn render_pass(&self) -> vk::RenderPass {
         self.render_passes[0].raw()
-    }
-
-    /// The whole image as a rectangle of texels.
-    pub fn full(&self) -> TexelRect {
-        [0, 0, self.extent.width, self.extent.height]
     }
 
     /// Begins this target's render pass starting as `start` says over `area` (cleared to
@@ -184,10 +176,8 @@ pub(crate) struct FieldPush {
     pub ramp_width_m: f32,
     /// k of eq. 4.
     pub k: f32,
-    /// Padding (the switches are 8-byte aligned).
-    pub _pad: f32,
-    /// fs_combine: weights of k alpha(d) and of the caustic gain G (1 on, 0 off).
-    pub switches: [f32; 2],
+    /// Padding (the region is 16-byte aligned).
+    pub _pad: [f32; 3],
     /// The texels the fields are computed in (`[x0, y0, x1, y1]`, ends excluded): the
     /// distance pass writes "beyond the ramp" outside.
     pub region: [i32; 4],
@@ -271,8 +261,8 @@ impl InducerFields {
 }
 
 /// Timestamps the floor passes write after each of their stages, in this order: the mask, the
-/// nearest shadow texels, the distance, the ramp, the live caustics, the overlay gain's combination.
-pub const FIELD_STAMPS: u32 = 6;
+/// nearest shadow texels, the distance, the ramp, the live caustics.
+pub const FIELD_STAMPS: u32 = 5;
 
 /// GPU milliseconds of each stage of the floor passes in one frame (0 for a stage that did
 /// not run: nothing moved, or no live caustics).
@@ -288,8 +278,6 @@ pub struct FieldPassesMs {
     pub ramp_ms: f64,
     /// The live caustic map (photon tracing, smoothing, copying).
     pub live_caustics_ms: f64,
-    /// The overlay gain's combination.
-    pub combine_ms: f64,
 }
 
 impl FieldPassesMs {
@@ -308,18 +296,12 @@ impl FieldPassesMs {
             distance_ms: ms[2],
             ramp_ms: ms[3],
             live_caustics_ms: ms[4],
-            combine_ms: ms[5],
         }
     }
 
     /// Their sum.
     pub fn total_ms(&self) -> f64 {
-        self.mask_ms
-            + self.nearest_ms
-            + self.distance_ms
-            + self.ramp_ms
-            + self.live_caustics_ms
-            + self.combine_ms
+        self.mask_ms + self.nearest_ms + self.distance_ms + self.ramp_ms + self.live_caustics_ms
     }
 }
 

@@ -1,7 +1,7 @@
 //! Caustics computed on the GPU for each pose of the object and the light (docs/caustics.md,
 //! eq. 6): photon splatting, then a smoothing by a box filter run three times along each
 //! axis, in compute passes (shaders/caustics_live.wgsl) into the caustic gain map the overlay
-//! combines, in place of a bake. Recorded with the inducer's fields, so only on frames after
+//! adds, in place of a bake. Recorded with the inducer's fields, so only on frames after
 //! a move; timed as the floor's `live caustics` stage ([`super::FieldPassesMs`]) and in
 //! wall-clock time.
 

@@ -21,14 +21,15 @@
 //!    per row), nearest in metres.
 //! 3. **Distance to the edge** (`fs_distance`, [`edge_distance_m`]): d in metres for every
 //!    lit texel, -1 inside the shadow.
-//! 4. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the precombined
-//!    overlay texture.
+//! 4. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the texture the
+//!    overlay filters.
 //!
 //! Per eye, the floor overlay (overlay.rs; shaders/floor_overlay.wgsl) is a world-anchored
 //! rectangle on the floor plane covering only the shadow plus the ramp (bounded on the CPU
 //! from the mesh's projected vertices, [`overlay_rect`]); it adds L_s = k alpha(d) L_r (eq. 3) with blend
 //! (ONE, ONE), discarding texels without inducer light before it reads the photo: at most two
-//! texture fetches per covered pixel. The see-through preview then shows
+//! texture fetches per covered pixel. With the caustics on it adds G L_r (eq. 6) in the same
+//! draw, G filtered from the caustic map (four more loads). The see-through preview then shows
 //! L_o = (1 + k alpha(d)) L_r (eq. 5).
 //!
 //! # Synchronisation

@@ -1,7 +1,8 @@
 //! The floor overlay (shaders/floor_overlay.wgsl): per eye, a world-anchored rectangle on the
 //! floor plane that adds a gain times the floor photo, L_s = k alpha(d) L_r (eq. 3) plus the
-//! corrected caustics G L_r, with blend (ONE, ONE): the inducer's own gain when the caustics
-//! are off, the precombined one when they are on.
+//! corrected caustics G L_r (eq. 6), with blend (ONE, ONE). Each pixel sums the inducer's gain
+//! and the caustic gain, as switched on, in the same draw: nothing is recombined when the
+//! switches change or the light moves.
 
 use ash::vk;
 use glam::Mat4;
@@ -22,6 +23,10 @@ struct OverlayPush {
     clip_from_plane: [f32; 16],
     /// The plane-local rectangle to draw (min x, min y, max x, max y).
     rect: [f32; 4],
+    /// Weights of k alpha(d) and of the caustic gain G (1 on, 0 off).
+    switches: [f32; 2],
+    /// Padding to the shader struct's 16-byte alignment.
+    _pad: [f32; 2],
 }
 
 /// The overlay's pipeline and descriptors, freed on drop.
@@ -32,20 +37,22 @@ pub(crate) struct OverlayPass {
     layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets.
     _pool: Owned<vk::DescriptorPool>,
-    /// Layout of the sets: gain, floor photo, sampler.
+    /// Layout of the set: gain, floor photo, sampler, caustic gain.
     _set_layout: Owned<vk::DescriptorSetLayout>,
-    /// One set per gain image.
-    sets: Vec<vk::DescriptorSet>,
+    /// The set.
+    set: vk::DescriptorSet,
 }
 
 impl OverlayPass {
-    /// The overlay drawing in `eye_render_pass`, reading one of the gains `gain_views` (R16F,
-    /// filtered) and the scene's floor photo.
+    /// The overlay drawing in `eye_render_pass`, reading the inducer's gain `gain_view`
+    /// (R16F, filtered by the sampler), the caustic gain `caustic_view` (R32F, filtered in the
+    /// shader) and the scene's floor photo.
     pub fn new(
         ctx: &GpuContext,
         eye_render_pass: vk::RenderPass,
         scene: &GpuScene,
-        gain_views: &[vk::ImageView],
+        gain_view: vk::ImageView,
+        caustic_view: vk::ImageView,
     ) -> Result<OverlayPass> {
         let fragment = vk::ShaderStageFlags::FRAGMENT;
         let set_layout = pipeline::set_layout(
@@ -54,12 +61,13 @@ impl OverlayPass {
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (2, vk::DescriptorType::SAMPLER, fragment),
+                (3, vk::DescriptorType::SAMPLED_IMAGE, fragment),
             ],
         )?;
         let layout = pipeline::layout(
             ctx,
             Some(set_layout.raw()),
-            vk::ShaderStageFlags::VERTEX,
+            PUSH_STAGES,
             size_of::<OverlayPush>() as u32,
         )?;
         // The overlay neither tests nor writes depth: it is drawn before the glass, which then
@@ -79,37 +87,33 @@ impl OverlayPass {
                 blend: Blend::Add,
             },
         )?;
-        let count = gain_views.len() as u32;
         let pool = pipeline::pool(
             ctx,
-            count,
+            1,
             &[
-                (vk::DescriptorType::SAMPLED_IMAGE, 2 * count),
-                (vk::DescriptorType::SAMPLER, count),
+                (vk::DescriptorType::SAMPLED_IMAGE, 3),
+                (vk::DescriptorType::SAMPLER, 1),
             ],
         )?;
-        let mut sets = Vec::with_capacity(gain_views.len());
-        for &view in gain_views {
-            let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
-            pipeline::write_image(ctx, set, 0, view);
-            pipeline::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
-            sets.push(set);
-        }
+        let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+        pipeline::write_image(ctx, set, 0, gain_view);
+        pipeline::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
+        pipeline::write_image(ctx, set, 3, caustic_view);
         Ok(OverlayPass {
             pipeline,
             layout,
             _pool: pool,
             _set_layout: set_layout,
-            sets,
+            set,
         })
     }
 
-    /// Records the rectangle `rect` (plane-local) of gain `gain` (an index of the views given
-    /// to [`OverlayPass::new`]) for one eye.
+    /// Records the rectangle `rect` (plane-local) for one eye, adding k alpha(d) and G
+    /// weighted by `switches`.
     ///
     /// # Safety
     /// `cmd` must be recording inside a render pass compatible with the one given to
-    /// [`OverlayPass::new`], and the gain image must have been written by commands submitted
+    /// [`OverlayPass::new`], and the gain images must have been written by commands submitted
     /// before (or recorded earlier into) `cmd`, and still be alive when it executes.
     pub unsafe fn record(
         &self,
@@ -117,13 +121,15 @@ impl OverlayPass {
         cmd: vk::CommandBuffer,
         eye: &EyeParams,
         world_from_plane: Mat4,
-        gain: usize,
+        switches: [f32; 2],
         rect: [f32; 4],
     ) {
         let d = &ctx.device;
         let push = OverlayPush {
             clip_from_plane: (eye.clip_from_world() * world_from_plane).to_cols_array(),
             rect,
+            switches,
+            _pad: [0.0; 2],
         };
         // SAFETY: the caller's contract; the pipeline, layout and set are this pass's and
         // live until the renderer has waited for its frames.
@@ -134,13 +140,13 @@ impl OverlayPass {
                 vk::PipelineBindPoint::GRAPHICS,
                 self.layout.raw(),
                 0,
-                &[self.sets[gain]],
+                &[self.set],
                 &[],
             );
             d.cmd_push_constants(
                 cmd,
                 self.layout.raw(),
-                vk::ShaderStageFlags::VERTEX,
+                PUSH_STAGES,
                 0,
                 bytemuck::bytes_of(&push),
             );
@@ -148,3 +154,9 @@ impl OverlayPass {
         }
     }
 }
+
+/// The stages reading the push constants: the vertex stage the rectangle, the fragment stage
+/// the switches.
+const PUSH_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
+    vk::ShaderStageFlags::VERTEX.as_raw() | vk::ShaderStageFlags::FRAGMENT.as_raw(),
+);

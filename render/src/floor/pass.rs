@@ -1,5 +1,5 @@
 //! The floor pass: builds the floor-space fields' pipelines once per scene and records their
-//! computation (mask, distance transform, distance, ramp, combination) when a frame first needs
+//! computation (mask, distance transform, distance, ramp, live caustics) when a frame first needs
 //! them (progress.rs tracks whether it has really run; readback.rs copies the fields back).
 //!
 //! Just over 600 lines: the field targets, the distance transform and the stamps already live
@@ -9,10 +9,9 @@
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 
-use super::distance_transform::{COMBINE, DIST, DistanceTransform, RAMP};
+use super::distance_transform::{DIST, DistanceTransform, RAMP};
 use super::fields::{
-    CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN, MASK, OVERLAY, Stamps,
-    TexelRect, bounding,
+    CLEAR, DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, Stamps, TexelRect, bounding,
 };
 use super::geometry::{
     Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect,
@@ -65,26 +64,26 @@ pub(crate) struct InducerPass {
     mask_pipeline: Owned<vk::Pipeline>,
     /// Layout of the mask pass (push constants only).
     mask_layout: Owned<vk::PipelineLayout>,
-    /// Distance, ramp and combine pipelines (`DIST` ..= `COMBINE`).
+    /// Distance and ramp pipelines (`DIST`, `RAMP`).
     field_pipelines: Vec<Owned<vk::Pipeline>>,
     /// Their pipeline layout.
     field_layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets below.
     _pool: Owned<vk::DescriptorPool>,
-    /// Set layout of the full-screen passes: source and mask (or gain and G) textures, the
-    /// sampler of the gain (fs_combine only) and the nearest shadow texels (fs_distance).
+    /// Set layout of the full-screen passes: source and mask textures and the nearest shadow
+    /// texels (fs_distance).
     _field_set_layout: Owned<vk::DescriptorSetLayout>,
     /// The set reading each field image as the source (null for images never read so).
     source_sets: [vk::DescriptorSet; FIELDS.len()],
-    /// The combine pass's set: the gain (with the photos' clamped bilinear sampler) and G.
-    combine_set: vk::DescriptorSet,
-    /// The caustic gain G (R32F, read texel for texel by fs_combine; zeros without a map).
+    /// The caustic gain G (R32F, filtered by the overlay; zeros without a map).
     caustic: Image,
+    /// Its size: the bake's, or the fields' without one.
+    caustic_extent: vk::Extent2D,
     /// Caustics computed per pose into `caustic`, once enabled.
     live: Option<LiveCaustics>,
     /// The nearest shadow texel of every texel (read by the distance pass).
     transform: DistanceTransform,
-    /// Mask, seeds (two), distance, gain and overlay gain, in the order of [`FIELDS`].
+    /// Mask, distance and gain, in the order of [`FIELDS`].
     pub(super) targets: Vec<FieldTarget>,
 }
 
@@ -107,8 +106,8 @@ impl InducerPass {
             width: n,
             height: n,
         };
-        // The overlay gain has the caustic map's size; G is zeros when the scene has no map,
-        // so that fs_combine always reads a valid image of the overlay gain's size.
+        // G is zeros when the scene has no map, so that the overlay always reads a valid
+        // image (and live caustics have a map to write, at the fields' size).
         let zeros;
         let (caustic_extent, caustic_gain, caustic_rect) = match &desc.caustics {
             Some(c) => (
@@ -126,13 +125,8 @@ impl InducerPass {
         };
 
         let mut targets = Vec::with_capacity(FIELDS.len());
-        for (index, (name, format)) in FIELDS.into_iter().enumerate() {
-            let extent = if index == OVERLAY {
-                caustic_extent
-            } else {
-                field_extent
-            };
-            targets.push(FieldTarget::new(ctx, name, format, extent)?);
+        for (name, format) in FIELDS {
+            targets.push(FieldTarget::new(ctx, name, format, field_extent)?);
         }
 
         let vertex = vk::ShaderStageFlags::VERTEX;
@@ -158,8 +152,7 @@ impl InducerPass {
             &[
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
-                (2, vk::DescriptorType::SAMPLER, fragment),
-                (3, vk::DescriptorType::STORAGE_BUFFER, fragment),
+                (2, vk::DescriptorType::STORAGE_BUFFER, fragment),
             ],
         )?;
         let field_layout = pipeline::layout(
@@ -168,11 +161,10 @@ impl InducerPass {
             fragment,
             size_of::<FieldPush>() as u32,
         )?;
-        // In the order DIST, RAMP, COMBINE, with the field each writes.
+        // In the order DIST, RAMP, with the field each writes.
         let field_stages = [
             (shaders::DISTANCE_FS, c"fs_distance", DISTANCE),
             (shaders::RAMP_FS, c"fs_ramp", GAIN),
-            (shaders::COMBINE_FS, c"fs_combine", OVERLAY),
         ];
         let mut field_pipelines = Vec::with_capacity(field_stages.len());
         for (spirv, entry, target) in field_stages {
@@ -202,13 +194,12 @@ impl InducerPass {
         let mask_view = targets[MASK].image.view;
         let transform = DistanceTransform::new(ctx, mask_view, n, floor.size_m / n as f32)?;
         let sources = [MASK, DISTANCE];
-        let sets = sources.len() as u32 + 1;
+        let sets = sources.len() as u32;
         let pool = pipeline::pool(
             ctx,
             sets,
             &[
                 (vk::DescriptorType::SAMPLED_IMAGE, 2 * sets),
-                (vk::DescriptorType::SAMPLER, sets),
                 (vk::DescriptorType::STORAGE_BUFFER, sets),
             ],
         )?;
@@ -219,24 +210,18 @@ impl InducerPass {
         for source in sources {
             let set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
             let view = targets[source].image.view;
-            pipeline::write_texture(ctx, set, 0, 2, view, scene.photo_sampler());
+            pipeline::write_image(ctx, set, 0, view);
             pipeline::write_image(ctx, set, 1, mask_view);
-            pipeline::write_storage_buffer(ctx, set, 3, nearest);
+            pipeline::write_storage_buffer(ctx, set, 2, nearest);
             source_sets[source] = set;
         }
-        let combine_set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
-        pipeline::write_texture(
+        let overlay = OverlayPass::new(
             ctx,
-            combine_set,
-            0,
-            2,
+            eye_render_pass,
+            scene,
             targets[GAIN].image.view,
-            scene.photo_sampler(),
-        );
-        pipeline::write_image(ctx, combine_set, 1, caustic.view);
-        pipeline::write_storage_buffer(ctx, combine_set, 3, nearest);
-        let gains = [targets[GAIN].image.view, targets[OVERLAY].image.view];
-        let overlay = OverlayPass::new(ctx, eye_render_pass, scene, &gains)?;
+            caustic.view,
+        )?;
 
         Ok(InducerPass {
             desc: params,
@@ -258,8 +243,8 @@ impl InducerPass {
             _pool: pool,
             _field_set_layout: field_set_layout,
             source_sets,
-            combine_set,
             caustic,
+            caustic_extent,
             transform,
             live: None,
             targets,
@@ -294,7 +279,7 @@ impl InducerPass {
         desc: &SceneDesc,
         live: LiveCausticsDesc,
     ) -> Result<()> {
-        let extent = self.targets[OVERLAY].extent;
+        let extent = self.caustic_extent;
         self.live = Some(LiveCaustics::new(
             ctx,
             &desc.mesh,
@@ -319,24 +304,22 @@ impl InducerPass {
     }
 
     /// The push constants shared by the full-screen passes.
-    fn push(&self, switches: [f32; 2], region: Option<TexelRect>) -> FieldPush {
+    fn push(&self, region: TexelRect) -> FieldPush {
         FieldPush {
             texel_m: self.texel_m.to_array(),
             size: self.desc.resolution_px as i32,
             ramp_width_m: self.desc.ramp_width_m,
             k: self.desc.k,
-            _pad: 0.0,
-            switches,
-            region: region.map_or([0; 4], |r| r.map(|v| v as i32)),
+            _pad: [0.0; 3],
+            region: region.map(|v| v as i32),
         }
     }
 
-    /// Records what a frame drawing the overlay with these switches still needs: the fields'
-    /// computation when no submitted work holds it, and, with `caustics`, the overlay gain's
-    /// combination (k alpha(d) if `inducer`, + G) when the last one submitted was for other
-    /// switches or the fields moved since. Returns what was recorded, for [`InducerPass::submitted`] and
-    /// [`InducerPass::finished`]; records nothing (the scene is static) otherwise. With
-    /// `stamps`, writes all [`FIELD_STAMPS`] timestamps, one after each stage.
+    /// Records what a frame drawing the overlay still needs: the fields' computation (and the
+    /// live caustic map's) when no submitted work holds it. Returns what was recorded, for
+    /// [`InducerPass::submitted`] and [`InducerPass::finished`]; records nothing (the scene
+    /// is static) otherwise. With `stamps`, writes all [`super::FIELD_STAMPS`] timestamps,
+    /// one after each stage.
     ///
     /// # Safety
     /// `cmd` must be recording outside any render pass, and be submitted before any command
@@ -348,84 +331,26 @@ impl InducerPass {
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
-        inducer: bool,
-        caustics: bool,
         stamps: Option<Stamps>,
     ) -> Prepared {
         let d = &ctx.device;
-        let switches = u8::from(inducer) | (u8::from(caustics) << 1);
-        // Without caustics the overlay draws the inducer's gain itself: nothing to combine.
-        let mut prepared = self.progress.plan(caustics.then_some(switches));
-        let stamp = |range| {
-            if let Some(stamps) = stamps {
-                // SAFETY: the caller's contract (recording outside a render pass, queries
-                // reset).
-                unsafe { stamps.write(d, cmd, range) };
-            }
-        };
+        let mut prepared = self.progress.plan();
         // SAFETY: the caller's contract covers both recordings (outside a render pass, the
-        // objects outlive the execution).
+        // objects outlive the execution) and the stamps.
         unsafe {
             if prepared.fields {
                 prepared.fields_within = self.record_fields(ctx, cmd, scene, stamps);
                 if let Some(live) = &self.live {
                     live.record(ctx, cmd, &self.pose, &self.caustic);
                 }
-            } else {
-                stamp(0..4);
+            } else if let Some(stamps) = stamps {
+                stamps.write(d, cmd, 0..4);
             }
-            stamp(4..5);
-            if let Some(switches) = prepared.combined {
-                let caustics_moved = prepared.fields && self.live.is_some();
-                (prepared.overlay_within, prepared.overlay_inducer) =
-                    self.record_combine(ctx, cmd, switches, caustics_moved);
+            if let Some(stamps) = stamps {
+                stamps.write(d, cmd, 4..5);
             }
-            stamp(5..FIELD_STAMPS);
         }
         prepared
-    }
-
-    /// Records the overlay gain's combination for `switches` (bit 0 inducer, bit 1
-    /// caustics) over the texels whose value can have changed since the last combination
-    /// submitted: where the inducer's rectangle was and is when only the fields moved (the
-    /// same switches, the caustic gain unchanged unless `caustics_moved`), else where the
-    /// overlay may be non-zero before or after. Every texel drawn gets its value, so nothing
-    /// is cleared. Returns the texels that may be non-zero afterwards and the inducer's part
-    /// of them.
-    ///
-    /// # Safety
-    /// As [`InducerPass::prepare`], after the fields' recording (if any).
-    unsafe fn record_combine(
-        &self,
-        ctx: &GpuContext,
-        cmd: vk::CommandBuffer,
-        switches: u8,
-        caustics_moved: bool,
-    ) -> (Option<TexelRect>, Option<TexelRect>) {
-        let (inducer, caustics) = (switches & 1 != 0, switches & 2 != 0);
-        let target = &self.targets[OVERLAY];
-        let (w, h) = (target.extent.width, target.extent.height);
-        let inducer_part = self.rect.filter(|_| inducer).map(|r| texel_rect(r, w, h));
-        let within = self
-            .overlay_rect(inducer, caustics)
-            .map(|r| texel_rect(r, w, h));
-        let (start, area) = match (self.progress.overlay_written, self.progress.last_combined) {
-            (Written::Anywhere, _) => (FieldStart::Discard, Some(target.full())),
-            (Written::Within(_), Some((last, before))) if last == switches && !caustics_moved => {
-                (FieldStart::KeepDraw, bounding(before, inducer_part))
-            }
-            (Written::Within(before), _) => (FieldStart::KeepDraw, bounding(before, within)),
-        };
-        if let Some(area) = area {
-            let push = self.push(
-                [f32::from(u8::from(inducer)), f32::from(u8::from(caustics))],
-                None,
-            );
-            let set = self.combine_set;
-            // SAFETY: the caller's contract; `Keep` only once submitted work drew the image.
-            unsafe { self.full_screen(ctx, cmd, OVERLAY, COMBINE, start, area, set, &push) };
-        }
-        (within, inducer_part)
     }
 
     /// The command buffer `prepared` was recorded into has been submitted.
@@ -441,7 +366,7 @@ impl InducerPass {
         let live_map = ok && prepared.fields && self.progress.is_current(prepared);
         self.progress.finished(prepared, ok);
         if let Some(live) = self.live.as_ref().filter(|_| live_map) {
-            let extent = self.targets[OVERLAY].extent;
+            let extent = self.caustic_extent;
             self.caustic_rect = match live.bounds() {
                 Ok(bounds) => bounds.map(|b| texels_plane_rect(b, extent.width, extent.height)),
                 // Unreadable (never on a host-visible buffer): the whole floor stays.
@@ -539,7 +464,7 @@ impl InducerPass {
             };
             self.transform.record(ctx, cmd, region);
             stamp(1..2);
-            let push = self.push([0.0; 2], Some(region));
+            let push = self.push(region);
             for (target, pipeline, source, k) in
                 [(DISTANCE, DIST, MASK, 2), (GAIN, RAMP, DISTANCE, 3)]
             {
@@ -615,25 +540,16 @@ impl InducerPass {
         inducer: bool,
         caustics: bool,
     ) {
-        // The precombined gain with the caustics, the inducer's own without.
-        let gain = if caustics {
-            COMBINED_GAIN
-        } else {
-            INDUCER_GAIN
-        };
         if let Some(rect) = self.overlay_rect(inducer, caustics) {
+            let switches = [inducer, caustics].map(|on| f32::from(u8::from(on)));
             // SAFETY: the caller's contract, which is the overlay's.
             unsafe {
                 self.overlay
-                    .record(ctx, cmd, eye, self.world_from_plane, gain, rect)
+                    .record(ctx, cmd, eye, self.world_from_plane, switches, rect)
             };
         }
     }
 }
-
-/// The overlay's gains: the inducer's k alpha(d), the combined k alpha(d) + G.
-const INDUCER_GAIN: usize = 0;
-const COMBINED_GAIN: usize = 1;
 
 /// The floor's whole unit square, plane-local.
 const WHOLE_FLOOR: [f32; 4] = [-0.5, -0.5, 0.5, 0.5];

@@ -43,16 +43,9 @@ pub(crate) struct Prepared {
     pub(super) generation: u64,
     /// The fields (mask, distance, gain) were recorded.
     pub(super) fields: bool,
-    /// The overlay gain's combination for these switches was recorded.
-    pub(super) combined: Option<u8>,
     /// With `fields`: the texels of the mask, distance and gain that may differ from their
     /// cleared values once it ran.
     pub(super) fields_within: Option<TexelRect>,
-    /// With `combined`: the texels of the overlay gain that may be non-zero once it ran,
-    /// and the inducer's share of them.
-    pub(super) overlay_within: Option<TexelRect>,
-    /// With `combined`: the overlay texels of the inducer's rectangle it was drawn for.
-    pub(super) overlay_inducer: Option<TexelRect>,
 }
 
 /// Progress of the floor fields' computation: changes only when the renderer reports what
@@ -66,26 +59,17 @@ pub(super) struct Progress {
     pub computations: u64,
     /// The mask, distance and gain fields.
     pub fields: Computation,
-    /// The switches (bit 0 inducer, bit 1 caustics) of the last overlay gain combination
-    /// submitted, while it is submitted or done.
-    combined_for: Option<u8>,
     /// Where the mask, distance and gain may differ from their cleared values after the
     /// work submitted so far.
     pub fields_written: Written,
-    /// Where the overlay gain may be non-zero after the work submitted so far.
-    pub overlay_written: Written,
-    /// The last combination submitted (of any generation): its switches and the overlay
-    /// texels of the inducer's rectangle it was drawn for.
-    pub last_combined: Option<(u8, Option<TexelRect>)>,
 }
 
 impl Progress {
-    /// What must be recorded for a frame drawing with `switches`.
-    pub fn plan(&self, switches: Option<u8>) -> Prepared {
+    /// What must be recorded for a frame drawing the overlay.
+    pub fn plan(&self) -> Prepared {
         Prepared {
             generation: self.generation,
             fields: self.fields == Computation::Missing,
-            combined: switches.filter(|&s| self.combined_for != Some(s)),
             ..Prepared::default()
         }
     }
@@ -95,12 +79,11 @@ impl Progress {
         prepared.generation == self.generation
     }
 
-    /// The object or the light moved: the fields and the combination are due again, and
-    /// work recorded before is of an older generation.
+    /// The object or the light moved: the fields are due again, and work recorded before is
+    /// of an older generation.
     pub fn invalidate(&mut self) {
         self.generation += 1;
         self.fields = Computation::Missing;
-        self.combined_for = None;
     }
 
     /// The work `prepared` was recorded into has been submitted.
@@ -109,19 +92,12 @@ impl Progress {
         if prepared.fields {
             self.fields_written = Written::Within(prepared.fields_within);
         }
-        if let Some(switches) = prepared.combined {
-            self.overlay_written = Written::Within(prepared.overlay_within);
-            self.last_combined = Some((switches, prepared.overlay_inducer));
-        }
         if prepared.generation != self.generation {
             return;
         }
         if prepared.fields {
             self.computations += 1;
             self.fields = Computation::Submitted;
-        }
-        if prepared.combined.is_some() {
-            self.combined_for = prepared.combined;
         }
     }
 
@@ -130,10 +106,6 @@ impl Progress {
     pub fn finished(&mut self, prepared: Prepared, ok: bool) {
         if !ok && prepared.fields {
             self.fields_written = Written::Anywhere;
-        }
-        if !ok && prepared.combined.is_some() {
-            self.overlay_written = Written::Anywhere;
-            self.last_combined = None;
         }
         if prepared.generation != self.generation {
             return;
@@ -145,9 +117,6 @@ impl Progress {
                 Computation::Missing
             };
         }
-        if !ok && prepared.combined.is_some() && self.combined_for == prepared.combined {
-            self.combined_for = None;
-        }
     }
 }
 
@@ -158,51 +127,41 @@ mod tests {
     #[test]
     fn fields_count_as_computed_only_after_their_work_finished() {
         let mut progress = Progress::default();
-        let first = progress.plan(Some(1));
+        let first = progress.plan();
         assert_eq!(
             first,
             Prepared {
                 generation: 0,
                 fields: true,
-                combined: Some(1),
                 ..Prepared::default()
             }
         );
         // Recording alone changes nothing: a failed submit leaves everything to redo.
-        assert_eq!(progress.plan(Some(1)), first);
+        assert_eq!(progress.plan(), first);
         progress.submitted(first);
         assert_eq!(progress.fields, Computation::Submitted);
         // Work submitted later is ordered after it: nothing to record again.
-        assert_eq!(progress.plan(Some(1)), Prepared::default());
+        assert_eq!(progress.plan(), Prepared::default());
         progress.finished(first, true);
         assert_eq!(progress.fields, Computation::Done);
-        // Other switches need only a new combination.
-        assert_eq!(
-            progress.plan(Some(3)),
-            Prepared {
-                generation: 0,
-                fields: false,
-                combined: Some(3),
-                ..Prepared::default()
-            }
-        );
+        assert!(!progress.plan().fields);
     }
 
     #[test]
     fn a_move_makes_everything_due_and_ignores_older_work() {
         let mut progress = Progress::default();
-        let first = progress.plan(Some(3));
+        let first = progress.plan();
         progress.submitted(first);
         progress.invalidate();
-        let second = progress.plan(Some(3));
-        assert!(second.fields && second.combined == Some(3));
+        let second = progress.plan();
+        assert!(second.fields && second.generation == 1);
         progress.submitted(second);
         // The older frame finishing does not mark the newer computation done ...
         progress.finished(first, true);
         assert_eq!(progress.fields, Computation::Submitted);
         // ... nor does its failure make it due again.
         progress.finished(first, false);
-        assert!(!progress.plan(Some(3)).fields);
+        assert!(!progress.plan().fields);
         progress.finished(second, true);
         assert_eq!(progress.fields, Computation::Done);
     }
@@ -210,10 +169,10 @@ mod tests {
     #[test]
     fn a_failed_wait_makes_the_fields_due_again() {
         let mut progress = Progress::default();
-        let first = progress.plan(Some(2));
+        let first = progress.plan();
         progress.submitted(first);
         progress.finished(first, false);
-        assert_eq!(progress.plan(Some(2)), first);
+        assert_eq!(progress.plan(), first);
     }
 
     #[test]
@@ -222,33 +181,24 @@ mod tests {
         assert_eq!(progress.fields_written, Written::Anywhere);
         let first = Prepared {
             fields_within: Some([1, 2, 3, 4]),
-            overlay_within: Some([0, 0, 8, 8]),
-            overlay_inducer: Some([2, 4, 6, 8]),
-            ..progress.plan(Some(1))
+            ..progress.plan()
         };
         // Recorded but not submitted: nothing drawn.
         assert_eq!(progress.fields_written, Written::Anywhere);
         progress.submitted(first);
         assert_eq!(progress.fields_written, Written::Within(Some([1, 2, 3, 4])));
-        assert_eq!(
-            progress.overlay_written,
-            Written::Within(Some([0, 0, 8, 8]))
-        );
-        assert_eq!(progress.last_combined, Some((1, Some([2, 4, 6, 8]))));
         progress.finished(first, true);
         assert_eq!(progress.fields_written, Written::Within(Some([1, 2, 3, 4])));
         // Work that failed leaves the images unknown, whatever its generation.
         progress.invalidate();
         let second = Prepared {
             fields_within: None,
-            ..progress.plan(Some(1))
+            ..progress.plan()
         };
         progress.submitted(second);
         assert_eq!(progress.fields_written, Written::Within(None));
         progress.invalidate();
         progress.finished(second, false);
         assert_eq!(progress.fields_written, Written::Anywhere);
-        assert_eq!(progress.overlay_written, Written::Anywhere);
-        assert_eq!(progress.last_combined, None);
     }
 }

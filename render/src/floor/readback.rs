@@ -5,7 +5,6 @@ use gpu_allocator::MemoryLocation;
 
 use super::fields::{DISTANCE, GAIN, InducerFields, MASK, READBACK_BYTES_PER_TEXEL};
 use super::pass::InducerPass;
-use super::progress::Prepared;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::{Buffer, subresource_range};
@@ -26,10 +25,7 @@ impl InducerPass {
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        let mut prepared = Prepared {
-            combined: None,
-            ..self.progress.plan(None)
-        };
+        let mut prepared = self.progress.plan();
         let this = &*self;
         let d = &ctx.device;
         // SAFETY: one_shot records outside a render pass and waits for the work (on a timeout

@@ -29,6 +29,13 @@ const VARIANTS: &[Variant] = &[
         "absorbing.ball",
     ),
     ("glass", "fs_two_surface_", &[("CONVEX", 1.0)], "convex"),
+    ("floor_overlay", "fs_main", &[("CAUSTICS", 1.0)], "caustics"),
+    (
+        "floor_overlay",
+        "fs_main",
+        &[("CAUSTICS", 1.0), ("FILTERED_CAUSTICS", 1.0)],
+        "caustics.filtered",
+    ),
     (
         "glass",
         "fs_two_surface_",

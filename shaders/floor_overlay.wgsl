@@ -26,6 +26,13 @@ var<push_constant> overlay: Overlay;
 // The caustic gain G (R32F, the bake's or the live map's size) over the floor's unit square.
 @group(0) @binding(3) var caustic: texture_2d<f32>;
 
+// The pipeline adds the caustic gain G (pipeline constant, so that the inducer's own pipeline
+// has no caustic code: a branch on a uniform costs both of its sides on a CPU device).
+override CAUSTICS: bool = false;
+// G is sampled through the sampler's bilinear filter, where the device filters R32_SFLOAT
+// (optional in Vulkan; render/src/floor/overlay.rs checks it), instead of four loads.
+override FILTERED_CAUSTICS: bool = false;
+
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,
@@ -50,6 +57,9 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VertexOut {
 // filter it; computed from four loads because linear filtering of R32_SFLOAT is optional in
 // Vulkan. Same formula as Bake::sample on the CPU.
 fn caustic_gain(uv: vec2<f32>) -> f32 {
+    if FILTERED_CAUSTICS {
+        return textureSampleLevel(caustic, clamp_sampler, uv, 0.0).r;
+    }
     let size = vec2<i32>(textureDimensions(caustic));
     let last = vec2<f32>(size - 1);
     let t = clamp(uv * vec2<f32>(size) - 0.5, vec2<f32>(0.0), last);
@@ -69,7 +79,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
         // eq. 4: alpha'(d) = k alpha(d).
         overlay_gain += overlay.switches.x * textureSampleLevel(gain, clamp_sampler, in.uv, 0.0).r;
     }
-    if overlay.switches.y > 0.0 {
+    if CAUSTICS && overlay.switches.y > 0.0 {
         // eq. 6: L'_c = max(0, L_c - L_r) = G L_r; G >= 0 is checked on loading.
         overlay_gain += overlay.switches.y * caustic_gain(in.uv);
     }

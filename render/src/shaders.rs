@@ -62,7 +62,13 @@ pub const ROWS_CS: &[u8] = spirv!("inducer_distance.cs_rows");
 pub const DISTANCE_FS: &[u8] = spirv!("inducer_field.fs_distance");
 pub const RAMP_FS: &[u8] = spirv!("inducer_field.fs_ramp");
 pub const OVERLAY_VS: &[u8] = spirv!("floor_overlay.vs_main");
-pub const OVERLAY_FS: &[u8] = spirv!("floor_overlay.fs_main");
+/// The floor overlay's fragment shader: the inducer's gain alone, with the caustic gain G
+/// (`CAUSTICS`), and with G filtered by the sampler (`FILTERED_CAUSTICS`).
+pub const OVERLAY_FS: [&[u8]; 3] = [
+    spirv!("floor_overlay.fs_main"),
+    spirv!("floor_overlay.fs_main.caustics"),
+    spirv!("floor_overlay.fs_main.caustics.filtered"),
+];
 pub const CAUSTICS_TRACE_CS: &[u8] = spirv!("caustics_live.cs_trace");
 pub const CAUSTICS_SMOOTH_CS: &[u8] = spirv!("caustics_live.cs_smooth");
 

@@ -31,9 +31,10 @@ struct OverlayPush {
 
 /// The overlay's pipeline and descriptors, freed on drop.
 pub(crate) struct OverlayPass {
-    /// The pipeline (additive, in the eye render pass).
-    pipeline: Owned<vk::Pipeline>,
-    /// Its layout.
+    /// The pipelines (additive, in the eye render pass): the inducer's gain alone, and with
+    /// the caustic gain added.
+    pipelines: Vec<Owned<vk::Pipeline>>,
+    /// Their layout.
     layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets.
     _pool: Owned<vk::DescriptorPool>,
@@ -70,23 +71,49 @@ impl OverlayPass {
             PUSH_STAGES,
             size_of::<OverlayPush>() as u32,
         )?;
+        // G through the sampler's filter where the device filters R32_SFLOAT, else four loads.
+        // SAFETY: the physical device is the context's.
+        let features = unsafe {
+            ctx.instance
+                .get_physical_device_format_properties(ctx.physical, vk::Format::R32_SFLOAT)
+        }
+        .optimal_tiling_features;
+        let filtered = features.contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
+        let caustic_shader = if filtered {
+            OVERLAY_FS[2]
+        } else {
+            OVERLAY_FS[1]
+        };
+        tracing::debug!(
+            "floor overlay: G {}",
+            if filtered {
+                "filtered by the sampler"
+            } else {
+                "filtered from four loads (this device does not filter R32_SFLOAT)"
+            }
+        );
         // The overlay neither tests nor writes depth: it is drawn before the glass, which then
         // covers it where the object is in front (on a see-through display the real floor
         // behind the glass is seen through the glass's own layer).
-        let pipeline = pipeline::create(
-            ctx,
-            &PipelineSpec {
-                render_pass: eye_render_pass,
-                layout: layout.raw(),
-                vertex: (OVERLAY_VS, c"vs_main"),
-                fragment: (OVERLAY_FS, c"fs_main"),
-                bindings: &[],
-                attributes: &[],
-                cull: vk::CullModeFlags::NONE,
-                depth: false,
-                blend: Blend::Add,
-            },
-        )?;
+        let pipelines = [OVERLAY_FS[0], caustic_shader]
+            .into_iter()
+            .map(|fragment| {
+                pipeline::create(
+                    ctx,
+                    &PipelineSpec {
+                        render_pass: eye_render_pass,
+                        layout: layout.raw(),
+                        vertex: (OVERLAY_VS, c"vs_main"),
+                        fragment: (fragment, c"fs_main"),
+                        bindings: &[],
+                        attributes: &[],
+                        cull: vk::CullModeFlags::NONE,
+                        depth: false,
+                        blend: Blend::Add,
+                    },
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
         let pool = pipeline::pool(
             ctx,
             1,
@@ -100,7 +127,7 @@ impl OverlayPass {
         pipeline::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
         pipeline::write_image(ctx, set, 3, caustic_view);
         Ok(OverlayPass {
-            pipeline,
+            pipelines,
             layout,
             _pool: pool,
             _set_layout: set_layout,
@@ -134,7 +161,9 @@ impl OverlayPass {
         // SAFETY: the caller's contract; the pipeline, layout and set are this pass's and
         // live until the renderer has waited for its frames.
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw());
+            // The caustic pipeline only when G is added.
+            let pipeline = &self.pipelines[usize::from(switches[1] > 0.0)];
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw());
             d.cmd_bind_descriptor_sets(
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,

@@ -1,10 +1,6 @@
 //! The floor pass: builds the floor-space fields' pipelines once per scene and records their
 //! computation (mask, distance transform, distance, ramp, live caustics) when a frame first needs
 //! them (progress.rs tracks whether it has really run; readback.rs copies the fields back).
-//!
-//! Just over 600 lines: the field targets, the distance transform and the stamps already live
-//! in their own modules; what stays is the one ordered recording of the floor passes and the
-//! regions they touch, which reads best in one place.
 
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};

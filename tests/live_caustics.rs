@@ -25,11 +25,13 @@ fn scene(name: &str) -> Scene {
 }
 
 /// Renders one frame with the caustics on for each light position (`None`: the scene's) and
-/// returns the live gain maps, with the wall-clock milliseconds of each frame.
+/// returns the live gain maps, with the wall-clock milliseconds of each frame. With
+/// `fields_first`, the inducer's fields are read back before the first frame.
 fn live_gains(
     scene: &Scene,
     live: LiveCausticsDesc,
     lights: &[Option<Vec3>],
+    fields_first: bool,
 ) -> Vec<(Vec<f32>, f64)> {
     let ctx = GpuContext::headless(&ContextOptions {
         validation: true,
@@ -56,6 +58,9 @@ fn live_gains(
             ..Look::default()
         },
     };
+    if fields_first {
+        renderer.inducer_fields().expect("the fields read back");
+    }
     let mut out = Vec::new();
     for light in lights {
         if let Some(light) = light {
@@ -175,7 +180,7 @@ fn live_sphere_caustics_match_the_bake_and_focus_on_the_light_axis() {
     let offset = scene.light.position_m - center;
     let turned = center + Quat::from_rotation_y(std::f32::consts::FRAC_PI_2) * offset;
     let live = LiveCausticsDesc::default();
-    let frames = live_gains(&scene, live, &[None, Some(turned)]);
+    let frames = live_gains(&scene, live, &[None, Some(turned)], false);
     let (gain, wall_ms) = &frames[0];
     assert_eq!(gain.len(), bake.gain.len());
     let reference = smoothed(&bake.gain, w as usize, live.smoothing_px);
@@ -213,7 +218,7 @@ fn live_diamond_caustics_match_the_bake() {
     let scene = scene("diamond.toml");
     let bake = scene.caustics.gain.as_ref().expect("the bake is loaded");
     let live = LiveCausticsDesc::default();
-    let frames = live_gains(&scene, live, &[None]);
+    let frames = live_gains(&scene, live, &[None], false);
     let (gain, wall_ms) = &frames[0];
     assert_eq!(gain.len(), bake.gain.len());
     let reference = smoothed(&bake.gain, bake.width_px as usize, live.smoothing_px);
@@ -233,4 +238,22 @@ fn live_diamond_caustics_match_the_bake() {
         "the diamond's caustic covers {region} texels"
     );
     assert!(rms < 0.05, "relative RMS {rms}");
+}
+
+#[test]
+fn reading_the_fields_back_first_computes_the_live_map_too() {
+    // A read-back of the inducer's fields computes the pose's work, the live caustic map with
+    // it: the frame after it must show that map, not an empty one, and the same one as a
+    // frame without the read-back (integer atomics: the same bits).
+    let scene = scene("diamond.toml");
+    let live = LiveCausticsDesc::default();
+    let plain = live_gains(&scene, live, &[None], false);
+    let after_read_back = live_gains(&scene, live, &[None], true);
+    let lit = plain[0].0.iter().filter(|&&g| g > 0.0).count();
+    assert!(lit > 1000, "the live map has {lit} lit texels");
+    assert!(
+        plain[0].0 == after_read_back[0].0,
+        "the map after a read-back differs ({} lit texels)",
+        after_read_back[0].0.iter().filter(|&&g| g > 0.0).count()
+    );
 }

@@ -335,10 +335,7 @@ impl InducerPass {
         // objects outlive the execution) and the stamps.
         unsafe {
             if prepared.fields {
-                prepared.fields_within = self.record_fields(ctx, cmd, scene, stamps);
-                if let Some(live) = &self.live {
-                    live.record(ctx, cmd, &self.pose, &self.caustic);
-                }
+                prepared.fields_within = self.record_pose_work(ctx, cmd, scene, stamps);
             } else if let Some(stamps) = stamps {
                 stamps.write(d, cmd, 0..4);
             }
@@ -379,6 +376,28 @@ impl InducerPass {
         )
     }
 
+    /// Records what a new pose needs: the fields ([`InducerPass::record_fields`]) and, with
+    /// live caustics, the caustic map. Returns the fields' texels as `record_fields` does.
+    ///
+    /// # Safety
+    /// As [`InducerPass::prepare`].
+    pub(super) unsafe fn record_pose_work(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        stamps: Option<Stamps>,
+    ) -> Option<TexelRect> {
+        // SAFETY: the caller's contract, which is both recordings'.
+        unsafe {
+            let within = self.record_fields(ctx, cmd, scene, stamps);
+            if let Some(live) = &self.live {
+                live.record(ctx, cmd, &self.pose, &self.caustic);
+            }
+            within
+        }
+    }
+
     /// Records the mask, the distance transform and the distance and ramp passes, each stage
     /// followed by its stamp (the first four of `stamps`); returns the texels that may differ
     /// from the cleared values once they ran (the overlay's rectangle).
@@ -390,7 +409,7 @@ impl InducerPass {
     ///
     /// # Safety
     /// As [`InducerPass::prepare`].
-    pub(super) unsafe fn record_fields(
+    unsafe fn record_fields(
         &self,
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,

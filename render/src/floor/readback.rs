@@ -33,7 +33,8 @@ impl InducerPass {
         // render passes (or the fields' recording just before), and are put back there.
         let result = ctx.one_shot(|cmd| unsafe {
             if prepared.fields {
-                prepared.fields_within = this.record_fields(ctx, cmd, scene, None);
+                // The live caustic map with them: the pose's work counts as done after this.
+                prepared.fields_within = this.record_pose_work(ctx, cmd, scene, None);
             }
             this.record_copies(d, cmd, &offsets, &buffer);
         });
@@ -43,8 +44,8 @@ impl InducerPass {
             }
             return Err(e);
         }
-        self.progress.submitted(prepared);
-        self.progress.finished(prepared, true);
+        self.submitted(prepared);
+        self.finished(prepared, true);
         Ok(InducerFields::decode(
             buffer.mapped()?,
             n,

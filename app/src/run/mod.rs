@@ -142,10 +142,9 @@ impl FrameSink for RunSink {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
         self.apply_typed_controls(input);
         let placement = self.motion.placement(input.time_ns)?;
-        let pose = self.motion.pose_of(&placement);
-        self.looks
-            .set_object_pose(placement.object_position_m, pose.world_from_model);
-        self.object_center_m = placement.object_position_m;
+        let (center, pose) = (placement.object_position_m, self.motion.pose_of(&placement));
+        self.looks.set_object_pose(center, pose.world_from_model);
+        self.object_center_m = center;
         Some(pose)
     }
 

@@ -39,13 +39,7 @@ fn view(xvfb: &Path, scene: &Path, args: &[&str], cwd: &Path) -> Output {
         .current_dir(cwd)
         .output()
         .expect("running xvfb-run");
-    assert!(
-        out.status.success(),
-        "vitreous view failed: {}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
+    shots::succeeded(out)
 }
 
 #[test]

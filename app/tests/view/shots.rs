@@ -5,6 +5,18 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
+/// `out` of a `vitreous view` run, which must have succeeded (its output in the message if
+/// not).
+pub fn succeeded(out: std::process::Output) -> std::process::Output {
+    assert!(
+        out.status.success(),
+        "vitreous view failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// The program `name` on PATH; None outside CI when it is missing (in CI a missing one fails
 /// the test), with `install` saying what installs it.
 pub fn program(name: &str, install: &str) -> Option<PathBuf> {

@@ -96,14 +96,7 @@ impl Weston {
             }
             std::thread::sleep(Duration::from_millis(50));
         }
-        let out = child.wait_with_output().expect("its output");
-        assert!(
-            out.status.success(),
-            "vitreous view failed: {}\n{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
-        out
+        super::shots::succeeded(child.wait_with_output().expect("its output"))
     }
 }
 

@@ -50,6 +50,8 @@ pub unsafe extern "system" fn get_action_state_boolean(
     state: *mut sys::ActionStateBoolean,
 ) -> sys::Result {
     guard("xrGetActionStateBoolean", || {
+        // SAFETY: the app's structure, null or valid.
+        let action = unsafe { info.as_ref() }.map(|get| get.action.into_raw());
         let found = {
             let reg = registry();
             reg.session(session.into_raw()).map(|(s, i)| {
@@ -58,11 +60,13 @@ pub unsafe extern "system" fn get_action_state_boolean(
                     i.buttons.clone(),
                     s.first_display_ns,
                     s.syncs_ns,
-                    i.button_actions.clone(),
+                    // The scripted inputs of this action only: the call comes several times a
+                    // frame.
+                    action.and_then(|a| i.button_actions.get(&a).cloned()),
                 )
             })
         };
-        let Some((next, buttons, first_ns, (previous_ns, now_ns), actions)) = found else {
+        let Some((next, buttons, first_ns, (previous_ns, now_ns), inputs)) = found else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the next layer's function with the app's arguments.
@@ -77,9 +81,7 @@ pub unsafe extern "system" fn get_action_state_boolean(
         let (Some(buttons), Some(first_ns), Some(now_ns)) = (buttons, first_ns, now_ns) else {
             return r;
         };
-        let Some(input) = actions
-            .get(&get.action.into_raw())
-            .and_then(|inputs| buttons.input_for(inputs, get.subaction_path))
+        let Some(input) = inputs.and_then(|inputs| buttons.input_for(&inputs, get.subaction_path))
         else {
             return r;
         };

@@ -40,6 +40,11 @@ struct Params {
     // x: self-intersection offset, model units; y: fixed-point units per unit of G;
     // z: paths below this weight end; w: gains below this are stored as 0.
     misc: vec4<f32>,
+    // xyz: the centre of the shell every surface point lies in, model units; w: its inner
+    // radius (0: a ball).
+    shell: vec4<f32>,
+    // x: the shell's outer radius; y: the slack added to its stretches, model units.
+    shell_outer: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> p: Params;
@@ -60,6 +65,9 @@ struct Params {
 @group(0) @binding(8) var<storage, read_write> bounds: array<atomic<u32>, 4>;
 // The fixed-point gains smoothed along the rows (between the two smoothing passes).
 @group(0) @binding(9) var<storage, read_write> scratch: array<u32>;
+// Per triangle its first corner and two edges (xyz, model units), gathered once so that a
+// test reads three vectors instead of three indices and three positions.
+@group(0) @binding(10) var<storage, read> corners: array<vec4<f32>>;
 
 const NONE: u32 = 0xffffffffu;
 const PI: f32 = 3.14159265358979;
@@ -82,11 +90,9 @@ struct Ray {
 
 // Möller-Trumbore: (t, u, v) of the hit of the ray with triangle `tri`, t < 0 for none.
 fn triangle_hit(o: vec3<f32>, d: vec3<f32>, tri: u32) -> vec3<f32> {
-    let a = positions[indices[3u * tri]].xyz;
-    let b = positions[indices[3u * tri + 1u]].xyz;
-    let c = positions[indices[3u * tri + 2u]].xyz;
-    let e1 = b - a;
-    let e2 = c - a;
+    let a = corners[3u * tri].xyz;
+    let e1 = corners[3u * tri + 1u].xyz;
+    let e2 = corners[3u * tri + 2u].xyz;
     let pv = cross(d, e2);
     let det = dot(e1, pv);
     if det == 0.0 {
@@ -106,9 +112,12 @@ fn triangle_hit(o: vec3<f32>, d: vec3<f32>, tri: u32) -> vec3<f32> {
     return vec3<f32>(dot(e2, qv) * inv, u, v);
 }
 
-// The nearest surface hit along the ray before `t_max`, walking the grid's cells in order.
-fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
-    var best = Hit(t_max, NONE, 0.0, 0.0);
+// The nearest surface hit along the ray at a distance within [t_from, t_to], or `best` when
+// that is nearer, walking the grid's cells in order over that stretch. Hits found in the
+// cells walked beyond `t_to` are kept too (they are real, and nearer ones are found by a
+// later walk that starts from `best`).
+fn walk_grid(o: vec3<f32>, d: vec3<f32>, t_from: f32, t_to: f32, best_so_far: Hit) -> Hit {
+    var best = best_so_far;
     let dims = vec3<i32>(p.grid_dims.xyz);
     let side = p.grid_origin.w;
     let lo = p.grid_origin.xyz;
@@ -117,9 +126,10 @@ fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
     let inv = 1.0 / safe;
     let t0 = (lo - o) * inv;
     let t1 = (hi - o) * inv;
-    let t_in = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
-    let t_out = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
-    if t_in > min(t_out, t_max) {
+    let t_in = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0)),
+        t_from);
+    let t_out = min(min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z)), t_to);
+    if t_in > min(t_out, best.t) {
         return best;
     }
     let start = o + d * t_in;
@@ -156,6 +166,51 @@ fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
         if any(cell < vec3<i32>(0)) || any(cell >= dims) {
             break;
         }
+    }
+    return best;
+}
+
+// The nearest surface hit along the ray (unit `d`) before `t_max`. Every point of the mesh
+// lies in the shell between two spheres about its centre (`shell`, `shell_outer`), so only
+// the ray's one or two stretches inside that shell are walked: a ball-like mesh's hollow
+// middle and the space around it cost no grid steps.
+fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
+    let none = Hit(t_max, NONE, 0.0, 0.0);
+    let oc = o - p.shell.xyz;
+    let b = dot(oc, d);
+    // The ray's nearest approach to the centre, squared (stable far from the object).
+    let q = oc - b * d;
+    let q2 = dot(q, q);
+    let outer = p.shell_outer.x;
+    let h_out = outer * outer - q2;
+    if h_out < 0.0 {
+        return none;
+    }
+    let s_out = sqrt(h_out);
+    let pad = p.shell_outer.y;
+    let enter = max(-b - s_out - pad, 0.0);
+    let leave = min(-b + s_out + pad, t_max);
+    if enter > leave {
+        return none;
+    }
+    let inner = p.shell.w;
+    let h_in = inner * inner - q2;
+    if inner <= 0.0 || h_in <= 0.0 {
+        return walk_grid(o, d, enter, leave, none);
+    }
+    let s_in = sqrt(h_in);
+    // The stretch before the inner ball, then the one after it.
+    var best = none;
+    let near_end = min(-b - s_in + pad, leave);
+    if enter <= near_end {
+        best = walk_grid(o, d, enter, near_end, best);
+        if best.tri != NONE && best.t <= near_end {
+            return best;
+        }
+    }
+    let far_start = max(-b + s_in - pad, enter);
+    if far_start <= leave {
+        best = walk_grid(o, d, far_start, leave, best);
     }
     return best;
 }

@@ -74,6 +74,41 @@ const MIN_WEIGHT: f32 = 1e-4;
 /// Gains below this are stored as 0 (the bake's `MIN_GAIN`).
 const MIN_GAIN: f32 = 0.001;
 
+/// The slack on the shell's radii and on a ray's stretches inside it, relative to the mesh's
+/// outer radius (f32 rounding of a ray from a light some 40 radii away is about 1e-5 of it).
+const SHELL_SLACK: f32 = 1e-3;
+
+/// The smallest distance from `center` to the plane of any of the mesh's triangles (model
+/// units; degenerate triangles skipped): every point of the surface is at least that far
+/// from `center` (0 where a plane passes through it).
+fn inner_radius(positions: &[Vec3], indices: &[u32], center: Vec3) -> f32 {
+    indices
+        .chunks_exact(3)
+        .filter_map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+            let normal = (b - a).cross(c - a).try_normalize()?;
+            Some(normal.dot(a - center).abs())
+        })
+        .fold(f32::INFINITY, f32::min)
+        .min(
+            positions
+                .iter()
+                .map(|p| p.distance(center))
+                .fold(f32::INFINITY, f32::min),
+        )
+}
+
+/// Per triangle its first corner and its two edges from it (model units), in order.
+fn corner_and_edges(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    indices
+        .chunks_exact(3)
+        .flat_map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+            [a, b - a, c - a]
+        })
+        .collect()
+}
+
 /// Uniform block matching `Params` in caustics_live.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -90,6 +125,8 @@ struct Params {
     grid_dims: [u32; 4],
     map: [u32; 4],
     misc: [f32; 4],
+    shell: [f32; 4],
+    shell_outer: [f32; 4],
 }
 
 /// The compute passes, their buffers and what they need of the mesh; freed on drop.
@@ -110,7 +147,7 @@ pub(crate) struct LiveCaustics {
     /// `Params`, rewritten before each computation.
     params: Buffer,
     /// Mesh and grid buffers, read by the trace pass.
-    _mesh: [Buffer; 5],
+    _mesh: [Buffer; 6],
     /// Fixed-point sums per texel.
     sums: Buffer,
     /// The fixed-point map smoothed along the rows.
@@ -134,6 +171,9 @@ pub(crate) struct LiveCaustics {
     model_center: Vec3,
     /// Largest distance of a vertex from it, model units.
     model_radius: f32,
+    /// Smallest distance from it to a triangle's plane, model units: no surface point lies
+    /// nearer the centre.
+    model_inner_radius: f32,
     /// Floor unit square to world.
     world_from_plane: Mat4,
     /// Relative index of refraction.
@@ -179,6 +219,7 @@ impl LiveCaustics {
             .iter()
             .map(|p| p.distance(model_center))
             .fold(0.0f32, f32::max);
+        let model_inner_radius = inner_radius(mesh.positions, mesh.indices, model_center);
         let vec4s =
             |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.extend(0.0).to_array()).collect() };
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
@@ -212,6 +253,12 @@ impl LiveCaustics {
                 ctx,
                 "caustics grid triangles",
                 bytemuck::cast_slice(&grid.triangles),
+                storage,
+            )?,
+            Buffer::with_data(
+                ctx,
+                "caustics triangle corners",
+                bytemuck::cast_slice(&vec4s(&corner_and_edges(mesh.positions, mesh.indices))),
                 storage,
             )?,
         ];
@@ -253,7 +300,7 @@ impl LiveCaustics {
         )?;
         let compute = vk::ShaderStageFlags::COMPUTE;
         let mut bindings = vec![(0, vk::DescriptorType::UNIFORM_BUFFER, compute)];
-        bindings.extend((1..=9).map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute)));
+        bindings.extend((1..=10).map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute)));
         let set_layout = pipeline::set_layout(ctx, &bindings)?;
         // The smoothing step; the trace pass reads none.
         let layout = pipeline::layout(ctx, Some(set_layout.raw()), compute, 4)?;
@@ -265,13 +312,14 @@ impl LiveCaustics {
             1,
             &[
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
-                (vk::DescriptorType::STORAGE_BUFFER, 9),
+                (vk::DescriptorType::STORAGE_BUFFER, 10),
             ],
         )?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
-        buffers.extend(mesh_buffers.iter().map(|b| b.buffer));
+        buffers.extend(mesh_buffers[..5].iter().map(|b| b.buffer));
         buffers.extend([sums.buffer, gain.buffer, bounds.buffer, scratch.buffer]);
+        buffers.push(mesh_buffers[5].buffer);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|&buffer| {
@@ -320,6 +368,7 @@ impl LiveCaustics {
             grid_dims: grid.dims,
             model_center,
             model_radius,
+            model_inner_radius,
             world_from_plane,
             ior,
         })
@@ -356,6 +405,8 @@ impl LiveCaustics {
             .length();
         let texel_area = floor_area / (self.size[0] as f32 * self.size[1] as f32);
         let [gx, gy, gz] = self.grid_dims;
+        // Rounding room for the shell's radii and the stretches of a ray inside it.
+        let slack = self.model_radius * SHELL_SLACK;
         Params {
             model_from_world: m.inverse().to_cols_array(),
             world_from_model: m.to_cols_array(),
@@ -374,6 +425,11 @@ impl LiveCaustics {
                 self.desc.smoothing_px,
             ],
             misc: Vec4::new(self.model_radius * 2e-5, FIXED_POINT, MIN_WEIGHT, MIN_GAIN).to_array(),
+            shell: self
+                .model_center
+                .extend((self.model_inner_radius - slack).max(0.0))
+                .to_array(),
+            shell_outer: [self.model_radius + slack, slack, 0.0, 0.0],
         }
     }
 
@@ -557,5 +613,57 @@ mod tests {
     fn smoothing_runs_along_rows_then_columns_or_rows_alone_without_a_box() {
         assert_eq!(smooth_steps(0), vec![LAST_STEP]);
         assert_eq!(smooth_steps(5), vec![0, 1 | LAST_STEP]);
+    }
+
+    /// A cube of half-side 1 about the origin, 12 triangles, offset by `shift`.
+    fn cube(shift: Vec3) -> (Vec<Vec3>, Vec<u32>) {
+        let positions = (0..8)
+            .map(|i| {
+                let bit = |k: u32| if i >> k & 1 == 1 { 1.0 } else { -1.0 };
+                Vec3::new(bit(0), bit(1), bit(2)) + shift
+            })
+            .collect();
+        let faces = [
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+        ];
+        let indices = faces
+            .iter()
+            .flat_map(|[a, b, c, d]| [*a, *b, *c, *a, *c, *d])
+            .collect();
+        (positions, indices)
+    }
+
+    #[test]
+    fn the_shell_holds_every_surface_point() {
+        // About the centre the faces' planes are 1 away, the corners sqrt(3).
+        let (positions, indices) = cube(Vec3::ZERO);
+        assert!((inner_radius(&positions, &indices, Vec3::ZERO) - 1.0).abs() < 1e-6);
+        // Seen from a point in the plane of a face, the shell reaches down to it.
+        assert_eq!(inner_radius(&positions, &indices, Vec3::X), 0.0);
+        // Points sampled over every triangle lie no nearer than the inner radius, from an
+        // off-centre point too.
+        let (positions, indices) = cube(Vec3::new(0.3, -0.2, 0.1));
+        let center = Vec3::new(0.1, 0.1, -0.2);
+        let inner = inner_radius(&positions, &indices, center);
+        assert!(inner > 0.5, "{inner}");
+        for t in indices.chunks_exact(3) {
+            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+            for (u, v) in [(0.0, 0.0), (0.5, 0.5), (0.2, 0.3), (1.0, 0.0), (0.0, 1.0)] {
+                let point = a + u * (b - a) + v * (c - a);
+                assert!(point.distance(center) >= inner - 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn a_triangle_is_stored_as_its_first_corner_and_two_edges() {
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let edges = corner_and_edges(&positions, &[1, 2, 3]);
+        assert_eq!(edges, vec![Vec3::X, Vec3::Y - Vec3::X, Vec3::Z - Vec3::X]);
     }
 }

@@ -5,9 +5,12 @@
 use glam::Vec3;
 
 /// Grid cells per triangle of the mesh: smaller cells hold fewer triangles to test, more
-/// cells take more steps; on the glass sphere (9024 triangles) 4 cut the `live caustics`
-/// stage by about 7 % against 1 (155-156 ms against 164-172 ms on lavapipe; 8 as 4).
-const CELLS_PER_TRIANGLE: f32 = 4.0;
+/// cells take more steps. Since a ray walks only its stretches through the shell the surface
+/// lies in (caustics_live.wgsl `closest_hit`), steps are few: on the glass sphere (9024
+/// triangles) 16 cut the unsmoothed `live caustics` stage at 1980 x 1980 from 83 ms to 72 ms
+/// against 4 on lavapipe (64, which the 64 cells per axis cap, 71 ms). Before the shell, 4
+/// had cut it by about 7 % against 1 (155-156 ms against 164-172 ms).
+const CELLS_PER_TRIANGLE: f32 = 16.0;
 
 /// A uniform grid over the mesh's bounding box, model space: the triangles overlapping each
 /// cell (x fastest, then y, then z).
@@ -97,9 +100,10 @@ mod tests {
         ];
         let indices = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
         let grid = Grid::new(&positions, &indices);
-        // Three cells per side over the unit box (cbrt(4 x 4) rounded up), grown by a hair
-        // for the padding.
-        assert_eq!(grid.dims, [4, 4, 4]);
+        // Four cells per side over the unit box (cbrt(4 x 16)), one more for the padding's
+        // hair beyond it.
+        assert_eq!(grid.dims, [5, 5, 5]);
+        assert!((grid.side - 0.25).abs() < 1e-6);
         // Each triangle appears at least once, the one facing the origin's corner in all
         // cells its box touches.
         for t in 0..4u32 {

@@ -273,12 +273,12 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         .context("preparing the renderer")?;
     views::enable_live_caustics(&mut renderer, &scene, any_caustics)
         .context("preparing live caustics")?;
-    // The same scene with caustics computed per pose, on a map of the bake's size.
+    // The same scene with caustics computed per pose, on the scene's live map
+    // (`[caustics] resolution_px`, `smoothing_px`, `photons_per_side`).
     let mut live_renderer = match (options.live_caustics, &scene.caustics.gain) {
         (true, Some(bake)) if scene.caustics.mode == CausticsMode::Baked => {
             let mut live = scene.clone();
             live.caustics.mode = CausticsMode::Live;
-            live.caustics.resolution_px = bake.width_px;
             live.load_caustics()?;
             let ctx = GpuContext::headless(&ContextOptions {
                 validation: options.validate,

@@ -12,7 +12,9 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 use sha2::{Digest, Sha256};
 use toml::Spanned;
 use vitreous_render::Attenuation;
-use vitreous_render::floor::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE, MAX_SMOOTHING_PX};
+use vitreous_render::floor::{
+    DEFAULT_LIVE_RESOLUTION_PX, LiveCausticsDesc, MAX_PHOTONS_PER_SIDE, MAX_SMOOTHING_PX,
+};
 use vitreous_xr::{Fov, Pose};
 
 use super::error::Source;
@@ -351,7 +353,7 @@ impl Loader<'_> {
             resolution_px: self.count(
                 "caustics.resolution_px",
                 raw.caustics.resolution_px.as_ref(),
-                1980,
+                DEFAULT_LIVE_RESOLUTION_PX,
                 16..=4096,
             )?,
             photons_per_side: self.count(

@@ -73,7 +73,10 @@ pub use crate::scene::{
 pub(crate) use fields::Stamps;
 pub use fields::{FIELD_STAMPS, FieldPassesMs, InducerFields};
 pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
-pub use live::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE, MAX_SMOOTHING_PX};
+pub use live::{
+    DEFAULT_RESOLUTION_PX as DEFAULT_LIVE_RESOLUTION_PX, LiveCausticsDesc, MAX_PHOTONS_PER_SIDE,
+    MAX_SMOOTHING_PX,
+};
 pub(crate) use pass::InducerPass;
 pub(crate) use progress::Prepared;
 pub use reference::{

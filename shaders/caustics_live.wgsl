@@ -43,7 +43,8 @@ struct Params {
     // xyz: the centre of the shell every surface point lies in, model units; w: its inner
     // radius (0: a ball).
     shell: vec4<f32>,
-    // x: the shell's outer radius; y: the slack added to its stretches, model units.
+    // x: the shell's outer radius; y: the slack added to its stretches, model units; z: 1 when
+    // the mesh bounds one convex body (a ray leaving it outward meets no more of it), else 0.
     shell_outer: vec4<f32>,
 };
 
@@ -389,7 +390,12 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
         if ray.inside == 0u {
             to_floor = floor_t(ray.origin, ray.dir);
         }
-        hit = closest_hit(ray.origin, ray.dir, select(1e30, to_floor, to_floor > 0.0));
+        if ray.inside == 0u && p.shell_outer.z > 0.0 {
+            // Leaving a convex body outward: nothing of it lies ahead.
+            hit = Hit(0.0, NONE, 0.0, 0.0);
+        } else {
+            hit = closest_hit(ray.origin, ray.dir, select(1e30, to_floor, to_floor > 0.0));
+        }
         if hit.tri == NONE && to_floor > 0.0 {
             deposit(ray.origin + ray.dir * to_floor, ray.weight);
         }

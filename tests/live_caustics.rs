@@ -261,6 +261,25 @@ fn live_diamond_caustics_match_the_bake() {
 }
 
 #[test]
+fn the_shipped_sphere_and_diamond_are_convex_the_torus_is_not() {
+    // Photons leaving a convex mesh outward skip the search for another surface.
+    for (name, convex) in [
+        ("glass-sphere.toml", true),
+        ("diamond.toml", true),
+        ("torus.toml", false),
+    ] {
+        let path = workspace().join("config/scenes").join(name);
+        let scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+        let mesh = &scene.object.mesh;
+        assert_eq!(
+            vitreous_render::convex::is_convex(&mesh.positions, &mesh.indices),
+            convex,
+            "{name}"
+        );
+    }
+}
+
+#[test]
 fn reading_the_fields_back_first_computes_the_live_map_too() {
     // A read-back of the inducer's fields computes the pose's work, the live caustic map with
     // it: the frame after it must show that map, not an empty one, and the same one as a

@@ -2,6 +2,8 @@
 //! finds where a ray inside leaves them exactly (shaders/glass.wgsl `convex_exit`), without
 //! the radial map, whose filtered texels round every facet edge over a texel.
 
+use std::collections::HashMap;
+
 use glam::{Vec3, Vec4};
 
 /// Most facet planes a convex object may have for the exact exit (a round brilliant has 73
@@ -86,6 +88,122 @@ pub fn convex_exit(planes: &[Vec4], p: Vec3, d: Vec3) -> Option<(f32, Vec3)> {
         .min_by(|x, y| x.0.total_cmp(&y.0))
 }
 
+/// Whether the mesh is the closed surface of one convex body, its triangles wound
+/// counter-clockwise seen from outside: every edge joins exactly two triangles, in opposite
+/// directions; the triangles form one connected surface enclosing a positive volume; and
+/// across every edge the far corner of each triangle lies behind the other's plane (or within
+/// 1e-5 of the mesh's size in front of it: flat facets split into triangles). A closed,
+/// connected surface convex at every edge bounds a convex body, so a ray leaving it outward
+/// never meets it again. Vertices within that tolerance of one another count as one
+/// (flat-shaded meshes repeat them per facet, seams repeat them rounded); a triangle with
+/// two corners at one position makes the answer no.
+pub fn is_convex(positions: &[Vec3], indices: &[u32]) -> bool {
+    if indices.is_empty() || !indices.len().is_multiple_of(3) {
+        return false;
+    }
+    let (lo, hi) = positions
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
+            (l.min(p), h.max(p))
+        });
+    let tolerance = 1e-5 * (hi - lo).length();
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return false;
+    }
+    // Vertices within the tolerance of one another are one (seams repeat them, rounded).
+    let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    let mut unique: Vec<Vec3> = Vec::new();
+    let mut welded = Vec::with_capacity(positions.len());
+    for &p in positions {
+        let cell = ((p - lo) / tolerance).floor().as_i64vec3().to_array();
+        let mut found = None;
+        'near: for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let key = [cell[0] + dx, cell[1] + dy, cell[2] + dz];
+                    if let Some(ids) = cells.get(&key) {
+                        found = ids
+                            .iter()
+                            .copied()
+                            .find(|&id| unique[id as usize].distance(p) <= tolerance);
+                        if found.is_some() {
+                            break 'near;
+                        }
+                    }
+                }
+            }
+        }
+        let id = found.unwrap_or_else(|| {
+            unique.push(p);
+            let id = unique.len() as u32 - 1;
+            cells.entry(cell).or_default().push(id);
+            id
+        });
+        welded.push(id);
+    }
+    let Some(triangles) = indices
+        .chunks_exact(3)
+        .map(|t| {
+            let v = [0, 1, 2].map(|k| welded.get(t[k] as usize).copied());
+            match v {
+                [Some(a), Some(b), Some(c)] if a != b && b != c && a != c => Some([a, b, c]),
+                _ => None,
+            }
+        })
+        .collect::<Option<Vec<[u32; 3]>>>()
+    else {
+        return false;
+    };
+    // Per undirected edge: its sides, each (triangle, far corner, whether the triangle runs
+    // along it from the lower id).
+    type Side = (usize, u32, bool);
+    let mut edges: HashMap<(u32, u32), Vec<Side>> = HashMap::new();
+    for (t, v) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b, far) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
+            edges
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push((t, far, a < b));
+        }
+    }
+    let corner = |id: u32| unique[id as usize];
+    let normal = |t: usize| {
+        let [a, b, c] = triangles[t].map(corner);
+        (b - a).cross(c - a).normalize_or_zero()
+    };
+    let in_front = |t: usize, id: u32| normal(t).dot(corner(id) - corner(triangles[t][0]));
+    let mut parent: Vec<usize> = (0..triangles.len()).collect();
+    fn root(parent: &mut [usize], mut t: usize) -> usize {
+        while parent[t] != t {
+            parent[t] = parent[parent[t]];
+            t = parent[t];
+        }
+        t
+    }
+    for list in edges.values() {
+        let [(t0, far0, up0), (t1, far1, up1)] = list[..] else {
+            return false;
+        };
+        if up0 == up1 || in_front(t0, far1) > tolerance || in_front(t1, far0) > tolerance {
+            return false;
+        }
+        let (r0, r1) = (root(&mut parent, t0), root(&mut parent, t1));
+        parent[r0] = r1;
+    }
+    let first = root(&mut parent, 0);
+    let connected = (0..triangles.len()).all(|t| root(&mut parent, t) == first);
+    // Six times the enclosed volume, positive when the triangles face outward.
+    let volume: f32 = triangles
+        .iter()
+        .map(|v| {
+            let [a, b, c] = v.map(corner);
+            (a - lo).dot((b - lo).cross(c - lo))
+        })
+        .sum();
+    connected && volume > 0.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -123,5 +241,28 @@ mod tests {
         assert!(facet_planes(&dented, &n, &i, Vec3::ZERO).is_none());
         // No mesh at all.
         assert!(facet_planes(&[], &[], &[], Vec3::ZERO).is_none());
+    }
+
+    #[test]
+    fn convex_meshes_are_told_from_dented_open_split_and_inside_out_ones() {
+        let (p, _, i) = cube(0.5);
+        assert!(is_convex(&p, &i));
+        // The -x face pushed in past the centre.
+        let mut dented = p.clone();
+        for v in dented.iter_mut().take(4) {
+            v.x = 0.3;
+        }
+        assert!(!is_convex(&dented, &i));
+        // One face missing: open.
+        assert!(!is_convex(&p, &i[..i.len() - 6]));
+        // Wound inward.
+        let inward: Vec<u32> = i.chunks_exact(3).flat_map(|t| [t[0], t[2], t[1]]).collect();
+        assert!(!is_convex(&p, &inward));
+        // Two cubes side by side: each convex, together not one body.
+        let mut two = p.clone();
+        two.extend(p.iter().map(|v| *v + Vec3::new(2.0, 0.0, 0.0)));
+        let mut both = i.clone();
+        both.extend(i.iter().map(|&k| k + p.len() as u32));
+        assert!(!is_convex(&two, &both));
     }
 }

@@ -9,7 +9,7 @@ use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
-use super::triangle_grid::Grid;
+use super::triangle_grid::{Grid, corner_and_edges, inner_radius};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::memory::{Buffer, Image, subresource_range};
@@ -85,37 +85,6 @@ const MIN_GAIN: f32 = 0.001;
 /// outer radius (f32 rounding of a ray from a light some 40 radii away is about 1e-5 of it).
 const SHELL_SLACK: f32 = 1e-3;
 
-/// The smallest distance from `center` to the plane of any of the mesh's triangles (model
-/// units; degenerate triangles skipped): every point of the surface is at least that far
-/// from `center` (0 where a plane passes through it).
-fn inner_radius(positions: &[Vec3], indices: &[u32], center: Vec3) -> f32 {
-    indices
-        .chunks_exact(3)
-        .filter_map(|t| {
-            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
-            let normal = (b - a).cross(c - a).try_normalize()?;
-            Some(normal.dot(a - center).abs())
-        })
-        .fold(f32::INFINITY, f32::min)
-        .min(
-            positions
-                .iter()
-                .map(|p| p.distance(center))
-                .fold(f32::INFINITY, f32::min),
-        )
-}
-
-/// Per triangle its first corner and its two edges from it (model units), in order.
-fn corner_and_edges(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
-    indices
-        .chunks_exact(3)
-        .flat_map(|t| {
-            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
-            [a, b - a, c - a]
-        })
-        .collect()
-}
-
 /// Uniform block matching `Params` in caustics_live.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -181,6 +150,9 @@ pub(crate) struct LiveCaustics {
     /// Smallest distance from it to a triangle's plane, model units: no surface point lies
     /// nearer the centre.
     model_inner_radius: f32,
+    /// Whether the mesh bounds one convex body ([`crate::convex::is_convex`]): a photon
+    /// leaving it outward then meets no more of it.
+    convex: bool,
     /// Floor unit square to world.
     world_from_plane: Mat4,
     /// Relative index of refraction.
@@ -227,6 +199,7 @@ impl LiveCaustics {
             .map(|p| p.distance(model_center))
             .fold(0.0f32, f32::max);
         let model_inner_radius = inner_radius(mesh.positions, mesh.indices, model_center);
+        let convex = crate::convex::is_convex(mesh.positions, mesh.indices);
         let vec4s =
             |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.extend(0.0).to_array()).collect() };
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
@@ -376,6 +349,7 @@ impl LiveCaustics {
             model_center,
             model_radius,
             model_inner_radius,
+            convex,
             world_from_plane,
             ior,
         })
@@ -436,7 +410,12 @@ impl LiveCaustics {
                 .model_center
                 .extend((self.model_inner_radius - slack).max(0.0))
                 .to_array(),
-            shell_outer: [self.model_radius + slack, slack, 0.0, 0.0],
+            shell_outer: [
+                self.model_radius + slack,
+                slack,
+                if self.convex { 1.0 } else { 0.0 },
+                0.0,
+            ],
         }
     }
 
@@ -620,57 +599,5 @@ mod tests {
     fn smoothing_runs_along_rows_then_columns_or_rows_alone_without_a_box() {
         assert_eq!(smooth_steps(0), vec![LAST_STEP]);
         assert_eq!(smooth_steps(5), vec![0, 1 | LAST_STEP]);
-    }
-
-    /// A cube of half-side 1 about the origin, 12 triangles, offset by `shift`.
-    fn cube(shift: Vec3) -> (Vec<Vec3>, Vec<u32>) {
-        let positions = (0..8)
-            .map(|i| {
-                let bit = |k: u32| if i >> k & 1 == 1 { 1.0 } else { -1.0 };
-                Vec3::new(bit(0), bit(1), bit(2)) + shift
-            })
-            .collect();
-        let faces = [
-            [0, 2, 6, 4],
-            [1, 5, 7, 3],
-            [0, 4, 5, 1],
-            [2, 3, 7, 6],
-            [0, 1, 3, 2],
-            [4, 6, 7, 5],
-        ];
-        let indices = faces
-            .iter()
-            .flat_map(|[a, b, c, d]| [*a, *b, *c, *a, *c, *d])
-            .collect();
-        (positions, indices)
-    }
-
-    #[test]
-    fn the_shell_holds_every_surface_point() {
-        // About the centre the faces' planes are 1 away, the corners sqrt(3).
-        let (positions, indices) = cube(Vec3::ZERO);
-        assert!((inner_radius(&positions, &indices, Vec3::ZERO) - 1.0).abs() < 1e-6);
-        // Seen from a point in the plane of a face, the shell reaches down to it.
-        assert_eq!(inner_radius(&positions, &indices, Vec3::X), 0.0);
-        // Points sampled over every triangle lie no nearer than the inner radius, from an
-        // off-centre point too.
-        let (positions, indices) = cube(Vec3::new(0.3, -0.2, 0.1));
-        let center = Vec3::new(0.1, 0.1, -0.2);
-        let inner = inner_radius(&positions, &indices, center);
-        assert!(inner > 0.5, "{inner}");
-        for t in indices.chunks_exact(3) {
-            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
-            for (u, v) in [(0.0, 0.0), (0.5, 0.5), (0.2, 0.3), (1.0, 0.0), (0.0, 1.0)] {
-                let point = a + u * (b - a) + v * (c - a);
-                assert!(point.distance(center) >= inner - 1e-6);
-            }
-        }
-    }
-
-    #[test]
-    fn a_triangle_is_stored_as_its_first_corner_and_two_edges() {
-        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
-        let edges = corner_and_edges(&positions, &[1, 2, 3]);
-        assert_eq!(edges, vec![Vec3::X, Vec3::Y - Vec3::X, Vec3::Z - Vec3::X]);
     }
 }

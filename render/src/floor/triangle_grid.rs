@@ -1,6 +1,8 @@
-//! A uniform grid of triangle lists over a mesh, model space: how the live caustics' photons
-//! (shaders/caustics_live.wgsl) find the few triangles a segment can meet among the sphere's
-//! 9024, built once on the CPU when live caustics are enabled.
+//! What the live caustics' photons (shaders/caustics_live.wgsl) need of the mesh, built once
+//! on the CPU when live caustics are enabled, in model space: a uniform grid of triangle
+//! lists, so that a segment tests the few triangles it can meet among the sphere's 9024; the
+//! shell every surface point lies in, so that it walks only its stretches through it; and the
+//! triangles as a corner and two edges.
 
 use glam::Vec3;
 
@@ -86,6 +88,37 @@ impl Grid {
     }
 }
 
+/// The smallest distance from `center` to the plane of any of the mesh's triangles (model
+/// units; degenerate triangles skipped): every point of the surface is at least that far
+/// from `center` (0 where a plane passes through it).
+pub(crate) fn inner_radius(positions: &[Vec3], indices: &[u32], center: Vec3) -> f32 {
+    indices
+        .chunks_exact(3)
+        .filter_map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+            let normal = (b - a).cross(c - a).try_normalize()?;
+            Some(normal.dot(a - center).abs())
+        })
+        .fold(f32::INFINITY, f32::min)
+        .min(
+            positions
+                .iter()
+                .map(|p| p.distance(center))
+                .fold(f32::INFINITY, f32::min),
+        )
+}
+
+/// Per triangle its first corner and its two edges from it (model units), in order.
+pub(crate) fn corner_and_edges(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    indices
+        .chunks_exact(3)
+        .flat_map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+            [a, b - a, c - a]
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -113,5 +146,57 @@ mod tests {
         assert_eq!(total as usize, grid.triangles.len());
         let corner = grid.cells[0];
         assert_eq!(corner[1], 4, "every face touches the cell at the origin");
+    }
+
+    /// A cube of half-side 1 about the origin, 12 triangles, offset by `shift`.
+    fn cube(shift: Vec3) -> (Vec<Vec3>, Vec<u32>) {
+        let positions = (0..8)
+            .map(|i| {
+                let bit = |k: u32| if i >> k & 1 == 1 { 1.0 } else { -1.0 };
+                Vec3::new(bit(0), bit(1), bit(2)) + shift
+            })
+            .collect();
+        let faces = [
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+        ];
+        let indices = faces
+            .iter()
+            .flat_map(|[a, b, c, d]| [*a, *b, *c, *a, *c, *d])
+            .collect();
+        (positions, indices)
+    }
+
+    #[test]
+    fn the_shell_holds_every_surface_point() {
+        // About the centre the faces' planes are 1 away, the corners sqrt(3).
+        let (positions, indices) = cube(Vec3::ZERO);
+        assert!((inner_radius(&positions, &indices, Vec3::ZERO) - 1.0).abs() < 1e-6);
+        // Seen from a point in the plane of a face, the shell reaches down to it.
+        assert_eq!(inner_radius(&positions, &indices, Vec3::X), 0.0);
+        // Points sampled over every triangle lie no nearer than the inner radius, from an
+        // off-centre point too.
+        let (positions, indices) = cube(Vec3::new(0.3, -0.2, 0.1));
+        let center = Vec3::new(0.1, 0.1, -0.2);
+        let inner = inner_radius(&positions, &indices, center);
+        assert!(inner > 0.5, "{inner}");
+        for t in indices.chunks_exact(3) {
+            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+            for (u, v) in [(0.0, 0.0), (0.5, 0.5), (0.2, 0.3), (1.0, 0.0), (0.0, 1.0)] {
+                let point = a + u * (b - a) + v * (c - a);
+                assert!(point.distance(center) >= inner - 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn a_triangle_is_stored_as_its_first_corner_and_two_edges() {
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let edges = corner_and_edges(&positions, &[1, 2, 3]);
+        assert_eq!(edges, vec![Vec3::X, Vec3::Y - Vec3::X, Vec3::Z - Vec3::X]);
     }
 }

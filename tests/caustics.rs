@@ -103,6 +103,20 @@ fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], effects: &str) -> Readb
 
 #[test]
 fn eye_image_adds_inducer_and_caustic_gain_times_a_uniform_floor() {
+    adds_inducer_and_caustic_gain(false);
+}
+
+/// As above on the overlay's other path, G filtered from four loads (devices that do not
+/// filter R32_SFLOAT, which Vulkan leaves optional; lavapipe filters it).
+#[test]
+fn eye_image_adds_the_gains_with_g_from_four_loads() {
+    adds_inducer_and_caustic_gain(true);
+}
+
+/// Each pixel of the floor in conditions c, b and inducer against k alpha(d) + G of the CPU
+/// reference times a uniform grey photo; with `four_loads` the overlay is built as on a device
+/// that does not filter R32_SFLOAT.
+fn adds_inducer_and_caustic_gain(four_loads: bool) {
     const GREY: u8 = 120;
     let mut s = scene("glass-sphere.toml");
     s.floor.photo = Image::new(8, 8, PixelData::Srgb8([GREY, GREY, GREY, 255].repeat(64))).unwrap();
@@ -118,6 +132,9 @@ fn eye_image_adds_inducer_and_caustic_gain_times_a_uniform_floor() {
         device_name: None,
     })
     .expect("Vulkan device with validation");
+    if four_loads {
+        ctx.pretend_r32_float_unfiltered();
+    }
     let mut r = Renderer::new(ctx, &views::scene_desc(&s, None), w, h).expect("renderer");
     let eyes = top_down_eyes(&s);
     let none = render(&mut r, eyes, "a");
@@ -176,8 +193,13 @@ fn eye_image_adds_inducer_and_caustic_gain_times_a_uniform_floor() {
             }
         }
         eprintln!(
-            "{name}: {caustic_px} caustic pixels ({both_px} also in the ramp), {dark_px} \
-             without overlay, worst error {worst:.4} of L_r"
+            "{name}{}: {caustic_px} caustic pixels ({both_px} also in the ramp), {dark_px} \
+             without overlay, worst error {worst:.4} of L_r",
+            if four_loads {
+                " (G from four loads)"
+            } else {
+                ""
+            }
         );
         if caustics_on {
             assert!(caustic_px > 1000, "{name}: {caustic_px}");

@@ -6,7 +6,7 @@
 //! headless implementation.
 
 use std::ffi::{CStr, c_char, c_void};
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -184,6 +184,8 @@ pub struct GpuContext {
     /// Allocations left before [`GpuContext::fail_allocation_after`]'s injected failure
     /// (`u32::MAX`: never).
     allocations_before_failure: AtomicU32,
+    /// Set by [`GpuContext::pretend_r32_float_unfiltered`].
+    r32_float_unfiltered: AtomicBool,
     /// Command pool for one-shot uploads.
     upload_pool: vk::CommandPool,
     /// Human-readable device name.
@@ -372,6 +374,7 @@ impl GpuContext {
             queue,
             allocator: Some(Arc::new(Mutex::new(allocator))),
             allocations_before_failure: AtomicU32::new(u32::MAX),
+            r32_float_unfiltered: AtomicBool::new(false),
             upload_pool,
             driver,
             timestamp_period_ns,
@@ -408,6 +411,26 @@ impl GpuContext {
     pub fn fail_allocation_after(&self, count: u32) {
         self.allocations_before_failure
             .store(count, Ordering::Relaxed);
+    }
+
+    /// Whether the device filters sampled R32_SFLOAT images linearly (optional in Vulkan;
+    /// where it does not, the floor overlay filters the caustic gain from four loads).
+    pub fn filters_r32_float(&self) -> bool {
+        // SAFETY: the physical device is this context's.
+        let features = unsafe {
+            self.instance
+                .get_physical_device_format_properties(self.physical, vk::Format::R32_SFLOAT)
+        }
+        .optimal_tiling_features;
+        features.contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR)
+            && !self.r32_float_unfiltered.load(Ordering::Relaxed)
+    }
+
+    /// From now on [`GpuContext::filters_r32_float`] answers no, as on a device without the
+    /// feature: for tests of the overlay's four-load path on devices that filter.
+    #[doc(hidden)]
+    pub fn pretend_r32_float_unfiltered(&self) {
+        self.r32_float_unfiltered.store(true, Ordering::Relaxed);
     }
 
     /// Counts one allocation towards an injected failure; the error when it is due.

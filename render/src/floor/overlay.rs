@@ -72,13 +72,7 @@ impl OverlayPass {
             size_of::<OverlayPush>() as u32,
         )?;
         // G through the sampler's filter where the device filters R32_SFLOAT, else four loads.
-        // SAFETY: the physical device is the context's.
-        let features = unsafe {
-            ctx.instance
-                .get_physical_device_format_properties(ctx.physical, vk::Format::R32_SFLOAT)
-        }
-        .optimal_tiling_features;
-        let filtered = features.contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
+        let filtered = ctx.filters_r32_float();
         let caustic_shader = if filtered {
             OVERLAY_FS[2]
         } else {

@@ -5,16 +5,19 @@
 // L_o = L_r + L_s + L'_c = (1 + k alpha(d) + G) L_r (eq. 5); the shadow keeps L_r (+ L'_c).
 //
 // Only the rectangle around the shadow plus the ramp's width (and the caustics' extent) is
-// drawn (computed on the CPU). Each pixel sums the two gains itself, each only when switched
+// drawn (computed on the CPU; on the frames that compute a live caustic map, joined here with
+// that map's box, which only the GPU knows then). Each pixel sums the two gains itself, each only when switched
 // on: k alpha(d) filtered from the inducer's field, G filtered from the caustic map; texels
 // with no light are discarded before the photo is read.
 
 struct Overlay {
     clip_from_plane: mat4x4<f32>,
-    // The drawn part of the floor's unit square: min x, min y, max x, max y (plane-local).
+    // The drawn part of the floor's unit square: min x, min y, max x, max y (plane-local;
+    // nothing when min x > max x).
     rect: vec4<f32>,
-    // Weights of the inducer's gain and of the caustic gain G (1 on, 0 off).
-    switches: vec2<f32>,
+    // x, y: weights of the inducer's gain and of the caustic gain G (1 on, 0 off); z: 1 to
+    // draw also over the live caustic map's box in `live_bounds`.
+    switches: vec4<f32>,
 };
 
 var<push_constant> overlay: Overlay;
@@ -25,6 +28,10 @@ var<push_constant> overlay: Overlay;
 @group(0) @binding(2) var clamp_sampler: sampler;
 // The caustic gain G (R32F, the bake's or the live map's size) over the floor's unit square.
 @group(0) @binding(3) var caustic: texture_2d<f32>;
+// The live caustic map's non-zero texels, x0, y0, x1, y1 (ends included; none when x0 > x1),
+// written by the live computation earlier in the frame (render/src/floor/live.rs): on the
+// frames that compute a map only the GPU knows it.
+@group(0) @binding(4) var<storage, read> live_bounds: array<u32, 4>;
 
 // The pipeline adds the caustic gain G (pipeline constant, so that the inducer's own pipeline
 // has no caustic code: a branch on a uniform costs both of its sides on a CPU device).
@@ -38,14 +45,37 @@ struct VertexOut {
     @location(0) uv: vec2<f32>,
 };
 
+// The plane-local rectangle of the texels in `live_bounds` plus one texel on each side (as
+// caustic_rect and texels_plane_rect on the CPU); `rect` when it holds none.
+fn with_live_bounds(rect: vec4<f32>) -> vec4<f32> {
+    let b = vec4<f32>(f32(live_bounds[0]), f32(live_bounds[1]), f32(live_bounds[2]),
+        f32(live_bounds[3]));
+    if live_bounds[0] > live_bounds[2] {
+        return rect;
+    }
+    let size = vec2<f32>(textureDimensions(caustic));
+    let u = (vec2<f32>(b.x, b.z) + vec2<f32>(-1.0, 2.0)) / size.x;
+    let v = (vec2<f32>(b.y, b.w) + vec2<f32>(-1.0, 2.0)) / size.y;
+    let live = vec4<f32>(max(u.x - 0.5, -0.5), max(0.5 - v.y, -0.5), min(u.y - 0.5, 0.5),
+        min(0.5 - v.x, 0.5));
+    if rect.x > rect.z {
+        return live;
+    }
+    return vec4<f32>(min(rect.xy, live.xy), max(rect.zw, live.zw));
+}
+
 @vertex
 fn vs_main(@builtin(vertex_index) index: u32) -> VertexOut {
-    let r = overlay.rect;
+    var r = overlay.rect;
+    if overlay.switches.z > 0.0 {
+        r = with_live_bounds(r);
+    }
     var corners = array<vec2<f32>, 6>(
         vec2<f32>(r.x, r.y), vec2<f32>(r.z, r.y), vec2<f32>(r.z, r.w),
         vec2<f32>(r.x, r.y), vec2<f32>(r.z, r.w), vec2<f32>(r.x, r.w),
     );
-    let c = corners[index];
+    // An empty rectangle: every corner at one point, so that nothing is drawn.
+    let c = select(corners[index], r.xy, r.x > r.z);
     var out: VertexOut;
     out.clip = overlay.clip_from_plane * vec4<f32>(c, 0.0, 1.0);
     // As world.wgsl: the photo's top edge lies towards the plane's local +y.

@@ -9,11 +9,13 @@ use std::path::{Path, PathBuf};
 use glam::{Quat, Vec2, Vec3};
 use vitreous::caustics::{Bake, BakeError};
 use vitreous::effects::EffectSet;
-use vitreous::scene::{Image, PixelData, Scene, load_scene};
+use vitreous::scene::{CausticsMode, Image, PixelData, Scene, load_scene};
 use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::renderer::Want;
-use vitreous_render::{ContextOptions, FrameParams, GpuContext, Readback, Reflection, Renderer};
+use vitreous_render::{
+    ContextOptions, FrameParams, GpuContext, Readback, Reflection, Renderer, ScenePose,
+};
 use vitreous_tests::{pixel_on_floor, render_once};
 
 fn workspace() -> PathBuf {
@@ -214,6 +216,58 @@ fn adds_inducer_and_caustic_gain(four_loads: bool) {
         .filter(|p| p[..3].iter().any(|&c| c != 0))
         .count();
     assert!(lit < (w * h / 4) as usize, "{lit} lit pixels with a");
+    let v = r.context().validation();
+    assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
+}
+
+#[test]
+fn the_frame_that_computes_a_live_map_shows_it_as_the_next_frame_does() {
+    // On the frame that computes a live caustic map only the GPU knows where its light lies:
+    // the overlay takes the map's bounds from the buffer the computation wrote. Its eye image
+    // must be the next frame's, drawn over the bounds the host has read back by then; also
+    // after the light moved.
+    let mut s = scene("glass-sphere.toml");
+    s.caustics.mode = CausticsMode::Live;
+    s.load_caustics().unwrap_or_else(|e| panic!("{e}"));
+    let (w, h) = (160u32, 120u32);
+    let ctx = GpuContext::headless(&ContextOptions {
+        validation: true,
+        device_name: None,
+    })
+    .expect("Vulkan device with validation");
+    let desc = views::scene_desc(&s, None);
+    let mut r = Renderer::new(ctx, &desc, w, h).expect("renderer");
+    views::enable_live_caustics(&mut r, &s, true).expect("live caustics");
+    let eyes = top_down_eyes(&s);
+    let lit = |frame: &Readback| {
+        frame.eyes[0]
+            .chunks_exact(4)
+            .filter(|p| p[..3].iter().any(|&c| c != 0))
+            .count()
+    };
+    let center = s.object.center_m;
+    let turned = center + Quat::from_rotation_y(0.3) * (s.light.position_m - center);
+    let mut pictures = Vec::new();
+    for light in [s.light.position_m, turned] {
+        r.set_pose(ScenePose {
+            light_position_m: light,
+            ..ScenePose::of(&desc)
+        });
+        let computing = render(&mut r, eyes, "b");
+        let next = render(&mut r, eyes, "b");
+        eprintln!(
+            "light at {light}: {} lit pixels on the frame computing the map, {} on the next",
+            lit(&computing),
+            lit(&next)
+        );
+        assert!(lit(&computing) > 2000, "{} lit pixels", lit(&computing));
+        assert!(computing.eyes == next.eyes, "the two frames differ");
+        pictures.push(next);
+    }
+    assert!(
+        pictures[0].eyes != pictures[1].eyes,
+        "the caustics did not move"
+    );
     let v = r.context().validation();
     assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
 }

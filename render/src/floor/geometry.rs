@@ -3,6 +3,9 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
+use crate::pose::ScenePose;
+use crate::scene::InducerDesc;
+
 /// eq. 1 (the shadow region): the homogeneous planar projection from a point light at
 /// `light_m` onto the plane through `plane_point_m` with unit normal `normal` (pointing to the
 /// light's side). A point X maps to `M * (X, 1)`, whose perspective division is where the ray
@@ -154,6 +157,29 @@ pub(crate) fn union_rect(a: Option<[f32; 4]>, b: Option<[f32; 4]>) -> Option<[f3
         (a, None) => a,
         (None, b) => b,
     }
+}
+
+/// The mask's projection (eq. 1: `None` when the light is not above the floor) and the
+/// plane-local rectangle the inducer's light covers (`None` when nothing can be lit) for the
+/// object and light of `pose`.
+pub(crate) fn shadow_of(
+    floor: &Floor,
+    params: &InducerDesc,
+    positions: &[Vec3],
+    pose: &ScenePose,
+) -> (Option<Mat4>, Option<[f32; 4]>) {
+    let shadow = planar_shadow(floor.center_m, floor.normal, pose.light_position_m);
+    let rect = shadow.and_then(|shadow| {
+        // Ramp width plus two texels (rasterisation and the overlay's bilinear footprint).
+        let margin =
+            Vec2::splat(params.ramp_width_m) / floor.size_m + 2.0 / params.resolution_px as f32;
+        let world = positions
+            .iter()
+            .map(|p| pose.world_from_model.transform_point3(*p));
+        overlay_rect(world, shadow, floor.plane_from_world, margin)
+    });
+    let clip = shadow.map(|s| mask_clip_from_model(floor, s, pose.world_from_model));
+    (clip, rect)
 }
 
 #[cfg(test)]

@@ -131,8 +131,9 @@ pub(crate) struct LiveCaustics {
     /// The smoothed gain map, host-visible (for tests).
     gain: Buffer,
     /// The box of the non-zero gains (`[x0, y0, x1, y1]`, ends included; empty when
-    /// x0 > x1), host-visible.
-    bounds: Buffer,
+    /// x0 > x1): the overlay's buffer ([`super::overlay::OverlayPass::live_bounds`]), which
+    /// its vertex stage reads on the frames that compute a map.
+    bounds: vk::Buffer,
     /// Map width and height, texels.
     size: [u32; 2],
     /// Photons and path length.
@@ -161,7 +162,8 @@ pub(crate) struct LiveCaustics {
 
 impl LiveCaustics {
     /// Prepares the passes for `mesh` (model units, outward normals, closed) over a floor
-    /// mapped by `world_from_plane`, writing a `size` gain map.
+    /// mapped by `world_from_plane`, writing a `size` gain map and the box of its non-zero
+    /// texels into `bounds` (16 bytes, a storage buffer that outlives the passes).
     pub fn new(
         ctx: &GpuContext,
         mesh: &MeshRef,
@@ -169,6 +171,7 @@ impl LiveCaustics {
         world_from_plane: Mat4,
         size: [u32; 2],
         desc: LiveCausticsDesc,
+        bounds: vk::Buffer,
     ) -> Result<LiveCaustics> {
         if !(1..=MAX_PHOTONS_PER_SIDE).contains(&desc.photons_per_side)
             || desc.max_interactions == 0
@@ -264,13 +267,6 @@ impl LiveCaustics {
             storage | vk::BufferUsageFlags::TRANSFER_SRC,
             MemoryLocation::GpuToCpu,
         )?;
-        let bounds = Buffer::new(
-            ctx,
-            "caustics bounds",
-            size_of::<[u32; 4]>() as u64,
-            storage | vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
         let params = Buffer::new(
             ctx,
             "caustics parameters",
@@ -298,7 +294,7 @@ impl LiveCaustics {
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
         buffers.extend(mesh_buffers[..5].iter().map(|b| b.buffer));
-        buffers.extend([sums.buffer, gain.buffer, bounds.buffer, scratch.buffer]);
+        buffers.extend([sums.buffer, gain.buffer, bounds, scratch.buffer]);
         buffers.push(mesh_buffers[5].buffer);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
@@ -454,14 +450,16 @@ impl LiveCaustics {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let transfer = vk::PipelineStageFlags::TRANSFER;
         let groups = |n: u32| n.div_ceil(8);
+        let vertex = vk::PipelineStageFlags::VERTEX_SHADER;
         // SAFETY: the caller's contract (outside a render pass, everything outlives the
-        // execution); the barriers order every access to the parameters, the sums, the gain
-        // and the image against earlier and later work on the queue; the image is moved from
-        // and back to the layout it is in.
+        // execution); the barriers order every access to the parameters, the sums, the gain,
+        // the bounds (read by earlier and later overlays' vertex stage) and the image against
+        // earlier and later work on the queue; the image is moved from and back to the layout
+        // it is in.
         unsafe {
             d.cmd_pipeline_barrier(
                 cmd,
-                compute | transfer | vk::PipelineStageFlags::HOST,
+                compute | transfer | vertex | vk::PipelineStageFlags::HOST,
                 transfer,
                 vk::DependencyFlags::empty(),
                 &memory(
@@ -478,7 +476,7 @@ impl LiveCaustics {
             d.cmd_update_buffer(cmd, self.params.buffer, 0, bytemuck::bytes_of(&params));
             d.cmd_fill_buffer(cmd, self.sums.buffer, 0, vk::WHOLE_SIZE, 0);
             let empty: [u32; 4] = [u32::MAX, u32::MAX, 0, 0];
-            d.cmd_update_buffer(cmd, self.bounds.buffer, 0, bytemuck::bytes_of(&empty));
+            d.cmd_update_buffer(cmd, self.bounds, 0, bytemuck::bytes_of(&empty));
             d.cmd_pipeline_barrier(
                 cmd,
                 transfer,
@@ -553,9 +551,12 @@ impl LiveCaustics {
             d.cmd_pipeline_barrier(
                 cmd,
                 transfer | compute,
-                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::HOST,
+                vertex | vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::HOST,
                 vk::DependencyFlags::empty(),
-                &memory(vk::AccessFlags::SHADER_WRITE, vk::AccessFlags::HOST_READ),
+                &memory(
+                    vk::AccessFlags::SHADER_WRITE,
+                    vk::AccessFlags::HOST_READ | vk::AccessFlags::SHADER_READ,
+                ),
                 &[],
                 &image_barrier(
                     vk::ImageLayout::TRANSFER_DST_OPTIMAL,
@@ -565,18 +566,6 @@ impl LiveCaustics {
                 ),
             );
         }
-    }
-
-    /// The texels `[x0, y0, x1, y1]` (ends excluded) holding every non-zero gain of the last
-    /// computation that finished (wait for the frame first); `None` when all are 0.
-    pub fn bounds(&self) -> Result<Option<[u32; 4]>> {
-        let b: Vec<u32> = self
-            .bounds
-            .mapped()?
-            .chunks_exact(4)
-            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .collect();
-        Ok((b[0] <= b[2] && b[1] <= b[3]).then(|| [b[0], b[1], b[2] + 1, b[3] + 1]))
     }
 
     /// The gain map of the last computation that finished, row 0 at the photo's top (wait

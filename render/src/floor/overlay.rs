@@ -6,10 +6,12 @@
 
 use ash::vk;
 use glam::Mat4;
+use gpu_allocator::MemoryLocation;
 
 use crate::camera::EyeParams;
 use crate::context::GpuContext;
 use crate::error::Result;
+use crate::memory::Buffer;
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, PipelineSpec};
 use crate::scene::GpuScene;
@@ -21,12 +23,12 @@ use crate::shaders::{OVERLAY_FS, OVERLAY_VS};
 struct OverlayPush {
     /// Floor plane (unit square) to this eye's clip space.
     clip_from_plane: [f32; 16],
-    /// The plane-local rectangle to draw (min x, min y, max x, max y).
+    /// The plane-local rectangle to draw (min x, min y, max x, max y; empty when min x >
+    /// max x).
     rect: [f32; 4],
-    /// Weights of k alpha(d) and of the caustic gain G (1 on, 0 off).
-    switches: [f32; 2],
-    /// Padding to the shader struct's 16-byte alignment.
-    _pad: [f32; 2],
+    /// Weights of k alpha(d) and of the caustic gain G (1 on, 0 off); 1 to draw also over
+    /// the box in the live bounds buffer; 0.
+    switches: [f32; 4],
 }
 
 /// The overlay's pipeline and descriptors, freed on drop.
@@ -42,6 +44,23 @@ pub(crate) struct OverlayPass {
     _set_layout: Owned<vk::DescriptorSetLayout>,
     /// The set.
     set: vk::DescriptorSet,
+    /// The box of the live caustic map's non-zero texels (`[x0, y0, x1, y1]`, ends included;
+    /// empty when x0 > x1), written by the live computation, read by the vertex stage on the
+    /// frames that compute a map and by the host once they finished; empty until then.
+    live_bounds: Buffer,
+}
+
+/// A rectangle the vertex stage draws nothing for (min x > max x).
+pub(crate) const NO_RECT: [f32; 4] = [1.0, 1.0, -1.0, -1.0];
+
+/// Where the overlay draws.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct OverlayArea {
+    /// A plane-local rectangle (min x, min y, max x, max y; [`NO_RECT`] for none).
+    pub rect: [f32; 4],
+    /// Joined with the box in the live bounds buffer, as the GPU wrote it earlier on the
+    /// queue.
+    pub with_live_bounds: bool,
 }
 
 impl OverlayPass {
@@ -62,9 +81,25 @@ impl OverlayPass {
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (2, vk::DescriptorType::SAMPLER, fragment),
-                (3, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+                (3, vk::DescriptorType::SAMPLED_IMAGE, PUSH_STAGES),
+                (
+                    4,
+                    vk::DescriptorType::STORAGE_BUFFER,
+                    vk::ShaderStageFlags::VERTEX,
+                ),
             ],
         )?;
+        let mut live_bounds = Buffer::new(
+            ctx,
+            "live caustic bounds",
+            size_of::<[u32; 4]>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let empty: [u32; 4] = [u32::MAX, u32::MAX, 0, 0];
+        live_bounds
+            .mapped_mut()?
+            .copy_from_slice(bytemuck::bytes_of(&empty));
         let layout = pipeline::layout(
             ctx,
             Some(set_layout.raw()),
@@ -114,23 +149,42 @@ impl OverlayPass {
             &[
                 (vk::DescriptorType::SAMPLED_IMAGE, 3),
                 (vk::DescriptorType::SAMPLER, 1),
+                (vk::DescriptorType::STORAGE_BUFFER, 1),
             ],
         )?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         pipeline::write_image(ctx, set, 0, gain_view);
         pipeline::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
         pipeline::write_image(ctx, set, 3, caustic_view);
+        pipeline::write_storage_buffer(ctx, set, 4, live_bounds.buffer);
         Ok(OverlayPass {
             pipelines,
             layout,
             _pool: pool,
             _set_layout: set_layout,
             set,
+            live_bounds,
         })
     }
 
-    /// Records the rectangle `rect` (plane-local) for one eye, adding k alpha(d) and G
-    /// weighted by `switches`.
+    /// The buffer the live computation writes its map's bounds to.
+    pub fn live_bounds_buffer(&self) -> vk::Buffer {
+        self.live_bounds.buffer
+    }
+
+    /// The texels `[x0, y0, x1, y1]` (ends excluded) holding every non-zero gain of the last
+    /// live computation that finished (wait for the frame first); `None` when all are 0.
+    pub fn live_bounds(&self) -> Result<Option<[u32; 4]>> {
+        let b: Vec<u32> = self
+            .live_bounds
+            .mapped()?
+            .chunks_exact(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        Ok((b[0] <= b[2] && b[1] <= b[3]).then(|| [b[0], b[1], b[2] + 1, b[3] + 1]))
+    }
+
+    /// Records `area` for one eye, adding k alpha(d) and G weighted by `switches`.
     ///
     /// # Safety
     /// `cmd` must be recording inside a render pass compatible with the one given to
@@ -143,14 +197,14 @@ impl OverlayPass {
         eye: &EyeParams,
         world_from_plane: Mat4,
         switches: [f32; 2],
-        rect: [f32; 4],
+        area: OverlayArea,
     ) {
         let d = &ctx.device;
+        let live = f32::from(u8::from(area.with_live_bounds));
         let push = OverlayPush {
             clip_from_plane: (eye.clip_from_world() * world_from_plane).to_cols_array(),
-            rect,
-            switches,
-            _pad: [0.0; 2],
+            rect: area.rect,
+            switches: [switches[0], switches[1], live, 0.0],
         };
         // SAFETY: the caller's contract; the pipeline, layout and set are this pass's and
         // live until the renderer has waited for its frames.
@@ -178,8 +232,8 @@ impl OverlayPass {
     }
 }
 
-/// The stages reading the push constants: the vertex stage the rectangle, the fragment stage
-/// the switches.
+/// The stages reading the push constants (the vertex stage the rectangle, the fragment stage
+/// the switches) and the caustic map (the vertex stage its size).
 const PUSH_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
     vk::ShaderStageFlags::VERTEX.as_raw() | vk::ShaderStageFlags::FRAGMENT.as_raw(),
 );

@@ -9,12 +9,9 @@ use super::distance_transform::{DIST, DistanceTransform, RAMP};
 use super::fields::{
     CLEAR, DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, Stamps, TexelRect, bounding,
 };
-use super::geometry::{
-    Floor, caustic_rect, mask_clip_from_model, overlay_rect, planar_shadow, texel_rect,
-    texels_plane_rect, union_rect,
-};
+use super::geometry::{Floor, caustic_rect, shadow_of, texel_rect, texels_plane_rect, union_rect};
 use super::live::{LiveCaustics, LiveCausticsDesc};
-use super::overlay::OverlayPass;
+use super::overlay::{NO_RECT, OverlayArea, OverlayPass};
 use super::progress::{Prepared, Progress, Written};
 use crate::camera::EyeParams;
 use crate::context::GpuContext;
@@ -47,9 +44,12 @@ pub(crate) struct InducerPass {
     mask_clip_from_model: Option<Mat4>,
     /// Plane-local rectangle the inducer's light covers; `None` when nothing can be lit.
     pub(super) rect: Option<[f32; 4]>,
-    /// Plane-local rectangle of the caustics' non-zero extent; `None` without caustics (the
-    /// whole floor while a live map is being computed).
+    /// Plane-local rectangle of the caustics' non-zero extent; `None` without caustics or
+    /// while only the GPU knows it.
     caustic_rect: Option<[f32; 4]>,
+    /// A live map is computed for the current pose and the host has not yet read its bounds:
+    /// the overlay takes them from the GPU ([`OverlayPass::live_bounds`]).
+    live_rect_on_gpu: bool,
     /// Triangle indices of the mesh.
     index_count: u32,
     /// What has really been computed.
@@ -229,6 +229,7 @@ impl InducerPass {
             mask_clip_from_model,
             rect,
             caustic_rect,
+            live_rect_on_gpu: false,
             index_count: scene.index_count,
             progress: Progress::default(),
             overlay,
@@ -259,16 +260,16 @@ impl InducerPass {
         self.rect = rect;
         self.pose = pose;
         if self.live.is_some() {
-            // Anywhere, until the new map's computation has finished.
-            self.caustic_rect = Some(WHOLE_FLOOR);
+            // Where the GPU finds it, until the new map's computation has finished.
+            (self.caustic_rect, self.live_rect_on_gpu) = (None, true);
         }
         self.progress.invalidate();
     }
 
     /// Computes the caustic gain map on the GPU for each pose from now on (with the fields,
     /// so on the next frame drawing the overlay and after every move), at the map's current
-    /// size (the bake's, or the inducer's resolution without one); the overlay covers the
-    /// whole floor on the frames that compute it, then only the box of its non-zero texels.
+    /// size (the bake's, or the inducer's resolution without one); the overlay covers the box
+    /// of its non-zero texels, read by the GPU until the host can read it.
     pub fn enable_live(
         &mut self,
         ctx: &GpuContext,
@@ -283,8 +284,9 @@ impl InducerPass {
             self.world_from_plane,
             [extent.width, extent.height],
             live,
+            self.overlay.live_bounds_buffer(),
         )?);
-        self.caustic_rect = Some(WHOLE_FLOOR);
+        (self.caustic_rect, self.live_rect_on_gpu) = (None, true);
         self.progress.invalidate();
         Ok(())
     }
@@ -358,13 +360,14 @@ impl InducerPass {
     pub fn finished(&mut self, prepared: Prepared, ok: bool) {
         let live_map = ok && prepared.fields && self.progress.is_current(prepared);
         self.progress.finished(prepared, ok);
-        if let Some(live) = self.live.as_ref().filter(|_| live_map) {
+        if self.live.is_some() && live_map {
             let extent = self.caustic_extent;
-            self.caustic_rect = match live.bounds() {
+            self.caustic_rect = match self.overlay.live_bounds() {
                 Ok(bounds) => bounds.map(|b| texels_plane_rect(b, extent.width, extent.height)),
-                // Unreadable (never on a host-visible buffer): the whole floor stays.
+                // Unreadable (never on a host-visible buffer): the whole floor.
                 Err(_) => Some(WHOLE_FLOOR),
             };
+            self.live_rect_on_gpu = false;
         }
     }
 
@@ -555,12 +558,19 @@ impl InducerPass {
         inducer: bool,
         caustics: bool,
     ) {
-        if let Some(rect) = self.overlay_rect(inducer, caustics) {
+        let with_live_bounds = caustics && self.live_rect_on_gpu;
+        let rect = self.overlay_rect(inducer, caustics);
+        if rect.is_some() || with_live_bounds {
             let switches = [inducer, caustics].map(|on| f32::from(u8::from(on)));
-            // SAFETY: the caller's contract, which is the overlay's.
+            let area = OverlayArea {
+                rect: rect.unwrap_or(NO_RECT),
+                with_live_bounds,
+            };
+            // SAFETY: the caller's contract, which is the overlay's (the live bounds are
+            // written by the live computation recorded before with the pose's work).
             unsafe {
                 self.overlay
-                    .record(ctx, cmd, eye, self.world_from_plane, switches, rect)
+                    .record(ctx, cmd, eye, self.world_from_plane, switches, area)
             };
         }
     }
@@ -568,26 +578,3 @@ impl InducerPass {
 
 /// The floor's whole unit square, plane-local.
 const WHOLE_FLOOR: [f32; 4] = [-0.5, -0.5, 0.5, 0.5];
-
-/// The mask's projection (eq. 1: `None` when the light is not above the floor) and the
-/// plane-local rectangle the inducer's light covers (`None` when nothing can be lit) for the
-/// object and light of `pose`.
-fn shadow_of(
-    floor: &Floor,
-    params: &InducerDesc,
-    positions: &[Vec3],
-    pose: &ScenePose,
-) -> (Option<Mat4>, Option<[f32; 4]>) {
-    let shadow = planar_shadow(floor.center_m, floor.normal, pose.light_position_m);
-    let rect = shadow.and_then(|shadow| {
-        // Ramp width plus two texels (rasterisation and the overlay's bilinear footprint).
-        let margin =
-            Vec2::splat(params.ramp_width_m) / floor.size_m + 2.0 / params.resolution_px as f32;
-        let world = positions
-            .iter()
-            .map(|p| pose.world_from_model.transform_point3(*p));
-        overlay_rect(world, shadow, floor.plane_from_world, margin)
-    });
-    let clip = shadow.map(|s| mask_clip_from_model(floor, s, pose.world_from_model));
-    (clip, rect)
-}

@@ -199,8 +199,11 @@ fn rolling_diamond_moves_and_turns_on_the_table() {
         scene.placement_at(2.3).light_position_m,
         scene.light.position_m
     );
-    // A moving scene's caustic bake is refused: it holds one pose.
+    // Its caustics are computed live; a caustic bake is refused: it holds one pose.
     let mut scene = scene;
+    assert_eq!(scene.caustics.mode, vitreous::scene::CausticsMode::Live);
+    scene.load_caustics().expect("live caustics read no file");
+    scene.caustics.mode = vitreous::scene::CausticsMode::Baked;
     let err = scene.load_caustics().unwrap_err();
     assert!(err.to_string().contains("[motion]"), "{err}");
 }

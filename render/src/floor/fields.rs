@@ -261,8 +261,8 @@ impl InducerFields {
 }
 
 /// Timestamps the floor passes write after each of their stages, in this order: the mask, the
-/// nearest shadow texels, the distance, the ramp, the live caustics.
-pub const FIELD_STAMPS: u32 = 5;
+/// nearest shadow texels, the distance, the ramp, the live caustics' photons, their smoothing.
+pub const FIELD_STAMPS: u32 = 6;
 
 /// GPU milliseconds of each stage of the floor passes in one frame (0 for a stage that did
 /// not run: nothing moved, or no live caustics).
@@ -276,8 +276,10 @@ pub struct FieldPassesMs {
     pub distance_ms: f64,
     /// The gain k alpha(d) (eq. 2, 4).
     pub ramp_ms: f64,
-    /// The live caustic map (photon tracing, smoothing, copying).
-    pub live_caustics_ms: f64,
+    /// The live caustic map's photons: clearing the sums, tracing and splatting.
+    pub caustic_photons_ms: f64,
+    /// The live caustic map's smoothing, clamp and bound, and its copy into the image.
+    pub caustic_smoothing_ms: f64,
 }
 
 impl FieldPassesMs {
@@ -295,13 +297,19 @@ impl FieldPassesMs {
             nearest_ms: ms[1],
             distance_ms: ms[2],
             ramp_ms: ms[3],
-            live_caustics_ms: ms[4],
+            caustic_photons_ms: ms[4],
+            caustic_smoothing_ms: ms[5],
         }
+    }
+
+    /// The live caustic map's stages together.
+    pub fn live_caustics_ms(&self) -> f64 {
+        self.caustic_photons_ms + self.caustic_smoothing_ms
     }
 
     /// Their sum.
     pub fn total_ms(&self) -> f64 {
-        self.mask_ms + self.nearest_ms + self.distance_ms + self.ramp_ms + self.live_caustics_ms
+        self.mask_ms + self.nearest_ms + self.distance_ms + self.ramp_ms + self.live_caustics_ms()
     }
 }
 

@@ -9,6 +9,7 @@ use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
+use super::fields::Stamps;
 use super::triangle_grid::{Grid, corner_and_edges, inner_radius};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -413,17 +414,19 @@ impl LiveCaustics {
 
     /// Records the computation of the gain map for `pose` and its copy into `caustic` (an
     /// R32F image of the map's size in SHADER_READ_ONLY_OPTIMAL, left there), ordered after
-    /// earlier work's reads of both and before later fragment reads of `caustic`.
+    /// earlier work's reads of both and before later fragment reads of `caustic`. With
+    /// `stamps`, writes the floor's two caustic stamps: after the photons, after the rest.
     ///
     /// # Safety
     /// `cmd` must be recording outside any render pass; `self` and `caustic` must outlive its
-    /// execution.
+    /// execution; the stamps' pool must hold their queries, reset.
     pub unsafe fn record(
         &self,
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         pose: &ScenePose,
         caustic: &Image,
+        stamps: Option<Stamps>,
     ) {
         let d = &ctx.device;
         let params = self.params(pose);
@@ -490,6 +493,9 @@ impl LiveCaustics {
             let [w, h] = self.size;
             d.cmd_bind_pipeline(cmd, bind, self.trace.raw());
             d.cmd_dispatch(cmd, groups(n), groups(n), 1);
+            if let Some(stamps) = stamps {
+                stamps.write(d, cmd, 4..5);
+            }
             d.cmd_bind_pipeline(cmd, bind, self.smooth.raw());
             for step in smooth_steps(self.desc.smoothing_px) {
                 // Each pass reads what the one before wrote (the first, the photons' sums).
@@ -558,6 +564,9 @@ impl LiveCaustics {
                     vk::AccessFlags::SHADER_READ,
                 ),
             );
+            if let Some(stamps) = stamps {
+                stamps.write(d, cmd, 5..6);
+            }
         }
     }
 

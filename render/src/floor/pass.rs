@@ -7,7 +7,8 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::distance_transform::{DIST, DistanceTransform, RAMP};
 use super::fields::{
-    CLEAR, DISTANCE, FIELDS, FieldPush, FieldTarget, GAIN, MASK, Stamps, TexelRect, bounding,
+    CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN, MASK, Stamps, TexelRect,
+    bounding,
 };
 use super::geometry::{Floor, caustic_rect, shadow_of, texel_rect, texels_plane_rect, union_rect};
 use super::live::{LiveCaustics, LiveCausticsDesc};
@@ -339,10 +340,7 @@ impl InducerPass {
             if prepared.fields {
                 prepared.fields_within = self.record_pose_work(ctx, cmd, scene, stamps);
             } else if let Some(stamps) = stamps {
-                stamps.write(d, cmd, 0..4);
-            }
-            if let Some(stamps) = stamps {
-                stamps.write(d, cmd, 4..5);
+                stamps.write(d, cmd, 0..FIELD_STAMPS);
             }
         }
         prepared
@@ -394,8 +392,13 @@ impl InducerPass {
         // SAFETY: the caller's contract, which is both recordings'.
         unsafe {
             let within = self.record_fields(ctx, cmd, scene, stamps);
-            if let Some(live) = &self.live {
-                live.record(ctx, cmd, &self.pose, &self.caustic);
+            match &self.live {
+                Some(live) => live.record(ctx, cmd, &self.pose, &self.caustic, stamps),
+                None => {
+                    if let Some(stamps) = stamps {
+                        stamps.write(&ctx.device, cmd, 4..FIELD_STAMPS);
+                    }
+                }
             }
             within
         }

@@ -11,7 +11,7 @@ use vitreous_render::{ContextOptions, GpuContext, Renderer};
 
 use crate::blur_stack::DefocusSetup;
 use crate::effects::EffectSet;
-use crate::scene::{DiskFiles, Scene, SceneFiles, load_scene_from};
+use crate::scene::{CausticsMode, DiskFiles, Scene, SceneFiles, load_scene_from};
 use crate::views;
 
 /// A scene loaded with what its renderer needs.
@@ -38,8 +38,12 @@ impl Loaded {
         let effects = effects.unwrap_or(scene.effects);
         effects.ensure_implemented()?;
         let mut caustics_note = None;
-        let caustics_loaded = match &scene.caustics.bake {
-            Some(_) if EffectSet::IMPLEMENTED.caustics => match scene.load_caustics() {
+        // A bake to read, or a live map (nothing read; computed for each pose).
+        let has_caustics =
+            scene.caustics.bake.is_some() || scene.caustics.mode == CausticsMode::Live;
+        let caustics_loaded = has_caustics
+            && EffectSet::IMPLEMENTED.caustics
+            && match scene.load_caustics() {
                 Ok(()) => true,
                 Err(e) => {
                     let note = format!("caustic bake not used (conditions b, c off): {e}");
@@ -47,9 +51,7 @@ impl Loaded {
                     caustics_note = Some(note);
                     false
                 }
-            },
-            _ => false,
-        };
+            };
         if effects.caustics && !caustics_loaded {
             bail!(
                 "effects {effects} need the scene's caustic bake: {}",
@@ -71,16 +73,20 @@ impl Loaded {
         })
     }
 
-    /// A renderer of this scene with eye images of `size`, on a new device.
+    /// A renderer of this scene with eye images of `size`, on a new device; with the caustics
+    /// computed for each pose when the scene asks for them live.
     pub(super) fn renderer(&self, size: (u32, u32), options: &ContextOptions) -> Result<Renderer> {
         let ctx = GpuContext::headless(options).context("setting up the Vulkan device")?;
-        Renderer::new(
+        let mut renderer = Renderer::new(
             ctx,
             &views::scene_desc(&self.scene, self.setup.as_ref()),
             size.0,
             size.1,
         )
-        .context("preparing the renderer")
+        .context("preparing the renderer")?;
+        views::enable_live_caustics(&mut renderer, &self.scene, self.caustics_loaded)
+            .context("preparing live caustics")?;
+        Ok(renderer)
     }
 }
 

@@ -209,6 +209,37 @@ pub(crate) fn assert_resized(dir: &Path) {
 }
 
 #[test]
+fn a_live_scene_computes_its_caustics_as_the_light_moves() {
+    // moving-light.toml names no bake: its caustics are computed for each pose.
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let out = view(
+        &xvfb,
+        &scene("moving-light.toml"),
+        &[
+            "--frames",
+            "8",
+            "--effects",
+            "c",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        log.contains("caustics computed on the GPU for each pose"),
+        "{log}"
+    );
+    let s = summary(&out_dir);
+    assert_eq!(s["frames"], 8, "{s:#}");
+    assert_eq!(s["moved_frames"], 7, "the light moves every frame: {s:#}");
+    assert_eq!(s["validation"]["errors"], 0, "{s:#}");
+    assert_eq!(s["validation"]["warnings"], 0, "{s:#}");
+}
+
+#[test]
 fn a_resized_window_gets_a_new_swapchain_and_renderer() {
     let Some(xvfb) = xvfb_run() else { return };
     let dir = tempfile::tempdir().unwrap();

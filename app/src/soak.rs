@@ -270,13 +270,15 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
                     Reflection::Phong,
                     &GazeSettings::default(),
                 )?;
-                let renderer = Renderer::new(
+                let mut renderer = Renderer::new(
                     ctx,
                     &views::scene_desc(&scene, defocus.as_ref()),
                     options.size.0,
                     options.size.1,
                 )
                 .context("preparing the renderer")?;
+                views::enable_live_caustics(&mut renderer, &scene, effects.caustics)
+                    .context("preparing live caustics")?;
                 messages_before = 0;
                 current.insert((renderer, planner))
             }

@@ -58,7 +58,7 @@ use crate::look::{GazeSettings, planners_for};
 use crate::motion_clock::MotionClock;
 use crate::output::write_atomic;
 use crate::replay::{Spread, ValidationSummary};
-use crate::scene::load_scene;
+use crate::scene::{CausticsMode, load_scene};
 use crate::scene_edit::SceneEdit;
 use crate::study::run::StudyStage;
 use crate::views;
@@ -237,9 +237,9 @@ fn run_with(
     if effects.caustics {
         scene.load_caustics()?;
     }
-    // The caustic conditions are offered live only with the scene's bake loaded.
+    // The caustic conditions are offered live only with the bake loaded or live caustics.
     let caustics_loaded = effects.caustics
-        || (scene.caustics.bake.is_some()
+        || ((scene.caustics.bake.is_some() || scene.caustics.mode == CausticsMode::Live)
             && EffectSet::IMPLEMENTED.caustics
             && scene
                 .load_caustics()

@@ -436,18 +436,17 @@ fn block_mean(gain: &[f32], width: usize, f: usize) -> Vec<f32> {
 }
 
 /// The measurements behind docs/caustics.md's tables of live maps (run it with
-/// `cargo test --release -p vitreous-tests --test gpu -- --ignored --nocapture sweep`):
-/// relative RMS against the bake, averaged down to the live map's resolution and smoothed
-/// alike, for map sizes, smoothing radii and photon counts. With VITREOUS_SWEEP_BAKES=dir,
-/// `dir/<scene>-<side>.exr` (a bake at that side, `vitreous-caustics bake --resolution`) is
-/// also a reference, and compared with the averaged bake.
+/// `cargo test --release -p vitreous-tests --test gpu -- --ignored --nocapture sweep`): for
+/// map sizes, smoothing radii and photon counts, the relative RMS against the shipped bake
+/// averaged down to the live map's resolution and smoothed alike, and against the baker's
+/// own map at that resolution (baked here, once per size), smoothed alike.
 #[test]
 #[ignore]
 fn sweep() {
-    let bakes = std::env::var_os("VITREOUS_SWEEP_BAKES").map(PathBuf::from);
     for name in ["glass-sphere", "diamond"] {
         let base = scene(&format!("{name}.toml"));
         let full = base.caustics.gain.as_ref().expect("the bake").width_px as usize;
+        let mut own_bakes: Vec<(usize, Vec<f32>)> = Vec::new();
         for (factor, radius, photons) in [
             (1usize, 5u32, 128u32),
             (2, 2, 128),
@@ -460,6 +459,10 @@ fn sweep() {
         ] {
             let side = full / factor;
             let (live_scene, averaged) = live_scene(&format!("{name}.toml"), Some(side as u32));
+            if !own_bakes.iter().any(|(s, _)| *s == side) {
+                own_bakes.push((side, baked_at(&live_scene, side as u32, 1 << 18)));
+            }
+            let own = &own_bakes.iter().find(|(s, _)| *s == side).expect("baked").1;
             let live = LiveCausticsDesc {
                 photons_per_side: photons,
                 smoothing_px: radius,
@@ -467,28 +470,19 @@ fn sweep() {
             };
             let (gain, wall_ms) = &live_gains(&live_scene, live, &[None], false)[0];
             let reference = smoothed(&averaged, side, radius);
+            let own_smoothed = smoothed(own, side, radius);
             let (px, py) = peak(gain, side as u32);
             let axis = axis_texel(&base, base.light.position_m, side as u32, side as u32);
             eprintln!(
                 "{name} {side}x{side} r = {radius} {photons}^2 photons: relative RMS {:.2} % over \
-                 {} texels, peak G {:.1} at ({px}, {py}) (light axis at {axis}), {wall_ms:.0} ms",
+                 {} texels (the baker's own map: {:.2} %; it against the averaged bake {:.2} %), \
+                 peak G {:.1} at ({px}, {py}) (light axis at {axis}), {wall_ms:.0} ms",
                 relative_rms(gain, &reference) * 100.0,
                 reference.iter().filter(|&&g| g > 0.1).count(),
+                relative_rms(gain, &own_smoothed) * 100.0,
+                relative_rms(&own_smoothed, &reference) * 100.0,
                 gain[py as usize * side + px as usize],
             );
-            if let Some(dir) = &bakes {
-                let path = dir.join(format!("{name}-{side}.exr"));
-                if let Ok(own) = vitreous::caustics::read_bake_unchecked(&path) {
-                    let own_smoothed = smoothed(&own.gain, side, radius);
-                    eprintln!(
-                        "  {}: the live map's relative RMS against it smoothed alike {:.2} %; \
-                         it against the averaged bake, both smoothed, {:.2} %",
-                        path.display(),
-                        relative_rms(gain, &own_smoothed) * 100.0,
-                        relative_rms(&own_smoothed, &reference) * 100.0
-                    );
-                }
-            }
         }
     }
 }

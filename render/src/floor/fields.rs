@@ -263,6 +263,8 @@ impl InducerFields {
 /// Timestamps the floor passes write after each of their stages, in this order: the mask, the
 /// nearest shadow texels, the distance, the ramp, the live caustics' photons, their smoothing.
 pub const FIELD_STAMPS: u32 = 6;
+/// The stamp written after the live caustics' photons (the one after their smoothing follows).
+pub(crate) const CAUSTIC_PHOTONS_STAMP: u32 = 4;
 
 /// GPU milliseconds of each stage of the floor passes in one frame (0 for a stage that did
 /// not run: nothing moved, or no live caustics).

@@ -9,7 +9,7 @@ use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
-use super::fields::Stamps;
+use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
 use super::triangle_grid::{Grid, corner_and_edges, inner_radius};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -494,7 +494,7 @@ impl LiveCaustics {
             d.cmd_bind_pipeline(cmd, bind, self.trace.raw());
             d.cmd_dispatch(cmd, groups(n), groups(n), 1);
             if let Some(stamps) = stamps {
-                stamps.write(d, cmd, 4..5);
+                stamps.write(d, cmd, CAUSTIC_PHOTONS_STAMP..CAUSTIC_PHOTONS_STAMP + 1);
             }
             d.cmd_bind_pipeline(cmd, bind, self.smooth.raw());
             for step in smooth_steps(self.desc.smoothing_px) {
@@ -565,7 +565,7 @@ impl LiveCaustics {
                 ),
             );
             if let Some(stamps) = stamps {
-                stamps.write(d, cmd, 5..6);
+                stamps.write(d, cmd, CAUSTIC_PHOTONS_STAMP + 1..FIELD_STAMPS);
             }
         }
     }

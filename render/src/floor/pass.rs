@@ -7,8 +7,8 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::distance_transform::{DIST, DistanceTransform, RAMP};
 use super::fields::{
-    CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN, MASK, Stamps, TexelRect,
-    bounding,
+    CAUSTIC_PHOTONS_STAMP, CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN,
+    MASK, Stamps, TexelRect, bounding,
 };
 use super::geometry::{Floor, caustic_rect, shadow_of, texel_rect, texels_plane_rect, union_rect};
 use super::live::{LiveCaustics, LiveCausticsDesc};
@@ -396,7 +396,7 @@ impl InducerPass {
                 Some(live) => live.record(ctx, cmd, &self.pose, &self.caustic, stamps),
                 None => {
                     if let Some(stamps) = stamps {
-                        stamps.write(&ctx.device, cmd, 4..FIELD_STAMPS);
+                        stamps.write(&ctx.device, cmd, CAUSTIC_PHOTONS_STAMP..FIELD_STAMPS);
                     }
                 }
             }

@@ -3,13 +3,18 @@
 // the cone from the light around the object, traces it through the mesh (Snell refraction,
 // exact Fresnel weights, both branches followed) and adds its share of the relative gain G to
 // the four floor texels around where it lands; a photon that meets the object also takes its
-// straight continuation away (the shadow, E_blocked). `cs_smooth` then takes G = max(0, sum)
-// per texel, as the bake stores it, and smooths it (density estimation: a lone photon's share
-// spreads over the kernel, as a beam's does in the bake) with a box filter run three times
-// along the rows, then three times along the columns, one dispatch each way; the last zeroes
-// gains below MIN_GAIN (as in the bake) and bounds the non-zero texels, which the overlay
-// covers (its vertex stage reads the bound on the frame that computes the map). Without
-// smoothing a single dispatch of a one-texel box does only the latter.
+// straight continuation away (the shadow, E_blocked). The smoothing passes then take
+// G = max(0, sum) per texel, as the bake stores it, and smooth it (density estimation: a lone
+// photon's share spreads over the kernel, as a beam's does in the bake) with a box filter run
+// three times along the rows, then three times along the columns, one dispatch each way
+// (`cs_smooth_rows` and `cs_smooth_columns` for radii up to 2, `cs_smooth_wide` above); the
+// last zeroes gains below MIN_GAIN (as in the bake) and bounds the non-zero texels, which the
+// overlay covers (its vertex stage reads the bound on the frame that computes the map).
+// Without smoothing a single dispatch along the columns does only the latter.
+//
+// On a CPU device (lavapipe) every access of a storage buffer is a loop over the SIMD lanes,
+// so the passes read their parameters once into registers and move four texels per access
+// where they can.
 //
 // Geometry is traced in the object's model space (the mesh never moves there); a uniform grid
 // of triangle lists, built once on the CPU, finds the surfaces.
@@ -51,36 +56,44 @@ struct Params {
 };
 
 @group(0) @binding(0) var<storage, read> p: Params;
-// Model-space positions (xyz) and outward unit vertex normals (xyz).
-@group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> normals: array<vec4<f32>>;
-// Triangle list.
-@group(0) @binding(3) var<storage, read> indices: array<u32>;
+// The parameters, read once per invocation of the trace: on a CPU device each read of a
+// storage buffer is a loop over the lanes, so reading them where they are used costs more
+// than the tracing's arithmetic.
+var<private> params: Params;
+// Per triangle the outward unit normals of its three vertices (xyz), in the triangle's order.
+@group(0) @binding(1) var<storage, read> vertex_normals: array<vec4<f32>>;
 // Per grid cell (x fastest): first entry in cell_tris and count.
-@group(0) @binding(4) var<storage, read> cells: array<vec2<u32>>;
-@group(0) @binding(5) var<storage, read> cell_tris: array<u32>;
+@group(0) @binding(2) var<storage, read> cells: array<vec2<u32>>;
+@group(0) @binding(3) var<storage, read> cell_tris: array<u32>;
 // Fixed-point sums of G per texel (row 0 at the photo's top).
-@group(0) @binding(6) var<storage, read_write> sums: array<atomic<i32>>;
+@group(0) @binding(4) var<storage, read_write> sums: array<atomic<i32>>;
 // The smoothed gain map.
-@group(0) @binding(7) var<storage, read_write> gain: array<f32>;
+@group(0) @binding(5) var<storage, read_write> gain: array<vec4<f32>>;
 // The box of the non-zero gains: smallest x, smallest y, largest x, largest y (texels; the
 // CPU sets it to an empty box before each computation).
-@group(0) @binding(8) var<storage, read_write> bounds: array<atomic<u32>, 4>;
-// The fixed-point gains smoothed along the rows (between the two smoothing passes).
-@group(0) @binding(9) var<storage, read_write> scratch: array<u32>;
+@group(0) @binding(6) var<storage, read_write> bounds: array<atomic<u32>, 4>;
+// The gains smoothed along the rows, fixed-point units (between the two smoothing passes).
+@group(0) @binding(7) var<storage, read_write> scratch: array<vec4<f32>>;
 // Per triangle its first corner and two edges (xyz, model units), gathered once so that a
 // test reads three vectors instead of three indices and three positions.
-@group(0) @binding(10) var<storage, read> corners: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read> corners: array<vec4<f32>>;
+// The sums again, four texels at a time, for the smoothing (which runs after the trace's
+// atomics have finished and writes none).
+@group(0) @binding(9) var<storage, read> sums4: array<vec4<i32>>;
 
 const NONE: u32 = 0xffffffffu;
 const PI: f32 = 3.14159265358979;
 const STACK: u32 = 16u;
 
+// A ray's hit with triangle `tri` at distance t, barycentric (u, v), and the triangle's
+// geometric normal (edge 1 x edge 2, not normalised): kept from the test, so that the hit's
+// shading reads only the vertex normals.
 struct Hit {
     t: f32,
     tri: u32,
     u: f32,
     v: f32,
+    normal: vec3<f32>,
 };
 
 struct Ray {
@@ -91,28 +104,29 @@ struct Ray {
     inside: u32,
 };
 
-// Möller-Trumbore: (t, u, v) of the hit of the ray with triangle `tri`, t < 0 for none.
-fn triangle_hit(o: vec3<f32>, d: vec3<f32>, tri: u32) -> vec3<f32> {
+// Möller-Trumbore: the hit of the ray with triangle `tri`, t < 0 for none.
+fn triangle_hit(o: vec3<f32>, d: vec3<f32>, tri: u32) -> Hit {
+    let none = Hit(-1.0, NONE, 0.0, 0.0, vec3<f32>(0.0));
     let a = corners[3u * tri].xyz;
     let e1 = corners[3u * tri + 1u].xyz;
     let e2 = corners[3u * tri + 2u].xyz;
     let pv = cross(d, e2);
     let det = dot(e1, pv);
     if det == 0.0 {
-        return vec3<f32>(-1.0, 0.0, 0.0);
+        return none;
     }
     let inv = 1.0 / det;
     let tv = o - a;
     let u = dot(tv, pv) * inv;
     if u < 0.0 || u > 1.0 {
-        return vec3<f32>(-1.0, 0.0, 0.0);
+        return none;
     }
     let qv = cross(tv, e1);
     let v = dot(d, qv) * inv;
     if v < 0.0 || u + v > 1.0 {
-        return vec3<f32>(-1.0, 0.0, 0.0);
+        return none;
     }
-    return vec3<f32>(dot(e2, qv) * inv, u, v);
+    return Hit(dot(e2, qv) * inv, tri, u, v, cross(e1, e2));
 }
 
 // The nearest surface hit along the ray at a distance within [t_from, t_to], or `best` when
@@ -121,9 +135,9 @@ fn triangle_hit(o: vec3<f32>, d: vec3<f32>, tri: u32) -> vec3<f32> {
 // later walk that starts from `best`).
 fn walk_grid(o: vec3<f32>, d: vec3<f32>, t_from: f32, t_to: f32, best_so_far: Hit) -> Hit {
     var best = best_so_far;
-    let dims = vec3<i32>(p.grid_dims.xyz);
-    let side = p.grid_origin.w;
-    let lo = p.grid_origin.xyz;
+    let dims = vec3<i32>(params.grid_dims.xyz);
+    let side = params.grid_origin.w;
+    let lo = params.grid_origin.xyz;
     let hi = lo + vec3<f32>(dims) * side;
     let safe = select(d, vec3<f32>(1e-30), abs(d) < vec3<f32>(1e-30));
     let inv = 1.0 / safe;
@@ -148,8 +162,8 @@ fn walk_grid(o: vec3<f32>, d: vec3<f32>, t_from: f32, t_to: f32, best_so_far: Hi
         for (var e = 0u; e < range.y; e++) {
             let tri = cell_tris[range.x + e];
             let h = triangle_hit(o, d, tri);
-            if h.x > p.misc.x && h.x < best.t {
-                best = Hit(h.x, tri, h.y, h.z);
+            if h.t > params.misc.x && h.t < best.t {
+                best = h;
             }
         }
         let exit = min(min(t_next.x, t_next.y), t_next.z);
@@ -178,25 +192,25 @@ fn walk_grid(o: vec3<f32>, d: vec3<f32>, t_from: f32, t_to: f32, best_so_far: Hi
 // the ray's one or two stretches inside that shell are walked: a ball-like mesh's hollow
 // middle and the space around it cost no grid steps.
 fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
-    let none = Hit(t_max, NONE, 0.0, 0.0);
-    let oc = o - p.shell.xyz;
+    let none = Hit(t_max, NONE, 0.0, 0.0, vec3<f32>(0.0));
+    let oc = o - params.shell.xyz;
     let b = dot(oc, d);
     // The ray's nearest approach to the centre, squared (stable far from the object).
     let q = oc - b * d;
     let q2 = dot(q, q);
-    let outer = p.shell_outer.x;
+    let outer = params.shell_outer.x;
     let h_out = outer * outer - q2;
     if h_out < 0.0 {
         return none;
     }
     let s_out = sqrt(h_out);
-    let pad = p.shell_outer.y;
+    let pad = params.shell_outer.y;
     let enter = max(-b - s_out - pad, 0.0);
     let leave = min(-b + s_out + pad, t_max);
     if enter > leave {
         return none;
     }
-    let inner = p.shell.w;
+    let inner = params.shell.w;
     let h_in = inner * inner - q2;
     if inner <= 0.0 || h_in <= 0.0 {
         return walk_grid(o, d, enter, leave, none);
@@ -221,9 +235,9 @@ fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
 // Distance along the ray to the floor's visible side, model units; negative when it does not
 // approach it.
 fn floor_t(o: vec3<f32>, d: vec3<f32>) -> f32 {
-    let point = (p.model_from_world * vec4<f32>(p.world_from_plane[3].xyz, 1.0)).xyz;
-    let world_normal = normalize(cross(p.world_from_plane[0].xyz, p.world_from_plane[1].xyz));
-    let normal = normalize((p.model_from_world * vec4<f32>(world_normal, 0.0)).xyz);
+    let point = (params.model_from_world * vec4<f32>(params.world_from_plane[3].xyz, 1.0)).xyz;
+    let world_normal = normalize(cross(params.world_from_plane[0].xyz, params.world_from_plane[1].xyz));
+    let normal = normalize((params.model_from_world * vec4<f32>(world_normal, 0.0)).xyz);
     let denom = dot(d, normal);
     if denom >= 0.0 {
         return -1.0;
@@ -237,23 +251,23 @@ fn floor_t(o: vec3<f32>, d: vec3<f32>) -> f32 {
 // rather than at each texel centre (a texel away the two differ by 0.2 % at most on the
 // shipped floors; the bake takes the texel's).
 fn deposit(point_m: vec3<f32>, weight: f32) {
-    let world = (p.world_from_model * vec4<f32>(point_m, 1.0)).xyz;
-    let local = (p.plane_from_world * vec4<f32>(world, 1.0)).xy;
+    let world = (params.world_from_model * vec4<f32>(point_m, 1.0)).xyz;
+    let local = (params.plane_from_world * vec4<f32>(world, 1.0)).xy;
     if abs(local.x) > 0.5 || abs(local.y) > 0.5 {
         return;
     }
-    let size = vec2<i32>(p.map.xy);
+    let size = vec2<i32>(params.map.xy);
     let t = vec2<f32>(local.x + 0.5, 0.5 - local.y) * vec2<f32>(size) - 0.5;
     let base = vec2<i32>(floor(t));
     let f = t - floor(t);
-    let normal = normalize(cross(p.world_from_plane[0].xyz, p.world_from_plane[1].xyz));
-    let to_light = p.light.xyz - world;
+    let normal = normalize(cross(params.world_from_plane[0].xyz, params.world_from_plane[1].xyz));
+    let to_light = params.light.xyz - world;
     let r2 = dot(to_light, to_light);
     let cos_theta = dot(to_light, normal) * inverseSqrt(r2);
     if cos_theta <= 0.0 {
         return;
     }
-    let g0 = weight * p.light.w * r2 / (p.basis_v.w * cos_theta) * p.misc.y;
+    let g0 = weight * params.light.w * r2 / (params.basis_v.w * cos_theta) * params.misc.y;
     for (var k = 0; k < 4; k++) {
         let texel = base + vec2<i32>(k & 1, k >> 1u);
         if any(texel < vec2<i32>(0)) || any(texel >= size) {
@@ -261,7 +275,7 @@ fn deposit(point_m: vec3<f32>, weight: f32) {
         }
         let wx = select(1.0 - f.x, f.x, (k & 1) == 1);
         let wy = select(1.0 - f.y, f.y, (k >> 1u) == 1);
-        let index = texel.y * size.x + texel.x;
+        let index = texel.y * i32(row_pitch(params.map.x)) + texel.x;
         atomicAdd(&sums[index], i32(round(g0 * wx * wy)));
     }
 }
@@ -292,23 +306,24 @@ fn cone_direction(s: f32, t: f32) -> vec3<f32> {
         r = b;
         phi = PI / 2.0 - PI / 4.0 * (a / b);
     }
-    let k = r * r * p.axis.w;
+    let k = r * r * params.axis.w;
     let cos_theta = 1.0 - k;
     let sin_theta = sign(r) * sqrt(max(k * (2.0 - k), 0.0));
-    let d = sin_theta * (cos(phi) * p.basis_u.xyz + sin(phi) * p.basis_v.xyz)
-        + cos_theta * p.axis.xyz;
+    let d = sin_theta * (cos(phi) * params.basis_u.xyz + sin(phi) * params.basis_v.xyz)
+        + cos_theta * params.axis.xyz;
     return normalize(d);
 }
 
 @compute @workgroup_size(8, 8, 1)
 fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
-    let n = p.grid_dims.w;
+    params = p;
+    let n = params.grid_dims.w;
     if id.x >= n || id.y >= n {
         return;
     }
     let world_dir = cone_direction((f32(id.x) + 0.5) / f32(n), (f32(id.y) + 0.5) / f32(n));
-    let origin = (p.model_from_world * vec4<f32>(p.light.xyz, 1.0)).xyz;
-    let dir = normalize((p.model_from_world * vec4<f32>(world_dir, 0.0)).xyz);
+    let origin = (params.model_from_world * vec4<f32>(params.light.xyz, 1.0)).xyz;
+    let dir = normalize((params.model_from_world * vec4<f32>(world_dir, 0.0)).xyz);
     let straight = floor_t(origin, dir);
     let first = closest_hit(origin, dir, select(1e30, straight, straight > 0.0));
     if first.tri == NONE {
@@ -325,23 +340,20 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     loop {
         if hit.tri != NONE {
             // Split at the surface into the reflected and the refracted part.
-            if ray.interactions < p.map.z {
+            if ray.interactions < params.map.z {
                 let tri = hit.tri;
-                let i0 = indices[3u * tri];
-                let i1 = indices[3u * tri + 1u];
-                let i2 = indices[3u * tri + 2u];
-                let a = positions[i0].xyz;
                 let point = ray.origin + ray.dir * hit.t;
-                let geometric = normalize(cross(positions[i1].xyz - a, positions[i2].xyz - a));
-                let shading = normalize((1.0 - hit.u - hit.v) * normals[i0].xyz
-                    + hit.u * normals[i1].xyz + hit.v * normals[i2].xyz);
+                let geometric = normalize(hit.normal);
+                let shading = normalize((1.0 - hit.u - hit.v) * vertex_normals[3u * tri].xyz
+                    + hit.u * vertex_normals[3u * tri + 1u].xyz
+                    + hit.v * vertex_normals[3u * tri + 2u].xyz);
                 let entering = dot(ray.dir, geometric) < 0.0;
                 let side_g = select(-geometric, geometric, entering);
                 var side_s = select(-shading, shading, entering);
                 if !(dot(side_s, ray.dir) < 0.0 && dot(side_s, side_g) > 0.0) {
                     side_s = side_g;
                 }
-                let eta = select(p.basis_u.w, 1.0 / p.basis_u.w, entering);
+                let eta = select(params.basis_u.w, 1.0 / params.basis_u.w, entering);
                 let reflectance = fresnel_exact(-dot(ray.dir, side_s), eta);
                 var r = reflect(ray.dir, side_s);
                 if dot(r, side_g) <= 0.0 {
@@ -357,14 +369,14 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
                 let refracts = dot(t, t) > 0.0 && dot(t, side_g) < 0.0;
                 let reflected_weight = select(ray.weight, ray.weight * reflectance, refracts);
                 let interactions = ray.interactions + 1u;
-                if reflected_weight >= p.misc.z && depth < STACK {
-                    stack[depth] = Ray(point + side_g * p.misc.x, r, reflected_weight,
+                if reflected_weight >= params.misc.z && depth < STACK {
+                    stack[depth] = Ray(point + side_g * params.misc.x, r, reflected_weight,
                         interactions, ray.inside);
                     depth++;
                 }
                 let refracted_weight = ray.weight * (1.0 - reflectance);
-                if refracts && refracted_weight >= p.misc.z && depth < STACK {
-                    stack[depth] = Ray(point - side_g * p.misc.x, t, refracted_weight,
+                if refracts && refracted_weight >= params.misc.z && depth < STACK {
+                    stack[depth] = Ray(point - side_g * params.misc.x, t, refracted_weight,
                         interactions, 1u - ray.inside);
                     depth++;
                 }
@@ -379,9 +391,9 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
         if ray.inside == 0u {
             to_floor = floor_t(ray.origin, ray.dir);
         }
-        if ray.inside == 0u && p.shell_outer.z > 0.0 {
+        if ray.inside == 0u && params.shell_outer.z > 0.0 {
             // Leaving a convex body outward: nothing of it lies ahead.
-            hit = Hit(0.0, NONE, 0.0, 0.0);
+            hit = Hit(0.0, NONE, 0.0, 0.0, vec3<f32>(0.0));
         } else {
             hit = closest_hit(ray.origin, ray.dir, select(1e30, to_floor, to_floor > 0.0));
         }
@@ -392,16 +404,163 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Which smoothing pass a dispatch runs (`smooth_steps` in live.rs): bit 0 clear along the
-// rows (reading the photons' sums), set along the columns (reading the rows' result); bit 8
-// set on the last pass, which writes the gain map.
+// rows, set along the columns; bit 1 set when a pass along the columns reads the photons'
+// sums itself (no smoothing); bit 8 set on the last pass, which writes the gain map.
 struct SmoothStep {
     bits: u32,
 };
 var<push_constant> smooth_step: SmoothStep;
 
+const COLUMNS_STEP: u32 = 0x1u;
+const FROM_SUMS_STEP: u32 = 0x2u;
 const LAST_STEP: u32 = 0x100u;
 // Most texels in one box: 2 x 64 + 1 (`MAX_SMOOTHING_PX` in live.rs).
 const MAX_BOX: u32 = 129u;
+// Largest radius the short kernel takes (`SHORT_KERNEL_PX` in live.rs).
+const SHORT_KERNEL_PX: u32 = 2u;
+
+// Texels from one row of the map's buffers to the next: the width rounded up to whole
+// vectors of four, so that the short kernel's passes read and write four texels at a time
+// (texels past the width stay 0 in the sums, and their gains are neither kept nor copied).
+fn row_pitch(width: u32) -> u32 {
+    return (width + 3u) & ~3u;
+}
+
+// Widens the bound of the non-zero gains by the box [lo, hi] (texels, ends included).
+fn widen_bounds(lo: vec2<u32>, hi: vec2<u32>) {
+    atomicMin(&bounds[0], lo.x);
+    atomicMin(&bounds[1], lo.y);
+    atomicMax(&bounds[2], hi.x);
+    atomicMax(&bounds[3], hi.y);
+}
+
+// The kernel of the box of 2 radius + 1 texels applied three times, for a radius of 0, 1
+// or 2, over a window of 13 texels (slot 6 the centre): integer weights over their sum (1, 27,
+// 125).
+fn short_kernel(radius: u32) -> array<vec4<f32>, 4> {
+    if radius == 2u {
+        let k = 1.0 / 125.0;
+        return array<vec4<f32>, 4>(vec4<f32>(1.0, 3.0, 6.0, 10.0) * k,
+            vec4<f32>(15.0, 18.0, 19.0, 18.0) * k, vec4<f32>(15.0, 10.0, 6.0, 3.0) * k,
+            vec4<f32>(1.0, 0.0, 0.0, 0.0) * k);
+    }
+    if radius == 1u {
+        let k = 1.0 / 27.0;
+        return array<vec4<f32>, 4>(vec4<f32>(0.0, 0.0, 0.0, 1.0) * k,
+            vec4<f32>(3.0, 6.0, 7.0, 6.0) * k, vec4<f32>(3.0, 1.0, 0.0, 0.0) * k,
+            vec4<f32>(0.0));
+    }
+    return array<vec4<f32>, 4>(vec4<f32>(0.0), vec4<f32>(0.0, 0.0, 1.0, 0.0), vec4<f32>(0.0),
+        vec4<f32>(0.0));
+}
+
+// The last 13 inputs of a stream of texels, oldest first (`w3` the newest), in registers.
+struct Window {
+    w0: vec4<f32>,
+    w1: vec4<f32>,
+    w2: vec4<f32>,
+    w3: f32,
+};
+
+// Feeds the next input `v` to `w` (the inputs before the first count as 0); returns the
+// smoothed value of the input 6 back (the window's centre).
+fn window_feed(w: ptr<function, Window>, v: f32, k: array<vec4<f32>, 4>) -> f32 {
+    (*w).w0 = vec4<f32>((*w).w0.yzw, (*w).w1.x);
+    (*w).w1 = vec4<f32>((*w).w1.yzw, (*w).w2.x);
+    (*w).w2 = vec4<f32>((*w).w2.yzw, (*w).w3);
+    (*w).w3 = v;
+    return dot((*w).w0, k[0]) + dot((*w).w1, k[1]) + dot((*w).w2, k[2]) + (*w).w3 * k[3].x;
+}
+
+// The short kernel (radius <= 2) along the rows, one row per invocation, four texels per
+// step: reads G = max(0, sum) of the photons' sums (eq. 6's clamp, per texel as the bake
+// stores it) and writes the row's smoothed values (fixed-point units) into `scratch`. On a
+// CPU device each access of a storage buffer is a loop over the lanes, so a texel's cost
+// is its share of the accesses: a quarter of a read and of a write here.
+@compute @workgroup_size(64, 1, 1)
+fn cs_smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= p.map.y {
+        return;
+    }
+    let blocks = row_pitch(p.map.x) / 4u;
+    let base = id.x * blocks;
+    let k = short_kernel(p.map.w);
+    var w = Window(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0), 0.0);
+    var previous = vec4<f32>(0.0);
+    // After block b (texels 4b..4b+3) the window yields texels 4b-6..4b-3, so block b-2 is
+    // the last two of the step before and the first two of this one.
+    for (var b = 0u; b < blocks + 2u; b++) {
+        var v = vec4<f32>(0.0);
+        if b < blocks {
+            v = vec4<f32>(max(sums4[base + b], vec4<i32>(0)));
+        }
+        let out = vec4<f32>(window_feed(&w, v.x, k), window_feed(&w, v.y, k),
+            window_feed(&w, v.z, k), window_feed(&w, v.w, k));
+        if b >= 2u {
+            scratch[base + b - 2u] = vec4<f32>(previous.zw, out.xy);
+        }
+        previous = out;
+    }
+}
+
+// The short kernel along the columns, four adjacent columns per invocation, one row per
+// step: reads the rows' result (or, without smoothing, G = max(0, sum) of the photons' sums
+// directly), writes the gain map with gains below MIN_GAIN zeroed, and bounds the non-zero
+// texels.
+@compute @workgroup_size(64, 1, 1)
+fn cs_smooth_columns(@builtin(global_invocation_id) id: vec3<u32>) {
+    let blocks = row_pitch(p.map.x) / 4u;
+    if id.x >= blocks {
+        return;
+    }
+    let from_sums = (smooth_step.bits & FROM_SUMS_STEP) != 0u;
+    let height = p.map.y;
+    let k = short_kernel(p.map.w);
+    let unit = p.misc.y;
+    let min_gain = p.misc.w;
+    let x = vec4<u32>(4u * id.x) + vec4<u32>(0u, 1u, 2u, 3u);
+    let on_map = x < vec4<u32>(p.map.x);
+    let zero = Window(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0), 0.0);
+    var c0 = zero;
+    var c1 = zero;
+    var c2 = zero;
+    var c3 = zero;
+    var first = NONE;
+    var final_row = 0u;
+    var kept_columns = vec4<bool>(false);
+    for (var n = 0u; n < height + 6u; n++) {
+        var v = vec4<f32>(0.0);
+        if n < height {
+            if from_sums {
+                v = vec4<f32>(max(sums4[n * blocks + id.x], vec4<i32>(0)));
+            } else {
+                v = scratch[n * blocks + id.x];
+            }
+        }
+        let mean = vec4<f32>(window_feed(&c0, v.x, k), window_feed(&c1, v.y, k),
+            window_feed(&c2, v.z, k), window_feed(&c3, v.w, k));
+        if n < 6u {
+            continue;
+        }
+        let at = n - 6u;
+        let g = mean / unit;
+        let kept = g >= vec4<f32>(min_gain) & on_map;
+        gain[at * blocks + id.x] = select(vec4<f32>(0.0), g, kept);
+        if any(kept) {
+            first = min(first, at);
+            final_row = at;
+            kept_columns = kept_columns | kept;
+        }
+    }
+    if first != NONE {
+        // The first and last kept of the four columns.
+        let lo = select(select(select(x.w, x.z, kept_columns.z), x.y, kept_columns.y), x.x,
+            kept_columns.x);
+        let hi = select(select(select(x.x, x.y, kept_columns.y), x.z, kept_columns.z), x.w,
+            kept_columns.w);
+        widen_bounds(vec2<u32>(lo, first), vec2<u32>(hi, final_row));
+    }
+}
 
 // A box mean over a stream of texels: the last 2 radius + 1 inputs and their sum, exactly in
 // 64 bits (low and high words), so that nothing drifts along a line.
@@ -409,17 +568,17 @@ struct RunningBox {
     ring: array<u32, MAX_BOX>,
     low: u32,
     high: u32,
-    count: u32,
+    slot: u32,
 };
 
 // Feeds the next input `v` of the stream to `b` (the inputs before the first count as 0);
 // returns the mean of the 2 radius + 1 inputs centred `radius` inputs back.
 fn box_feed(b: ptr<function, RunningBox>, v: u32, radius: u32) -> f32 {
     let span = 2u * radius + 1u;
-    let slot = (*b).count % span;
+    let slot = (*b).slot;
     let old = (*b).ring[slot];
     (*b).ring[slot] = v;
-    (*b).count += 1u;
+    (*b).slot = select(slot + 1u, 0u, slot + 1u == span);
     (*b).low += v;
     (*b).high += select(0u, 1u, (*b).low < v);
     (*b).high -= select(0u, 1u, (*b).low < old);
@@ -427,25 +586,28 @@ fn box_feed(b: ptr<function, RunningBox>, v: u32, radius: u32) -> f32 {
     return (f32((*b).high) * 4294967296.0 + f32((*b).low)) / f32(span);
 }
 
-// The smoothing along one line (a row or a column) per invocation: the box of 2 radius + 1
-// texels three times over, streamed (each box's means feed the next, rounded to fixed point,
-// and texels beyond the map's edge count as 0 at every box: their light is lost, as off the
-// floor). Along the rows it reads G = max(0, sum) of the photons' sums (eq. 6's clamp, per
-// texel as the bake stores it). The last pass also zeroes gains below MIN_GAIN and bounds
-// the non-zero texels.
+// Radii above SHORT_KERNEL_PX: the smoothing along one line (a row or a column) per
+// invocation, the box of 2 radius + 1 texels three times over, streamed through ring buffers
+// (each box's means feed the next, rounded to fixed point, and texels beyond the map's edge
+// count as 0 at every box: their light is lost, as off the floor), so that the cost does not
+// grow with the radius. Along the rows it reads G = max(0, sum) of the photons' sums; the
+// last pass, along the columns, zeroes gains below MIN_GAIN and bounds the non-zero texels.
 @compute @workgroup_size(64, 1, 1)
-fn cs_smooth(@builtin(global_invocation_id) id: vec3<u32>) {
-    let columns = (smooth_step.bits & 1u) != 0u;
+fn cs_smooth_wide(@builtin(global_invocation_id) id: vec3<u32>) {
+    let columns = (smooth_step.bits & COLUMNS_STEP) != 0u;
     let last = (smooth_step.bits & LAST_STEP) != 0u;
     let width = p.map.x;
+    let pitch = row_pitch(p.map.x);
     let lines = select(p.map.y, width, columns);
     let length = select(width, p.map.y, columns);
     if id.x >= lines {
         return;
     }
-    let stride = select(1u, width, columns);
-    let start = select(id.x * width, id.x, columns);
+    let stride = select(1u, pitch, columns);
+    let start = select(id.x * pitch, id.x, columns);
     let radius = p.map.w;
+    let unit = p.misc.y;
+    let min_gain = p.misc.w;
     var box1: RunningBox;
     var box2: RunningBox;
     var box3: RunningBox;
@@ -458,9 +620,9 @@ fn cs_smooth(@builtin(global_invocation_id) id: vec3<u32>) {
         if n < length {
             let index = start + n * stride;
             if columns {
-                v = scratch[index];
+                v = u32(scratch[index / 4u][index % 4u]);
             } else {
-                v = u32(max(atomicLoad(&sums[index]), 0));
+                v = u32(max(sums4[index / 4u][index % 4u], 0));
             }
         }
         let mean1 = box_feed(&box1, v, radius);
@@ -480,24 +642,20 @@ fn cs_smooth(@builtin(global_invocation_id) id: vec3<u32>) {
         let at = at2 - radius;
         let index = start + at * stride;
         if last {
-            let g = mean / p.misc.y;
-            let kept = g >= p.misc.w;
-            gain[index] = select(0.0, g, kept);
+            let g = mean / unit;
+            let kept = g >= min_gain;
+            gain[index / 4u][index % 4u] = select(0.0, g, kept);
             if kept {
                 first = min(first, at);
                 final_texel = at;
             }
         } else {
-            scratch[index] = u32(round(mean));
+            scratch[index / 4u][index % 4u] = round(mean);
         }
     }
     if first != NONE {
         // Along the line from `first` to `final_texel`; across it, the line itself.
-        let lo = select(vec2<u32>(first, id.x), vec2<u32>(id.x, first), columns);
-        let hi = select(vec2<u32>(final_texel, id.x), vec2<u32>(id.x, final_texel), columns);
-        atomicMin(&bounds[0], lo.x);
-        atomicMin(&bounds[1], lo.y);
-        atomicMax(&bounds[2], hi.x);
-        atomicMax(&bounds[3], hi.y);
+        widen_bounds(select(vec2<u32>(first, id.x), vec2<u32>(id.x, first), columns),
+            select(vec2<u32>(final_texel, id.x), vec2<u32>(id.x, final_texel), columns));
     }
 }

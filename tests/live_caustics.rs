@@ -279,6 +279,55 @@ fn live_sphere_caustics_match_the_bake_and_focus_on_the_light_axis() {
     );
 }
 
+/// Every way the GPU smooths (no box, the short kernel's passes for radii 1 and 2, the ring
+/// buffers' for wider boxes) against the CPU's direct convolution of the GPU's unsmoothed
+/// map, on a map whose width is no multiple of four (its rows are padded on the GPU).
+#[test]
+fn the_gpu_smoothing_is_the_three_box_kernel_at_every_radius() {
+    let (scene, _) = live_scene("glass-sphere.toml", Some(990));
+    let side = scene.caustics.resolution_px;
+    assert_ne!(side % 4, 0, "the rows need padding");
+    let gains = |smoothing_px| {
+        let live = LiveCausticsDesc {
+            smoothing_px,
+            ..LiveCausticsDesc::default()
+        };
+        live_gains(&scene, live, &[None], false).remove(0).0
+    };
+    let raw = gains(0);
+    assert!(
+        raw.iter().all(|&g| g == 0.0 || g >= 1e-3),
+        "gains below MIN_GAIN are zeroed"
+    );
+    assert!(
+        raw.iter().any(|&g| g > 100.0),
+        "the focus is in the unsmoothed map"
+    );
+    for radius in [1, 2, 3, 5] {
+        let gpu = gains(radius);
+        let cpu = smoothed(&raw, side as usize, radius);
+        let rms = relative_rms(&gpu, &cpu);
+        let peak_gpu = gpu.iter().copied().fold(0.0f32, f32::max);
+        let peak_cpu = cpu.iter().copied().fold(0.0f32, f32::max);
+        eprintln!(
+            "radius {radius}: relative RMS {:.4} % against the CPU's smoothing of the \
+             unsmoothed map, peak G {peak_gpu:.2} against {peak_cpu:.2}",
+            rms * 100.0
+        );
+        // The GPU smooths the sums before zeroing gains below MIN_GAIN (0.001), the CPU the
+        // map zeroed first: that, and fixed-point rounding, is all that may differ.
+        assert!(rms < 1e-3, "radius {radius}: relative RMS {rms}");
+        assert!(
+            (peak_gpu - peak_cpu).abs() <= 1e-3 * peak_cpu,
+            "radius {radius}"
+        );
+        assert!(
+            gpu.iter().all(|&g| g == 0.0 || g >= 1e-3),
+            "radius {radius}: gains below MIN_GAIN are zeroed"
+        );
+    }
+}
+
 #[test]
 fn live_diamond_caustics_match_the_bake() {
     let (scene, averaged) = live_scene("diamond.toml", None);

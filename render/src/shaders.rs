@@ -70,7 +70,13 @@ pub const OVERLAY_FS: [&[u8]; 3] = [
     spirv!("floor_overlay.fs_main.caustics.filtered"),
 ];
 pub const CAUSTICS_TRACE_CS: &[u8] = spirv!("caustics_live.cs_trace");
-pub const CAUSTICS_SMOOTH_CS: &[u8] = spirv!("caustics_live.cs_smooth");
+/// The smoothing's passes: the short kernel along the rows and along the columns, and the
+/// ring buffers' pass for wider boxes.
+pub const CAUSTICS_SMOOTH_CS: [&[u8]; 3] = [
+    spirv!("caustics_live.cs_smooth_rows"),
+    spirv!("caustics_live.cs_smooth_columns"),
+    spirv!("caustics_live.cs_smooth_wide"),
+];
 
 /// Reinterprets SPIR-V bytes as words (include_bytes gives no alignment guarantee).
 pub fn words(bytes: &[u8]) -> Vec<u32> {

@@ -58,20 +58,52 @@ pub const DEFAULT_RESOLUTION_PX: u32 = 990;
 pub const MAX_PHOTONS_PER_SIDE: u32 = 4096;
 /// Largest smoothing box radius accepted, texels.
 pub const MAX_SMOOTHING_PX: u32 = 64;
-/// Invocations per workgroup of the smoothing (`cs_smooth`), one line each.
+/// Invocations per workgroup of the smoothing's passes.
 const SMOOTH_GROUP: u32 = 64;
-/// Flag of the last smoothing step (`LAST_STEP` in caustics_live.wgsl).
+/// Largest radius the smoothing's short kernel takes (`SHORT_KERNEL_PX` in
+/// caustics_live.wgsl): its 6 r + 1 = 13 weights fit in registers.
+const SHORT_KERNEL_PX: u32 = 2;
+/// Flags of a smoothing step (`COLUMNS_STEP`, `FROM_SUMS_STEP`, `LAST_STEP` in
+/// caustics_live.wgsl): along the columns; reading the photons' sums (no smoothing); the last.
+const COLUMNS_STEP: u32 = 0x1;
+const FROM_SUMS_STEP: u32 = 0x2;
 const LAST_STEP: u32 = 0x100;
 
-/// The push constants of the smoothing's dispatches, in order, for a box of `radius` texels:
-/// along the rows (0), then along the columns (1), the last flagged; only along the rows
-/// without smoothing (where the three boxes of one texel only clamp, zero and bound).
-fn smooth_steps(radius: u32) -> Vec<u32> {
-    if radius == 0 {
-        vec![LAST_STEP]
-    } else {
-        vec![0, 1 | LAST_STEP]
+/// A smoothing pass's shader (index into `shaders::CAUSTICS_SMOOTH_CS`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum SmoothPass {
+    /// The short kernel along the rows, one row per invocation.
+    Rows = 0,
+    /// The short kernel along the columns, four columns per invocation.
+    Columns = 1,
+    /// Ring buffers, one row or column per invocation.
+    Wide = 2,
+}
+
+/// The smoothing's dispatches, in order, for a box of `radius` texels: its pass and push
+/// constant. Along the rows, then along the columns (the last); without smoothing one pass
+/// along the columns that reads the sums, clamps, zeroes and bounds.
+fn smooth_steps(radius: u32) -> Vec<(SmoothPass, u32)> {
+    match radius {
+        0 => vec![(
+            SmoothPass::Columns,
+            COLUMNS_STEP | FROM_SUMS_STEP | LAST_STEP,
+        )],
+        r if r <= SHORT_KERNEL_PX => vec![
+            (SmoothPass::Rows, 0),
+            (SmoothPass::Columns, COLUMNS_STEP | LAST_STEP),
+        ],
+        _ => vec![
+            (SmoothPass::Wide, 0),
+            (SmoothPass::Wide, COLUMNS_STEP | LAST_STEP),
+        ],
     }
+}
+
+/// Texels from one row of the map's buffers to the next: the width rounded up to whole
+/// vectors of four (`row_pitch` in caustics_live.wgsl).
+fn row_pitch(width: u32) -> u32 {
+    width.next_multiple_of(4)
 }
 
 /// Fixed-point units per unit of gain in the sums (integer atomics keep the result the same
@@ -114,9 +146,9 @@ struct Params {
 pub(crate) struct LiveCaustics {
     /// Photon tracing and splatting.
     trace: Owned<vk::Pipeline>,
-    /// One pass of the smoothing (the first also clamps, the last zeroes small gains and
-    /// bounds).
-    smooth: Owned<vk::Pipeline>,
+    /// The smoothing's passes ([`SmoothPass`]; the first also clamps, the last zeroes small
+    /// gains and bounds).
+    smooth: [Owned<vk::Pipeline>; 3],
     /// Layout of both (one set; the smoothing step as push constant).
     layout: Owned<vk::PipelineLayout>,
     /// Pool of the set.
@@ -128,7 +160,7 @@ pub(crate) struct LiveCaustics {
     /// `Params`, rewritten before each computation.
     params: Buffer,
     /// Mesh and grid buffers, read by the trace pass.
-    _mesh: [Buffer; 6],
+    _mesh: [Buffer; 4],
     /// Fixed-point sums per texel.
     sums: Buffer,
     /// The fixed-point map smoothed along the rows.
@@ -212,23 +244,17 @@ impl LiveCaustics {
             |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.extend(0.0).to_array()).collect() };
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let cells: Vec<u32> = grid.cells.iter().flatten().copied().collect();
+        // Each triangle's three vertex normals, so that a hit reads them without its indices.
+        let vertex_normals: Vec<Vec3> = mesh
+            .indices
+            .iter()
+            .map(|&i| mesh.normals[i as usize])
+            .collect();
         let mesh_buffers = [
             Buffer::with_data(
                 ctx,
-                "caustics positions",
-                bytemuck::cast_slice(&vec4s(mesh.positions)),
-                storage,
-            )?,
-            Buffer::with_data(
-                ctx,
-                "caustics normals",
-                bytemuck::cast_slice(&vec4s(mesh.normals)),
-                storage,
-            )?,
-            Buffer::with_data(
-                ctx,
-                "caustics indices",
-                bytemuck::cast_slice(mesh.indices),
+                "caustics vertex normals",
+                bytemuck::cast_slice(&vec4s(&vertex_normals)),
                 storage,
             )?,
             Buffer::with_data(
@@ -250,7 +276,7 @@ impl LiveCaustics {
                 storage,
             )?,
         ];
-        let texels = u64::from(size[0]) * u64::from(size[1]);
+        let texels = u64::from(row_pitch(size[0])) * u64::from(size[1]);
         let sums = Buffer::new(
             ctx,
             "caustics sums",
@@ -283,21 +309,41 @@ impl LiveCaustics {
         // The parameters in a storage buffer, not a uniform one: on lavapipe, which can inline
         // uniform values into a shader's loops and compile it again when they change, that
         // took about 1 ms off a moved frame's stage at the defaults and 6 ms with one photon.
-        let bindings: Vec<_> = (0..=10)
+        let bindings: Vec<_> = (0..=9)
             .map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute))
             .collect();
         let set_layout = pipeline::set_layout(ctx, &bindings)?;
         // The smoothing step; the trace pass reads none.
         let layout = pipeline::layout(ctx, Some(set_layout.raw()), compute, 4)?;
         let trace = pipeline::compute(ctx, layout.raw(), shaders::CAUSTICS_TRACE_CS, c"cs_trace")?;
-        let smooth =
-            pipeline::compute(ctx, layout.raw(), shaders::CAUSTICS_SMOOTH_CS, c"cs_smooth")?;
-        let pool = pipeline::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 11)])?;
+        let smooth = [
+            pipeline::compute(
+                ctx,
+                layout.raw(),
+                shaders::CAUSTICS_SMOOTH_CS[0],
+                c"cs_smooth_rows",
+            )?,
+            pipeline::compute(
+                ctx,
+                layout.raw(),
+                shaders::CAUSTICS_SMOOTH_CS[1],
+                c"cs_smooth_columns",
+            )?,
+            pipeline::compute(
+                ctx,
+                layout.raw(),
+                shaders::CAUSTICS_SMOOTH_CS[2],
+                c"cs_smooth_wide",
+            )?,
+        ];
+        let pool = pipeline::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 10)])?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
-        buffers.extend(mesh_buffers[..5].iter().map(|b| b.buffer));
+        buffers.extend(mesh_buffers[..3].iter().map(|b| b.buffer));
         buffers.extend([sums.buffer, gain.buffer, bounds, scratch.buffer]);
-        buffers.push(mesh_buffers[5].buffer);
+        buffers.push(mesh_buffers[3].buffer);
+        // The sums again, read four texels at a time by the smoothing.
+        buffers.push(sums.buffer);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|&buffer| {
@@ -496,8 +542,7 @@ impl LiveCaustics {
             if let Some(stamps) = stamps {
                 stamps.write(d, cmd, CAUSTIC_PHOTONS_STAMP..CAUSTIC_PHOTONS_STAMP + 1);
             }
-            d.cmd_bind_pipeline(cmd, bind, self.smooth.raw());
-            for step in smooth_steps(self.desc.smoothing_px) {
+            for (pass, step) in smooth_steps(self.desc.smoothing_px) {
                 // Each pass reads what the one before wrote (the first, the photons' sums).
                 d.cmd_pipeline_barrier(
                     cmd,
@@ -511,8 +556,13 @@ impl LiveCaustics {
                     &[],
                     &[],
                 );
-                let columns = step & 1 != 0;
-                let lines = if columns { w } else { h };
+                d.cmd_bind_pipeline(cmd, bind, self.smooth[pass as usize].raw());
+                let lines = match pass {
+                    SmoothPass::Rows => h,
+                    SmoothPass::Columns => row_pitch(w) / 4,
+                    SmoothPass::Wide if step & COLUMNS_STEP != 0 => w,
+                    SmoothPass::Wide => h,
+                };
                 d.cmd_push_constants(
                     cmd,
                     self.layout.raw(),
@@ -539,7 +589,8 @@ impl LiveCaustics {
                     vk::AccessFlags::TRANSFER_WRITE,
                 ),
             );
-            let region = crate::memory::color_copy_region(0, self.size[0], self.size[1], 1, 1);
+            let region = crate::memory::color_copy_region(0, self.size[0], self.size[1], 1, 1)
+                .buffer_row_length(row_pitch(self.size[0]));
             d.cmd_copy_buffer_to_image(
                 cmd,
                 self.gain.buffer,
@@ -573,11 +624,19 @@ impl LiveCaustics {
     /// The gain map of the last computation that finished, row 0 at the photo's top (wait
     /// for the frame first).
     pub fn gain(&self) -> Result<Vec<f32>> {
-        Ok(self
+        let [w, h] = self.size.map(|n| n as usize);
+        let pitch = row_pitch(self.size[0]) as usize;
+        let texels: Vec<f32> = self
             .gain
             .mapped()?
             .chunks_exact(4)
             .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        Ok(texels
+            .chunks_exact(pitch)
+            .take(h)
+            .flat_map(|row| &row[..w])
+            .copied()
             .collect())
     }
 }
@@ -587,8 +646,22 @@ mod tests {
     use super::*;
 
     #[test]
-    fn smoothing_runs_along_rows_then_columns_or_rows_alone_without_a_box() {
-        assert_eq!(smooth_steps(0), vec![LAST_STEP]);
-        assert_eq!(smooth_steps(5), vec![0, 1 | LAST_STEP]);
+    fn smoothing_runs_along_rows_then_columns_or_once_without_a_box() {
+        use SmoothPass::*;
+        let once = COLUMNS_STEP | FROM_SUMS_STEP | LAST_STEP;
+        assert_eq!(smooth_steps(0), vec![(Columns, once)]);
+        let short = vec![(Rows, 0), (Columns, COLUMNS_STEP | LAST_STEP)];
+        assert_eq!(smooth_steps(1), short);
+        assert_eq!(smooth_steps(2), short);
+        let wide = vec![(Wide, 0), (Wide, COLUMNS_STEP | LAST_STEP)];
+        assert_eq!(smooth_steps(3), wide);
+        assert_eq!(smooth_steps(MAX_SMOOTHING_PX), wide);
+    }
+
+    #[test]
+    fn rows_are_padded_to_whole_vectors_of_four() {
+        assert_eq!(row_pitch(990), 992);
+        assert_eq!(row_pitch(992), 992);
+        assert_eq!(row_pitch(1), 4);
     }
 }

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
+use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer, ScenePose};
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 
@@ -18,6 +18,7 @@ use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::look::LookPlanner;
 use crate::look::{GazeSettings, planner_for};
+use crate::motion_clock::MotionClock;
 use crate::replay::{check_size, load_trace};
 use crate::scene::load_scene;
 use crate::views;
@@ -68,14 +69,23 @@ pub struct SoakPass {
     pub heap_in_use_kib: u64,
     /// Validation errors and warnings of the pass.
     pub validation_messages: u32,
+    /// Frames where the scene's `[motion]` moved the object or the light (each recomputes the
+    /// inducer's fields, and a live scene's caustics).
+    pub moved_frames: u64,
 }
 
 impl std::fmt::Display for SoakPass {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "pass {} ({} frames): resident {} KiB, heap in use {} KiB, {} validation messages",
-            self.pass, self.frames, self.rss_kib, self.heap_in_use_kib, self.validation_messages
+            "pass {} ({} frames, {} moved): resident {} KiB, heap in use {} KiB, {} validation \
+             messages",
+            self.pass,
+            self.frames,
+            self.moved_frames,
+            self.rss_kib,
+            self.heap_in_use_kib,
+            self.validation_messages
         )
     }
 }
@@ -154,13 +164,18 @@ impl SoakReport {
     }
 }
 
-/// Renders every frame, reads back some, keeps nothing.
+/// Renders every frame at the scene's pose for its time, reads back some, keeps nothing.
 struct Discard {
     planner: LookPlanner,
     read_back_every: u64,
+    motion: MotionClock,
 }
 
 impl FrameSink for Discard {
+    fn pose(&mut self, input: &FrameInput) -> Option<ScenePose> {
+        self.motion.pose(input.time_ns, &mut self.planner)
+    }
+
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         let read = input.index.is_multiple_of(self.read_back_every);
         FramePlan {
@@ -296,6 +311,7 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
         let mut sink = Discard {
             planner: planner.restarted(),
             read_back_every: options.read_back_every,
+            motion: MotionClock::new(&scene),
         };
         let records = frame_loop::run(&mut backend, renderer, &mut sink)?;
         let log = renderer.context().validation();
@@ -315,6 +331,7 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
             heap_in_use_kib,
             rss_kib: resident_kib()?,
             validation_messages: messages,
+            moved_frames: sink.motion.moved_frames,
         };
         progress(&pass);
         passes.push(pass);

@@ -11,6 +11,7 @@ mod scene_edits;
 mod scene_errors;
 mod scene_load;
 mod scene_shipped;
+mod soak;
 mod study_analyze;
 mod study_run;
 mod trace_analyze;

@@ -137,6 +137,12 @@ fn live_gains_at(
             .live_caustic_gain()
             .expect("read back")
             .expect("live caustics are on");
+        let bounds = renderer.live_caustic_bounds().expect("read back");
+        assert_eq!(
+            bounds,
+            nonzero_box(&gain, square_side(&gain)),
+            "the GPU's bound of the non-zero gains"
+        );
         out.push((gain, wall_ms));
     }
     let v = renderer.context().validation();
@@ -202,6 +208,27 @@ fn smoothed(gain: &[f32], width: usize, radius: u32) -> Vec<f32> {
         .into_iter()
         .map(|g| g as f32)
         .collect()
+}
+
+/// The side of a square map.
+fn square_side(gain: &[f32]) -> u32 {
+    let side = (gain.len() as f64).sqrt() as u32;
+    assert_eq!((side * side) as usize, gain.len(), "a square map");
+    side
+}
+
+/// The texels `[x0, y0, x1, y1]` (ends excluded) holding every non-zero gain of a `width`
+/// texels wide map; `None` when all are 0.
+fn nonzero_box(gain: &[f32], width: u32) -> Option<[u32; 4]> {
+    let mut b: Option<[u32; 4]> = None;
+    for (i, _) in gain.iter().enumerate().filter(|(_, g)| **g != 0.0) {
+        let (x, y) = (i as u32 % width, i as u32 / width);
+        b = Some(match b {
+            None => [x, y, x + 1, y + 1],
+            Some([x0, y0, x1, y1]) => [x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1)],
+        });
+    }
+    b
 }
 
 /// The texel (column, row) with the largest gain.

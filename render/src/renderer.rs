@@ -294,6 +294,14 @@ impl Renderer {
         self.inducer.live_gain()
     }
 
+    /// The texels `[x0, y0, x1, y1]` (ends excluded) holding every non-zero gain of the live
+    /// map of the last finished frame that computed it, as the GPU bounded them for the
+    /// overlay (call [`Renderer::flush`] first); `None` when all are 0 or without live
+    /// caustics.
+    pub fn live_caustic_bounds(&self) -> Result<Option<[u32; 4]>> {
+        self.inducer.live_bounds()
+    }
+
     /// How many times the shadow inducer's fields (mask, distance, gain) were computed: once
     /// for the first frame that drew them, then once per frame after the object or light moved.
     pub fn inducer_computations(&self) -> u64 {

@@ -297,6 +297,15 @@ impl InducerPass {
         self.live.as_ref().map(LiveCaustics::gain).transpose()
     }
 
+    /// The texels `[x0, y0, x1, y1]` (ends excluded) the last finished live computation found
+    /// its non-zero gains in (`None` when all are 0, or without live caustics).
+    pub fn live_bounds(&self) -> Result<Option<[u32; 4]>> {
+        match self.live {
+            Some(_) => self.overlay.live_bounds(),
+            None => Ok(None),
+        }
+    }
+
     /// How many computations of the fields were submitted since the pass was made.
     pub fn computations(&self) -> u64 {
         self.progress.computations

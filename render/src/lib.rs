@@ -53,7 +53,7 @@ pub use error::{RenderError, Result};
 /// The floor passes under their earlier name.
 pub use floor as inducer;
 pub use floor::InducerFields;
-pub use memory::color_copy_region;
+pub use memory::{color_copy_region, layout_barrier, subresource_range};
 pub use pose::ScenePose;
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{

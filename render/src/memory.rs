@@ -346,15 +346,15 @@ pub fn upload_volume(
     // UNDEFINED layout, as the first barrier says.
     let result = ctx.one_shot(|cmd| unsafe {
         let range = subresource_range(vk::ImageAspectFlags::COLOR, 0, 1);
-        let to_dst = vk::ImageMemoryBarrier::default()
-            .src_access_mask(vk::AccessFlags::empty())
-            .dst_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-            .old_layout(vk::ImageLayout::UNDEFINED)
-            .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(image.image)
-            .subresource_range(range);
+        let to_dst = layout_barrier(
+            image.image,
+            range,
+            (vk::ImageLayout::UNDEFINED, vk::AccessFlags::empty()),
+            (
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                vk::AccessFlags::TRANSFER_WRITE,
+            ),
+        );
         device.cmd_pipeline_barrier(
             cmd,
             vk::PipelineStageFlags::TOP_OF_PIPE,
@@ -372,15 +372,18 @@ pub fn upload_volume(
             vk::ImageLayout::TRANSFER_DST_OPTIMAL,
             &[region],
         );
-        let to_read = vk::ImageMemoryBarrier::default()
-            .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-            .dst_access_mask(vk::AccessFlags::SHADER_READ)
-            .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-            .new_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(image.image)
-            .subresource_range(range);
+        let to_read = layout_barrier(
+            image.image,
+            range,
+            (
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                vk::AccessFlags::TRANSFER_WRITE,
+            ),
+            (
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                vk::AccessFlags::SHADER_READ,
+            ),
+        );
         device.cmd_pipeline_barrier(
             cmd,
             vk::PipelineStageFlags::TRANSFER,
@@ -412,6 +415,25 @@ pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
         }
         _ => vk::ImageAspectFlags::COLOR,
     }
+}
+
+/// A layout transition of `range` of `image` for `vkCmdPipelineBarrier`: from `old` after
+/// accesses `src` to `new` before accesses `dst`, on one queue (no ownership transfer).
+pub fn layout_barrier(
+    image: vk::Image,
+    range: vk::ImageSubresourceRange,
+    (old, src): (vk::ImageLayout, vk::AccessFlags),
+    (new, dst): (vk::ImageLayout, vk::AccessFlags),
+) -> vk::ImageMemoryBarrier<'static> {
+    vk::ImageMemoryBarrier::default()
+        .src_access_mask(src)
+        .dst_access_mask(dst)
+        .old_layout(old)
+        .new_layout(new)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(range)
 }
 
 /// A subresource range of `count` layers from `base`, one mip level.

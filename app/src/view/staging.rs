@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use ash::vk;
-use vitreous_render::GpuContext;
+use vitreous_render::{GpuContext, layout_barrier, subresource_range};
 
 /// A staging buffer, mapped for as long as it lives. Freed with [`Staging::free`] (it holds
 /// no device, so it cannot free itself on drop).
@@ -112,32 +112,24 @@ pub unsafe fn record_copy(
     image: vk::Image,
     extent: vk::Extent2D,
 ) {
-    let range = vk::ImageSubresourceRange {
-        aspect_mask: vk::ImageAspectFlags::COLOR,
-        base_mip_level: 0,
-        level_count: 1,
-        base_array_layer: 0,
-        layer_count: 1,
-    };
-    let to_dst = vk::ImageMemoryBarrier::default()
-        .src_access_mask(vk::AccessFlags::empty())
-        .dst_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-        .old_layout(vk::ImageLayout::UNDEFINED)
-        .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(range);
+    let range = subresource_range(vk::ImageAspectFlags::COLOR, 0, 1);
+    let transfer_dst = (
+        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+        vk::AccessFlags::TRANSFER_WRITE,
+    );
+    let to_dst = layout_barrier(
+        image,
+        range,
+        (vk::ImageLayout::UNDEFINED, vk::AccessFlags::empty()),
+        transfer_dst,
+    );
     let region = vitreous_render::color_copy_region(0, extent.width, extent.height, 1, 1);
-    let to_present = vk::ImageMemoryBarrier::default()
-        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-        .dst_access_mask(vk::AccessFlags::empty())
-        .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-        .new_layout(vk::ImageLayout::PRESENT_SRC_KHR)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(range);
+    let to_present = layout_barrier(
+        image,
+        range,
+        transfer_dst,
+        (vk::ImageLayout::PRESENT_SRC_KHR, vk::AccessFlags::empty()),
+    );
     // SAFETY: the caller's contract.
     unsafe {
         // The acquire semaphore is waited for at TRANSFER, so the layout change happens after

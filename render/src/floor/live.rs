@@ -13,7 +13,7 @@ use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
 use super::triangle_grid::{Grid, corner_and_edges, inner_radius};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::memory::{Buffer, Image, subresource_range};
+use crate::memory::{Buffer, Image, layout_barrier, subresource_range};
 use crate::owned::Owned;
 use crate::pipeline;
 use crate::pose::ScenePose;
@@ -482,15 +482,8 @@ impl LiveCaustics {
                 .dst_access_mask(dst)]
         };
         let image_barrier = |old, new, src, dst| {
-            [vk::ImageMemoryBarrier::default()
-                .src_access_mask(src)
-                .dst_access_mask(dst)
-                .old_layout(old)
-                .new_layout(new)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .image(caustic.image)
-                .subresource_range(subresource_range(vk::ImageAspectFlags::COLOR, 0, 1))]
+            let range = subresource_range(vk::ImageAspectFlags::COLOR, 0, 1);
+            [layout_barrier(caustic.image, range, (old, src), (new, dst))]
         };
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let transfer = vk::PipelineStageFlags::TRANSFER;

@@ -7,7 +7,7 @@ use super::fields::{DISTANCE, GAIN, InducerFields, MASK, READBACK_BYTES_PER_TEXE
 use super::pass::InducerPass;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::memory::{Buffer, subresource_range};
+use crate::memory::{Buffer, layout_barrier, subresource_range};
 use crate::scene::GpuScene;
 
 impl InducerPass {
@@ -70,15 +70,8 @@ impl InducerPass {
         let n = self.desc.resolution_px;
         let range = subresource_range(vk::ImageAspectFlags::COLOR, 0, 1);
         let barrier = |image: usize, old, new, src_access, dst_access| {
-            vk::ImageMemoryBarrier::default()
-                .src_access_mask(src_access)
-                .dst_access_mask(dst_access)
-                .old_layout(old)
-                .new_layout(new)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .image(self.targets[image].image.image)
-                .subresource_range(range)
+            let image = self.targets[image].image.image;
+            layout_barrier(image, range, (old, src_access), (new, dst_access))
         };
         let to_copy: Vec<_> = offsets
             .iter()

@@ -19,6 +19,7 @@ use ash::vk;
 use super::{Composition, FrameResult, Renderer, Want};
 use crate::camera::FrameParams;
 use crate::error::{RenderError, Result, VkContext};
+use crate::memory::{layout_barrier, subresource_range};
 use crate::owned::Owned;
 use crate::{pipeline, target};
 
@@ -92,21 +93,8 @@ pub(super) unsafe fn transition(
     let access = vk::AccessFlags::COLOR_ATTACHMENT_WRITE
         | vk::AccessFlags::COLOR_ATTACHMENT_READ
         | vk::AccessFlags::TRANSFER_READ;
-    let barrier = vk::ImageMemoryBarrier::default()
-        .src_access_mask(access)
-        .dst_access_mask(access)
-        .old_layout(from)
-        .new_layout(to)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(vk::ImageSubresourceRange {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            base_mip_level: 0,
-            level_count: 1,
-            base_array_layer: 0,
-            layer_count: 2,
-        });
+    let range = subresource_range(vk::ImageAspectFlags::COLOR, 0, 2);
+    let barrier = layout_barrier(image, range, (from, access), (to, access));
     // SAFETY: the caller's contract: `cmd` records outside a render pass and `image` is in
     // layout `from`.
     unsafe {

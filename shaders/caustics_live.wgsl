@@ -51,7 +51,9 @@ struct Params {
     // radius (0: a ball).
     shell: vec4<f32>,
     // x: the shell's outer radius; y: the slack added to its stretches, model units; z: 1 when
-    // the mesh bounds one convex body (a ray leaving it outward meets no more of it), else 0.
+    // the mesh bounds one convex body (a ray leaving it outward meets no more of it), else 0;
+    // w: 1 when, besides, the inner ball lies inside it (a ray inside the body meets no
+    // surface before it has passed the ball), else 0.
     shell_outer: vec4<f32>,
 };
 
@@ -190,8 +192,10 @@ fn walk_grid(o: vec3<f32>, d: vec3<f32>, t_from: f32, t_to: f32, best_so_far: Hi
 // The nearest surface hit along the ray (unit `d`) before `t_max`. Every point of the mesh
 // lies in the shell between two spheres about its centre (`shell`, `shell_outer`), so only
 // the ray's one or two stretches inside that shell are walked: a ball-like mesh's hollow
-// middle and the space around it cost no grid steps.
-fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
+// middle and the space around it cost no grid steps. With `past_inner` the ray is inside a
+// convex body that holds the inner ball, so it meets the surface only past the ball, and the
+// stretch before the ball is not walked.
+fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32, past_inner: bool) -> Hit {
     let none = Hit(t_max, NONE, 0.0, 0.0, vec3<f32>(0.0));
     let oc = o - params.shell.xyz;
     let b = dot(oc, d);
@@ -219,7 +223,7 @@ fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
     // The stretch before the inner ball, then the one after it.
     var best = none;
     let near_end = min(-b - s_in + pad, leave);
-    if enter <= near_end {
+    if enter <= near_end && !past_inner {
         best = walk_grid(o, d, enter, near_end, best);
         if best.tri != NONE && best.t <= near_end {
             return best;
@@ -325,7 +329,7 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     let origin = (params.model_from_world * vec4<f32>(params.light.xyz, 1.0)).xyz;
     let dir = normalize((params.model_from_world * vec4<f32>(world_dir, 0.0)).xyz);
     let straight = floor_t(origin, dir);
-    let first = closest_hit(origin, dir, select(1e30, straight, straight > 0.0));
+    let first = closest_hit(origin, dir, select(1e30, straight, straight > 0.0), false);
     if first.tri == NONE {
         // Missed the object: the bare floor's light, which G is relative to.
         return;
@@ -395,7 +399,8 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
             // Leaving a convex body outward: nothing of it lies ahead.
             hit = Hit(0.0, NONE, 0.0, 0.0, vec3<f32>(0.0));
         } else {
-            hit = closest_hit(ray.origin, ray.dir, select(1e30, to_floor, to_floor > 0.0));
+            hit = closest_hit(ray.origin, ray.dir, select(1e30, to_floor, to_floor > 0.0),
+                ray.inside == 1u && params.shell_outer.w > 0.0);
         }
         if hit.tri == NONE && to_floor > 0.0 {
             deposit(ray.origin + ray.dir * to_floor, ray.weight);

@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
 use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
-use super::triangle_grid::{Grid, corner_and_edges, inner_radius};
+use super::triangle_grid::{Grid, behind_every_plane, corner_and_edges, inner_radius};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::memory::{Buffer, Image, layout_barrier, subresource_range};
@@ -191,6 +191,10 @@ pub(crate) struct LiveCaustics {
     /// Whether the mesh bounds one convex body ([`crate::convex::is_convex`]): a photon
     /// leaving it outward then meets no more of it.
     convex: bool,
+    /// Whether, besides, the shell's inner ball lies inside that body
+    /// ([`behind_every_plane`]): a photon inside it then meets no surface before it has
+    /// passed the ball.
+    inner_ball_inside: bool,
     /// Floor unit square to world.
     world_from_plane: Mat4,
     /// Relative index of refraction.
@@ -240,6 +244,8 @@ impl LiveCaustics {
             .fold(0.0f32, f32::max);
         let model_inner_radius = inner_radius(mesh.positions, mesh.indices, model_center);
         let convex = crate::convex::is_convex(mesh.positions, mesh.indices);
+        let inner_ball_inside =
+            convex && behind_every_plane(mesh.positions, mesh.indices, model_center);
         let vec4s =
             |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.extend(0.0).to_array()).collect() };
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
@@ -389,6 +395,7 @@ impl LiveCaustics {
             model_radius,
             model_inner_radius,
             convex,
+            inner_ball_inside,
             world_from_plane,
             ior,
         })
@@ -453,7 +460,7 @@ impl LiveCaustics {
                 self.model_radius + slack,
                 slack,
                 if self.convex { 1.0 } else { 0.0 },
-                0.0,
+                if self.inner_ball_inside { 1.0 } else { 0.0 },
             ],
         }
     }

@@ -108,6 +108,20 @@ pub(crate) fn inner_radius(positions: &[Vec3], indices: &[u32], center: Vec3) ->
         )
 }
 
+/// Whether `center` lies strictly behind the plane of every triangle (wound outward;
+/// degenerate ones skipped). For a convex mesh that means it lies inside, and so does the
+/// ball of [`inner_radius`] about it: a ray inside the body then meets no surface before it
+/// has passed that ball.
+pub(crate) fn behind_every_plane(positions: &[Vec3], indices: &[u32], center: Vec3) -> bool {
+    indices.chunks_exact(3).all(|t| {
+        let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+        (b - a)
+            .cross(c - a)
+            .try_normalize()
+            .is_none_or(|n| n.dot(center - a) < 0.0)
+    })
+}
+
 /// Per triangle its first corner and its two edges from it (model units), in order.
 pub(crate) fn corner_and_edges(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
     indices
@@ -191,6 +205,31 @@ mod tests {
                 assert!(point.distance(center) >= inner - 1e-6);
             }
         }
+    }
+
+    #[test]
+    fn a_centre_is_behind_every_plane_only_inside_the_body() {
+        // `cube` winds its faces inward: turned outward.
+        let (positions, inward) = cube(Vec3::ZERO);
+        let indices: Vec<u32> = inward
+            .chunks_exact(3)
+            .flat_map(|t| [t[0], t[2], t[1]])
+            .collect();
+        assert!(!behind_every_plane(&positions, &inward, Vec3::ZERO));
+        assert!(behind_every_plane(&positions, &indices, Vec3::ZERO));
+        assert!(behind_every_plane(&positions, &indices, Vec3::splat(0.9)));
+        assert!(!behind_every_plane(
+            &positions,
+            &indices,
+            Vec3::new(1.1, 0.0, 0.0)
+        ));
+        // On a face's plane is not behind it.
+        assert!(!behind_every_plane(&positions, &indices, Vec3::X));
+        // A corner tetrahedron's bounding-box centre lies outside it.
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let indices = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
+        assert!(!behind_every_plane(&positions, &indices, Vec3::splat(0.5)));
+        assert!(behind_every_plane(&positions, &indices, Vec3::splat(0.2)));
     }
 
     #[test]

@@ -10,6 +10,7 @@ use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
 use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
+use super::smoothing::{COLUMNS_STEP, SMOOTH_GROUP, SmoothPass, row_pitch, smooth_steps};
 use super::triangle_grid::{Grid, behind_every_plane, corner_and_edges, inner_radius};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -58,54 +59,6 @@ pub const DEFAULT_RESOLUTION_PX: u32 = 990;
 pub const MAX_PHOTONS_PER_SIDE: u32 = 4096;
 /// Largest smoothing box radius accepted, texels.
 pub const MAX_SMOOTHING_PX: u32 = 64;
-/// Invocations per workgroup of the smoothing's passes.
-const SMOOTH_GROUP: u32 = 64;
-/// Largest radius the smoothing's short kernel takes (`SHORT_KERNEL_PX` in
-/// caustics_live.wgsl): its 6 r + 1 = 13 weights fit in registers.
-const SHORT_KERNEL_PX: u32 = 2;
-/// Flags of a smoothing step (`COLUMNS_STEP`, `FROM_SUMS_STEP`, `LAST_STEP` in
-/// caustics_live.wgsl): along the columns; reading the photons' sums (no smoothing); the last.
-const COLUMNS_STEP: u32 = 0x1;
-const FROM_SUMS_STEP: u32 = 0x2;
-const LAST_STEP: u32 = 0x100;
-
-/// A smoothing pass's shader (index into `shaders::CAUSTICS_SMOOTH_CS`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum SmoothPass {
-    /// The short kernel along the rows, one row per invocation.
-    Rows = 0,
-    /// The short kernel along the columns, four columns per invocation.
-    Columns = 1,
-    /// Ring buffers, one row or column per invocation.
-    Wide = 2,
-}
-
-/// The smoothing's dispatches, in order, for a box of `radius` texels: its pass and push
-/// constant. Along the rows, then along the columns (the last); without smoothing one pass
-/// along the columns that reads the sums, clamps, zeroes and bounds.
-fn smooth_steps(radius: u32) -> Vec<(SmoothPass, u32)> {
-    match radius {
-        0 => vec![(
-            SmoothPass::Columns,
-            COLUMNS_STEP | FROM_SUMS_STEP | LAST_STEP,
-        )],
-        r if r <= SHORT_KERNEL_PX => vec![
-            (SmoothPass::Rows, 0),
-            (SmoothPass::Columns, COLUMNS_STEP | LAST_STEP),
-        ],
-        _ => vec![
-            (SmoothPass::Wide, 0),
-            (SmoothPass::Wide, COLUMNS_STEP | LAST_STEP),
-        ],
-    }
-}
-
-/// Texels from one row of the map's buffers to the next: the width rounded up to whole
-/// vectors of four (`row_pitch` in caustics_live.wgsl).
-fn row_pitch(width: u32) -> u32 {
-    width.next_multiple_of(4)
-}
-
 /// Fixed-point units per unit of gain in the sums (integer atomics keep the result the same
 /// whatever order photons land in).
 const FIXED_POINT: f32 = 65536.0;
@@ -638,30 +591,5 @@ impl LiveCaustics {
             .flat_map(|row| &row[..w])
             .copied()
             .collect())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn smoothing_runs_along_rows_then_columns_or_once_without_a_box() {
-        use SmoothPass::*;
-        let once = COLUMNS_STEP | FROM_SUMS_STEP | LAST_STEP;
-        assert_eq!(smooth_steps(0), vec![(Columns, once)]);
-        let short = vec![(Rows, 0), (Columns, COLUMNS_STEP | LAST_STEP)];
-        assert_eq!(smooth_steps(1), short);
-        assert_eq!(smooth_steps(2), short);
-        let wide = vec![(Wide, 0), (Wide, COLUMNS_STEP | LAST_STEP)];
-        assert_eq!(smooth_steps(3), wide);
-        assert_eq!(smooth_steps(MAX_SMOOTHING_PX), wide);
-    }
-
-    #[test]
-    fn rows_are_padded_to_whole_vectors_of_four() {
-        assert_eq!(row_pitch(990), 992);
-        assert_eq!(row_pitch(992), 992);
-        assert_eq!(row_pitch(1), 4);
     }
 }

@@ -47,7 +47,7 @@
 //! - `overlay`: the per-eye overlay pipeline;
 //! - `live`: the caustic gain map computed per pose on the GPU (photon splatting, then
 //!   smoothing), instead of a bake; `triangle_grid`: the grid of triangle lists its photons
-//!   walk;
+//!   walk; `smoothing`: which smoothing passes run for a radius, and the map's row layout;
 //! - `pass`: the pass that builds all of it and records it once per pose;
 //! - `progress`: whether that computation has really run (set only after its fence);
 //! - `readback`: copying the fields back to the CPU.
@@ -64,6 +64,7 @@ mod pass;
 mod progress;
 mod readback;
 mod reference;
+mod smoothing;
 mod triangle_grid;
 
 pub use crate::scene::{

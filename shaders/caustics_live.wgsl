@@ -67,7 +67,8 @@ var<private> params: Params;
 // Per grid cell (x fastest): first entry in cell_tris and count.
 @group(0) @binding(2) var<storage, read> cells: array<vec2<u32>>;
 @group(0) @binding(3) var<storage, read> cell_tris: array<u32>;
-// Fixed-point sums of G per texel (row 0 at the photo's top).
+// Fixed-point sums of G per texel (row 0 at the photo's top; rows `row_pitch` texels apart,
+// as in the other maps below).
 @group(0) @binding(4) var<storage, read_write> sums: array<atomic<i32>>;
 // The smoothed gain map.
 @group(0) @binding(5) var<storage, read_write> gain: array<vec4<f32>>;

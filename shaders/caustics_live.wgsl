@@ -62,6 +62,11 @@ struct Params {
 // storage buffer is a loop over the lanes, so reading them where they are used costs more
 // than the tracing's arithmetic.
 var<private> params: Params;
+// The floor's plane, from the parameters once per invocation (`floor_once`): a point of it and
+// its unit normal towards its visible side in model space, and that normal in world space.
+var<private> floor_point_m: vec3<f32>;
+var<private> floor_normal_m: vec3<f32>;
+var<private> floor_normal_world: vec3<f32>;
 // Per triangle the outward unit normals of its three vertices (xyz), in the triangle's order.
 @group(0) @binding(1) var<storage, read> vertex_normals: array<vec4<f32>>;
 // Per grid cell (x fastest): first entry in cell_tris and count.
@@ -237,17 +242,22 @@ fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32, past_inner: bool) -> Hit 
     return best;
 }
 
+// Sets the floor's plane from the parameters (once per invocation, not per segment).
+fn floor_once() {
+    let plane = params.world_from_plane;
+    floor_normal_world = normalize(cross(plane[0].xyz, plane[1].xyz));
+    floor_point_m = (params.model_from_world * vec4<f32>(plane[3].xyz, 1.0)).xyz;
+    floor_normal_m = normalize((params.model_from_world * vec4<f32>(floor_normal_world, 0.0)).xyz);
+}
+
 // Distance along the ray to the floor's visible side, model units; negative when it does not
 // approach it.
 fn floor_t(o: vec3<f32>, d: vec3<f32>) -> f32 {
-    let point = (params.model_from_world * vec4<f32>(params.world_from_plane[3].xyz, 1.0)).xyz;
-    let world_normal = normalize(cross(params.world_from_plane[0].xyz, params.world_from_plane[1].xyz));
-    let normal = normalize((params.model_from_world * vec4<f32>(world_normal, 0.0)).xyz);
-    let denom = dot(d, normal);
+    let denom = dot(d, floor_normal_m);
     if denom >= 0.0 {
         return -1.0;
     }
-    return dot(point - o, normal) / denom;
+    return dot(floor_point_m - o, floor_normal_m) / denom;
 }
 
 // Adds `weight` photons' worth of G at the model-space floor point, split bilinearly between
@@ -265,10 +275,9 @@ fn deposit(point_m: vec3<f32>, weight: f32) {
     let t = vec2<f32>(local.x + 0.5, 0.5 - local.y) * vec2<f32>(size) - 0.5;
     let base = vec2<i32>(floor(t));
     let f = t - floor(t);
-    let normal = normalize(cross(params.world_from_plane[0].xyz, params.world_from_plane[1].xyz));
     let to_light = params.light.xyz - world;
     let r2 = dot(to_light, to_light);
-    let cos_theta = dot(to_light, normal) * inverseSqrt(r2);
+    let cos_theta = dot(to_light, floor_normal_world) * inverseSqrt(r2);
     if cos_theta <= 0.0 {
         return;
     }
@@ -322,6 +331,7 @@ fn cone_direction(s: f32, t: f32) -> vec3<f32> {
 @compute @workgroup_size(8, 8, 1)
 fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     params = p;
+    floor_once();
     let n = params.grid_dims.w;
     if id.x >= n || id.y >= n {
         return;
@@ -409,7 +419,7 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// Which smoothing pass a dispatch runs (`smooth_steps` in live.rs): bit 0 clear along the
+// Which smoothing pass a dispatch runs (`smooth_steps` in smoothing.rs): bit 0 clear along the
 // rows, set along the columns; bit 1 set when a pass along the columns reads the photons'
 // sums itself (no smoothing); bit 8 set on the last pass, which writes the gain map.
 struct SmoothStep {
@@ -422,7 +432,7 @@ const FROM_SUMS_STEP: u32 = 0x2u;
 const LAST_STEP: u32 = 0x100u;
 // Most texels in one box: 2 x 64 + 1 (`MAX_SMOOTHING_PX` in live.rs).
 const MAX_BOX: u32 = 129u;
-// Largest radius the short kernel takes (`SHORT_KERNEL_PX` in live.rs).
+// Largest radius the short kernel takes (`SHORT_KERNEL_PX` in smoothing.rs).
 const SHORT_KERNEL_PX: u32 = 2u;
 
 // Texels from one row of the map's buffers to the next: the width rounded up to whole

@@ -55,6 +55,10 @@ struct Params {
     // w: 1 when, besides, the inner ball lies inside it (a ray inside the body meets no
     // surface before it has passed the ball), else 0.
     shell_outer: vec4<f32>,
+    // The smoothing's tiles of TILE x TILE texels: x, y: tiles across and down the map's
+    // buffers; z: words of tile bits per tile row; w: 1 when the smoothing skips the tiles
+    // whose smoothed gains are certain to be below MIN_GAIN, else 0 (every texel smoothed).
+    tiles: vec4<u32>,
 };
 
 @group(0) @binding(0) var<storage, read> p: Params;
@@ -88,8 +92,21 @@ var<private> floor_normal_world: vec3<f32>;
 // The sums again, four texels at a time, for the smoothing (which runs after the trace's
 // atomics have finished and writes none).
 @group(0) @binding(9) var<storage, read> sums4: array<vec4<i32>>;
+// Per cell of 4 x 4 texels (`mass_pitch` cells a row), the positive shares of G deposited with
+// their first texel in it, fixed-point units: no texel's G = max(0, sum) exceeds the shares
+// it was dealt. The CPU zeroes it before each computation.
+@group(0) @binding(10) var<storage, read_write> cell_mass: array<atomic<u32>>;
+// Per tile row, `tiles.z` words of bits of the tiles the smoothing writes (tile x in bit
+// x % 32 of word x / 32): those whose smoothed gains can reach MIN_GAIN (`cs_smooth_tiles`).
+@group(0) @binding(11) var<storage, read_write> tile_bits: array<u32>;
+// The cells' masses again, four cells at a time, for `cs_smooth_tiles`.
+@group(0) @binding(12) var<storage, read> cell_mass4: array<vec4<u32>>;
 
 const NONE: u32 = 0xffffffffu;
+// Side of the smoothing's tiles, texels (`TILE_PX` in smoothing.rs): whole vectors of four,
+// and at least the short kernel's reach, so that a tile's gains depend on its own and its
+// neighbours' texels only.
+const TILE: i32 = 8;
 const PI: f32 = 3.14159265358979;
 const STACK: u32 = 16u;
 
@@ -282,6 +299,7 @@ fn deposit(point_m: vec3<f32>, weight: f32) {
         return;
     }
     let g0 = weight * params.light.w * r2 / (params.basis_v.w * cos_theta) * params.misc.y;
+    var positive = 0;
     for (var k = 0; k < 4; k++) {
         let texel = base + vec2<i32>(k & 1, k >> 1u);
         if any(texel < vec2<i32>(0)) || any(texel >= size) {
@@ -290,8 +308,22 @@ fn deposit(point_m: vec3<f32>, weight: f32) {
         let wx = select(1.0 - f.x, f.x, (k & 1) == 1);
         let wy = select(1.0 - f.y, f.y, (k >> 1u) == 1);
         let index = texel.y * i32(row_pitch(params.map.x)) + texel.x;
-        atomicAdd(&sums[index], i32(round(g0 * wx * wy)));
+        let share = i32(round(g0 * wx * wy));
+        atomicAdd(&sums[index], share);
+        positive += max(share, 0);
     }
+    if params.tiles.w != 0u && positive > 0 {
+        // Its texels lie within [4c, 4c + 4] along each axis of its cell c (a first texel
+        // just off the map's top or left edge counts in cell 0).
+        let cell = vec2<u32>(max(base, vec2<i32>(0))) / 4u;
+        atomicAdd(&cell_mass[cell.y * mass_pitch() + cell.x], u32(positive));
+    }
+}
+
+// Cells of 4 x 4 texels from one row of `cell_mass` to the next: the two per tile across,
+// rounded up to whole vectors of four.
+fn mass_pitch() -> u32 {
+    return (2u * params.tiles.x + 3u) & ~3u;
 }
 
 // Snell refraction through a surface whose normal `facing` points back to the incident side;
@@ -488,11 +520,112 @@ fn window_feed(w: ptr<function, Window>, v: f32, k: array<vec4<f32>, 4>) -> f32 
     return dot((*w).w0, k[0]) + dot((*w).w1, k[1]) + dot((*w).w2, k[2]) + (*w).w3 * k[3].x;
 }
 
+// The weight of the box of 2 radius + 1 texels applied three times at `d` texels from the
+// centre: the ways to write d as a sum of three integers in [-radius, radius], over their
+// count (2 radius + 1)^3.
+fn kernel_weight(radius: u32, d: i32) -> f32 {
+    let r = i32(radius);
+    var ways = 0;
+    for (var a = -r; a <= r; a++) {
+        ways += max(0, 2 * r + 1 - abs(d - a));
+    }
+    let n = f32(2 * r + 1);
+    return f32(ways) / (n * n * n);
+}
+
+// The kernel's largest weights between the texels of a tile (8 along an axis, from 8t) and
+// those of deposits in each of the six cells 2t - 2 .. 2t + 3 along that axis (texels
+// [4c, 4c + 4]): 4, 0, 0, 0, 1 and 5 texels apart. Cells further off are 8 texels or more
+// away, beyond the short kernel's reach.
+struct CellWeights {
+    near: vec4<f32>,
+    far: vec2<f32>,
+};
+
+fn cell_weights(radius: u32) -> CellWeights {
+    return CellWeights(
+        vec4<f32>(kernel_weight(radius, 4), kernel_weight(radius, 0), kernel_weight(radius, 0),
+            kernel_weight(radius, 0)),
+        vec2<f32>(kernel_weight(radius, 1), kernel_weight(radius, 5)));
+}
+
+// The word of bits that holds tile `x` of tile row `y` (see `tile_bits`); 0 beyond the map.
+fn tile_word(x: u32, y: i32) -> u32 {
+    if y < 0 || y >= i32(p.tiles.y) {
+        return 0u;
+    }
+    return tile_bits[u32(y) * p.tiles.z + x / 32u];
+}
+
+// The masses of cells 4g .. 4g + 3 in cell row y (0 beyond the map).
+fn cell_row(y: i32, g: u32, pitch4: u32) -> vec4<f32> {
+    if y < 0 || u32(y) >= 2u * p.tiles.y {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(cell_mass4[u32(y) * pitch4 + g]);
+}
+
+// The bits of the tiles the smoothing writes, one tile row per invocation: a tile's bound is
+// the sum over the 6 x 6 cells around it of each cell's mass times the kernel's largest
+// weight between their texels (the kernel is separable), and the tile is written when the
+// bound reaches MIN_GAIN with a factor 2 of room for rounding. Along the row the cells are
+// read four at a time: the sum of each column of four cells over the six cell rows, then
+// each tile's six columns from the last two of those sums.
+@compute @workgroup_size(64, 1, 1)
+fn cs_smooth_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
+    let row = id.x;
+    let across = p.tiles.x;
+    if row >= p.tiles.y {
+        return;
+    }
+    let w = cell_weights(p.map.w);
+    let pitch4 = (2u * across + 3u) / 4u;
+    let threshold = 0.5 * p.misc.w * p.misc.y;
+    let top = i32(2u * row) - 2;
+    var previous = vec4<f32>(0.0);
+    var bits = 0u;
+    for (var g = 0u; g <= pitch4; g++) {
+        // The six cell rows' masses of cells 4g .. 4g + 3, weighted and summed.
+        var column = vec4<f32>(0.0);
+        if g < pitch4 {
+            column = w.near.x * cell_row(top, g, pitch4) + w.near.y * cell_row(top + 1, g, pitch4)
+                + w.near.z * cell_row(top + 2, g, pitch4) + w.near.w * cell_row(top + 3, g, pitch4)
+                + w.far.x * cell_row(top + 4, g, pitch4) + w.far.y * cell_row(top + 5, g, pitch4);
+        }
+        // Tiles 2g - 1 (cells 4g - 4 .. 4g + 1) and 2g (cells 4g - 2 .. 4g + 3).
+        for (var k = 0u; k < 2u; k++) {
+            let tile = 2u * g + k;
+            if tile == 0u || tile > across {
+                continue;
+            }
+            let x = tile - 1u;
+            var bound = 0.0;
+            if k == 0u {
+                bound = dot(previous, w.near) + dot(column.xy, w.far);
+            } else {
+                bound = dot(vec4<f32>(previous.zw, column.xy), w.near) + dot(column.zw, w.far);
+            }
+            if bound > 0.0 && bound >= threshold {
+                bits |= 1u << (x % 32u);
+            }
+            if x % 32u == 31u || x + 1u == across {
+                tile_bits[row * p.tiles.z + x / 32u] = bits;
+                bits = 0u;
+            }
+        }
+        previous = column;
+    }
+}
+
 // The short kernel (radius <= 2) along the rows, one row per invocation, four texels per
 // step: reads G = max(0, sum) of the photons' sums (eq. 6's clamp, per texel as the bake
 // stores it) and writes the row's smoothed values (fixed-point units) into `scratch`. On a
 // CPU device each access of a storage buffer is a loop over the lanes, so a texel's cost
-// is its share of the accesses: a quarter of a read and of a write here.
+// is its share of the accesses: a quarter of a read and of a write here. When the smoothing
+// skips tiles, only the tiles whose rows the pass along the columns reads (those it writes
+// and those above and below them) are written: the row is walked tile by tile, and the
+// window, fed the two vectors before a tile that follows a skipped one, holds the same inputs
+// there as it would along the whole row.
 @compute @workgroup_size(64, 1, 1)
 fn cs_smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= p.map.y {
@@ -501,28 +634,53 @@ fn cs_smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
     let blocks = row_pitch(p.map.x) / 4u;
     let base = id.x * blocks;
     let k = short_kernel(p.map.w);
+    let skip = p.tiles.w != 0u;
+    // The spans walked: the tiles along the row, or the whole row as one.
+    let spans = select(1u, p.tiles.x, skip);
+    let span_blocks = select(blocks, u32(TILE) / 4u, skip);
+    let tile_row = id.x / u32(TILE);
     var w = Window(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0), 0.0);
     var previous = vec4<f32>(0.0);
-    // After block b (texels 4b..4b+3) the window yields texels 4b-6..4b-3, so block b-2 is
-    // the last two of the step before and the first two of this one.
-    for (var b = 0u; b < blocks + 2u; b++) {
-        var v = vec4<f32>(0.0);
-        if b < blocks {
-            v = vec4<f32>(max(sums4[base + b], vec4<i32>(0)));
+    // The next block the window takes.
+    var next = 0u;
+    var bits = 0u;
+    for (var s = 0u; s < spans; s++) {
+        if skip {
+            if s % 32u == 0u {
+                // The pass along the columns reads the rows of the tiles it writes and of
+                // those above and below them.
+                let y = i32(tile_row);
+                bits = tile_word(s, y - 1) | tile_word(s, y) | tile_word(s, y + 1);
+            }
+            if (bits & (1u << (s % 32u))) == 0u {
+                continue;
+            }
         }
-        let out = vec4<f32>(window_feed(&w, v.x, k), window_feed(&w, v.y, k),
-            window_feed(&w, v.z, k), window_feed(&w, v.w, k));
-        if b >= 2u {
-            scratch[base + b - 2u] = vec4<f32>(previous.zw, out.xy);
+        let first = s * span_blocks;
+        let end = min(first + span_blocks, blocks);
+        next = max(next, max(first, 2u) - 2u);
+        // After block b (texels 4b..4b+3) the window yields texels 4b-6..4b-3, so block b-2
+        // is the last two of the step before and the first two of this one.
+        for (; next < end + 2u; next++) {
+            var v = vec4<f32>(0.0);
+            if next < blocks {
+                v = vec4<f32>(max(sums4[base + next], vec4<i32>(0)));
+            }
+            let out = vec4<f32>(window_feed(&w, v.x, k), window_feed(&w, v.y, k),
+                window_feed(&w, v.z, k), window_feed(&w, v.w, k));
+            if next >= first + 2u {
+                scratch[base + next - 2u] = vec4<f32>(previous.zw, out.xy);
+            }
+            previous = out;
         }
-        previous = out;
     }
 }
 
 // The short kernel along the columns, four adjacent columns per invocation, one row per
 // step: reads the rows' result (or, without smoothing, G = max(0, sum) of the photons' sums
 // directly), writes the gain map with gains below MIN_GAIN zeroed, and bounds the non-zero
-// texels.
+// texels. When the smoothing skips tiles, only the tiles of `tile_bits` are written (the CPU
+// has zeroed the map), walked as the rows' pass walks its tiles.
 @compute @workgroup_size(64, 1, 1)
 fn cs_smooth_columns(@builtin(global_invocation_id) id: vec3<u32>) {
     let blocks = row_pitch(p.map.x) / 4u;
@@ -534,6 +692,10 @@ fn cs_smooth_columns(@builtin(global_invocation_id) id: vec3<u32>) {
     let k = short_kernel(p.map.w);
     let unit = p.misc.y;
     let min_gain = p.misc.w;
+    let skip = p.tiles.w != 0u;
+    let spans = select(1u, p.tiles.y, skip);
+    let span_rows = select(height, u32(TILE), skip);
+    let tile = id.x / (u32(TILE) / 4u);
     let x = vec4<u32>(4u * id.x) + vec4<u32>(0u, 1u, 2u, 3u);
     let on_map = x < vec4<u32>(p.map.x);
     let zero = Window(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0), 0.0);
@@ -544,28 +706,38 @@ fn cs_smooth_columns(@builtin(global_invocation_id) id: vec3<u32>) {
     var first = NONE;
     var final_row = 0u;
     var kept_columns = vec4<bool>(false);
-    for (var n = 0u; n < height + 6u; n++) {
-        var v = vec4<f32>(0.0);
-        if n < height {
-            if from_sums {
-                v = vec4<f32>(max(sums4[n * blocks + id.x], vec4<i32>(0)));
-            } else {
-                v = scratch[n * blocks + id.x];
-            }
-        }
-        let mean = vec4<f32>(window_feed(&c0, v.x, k), window_feed(&c1, v.y, k),
-            window_feed(&c2, v.z, k), window_feed(&c3, v.w, k));
-        if n < 6u {
+    // The next row the windows take.
+    var next = 0u;
+    for (var s = 0u; s < spans; s++) {
+        if skip && (tile_word(tile, i32(s)) & (1u << (tile % 32u))) == 0u {
             continue;
         }
-        let at = n - 6u;
-        let g = mean / unit;
-        let kept = g >= vec4<f32>(min_gain) & on_map;
-        gain[at * blocks + id.x] = select(vec4<f32>(0.0), g, kept);
-        if any(kept) {
-            first = min(first, at);
-            final_row = at;
-            kept_columns = kept_columns | kept;
+        let top = s * span_rows;
+        let end = min(top + span_rows, height);
+        next = max(next, max(top, 6u) - 6u);
+        for (; next < end + 6u; next++) {
+            var v = vec4<f32>(0.0);
+            if next < height {
+                if from_sums {
+                    v = vec4<f32>(max(sums4[next * blocks + id.x], vec4<i32>(0)));
+                } else {
+                    v = scratch[next * blocks + id.x];
+                }
+            }
+            let mean = vec4<f32>(window_feed(&c0, v.x, k), window_feed(&c1, v.y, k),
+                window_feed(&c2, v.z, k), window_feed(&c3, v.w, k));
+            if next < top + 6u {
+                continue;
+            }
+            let at = next - 6u;
+            let g = mean / unit;
+            let kept = g >= vec4<f32>(min_gain) & on_map;
+            gain[at * blocks + id.x] = select(vec4<f32>(0.0), g, kept);
+            if any(kept) {
+                first = min(first, at);
+                final_row = at;
+                kept_columns = kept_columns | kept;
+            }
         }
     }
     if first != NONE {

@@ -67,15 +67,25 @@ fn baked_at(scene: &Scene, side: u32, budget: u64) -> Vec<f32> {
     .gain
 }
 
+/// One frame's live caustic map.
+struct LiveFrame {
+    /// The gain map.
+    gain: Vec<f32>,
+    /// Wall-clock milliseconds of the frame.
+    wall_ms: f64,
+    /// The smoothing's tiles written, and the map's.
+    tiles: [u32; 2],
+}
+
 /// Renders one frame with the caustics on for each light position (`None`: the scene's) and
-/// returns the live gain maps, with the wall-clock milliseconds of each frame. With
-/// `fields_first`, the inducer's fields are read back before the first frame.
+/// returns the live maps. With `fields_first`, the inducer's fields are read back before the
+/// first frame.
 fn live_gains(
     scene: &Scene,
     live: LiveCausticsDesc,
     lights: &[Option<Vec3>],
     fields_first: bool,
-) -> Vec<(Vec<f32>, f64)> {
+) -> Vec<LiveFrame> {
     let rest = ScenePose::of(&views::scene_desc(scene, None));
     let poses: Vec<_> = lights
         .iter()
@@ -95,7 +105,7 @@ fn live_gains_at(
     live: LiveCausticsDesc,
     poses: &[Option<ScenePose>],
     fields_first: bool,
-) -> Vec<(Vec<f32>, f64)> {
+) -> Vec<LiveFrame> {
     let ctx = GpuContext::headless(&ContextOptions {
         validation: true,
         device_name: None,
@@ -137,13 +147,29 @@ fn live_gains_at(
             .live_caustic_gain()
             .expect("read back")
             .expect("live caustics are on");
+        let side = square_side(&gain);
         let bounds = renderer.live_caustic_bounds().expect("read back");
         assert_eq!(
             bounds,
-            nonzero_box(&gain, square_side(&gain)),
+            nonzero_box(&gain, side),
             "the GPU's bound of the non-zero gains"
         );
-        out.push((gain, wall_ms));
+        let tiles = renderer
+            .live_caustic_tiles()
+            .expect("read back")
+            .expect("live caustics are on");
+        let lit = lit_tiles(&gain, side);
+        assert!(
+            tiles[0] >= lit && tiles[0] <= tiles[1],
+            "{} tiles written of {}, {lit} hold gains",
+            tiles[0],
+            tiles[1]
+        );
+        out.push(LiveFrame {
+            gain,
+            wall_ms,
+            tiles,
+        });
     }
     let v = renderer.context().validation();
     assert_eq!(
@@ -210,6 +236,20 @@ fn smoothed(gain: &[f32], width: usize, radius: u32) -> Vec<f32> {
         .collect()
 }
 
+/// How many of the smoothing's 8 x 8 tiles of a square map `side` texels wide hold a non-zero
+/// gain.
+fn lit_tiles(gain: &[f32], side: u32) -> u32 {
+    let tiles = side.div_ceil(8) as usize;
+    let mut lit = vec![false; tiles * tiles];
+    for (i, &g) in gain.iter().enumerate() {
+        if g != 0.0 {
+            let (x, y) = (i % side as usize, i / side as usize);
+            lit[(y / 8) * tiles + x / 8] = true;
+        }
+    }
+    lit.iter().filter(|&&l| l).count() as u32
+}
+
 /// The side of a square map.
 fn square_side(gain: &[f32]) -> u32 {
     let side = (gain.len() as f64).sqrt() as u32;
@@ -267,13 +307,15 @@ fn live_sphere_caustics_match_the_bake_and_focus_on_the_light_axis() {
     let turned = center + Quat::from_rotation_y(std::f32::consts::FRAC_PI_2) * offset;
     let live = LiveCausticsDesc::default();
     let frames = live_gains(&scene, live, &[None, Some(turned)], false);
-    let (gain, wall_ms) = &frames[0];
+    let LiveFrame { gain, wall_ms, .. } = &frames[0];
     // The baker's map at the live map's resolution, and the shipped bake averaged down to it.
     let reference = smoothed(&baked_at(&scene, w, 1 << 18), w as usize, live.smoothing_px);
     let rms = relative_rms(gain, &reference);
     let rms_averaged = relative_rms(gain, &smoothed(&averaged, w as usize, live.smoothing_px));
     let (bx, by) = peak(&reference, w);
-    for ((gain, wall_ms), light) in frames.iter().zip([scene.light.position_m, turned]) {
+    for (LiveFrame { gain, wall_ms, .. }, light) in
+        frames.iter().zip([scene.light.position_m, turned])
+    {
         let (px, py) = peak(gain, w);
         let expected = axis_texel(&scene, light, w, h);
         eprintln!(
@@ -320,7 +362,7 @@ fn the_gpu_smoothing_is_the_three_box_kernel_at_every_radius() {
                 smoothing_px,
                 ..LiveCausticsDesc::default()
             };
-            live_gains(&scene, live, &[None], false).remove(0).0
+            live_gains(&scene, live, &[None], false).remove(0).gain
         };
         let raw = gains(0);
         assert_eq!(raw.len(), (side * side) as usize);
@@ -366,13 +408,61 @@ fn the_gpu_smoothing_is_the_three_box_kernel_at_every_radius() {
     }
 }
 
+/// The short kernel's passes skip the tiles whose gains are certain to be stored as 0: the
+/// map is the same, bit for bit, as when every texel is smoothed, at every radius they take,
+/// on maps whose rows are padded; and they do skip most of the glass sphere's floor.
+#[test]
+fn skipping_tiles_leaves_the_map_unchanged() {
+    for side in [990, 66] {
+        let (scene, _) = live_scene("glass-sphere.toml", Some(side));
+        for smoothing_px in [0, 1, 2] {
+            let frame = |skip_tiles| {
+                let live = LiveCausticsDesc {
+                    smoothing_px,
+                    skip_tiles,
+                    ..LiveCausticsDesc::default()
+                };
+                live_gains(&scene, live, &[None], false).remove(0)
+            };
+            let (skipping, every) = (frame(true), frame(false));
+            let [written, total] = skipping.tiles;
+            eprintln!(
+                "{side} x {side}, radius {smoothing_px}: {written} of {total} tiles written \
+                 ({:.0} %), {} hold gains",
+                100.0 * f64::from(written) / f64::from(total),
+                lit_tiles(&skipping.gain, side)
+            );
+            assert_eq!(every.tiles, [total, total], "without skipping every tile");
+            let differing = skipping
+                .gain
+                .iter()
+                .zip(&every.gain)
+                .filter(|(a, b)| a.to_bits() != b.to_bits())
+                .count();
+            assert_eq!(differing, 0, "{side}, radius {smoothing_px}: texels differ");
+            assert!(
+                skipping.gain.iter().any(|&g| g > 0.1),
+                "{side}, radius {smoothing_px}: the caustic is there"
+            );
+            if side == 990 {
+                // The sphere's caustic and the light it reflects cover about a third of the
+                // floor's tiles (smoothed over more, a little more).
+                assert!(
+                    written * 2 < total,
+                    "radius {smoothing_px}: {written} of {total} tiles written"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn live_diamond_caustics_match_the_bake() {
     let (scene, averaged) = live_scene("diamond.toml", None);
     let side = scene.caustics.resolution_px;
     let live = LiveCausticsDesc::default();
     let frames = live_gains(&scene, live, &[None], false);
-    let (gain, wall_ms) = &frames[0];
+    let LiveFrame { gain, wall_ms, .. } = &frames[0];
     let reference = smoothed(
         &baked_at(&scene, side, 1 << 18),
         side as usize,
@@ -419,7 +509,7 @@ fn live_caustics_follow_the_object() {
         &[None, Some(moved)],
         false,
     );
-    let (at_rest, after) = (&frames[0].0, &frames[1].0);
+    let (at_rest, after) = (&frames[0].gain, &frames[1].gain);
     // The moved map read 50 texels on, against the map at rest (zeros past the edge).
     let back: Vec<f32> = (0..side * side)
         .map(|i| {
@@ -457,7 +547,7 @@ fn live_torus_caustics_match_a_bake_of_it() {
     let bake = baked_at(&scene, side, 1 << 16);
     let bake_s = started.elapsed().as_secs_f64();
     let live = LiveCausticsDesc::default();
-    let (gain, wall_ms) = &live_gains(&scene, live, &[None], false)[0];
+    let LiveFrame { gain, wall_ms, .. } = &live_gains(&scene, live, &[None], false)[0];
     let reference = smoothed(&bake, side as usize, live.smoothing_px);
     let rms = relative_rms(gain, &reference);
     let region = reference.iter().filter(|&&g| g > 0.1).count();
@@ -498,12 +588,12 @@ fn reading_the_fields_back_first_computes_the_live_map_too() {
     let live = LiveCausticsDesc::default();
     let plain = live_gains(&scene, live, &[None], false);
     let after_read_back = live_gains(&scene, live, &[None], true);
-    let lit = plain[0].0.iter().filter(|&&g| g > 0.0).count();
+    let lit = plain[0].gain.iter().filter(|&&g| g > 0.0).count();
     assert!(lit > 1000, "the live map has {lit} lit texels");
     assert!(
-        plain[0].0 == after_read_back[0].0,
+        plain[0].gain == after_read_back[0].gain,
         "the map after a read-back differs ({} lit texels)",
-        after_read_back[0].0.iter().filter(|&&g| g > 0.0).count()
+        after_read_back[0].gain.iter().filter(|&&g| g > 0.0).count()
     );
 }
 
@@ -555,7 +645,7 @@ fn sweep() {
                 smoothing_px: radius,
                 ..LiveCausticsDesc::default()
             };
-            let (gain, wall_ms) = &live_gains(&live_scene, live, &[None], false)[0];
+            let LiveFrame { gain, wall_ms, .. } = &live_gains(&live_scene, live, &[None], false)[0];
             let reference = smoothed(&averaged, side, radius);
             let own_smoothed = smoothed(own, side, radius);
             let (px, py) = peak(gain, side as u32);

@@ -302,6 +302,13 @@ impl Renderer {
         self.inducer.live_bounds()
     }
 
+    /// How many of the live map's smoothing tiles of 8 x 8 texels the last finished frame that
+    /// computed it wrote, and how many the map has; the others hold no gain (call
+    /// [`Renderer::flush`] first); `None` without live caustics.
+    pub fn live_caustic_tiles(&self) -> Result<Option<[u32; 2]>> {
+        self.inducer.live_tiles()
+    }
+
     /// How many times the shadow inducer's fields (mask, distance, gain) were computed: once
     /// for the first frame that drew them, then once per frame after the object or light moved.
     pub fn inducer_computations(&self) -> u64 {

@@ -70,12 +70,13 @@ pub const OVERLAY_FS: [&[u8]; 3] = [
     spirv!("floor_overlay.fs_main.caustics.filtered"),
 ];
 pub const CAUSTICS_TRACE_CS: &[u8] = spirv!("caustics_live.cs_trace");
-/// The smoothing's passes: the short kernel along the rows and along the columns, and the
-/// ring buffers' pass for wider boxes.
-pub const CAUSTICS_SMOOTH_CS: [&[u8]; 3] = [
+/// The smoothing's passes: the short kernel along the rows and along the columns, the ring
+/// buffers' pass for wider boxes, and the short kernel's tiles.
+pub const CAUSTICS_SMOOTH_CS: [&[u8]; 4] = [
     spirv!("caustics_live.cs_smooth_rows"),
     spirv!("caustics_live.cs_smooth_columns"),
     spirv!("caustics_live.cs_smooth_wide"),
+    spirv!("caustics_live.cs_smooth_tiles"),
 ];
 
 /// Reinterprets SPIR-V bytes as words (include_bytes gives no alignment guarantee).

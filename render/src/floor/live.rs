@@ -10,7 +10,9 @@ use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
 use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
-use super::smoothing::{COLUMNS_STEP, SMOOTH_GROUP, SmoothPass, row_pitch, smooth_steps};
+use super::smoothing::{
+    COLUMNS_STEP, SHORT_KERNEL_PX, SMOOTH_GROUP, SmoothPass, row_pitch, smooth_steps, tile_layout,
+};
 use super::triangle_grid::{Grid, behind_every_plane, corner_and_edges, inner_radius};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -33,6 +35,9 @@ pub struct LiveCausticsDesc {
     /// then three times along the columns, a kernel close to a Gaussian of standard deviation
     /// sqrt(r (r + 1)) texels, 6r + 1 texels wide.
     pub smoothing_px: u32,
+    /// Whether a smoothing of radius 0 to 2 skips the tiles whose gains are certain to be
+    /// stored as 0 (docs/caustics.md, *Smoothing*); the map is the same either way.
+    pub skip_tiles: bool,
 }
 
 impl Default for LiveCausticsDesc {
@@ -45,6 +50,7 @@ impl Default for LiveCausticsDesc {
             photons_per_side: 128,
             max_interactions: 12,
             smoothing_px: 2,
+            skip_tiles: true,
         }
     }
 }
@@ -93,15 +99,16 @@ struct Params {
     misc: [f32; 4],
     shell: [f32; 4],
     shell_outer: [f32; 4],
+    tiles: [u32; 4],
 }
 
 /// The compute passes, their buffers and what they need of the mesh; freed on drop.
 pub(crate) struct LiveCaustics {
     /// Photon tracing and splatting.
     trace: Owned<vk::Pipeline>,
-    /// The smoothing's passes ([`SmoothPass`]; the first also clamps, the last zeroes small
-    /// gains and bounds).
-    smooth: [Owned<vk::Pipeline>; 3],
+    /// The smoothing's passes ([`SmoothPass`]; the first along the rows also clamps, the
+    /// last zeroes small gains and bounds).
+    smooth: [Owned<vk::Pipeline>; 4],
     /// Layout of both (one set; the smoothing step as push constant).
     layout: Owned<vk::PipelineLayout>,
     /// Pool of the set.
@@ -118,6 +125,12 @@ pub(crate) struct LiveCaustics {
     sums: Buffer,
     /// The fixed-point map smoothed along the rows.
     _scratch: Buffer,
+    /// Per cell of 4 x 4 texels, the positive shares of G deposited in it (zeroed before each
+    /// computation that skips tiles).
+    cell_mass: Buffer,
+    /// Per tile row, the bits of the tiles the smoothing writes; all set when it skips none.
+    /// Host-visible ([`LiveCaustics::tiles_written`]).
+    tile_bits: Buffer,
     /// The smoothed gain map, host-visible (for tests).
     gain: Buffer,
     /// The box of the non-zero gains (`[x0, y0, x1, y1]`, ends included; empty when
@@ -254,7 +267,23 @@ impl LiveCaustics {
             ctx,
             "caustics gain",
             texels * 4,
-            storage | vk::BufferUsageFlags::TRANSFER_SRC,
+            storage | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let [across, down, words] = tile_layout(size[0], size[1]);
+        // Two cells per tile along each axis, rows padded to whole vectors of four cells.
+        let cell_mass = Buffer::new(
+            ctx,
+            "caustics cell masses",
+            u64::from((2 * across).next_multiple_of(4) * 2 * down) * 4,
+            storage | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
+        let tile_bits = Buffer::new(
+            ctx,
+            "caustics tile bits",
+            u64::from(down * words) * 4,
+            storage | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
         let params = Buffer::new(
@@ -268,7 +297,7 @@ impl LiveCaustics {
         // The parameters in a storage buffer, not a uniform one: on lavapipe, which can inline
         // uniform values into a shader's loops and compile it again when they change, that
         // took about 1 ms off a moved frame's stage at the defaults and 6 ms with one photon.
-        let bindings: Vec<_> = (0..=9)
+        let bindings: Vec<_> = (0..=12)
             .map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute))
             .collect();
         let set_layout = pipeline::set_layout(ctx, &bindings)?;
@@ -294,8 +323,14 @@ impl LiveCaustics {
                 shaders::CAUSTICS_SMOOTH_CS[2],
                 c"cs_smooth_wide",
             )?,
+            pipeline::compute(
+                ctx,
+                layout.raw(),
+                shaders::CAUSTICS_SMOOTH_CS[3],
+                c"cs_smooth_tiles",
+            )?,
         ];
-        let pool = pipeline::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 10)])?;
+        let pool = pipeline::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 13)])?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
         buffers.extend(mesh_buffers[..3].iter().map(|b| b.buffer));
@@ -303,6 +338,8 @@ impl LiveCaustics {
         buffers.push(mesh_buffers[3].buffer);
         // The sums again, read four texels at a time by the smoothing.
         buffers.push(sums.buffer);
+        // The cells' masses, then again four at a time.
+        buffers.extend([cell_mass.buffer, tile_bits.buffer, cell_mass.buffer]);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|&buffer| {
@@ -337,6 +374,8 @@ impl LiveCaustics {
             _mesh: mesh_buffers,
             sums,
             _scratch: scratch,
+            cell_mass,
+            tile_bits,
             gain,
             bounds,
             size,
@@ -385,6 +424,10 @@ impl LiveCaustics {
             .length();
         let texel_area = floor_area / (self.size[0] as f32 * self.size[1] as f32);
         let [gx, gy, gz] = self.grid_dims;
+        let [across, down, words] = tile_layout(self.size[0], self.size[1]);
+        let skip_tiles = self.desc.skip_tiles
+            && self.desc.smoothing_px <= SHORT_KERNEL_PX
+            && self.shares_fit(light, solid_angle * (n * n) as f32, texel_area);
         // Rounding room for the shell's radii and the stretches of a ray inside it.
         let slack = self.model_radius * SHELL_SLACK;
         Params {
@@ -415,7 +458,33 @@ impl LiveCaustics {
                 if self.convex { 1.0 } else { 0.0 },
                 if self.inner_ball_inside { 1.0 } else { 0.0 },
             ],
+            tiles: [across, down, words, u32::from(skip_tiles)],
         }
+    }
+
+    /// Whether the positive shares of G that the photons of a cone of `cone_sr` steradians
+    /// from `light` deposit add up to less than 2^31 fixed-point units, so that no cell's mass
+    /// (`cell_mass` in caustics_live.wgsl, a u32 sum) can wrap round. A photon's paths split
+    /// its light, so its shares sum to at most one share at the floor's point where G per
+    /// unit of light, r^2 / cos theta = r^3 / height, is largest: the corner farthest from the
+    /// light. Each path's rounding adds at most 2 units, and paths end below MIN_WEIGHT, so a
+    /// photon has at most 1 / MIN_WEIGHT of them.
+    fn shares_fit(&self, light: Vec3, cone_sr: f32, texel_area: f32) -> bool {
+        let p = self.world_from_plane;
+        let normal = p.x_axis.truncate().cross(p.y_axis.truncate()).normalize();
+        let height = (light - p.w_axis.truncate()).dot(normal);
+        if height <= 0.0 {
+            // Behind the floor: the photons deposit nothing.
+            return true;
+        }
+        let farthest = [(-0.5, -0.5), (-0.5, 0.5), (0.5, -0.5), (0.5, 0.5)]
+            .map(|(x, y)| p.transform_point3(Vec3::new(x, y, 0.0)).distance(light))
+            .into_iter()
+            .fold(0.0f32, f32::max);
+        let photons = self.desc.photons_per_side as f32 * self.desc.photons_per_side as f32;
+        let most = cone_sr * farthest.powi(3) / (height * texel_area) * FIXED_POINT
+            + photons * 2.0 / MIN_WEIGHT;
+        most < 2f32.powi(31)
     }
 
     /// Records the computation of the gain map for `pose` and its copy into `caustic` (an
@@ -472,6 +541,14 @@ impl LiveCaustics {
             );
             d.cmd_update_buffer(cmd, self.params.buffer, 0, bytemuck::bytes_of(&params));
             d.cmd_fill_buffer(cmd, self.sums.buffer, 0, vk::WHOLE_SIZE, 0);
+            if params.tiles[3] != 0 {
+                // The smoothing writes the live tiles only.
+                d.cmd_fill_buffer(cmd, self.cell_mass.buffer, 0, vk::WHOLE_SIZE, 0);
+                d.cmd_fill_buffer(cmd, self.gain.buffer, 0, vk::WHOLE_SIZE, 0);
+            } else {
+                // Every tile is written.
+                d.cmd_fill_buffer(cmd, self.tile_bits.buffer, 0, vk::WHOLE_SIZE, u32::MAX);
+            }
             let empty: [u32; 4] = [u32::MAX, u32::MAX, 0, 0];
             d.cmd_update_buffer(cmd, self.bounds, 0, bytemuck::bytes_of(&empty));
             d.cmd_pipeline_barrier(
@@ -496,6 +573,10 @@ impl LiveCaustics {
                 stamps.write(d, cmd, CAUSTIC_PHOTONS_STAMP..CAUSTIC_PHOTONS_STAMP + 1);
             }
             for (pass, step) in smooth_steps(self.desc.smoothing_px) {
+                if pass == SmoothPass::Tiles && params.tiles[3] == 0 {
+                    // Every texel is smoothed.
+                    continue;
+                }
                 // Each pass reads what the one before wrote (the first, the photons' sums).
                 d.cmd_pipeline_barrier(
                     cmd,
@@ -511,6 +592,7 @@ impl LiveCaustics {
                 );
                 d.cmd_bind_pipeline(cmd, bind, self.smooth[pass as usize].raw());
                 let lines = match pass {
+                    SmoothPass::Tiles => params.tiles[1],
                     SmoothPass::Rows => h,
                     SmoothPass::Columns => row_pitch(w) / 4,
                     SmoothPass::Wide if step & COLUMNS_STEP != 0 => w,
@@ -572,6 +654,22 @@ impl LiveCaustics {
                 stamps.write(d, cmd, CAUSTIC_PHOTONS_STAMP + 1..FIELD_STAMPS);
             }
         }
+    }
+
+    /// How many of the smoothing's tiles the last computation that finished wrote, and how
+    /// many the map has (wait for the frame first).
+    pub fn tiles_written(&self) -> Result<[u32; 2]> {
+        let [across, down, words] = tile_layout(self.size[0], self.size[1]);
+        let bits = self.tile_bits.mapped()?;
+        let mut written = 0;
+        for row in 0..down {
+            for x in 0..across {
+                let at = ((row * words + x / 32) * 4) as usize;
+                let word = u32::from_le_bytes([bits[at], bits[at + 1], bits[at + 2], bits[at + 3]]);
+                written += (word >> (x % 32)) & 1;
+            }
+        }
+        Ok([written, across * down])
     }
 
     /// The gain map of the last computation that finished, row 0 at the photo's top (wait

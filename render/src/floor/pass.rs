@@ -297,6 +297,15 @@ impl InducerPass {
         self.live.as_ref().map(LiveCaustics::gain).transpose()
     }
 
+    /// How many of the live map's smoothing tiles the last finished computation wrote, and
+    /// how many it has (`None` without live caustics).
+    pub fn live_tiles(&self) -> Result<Option<[u32; 2]>> {
+        self.live
+            .as_ref()
+            .map(LiveCaustics::tiles_written)
+            .transpose()
+    }
+
     /// The texels `[x0, y0, x1, y1]` (ends excluded) the last finished live computation found
     /// its non-zero gains in (`None` when all are 0, or without live caustics).
     pub fn live_bounds(&self) -> Result<Option<[u32; 4]>> {

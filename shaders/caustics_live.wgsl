@@ -382,6 +382,9 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var stack: array<Ray, STACK>;
     var depth = 0u;
+    // The ray a convex body's split keeps inside it: the next to follow, in registers.
+    var carried: Ray;
+    var carrying = false;
     var ray = Ray(origin, dir, 1.0, 0u, 0u);
     var hit = first;
     loop {
@@ -415,36 +418,61 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
                 let refracts = dot(t, t) > 0.0 && dot(t, side_g) < 0.0;
                 let reflected_weight = select(ray.weight, ray.weight * reflectance, refracts);
+                let refracted_weight = select(0.0, ray.weight * (1.0 - reflectance), refracts);
                 let interactions = ray.interactions + 1u;
-                if reflected_weight >= params.misc.z && depth < STACK {
-                    stack[depth] = Ray(point + side_g * params.misc.x, r, reflected_weight,
-                        interactions, ray.inside);
-                    depth++;
-                }
-                let refracted_weight = ray.weight * (1.0 - reflectance);
-                if refracts && refracted_weight >= params.misc.z && depth < STACK {
-                    stack[depth] = Ray(point - side_g * params.misc.x, t, refracted_weight,
-                        interactions, 1u - ray.inside);
-                    depth++;
+                let reflected = Ray(point + side_g * params.misc.x, r, reflected_weight,
+                    interactions, ray.inside);
+                let refracted = Ray(point - side_g * params.misc.x, t, refracted_weight,
+                    interactions, 1u - ray.inside);
+                if params.shell_outer.z > 0.0 {
+                    // A convex body: of the two parts one leaves it (the reflected one outside,
+                    // the refracted one inside) and meets no more of it, so it lands at once;
+                    // the other is the only ray left, followed next without the stack, so
+                    // that every turn of the loop walks the grid for every lane that has a
+                    // ray left.
+                    var leaving = refracted;
+                    var staying = reflected;
+                    if ray.inside == 0u {
+                        leaving = reflected;
+                        staying = refracted;
+                    }
+                    if staying.weight >= params.misc.z {
+                        carried = staying;
+                        carrying = true;
+                    }
+                    if leaving.weight >= params.misc.z {
+                        let to_floor = floor_t(leaving.origin, leaving.dir);
+                        if to_floor > 0.0 {
+                            deposit(leaving.origin + leaving.dir * to_floor, leaving.weight);
+                        }
+                    }
+                } else {
+                    if reflected_weight >= params.misc.z && depth < STACK {
+                        stack[depth] = reflected;
+                        depth++;
+                    }
+                    if refracts && refracted_weight >= params.misc.z && depth < STACK {
+                        stack[depth] = refracted;
+                        depth++;
+                    }
                 }
             }
         }
-        if depth == 0u {
+        if carrying {
+            ray = carried;
+            carrying = false;
+        } else if depth > 0u {
+            depth--;
+            ray = stack[depth];
+        } else {
             break;
         }
-        depth--;
-        ray = stack[depth];
         var to_floor = -1.0;
         if ray.inside == 0u {
             to_floor = floor_t(ray.origin, ray.dir);
         }
-        if ray.inside == 0u && params.shell_outer.z > 0.0 {
-            // Leaving a convex body outward: nothing of it lies ahead.
-            hit = Hit(0.0, NONE, 0.0, 0.0, vec3<f32>(0.0));
-        } else {
-            hit = closest_hit(ray.origin, ray.dir, select(1e30, to_floor, to_floor > 0.0),
-                ray.inside == 1u && params.shell_outer.w > 0.0);
-        }
+        hit = closest_hit(ray.origin, ray.dir, select(1e30, to_floor, to_floor > 0.0),
+            ray.inside == 1u && params.shell_outer.w > 0.0);
         if hit.tri == NONE && to_floor > 0.0 {
             deposit(ray.origin + ray.dir * to_floor, ray.weight);
         }

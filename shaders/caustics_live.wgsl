@@ -596,9 +596,10 @@ fn cell_row(y: i32, g: u32, pitch4: u32) -> vec4<f32> {
 // The bits of the tiles the smoothing writes, one tile row per invocation: a tile's bound is
 // the sum over the 6 x 6 cells around it of each cell's mass times the kernel's largest
 // weight between their texels (the kernel is separable), and the tile is written when the
-// bound reaches MIN_GAIN with a factor 2 of room for rounding. Along the row the cells are
-// read four at a time: the sum of each column of four cells over the six cell rows, then
-// each tile's six columns from the last two of those sums.
+// bound reaches 0.999 MIN_GAIN (room for rounding: the bound and the passes' f32 sums are
+// each good to about 1e-5 of the exact values, and the masses are exact integers). Along the
+// row the cells are read four at a time: the sum of each column of four cells over the six
+// cell rows, then each tile's six columns from the last two of those sums.
 @compute @workgroup_size(64, 1, 1)
 fn cs_smooth_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     let row = id.x;
@@ -608,7 +609,7 @@ fn cs_smooth_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let w = cell_weights(p.map.w);
     let pitch4 = (2u * across + 3u) / 4u;
-    let threshold = 0.5 * p.misc.w * p.misc.y;
+    let threshold = 0.999 * p.misc.w * p.misc.y;
     let top = i32(2u * row) - 2;
     var previous = vec4<f32>(0.0);
     var bits = 0u;

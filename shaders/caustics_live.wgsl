@@ -93,8 +93,9 @@ var<private> floor_normal_world: vec3<f32>;
 // atomics have finished and writes none).
 @group(0) @binding(9) var<storage, read> sums4: array<vec4<i32>>;
 // Per cell of 4 x 4 texels (`mass_pitch` cells a row), the positive shares of G deposited with
-// their first texel in it, fixed-point units: no texel's G = max(0, sum) exceeds the shares
-// it was dealt. The CPU zeroes it before each computation.
+// their first texel in it, in units of MASS_UNIT fixed-point units, each deposit's rounded
+// up: no texel's G = max(0, sum) exceeds the shares it was dealt. The CPU zeroes it before
+// each computation.
 @group(0) @binding(10) var<storage, read_write> cell_mass: array<atomic<u32>>;
 // Per tile row, `tiles.z` words of bits of the tiles the smoothing writes (tile x in bit
 // x % 32 of word x / 32): those whose smoothed gains can reach MIN_GAIN (`cs_smooth_tiles`).
@@ -103,6 +104,10 @@ var<private> floor_normal_world: vec3<f32>;
 @group(0) @binding(12) var<storage, read> cell_mass4: array<vec4<u32>>;
 
 const NONE: u32 = 0xffffffffu;
+// Fixed-point units per unit of `cell_mass` (`MASS_UNIT` in live.rs): room for the masses of
+// 16 times more light than whole fixed-point units would leave, for less than 16 units
+// (G = 2.4e-4) more per deposit.
+const MASS_UNIT: u32 = 16u;
 // Side of the smoothing's tiles, texels (`TILE_PX` in smoothing.rs): whole vectors of four,
 // and at least the short kernel's reach, so that a tile's gains depend on its own and its
 // neighbours' texels only.
@@ -316,7 +321,8 @@ fn deposit(point_m: vec3<f32>, weight: f32) {
         // Its texels lie within [4c, 4c + 4] along each axis of its cell c (a first texel
         // just off the map's top or left edge counts in cell 0).
         let cell = vec2<u32>(max(base, vec2<i32>(0))) / 4u;
-        atomicAdd(&cell_mass[cell.y * mass_pitch() + cell.x], u32(positive));
+        atomicAdd(&cell_mass[cell.y * mass_pitch() + cell.x],
+            (u32(positive) + MASS_UNIT - 1u) / MASS_UNIT);
     }
 }
 
@@ -609,7 +615,7 @@ fn cs_smooth_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let w = cell_weights(p.map.w);
     let pitch4 = (2u * across + 3u) / 4u;
-    let threshold = 0.999 * p.misc.w * p.misc.y;
+    let threshold = 0.999 * p.misc.w * p.misc.y / f32(MASS_UNIT);
     let top = i32(2u * row) - 2;
     var previous = vec4<f32>(0.0);
     var bits = 0u;

@@ -427,7 +427,13 @@ impl LiveCaustics {
         let [across, down, words] = tile_layout(self.size[0], self.size[1]);
         let skip_tiles = self.desc.skip_tiles
             && self.desc.smoothing_px <= SHORT_KERNEL_PX
-            && self.shares_fit(light, solid_angle * (n * n) as f32, texel_area);
+            && shares_fit(
+                self.world_from_plane,
+                light,
+                solid_angle * (n * n) as f32,
+                texel_area,
+                n,
+            );
         // Rounding room for the shell's radii and the stretches of a ray inside it.
         let slack = self.model_radius * SHELL_SLACK;
         Params {
@@ -460,31 +466,6 @@ impl LiveCaustics {
             ],
             tiles: [across, down, words, u32::from(skip_tiles)],
         }
-    }
-
-    /// Whether the positive shares of G that the photons of a cone of `cone_sr` steradians
-    /// from `light` deposit add up to less than 2^31 fixed-point units, so that no cell's mass
-    /// (`cell_mass` in caustics_live.wgsl, a u32 sum) can wrap round. A photon's paths split
-    /// its light, so its shares sum to at most one share at the floor's point where G per
-    /// unit of light, r^2 / cos theta = r^3 / height, is largest: the corner farthest from the
-    /// light. Each path's rounding adds at most 2 units, and paths end below MIN_WEIGHT, so a
-    /// photon has at most 1 / MIN_WEIGHT of them.
-    fn shares_fit(&self, light: Vec3, cone_sr: f32, texel_area: f32) -> bool {
-        let p = self.world_from_plane;
-        let normal = p.x_axis.truncate().cross(p.y_axis.truncate()).normalize();
-        let height = (light - p.w_axis.truncate()).dot(normal);
-        if height <= 0.0 {
-            // Behind the floor: the photons deposit nothing.
-            return true;
-        }
-        let farthest = [(-0.5, -0.5), (-0.5, 0.5), (0.5, -0.5), (0.5, 0.5)]
-            .map(|(x, y)| p.transform_point3(Vec3::new(x, y, 0.0)).distance(light))
-            .into_iter()
-            .fold(0.0f32, f32::max);
-        let photons = self.desc.photons_per_side as f32 * self.desc.photons_per_side as f32;
-        let most = cone_sr * farthest.powi(3) / (height * texel_area) * FIXED_POINT
-            + photons * 2.0 / MIN_WEIGHT;
-        most < 2f32.powi(31)
     }
 
     /// Records the computation of the gain map for `pose` and its copy into `caustic` (an
@@ -689,5 +670,82 @@ impl LiveCaustics {
             .flat_map(|row| &row[..w])
             .copied()
             .collect())
+    }
+}
+
+/// Fixed-point units per unit of the smoothing's cell masses (`MASS_UNIT` in
+/// caustics_live.wgsl).
+const MASS_UNIT: f32 = 16.0;
+
+/// Whether the positive shares of G that `photons_per_side`^2 photons in a cone of `cone_sr`
+/// steradians from `light` deposit on the floor `world_from_plane` maps (texels of
+/// `texel_area`) add up to less than 2^31 units of [`MASS_UNIT`], so that no cell's mass
+/// (`cell_mass` in caustics_live.wgsl, a u32 sum) can wrap round. A photon's paths split its
+/// light, so its shares sum to at most one share at the floor's point where G per unit of
+/// light, r^2 / cos theta = r^3 / height, is largest: the corner farthest from the light.
+/// Each path's rounding adds at most 3 units, and paths end below MIN_WEIGHT, so a photon has
+/// at most 1 / MIN_WEIGHT of them. The shipped scenes stay below it by a factor of about 30.
+fn shares_fit(
+    world_from_plane: Mat4,
+    light: Vec3,
+    cone_sr: f32,
+    texel_area: f32,
+    photons_per_side: u32,
+) -> bool {
+    let p = world_from_plane;
+    let normal = p.x_axis.truncate().cross(p.y_axis.truncate()).normalize();
+    let height = (light - p.w_axis.truncate()).dot(normal);
+    if height <= 0.0 {
+        // Behind the floor: the photons deposit nothing.
+        return true;
+    }
+    let farthest = [(-0.5, -0.5), (-0.5, 0.5), (0.5, -0.5), (0.5, 0.5)]
+        .map(|(x, y)| p.transform_point3(Vec3::new(x, y, 0.0)).distance(light))
+        .into_iter()
+        .fold(0.0f32, f32::max);
+    let photons = photons_per_side as f32 * photons_per_side as f32;
+    let most = cone_sr * farthest.powi(3) / (height * texel_area) * FIXED_POINT / MASS_UNIT
+        + photons * 3.0 / MIN_WEIGHT;
+    most < 2f32.powi(31)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shares_fit_unless_the_light_is_nearly_level_with_the_floor() {
+        // The shipped 1 m floor facing up, 990 x 990 texels, and an 80 mm ball 1.4 m from a
+        // light 1 m above it: a cone of about 2.5e-3 sr.
+        let floor = Mat4::from_rotation_translation(
+            glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+            Vec3::new(0.0, -0.3, -1.5),
+        );
+        let texel = 1.0 / (990.0 * 990.0);
+        let cone = 2.5e-3;
+        let above = Vec3::new(0.0, 0.7, -2.5);
+        assert!(shares_fit(floor, above, cone, texel, 128));
+        // A light as far off, 0.1 m above the floor: G per unit of light at the far corner is
+        // six times larger, within the room the mass unit leaves.
+        assert!(shares_fit(
+            floor,
+            Vec3::new(0.0, -0.2, -2.5),
+            cone,
+            texel,
+            128
+        ));
+        // 1 mm above the floor's plane: a thousand times larger.
+        let level = Vec3::new(0.0, -0.299, -2.5);
+        assert!(!shares_fit(floor, level, cone, texel, 128));
+        // Below it: nothing lands.
+        assert!(shares_fit(
+            floor,
+            Vec3::new(0.0, -1.0, -1.5),
+            cone,
+            texel,
+            128
+        ));
+        // Enough photons alone exceed it through their rounding.
+        assert!(!shares_fit(floor, above, cone, texel, 4096));
     }
 }

@@ -73,10 +73,10 @@ pub const CAUSTICS_TRACE_CS: &[u8] = spirv!("caustics_live.cs_trace");
 /// The smoothing's passes: the short kernel along the rows and along the columns, the ring
 /// buffers' pass for wider boxes, and the short kernel's tiles.
 pub const CAUSTICS_SMOOTH_CS: [&[u8]; 4] = [
-    spirv!("caustics_live.cs_smooth_rows"),
-    spirv!("caustics_live.cs_smooth_columns"),
-    spirv!("caustics_live.cs_smooth_wide"),
-    spirv!("caustics_live.cs_smooth_tiles"),
+    spirv!("caustics_smooth.cs_smooth_rows"),
+    spirv!("caustics_smooth.cs_smooth_columns"),
+    spirv!("caustics_smooth.cs_smooth_wide"),
+    spirv!("caustics_smooth.cs_smooth_tiles"),
 ];
 
 /// Reinterprets SPIR-V bytes as words (include_bytes gives no alignment guarantee).

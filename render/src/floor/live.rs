@@ -1,7 +1,7 @@
 //! Caustics computed on the GPU for each pose of the object and the light (docs/caustics.md,
-//! eq. 6): photon splatting, then a smoothing by a box filter run three times along each
-//! axis, in compute passes (shaders/caustics_live.wgsl) into the caustic gain map the overlay
-//! adds, in place of a bake. Recorded with the inducer's fields, so only on frames after
+//! eq. 6): photon splatting (shaders/caustics_live.wgsl), then a smoothing by a box filter run
+//! three times along each axis (shaders/caustics_smooth.wgsl, planned by [`super::smoothing`]),
+//! in compute passes into the caustic gain map the overlay adds, in place of a bake. Recorded with the inducer's fields, so only on frames after
 //! a move; timed as the floor's `live caustics` stage ([`super::FieldPassesMs`]) and in
 //! wall-clock time.
 
@@ -11,7 +11,7 @@ use gpu_allocator::MemoryLocation;
 
 use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
 use super::smoothing::{
-    COLUMNS_STEP, SHORT_KERNEL_PX, SMOOTH_GROUP, SmoothPass, row_pitch, smooth_steps, tile_layout,
+    SHORT_KERNEL_PX, SmoothPass, SmoothTiles, record_smoothing, row_pitch, shares_fit, smooth_steps,
 };
 use super::triangle_grid::{Grid, behind_every_plane, corner_and_edges, inner_radius};
 use crate::context::GpuContext;
@@ -67,13 +67,13 @@ pub const MAX_PHOTONS_PER_SIDE: u32 = 4096;
 pub const MAX_SMOOTHING_PX: u32 = 64;
 /// Fixed-point units per unit of gain in the sums (integer atomics keep the result the same
 /// whatever order photons land in).
-const FIXED_POINT: f32 = 65536.0;
+pub(super) const FIXED_POINT: f32 = 65536.0;
 /// Paths below this weight end. The bake follows them to 1e-4; the live maps of the sphere,
 /// the diamond and the torus are as close to their bakes with 1e-2 (0.52 %, 3.23 % and 3.38 %
 /// against 0.51 %, 3.23 % and 3.40 %), and the sphere's stage after a move costs about 10 ms
 /// less on lavapipe (a ball's second internal reflection, 0.16 % of the light, is one more
 /// walk through the glass for every photon).
-const MIN_WEIGHT: f32 = 1e-2;
+pub(super) const MIN_WEIGHT: f32 = 1e-2;
 /// Gains below this are stored as 0 (the bake's `MIN_GAIN`).
 const MIN_GAIN: f32 = 0.001;
 
@@ -81,7 +81,7 @@ const MIN_GAIN: f32 = 0.001;
 /// outer radius (f32 rounding of a ray from a light some 40 radii away is about 1e-5 of it).
 const SHELL_SLACK: f32 = 1e-3;
 
-/// Uniform block matching `Params` in caustics_live.wgsl.
+/// Uniform block matching `Params` in shaders/shared/caustics_maps.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct Params {
@@ -125,12 +125,8 @@ pub(crate) struct LiveCaustics {
     sums: Buffer,
     /// The fixed-point map smoothed along the rows.
     _scratch: Buffer,
-    /// Per cell of 4 x 4 texels, the positive shares of G deposited in it (zeroed before each
-    /// computation that skips tiles).
-    cell_mass: Buffer,
-    /// Per tile row, the bits of the tiles the smoothing writes; all set when it skips none.
-    /// Host-visible ([`LiveCaustics::tiles_written`]).
-    tile_bits: Buffer,
+    /// The smoothing's cell masses and tile bits.
+    tiles: SmoothTiles,
     /// The smoothed gain map, host-visible (for tests).
     gain: Buffer,
     /// The box of the non-zero gains (`[x0, y0, x1, y1]`, ends included; empty when
@@ -270,22 +266,7 @@ impl LiveCaustics {
             storage | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        let [across, down, words] = tile_layout(size[0], size[1]);
-        // Two cells per tile along each axis, rows padded to whole vectors of four cells.
-        let cell_mass = Buffer::new(
-            ctx,
-            "caustics cell masses",
-            u64::from((2 * across).next_multiple_of(4) * 2 * down) * 4,
-            storage | vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuOnly,
-        )?;
-        let tile_bits = Buffer::new(
-            ctx,
-            "caustics tile bits",
-            u64::from(down * words) * 4,
-            storage | vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let tiles = SmoothTiles::new(ctx, size)?;
         let params = Buffer::new(
             ctx,
             "caustics parameters",
@@ -304,32 +285,7 @@ impl LiveCaustics {
         // The smoothing step; the trace pass reads none.
         let layout = pipeline::layout(ctx, Some(set_layout.raw()), compute, 4)?;
         let trace = pipeline::compute(ctx, layout.raw(), shaders::CAUSTICS_TRACE_CS, c"cs_trace")?;
-        let smooth = [
-            pipeline::compute(
-                ctx,
-                layout.raw(),
-                shaders::CAUSTICS_SMOOTH_CS[0],
-                c"cs_smooth_rows",
-            )?,
-            pipeline::compute(
-                ctx,
-                layout.raw(),
-                shaders::CAUSTICS_SMOOTH_CS[1],
-                c"cs_smooth_columns",
-            )?,
-            pipeline::compute(
-                ctx,
-                layout.raw(),
-                shaders::CAUSTICS_SMOOTH_CS[2],
-                c"cs_smooth_wide",
-            )?,
-            pipeline::compute(
-                ctx,
-                layout.raw(),
-                shaders::CAUSTICS_SMOOTH_CS[3],
-                c"cs_smooth_tiles",
-            )?,
-        ];
+        let smooth = SmoothPass::pipelines(ctx, layout.raw())?;
         let pool = pipeline::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 13)])?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
@@ -339,7 +295,8 @@ impl LiveCaustics {
         // The sums again, read four texels at a time by the smoothing.
         buffers.push(sums.buffer);
         // The cells' masses, then again four at a time.
-        buffers.extend([cell_mass.buffer, tile_bits.buffer, cell_mass.buffer]);
+        let [cell_mass, tile_bits] = tiles.buffers();
+        buffers.extend([cell_mass, tile_bits, cell_mass]);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|&buffer| {
@@ -374,8 +331,7 @@ impl LiveCaustics {
             _mesh: mesh_buffers,
             sums,
             _scratch: scratch,
-            cell_mass,
-            tile_bits,
+            tiles,
             gain,
             bounds,
             size,
@@ -424,7 +380,7 @@ impl LiveCaustics {
             .length();
         let texel_area = floor_area / (self.size[0] as f32 * self.size[1] as f32);
         let [gx, gy, gz] = self.grid_dims;
-        let [across, down, words] = tile_layout(self.size[0], self.size[1]);
+        let [across, down, words] = self.tiles.layout();
         let skip_tiles = self.desc.skip_tiles
             && self.desc.smoothing_px <= SHORT_KERNEL_PX
             && shares_fit(
@@ -522,13 +478,11 @@ impl LiveCaustics {
             );
             d.cmd_update_buffer(cmd, self.params.buffer, 0, bytemuck::bytes_of(&params));
             d.cmd_fill_buffer(cmd, self.sums.buffer, 0, vk::WHOLE_SIZE, 0);
-            if params.tiles[3] != 0 {
+            let skipping = params.tiles[3] != 0;
+            self.tiles.record_clear(d, cmd, skipping);
+            if skipping {
                 // The smoothing writes the live tiles only.
-                d.cmd_fill_buffer(cmd, self.cell_mass.buffer, 0, vk::WHOLE_SIZE, 0);
                 d.cmd_fill_buffer(cmd, self.gain.buffer, 0, vk::WHOLE_SIZE, 0);
-            } else {
-                // Every tile is written.
-                d.cmd_fill_buffer(cmd, self.tile_bits.buffer, 0, vk::WHOLE_SIZE, u32::MAX);
             }
             let empty: [u32; 4] = [u32::MAX, u32::MAX, 0, 0];
             d.cmd_update_buffer(cmd, self.bounds, 0, bytemuck::bytes_of(&empty));
@@ -547,47 +501,19 @@ impl LiveCaustics {
             let bind = vk::PipelineBindPoint::COMPUTE;
             d.cmd_bind_descriptor_sets(cmd, bind, self.layout.raw(), 0, &[self.set], &[]);
             let n = self.desc.photons_per_side;
-            let [w, h] = self.size;
             d.cmd_bind_pipeline(cmd, bind, self.trace.raw());
             d.cmd_dispatch(cmd, groups(n), groups(n), 1);
             if let Some(stamps) = stamps {
                 stamps.write(d, cmd, CAUSTIC_PHOTONS_STAMP..CAUSTIC_PHOTONS_STAMP + 1);
             }
-            for (pass, step) in smooth_steps(self.desc.smoothing_px) {
-                if pass == SmoothPass::Tiles && params.tiles[3] == 0 {
-                    // Every texel is smoothed.
-                    continue;
-                }
-                // Each pass reads what the one before wrote (the first, the photons' sums).
-                d.cmd_pipeline_barrier(
-                    cmd,
-                    compute,
-                    compute,
-                    vk::DependencyFlags::empty(),
-                    &memory(
-                        vk::AccessFlags::SHADER_WRITE,
-                        vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
-                    ),
-                    &[],
-                    &[],
-                );
-                d.cmd_bind_pipeline(cmd, bind, self.smooth[pass as usize].raw());
-                let lines = match pass {
-                    SmoothPass::Tiles => params.tiles[1],
-                    SmoothPass::Rows => h,
-                    SmoothPass::Columns => row_pitch(w) / 4,
-                    SmoothPass::Wide if step & COLUMNS_STEP != 0 => w,
-                    SmoothPass::Wide => h,
-                };
-                d.cmd_push_constants(
-                    cmd,
-                    self.layout.raw(),
-                    vk::ShaderStageFlags::COMPUTE,
-                    0,
-                    &step.to_le_bytes(),
-                );
-                d.cmd_dispatch(cmd, lines.div_ceil(SMOOTH_GROUP), 1, 1);
-            }
+            record_smoothing(
+                d,
+                cmd,
+                self.layout.raw(),
+                &self.smooth,
+                &smooth_steps(self.desc.smoothing_px, params.tiles[3] != 0),
+                self.size,
+            );
             d.cmd_pipeline_barrier(
                 cmd,
                 compute | vk::PipelineStageFlags::FRAGMENT_SHADER,
@@ -640,17 +566,7 @@ impl LiveCaustics {
     /// How many of the smoothing's tiles the last computation that finished wrote, and how
     /// many the map has (wait for the frame first).
     pub fn tiles_written(&self) -> Result<[u32; 2]> {
-        let [across, down, words] = tile_layout(self.size[0], self.size[1]);
-        let bits = self.tile_bits.mapped()?;
-        let mut written = 0;
-        for row in 0..down {
-            for x in 0..across {
-                let at = ((row * words + x / 32) * 4) as usize;
-                let word = u32::from_le_bytes([bits[at], bits[at + 1], bits[at + 2], bits[at + 3]]);
-                written += (word >> (x % 32)) & 1;
-            }
-        }
-        Ok([written, across * down])
+        self.tiles.written()
     }
 
     /// The gain map of the last computation that finished, row 0 at the photo's top (wait
@@ -670,82 +586,5 @@ impl LiveCaustics {
             .flat_map(|row| &row[..w])
             .copied()
             .collect())
-    }
-}
-
-/// Fixed-point units per unit of the smoothing's cell masses (`MASS_UNIT` in
-/// caustics_live.wgsl).
-const MASS_UNIT: f32 = 16.0;
-
-/// Whether the positive shares of G that `photons_per_side`^2 photons in a cone of `cone_sr`
-/// steradians from `light` deposit on the floor `world_from_plane` maps (texels of
-/// `texel_area`) add up to less than 2^31 units of [`MASS_UNIT`], so that no cell's mass
-/// (`cell_mass` in caustics_live.wgsl, a u32 sum) can wrap round. A photon's paths split its
-/// light, so its shares sum to at most one share at the floor's point where G per unit of
-/// light, r^2 / cos theta = r^3 / height, is largest: the corner farthest from the light.
-/// Each path's rounding adds at most 3 units, and paths end below MIN_WEIGHT, so a photon has
-/// at most 1 / MIN_WEIGHT of them. The shipped scenes stay below it by a factor of about 30.
-fn shares_fit(
-    world_from_plane: Mat4,
-    light: Vec3,
-    cone_sr: f32,
-    texel_area: f32,
-    photons_per_side: u32,
-) -> bool {
-    let p = world_from_plane;
-    let normal = p.x_axis.truncate().cross(p.y_axis.truncate()).normalize();
-    let height = (light - p.w_axis.truncate()).dot(normal);
-    if height <= 0.0 {
-        // Behind the floor: the photons deposit nothing.
-        return true;
-    }
-    let farthest = [(-0.5, -0.5), (-0.5, 0.5), (0.5, -0.5), (0.5, 0.5)]
-        .map(|(x, y)| p.transform_point3(Vec3::new(x, y, 0.0)).distance(light))
-        .into_iter()
-        .fold(0.0f32, f32::max);
-    let photons = photons_per_side as f32 * photons_per_side as f32;
-    let most = cone_sr * farthest.powi(3) / (height * texel_area) * FIXED_POINT / MASS_UNIT
-        + photons * 3.0 / MIN_WEIGHT;
-    most < 2f32.powi(31)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_shares_fit_unless_the_light_is_nearly_level_with_the_floor() {
-        // The shipped 1 m floor facing up, 990 x 990 texels, and an 80 mm ball 1.4 m from a
-        // light 1 m above it: a cone of about 2.5e-3 sr.
-        let floor = Mat4::from_rotation_translation(
-            glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
-            Vec3::new(0.0, -0.3, -1.5),
-        );
-        let texel = 1.0 / (990.0 * 990.0);
-        let cone = 2.5e-3;
-        let above = Vec3::new(0.0, 0.7, -2.5);
-        assert!(shares_fit(floor, above, cone, texel, 128));
-        // A light as far off, 0.1 m above the floor: G per unit of light at the far corner is
-        // six times larger, within the room the mass unit leaves.
-        assert!(shares_fit(
-            floor,
-            Vec3::new(0.0, -0.2, -2.5),
-            cone,
-            texel,
-            128
-        ));
-        // 1 mm above the floor's plane: a thousand times larger.
-        let level = Vec3::new(0.0, -0.299, -2.5);
-        assert!(!shares_fit(floor, level, cone, texel, 128));
-        // Below it: nothing lands.
-        assert!(shares_fit(
-            floor,
-            Vec3::new(0.0, -1.0, -1.5),
-            cone,
-            texel,
-            128
-        ));
-        // Enough photons alone exceed it through their rounding.
-        assert!(!shares_fit(floor, above, cone, texel, 4096));
     }
 }

@@ -562,7 +562,8 @@ fn live_torus_caustics_match_a_bake_of_it() {
 
 #[test]
 fn the_shipped_sphere_and_diamond_are_convex_the_torus_is_not() {
-    // Photons leaving a convex mesh outward skip the search for another surface.
+    // Photons leaving a convex mesh outward skip the search for another surface; the shadow
+    // mask of a closed one (all three) is drawn from one side's triangles.
     for (name, convex) in [
         ("glass-sphere.toml", true),
         ("diamond.toml", true),
@@ -574,6 +575,10 @@ fn the_shipped_sphere_and_diamond_are_convex_the_torus_is_not() {
         assert_eq!(
             vitreous_render::convex::is_convex(&mesh.positions, &mesh.indices),
             convex,
+            "{name}"
+        );
+        assert!(
+            vitreous_render::convex::is_closed(&mesh.positions, &mesh.indices),
             "{name}"
         );
     }

@@ -88,6 +88,118 @@ pub fn convex_exit(planes: &[Vec4], p: Vec3, d: Vec3) -> Option<(f32, Vec3)> {
         .min_by(|x, y| x.0.total_cmp(&y.0))
 }
 
+/// One side of an edge: the triangle along it, its far corner, and whether the triangle runs
+/// along the edge from its lower id.
+type Side = (usize, u32, bool);
+
+/// A mesh with vertices within a tolerance of one another merged: its distinct positions, its
+/// triangles over them, and per undirected edge its sides.
+struct Welded {
+    /// Distinct positions.
+    unique: Vec<Vec3>,
+    /// Triangles as indices into `unique`, three distinct each.
+    triangles: Vec<[u32; 3]>,
+    /// Per edge (lower id, higher id): its sides.
+    edges: HashMap<(u32, u32), Vec<Side>>,
+    /// The tolerance: 1e-5 of the bounding box's diagonal.
+    tolerance: f32,
+    /// The bounding box's lower corner.
+    lo: Vec3,
+}
+
+impl Welded {
+    /// Vertices within 1e-5 of the mesh's size of one another count as one (flat-shaded
+    /// meshes repeat them per facet, seams repeat them rounded). None for no triangles, a
+    /// degenerate box, or a triangle with two corners at one position.
+    fn new(positions: &[Vec3], indices: &[u32]) -> Option<Welded> {
+        if indices.is_empty() || !indices.len().is_multiple_of(3) {
+            return None;
+        }
+        let (lo, hi) = positions
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
+                (l.min(p), h.max(p))
+            });
+        let tolerance = 1e-5 * (hi - lo).length();
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return None;
+        }
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        let mut unique: Vec<Vec3> = Vec::new();
+        let mut welded = Vec::with_capacity(positions.len());
+        for &p in positions {
+            let cell = ((p - lo) / tolerance).floor().as_i64vec3().to_array();
+            let mut found = None;
+            'near: for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let key = [cell[0] + dx, cell[1] + dy, cell[2] + dz];
+                        if let Some(ids) = cells.get(&key) {
+                            found = ids
+                                .iter()
+                                .copied()
+                                .find(|&id| unique[id as usize].distance(p) <= tolerance);
+                            if found.is_some() {
+                                break 'near;
+                            }
+                        }
+                    }
+                }
+            }
+            let id = found.unwrap_or_else(|| {
+                unique.push(p);
+                let id = unique.len() as u32 - 1;
+                cells.entry(cell).or_default().push(id);
+                id
+            });
+            welded.push(id);
+        }
+        let triangles = indices
+            .chunks_exact(3)
+            .map(|t| {
+                let v = [0, 1, 2].map(|k| welded.get(t[k] as usize).copied());
+                match v {
+                    [Some(a), Some(b), Some(c)] if a != b && b != c && a != c => Some([a, b, c]),
+                    _ => None,
+                }
+            })
+            .collect::<Option<Vec<[u32; 3]>>>()?;
+        let mut edges: HashMap<(u32, u32), Vec<Side>> = HashMap::new();
+        for (t, v) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b, far) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
+                edges
+                    .entry((a.min(b), a.max(b)))
+                    .or_default()
+                    .push((t, far, a < b));
+            }
+        }
+        Some(Welded {
+            unique,
+            triangles,
+            edges,
+            tolerance,
+            lo,
+        })
+    }
+
+    /// Whether every edge joins exactly two triangles, in opposite directions.
+    fn closed(&self) -> bool {
+        self.edges
+            .values()
+            .all(|list| matches!(list[..], [(_, _, up0), (_, _, up1)] if up0 != up1))
+    }
+}
+
+/// Whether the mesh is a closed surface, its triangles wound consistently: every edge joins
+/// exactly two triangles, in opposite directions (vertices within 1e-5 of the mesh's size of
+/// one another counting as one). Every ray from outside that meets such a surface enters it
+/// through a triangle facing the ray and leaves through one facing away, so a silhouette is
+/// drawn whole by either kind alone.
+pub fn is_closed(positions: &[Vec3], indices: &[u32]) -> bool {
+    Welded::new(positions, indices).is_some_and(|w| w.closed())
+}
+
 /// Whether the mesh is the closed surface of one convex body, its triangles wound
 /// counter-clockwise seen from outside: every edge joins exactly two triangles, in opposite
 /// directions; the triangles form one connected surface enclosing a positive volume; and
@@ -98,75 +210,19 @@ pub fn convex_exit(planes: &[Vec4], p: Vec3, d: Vec3) -> Option<(f32, Vec3)> {
 /// (flat-shaded meshes repeat them per facet, seams repeat them rounded); a triangle with
 /// two corners at one position makes the answer no.
 pub fn is_convex(positions: &[Vec3], indices: &[u32]) -> bool {
-    if indices.is_empty() || !indices.len().is_multiple_of(3) {
-        return false;
-    }
-    let (lo, hi) = positions
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
-            (l.min(p), h.max(p))
-        });
-    let tolerance = 1e-5 * (hi - lo).length();
-    if !(tolerance.is_finite() && tolerance > 0.0) {
-        return false;
-    }
-    // Vertices within the tolerance of one another are one (seams repeat them, rounded).
-    let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-    let mut unique: Vec<Vec3> = Vec::new();
-    let mut welded = Vec::with_capacity(positions.len());
-    for &p in positions {
-        let cell = ((p - lo) / tolerance).floor().as_i64vec3().to_array();
-        let mut found = None;
-        'near: for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let key = [cell[0] + dx, cell[1] + dy, cell[2] + dz];
-                    if let Some(ids) = cells.get(&key) {
-                        found = ids
-                            .iter()
-                            .copied()
-                            .find(|&id| unique[id as usize].distance(p) <= tolerance);
-                        if found.is_some() {
-                            break 'near;
-                        }
-                    }
-                }
-            }
-        }
-        let id = found.unwrap_or_else(|| {
-            unique.push(p);
-            let id = unique.len() as u32 - 1;
-            cells.entry(cell).or_default().push(id);
-            id
-        });
-        welded.push(id);
-    }
-    let Some(triangles) = indices
-        .chunks_exact(3)
-        .map(|t| {
-            let v = [0, 1, 2].map(|k| welded.get(t[k] as usize).copied());
-            match v {
-                [Some(a), Some(b), Some(c)] if a != b && b != c && a != c => Some([a, b, c]),
-                _ => None,
-            }
-        })
-        .collect::<Option<Vec<[u32; 3]>>>()
-    else {
+    let Some(welded) = Welded::new(positions, indices) else {
         return false;
     };
-    // Per undirected edge: its sides, each (triangle, far corner, whether the triangle runs
-    // along it from the lower id).
-    type Side = (usize, u32, bool);
-    let mut edges: HashMap<(u32, u32), Vec<Side>> = HashMap::new();
-    for (t, v) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b, far) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
-            edges
-                .entry((a.min(b), a.max(b)))
-                .or_default()
-                .push((t, far, a < b));
-        }
+    if !welded.closed() {
+        return false;
     }
+    let Welded {
+        unique,
+        triangles,
+        edges,
+        tolerance,
+        lo,
+    } = &welded;
     let corner = |id: u32| unique[id as usize];
     let normal = |t: usize| {
         let [a, b, c] = triangles[t].map(corner);
@@ -182,10 +238,10 @@ pub fn is_convex(positions: &[Vec3], indices: &[u32]) -> bool {
         t
     }
     for list in edges.values() {
-        let [(t0, far0, up0), (t1, far1, up1)] = list[..] else {
+        let [(t0, far0, _), (t1, far1, _)] = list[..] else {
             return false;
         };
-        if up0 == up1 || in_front(t0, far1) > tolerance || in_front(t1, far0) > tolerance {
+        if in_front(t0, far1) > *tolerance || in_front(t1, far0) > *tolerance {
             return false;
         }
         let (r0, r1) = (root(&mut parent, t0), root(&mut parent, t1));
@@ -198,7 +254,7 @@ pub fn is_convex(positions: &[Vec3], indices: &[u32]) -> bool {
         .iter()
         .map(|v| {
             let [a, b, c] = v.map(corner);
-            (a - lo).dot((b - lo).cross(c - lo))
+            (a - *lo).dot((b - *lo).cross(c - *lo))
         })
         .sum();
     connected && volume > 0.0
@@ -264,5 +320,27 @@ mod tests {
         let mut both = i.clone();
         both.extend(i.iter().map(|&k| k + p.len() as u32));
         assert!(!is_convex(&two, &both));
+    }
+
+    #[test]
+    fn closed_meshes_are_told_from_open_and_inconsistently_wound_ones() {
+        let (p, _, i) = cube(0.5);
+        assert!(is_closed(&p, &i));
+        // Wound inward, or two bodies: still closed.
+        let inward: Vec<u32> = i.chunks_exact(3).flat_map(|t| [t[0], t[2], t[1]]).collect();
+        assert!(is_closed(&p, &inward));
+        let mut two = p.clone();
+        two.extend(p.iter().map(|v| *v + Vec3::new(2.0, 0.0, 0.0)));
+        let mut both = i.clone();
+        both.extend(i.iter().map(|&k| k + p.len() as u32));
+        assert!(is_closed(&two, &both));
+        // One triangle missing: open.
+        assert!(!is_closed(&p, &i[..i.len() - 3]));
+        // One triangle turned over: its edges run the same way as its neighbours'.
+        let mut flipped = i.clone();
+        flipped.swap(1, 2);
+        assert!(!is_closed(&p, &flipped));
+        // Nothing at all.
+        assert!(!is_closed(&p, &[]));
     }
 }

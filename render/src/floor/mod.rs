@@ -15,7 +15,8 @@
 //!    light onto the floor plane by a homogeneous planar projection ([`planar_shadow`] in
 //!    geometry.rs) and rasterised straight into floor space; covered texels are in shadow.
 //!    For an opaque occluder this equals a conventional shadow-map lookup at each floor
-//!    texel, without the map's resolution and depth-bias artefacts.
+//!    texel, without the map's resolution and depth-bias artefacts. A closed mesh is drawn
+//!    from the triangles facing one way only (the same texels, half the triangles).
 //! 2. **Nearest shadow texel** (distance_transform.rs; shaders/inducer_distance.wgsl): an
 //!    exact Euclidean distance transform of the mask in two compute passes (per column, then
 //!    per row), nearest in metres.

@@ -138,7 +138,14 @@ impl InducerPass {
                 fragment: (shaders::MASK_FS, c"fs_main"),
                 bindings: &[MESH_POSITION_BINDING],
                 attributes: &[MESH_POSITION_ATTRIBUTE],
-                cull: vk::CullModeFlags::NONE,
+                // A closed mesh's shadow is drawn whole by the triangles facing either way
+                // alone (`convex::is_closed`): culling one kind halves the triangles the
+                // rasteriser sets up after every move.
+                cull: if crate::convex::is_closed(desc.mesh.positions, desc.mesh.indices) {
+                    vk::CullModeFlags::BACK
+                } else {
+                    vk::CullModeFlags::NONE
+                },
                 depth: false,
                 blend: Blend::Replace,
             },

@@ -410,10 +410,11 @@ fn the_gpu_smoothing_is_the_three_box_kernel_at_every_radius() {
 
 /// The short kernel's passes skip the tiles whose gains are certain to be stored as 0: the
 /// map is the same, bit for bit, as when every texel is smoothed, at every radius they take,
-/// on maps whose rows are padded; and they do skip most of the glass sphere's floor.
+/// on maps whose rows are padded (18 x 18: three tiles across, the last of one vector of
+/// four); and they do skip most of the glass sphere's floor.
 #[test]
 fn skipping_tiles_leaves_the_map_unchanged() {
-    for side in [990, 66] {
+    for side in [990, 66, 18] {
         let (scene, _) = live_scene("glass-sphere.toml", Some(side));
         for smoothing_px in [0, 1, 2] {
             let frame = |skip_tiles| {
@@ -440,8 +441,10 @@ fn skipping_tiles_leaves_the_map_unchanged() {
                 .filter(|(a, b)| a.to_bits() != b.to_bits())
                 .count();
             assert_eq!(differing, 0, "{side}, radius {smoothing_px}: texels differ");
+            // On the 18 x 18 map (55 mm texels) the smoothed focus stays below 0.1.
+            let least = if side >= 66 { 0.1 } else { 0.0 };
             assert!(
-                skipping.gain.iter().any(|&g| g > 0.1),
+                skipping.gain.iter().any(|&g| g > least),
                 "{side}, radius {smoothing_px}: the caustic is there"
             );
             if side == 990 {

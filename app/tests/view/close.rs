@@ -27,8 +27,7 @@ impl Xvfb {
     fn start() -> Option<Xvfb> {
         let xvfb = super::shots::program("Xvfb", "tools/ensure-vulkan --window (Debian: xvfb)")?;
         for n in 900..930 {
-            let taken = |p: String| std::path::Path::new(&p).exists();
-            if taken(format!("/tmp/.X11-unix/X{n}")) || taken(format!("/tmp/.X{n}-lock")) {
+            if display_in_use(n) {
                 continue;
             }
             let display = format!(":{n}");
@@ -40,6 +39,9 @@ impl Xvfb {
                     "640x480x24",
                     "-nolisten",
                     "tcp",
+                    // An X server resets when its last client leaves (as the probe below
+                    // does), and a connection made while it resets is refused.
+                    "-noreset",
                 ])
                 .stdout(Stdio::null())
                 .stderr(Stdio::null())
@@ -63,8 +65,32 @@ impl Xvfb {
     }
 }
 
+/// Whether a live X server holds display `:n`: its lock file names a running process. A lock
+/// left by a server that was killed is stale (Xvfb removes it when it starts).
+fn display_in_use(n: u32) -> bool {
+    let Ok(lock) = std::fs::read_to_string(format!("/tmp/.X{n}-lock")) else {
+        return false;
+    };
+    lock.trim().parse::<u32>().map_or(true, |pid| {
+        std::path::Path::new(&format!("/proc/{pid}")).exists()
+    })
+}
+
 impl Drop for Xvfb {
     fn drop(&mut self) {
+        // Terminated, not killed, so that it removes its lock file and socket (killed, it
+        // would leave them and the display would look taken to the next run).
+        let terminated = Command::new("kill")
+            .arg(self.child.id().to_string())
+            .status()
+            .is_ok_and(|s| s.success());
+        let asked = Instant::now();
+        while terminated && asked.elapsed() < Duration::from_secs(5) {
+            if self.child.try_wait().ok().flatten().is_some() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
         let _ = self.child.kill();
         let _ = self.child.wait();
     }

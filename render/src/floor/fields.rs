@@ -8,7 +8,11 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::Image;
 use crate::owned::Owned;
-use crate::pipeline::{self, FieldStart};
+use crate::pipeline::{
+    self, Blend, FieldStart, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec,
+};
+use crate::scene::MeshRef;
+use crate::shaders;
 
 /// Indices into the pass's field targets.
 pub(crate) const MASK: usize = 0;
@@ -349,4 +353,36 @@ impl Stamps {
             };
         }
     }
+}
+
+/// The shadow mask's pipeline (shaders/inducer_mask.wgsl) in `render_pass` with `layout` (the
+/// projection as push constant), drawing `mesh`'s positions from the scene's vertex buffer. A
+/// closed mesh's shadow is drawn whole by the triangles facing either way alone
+/// (`convex::is_closed`), so one kind is culled: half the triangles the rasteriser sets up
+/// after every move.
+pub(super) fn mask_pipeline(
+    ctx: &GpuContext,
+    render_pass: vk::RenderPass,
+    layout: vk::PipelineLayout,
+    mesh: &MeshRef,
+) -> Result<Owned<vk::Pipeline>> {
+    let cull = if crate::convex::is_closed(mesh.positions, mesh.indices) {
+        vk::CullModeFlags::BACK
+    } else {
+        vk::CullModeFlags::NONE
+    };
+    pipeline::create(
+        ctx,
+        &PipelineSpec {
+            render_pass,
+            layout,
+            vertex: (shaders::MASK_VS, c"vs_main"),
+            fragment: (shaders::MASK_FS, c"fs_main"),
+            bindings: &[MESH_POSITION_BINDING],
+            attributes: &[MESH_POSITION_ATTRIBUTE],
+            cull,
+            depth: false,
+            blend: Blend::Replace,
+        },
+    )
 }

@@ -8,7 +8,7 @@ use glam::{Mat4, Vec2, Vec3};
 use super::distance_transform::{DIST, DistanceTransform, RAMP};
 use super::fields::{
     CAUSTIC_PHOTONS_STAMP, CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN,
-    MASK, Stamps, TexelRect, bounding,
+    MASK, Stamps, TexelRect, bounding, mask_pipeline,
 };
 use super::geometry::{Floor, caustic_rect, shadow_of, texel_rect, texels_plane_rect, union_rect};
 use super::live::{LiveCaustics, LiveCausticsDesc};
@@ -19,9 +19,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::{Image, upload_texture};
 use crate::owned::Owned;
-use crate::pipeline::{
-    self, Blend, FieldStart, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec,
-};
+use crate::pipeline::{self, Blend, FieldStart, PipelineSpec};
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, InducerDesc, SceneDesc};
 use crate::shaders;
@@ -129,26 +127,11 @@ impl InducerPass {
         let vertex = vk::ShaderStageFlags::VERTEX;
         let fragment = vk::ShaderStageFlags::FRAGMENT;
         let mask_layout = pipeline::layout(ctx, None, vertex, size_of::<[f32; 16]>() as u32)?;
-        let mask_pipeline = pipeline::create(
+        let mask_pipeline = mask_pipeline(
             ctx,
-            &PipelineSpec {
-                render_pass: targets[MASK].render_pass(),
-                layout: mask_layout.raw(),
-                vertex: (shaders::MASK_VS, c"vs_main"),
-                fragment: (shaders::MASK_FS, c"fs_main"),
-                bindings: &[MESH_POSITION_BINDING],
-                attributes: &[MESH_POSITION_ATTRIBUTE],
-                // A closed mesh's shadow is drawn whole by the triangles facing either way
-                // alone (`convex::is_closed`): culling one kind halves the triangles the
-                // rasteriser sets up after every move.
-                cull: if crate::convex::is_closed(desc.mesh.positions, desc.mesh.indices) {
-                    vk::CullModeFlags::BACK
-                } else {
-                    vk::CullModeFlags::NONE
-                },
-                depth: false,
-                blend: Blend::Replace,
-            },
+            targets[MASK].render_pass(),
+            mask_layout.raw(),
+            &desc.mesh,
         )?;
 
         let field_set_layout = pipeline::set_layout(

@@ -13,8 +13,9 @@
 struct Field {
     // Floor metres per texel along the texture's x (u) and y (v).
     texel_m: vec2<f32>,
-    // Side of the floor-space textures, texels.
-    size: i32,
+    // Texels per row of `nearest` (the side of the floor-space textures rounded up to a
+    // multiple of 4).
+    nearest_pitch: i32,
     // D of eq. 2, metres.
     ramp_width_m: f32,
     // k of eq. 4.
@@ -70,7 +71,7 @@ fn fs_distance(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if textureLoad(shadow_mask, p, 0).r > 0.5 {
         return vec4<f32>(-1.0, 0.0, 0.0, 0.0);
     }
-    let seed = nearest[p.y * field.size + p.x];
+    let seed = nearest[p.y * field.nearest_pitch + p.x];
     if seed == NO_SEED {
         return vec4<f32>(FAR_M, 0.0, 0.0, 0.0);
     }

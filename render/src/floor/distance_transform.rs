@@ -22,6 +22,12 @@ use crate::shaders;
 pub(crate) const DIST: usize = 0;
 pub(crate) const RAMP: usize = 1;
 
+/// Texels per row of [`DistanceTransform::nearest`] (and per column of the column pass's
+/// rows) for fields of side `size`: a multiple of 4, as the passes move four at a time.
+pub(crate) fn pitch(size: u32) -> u32 {
+    size.next_multiple_of(4)
+}
+
 /// Push constants of the two passes, as `Transform` in inducer_distance.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -32,8 +38,10 @@ struct TransformPush {
     aspect2: f32,
     /// Side of the fields, texels.
     size: i32,
+    /// Words per column of the column rows and per row of `nearest`: [`pitch`].
+    pitch: i32,
     /// Padding to the block's 16-byte size.
-    _pad: [i32; 2],
+    _pad: i32,
 }
 
 /// The transform's pipelines and buffers; freed on drop.
@@ -52,7 +60,8 @@ pub(crate) struct DistanceTransform {
     set: vk::DescriptorSet,
     /// Scratch: the nearest shadow row per texel in its column, the rows' envelopes.
     _scratch: [Buffer; 3],
-    /// The nearest shadow texel per texel, x | y << 16 (read by `fs_distance`).
+    /// The nearest shadow texel per texel, x | y << 16, rows [`pitch`] texels apart (read by
+    /// `fs_distance`).
     pub nearest: Buffer,
     /// Side of the fields, texels.
     size: u32,
@@ -70,7 +79,8 @@ impl DistanceTransform {
         texel_m: glam::Vec2,
     ) -> Result<DistanceTransform> {
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let texels = u64::from(size) * u64::from(size);
+        // Column by column, and row by row, four texels per entry.
+        let texels = u64::from(size) * u64::from(pitch(size));
         let rows = u64::from(size) * (u64::from(size) + 1);
         let buffer = |name: &str, words: u64| {
             Buffer::new(ctx, name, words * 4, storage, MemoryLocation::GpuOnly)
@@ -78,7 +88,8 @@ impl DistanceTransform {
         let scratch = [
             buffer("inducer column rows", texels)?,
             buffer("inducer envelope", rows)?,
-            buffer("inducer envelope starts", rows)?,
+            // A start and a height per parabola.
+            buffer("inducer envelope starts", 2 * rows)?,
         ];
         let nearest = buffer("inducer nearest shadow texels", texels)?;
         let compute = vk::ShaderStageFlags::COMPUTE;
@@ -138,7 +149,8 @@ impl DistanceTransform {
             region: region.map(|v| v as i32),
             aspect2: self.aspect2,
             size: self.size as i32,
-            _pad: [0; 2],
+            pitch: pitch(self.size) as i32,
+            _pad: 0,
         };
         let barrier = |src_stage, src, dst| {
             let memory = [vk::MemoryBarrier::default()

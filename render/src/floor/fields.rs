@@ -174,8 +174,8 @@ pub(crate) fn bounding(a: Option<TexelRect>, b: Option<TexelRect>) -> Option<Tex
 pub(crate) struct FieldPush {
     /// Floor metres per texel along x and y.
     pub texel_m: [f32; 2],
-    /// Side of the fields, texels.
-    pub size: i32,
+    /// Texels per row of the nearest shadow texels ([`super::distance_transform::pitch`]).
+    pub nearest_pitch: i32,
     /// D of eq. 2, metres.
     pub ramp_width_m: f32,
     /// k of eq. 4.
@@ -239,23 +239,27 @@ impl InducerFields {
     }
 }
 
-/// Bytes per texel of the readback of the mask (R8), the distance (R32F) and the gain (R16F),
-/// stored one after another.
+/// Bytes per texel of the readback of the distance (R32F), the gain (R16F) and the mask (R8),
+/// stored one after another (in that order, so that each starts at a multiple of its texel's
+/// size).
 pub(crate) const READBACK_BYTES_PER_TEXEL: u64 = 7;
 
 impl InducerFields {
-    /// Decodes a readback of `n` x `n` texels: the mask, then the distances, then the gains.
+    /// Decodes a readback of `n` x `n` texels: the distances, then the gains, then the mask.
     pub(crate) fn decode(bytes: &[u8], n: u32, texel_m: Vec2, rect: Option<[f32; 4]>) -> Self {
         let t = n as usize * n as usize;
         InducerFields {
             resolution_px: n,
             texel_m,
-            mask: bytes[..t].iter().map(|&b| u8::from(b > 127)).collect(),
-            distance_m: bytes[t..5 * t]
+            mask: bytes[6 * t..7 * t]
+                .iter()
+                .map(|&b| u8::from(b > 127))
+                .collect(),
+            distance_m: bytes[..4 * t]
                 .chunks_exact(4)
                 .map(|f| f32::from_le_bytes([f[0], f[1], f[2], f[3]]))
                 .collect(),
-            gain: bytes[5 * t..7 * t]
+            gain: bytes[4 * t..6 * t]
                 .chunks_exact(2)
                 .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
                 .collect(),

@@ -5,7 +5,7 @@
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 
-use super::distance_transform::{DIST, DistanceTransform, RAMP};
+use super::distance_transform::{self, DIST, DistanceTransform, RAMP};
 use super::fields::{
     CAUSTIC_PHOTONS_STAMP, CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN,
     MASK, Stamps, TexelRect, bounding, mask_pipeline,
@@ -314,7 +314,7 @@ impl InducerPass {
     fn push(&self, region: TexelRect) -> FieldPush {
         FieldPush {
             texel_m: self.texel_m.to_array(),
-            size: self.desc.resolution_px as i32,
+            nearest_pitch: distance_transform::pitch(self.desc.resolution_px) as i32,
             ramp_width_m: self.desc.ramp_width_m,
             k: self.desc.k,
             _pad: [0.0; 3],

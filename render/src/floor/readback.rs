@@ -16,8 +16,9 @@ impl InducerPass {
     pub fn read_back(&mut self, ctx: &GpuContext, scene: &GpuScene) -> Result<InducerFields> {
         let n = self.desc.resolution_px;
         let texels = u64::from(n) * u64::from(n);
-        // Mask (1 byte), distance (4), gain (2) per texel, one after another.
-        let offsets = [(MASK, 0), (DISTANCE, texels), (GAIN, 5 * texels)];
+        // Distance (4 bytes), gain (2), mask (1) per texel, one after another: each copy
+        // starts at a multiple of its texel's size, whatever the side.
+        let offsets = [(DISTANCE, 0), (GAIN, 4 * texels), (MASK, 6 * texels)];
         let buffer = Buffer::new(
             ctx,
             "inducer readback",

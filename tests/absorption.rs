@@ -9,10 +9,12 @@ use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sample};
 use vitreous_render::renderer::Want;
 use vitreous_render::{
-    Attenuation, ContextOptions, FrameParams, GpuContext, LightDesc, Look, MeshRef, PlaneDesc,
-    Reflection, Refraction, Renderer, SceneDesc, TexelData, TextureDesc,
+    Attenuation, FrameParams, LightDesc, Look, PlaneDesc, Reflection, Refraction, Renderer,
+    SceneDesc,
 };
-use vitreous_tests::{flat_environment, grey_photo, render_once, uv_sphere};
+use vitreous_tests::{
+    flat_environment, grey_photo, linear, mesh_ref, render_once, scene_desc, srgb, uv_sphere,
+};
 
 const W: u32 = 320;
 const H: u32 = 240;
@@ -61,58 +63,32 @@ fn background_plane() -> Mat4 {
 /// Both eye images (sRGB RGBA8) of a 128 x 64 sphere mesh of the ball under `refraction`
 /// with `attenuation`, in front of a white photo.
 fn render(refraction: Refraction, attenuation: Attenuation) -> [Vec<u8>; 2] {
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
-    let (positions, normals, uvs, indices) = uv_sphere(128, 64);
+    let ctx = vitreous_tests::validated_context();
+    let sphere = uv_sphere(128, 64);
     let env = flat_environment(64, 32, 0.0);
     let white = grey_photo(64, 64, 255);
     let black = grey_photo(4, 4, 0);
     let scene = SceneDesc {
-        mesh: MeshRef {
-            positions: &positions,
-            normals: &normals,
-            uvs: &uvs,
-            indices: &indices,
-        },
-        world_from_model: vitreous_tests::place(CENTER, RADIUS),
         ior: IOR,
         refraction,
         attenuation,
-        environment: TextureDesc {
-            width: 64,
-            height: 32,
-            data: TexelData::LinearF32(&env),
-        },
-        floor: PlaneDesc {
-            world_from_plane: Mat4::from_translation(Vec3::new(0.0, -1.0, 0.0)),
-            photo: TextureDesc {
-                width: 4,
-                height: 4,
-                data: TexelData::Srgb8(&black),
-            },
-        },
-        background: PlaneDesc {
-            world_from_plane: background_plane(),
-            photo: TextureDesc {
-                width: 64,
-                height: 64,
-                data: TexelData::Srgb8(&white),
-            },
-        },
-        exposure: 1.0,
-        surface: None,
-        surface_transmittance: 1.0,
         light: LightDesc {
             position_m: Vec3::new(1.0, 1.0, 1.0),
             radiance: Vec3::ONE,
         },
-        background_stack: None,
-        surface_stack: None,
-        inducer: vitreous_render::InducerDesc::PAPER,
-        caustics: None,
+        ..scene_desc(
+            mesh_ref(&sphere),
+            vitreous_tests::place(CENTER, RADIUS),
+            linear(64, 32, &env),
+            PlaneDesc {
+                world_from_plane: Mat4::from_translation(Vec3::new(0.0, -1.0, 0.0)),
+                photo: srgb(4, 4, &black),
+            },
+            PlaneDesc {
+                world_from_plane: background_plane(),
+                photo: srgb(64, 64, &white),
+            },
+        )
     };
     let mut renderer = Renderer::new(ctx, &scene, W, H).expect("renderer");
     let params = FrameParams {

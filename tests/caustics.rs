@@ -13,9 +13,7 @@ use vitreous::scene::{CausticsMode, Image, PixelData, Scene, load_scene};
 use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::renderer::Want;
-use vitreous_render::{
-    ContextOptions, FrameParams, GpuContext, Readback, Reflection, Renderer, ScenePose,
-};
+use vitreous_render::{FrameParams, Readback, Reflection, Renderer, ScenePose};
 use vitreous_tests::{pixel_on_floor, render_once};
 
 fn workspace() -> PathBuf {
@@ -129,11 +127,7 @@ fn adds_inducer_and_caustic_gain(four_loads: bool) {
     let bake = spot_bake(n, centre, 0.8, &s.hash);
     s.caustics.gain = Some(bake.clone());
     let (w, h) = (320u32, 240u32);
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
+    let ctx = vitreous_tests::validated_context();
     if four_loads {
         ctx.pretend_r32_float_unfiltered();
     }
@@ -230,11 +224,7 @@ fn the_frame_that_computes_a_live_map_shows_it_as_the_next_frame_does() {
     s.caustics.mode = CausticsMode::Live;
     s.load_caustics().unwrap_or_else(|e| panic!("{e}"));
     let (w, h) = (160u32, 120u32);
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
+    let ctx = vitreous_tests::validated_context();
     let desc = views::scene_desc(&s, None);
     let mut r = Renderer::new(ctx, &desc, w, h).expect("renderer");
     views::enable_live_caustics(&mut r, &s, true).expect("live caustics");

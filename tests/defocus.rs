@@ -16,7 +16,7 @@ use vitreous::trace_cmd::synth_params_for;
 use vitreous::views;
 use vitreous_render::reference::{RefractionSample, refraction_sample};
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, Defocus, GpuContext, Look, Reflection, Renderer};
+use vitreous_render::{Defocus, Look, Reflection, Renderer};
 use vitreous_tests::render_once;
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
@@ -51,11 +51,7 @@ fn srgb_to_linear(b: u8) -> f32 {
 
 /// Renders one stereo frame of `scene` with `look`; returns the eye images.
 fn render(scene: &Scene, setup: &DefocusSetup, input: &FrameInput, look: Look) -> [Vec<u8>; 2] {
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .unwrap();
+    let ctx = vitreous_tests::validated_context();
     let mut renderer = Renderer::new(ctx, &views::scene_desc(scene, Some(setup)), W, H).unwrap();
     let want = Want {
         eyes: true,
@@ -267,11 +263,7 @@ fn sharpness_by_gaze(scene: &Scene) -> Vec<(GazeImage, f64)> {
         },
     )
     .unwrap();
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .unwrap();
+    let ctx = vitreous_tests::validated_context();
     let mut renderer = Renderer::new(ctx, &views::scene_desc(scene, Some(&setup)), W, H).unwrap();
     frame_loop::run(&mut backend, &mut renderer, &mut sink).unwrap();
     let v = renderer.context().validation();

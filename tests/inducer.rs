@@ -17,7 +17,7 @@ use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::floor::{self, InducerFields};
 use vitreous_render::renderer::Want;
-use vitreous_render::{ContextOptions, FrameParams, GpuContext, Look, Readback, Renderer};
+use vitreous_render::{FrameParams, Look, Readback, Renderer};
 use vitreous_tests::{pixel_on_floor, render_once};
 
 fn workspace() -> PathBuf {
@@ -38,11 +38,7 @@ fn sphere_scene(k: f32, d_m: f32) -> Scene {
 }
 
 fn renderer(scene: &Scene, width: u32, height: u32) -> Renderer {
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
+    let ctx = vitreous_tests::validated_context();
     Renderer::new(ctx, &views::scene_desc(scene, None), width, height).expect("renderer")
 }
 

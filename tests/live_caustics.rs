@@ -11,7 +11,7 @@ use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::floor::LiveCausticsDesc;
 use vitreous_render::renderer::Want;
-use vitreous_render::{ContextOptions, FrameParams, GpuContext, Look, Renderer, ScenePose};
+use vitreous_render::{FrameParams, Look, Renderer, ScenePose};
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -106,11 +106,7 @@ fn live_gains_at(
     poses: &[Option<ScenePose>],
     fields_first: bool,
 ) -> Vec<LiveFrame> {
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
+    let ctx = vitreous_tests::validated_context();
     let desc = views::scene_desc(scene, None);
     let mut renderer = Renderer::new(ctx, &desc, 32, 32).expect("renderer");
     renderer

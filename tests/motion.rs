@@ -14,7 +14,7 @@ use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::floor::InducerFields;
 use vitreous_render::renderer::Want;
-use vitreous_render::{ContextOptions, FrameParams, GpuContext, Look, Renderer};
+use vitreous_render::{FrameParams, Look, Renderer};
 use vitreous_tests::{lit_centroid, render_once};
 
 fn workspace() -> PathBuf {
@@ -27,11 +27,7 @@ fn scene(name: &str) -> Scene {
 }
 
 fn renderer(scene: &Scene, width: u32, height: u32) -> Renderer {
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
+    let ctx = vitreous_tests::validated_context();
     Renderer::new(ctx, &views::scene_desc(scene, None), width, height).expect("renderer")
 }
 

@@ -7,10 +7,9 @@ use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::reference::{SphereScene, marker_centroid};
 use vitreous_render::renderer::Want;
 use vitreous_render::{
-    ContextOptions, FrameParams, GpuContext, LightDesc, Look, MeshRef, PlaneDesc, Reflection,
-    Refraction, Renderer, SceneDesc, TexelData, TextureDesc,
+    FrameParams, LightDesc, Look, PlaneDesc, Reflection, Refraction, Renderer, SceneDesc,
 };
-use vitreous_tests::{render_once, uv_sphere};
+use vitreous_tests::{MeshData, linear, mesh_ref, render_once, scene_desc, srgb, uv_sphere};
 
 const W: u32 = 640;
 const H: u32 = 480;
@@ -97,9 +96,6 @@ fn environment(marker: bool) -> (u32, u32, Vec<f32>) {
 fn render(look: Look, surface_dot: bool, env_marker: bool) -> [Vec<u8>; 2] {
     render_with(look, surface_dot, env_marker, Refraction::Paper, eyes())
 }
-
-/// A mesh: positions, normals, uvs, indices.
-pub(crate) type MeshData = (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<u32>);
 
 /// A mesh and the radius of its model (the render scales it to the test's radius).
 pub(crate) type SphereMesh = (MeshData, f32);
@@ -224,12 +220,8 @@ pub(crate) fn render_shot(shot: &Shot, mesh: SphereMesh) -> [Vec<u8>; 2] {
         photo,
         photo_texels,
     } = shot;
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
-    let ((positions, normals, uvs, indices), model_radius) = mesh;
+    let ctx = vitreous_tests::validated_context();
+    let (mesh, model_radius) = mesh;
     let (ew, eh, env) = environment(env_marker);
     // A black surface texture with a white dot at uv (0.5, 0.5), opaque (transmittance 0).
     let dot = {
@@ -248,57 +240,32 @@ pub(crate) fn render_shot(shot: &Shot, mesh: SphereMesh) -> [Vec<u8>; 2] {
     };
     let floor_photo = marker_photo(4, 0, 0);
     let scene = SceneDesc {
-        mesh: MeshRef {
-            positions: &positions,
-            normals: &normals,
-            uvs: &uvs,
-            indices: &indices,
-        },
-        // Half a turn about y puts the texture's u = 0.5 towards the viewer.
-        world_from_model: Mat4::from_scale_rotation_translation(
-            Vec3::splat(RADIUS / model_radius),
-            Quat::from_rotation_y(std::f32::consts::PI),
-            CENTER,
-        ),
         ior,
         refraction,
-        attenuation: vitreous_render::Attenuation::NONE,
-        environment: TextureDesc {
-            width: ew,
-            height: eh,
-            data: TexelData::LinearF32(&env),
-        },
-        floor: PlaneDesc {
-            world_from_plane: Mat4::from_translation(Vec3::new(0.0, -1.0, 0.0)),
-            photo: TextureDesc {
-                width: 4,
-                height: 4,
-                data: TexelData::Srgb8(&floor_photo),
-            },
-        },
-        background: PlaneDesc {
-            world_from_plane: background_plane(),
-            photo: TextureDesc {
-                width: photo_texels,
-                height: photo_texels,
-                data: TexelData::Srgb8(photo),
-            },
-        },
-        exposure: 1.0,
-        surface: surface_dot.then_some(TextureDesc {
-            width: 256,
-            height: 128,
-            data: TexelData::Srgb8(&dot),
-        }),
+        surface: surface_dot.then_some(srgb(256, 128, &dot)),
         surface_transmittance: 0.0,
         light: LightDesc {
             position_m: Vec3::new(1.0, 1.0, 1.0),
             radiance: Vec3::ONE,
         },
-        background_stack: None,
-        surface_stack: None,
-        inducer: vitreous_render::InducerDesc::PAPER,
-        caustics: None,
+        ..scene_desc(
+            mesh_ref(&mesh),
+            // Half a turn about y puts the texture's u = 0.5 towards the viewer.
+            Mat4::from_scale_rotation_translation(
+                Vec3::splat(RADIUS / model_radius),
+                Quat::from_rotation_y(std::f32::consts::PI),
+                CENTER,
+            ),
+            linear(ew, eh, &env),
+            PlaneDesc {
+                world_from_plane: Mat4::from_translation(Vec3::new(0.0, -1.0, 0.0)),
+                photo: srgb(4, 4, &floor_photo),
+            },
+            PlaneDesc {
+                world_from_plane: background_plane(),
+                photo: srgb(photo_texels, photo_texels, photo),
+            },
+        )
     };
     let mut renderer = Renderer::new(ctx, &scene, size.0, size.1).expect("renderer");
     let params = FrameParams { eyes, look };

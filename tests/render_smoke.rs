@@ -5,63 +5,37 @@ use glam::{Quat, Vec2, Vec3};
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::renderer::Want;
 use vitreous_render::{
-    CausticsDesc, ContextOptions, FrameParams, GpuContext, LightDesc, Look, MeshRef, PlaneDesc,
-    RenderError, Renderer, SceneDesc, TexelData, TextureDesc,
+    CausticsDesc, FrameParams, Look, PlaneDesc, RenderError, Renderer, SceneDesc,
 };
-use vitreous_tests::{flat_environment, grey_photo, lit_centroid, place, uv_sphere};
+use vitreous_tests::{
+    flat_environment, grey_photo, linear, lit_centroid, mesh_ref, place, scene_desc, srgb,
+    uv_sphere,
+};
 
 #[test]
 fn sphere_centroid_matches_projection_in_both_eyes_with_validation_silent() {
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
-    let (positions, normals, uvs, indices) = uv_sphere(64, 32);
+    let ctx = vitreous_tests::validated_context();
+    let sphere = uv_sphere(64, 32);
     let env = flat_environment(64, 32, 0.8);
     let photo = grey_photo(8, 8, 128);
     let center = Vec3::new(0.01, -0.02, -0.45);
     let radius = 0.04;
-    let photo_desc = TextureDesc {
-        width: 8,
-        height: 8,
-        data: TexelData::Srgb8(&photo),
-    };
+    let photo_desc = srgb(8, 8, &photo);
     let scene = SceneDesc {
-        mesh: MeshRef {
-            positions: &positions,
-            normals: &normals,
-            uvs: &uvs,
-            indices: &indices,
-        },
-        world_from_model: place(center, radius),
         ior: 1.51,
-        refraction: vitreous_render::Refraction::Paper,
-        attenuation: vitreous_render::Attenuation::NONE,
-        environment: TextureDesc {
-            width: 64,
-            height: 32,
-            data: TexelData::LinearF32(&env),
-        },
-        floor: PlaneDesc {
-            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -0.5, -0.5)),
-            photo: photo_desc,
-        },
-        background: PlaneDesc {
-            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
-            photo: photo_desc,
-        },
-        exposure: 1.0,
-        surface: None,
-        surface_transmittance: 1.0,
-        light: LightDesc {
-            position_m: Vec3::new(0.0, 1.0, 0.0),
-            radiance: Vec3::ONE,
-        },
-        background_stack: None,
-        surface_stack: None,
-        inducer: vitreous_render::InducerDesc::PAPER,
-        caustics: None,
+        ..scene_desc(
+            mesh_ref(&sphere),
+            place(center, radius),
+            linear(64, 32, &env),
+            PlaneDesc {
+                world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -0.5, -0.5)),
+                photo: photo_desc,
+            },
+            PlaneDesc {
+                world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
+                photo: photo_desc,
+            },
+        )
     };
     let (w, h) = (320u32, 240u32);
     let mut renderer = Renderer::new(ctx, &scene, w, h).expect("renderer");
@@ -122,11 +96,7 @@ fn sphere_centroid_matches_projection_in_both_eyes_with_validation_silent() {
 /// The zero-message assertions above can fail: a deliberate misuse is counted.
 #[test]
 fn validation_messages_are_counted() {
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
+    let ctx = vitreous_tests::validated_context();
     assert_eq!(ctx.validation().errors(), 0);
     let info = ash::vk::BufferCreateInfo::default()
         .size(0)
@@ -151,48 +121,12 @@ fn validation_messages_are_counted() {
 /// silent; the attempt after the last step builds a working renderer.
 #[test]
 fn failed_construction_unwinds_without_leaks_at_every_step() {
-    let (positions, normals, uvs, indices) = uv_sphere(8, 4);
+    let sphere = uv_sphere(8, 4);
     let env = flat_environment(8, 4, 0.5);
     let photo = grey_photo(4, 4, 128);
     let gain = vec![0.5f32; 8 * 8];
-    let photo_desc = TextureDesc {
-        width: 4,
-        height: 4,
-        data: TexelData::Srgb8(&photo),
-    };
+    let photo_desc = srgb(4, 4, &photo);
     let scene = SceneDesc {
-        mesh: MeshRef {
-            positions: &positions,
-            normals: &normals,
-            uvs: &uvs,
-            indices: &indices,
-        },
-        world_from_model: place(Vec3::new(0.0, -0.2, -0.5), 0.05),
-        ior: 1.5,
-        refraction: vitreous_render::Refraction::Paper,
-        attenuation: vitreous_render::Attenuation::NONE,
-        environment: TextureDesc {
-            width: 8,
-            height: 4,
-            data: TexelData::LinearF32(&env),
-        },
-        floor: PlaneDesc {
-            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -0.5, -0.5)),
-            photo: photo_desc,
-        },
-        background: PlaneDesc {
-            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
-            photo: photo_desc,
-        },
-        exposure: 1.0,
-        surface: None,
-        surface_transmittance: 1.0,
-        light: LightDesc {
-            position_m: Vec3::new(0.0, 1.0, 0.0),
-            radiance: Vec3::ONE,
-        },
-        background_stack: None,
-        surface_stack: None,
         inducer: vitreous_render::InducerDesc {
             resolution_px: 32,
             ..vitreous_render::InducerDesc::PAPER
@@ -202,14 +136,23 @@ fn failed_construction_unwinds_without_leaks_at_every_step() {
             height: 8,
             gain: &gain,
         }),
+        ..scene_desc(
+            mesh_ref(&sphere),
+            place(Vec3::new(0.0, -0.2, -0.5), 0.05),
+            linear(8, 4, &env),
+            PlaneDesc {
+                world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -0.5, -0.5)),
+                photo: photo_desc,
+            },
+            PlaneDesc {
+                world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
+                photo: photo_desc,
+            },
+        )
     };
     let mut failed_steps = 0;
     for step in 0..200 {
-        let ctx = GpuContext::headless(&ContextOptions {
-            validation: true,
-            device_name: None,
-        })
-        .expect("Vulkan device with validation");
+        let ctx = vitreous_tests::validated_context();
         let log = ctx.validation_log();
         ctx.fail_allocation_after(step);
         let built = Renderer::new(ctx, &scene, 16, 12);
@@ -255,19 +198,11 @@ fn failed_construction_unwinds_without_leaks_at_every_step() {
 #[test]
 fn each_composition_draws_the_object_over_what_its_display_needs() {
     use vitreous_render::Composition;
-    let ctx = GpuContext::headless(&ContextOptions {
-        validation: true,
-        device_name: None,
-    })
-    .expect("Vulkan device with validation");
-    let (positions, normals, uvs, indices) = uv_sphere(32, 16);
+    let ctx = vitreous_tests::validated_context();
+    let sphere = uv_sphere(32, 16);
     let env = flat_environment(16, 8, 0.8);
     let photo = grey_photo(4, 4, 128);
-    let photo_desc = TextureDesc {
-        width: 4,
-        height: 4,
-        data: TexelData::Srgb8(&photo),
-    };
+    let photo_desc = srgb(4, 4, &photo);
     // The background photo plane fills the view far behind the object.
     let background = glam::Mat4::from_scale_rotation_translation(
         Vec3::new(10.0, 10.0, 1.0),
@@ -275,43 +210,23 @@ fn each_composition_draws_the_object_over_what_its_display_needs() {
         Vec3::new(0.0, 0.0, -2.0),
     );
     let scene = SceneDesc {
-        mesh: MeshRef {
-            positions: &positions,
-            normals: &normals,
-            uvs: &uvs,
-            indices: &indices,
-        },
-        world_from_model: place(Vec3::new(0.0, 0.0, -0.5), 0.05),
-        ior: 1.5,
-        refraction: vitreous_render::Refraction::Paper,
-        attenuation: vitreous_render::Attenuation::NONE,
-        environment: TextureDesc {
-            width: 16,
-            height: 8,
-            data: TexelData::LinearF32(&env),
-        },
-        floor: PlaneDesc {
-            world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -5.0, -0.5)),
-            photo: photo_desc,
-        },
-        background: PlaneDesc {
-            world_from_plane: background,
-            photo: photo_desc,
-        },
-        exposure: 1.0,
-        surface: None,
-        surface_transmittance: 1.0,
-        light: LightDesc {
-            position_m: Vec3::new(0.0, 1.0, 0.0),
-            radiance: Vec3::ONE,
-        },
-        background_stack: None,
-        surface_stack: None,
         inducer: vitreous_render::InducerDesc {
             resolution_px: 32,
             ..vitreous_render::InducerDesc::PAPER
         },
-        caustics: None,
+        ..scene_desc(
+            mesh_ref(&sphere),
+            place(Vec3::new(0.0, 0.0, -0.5), 0.05),
+            linear(16, 8, &env),
+            PlaneDesc {
+                world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -5.0, -0.5)),
+                photo: photo_desc,
+            },
+            PlaneDesc {
+                world_from_plane: background,
+                photo: photo_desc,
+            },
+        )
     };
     let (w, h) = (96u32, 72u32);
     let mut renderer = Renderer::new(ctx, &scene, w, h).expect("renderer");

@@ -3,7 +3,7 @@
 use glam::{Mat4, Vec2, Vec3};
 
 /// A UV sphere of unit radius: positions, normals, uvs, indices.
-pub fn uv_sphere(segments: u32, rings: u32) -> (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<u32>) {
+pub fn uv_sphere(segments: u32, rings: u32) -> MeshData {
     let mut positions = Vec::new();
     let mut uvs = Vec::new();
     for r in 0..=rings {
@@ -62,6 +62,82 @@ pub fn lit_centroid(rgba: &[u8], width: u32, threshold: u8) -> Option<(Vec2, usi
         }
     }
     (count > 0).then(|| ((sum / count as f64).as_vec2(), count))
+}
+
+/// The machine's Vulkan device with validation on (every test checks its messages).
+pub fn validated_context() -> vitreous_render::GpuContext {
+    vitreous_render::GpuContext::headless(&vitreous_render::ContextOptions {
+        validation: true,
+        device_name: None,
+    })
+    .expect("Vulkan device with validation")
+}
+
+/// Positions, normals, uvs and indices of a mesh, as [`uv_sphere`] makes them.
+pub type MeshData = (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<u32>);
+
+/// The renderer's view of `mesh`.
+pub fn mesh_ref(mesh: &MeshData) -> vitreous_render::MeshRef<'_> {
+    let (positions, normals, uvs, indices) = mesh;
+    vitreous_render::MeshRef {
+        positions,
+        normals,
+        uvs,
+        indices,
+    }
+}
+
+/// An sRGB RGBA8 texture of `width` x `height` texels.
+pub fn srgb(width: u32, height: u32, rgba: &[u8]) -> vitreous_render::TextureDesc<'_> {
+    vitreous_render::TextureDesc {
+        width,
+        height,
+        data: vitreous_render::TexelData::Srgb8(rgba),
+    }
+}
+
+/// A linear RGBA32F texture of `width` x `height` texels.
+pub fn linear(width: u32, height: u32, rgba: &[f32]) -> vitreous_render::TextureDesc<'_> {
+    vitreous_render::TextureDesc {
+        width,
+        height,
+        data: vitreous_render::TexelData::LinearF32(rgba),
+    }
+}
+
+/// A scene of `mesh` placed by `world_from_model` under `environment`, over the `floor` and
+/// `background` planes, with what the tests share: glass of index 1.5 refracted as the paper
+/// does, without absorption; exposure 1; no surface image or blur stacks; a white light 1 m
+/// above the origin; the paper's inducer; no caustics. Tests change the rest with
+/// `SceneDesc { field, ..scene_desc(..) }`.
+pub fn scene_desc<'a>(
+    mesh: vitreous_render::MeshRef<'a>,
+    world_from_model: Mat4,
+    environment: vitreous_render::TextureDesc<'a>,
+    floor: vitreous_render::PlaneDesc<'a>,
+    background: vitreous_render::PlaneDesc<'a>,
+) -> vitreous_render::SceneDesc<'a> {
+    vitreous_render::SceneDesc {
+        mesh,
+        world_from_model,
+        ior: 1.5,
+        refraction: vitreous_render::Refraction::Paper,
+        attenuation: vitreous_render::Attenuation::NONE,
+        environment,
+        floor,
+        background,
+        exposure: 1.0,
+        surface: None,
+        surface_transmittance: 1.0,
+        light: vitreous_render::LightDesc {
+            position_m: Vec3::new(0.0, 1.0, 0.0),
+            radiance: Vec3::ONE,
+        },
+        background_stack: None,
+        surface_stack: None,
+        inducer: vitreous_render::InducerDesc::PAPER,
+        caustics: None,
+    }
 }
 
 /// A model matrix placing a unit-radius mesh as a sphere of `radius_m` at `center_m`.

@@ -4,26 +4,15 @@
 //! caustics), G L_r for b (caustics only) and nothing for a; plus the shipped bakes' scene
 //! check and the errors for missing and foreign bakes.
 
-use std::path::{Path, PathBuf};
-
 use glam::{Quat, Vec2, Vec3};
 use vitreous::caustics::{Bake, BakeError};
 use vitreous::effects::EffectSet;
-use vitreous::scene::{CausticsMode, Image, PixelData, Scene, load_scene};
+use vitreous::scene::{CausticsMode, Image, PixelData, Scene};
 use vitreous::views;
-use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_render::camera::EyeParams;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Readback, Reflection, Renderer, ScenePose};
-use vitreous_tests::{pixel_on_floor, render_once};
-
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn scene(name: &str) -> Scene {
-    let path = workspace().join("config/scenes").join(name);
-    load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
-}
+use vitreous_tests::{eyes_looking_down, pixel_on_floor, render_once, shipped_scene};
 
 fn srgb_to_linear(v: u8) -> f32 {
     let c = f32::from(v) / 255.0;
@@ -56,14 +45,7 @@ fn shadow_centre(scene: &Scene) -> Vec3 {
 /// Two eyes 0.6 m above the shadow's middle looking straight down.
 fn top_down_eyes(scene: &Scene) -> [EyeParams; 2] {
     let above = shadow_centre(scene) + Vec3::Y * 0.6;
-    let fov = Fov {
-        left_rad: -0.4,
-        right_rad: 0.4,
-        up_rad: 0.3,
-        down_rad: -0.3,
-    };
-    let down = Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2);
-    [-0.0315f32, 0.0315].map(|x| EyeParams::new(above + Vec3::X * x, down, fov))
+    eyes_looking_down(above)
 }
 
 /// A caustic gain map at `n` x `n`: a Gaussian spot of peak `peak` and sigma 12 texels at
@@ -118,7 +100,7 @@ fn eye_image_adds_the_gains_with_g_from_four_loads() {
 /// that does not filter R32_SFLOAT.
 fn adds_inducer_and_caustic_gain(four_loads: bool) {
     const GREY: u8 = 120;
-    let mut s = scene("glass-sphere.toml");
+    let mut s = shipped_scene("glass-sphere.toml");
     s.floor.photo = Image::new(8, 8, PixelData::Srgb8([GREY, GREY, GREY, 255].repeat(64))).unwrap();
     let l_r = srgb_to_linear(GREY);
     // The spot straddles the shadow's edge towards the viewer (shadow, ramp and open floor).
@@ -220,7 +202,7 @@ fn the_frame_that_computes_a_live_map_shows_it_as_the_next_frame_does() {
     // the overlay takes the map's bounds from the buffer the computation wrote. Its eye image
     // must be the next frame's, drawn over the bounds the host has read back by then; also
     // after the light moved.
-    let mut s = scene("glass-sphere.toml");
+    let mut s = shipped_scene("glass-sphere.toml");
     s.caustics.mode = CausticsMode::Live;
     s.load_caustics().unwrap_or_else(|e| panic!("{e}"));
     let (w, h) = (160u32, 120u32);
@@ -265,7 +247,7 @@ fn the_frame_that_computes_a_live_map_shows_it_as_the_next_frame_does() {
 #[test]
 fn shipped_bakes_belong_to_their_scenes() {
     for name in ["glass-sphere.toml", "diamond.toml"] {
-        let mut s = scene(name);
+        let mut s = shipped_scene(name);
         s.load_caustics().unwrap_or_else(|e| panic!("{name}: {e}"));
         let bake = s.caustics.gain.as_ref().unwrap();
         let peak = bake.gain.iter().cloned().fold(0.0f32, f32::max);
@@ -279,7 +261,7 @@ fn shipped_bakes_belong_to_their_scenes() {
 
 #[test]
 fn missing_unnamed_and_foreign_bakes_are_named() {
-    let mut s = scene("glass-sphere.toml");
+    let mut s = shipped_scene("glass-sphere.toml");
     s.hash = "0000".into();
     let err = s.load_caustics().unwrap_err();
     assert!(matches!(err, BakeError::WrongScene { .. }), "{err}");
@@ -291,7 +273,7 @@ fn missing_unnamed_and_foreign_bakes_are_named() {
     assert!(matches!(err, BakeError::Missing { .. }), "{err}");
     assert!(err.to_string().contains("nowhere.exr"), "{err}");
 
-    let mut t = scene("torus.toml");
+    let mut t = shipped_scene("torus.toml");
     let err = t.load_caustics().unwrap_err();
     assert!(matches!(err, BakeError::NotNamed { .. }), "{err}");
     assert!(err.to_string().contains("torus.toml"), "{err}");

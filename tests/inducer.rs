@@ -8,48 +8,24 @@
 //! sphere resting on a 1 m floor, the paper's light 1 m above and 1 m beyond it; torus.toml)
 //! with the inducer parameters or the floor photo replaced where a test needs it.
 
-use std::path::{Path, PathBuf};
-
 use glam::{Quat, Vec2, Vec3};
 use vitreous::output::see_through;
-use vitreous::scene::{Image, PixelData, Scene, load_scene};
+use vitreous::scene::{Image, PixelData, Scene};
 use vitreous::views;
-use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_render::camera::EyeParams;
 use vitreous_render::floor::{self, InducerFields};
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Readback, Renderer};
-use vitreous_tests::{pixel_on_floor, render_once};
-
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn scene(name: &str) -> Scene {
-    let path = workspace().join("config/scenes").join(name);
-    load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
-}
+use vitreous_tests::{
+    assert_silent, eyes_looking_down, pixel_on_floor, render_once, scene_renderer, shipped_scene,
+};
 
 /// The glass-sphere scene with inducer parameters `k`, `d_m`.
 fn sphere_scene(k: f32, d_m: f32) -> Scene {
-    let mut s = scene("glass-sphere.toml");
+    let mut s = shipped_scene("glass-sphere.toml");
     s.inducer.k = k;
     s.inducer.ramp_width_m = d_m;
     s
-}
-
-fn renderer(scene: &Scene, width: u32, height: u32) -> Renderer {
-    let ctx = vitreous_tests::validated_context();
-    Renderer::new(ctx, &views::scene_desc(scene, None), width, height).expect("renderer")
-}
-
-fn assert_silent(renderer: &Renderer) {
-    let v = renderer.context().validation();
-    assert_eq!(
-        v.errors() + v.warnings(),
-        0,
-        "validation messages: {:#?}",
-        v.messages()
-    );
 }
 
 fn srgb_to_linear(v: u8) -> f32 {
@@ -211,11 +187,11 @@ fn distance_field_matches_exact_transform_within_one_texel() {
         ("torus.toml", None),
         ("glass-sphere.toml", Some(509)),
     ] {
-        let mut s = scene(name);
+        let mut s = shipped_scene(name);
         if let Some(side) = side {
             s.inducer.resolution_px = side;
         }
-        let mut r = renderer(&s, 64, 48);
+        let mut r = scene_renderer(&s, 64, 48);
         let fields = r.inducer_fields().unwrap();
         let shadow = fields.mask.iter().filter(|&&m| m == 1).count();
         assert!(shadow > 500, "{name}: only {shadow} shadow texels");
@@ -231,7 +207,7 @@ fn overlay_profile_leaving_the_shadow_follows_eq_2_to_4_for_each_k_and_d() {
     let mut gains = Vec::new();
     for (k, d_m) in [(0.3, 0.14), (0.15, 0.14), (0.3, 0.07), (0.6, 0.28)] {
         let s = sphere_scene(k, d_m);
-        let mut r = renderer(&s, 64, 48);
+        let mut r = scene_renderer(&s, 64, 48);
         let fields = r.inducer_fields().unwrap();
         check_gain_follows_distance(&fields, k, d_m);
         let (worst, profile) = check_profile(&s, &fields, k, d_m);
@@ -263,14 +239,7 @@ fn overlay_profile_leaving_the_shadow_follows_eq_2_to_4_for_each_k_and_d() {
 fn top_down_eyes(scene: &Scene) -> [EyeParams; 2] {
     let (_, far_z) = shadow_ends_z(scene);
     let above = Vec3::new(0.0, scene.floor.pose.position.y + 0.6, far_z + 0.09);
-    let fov = Fov {
-        left_rad: -0.4,
-        right_rad: 0.4,
-        up_rad: 0.3,
-        down_rad: -0.3,
-    };
-    let down = Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2);
-    [-0.0315f32, 0.0315].map(|x| EyeParams::new(above + Vec3::X * x, down, fov))
+    eyes_looking_down(above)
 }
 
 fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], inducer: bool, world: bool) -> Readback {
@@ -292,7 +261,7 @@ fn eye_image_adds_k_alpha_times_a_uniform_floor() {
     s.floor.photo = Image::new(8, 8, PixelData::Srgb8([GREY, GREY, GREY, 255].repeat(64))).unwrap();
     let l_r = srgb_to_linear(GREY);
     let (w, h) = (320u32, 240u32);
-    let mut r = renderer(&s, w, h);
+    let mut r = scene_renderer(&s, w, h);
     let eyes = top_down_eyes(&s);
     let off = render(&mut r, eyes, false, false);
     let on = render(&mut r, eyes, true, false);
@@ -335,9 +304,9 @@ fn eye_image_adds_k_alpha_times_a_uniform_floor() {
 
 #[test]
 fn glass_sphere_preview_shows_a_shadow_on_the_real_floor() {
-    let s = scene("glass-sphere.toml");
+    let s = shipped_scene("glass-sphere.toml");
     let (w, h) = (640u32, 480u32);
-    let mut r = renderer(&s, w, h);
+    let mut r = scene_renderer(&s, w, h);
     let head = s.viewer.head_position_m;
     let fov = views::render_fov(s.output.fov);
     let eyes = s
@@ -398,8 +367,8 @@ fn glass_sphere_preview_shows_a_shadow_on_the_real_floor() {
 /// edges meet and the whole patch is brightened (it never falls back to the plain floor).
 #[test]
 fn torus_hole_patch_is_brightened_everywhere() {
-    let s = scene("torus.toml");
-    let mut r = renderer(&s, 64, 48);
+    let s = shipped_scene("torus.toml");
+    let mut r = scene_renderer(&s, 64, 48);
     let f = r.inducer_fields().unwrap();
     let n = f.resolution_px as i32;
     // Lit texels reachable from the floor's border through lit texels: the open floor.

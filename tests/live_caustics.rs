@@ -2,7 +2,6 @@
 //! against the offline bake of the same scene at the same resolution, on the machine's
 //! Vulkan device with validation on.
 
-use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
@@ -12,14 +11,11 @@ use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::floor::LiveCausticsDesc;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Renderer, ScenePose};
+use vitreous_tests::{shipped_scene, workspace};
 
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn scene(name: &str) -> Scene {
-    let path = workspace().join("config/scenes").join(name);
-    let mut scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+/// The shipped scene `name` with its bake loaded.
+fn baked_scene(name: &str) -> Scene {
+    let mut scene = shipped_scene(name);
     scene.load_caustics().unwrap_or_else(|e| panic!("{e}"));
     scene
 }
@@ -29,7 +25,7 @@ fn scene(name: &str) -> Scene {
 /// covers, the same light over the same area (smoothed alike, within 0.5 % of the baker's map
 /// at 990 x 990 for the sphere and within 1 % for the diamond; docs/caustics.md).
 fn live_scene(name: &str, side: Option<u32>) -> (Scene, Vec<f32>) {
-    let baked = scene(name);
+    let baked = baked_scene(name);
     let bake = baked.caustics.gain.as_ref().expect("the bake is loaded");
     let mut live = baked.clone();
     live.caustics.mode = vitreous::scene::CausticsMode::Live;
@@ -625,7 +621,7 @@ fn block_mean(gain: &[f32], width: usize, f: usize) -> Vec<f32> {
 #[ignore]
 fn sweep() {
     for name in ["glass-sphere", "diamond"] {
-        let base = scene(&format!("{name}.toml"));
+        let base = baked_scene(&format!("{name}.toml"));
         let full = base.caustics.gain.as_ref().expect("the bake").width_px as usize;
         let mut own_bakes: Vec<(usize, Vec<f32>)> = Vec::new();
         for (factor, radius, photons) in [

@@ -4,8 +4,6 @@
 //! the shipped moving-light scene computes the fields once per frame that moved and never on
 //! frames that did not.
 
-use std::path::{Path, PathBuf};
-
 use glam::{DVec2, Quat, Vec2, Vec3};
 use vitreous::effects::EffectSet;
 use vitreous::replay::{ReplayOptions, replay};
@@ -15,31 +13,9 @@ use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::floor::InducerFields;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Renderer};
-use vitreous_tests::{lit_centroid, render_once};
-
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn scene(name: &str) -> Scene {
-    let path = workspace().join("config/scenes").join(name);
-    load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn renderer(scene: &Scene, width: u32, height: u32) -> Renderer {
-    let ctx = vitreous_tests::validated_context();
-    Renderer::new(ctx, &views::scene_desc(scene, None), width, height).expect("renderer")
-}
-
-fn assert_silent(renderer: &Renderer) {
-    let v = renderer.context().validation();
-    assert_eq!(
-        v.errors() + v.warnings(),
-        0,
-        "validation messages: {:#?}",
-        v.messages()
-    );
-}
+use vitreous_tests::{
+    assert_silent, lit_centroid, render_once, scene_renderer, shipped_scene, workspace,
+};
 
 /// Where a floor texel centre lies in the world.
 fn texel_world(scene: &Scene, n: u32, x: u32, y: u32) -> Vec3 {
@@ -74,10 +50,10 @@ fn shadowed(point: Vec3, light: Vec3, center: Vec3, radius: f32) -> bool {
 
 #[test]
 fn inducer_fields_follow_the_circling_light() {
-    let mut scene = scene("moving-light.toml");
+    let mut scene = shipped_scene("moving-light.toml");
     scene.inducer.resolution_px = 256;
     let n = scene.inducer.resolution_px;
-    let mut renderer = renderer(&scene, 32, 32);
+    let mut renderer = scene_renderer(&scene, 32, 32);
     let mut previous: Option<DVec2> = None;
     // Light beyond, to the left of, in front of and to the right of the sphere; then the
     // sphere itself moved 10 cm to the right under the last light.
@@ -195,12 +171,12 @@ fn fields_and_eyes(
 
 #[test]
 fn region_limited_fields_match_a_fresh_computation_as_the_object_crosses_the_floor() {
-    let mut scene = scene("glass-sphere.toml");
+    let mut scene = shipped_scene("glass-sphere.toml");
     scene.inducer.resolution_px = 256;
     scene.load_caustics().expect("the sphere's bake");
     let (k, d_m) = (scene.inducer.k, scene.inducer.ramp_width_m);
     let (w, h) = (96, 96);
-    let mut moving = renderer(&scene, w, h);
+    let mut moving = scene_renderer(&scene, w, h);
     let y = scene.object.center_m.y;
     let z = scene.floor.pose.position.z;
     // From the rest pose across the floor, to its right edge with the shadow leaving it at
@@ -215,7 +191,7 @@ fn region_limited_fields_match_a_fresh_computation_as_the_object_crosses_the_flo
     for (i, position) in positions.into_iter().enumerate() {
         let read_first = i % 2 == 1;
         let (fields, eyes) = fields_and_eyes(&scene, &mut moving, position, read_first);
-        let mut fresh = renderer(&scene, w, h);
+        let mut fresh = scene_renderer(&scene, w, h);
         let (full, full_eyes) = fields_and_eyes(&scene, &mut fresh, position, read_first);
         assert_silent(&fresh);
         let shadow = fields.mask.iter().filter(|&&m| m == 1).count();
@@ -237,9 +213,9 @@ fn region_limited_fields_match_a_fresh_computation_as_the_object_crosses_the_flo
 
 #[test]
 fn fields_are_clear_while_the_light_is_below_the_floor_and_come_back_after() {
-    let mut scene = scene("moving-light.toml");
+    let mut scene = shipped_scene("moving-light.toml");
     scene.inducer.resolution_px = 128;
-    let mut renderer = renderer(&scene, 32, 32);
+    let mut renderer = scene_renderer(&scene, 32, 32);
     let rest = scene.rest_placement();
     let lit = renderer.inducer_fields().expect("fields");
     assert!(
@@ -277,9 +253,9 @@ fn fields_are_clear_while_the_light_is_below_the_floor_and_come_back_after() {
 
 #[test]
 fn glass_follows_the_object_from_the_frame_its_pose_is_set() {
-    let scene = scene("rolling-diamond.toml");
+    let scene = shipped_scene("rolling-diamond.toml");
     let (w, h) = (128, 96);
-    let mut renderer = renderer(&scene, w, h);
+    let mut renderer = scene_renderer(&scene, w, h);
     let fov = Fov {
         left_rad: -0.2,
         right_rad: 0.2,

@@ -5,12 +5,28 @@ use glam::{Quat, Vec2, Vec3};
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::renderer::Want;
 use vitreous_render::{
-    CausticsDesc, FrameParams, Look, PlaneDesc, RenderError, Renderer, SceneDesc,
+    CausticsDesc, FrameParams, Look, PlaneDesc, RenderError, Renderer, SceneDesc, TextureDesc,
 };
 use vitreous_tests::{
     flat_environment, grey_photo, linear, lit_centroid, mesh_ref, place, scene_desc, srgb,
     uv_sphere,
 };
+
+/// A floor 0.5 m below and ahead of the eyes showing `photo`.
+fn floor(photo: TextureDesc<'_>) -> PlaneDesc<'_> {
+    PlaneDesc {
+        world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -0.5, -0.5)),
+        photo,
+    }
+}
+
+/// A wall 1 m ahead of the eyes showing `photo`.
+fn wall(photo: TextureDesc<'_>) -> PlaneDesc<'_> {
+    PlaneDesc {
+        world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
+        photo,
+    }
+}
 
 #[test]
 fn sphere_centroid_matches_projection_in_both_eyes_with_validation_silent() {
@@ -27,14 +43,8 @@ fn sphere_centroid_matches_projection_in_both_eyes_with_validation_silent() {
             mesh_ref(&sphere),
             place(center, radius),
             linear(64, 32, &env),
-            PlaneDesc {
-                world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -0.5, -0.5)),
-                photo: photo_desc,
-            },
-            PlaneDesc {
-                world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
-                photo: photo_desc,
-            },
+            floor(photo_desc),
+            wall(photo_desc),
         )
     };
     let (w, h) = (320u32, 240u32);
@@ -140,14 +150,8 @@ fn failed_construction_unwinds_without_leaks_at_every_step() {
             mesh_ref(&sphere),
             place(Vec3::new(0.0, -0.2, -0.5), 0.05),
             linear(8, 4, &env),
-            PlaneDesc {
-                world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, -0.5, -0.5)),
-                photo: photo_desc,
-            },
-            PlaneDesc {
-                world_from_plane: glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
-                photo: photo_desc,
-            },
+            floor(photo_desc),
+            wall(photo_desc),
         )
     };
     let mut failed_steps = 0;

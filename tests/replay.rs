@@ -1,20 +1,16 @@
 //! End to end on the machine's Vulkan device with validation on: shipped scenes and traces
 //! through the real frame loop, checked against a CPU projection of the object.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::Vec2;
 use vitreous::replay::{ReplayOptions, replay};
 use vitreous::scene::load_scene;
 use vitreous::views::eye_params;
-use vitreous_tests::lit_centroid;
+use vitreous_tests::{lit_centroid, workspace};
 use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::read_trace;
-
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOptions {
     ReplayOptions {

@@ -64,6 +64,51 @@ pub fn lit_centroid(rgba: &[u8], width: u32, threshold: u8) -> Option<(Vec2, usi
     (count > 0).then(|| ((sum / count as f64).as_vec2(), count))
 }
 
+/// The workspace's root folder.
+pub fn workspace() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The shipped scene `config/scenes/<name>`, loaded as `vitreous run` loads it (without its
+/// bake).
+pub fn shipped_scene(name: &str) -> vitreous::scene::Scene {
+    let path = workspace().join("config/scenes").join(name);
+    vitreous::scene::load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A renderer of `scene` with eye images of `width` x `height`, validation on.
+pub fn scene_renderer(
+    scene: &vitreous::scene::Scene,
+    width: u32,
+    height: u32,
+) -> vitreous_render::Renderer {
+    let desc = vitreous::views::scene_desc(scene, None);
+    vitreous_render::Renderer::new(validated_context(), &desc, width, height).expect("renderer")
+}
+
+/// Fails unless validation has been silent for `renderer`'s device.
+pub fn assert_silent(renderer: &vitreous_render::Renderer) {
+    let v = renderer.context().validation();
+    assert_eq!(
+        v.errors() + v.warnings(),
+        0,
+        "validation messages: {:#?}",
+        v.messages()
+    );
+}
+
+/// Two eyes 63 mm apart around `above`, looking straight down (0.8 x 0.6 rad field of view).
+pub fn eyes_looking_down(above: Vec3) -> [vitreous_render::EyeParams; 2] {
+    let fov = vitreous_render::camera::Fov {
+        left_rad: -0.4,
+        right_rad: 0.4,
+        up_rad: 0.3,
+        down_rad: -0.3,
+    };
+    let down = glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2);
+    [-0.0315f32, 0.0315].map(|x| vitreous_render::EyeParams::new(above + Vec3::X * x, down, fov))
+}
+
 /// The machine's Vulkan device with validation on (every test checks its messages).
 pub fn validated_context() -> vitreous_render::GpuContext {
     vitreous_render::GpuContext::headless(&vitreous_render::ContextOptions {

@@ -1,6 +1,8 @@
 //! Command-line values: each parser takes the text after an option and returns the value or a
 //! message saying what was expected and what was found (clap names the option).
 
+use vitreous_render::Reflection;
+
 use crate::effects::EffectSet;
 
 /// `WIDTHxHEIGHT` (`1280x960`) in whole pixels.
@@ -50,6 +52,24 @@ pub fn parse_gaze(s: &str) -> Result<vitreous_xr::openxr::GazeChoice, String> {
 /// An effect set or condition (`O4`, `c`, `disparity,defocus`).
 pub fn parse_effects(s: &str) -> Result<EffectSet, String> {
     EffectSet::parse(s).map_err(|e| e.to_string())
+}
+
+/// How the reflected image is drawn.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum ReflectionArg {
+    /// Phong highlight of the scene's point light.
+    Phong,
+    /// Environment map in the mirror direction, weighted by the Fresnel term.
+    Environment,
+}
+
+impl From<ReflectionArg> for Reflection {
+    fn from(r: ReflectionArg) -> Reflection {
+        match r {
+            ReflectionArg::Phong => Reflection::Phong,
+            ReflectionArg::Environment => Reflection::EnvironmentFresnel,
+        }
+    }
 }
 
 #[cfg(test)]

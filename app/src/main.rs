@@ -1,24 +1,23 @@
-//! The `vitreous` command: the clap definitions of every subcommand and their dispatch to the
-//! library. It passes 600 lines because each option's doc comment is its `--help` text; the
-//! work itself is in the library, one module per command.
+//! The `vitreous` command: the clap definitions of the subcommands and their dispatch to the
+//! library. `run`, `view`, `replay` and `study` define their options beside their code
+//! (`run::RunArgs`, `view::ViewArgs`, `replay::ReplayArgs`, `study::cli`); the work itself is
+//! in the library, one module per command.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
 use vitreous::bench::{BenchOptions, bench};
 use vitreous::cli_values::{
-    parse_blend, parse_effects, parse_frame_count, parse_frame_count_usize, parse_gaze, parse_size,
+    ReflectionArg, parse_effects, parse_frame_count, parse_frame_count_usize, parse_size,
 };
 use vitreous::effects::EffectSet;
 use vitreous::error_report::error_text;
-use vitreous::gaze::{FilterKind, GazeOverride, PupilSource};
+use vitreous::gaze::FilterKind;
 use vitreous::output::ensure_not_input;
-use vitreous::replay::{GazeSettings, ReplayOptions, replay};
 use vitreous::trace_analyze::{analyze_trace_file, plot_trace_file};
 use vitreous::trace_cmd::{self, SynthOptions};
-use vitreous_render::Reflection;
 
 /// Perception-based virtual glass for optical see-through headsets.
 #[derive(Parser, Debug)]
@@ -35,136 +34,13 @@ struct Cli {
 enum Command {
     /// Run a scene on a live OpenXR runtime (a headset, or Monado): Vulkan through
     /// XR_KHR_vulkan_enable2, additive blend when offered, gaze from the headset or a trace.
-    Run {
-        /// Scene file (TOML).
-        scene: PathBuf,
-        /// End the session after N frames (default: until the runtime or Ctrl-C ends it).
-        #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_frame_count)]
-        frames: Option<u64>,
-        /// Replay gaze from this trace when the headset has no per-eye eye tracker (with
-        /// XR_EXT_eye_gaze_interaction's combined ray alone, it decides the gaze image).
-        #[arg(long, value_name = "FILE")]
-        gaze_trace: Option<PathBuf>,
-        /// Gaze source: auto (XR_ML_eye_tracker, then XR_FB_eye_tracking_social, then
-        /// XR_EXT_eye_gaze_interaction, then the trace, then manual), or one of ml, fb, ext,
-        /// trace, manual (an error when it is not offered).
-        #[arg(long, value_name = "SOURCE", value_parser = parse_gaze, default_value = "auto")]
-        gaze: vitreous_xr::openxr::GazeChoice,
-        /// Record head pose and gaze of every frame into this trace file.
-        #[arg(long, value_name = "FILE")]
-        record: Option<PathBuf>,
-        /// Turn on the Vulkan validation layers and the OpenXR core validation layer; any
-        /// Vulkan message fails the run.
-        #[arg(long)]
-        validate: bool,
-        /// Read back a submitted swapchain image and fail unless the object is in it.
-        #[arg(long)]
-        readback_check: bool,
-        /// Blend mode instead of the automatic choice: additive, alpha-blend, opaque.
-        #[arg(long, value_parser = parse_blend)]
-        blend: Option<vitreous_xr::openxr::Blend>,
-        /// Eye image size instead of the runtime's recommended one, e.g. 640x480.
-        #[arg(long, value_name = "WxH", value_parser = parse_size)]
-        size: Option<(u32, u32)>,
-        /// Effects, overriding the scene's (as for replay).
-        #[arg(long, value_name = "LIST", value_parser = parse_effects)]
-        effects: Option<EffectSet>,
-        /// Fixation-depth filter overriding the scene's `[gaze] filter` (as for replay).
-        #[arg(long, value_name = "FILTER")]
-        filter: Option<FilterKind>,
-        /// Where A_p (eq. 13) comes from, overriding the scene's `[gaze] pupil`: paper (the
-        /// fixed diameter) or measured (the eye tracker's, smoothed).
-        #[arg(long = "pupil", value_name = "SOURCE")]
-        pupil_source: Option<PupilSource>,
-        /// Folder for summary.json (default: none written).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Read the live controls (`object x 10`, `turn -1`, `place`, `light y 10`,
-        /// `register z -1`, one a line) from standard input also when it is not a terminal (a
-        /// pipe or fifo); in a terminal they are always read.
-        #[arg(long)]
-        stdin_controls: bool,
-    },
+    Run(vitreous::run::RunArgs),
     /// Look around a scene in a desktop window: the frame loop and renderer of `run` with
     /// head and gaze from the mouse and keys (docs/view.md; F1 lists the keys).
     View(vitreous::view::ViewArgs),
     /// Replay a head/eye trace through the frame loop on a Vulkan device and write per-eye
     /// images, see-through previews and summary.json.
-    Replay {
-        /// Scene file (TOML).
-        scene: PathBuf,
-        /// Trace to replay (vitreous trace format v1); default: a synthetic trace for the scene.
-        #[arg(long)]
-        trace: Option<PathBuf>,
-        /// Output folder; default out/<scene name>.
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Stop after N frames.
-        #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_frame_count)]
-        frames: Option<u64>,
-        /// Save every K-th frame (0: none).
-        #[arg(
-            long,
-            value_name = "K",
-            default_value_t = 30,
-            allow_negative_numbers = true
-        )]
-        save_every: u64,
-        /// Eye image size overriding the scene's, e.g. 640x480.
-        #[arg(long, value_name = "WxH", value_parser = parse_size)]
-        size: Option<(u32, u32)>,
-        /// Turn on the Vulkan validation layers (with synchronisation validation); any message
-        /// fails the run.
-        #[arg(long)]
-        validate: bool,
-        /// Effects, overriding the scene's: none, disparity, defocus, inducer, caustics, all,
-        /// or a condition (O2..O5, a, b, c); comma-separated.
-        #[arg(long, value_name = "LIST", value_parser = parse_effects)]
-        effects: Option<EffectSet>,
-        /// Use the Vulkan device whose name contains this.
-        #[arg(long)]
-        device: Option<String>,
-        /// Display frame rate of the replay, hertz.
-        #[arg(
-            long,
-            value_name = "HZ",
-            default_value_t = 60.0,
-            allow_negative_numbers = true
-        )]
-        rate: f64,
-        /// One frame per trace sample, at the sample's time, instead of --rate: how
-        /// `vitreous run` rendered the trace it recorded, so the two compare frame by frame.
-        #[arg(long, conflicts_with = "rate")]
-        at_samples: bool,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-        /// Reflected image with per-eye refraction: a Phong highlight of the scene's light
-        /// (the paper's choice) or the environment map with a Fresnel term.
-        #[arg(long, value_enum, default_value_t = ReflectionArg::Phong)]
-        reflection: ReflectionArg,
-        /// Also write each saved eye image under the paper's and under two-surface refraction
-        /// beside the CPU ray-traced two-surface refraction layer (for sphere scenes: the
-        /// object's bounding sphere is traced).
-        #[arg(long)]
-        reference: bool,
-        /// Gaze image: auto (from the wearer's fixation depth), or forced to surface or
-        /// refracted, as the paper's experimenter did; default: the scene's `[gaze] image`.
-        #[arg(long, value_name = "IMAGE")]
-        gaze_image: Option<GazeOverride>,
-        /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, fixation (the gaze image
-        /// decided per fixation), ...; default: the scene's `[gaze] filter` (fixation if it
-        /// names none).
-        #[arg(long, value_name = "FILTER")]
-        filter: Option<FilterKind>,
-        /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
-        #[arg(long = "pupil-mm", value_name = "MM", allow_negative_numbers = true)]
-        pupil_mm: Option<f32>,
-        /// Where A_p (eq. 13) comes from, overriding the scene's `[gaze] pupil`: paper (the
-        /// fixed diameter) or measured (the trace's pupil diameters, smoothed).
-        #[arg(long = "pupil", value_name = "SOURCE")]
-        pupil_source: Option<PupilSource>,
-    },
+    Replay(vitreous::replay::ReplayArgs),
     /// Compare the frame time of the baseline and of effect sets, alternated frame by frame
     /// in one process on one device; prints medians, spreads and ratios to the baseline.
     Bench {
@@ -331,130 +207,11 @@ enum TraceCommand {
     },
 }
 
-/// How the reflected image is drawn.
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-enum ReflectionArg {
-    /// Phong highlight of the scene's point light.
-    Phong,
-    /// Environment map in the mirror direction, weighted by the Fresnel term.
-    Environment,
-}
-
-impl From<ReflectionArg> for Reflection {
-    fn from(r: ReflectionArg) -> Reflection {
-        match r {
-            ReflectionArg::Phong => Reflection::Phong,
-            ReflectionArg::Environment => Reflection::EnvironmentFresnel,
-        }
-    }
-}
-
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Run {
-            scene,
-            frames,
-            gaze_trace,
-            gaze,
-            record,
-            validate,
-            readback_check,
-            blend,
-            size,
-            effects,
-            filter,
-            pupil_source,
-            out,
-            stdin_controls,
-        } => {
-            if let Some(record) = &record {
-                let mut inputs = vec![scene.as_path()];
-                inputs.extend(gaze_trace.as_deref());
-                ensure_not_input(record, "--record", &inputs)?;
-            }
-            let s = vitreous::run::run(&vitreous::run::RunOptions {
-                scene,
-                frames,
-                gaze_trace,
-                gaze,
-                record,
-                validate,
-                readback_check,
-                blend,
-                size,
-                effects,
-                filter,
-                pupil_source,
-                out,
-                stdin_controls,
-                ..Default::default()
-            })?;
-            print!("{}", s.report());
-            Ok(())
-        }
+        Command::Run(args) => vitreous::run::run_command(args),
         Command::View(args) => vitreous::view::run(args),
-        Command::Replay {
-            scene,
-            trace,
-            out,
-            frames,
-            save_every,
-            size,
-            validate,
-            effects,
-            device,
-            rate,
-            at_samples,
-            quiet,
-            reflection,
-            reference,
-            gaze_image,
-            filter,
-            pupil_mm,
-            pupil_source,
-        } => {
-            let out = match out {
-                Some(out) => out,
-                None => {
-                    let stem = scene
-                        .file_stem()
-                        .context("the scene path has no file name")?;
-                    PathBuf::from("out").join(stem)
-                }
-            };
-            if let Some((w, h)) = size {
-                vitreous::replay::check_size(w, h)?;
-            }
-            let summary = replay(&ReplayOptions {
-                scene,
-                trace,
-                out: out.clone(),
-                frames,
-                save_every,
-                size,
-                validate,
-                effects,
-                device,
-                frame_rate_hz: rate,
-                at_samples,
-                progress: !quiet,
-                reflection: reflection.into(),
-                reference,
-                gaze: GazeSettings {
-                    filter,
-                    image: gaze_image,
-                    pupil_mm,
-                    pupil_source,
-                },
-            })?;
-            println!("{}", summary.summary_line());
-            println!(
-                "wrote {} images and summary.json to {}",
-                summary.saved.len(),
-                out.display()
-            );
-            Ok(())
-        }
+        Command::Replay(args) => vitreous::replay::replay_command(args),
         Command::Bench {
             scene,
             effects,

@@ -31,7 +31,10 @@ use crate::views;
 use summary::UnfinishedSummary;
 pub use summary::{ReplaySummary, RunStatus, ValidationSummary};
 
+mod cli;
 mod summary;
+
+pub use cli::{ReplayArgs, replay_command};
 
 /// Options of a replay.
 #[derive(Clone, Debug)]

@@ -21,6 +21,7 @@
 //! replay check), `summary.rs` (what the run reports); this file sets the session up, runs it
 //! and writes the summary.
 
+mod cli;
 mod controls;
 mod device;
 mod live;
@@ -43,6 +44,7 @@ use vitreous_xr::openxr::{
 };
 use vitreous_xr::trace::TraceWriter;
 
+pub use cli::{RunArgs, run_command};
 pub use device::XrDeviceCreator;
 pub use live::{CONDITION_CYCLE, GAZE_IMAGE_CYCLE, LiveLooks, STUDY_CONDITIONS, live_conditions};
 pub use readback::{

@@ -1,0 +1,135 @@
+//! The command line of `vitreous replay`.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+
+use super::{GazeSettings, ReplayOptions, check_size, replay};
+use crate::cli_values::{ReflectionArg, parse_effects, parse_frame_count, parse_size};
+use crate::effects::EffectSet;
+use crate::gaze::{FilterKind, GazeOverride, PupilSource};
+
+/// Options of `vitreous replay` (docs/cli.md).
+#[derive(clap::Args, Debug)]
+pub struct ReplayArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Trace to replay (vitreous trace format v1); default: a synthetic trace for the scene.
+    #[arg(long)]
+    pub trace: Option<PathBuf>,
+    /// Output folder; default out/<scene name>.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Stop after N frames.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_frame_count)]
+    pub frames: Option<u64>,
+    /// Save every K-th frame (0: none).
+    #[arg(
+        long,
+        value_name = "K",
+        default_value_t = 30,
+        allow_negative_numbers = true
+    )]
+    pub save_every: u64,
+    /// Eye image size overriding the scene's, e.g. 640x480.
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Turn on the Vulkan validation layers (with synchronisation validation); any message
+    /// fails the run.
+    #[arg(long)]
+    pub validate: bool,
+    /// Effects, overriding the scene's: none, disparity, defocus, inducer, caustics, all,
+    /// or a condition (O2..O5, a, b, c); comma-separated.
+    #[arg(long, value_name = "LIST", value_parser = parse_effects)]
+    pub effects: Option<EffectSet>,
+    /// Use the Vulkan device whose name contains this.
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Display frame rate of the replay, hertz.
+    #[arg(
+        long,
+        value_name = "HZ",
+        default_value_t = 60.0,
+        allow_negative_numbers = true
+    )]
+    pub rate: f64,
+    /// One frame per trace sample, at the sample's time, instead of --rate: how
+    /// `vitreous run` rendered the trace it recorded, so the two compare frame by frame.
+    #[arg(long, conflicts_with = "rate")]
+    pub at_samples: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Reflected image with per-eye refraction: a Phong highlight of the scene's light
+    /// (the paper's choice) or the environment map with a Fresnel term.
+    #[arg(long, value_enum, default_value_t = ReflectionArg::Phong)]
+    pub reflection: ReflectionArg,
+    /// Also write each saved eye image under the paper's and under two-surface refraction
+    /// beside the CPU ray-traced two-surface refraction layer (for sphere scenes: the
+    /// object's bounding sphere is traced).
+    #[arg(long)]
+    pub reference: bool,
+    /// Gaze image: auto (from the wearer's fixation depth), or forced to surface or
+    /// refracted, as the paper's experimenter did; default: the scene's `[gaze] image`.
+    #[arg(long, value_name = "IMAGE")]
+    pub gaze_image: Option<GazeOverride>,
+    /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, fixation (the gaze image
+    /// decided per fixation), ...; default: the scene's `[gaze] filter` (fixation if it
+    /// names none).
+    #[arg(long, value_name = "FILTER")]
+    pub filter: Option<FilterKind>,
+    /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
+    #[arg(long = "pupil-mm", value_name = "MM", allow_negative_numbers = true)]
+    pub pupil_mm: Option<f32>,
+    /// Where A_p (eq. 13) comes from, overriding the scene's `[gaze] pupil`: paper (the
+    /// fixed diameter) or measured (the trace's pupil diameters, smoothed).
+    #[arg(long = "pupil", value_name = "SOURCE")]
+    pub pupil_source: Option<PupilSource>,
+}
+
+/// Replays what `args` describe and prints where the output went (default
+/// `out/<scene name>`).
+pub fn replay_command(a: ReplayArgs) -> Result<()> {
+    let out = match a.out {
+        Some(out) => out,
+        None => {
+            let stem = a
+                .scene
+                .file_stem()
+                .context("the scene path has no file name")?;
+            PathBuf::from("out").join(stem)
+        }
+    };
+    if let Some((w, h)) = a.size {
+        check_size(w, h)?;
+    }
+    let summary = replay(&ReplayOptions {
+        scene: a.scene,
+        trace: a.trace,
+        out: out.clone(),
+        frames: a.frames,
+        save_every: a.save_every,
+        size: a.size,
+        validate: a.validate,
+        effects: a.effects,
+        device: a.device,
+        frame_rate_hz: a.rate,
+        at_samples: a.at_samples,
+        progress: !a.quiet,
+        reflection: a.reflection.into(),
+        reference: a.reference,
+        gaze: GazeSettings {
+            filter: a.filter,
+            image: a.gaze_image,
+            pupil_mm: a.pupil_mm,
+            pupil_source: a.pupil_source,
+        },
+    })?;
+    println!("{}", summary.summary_line());
+    println!(
+        "wrote {} images and summary.json to {}",
+        summary.saved.len(),
+        out.display()
+    );
+    Ok(())
+}

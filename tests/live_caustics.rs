@@ -633,6 +633,8 @@ fn sweep() {
             (4, 2, 128),
             (2, 2, 96),
             (2, 2, 64),
+            (3, 2, 96),
+            (4, 1, 96),
         ] {
             let side = full / factor;
             let (live_scene, averaged) = live_scene(&format!("{name}.toml"), Some(side as u32));

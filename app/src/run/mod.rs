@@ -16,10 +16,11 @@
 //! by [`LiveLooks`]: the next effect condition among those this build implements, and the
 //! forced gaze image (surface, refracted, auto).
 //!
-//! Parts: `device.rs` (Vulkan through the runtime), `live.rs` (conditions and live
-//! commands), `readback.rs` (the readback check), `recording.rs` (the recorded trace and its
-//! replay check), `summary.rs` (what the run reports); this file sets the session up, runs it
-//! and writes the summary.
+//! Parts: `cli.rs` (the command line), `device.rs` (Vulkan through the runtime), `live.rs`
+//! (conditions and live commands), `readback.rs` (the readback check), `recording.rs` (the
+//! recorded trace and its replay check), `summary.rs` (what the run reports), `test_frame.rs`
+//! (a frame for the crate's tests); this file sets the session up, runs it and writes the
+//! summary.
 
 mod cli;
 mod controls;
@@ -28,6 +29,8 @@ mod live;
 mod readback;
 mod recording;
 mod summary;
+#[cfg(test)]
+mod test_frame;
 
 use std::fs;
 use std::path::PathBuf;
@@ -52,6 +55,8 @@ pub use readback::{
 };
 pub use recording::ReplayCheck;
 pub use summary::{GazeSamples, RunSummary};
+#[cfg(test)]
+pub(crate) use test_frame::test_frame;
 
 use crate::effects::EffectSet;
 use crate::frame_log::FrameLog;
@@ -563,23 +568,6 @@ fn first_error<T>(result: Result<T>, cleanup: Result<()>) -> Result<T> {
             tracing::warn!("after the failure, also: {later:#}");
             Err(e)
         }
-    }
-}
-
-/// A frame at time 5 ns with identity poses and no gaze, for the tests of this module's parts.
-#[cfg(test)]
-pub(crate) fn test_frame() -> FrameInput {
-    use vitreous_xr::{EyeView, Fov, Pose};
-    let view = EyeView {
-        pose: Pose::IDENTITY,
-        fov: Fov::symmetric(1.0, 1.0),
-    };
-    FrameInput {
-        index: 0,
-        time_ns: 5,
-        head: Pose::IDENTITY,
-        views: [view, view],
-        gaze: None,
     }
 }
 

@@ -8,6 +8,8 @@ use std::path::{Path, PathBuf};
 use exr::prelude::*;
 use thiserror::Error;
 
+use crate::scene::{DiskFiles, SceneFiles};
+
 /// Name of the header attribute holding the scene hash.
 pub const SCENE_HASH_ATTRIBUTE: &str = "vitreous_scene_hash";
 /// Name of the header attribute holding the bake parameters (`key=value; ...`).
@@ -209,14 +211,55 @@ pub fn read_bake_unchecked(path: &Path) -> std::result::Result<Bake, BakeError> 
         path: path.to_path_buf(),
         reason,
     };
+    let bytes = DiskFiles
+        .read_bounded(path, MAX_BAKE_BYTES, "the largest bake is smaller")
+        .map_err(|source| match source.kind() {
+            std::io::ErrorKind::InvalidData => corrupt(source.to_string()),
+            _ => BakeError::Io {
+                path: path.to_path_buf(),
+                source,
+            },
+        })?;
+    decode_bake(&bytes).map_err(corrupt)
+}
+
+/// The largest side of a bake, texels: what the baker makes and the reader accepts.
+pub const MAX_BAKE_SIDE_PX: u32 = 16384;
+
+/// The largest bake file read, bytes: the largest map's f32 gains uncompressed, and room for
+/// its header and chunk table.
+pub const MAX_BAKE_BYTES: u64 = (MAX_BAKE_SIDE_PX as u64).pow(2) * 4 + (16 << 20);
+
+/// Decodes a bake from the bytes of its EXR file; `Err` says what is wrong with them. Each
+/// layer's size is checked (1..=[`MAX_BAKE_SIDE_PX`] texels per side) before any samples are
+/// read, and a panic of the EXR decoder on hostile input becomes an error.
+pub fn decode_bake(bytes: &[u8]) -> std::result::Result<Bake, String> {
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        .map_err(|e| format!("bad OpenEXR header: {e}"))?;
+    for header in &meta.headers {
+        let (w, h) = (header.layer_size.width(), header.layer_size.height());
+        let side = 1..=MAX_BAKE_SIDE_PX as usize;
+        if !side.contains(&w) || !side.contains(&h) {
+            return Err(format!(
+                "its layer is {w} x {h} texels; a bake has 1..={MAX_BAKE_SIDE_PX} per side"
+            ));
+        }
+    }
+    std::panic::catch_unwind(|| decode_checked(bytes)).unwrap_or_else(|_| {
+        Err("the OpenEXR decoder failed on this file (internal panic)".to_owned())
+    })
+}
+
+/// [`decode_bake`] once the header's sizes are known to be within the limits.
+fn decode_checked(bytes: &[u8]) -> std::result::Result<Bake, String> {
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .first_valid_layer()
         .all_attributes()
-        .from_file(path)
-        .map_err(|e| corrupt(e.to_string()))?;
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| e.to_string())?;
     let attr_text = |map: &std::collections::HashMap<Text, AttributeValue>, name: &str| {
         map.iter().find_map(|(k, v)| match v {
             AttributeValue::Text(t) if k.eq(name) => Some(t.to_string()),
@@ -226,7 +269,7 @@ pub fn read_bake_unchecked(path: &Path) -> std::result::Result<Bake, BakeError> 
     let layer = &image.layer_data;
     let scene_hash = attr_text(&image.attributes.other, SCENE_HASH_ATTRIBUTE)
         .or_else(|| attr_text(&layer.attributes.other, SCENE_HASH_ATTRIBUTE))
-        .ok_or_else(|| corrupt(format!("it has no `{SCENE_HASH_ATTRIBUTE}` attribute")))?;
+        .ok_or_else(|| format!("it has no `{SCENE_HASH_ATTRIBUTE}` attribute"))?;
     let params = attr_text(&layer.attributes.other, PARAMS_ATTRIBUTE)
         .or_else(|| attr_text(&image.attributes.other, PARAMS_ATTRIBUTE))
         .unwrap_or_default();
@@ -235,23 +278,20 @@ pub fn read_bake_unchecked(path: &Path) -> std::result::Result<Bake, BakeError> 
         .list
         .iter()
         .find(|c| c.name.to_string() == GAIN_CHANNEL)
-        .ok_or_else(|| corrupt(format!("it has no `{GAIN_CHANNEL}` channel")))?;
+        .ok_or_else(|| format!("it has no `{GAIN_CHANNEL}` channel"))?;
     let gain: Vec<f32> = match &channel.sample_data {
         FlatSamples::F32(v) => v.clone(),
         FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
-        FlatSamples::U32(_) => return Err(corrupt("the gain channel holds integers".into())),
+        FlatSamples::U32(_) => return Err("the gain channel holds integers".into()),
     };
     let (w, h) = (layer.size.width(), layer.size.height());
     if gain.len() != w * h || w == 0 || h == 0 {
-        return Err(corrupt(format!(
-            "{} samples for {w} x {h} texels",
-            gain.len()
-        )));
+        return Err(format!("{} samples for {w} x {h} texels", gain.len()));
     }
     if let Some(bad) = gain.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
-        return Err(corrupt(format!(
+        return Err(format!(
             "it holds a gain of {bad}; gains are finite and >= 0"
-        )));
+        ));
     }
     Ok(Bake {
         width_px: w as u32,
@@ -303,5 +343,48 @@ mod tests {
         let err = read_bake(&path, "other").unwrap_err();
         assert!(matches!(err, BakeError::WrongScene { .. }), "{err}");
         assert!(err.to_string().contains("abc123") && err.to_string().contains("other"));
+    }
+
+    /// A header claiming an absurd layer is refused before any sample is read, and so is a
+    /// file larger than the largest bake, without reading it.
+    #[test]
+    fn absurd_sizes_are_refused_before_reading() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("b.exr");
+        write_bake(&path, &sample()).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        let key = b"dataWindow\0box2i\0";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+        for (max_x, max_y, refused_for_size) in
+            [(99_999, 2, true), (4, 16_384, true), (-1, 2, false)]
+        {
+            let mut patched = bytes.clone();
+            let window = [0i32, 0, max_x, max_y].map(i32::to_le_bytes).concat();
+            patched[at..at + 16].copy_from_slice(&window);
+            let err = decode_bake(&patched).unwrap_err();
+            let size = format!(
+                "{} x {} texels; a bake has 1..=16384 per side",
+                max_x + 1,
+                max_y + 1
+            );
+            assert!(
+                !refused_for_size || err.contains(&size),
+                "{max_x} {max_y}: {err}"
+            );
+            std::fs::write(&path, &patched).unwrap();
+            let err = read_bake(&path, "abc123").unwrap_err();
+            assert!(matches!(err, BakeError::Corrupt { .. }), "{err}");
+        }
+        bytes.truncate(bytes.len() - 8);
+        assert!(decode_bake(&bytes).is_err());
+
+        let file = std::fs::File::create(&path).unwrap();
+        file.set_len(MAX_BAKE_BYTES + 1).unwrap();
+        let err = read_bake(&path, "abc123").unwrap_err();
+        assert!(matches!(err, BakeError::Corrupt { .. }), "{err}");
+        assert!(
+            err.to_string().contains("the largest bake is smaller"),
+            "{err}"
+        );
     }
 }

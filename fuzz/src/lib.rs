@@ -1,6 +1,6 @@
 //! Fuzz targets for the readers that take files from users: the trace v1 reader, the
-//! SRanipal and Tobii Pro Glasses 3 importers, the scene loader, the glTF model path and the
-//! study protocol, plan and responses readers.
+//! SRanipal, Tobii Pro Glasses 3 and Pupil Labs Neon importers, the scene loader, the glTF
+//! model path, the study protocol, plan and responses readers, and the caustic bake reader.
 //!
 //! Each target is a plain function from bytes to nothing that must not panic on any input.
 //! `fuzz_targets/*.rs` hand them to libFuzzer (`tools/fuzz`, `cargo fuzz`); the corpus test
@@ -19,7 +19,9 @@ use vitreous::scene::{Scene, SceneError, SceneFiles};
 use vitreous_xr::trace::{TraceReader, TraceSample, TraceWriter};
 
 /// Names of the targets, as in `fuzz_targets/` and `corpus/`.
-pub const TARGETS: [&str; 6] = ["trace_v1", "sranipal", "tobii_g3", "scene", "gltf", "study"];
+pub const TARGETS: [&str; 8] = [
+    "trace_v1", "sranipal", "tobii_g3", "neon", "scene", "gltf", "study", "bake",
+];
 
 /// Runs the target called `name` (one of [`TARGETS`]) on `data`; `false` for an unknown name.
 pub fn run(name: &str, data: &[u8]) -> bool {
@@ -27,6 +29,8 @@ pub fn run(name: &str, data: &[u8]) -> bool {
         "trace_v1" => trace_v1(data),
         "sranipal" => sranipal(data),
         "tobii_g3" => tobii_g3(data),
+        "neon" => neon(data),
+        "bake" => bake(data),
         "scene" => scene(data),
         "gltf" => gltf(data),
         "study" => study(data),
@@ -97,6 +101,98 @@ pub fn tobii_g3(data: &[u8]) {
     check_import(vitreous_xr::import::tobii_g3::parse_tobii_g3(
         data, "fuzz.gz", None,
     ));
+}
+
+/// The files a Neon recording folder may hold, by the index [`neon`] inputs name them with.
+pub const NEON_FILES: [&str; 16] = [
+    "gaze ps1.raw",
+    "gaze ps1.time",
+    "gaze.dtype",
+    "eye_state ps1.raw",
+    "eye_state ps1.time",
+    "eye_state.dtype",
+    "blinks ps1.raw",
+    "blinks ps1.time",
+    "blinks.dtype",
+    "imu ps1.raw",
+    "imu ps1.time",
+    "imu.dtype",
+    "calibration.bin",
+    "info.json",
+    "gaze ps2.raw",
+    "gaze ps2.time",
+];
+
+/// A Neon native recording folder, packed as the [`neon`] target reads it: per file one byte
+/// (its index in [`NEON_FILES`]), its length (u32, little-endian) and its bytes.
+pub fn pack_neon(files: &[(usize, &[u8])]) -> Vec<u8> {
+    let mut packed = Vec::new();
+    for (index, bytes) in files {
+        packed.push(*index as u8);
+        packed.extend_from_slice(&(bytes.len() as u32).to_le_bytes());
+        packed.extend_from_slice(bytes);
+    }
+    packed
+}
+
+/// The files of a packed folder ([`pack_neon`]), by name: an index wraps around the list, a
+/// length past the end takes what is left, a file named twice keeps its last bytes.
+pub fn unpack_neon(mut data: &[u8]) -> Vec<(&'static str, &[u8])> {
+    let mut files: Vec<(&'static str, &[u8])> = Vec::new();
+    while let [index, rest @ ..] = data {
+        let name = NEON_FILES[*index as usize % NEON_FILES.len()];
+        let (len, rest) = match rest.split_first_chunk::<4>() {
+            Some((len, rest)) => (u32::from_le_bytes(*len) as usize, rest),
+            None => (rest.len(), &[][..]),
+        };
+        let (bytes, rest) = rest.split_at(len.min(rest.len()));
+        files.retain(|(n, _)| *n != name);
+        files.push((name, bytes));
+        data = rest;
+    }
+    files
+}
+
+/// A Pupil Labs Neon native recording, packed ([`pack_neon`]): its files are written to a
+/// folder of their own (emptied first) and imported with
+/// [`vitreous_xr::import::neon::import_neon`]; like [`sranipal`], a successful import must make a
+/// valid trace that reads back unchanged.
+pub fn neon(data: &[u8]) {
+    thread_local! {
+        static FOLDER: tempfile::TempDir = tempfile::Builder::new()
+            .prefix("vitreous-fuzz-neon-")
+            .tempdir()
+            .expect("creating a temporary folder");
+    }
+    FOLDER.with(|folder| {
+        let dir = folder.path();
+        for entry in fs::read_dir(dir).expect("listing the recording folder") {
+            fs::remove_file(entry.expect("listing the recording folder").path())
+                .expect("emptying the recording folder");
+        }
+        for (name, bytes) in unpack_neon(data) {
+            fs::write(dir.join(name), bytes).expect("writing a recording file");
+        }
+        check_import(vitreous_xr::import::neon::import_neon(dir));
+    });
+}
+
+/// A caustic bake (OpenEXR): decoded with [`vitreous::caustics::decode_bake`]; an accepted
+/// bake has one finite, non-negative gain per texel.
+pub fn bake(data: &[u8]) {
+    match vitreous::caustics::decode_bake(data) {
+        Ok(bake) => {
+            let texels = bake.width_px as usize * bake.height_px as usize;
+            assert!(
+                texels > 0 && bake.gain.len() == texels,
+                "{} x {}",
+                bake.width_px,
+                bake.height_px
+            );
+            assert!(bake.gain.iter().all(|g| g.is_finite() && *g >= 0.0));
+        }
+        Err(reason) => assert!(!reason.is_empty()),
+    }
 }
 
 /// An importer's result: the samples of a success must make a valid trace that reads back

@@ -176,6 +176,58 @@ fn tobii_g3_survives_its_corpus() {
 }
 
 #[test]
+fn neon_survives_its_corpus() {
+    check("neon");
+}
+
+/// The seeds are whole recordings (the committed fixture of `xr/tests/data/neon`, packed): each
+/// one imports, so the fuzzer starts past the folder's checks.
+#[test]
+fn every_neon_seed_imports() {
+    every_seed("neon", |data| {
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        for (name, bytes) in vitreous_fuzz::unpack_neon(data) {
+            fs::write(dir.path().join(name), bytes).expect("writing a recording file");
+        }
+        let imported = vitreous_xr::import::neon::import_neon(dir.path());
+        imported.map(drop).map_err(|e| e.to_string())
+    });
+}
+
+#[test]
+fn packing_a_neon_folder_round_trips() {
+    let files: [(usize, &[u8]); 3] = [(0, b"ab"), (13, b"{}"), (0, b"xyz")];
+    let packed = vitreous_fuzz::pack_neon(&files);
+    let unpacked = vitreous_fuzz::unpack_neon(&packed);
+    assert_eq!(
+        unpacked,
+        [("info.json", &b"{}"[..]), ("gaze ps1.raw", &b"xyz"[..])]
+    );
+    // A cut length takes what is left; an index past the list wraps around.
+    assert_eq!(
+        vitreous_fuzz::unpack_neon(&[17, 9, 0]),
+        [("gaze ps1.time", &[][..])]
+    );
+    assert_eq!(
+        vitreous_fuzz::unpack_neon(&[2, 5, 0, 0, 0, b'a']),
+        [("gaze.dtype", &b"a"[..])]
+    );
+}
+
+#[test]
+fn bake_survives_its_corpus() {
+    check("bake");
+}
+
+/// The seeds are real bakes: each one decodes.
+#[test]
+fn every_bake_seed_decodes() {
+    every_seed("bake", |data| {
+        vitreous::caustics::decode_bake(data).map(drop)
+    });
+}
+
+#[test]
 fn scene_survives_its_corpus() {
     check("scene");
 }
@@ -184,9 +236,18 @@ fn scene_survives_its_corpus() {
 /// the asset reads rather than at "file not found".
 #[test]
 fn every_scene_seed_loads() {
-    for path in corpus("scene") {
-        let text = fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        if let Err(e) = vitreous_fuzz::load_scene(&text) {
+    every_seed("scene", |data| {
+        vitreous_fuzz::load_scene(data)
+            .map(drop)
+            .map_err(|e| e.to_string())
+    });
+}
+
+/// Panics naming the first seed of `target` that `accept` refuses, with its reason.
+fn every_seed(target: &str, accept: impl Fn(&[u8]) -> Result<(), String>) {
+    for path in corpus(target) {
+        let data = fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        if let Err(e) = accept(&data) {
             panic!("{}: {e}", path.display());
         }
     }
@@ -206,7 +267,9 @@ fn study_survives_its_corpus() {
 fn every_target_has_a_test_and_a_corpus() {
     assert_eq!(
         vitreous_fuzz::TARGETS,
-        ["trace_v1", "sranipal", "tobii_g3", "scene", "gltf", "study"]
+        [
+            "trace_v1", "sranipal", "tobii_g3", "neon", "scene", "gltf", "study", "bake"
+        ]
     );
     for target in vitreous_fuzz::TARGETS {
         assert!(!corpus(target).is_empty(), "corpus/{target} is empty");

@@ -199,14 +199,22 @@ pub struct DiskFiles;
 
 impl SceneFiles for DiskFiles {
     fn read_bounded(&self, path: &Path, limit: u64, what: &str) -> std::io::Result<Vec<u8>> {
+        let too_large = || {
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("larger than {} KiB; {what}", limit / 1024),
+            )
+        };
         let file = std::fs::File::open(path)?;
+        // The size on disk refuses a large file at once; reading at most one byte past the
+        // limit catches one that grows while it is read.
+        if file.metadata()?.len() > limit {
+            return Err(too_large());
+        }
         let mut bytes = Vec::new();
         file.take(limit + 1).read_to_end(&mut bytes)?;
         if bytes.len() as u64 > limit {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::InvalidData,
-                format!("larger than {} KiB; {what}", limit / 1024),
-            ));
+            return Err(too_large());
         }
         Ok(bytes)
     }

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use crate::emission::EmissionCone;
 use crate::splat::FluxGrid;
 use crate::trace::{Corner, End, Leaf, Tracer};
-use crate::{Bake, CausticScene, InputError};
+use crate::{Bake, CausticScene, InputError, MAX_BAKE_SIDE_PX};
 
 /// Bake settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -159,11 +159,11 @@ pub fn bake(
     let start = Instant::now();
     if params.width_px == 0
         || params.height_px == 0
-        || params.width_px > 16384
-        || params.height_px > 16384
+        || params.width_px > MAX_BAKE_SIDE_PX
+        || params.height_px > MAX_BAKE_SIDE_PX
     {
         return Err(InputError::BadValue(format!(
-            "the bake resolution must be 1..=16384 texels per side, found {} x {}",
+            "the bake resolution must be 1..={MAX_BAKE_SIDE_PX} texels per side, found {} x {}",
             params.width_px, params.height_px
         )));
     }

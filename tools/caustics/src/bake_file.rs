@@ -3,6 +3,6 @@
 //! share one definition (the app cannot depend on this crate: this crate depends on it).
 
 pub use vitreous::caustics::{
-    Bake, BakeError, GAIN_CHANNEL, PARAMS_ATTRIBUTE, SCENE_HASH_ATTRIBUTE, read_bake,
-    read_bake_unchecked, write_bake,
+    Bake, BakeError, GAIN_CHANNEL, MAX_BAKE_BYTES, MAX_BAKE_SIDE_PX, PARAMS_ATTRIBUTE,
+    SCENE_HASH_ATTRIBUTE, decode_bake, read_bake, read_bake_unchecked, write_bake,
 };

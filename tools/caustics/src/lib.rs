@@ -37,7 +37,9 @@ pub use vitreous_render::solid;
 pub use vitreous_render::solid::bvh;
 
 pub use bake::{BakeOutput, BakeParams, Comparison, FluxLedger, bake, compare, gain};
-pub use bake_file::{Bake, BakeError, read_bake, read_bake_unchecked, write_bake};
+pub use bake_file::{
+    Bake, BakeError, MAX_BAKE_SIDE_PX, decode_bake, read_bake, read_bake_unchecked, write_bake,
+};
 
 /// Everything the baker needs from a scene, as plain data in world coordinates.
 #[derive(Clone, Debug)]

@@ -12,7 +12,9 @@ use vitreous::views;
 use vitreous_render::camera::EyeParams;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Readback, Reflection, Renderer, ScenePose};
-use vitreous_tests::{eyes_looking_down, pixel_on_floor, render_once, shipped_scene};
+use vitreous_tests::{
+    FloorPixel, eyes_looking_down, floor_pixels, floor_uv, render_once, shipped_scene,
+};
 
 fn srgb_to_linear(v: u8) -> f32 {
     let c = f32::from(v) / 255.0;
@@ -21,16 +23,6 @@ fn srgb_to_linear(v: u8) -> f32 {
     } else {
         ((c + 0.055) / 1.055).powf(2.4)
     }
-}
-
-/// The photo coordinate of a world point on the floor.
-fn floor_uv(scene: &Scene, world: Vec3) -> Vec2 {
-    let local = scene
-        .floor
-        .world_from_plane()
-        .inverse()
-        .transform_point3(world);
-    Vec2::new(local.x + 0.5, 0.5 - local.y)
 }
 
 /// Where the straight ray from the light through the object's centre meets the floor: the
@@ -124,7 +116,6 @@ fn adds_inducer_and_caustic_gain(four_loads: bool) {
         ("c", render(&mut r, eyes, "c")),
     ];
     let fields = r.inducer_fields().unwrap();
-    let floor_y = s.floor.pose.position.y;
     for (name, frame) in &frames {
         let (inducer_on, caustics_on) = match *name {
             "c" => (true, true),
@@ -132,42 +123,40 @@ fn adds_inducer_and_caustic_gain(four_loads: bool) {
             _ => (true, false),
         };
         let (mut worst, mut caustic_px, mut both_px, mut dark_px) = (0.0f32, 0, 0, 0);
-        for (e, eye) in eyes.iter().enumerate() {
-            for y in 0..h {
-                for x in 0..w {
-                    let i = ((y * w + x) * 4) as usize;
-                    if none.eyes[e][i..i + 3].iter().any(|&c| c != 0) {
-                        continue; // the glass covers the floor here
-                    }
-                    let uv = floor_uv(&s, pixel_on_floor(eye, (w, h), x, y, floor_y));
-                    let k_alpha = if inducer_on {
-                        fields.gain_bilinear(uv)
-                    } else {
-                        0.0
-                    };
-                    let g = if caustics_on {
-                        bake.sample(uv.x, uv.y)
-                    } else {
-                        0.0
-                    };
-                    let expected = (k_alpha + g) * l_r;
-                    let got = srgb_to_linear(frame.eyes[e][i]);
-                    let err = (got - expected).abs() / l_r;
-                    assert!(
-                        err <= 0.02,
-                        "{name}: eye {e} pixel ({x}, {y}): {got} vs {expected} (k alpha {k_alpha}, G {g})"
-                    );
-                    worst = worst.max(err);
-                    if g > 0.05 {
-                        caustic_px += 1;
-                        if k_alpha > 0.05 {
-                            both_px += 1;
-                        }
-                    }
-                    if k_alpha == 0.0 && g == 0.0 && bake.sample(uv.x, uv.y) == 0.0 {
-                        dark_px += 1;
-                    }
+        for FloorPixel {
+            eye: e,
+            x,
+            y,
+            offset: i,
+            uv,
+        } in floor_pixels(&s, &eyes, &none)
+        {
+            let k_alpha = if inducer_on {
+                fields.gain_bilinear(uv)
+            } else {
+                0.0
+            };
+            let g = if caustics_on {
+                bake.sample(uv.x, uv.y)
+            } else {
+                0.0
+            };
+            let expected = (k_alpha + g) * l_r;
+            let got = srgb_to_linear(frame.eyes[e][i]);
+            let err = (got - expected).abs() / l_r;
+            assert!(
+                err <= 0.02,
+                "{name}: eye {e} pixel ({x}, {y}): {got} vs {expected} (k alpha {k_alpha}, G {g})"
+            );
+            worst = worst.max(err);
+            if g > 0.05 {
+                caustic_px += 1;
+                if k_alpha > 0.05 {
+                    both_px += 1;
                 }
+            }
+            if k_alpha == 0.0 && g == 0.0 && bake.sample(uv.x, uv.y) == 0.0 {
+                dark_px += 1;
             }
         }
         eprintln!(

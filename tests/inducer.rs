@@ -17,7 +17,8 @@ use vitreous_render::floor::{self, InducerFields};
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Readback, Renderer};
 use vitreous_tests::{
-    assert_silent, eyes_looking_down, pixel_on_floor, render_once, scene_renderer, shipped_scene,
+    FloorPixel, assert_silent, eyes_looking_down, floor_pixels, render_once, scene_renderer,
+    shipped_scene,
 };
 
 /// The glass-sphere scene with inducer parameters `k`, `d_m`.
@@ -45,16 +46,6 @@ fn texel_world(scene: &Scene, fields: &InducerFields, x: u32, y: u32) -> Vec3 {
         .floor
         .world_from_plane()
         .transform_point3(Vec3::new(uv.x - 0.5, 0.5 - uv.y, 0.0))
-}
-
-/// The photo coordinate of a world point on the floor.
-fn floor_uv(scene: &Scene, world: Vec3) -> Vec2 {
-    let local = scene
-        .floor
-        .world_from_plane()
-        .inverse()
-        .transform_point3(world);
-    Vec2::new(local.x + 0.5, 0.5 - local.y)
 }
 
 /// The two ends (world z) of the sphere's shadow on the floor along the symmetry line x = 0
@@ -266,32 +257,30 @@ fn eye_image_adds_k_alpha_times_a_uniform_floor() {
     let off = render(&mut r, eyes, false, false);
     let on = render(&mut r, eyes, true, false);
     let fields = r.inducer_fields().unwrap();
-    let floor_y = s.floor.pose.position.y;
     let texel = 1.0 / fields.resolution_px as f32;
     let (mut worst, mut ramp_pixels, mut zero_pixels) = (0.0f32, 0, 0);
-    for (e, eye) in eyes.iter().enumerate() {
-        for y in 0..h {
-            for x in 0..w {
-                let i = ((y * w + x) * 4) as usize;
-                if off.eyes[e][i..i + 3].iter().any(|&c| c != 0) {
-                    continue; // the glass covers the floor here
-                }
-                let uv = floor_uv(&s, pixel_on_floor(eye, (w, h), x, y, floor_y));
-                let got = srgb_to_linear(on.eyes[e][i]);
-                let expected = fields.gain_bilinear(uv) * l_r;
-                let err = (got - expected).abs() / l_r;
-                assert!(err <= 0.02, "eye {e} pixel ({x}, {y}): {got} vs {expected}");
-                worst = worst.max(err);
-                let around = [(0.0, 0.0), (1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)];
-                if around.iter().all(|&(dx, dy)| {
-                    fields.gain_bilinear(uv + Vec2::new(dx, dy) * 1.5 * texel) == 0.0
-                }) {
-                    assert_eq!(&on.eyes[e][i..i + 3], &[0, 0, 0], "eye {e} ({x}, {y})");
-                    zero_pixels += 1;
-                } else if expected > 0.05 * l_r {
-                    ramp_pixels += 1;
-                }
-            }
+    for FloorPixel {
+        eye: e,
+        x,
+        y,
+        offset: i,
+        uv,
+    } in floor_pixels(&s, &eyes, &off)
+    {
+        let got = srgb_to_linear(on.eyes[e][i]);
+        let expected = fields.gain_bilinear(uv) * l_r;
+        let err = (got - expected).abs() / l_r;
+        assert!(err <= 0.02, "eye {e} pixel ({x}, {y}): {got} vs {expected}");
+        worst = worst.max(err);
+        let around = [(0.0, 0.0), (1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)];
+        if around
+            .iter()
+            .all(|&(dx, dy)| fields.gain_bilinear(uv + Vec2::new(dx, dy) * 1.5 * texel) == 0.0)
+        {
+            assert_eq!(&on.eyes[e][i..i + 3], &[0, 0, 0], "eye {e} ({x}, {y})");
+            zero_pixels += 1;
+        } else if expected > 0.05 * l_r {
+            ramp_pixels += 1;
         }
     }
     eprintln!(

@@ -14,7 +14,7 @@ use vitreous_render::floor::InducerFields;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Renderer};
 use vitreous_tests::{
-    assert_silent, lit_centroid, render_once, scene_renderer, shipped_scene, workspace,
+    assert_silent, floor_uv, lit_centroid, render_once, scene_renderer, shipped_scene, workspace,
 };
 
 /// Where a floor texel centre lies in the world.
@@ -97,9 +97,9 @@ fn inducer_fields_follow_the_circling_light() {
         );
         // The shadow lies on the far side of the sphere from the light: floor-space offset
         // of the centroid from the sphere's foot against the light's.
-        let foot = texel_uv(&scene, center) * n as f32;
+        let foot = floor_uv(&scene, center) * n as f32;
         let away = (gpu.as_vec2() - foot).normalize();
-        let towards_light = (texel_uv(&scene, light) * n as f32 - foot).normalize();
+        let towards_light = (floor_uv(&scene, light) * n as f32 - foot).normalize();
         assert!(
             away.dot(towards_light) < -0.99,
             "at {time_s} s the shadow points {away}, the light {towards_light}"
@@ -115,16 +115,6 @@ fn inducer_fields_follow_the_circling_light() {
     // One computation per pose.
     assert_eq!(renderer.inducer_computations(), 5);
     assert_silent(&renderer);
-}
-
-/// The floor photo's texel coordinate (0..1, v down) under a world point.
-fn texel_uv(scene: &Scene, world: Vec3) -> Vec2 {
-    let local = scene
-        .floor
-        .world_from_plane()
-        .inverse()
-        .transform_point3(world);
-    Vec2::new(local.x + 0.5, 0.5 - local.y)
 }
 
 /// The fields and the eye images of `renderer` after moving the object to `position`: the

@@ -190,6 +190,61 @@ pub fn place(center_m: Vec3, radius_m: f32) -> Mat4 {
     Mat4::from_scale_rotation_translation(Vec3::splat(radius_m), glam::Quat::IDENTITY, center_m)
 }
 
+/// The photo coordinate of a world point on the scene's floor (u right, v down).
+pub fn floor_uv(scene: &vitreous::scene::Scene, world: Vec3) -> Vec2 {
+    let local = scene
+        .floor
+        .world_from_plane()
+        .inverse()
+        .transform_point3(world);
+    Vec2::new(local.x + 0.5, 0.5 - local.y)
+}
+
+/// A pixel of an eye image that shows the floor ([`floor_pixels`]).
+#[derive(Clone, Copy, Debug)]
+pub struct FloorPixel {
+    /// The eye (0 left, 1 right).
+    pub eye: usize,
+    /// Column and row.
+    pub x: u32,
+    pub y: u32,
+    /// Offset of its RGBA bytes in the eye image.
+    pub offset: usize,
+    /// The floor photo coordinate it shows.
+    pub uv: Vec2,
+}
+
+/// The pixels of both eyes' images where the floor shows: those that `bare`, a frame drawn
+/// without any floor overlay from the same eyes, leaves black (elsewhere the glass covers
+/// the floor).
+pub fn floor_pixels(
+    scene: &vitreous::scene::Scene,
+    eyes: &[vitreous_render::EyeParams; 2],
+    bare: &vitreous_render::Readback,
+) -> Vec<FloorPixel> {
+    let (w, h) = (bare.width, bare.height);
+    let floor_y = scene.floor.pose.position.y;
+    let mut pixels = Vec::new();
+    for (eye, params) in eyes.iter().enumerate() {
+        for y in 0..h {
+            for x in 0..w {
+                let offset = ((y * w + x) * 4) as usize;
+                if bare.eyes[eye][offset..offset + 3].iter().all(|&c| c == 0) {
+                    let uv = floor_uv(scene, pixel_on_floor(params, (w, h), x, y, floor_y));
+                    pixels.push(FloorPixel {
+                        eye,
+                        x,
+                        y,
+                        offset,
+                        uv,
+                    });
+                }
+            }
+        }
+    }
+    pixels
+}
+
 /// Where the centre of pixel (x, y) of an image of `size` pixels sees the horizontal floor
 /// plane at height `floor_y`.
 pub fn pixel_on_floor(

@@ -123,6 +123,17 @@ impl Registry {
         h
     }
 
+    /// A new eye tracker of extension `kind` on `session`: its handle, or `None` when the
+    /// layer knows no such session.
+    pub fn new_tracker(&mut self, session: u64, kind: GazeExtension) -> Option<u64> {
+        if !self.sessions.contains_key(&session) {
+            return None;
+        }
+        let h = self.new_handle();
+        self.trackers.insert(h, TrackerState { session, kind });
+        Some(h)
+    }
+
     /// A session's state and its instance's.
     pub fn session(&self, session: u64) -> Option<(&SessionState, &InstanceState)> {
         let s = self.sessions.get(&session)?;

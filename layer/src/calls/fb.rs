@@ -7,7 +7,7 @@ use super::{SessionContext, in_base};
 use crate::config::GazeExtension;
 use crate::entry::guard;
 use crate::eye_geometry::ray_pose;
-use crate::registry::{TrackerState, registry};
+use crate::registry::registry;
 
 /// The session context of an FB tracker the layer made.
 fn tracker_context(tracker: sys::EyeTrackerFB) -> Option<SessionContext> {
@@ -37,18 +37,9 @@ pub unsafe extern "system" fn create_eye_tracker(
         if info.ty != sys::EyeTrackerCreateInfoFB::TYPE {
             return sys::Result::ERROR_VALIDATION_FAILURE;
         }
-        let mut reg = registry();
-        if !reg.sessions.contains_key(&session.into_raw()) {
+        let Some(h) = registry().new_tracker(session.into_raw(), GazeExtension::Fb) else {
             return sys::Result::ERROR_HANDLE_INVALID;
-        }
-        let h = reg.new_handle();
-        reg.trackers.insert(
-            h,
-            TrackerState {
-                session: session.into_raw(),
-                kind: GazeExtension::Fb,
-            },
-        );
+        };
         *out = sys::EyeTrackerFB::from_raw(h);
         sys::Result::SUCCESS
     })

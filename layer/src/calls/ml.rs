@@ -26,7 +26,7 @@ use super::{SessionContext, in_base};
 use crate::config::GazeExtension;
 use crate::entry::guard;
 use crate::eye_geometry::{combined_ray, fixation_point, pose_along, ray_pose};
-use crate::registry::{TrackerState, registry};
+use crate::registry::registry;
 use crate::two_call;
 
 /// The session context of an ML tracker the layer made.
@@ -66,18 +66,9 @@ pub unsafe extern "system" fn create_eye_tracker(
         let Some(out) = (unsafe { tracker.as_mut() }) else {
             return sys::Result::ERROR_VALIDATION_FAILURE;
         };
-        let mut reg = registry();
-        if !reg.sessions.contains_key(&session.into_raw()) {
+        let Some(h) = registry().new_tracker(session.into_raw(), GazeExtension::Ml) else {
             return sys::Result::ERROR_HANDLE_INVALID;
-        }
-        let h = reg.new_handle();
-        reg.trackers.insert(
-            h,
-            TrackerState {
-                session: session.into_raw(),
-                kind: GazeExtension::Ml,
-            },
-        );
+        };
         *out = EyeTrackerML(h);
         sys::Result::SUCCESS
     })

@@ -93,36 +93,9 @@ impl CausticScene {
 /// Why a scene cannot be baked.
 #[derive(Debug, Error)]
 pub enum InputError {
-    /// The mesh has no triangles with area.
-    #[error("the object's mesh has no triangles with non-zero area")]
-    EmptyMesh,
-    /// Indices or positions are malformed.
-    #[error("the object's mesh is malformed: {0}")]
-    BadMesh(String),
-    /// Some edges are not shared by exactly two triangles.
-    #[error(
-        "the object's mesh does not enclose a volume: {open_edges} edge(s) are not shared by \
-         exactly two triangles (one near {example_m} m); caustics need a closed solid \
-         (close the holes, or join duplicated vertices)"
-    )]
-    OpenMesh {
-        /// Number of welded edges used by one, or more than two, triangles.
-        open_edges: usize,
-        /// Midpoint of one such edge, bake frame (metres from the bounding-sphere centre).
-        example_m: Vec3,
-    },
-    /// Neighbouring triangles disagree about which side is outside.
-    #[error(
-        "the object's mesh is inconsistently wound: {edges} edge(s) are traversed in the same \
-         direction by both triangles (one near {example_m} m); make every face \
-         counter-clockwise seen from outside"
-    )]
-    InconsistentWinding {
-        /// Number of such edges.
-        edges: usize,
-        /// Midpoint of one such edge, bake frame (metres from the bounding-sphere centre).
-        example_m: Vec3,
-    },
+    /// The mesh is not a closed solid (the caustics trace light through its volume).
+    #[error(transparent)]
+    Mesh(#[from] solid::SolidError),
     /// The light is inside the glass.
     #[error(
         "the light at {light_m} m (world) is inside the object; a caustic bake needs the light \
@@ -150,24 +123,4 @@ pub enum InputError {
     /// A number is out of range.
     #[error("{0}")]
     BadValue(String),
-}
-
-impl From<solid::SolidError> for InputError {
-    fn from(e: solid::SolidError) -> Self {
-        use solid::SolidError as S;
-        match e {
-            S::EmptyMesh => InputError::EmptyMesh,
-            S::BadMesh(m) => InputError::BadMesh(m),
-            S::OpenMesh {
-                open_edges,
-                example_m,
-            } => InputError::OpenMesh {
-                open_edges,
-                example_m,
-            },
-            S::InconsistentWinding { edges, example_m } => {
-                InputError::InconsistentWinding { edges, example_m }
-            }
-        }
-    }
 }

@@ -6,7 +6,7 @@ use std::f32::consts::PI;
 use glam::{Mat4, Quat, Vec2, Vec3};
 use vitreous_caustics::optics::{fresnel_reflectance, refract};
 use vitreous_caustics::{
-    BakeOutput, BakeParams, CausticScene, InputError, bake, compare, write_bake,
+    BakeOutput, BakeParams, CausticScene, InputError, bake, compare, solid::SolidError, write_bake,
 };
 
 /// A UV sphere of radius `radius_m` at `center_m`: smooth radial normals, seam duplicated,
@@ -375,7 +375,10 @@ fn open_meshes_inner_lights_and_flat_floors_are_refused_clearly() {
     let mut open = good.clone();
     open.indices.truncate(open.indices.len() - 3);
     let err = bake(&open, &p, &|_, _| {}).unwrap_err();
-    assert!(matches!(err, InputError::OpenMesh { .. }), "{err}");
+    assert!(
+        matches!(err, InputError::Mesh(SolidError::OpenMesh { .. })),
+        "{err}"
+    );
     assert!(
         err.to_string().contains("does not enclose a volume"),
         "{err}"

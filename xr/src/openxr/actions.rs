@@ -406,6 +406,20 @@ impl Controls {
 mod tests {
     use super::*;
 
+    /// A bound button: up, just pressed, held down, just released.
+    const UP: ButtonState = button(false, false);
+    const PRESSED: ButtonState = button(true, true);
+    const HELD: ButtonState = button(true, false);
+    const RELEASED: ButtonState = button(false, true);
+
+    const fn button(down: bool, changed: bool) -> ButtonState {
+        ButtonState {
+            active: true,
+            down,
+            changed,
+        }
+    }
+
     #[test]
     fn select_steps_the_primary_cycle_and_menu_the_secondary() {
         let select = Presses {
@@ -461,37 +475,18 @@ mod tests {
 
     #[test]
     fn presses_are_edges_and_chords_need_the_other_button_held() {
-        let up = ButtonState {
-            active: true,
-            ..Default::default()
-        };
-        let pressed = ButtonState {
-            active: true,
-            down: true,
-            changed: true,
-        };
-        let held = ButtonState {
-            active: true,
-            down: true,
-            changed: false,
-        };
-        let released = ButtonState {
-            active: true,
-            down: false,
-            changed: true,
-        };
-        assert_eq!(presses(up, up), Presses::default());
-        assert_eq!(presses(held, held), Presses::default());
-        assert_eq!(presses(released, up), Presses::default());
+        assert_eq!(presses(UP, UP), Presses::default());
+        assert_eq!(presses(HELD, HELD), Presses::default());
+        assert_eq!(presses(RELEASED, UP), Presses::default());
         assert_eq!(
-            presses(pressed, up),
+            presses(PRESSED, UP),
             Presses {
                 select: true,
                 ..Default::default()
             }
         );
         assert_eq!(
-            presses(held, pressed),
+            presses(HELD, PRESSED),
             Presses {
                 menu: true,
                 chord: true,
@@ -499,7 +494,7 @@ mod tests {
             }
         );
         assert_eq!(
-            presses(pressed, pressed),
+            presses(PRESSED, PRESSED),
             Presses {
                 select: true,
                 menu: true,
@@ -510,9 +505,9 @@ mod tests {
         // An unbound (inactive) input never presses.
         let inactive = ButtonState {
             active: false,
-            ..pressed
+            ..PRESSED
         };
-        assert_eq!(presses(inactive, up), Presses::default());
+        assert_eq!(presses(inactive, UP), Presses::default());
     }
 
     #[test]
@@ -526,37 +521,23 @@ mod tests {
 
     #[test]
     fn with_the_squeeze_held_select_and_menu_edit_the_object() {
-        let up = ButtonState {
-            active: true,
-            ..Default::default()
-        };
-        let pressed = ButtonState {
-            active: true,
-            down: true,
-            changed: true,
-        };
-        let held = ButtonState {
-            active: true,
-            down: true,
-            changed: false,
-        };
         // The right squeeze alone places the object; the left one alone does nothing.
-        let place = presses_with_squeeze(up, up, pressed);
+        let place = presses_with_squeeze(UP, UP, PRESSED);
         assert_eq!(commands_for(Hand::Right, place), [Command::PlaceObject]);
         assert!(commands_for(Hand::Left, place).is_empty());
         // Held: select and menu move (right) or turn (left) the object, never cycle or nudge.
-        let select = presses_with_squeeze(pressed, up, held);
+        let select = presses_with_squeeze(PRESSED, UP, HELD);
         assert_eq!(
             commands_for(Hand::Right, select),
             [Command::MoveObject(Vec3::new(0.0, 0.0, -OBJECT_STEP_M))]
         );
         assert_eq!(
-            commands_for(Hand::Left, presses_with_squeeze(up, pressed, held)),
+            commands_for(Hand::Left, presses_with_squeeze(UP, PRESSED, HELD)),
             [Command::TurnObject(-OBJECT_TURN_RAD)]
         );
         // Without the squeeze, as before.
         assert_eq!(
-            commands_for(Hand::Right, presses_with_squeeze(pressed, up, up)),
+            commands_for(Hand::Right, presses_with_squeeze(PRESSED, UP, UP)),
             [Command::Cycle(Cycle::Primary)]
         );
     }

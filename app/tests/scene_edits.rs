@@ -10,7 +10,7 @@ use vitreous::effects::EffectSet;
 use vitreous::replay::{ReplayOptions, replay};
 use vitreous::scene::load_scene;
 use vitreous_xr::trace::{EditRecord, TraceSample, TraceWriter};
-use vitreous_xr::{GazeRay, GazeSample, Pose};
+use vitreous_xr::{GazeSample, Pose};
 
 /// Frame spacing of the recording, nanoseconds (4 Hz).
 const STEP_NS: i64 = 250_000_000;
@@ -19,14 +19,7 @@ fn sample(time_ns: i64) -> TraceSample {
     TraceSample {
         time_ns,
         head: Pose::IDENTITY,
-        gaze: GazeSample {
-            sample_time_ns: time_ns,
-            left: GazeRay::INVALID,
-            right: GazeRay::INVALID,
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-        },
+        gaze: GazeSample::none(time_ns),
     }
 }
 

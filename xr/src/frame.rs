@@ -104,6 +104,22 @@ pub struct GazeSample {
     pub pupil_diameter_m: [Option<f32>; 2],
 }
 
+impl GazeSample {
+    /// A sample at `sample_time_ns` that holds no gaze: both eyes' rays invalid, no combined
+    /// ray, fixation or pupil measurement (a tracker's dropout; a frame without a tracker,
+    /// as recorded in a trace).
+    pub const fn none(sample_time_ns: i64) -> GazeSample {
+        GazeSample {
+            sample_time_ns,
+            left: GazeRay::INVALID,
+            right: GazeRay::INVALID,
+            combined: None,
+            fixation: None,
+            pupil_diameter_m: [None, None],
+        }
+    }
+}
+
 /// What a backend hands the frame loop for one frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrameInput {

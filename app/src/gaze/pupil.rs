@@ -164,16 +164,11 @@ fn mean_valid_diameter_m(sample: &GazeSample) -> Option<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use vitreous_xr::GazeRay;
 
     fn sample(t_ms: i64, pupils_mm: [Option<f32>; 2]) -> GazeSample {
         GazeSample {
-            sample_time_ns: t_ms * 1_000_000,
-            left: GazeRay::INVALID,
-            right: GazeRay::INVALID,
-            combined: None,
-            fixation: None,
             pupil_diameter_m: pupils_mm.map(|p| p.map(|mm| mm / 1000.0)),
+            ..GazeSample::none(t_ms * 1_000_000)
         }
     }
 

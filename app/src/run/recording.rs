@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{TraceSample, read_trace};
-use vitreous_xr::{Backend, FrameInput, GazeRay, GazeSample, Pose};
+use vitreous_xr::{Backend, FrameInput, GazeSample, Pose};
 
 use crate::scene::Scene;
 
@@ -33,14 +33,7 @@ pub(super) fn trace_sample(input: &FrameInput) -> TraceSample {
     TraceSample {
         time_ns: input.time_ns,
         head: input.head,
-        gaze: input.gaze.unwrap_or(GazeSample {
-            sample_time_ns: input.time_ns,
-            left: GazeRay::INVALID,
-            right: GazeRay::INVALID,
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-        }),
+        gaze: input.gaze.unwrap_or(GazeSample::none(input.time_ns)),
     }
 }
 

@@ -88,7 +88,6 @@ impl Playback {
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
-    use vitreous_xr::GazeRay;
 
     use super::*;
 
@@ -99,14 +98,7 @@ mod tests {
                 position: Vec3::X * i as f32,
                 orientation: glam::Quat::IDENTITY,
             },
-            gaze: GazeSample {
-                sample_time_ns: i * NS_PER_S / 10,
-                left: GazeRay::INVALID,
-                right: GazeRay::INVALID,
-                combined: None,
-                fixation: None,
-                pupil_diameter_m: [None, None],
-            },
+            gaze: GazeSample::none(i * NS_PER_S / 10),
         }
     }
 

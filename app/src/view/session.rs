@@ -14,7 +14,7 @@ use anyhow::{Context, Result};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, Renderer};
 use vitreous_xr::trace::{AtomicFile, TraceSample, TraceWriter};
-use vitreous_xr::{FrameInput, GazeRay, GazeSample};
+use vitreous_xr::{FrameInput, GazeSample};
 
 use super::ViewOptions;
 use super::desktop::Shared;
@@ -491,14 +491,7 @@ impl FrameSink for ViewSink {
         }
         if let Some(w) = &mut self.writer {
             self.recorded_until_ns = Some(input.time_ns);
-            let gaze = input.gaze.unwrap_or(GazeSample {
-                sample_time_ns: input.time_ns,
-                left: GazeRay::INVALID,
-                right: GazeRay::INVALID,
-                combined: None,
-                fixation: None,
-                pupil_diameter_m: [None, None],
-            });
+            let gaze = input.gaze.unwrap_or(GazeSample::none(input.time_ns));
             w.write(&TraceSample {
                 time_ns: input.time_ns,
                 head: input.head,

@@ -154,20 +154,6 @@ impl FieldTarget {
     }
 }
 
-/// The smallest rectangle holding both (either may be absent).
-pub(crate) fn bounding(a: Option<TexelRect>, b: Option<TexelRect>) -> Option<TexelRect> {
-    match (a, b) {
-        (Some(a), Some(b)) => Some([
-            a[0].min(b[0]),
-            a[1].min(b[1]),
-            a[2].max(b[2]),
-            a[3].max(b[3]),
-        ]),
-        (a, None) => a,
-        (None, b) => b,
-    }
-}
-
 /// Push constants of the floor-space passes, as `Field` in shaders/inducer_field.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]

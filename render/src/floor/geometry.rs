@@ -145,14 +145,20 @@ pub(crate) fn texel_rect(rect: [f32; 4], width: u32, height: u32) -> [u32; 4] {
     ]
 }
 
-/// The smallest rectangle holding both (either may be absent).
-pub(crate) fn union_rect(a: Option<[f32; 4]>, b: Option<[f32; 4]>) -> Option<[f32; 4]> {
+/// The smallest rectangle `[x0, y0, x1, y1]` holding both (either may be absent): plane
+/// rectangles (f32) or texel rectangles (u32).
+pub(crate) fn union_rect<T: Copy + PartialOrd>(
+    a: Option<[T; 4]>,
+    b: Option<[T; 4]>,
+) -> Option<[T; 4]> {
+    let low = |x: T, y: T| if y < x { y } else { x };
+    let high = |x: T, y: T| if y > x { y } else { x };
     match (a, b) {
         (Some(a), Some(b)) => Some([
-            a[0].min(b[0]),
-            a[1].min(b[1]),
-            a[2].max(b[2]),
-            a[3].max(b[3]),
+            low(a[0], b[0]),
+            low(a[1], b[1]),
+            high(a[2], b[2]),
+            high(a[3], b[3]),
         ]),
         (a, None) => a,
         (None, b) => b,
@@ -185,6 +191,21 @@ pub(crate) fn shadow_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn union_rect_holds_both_rectangles_of_either_kind() {
+        assert_eq!(
+            union_rect(Some([0.1f32, -0.2, 0.3, 0.0]), Some([-0.1, -0.1, 0.2, 0.4])),
+            Some([-0.1, -0.2, 0.3, 0.4])
+        );
+        assert_eq!(
+            union_rect(Some([4u32, 5, 9, 6]), Some([6, 2, 8, 7])),
+            Some([4, 2, 9, 7])
+        );
+        assert_eq!(union_rect(None, Some([1u32, 2, 3, 4])), Some([1, 2, 3, 4]));
+        assert_eq!(union_rect(Some([1u32, 2, 3, 4]), None), Some([1, 2, 3, 4]));
+        assert_eq!(union_rect::<u32>(None, None), None);
+    }
 
     #[test]
     fn planar_shadow_sends_points_along_the_light_ray_to_the_plane() {

@@ -8,7 +8,7 @@ use glam::{Mat4, Vec2, Vec3};
 use super::distance_transform::{self, DIST, DistanceTransform, RAMP};
 use super::fields::{
     CAUSTIC_PHOTONS_STAMP, CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN,
-    MASK, Stamps, TexelRect, bounding, mask_pipeline,
+    MASK, Stamps, TexelRect, mask_pipeline,
 };
 use super::geometry::{Floor, caustic_rect, shadow_of, texel_rect, texels_plane_rect, union_rect};
 use super::live::{LiveCaustics, LiveCausticsDesc};
@@ -445,7 +445,7 @@ impl InducerPass {
             Written::Within(before) => (before, FieldStart::KeepClear, FieldStart::KeepDraw),
         };
         // Nothing drawn before nor now: every field already holds its cleared value.
-        let Some(area) = bounding(before, region) else {
+        let Some(area) = union_rect(before, region) else {
             stamp(0..4);
             return None;
         };

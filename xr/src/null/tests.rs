@@ -15,14 +15,7 @@ fn sample(time_ns: i64, position: Vec3, yaw_rad: f32) -> TraceSample {
             position,
             orientation: Quat::from_rotation_y(yaw_rad),
         },
-        gaze: GazeSample {
-            sample_time_ns: time_ns,
-            left: GazeRay::INVALID,
-            right: GazeRay::INVALID,
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-        },
+        gaze: GazeSample::none(time_ns),
     }
 }
 

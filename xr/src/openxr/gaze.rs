@@ -488,12 +488,8 @@ impl ExtGaze {
             GazeRay::INVALID
         };
         Some(GazeSample {
-            sample_time_ns: sample_time.time.as_nanos(),
-            left: GazeRay::INVALID,
-            right: GazeRay::INVALID,
             combined: Some(combined),
-            fixation: None,
-            pupil_diameter_m: [None, None],
+            ..GazeSample::none(sample_time.time.as_nanos())
         })
     }
 }
@@ -596,12 +592,8 @@ mod tests {
             valid: true,
         };
         let ext = GazeSample {
-            sample_time_ns: 7,
-            left: GazeRay::INVALID,
-            right: GazeRay::INVALID,
             combined: Some(combined),
-            fixation: None,
-            pupil_diameter_m: [None, None],
+            ..GazeSample::none(7)
         };
         let merged = with_combined(Some(trace), Some(ext)).unwrap();
         assert_eq!((merged.left, merged.right), (trace.left, trace.right));

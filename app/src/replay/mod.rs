@@ -453,20 +453,9 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
             summary_path.display()
         );
     }
-    if summary.validation.errors + summary.validation.warnings > 0 {
-        bail!(
-            "the Vulkan validation layers reported {} errors and {} warnings (see {}), first: {}",
-            summary.validation.errors,
-            summary.validation.warnings,
-            options.out.join("summary.json").display(),
-            summary
-                .validation
-                .messages
-                .first()
-                .map(String::as_str)
-                .unwrap_or("")
-        );
-    }
+    summary
+        .validation
+        .check(Some(&options.out.join("summary.json")))?;
     Ok(summary)
 }
 

@@ -33,6 +33,21 @@ impl ValidationSummary {
             messages: v.messages(),
         }
     }
+
+    /// An error when the layers reported anything: the counts, the first message, and
+    /// `summary` (the file the rest is in), when there is one.
+    pub fn check(&self, summary: Option<&std::path::Path>) -> anyhow::Result<()> {
+        if self.errors + self.warnings == 0 {
+            return Ok(());
+        }
+        let see = summary.map_or(String::new(), |p| format!(" (see {})", p.display()));
+        anyhow::bail!(
+            "the Vulkan validation layers reported {} errors and {} warnings{see}, first: {}",
+            self.errors,
+            self.warnings,
+            self.messages.first().map(String::as_str).unwrap_or("")
+        )
+    }
 }
 
 /// How a replay ended, as `summary.json` says it. Anything but `complete` means the output
@@ -144,5 +159,37 @@ impl ReplaySummary {
             median(self.gpu_ms),
             median(self.cpu_ms),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validation_fails_on_any_message_and_names_the_first() {
+        let mut v = ValidationSummary {
+            enabled: true,
+            warnings: 0,
+            errors: 0,
+            messages: Vec::new(),
+        };
+        assert!(v.check(None).is_ok());
+        v.warnings = 1;
+        v.messages = vec!["VUID-x: first".into(), "second".into()];
+        let err = v.check(None).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            "the Vulkan validation layers reported 0 errors and 1 warnings, first: VUID-x: first"
+        );
+        v.errors = 2;
+        let err = v
+            .check(Some(std::path::Path::new("out/summary.json")))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("2 errors and 1 warnings (see out/summary.json), first: VUID-x"),
+            "{err}"
+        );
     }
 }

@@ -510,19 +510,7 @@ fn run_with(
         let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;
         write_atomic(&out.join("summary.json"), &json)?;
     }
-    if summary.validation.errors + summary.validation.warnings > 0 {
-        bail!(
-            "the Vulkan validation layers reported {} errors and {} warnings, first: {}",
-            summary.validation.errors,
-            summary.validation.warnings,
-            summary
-                .validation
-                .messages
-                .first()
-                .map(String::as_str)
-                .unwrap_or("")
-        );
-    }
+    summary.validation.check(None)?;
     if options.readback_check {
         match &summary.readback {
             Some(c) if c.passed => {}

@@ -333,14 +333,6 @@ fn view_with(
         let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;
         write_atomic(&out.join("summary.json"), &json)?;
     }
-    let v = &summary.validation;
-    if v.errors + v.warnings > 0 {
-        bail!(
-            "the Vulkan validation layers reported {} errors and {} warnings, first: {}",
-            v.errors,
-            v.warnings,
-            v.messages.first().map(String::as_str).unwrap_or("")
-        );
-    }
+    summary.validation.check(None)?;
     Ok((summary, sink.take_study()))
 }

@@ -130,7 +130,8 @@ pub enum BakeError {
     },
 }
 
-/// Writes `bake` to `path` (single channel `Y`, f32, ZIP, deterministic byte for byte).
+/// Writes `bake` to `path` (single channel `Y`, f32, ZIP, deterministic byte for byte),
+/// whole or not at all.
 pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError> {
     let write_err = |reason: String| BakeError::Write {
         path: path.to_path_buf(),
@@ -171,11 +172,15 @@ pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| write_err(e.to_string()))?;
     }
+    // Encoded in memory, then written through a temporary file renamed into place: an
+    // interrupted bake leaves the old file or none, never a half-written one.
+    let mut bytes = std::io::Cursor::new(Vec::new());
     image
         .write()
         .non_parallel()
-        .to_file(path)
-        .map_err(|e| write_err(e.to_string()))
+        .to_buffered(&mut bytes)
+        .map_err(|e| write_err(e.to_string()))?;
+    crate::output::write_atomic(path, bytes.get_ref()).map_err(|e| write_err(format!("{e:#}")))
 }
 
 /// Reads a bake and checks it belongs to the scene with hash `expected_scene_hash`.
@@ -323,6 +328,12 @@ mod tests {
         write_bake(&path, &sample()).unwrap();
         let back = read_bake(&path, "abc123").unwrap();
         assert_eq!(back, sample());
+        // Written through a temporary file, renamed into place: nothing else is left.
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["b.exr"]);
         assert_eq!(back.gain_at(4, 0), 2.0);
         assert!((back.sample(0.1, 1.0 / 6.0) - 0.0).abs() < 1e-6);
     }

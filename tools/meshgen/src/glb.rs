@@ -186,7 +186,13 @@ pub fn write(path: &Path, mesh: &Mesh, name: &str, material: &GlassMaterial) -> 
         std::fs::create_dir_all(parent)
             .with_context(|| format!("creating folder {}", parent.display()))?;
     }
-    std::fs::write(path, &bytes).with_context(|| format!("writing {}", path.display()))?;
+    // Beside the target, renamed into place once whole: an interrupted run leaves the old
+    // model or a `.partial` file, never a truncated model under the shipped name.
+    let mut partial = path.as_os_str().to_owned();
+    partial.push(".partial");
+    let partial = std::path::PathBuf::from(partial);
+    std::fs::write(&partial, &bytes).with_context(|| format!("writing {}", partial.display()))?;
+    std::fs::rename(&partial, path).with_context(|| format!("writing {}", path.display()))?;
     Ok(bytes.len())
 }
 

@@ -239,6 +239,13 @@ pub const MAX_BAKE_BYTES: u64 = (MAX_BAKE_SIDE_PX as u64).pow(2) * 4 + (16 << 20
 /// layer's size is checked (1..=[`MAX_BAKE_SIDE_PX`] texels per side) before any samples are
 /// read, and a panic of the EXR decoder on hostile input becomes an error.
 pub fn decode_bake(bytes: &[u8]) -> std::result::Result<Bake, String> {
+    std::panic::catch_unwind(|| decode_unguarded(bytes)).unwrap_or_else(|_| {
+        Err("the OpenEXR decoder failed on this file (internal panic)".to_owned())
+    })
+}
+
+/// [`decode_bake`] without the guard against the decoder's panics.
+fn decode_unguarded(bytes: &[u8]) -> std::result::Result<Bake, String> {
     let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
         .map_err(|e| format!("bad OpenEXR header: {e}"))?;
     for header in &meta.headers {
@@ -250,13 +257,6 @@ pub fn decode_bake(bytes: &[u8]) -> std::result::Result<Bake, String> {
             ));
         }
     }
-    std::panic::catch_unwind(|| decode_checked(bytes)).unwrap_or_else(|_| {
-        Err("the OpenEXR decoder failed on this file (internal panic)".to_owned())
-    })
-}
-
-/// [`decode_bake`] once the header's sizes are known to be within the limits.
-fn decode_checked(bytes: &[u8]) -> std::result::Result<Bake, String> {
     let image = read()
         .no_deep_data()
         .largest_resolution_level()

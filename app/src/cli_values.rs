@@ -37,6 +37,18 @@ pub fn parse_frame_count_usize(s: &str) -> Result<usize, String> {
     usize::try_from(n).map_err(|_| format!("{n} frames is more than this machine can count"))
 }
 
+/// A pupil diameter for `--pupil-mm`, millimetres: 1 to 9 (the range eq. 13-14 accept),
+/// refused here whether or not the run's effects use it.
+pub fn parse_pupil_mm(s: &str) -> Result<f32, String> {
+    let mm = s
+        .trim()
+        .parse::<f32>()
+        .map_err(|_| format!("expected a pupil diameter in millimetres, got '{s}'"))?;
+    crate::gaze::blur::check_pupil_diameter_m(mm / 1000.0)
+        .map(|_| mm)
+        .map_err(|e| e.to_string())
+}
+
 /// An OpenXR environment blend mode by its command-line name.
 pub fn parse_blend(s: &str) -> Result<vitreous_xr::openxr::Blend, String> {
     vitreous_xr::openxr::Blend::parse(s)

@@ -10,7 +10,8 @@ use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
 use vitreous::bench::{BenchOptions, bench};
 use vitreous::cli_values::{
-    ReflectionArg, parse_effects, parse_frame_count, parse_frame_count_usize, parse_size,
+    ReflectionArg, parse_effects, parse_frame_count, parse_frame_count_usize, parse_pupil_mm,
+    parse_size,
 };
 use vitreous::effects::EffectSet;
 use vitreous::error_report::error_text;
@@ -73,7 +74,8 @@ enum Command {
             long = "pupil-mm",
             value_name = "MM",
             value_delimiter = ',',
-            allow_negative_numbers = true
+            allow_negative_numbers = true,
+            value_parser = parse_pupil_mm
         )]
         pupils_mm: Vec<f32>,
         /// Also time each variant with the light turning 1 degree about the object every

@@ -176,6 +176,41 @@ fn absurd_sizes_are_refused() {
     assert!(!dir.path().join("out").exists());
 }
 
+/// A pupil diameter outside 1-9 mm is refused whether or not the effects use it (the
+/// glass sphere's condition c has no defocus).
+#[test]
+fn pupil_diameters_outside_the_human_range_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for (command, pupil) in [
+        ("replay", "-3"),
+        ("replay", "0"),
+        ("replay", "500"),
+        ("bench", "4,50"),
+    ] {
+        let out = vitreous(
+            &[
+                command,
+                &scene("glass-sphere.toml"),
+                "--pupil-mm",
+                pupil,
+                "--frames",
+                "2",
+            ],
+            dir.path(),
+        );
+        assert_clean_failure(&out, &["--pupil-mm", "is outside 1..=9 mm"]);
+    }
+    let out = vitreous(
+        &["replay", &scene("glass-sphere.toml"), "--pupil-mm", "wide"],
+        dir.path(),
+    );
+    assert_clean_failure(
+        &out,
+        &["--pupil-mm", "expected a pupil diameter in millimetres"],
+    );
+    assert!(!dir.path().join("out").exists());
+}
+
 #[test]
 fn unknown_and_unimplemented_effects_are_refused() {
     let dir = tempfile::tempdir().unwrap();

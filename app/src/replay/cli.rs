@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 
 use super::{GazeSettings, ReplayOptions, check_size, replay};
-use crate::cli_values::{ReflectionArg, parse_effects, parse_frame_count, parse_size};
+use crate::cli_values::{
+    ReflectionArg, parse_effects, parse_frame_count, parse_pupil_mm, parse_size,
+};
 use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, GazeOverride, PupilSource};
 
@@ -79,7 +81,8 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "FILTER")]
     pub filter: Option<FilterKind>,
     /// Pupil diameter A_p overriding the scene's, millimetres (1-9).
-    #[arg(long = "pupil-mm", value_name = "MM", allow_negative_numbers = true)]
+    #[arg(long = "pupil-mm", value_name = "MM", allow_negative_numbers = true,
+          value_parser = parse_pupil_mm)]
     pub pupil_mm: Option<f32>,
     /// Where A_p (eq. 13) comes from, overriding the scene's `[gaze] pupil`: paper (the
     /// fixed diameter) or measured (the trace's pupil diameters, smoothed).

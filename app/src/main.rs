@@ -200,7 +200,7 @@ enum TraceCommand {
         /// Tracker sample rate, hertz.
         #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
         rate: f32,
-        /// Seconds between gaze switches.
+        /// Seconds between gaze switches (0 or less: the gaze stays on the surface point).
         #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
         switch_period: f32,
         /// Random seed (the same seed gives the same trace).

@@ -108,16 +108,54 @@ pub fn synth(scene_path: &Path, options: &SynthOptions, out: &Path) -> Result<St
     };
     let trace = synthesize_with_truth(&params).context("synthesising the trace")?;
     write_trace_file(&trace.samples, out)?;
+    let surface = params.targets[SURFACE_TARGET].point_m.to_array();
+    let refracted = params.targets[REFRACTED_TARGET].point_m.to_array();
+    let gaze = if params.switch_period_s > 0.0 {
+        format!(
+            "gaze alternates every {} s between the surface point {surface:.3?} and the \
+             refracted point {refracted:.3?}",
+            params.switch_period_s
+        )
+    } else {
+        format!("gaze stays on the surface point {surface:.3?}")
+    };
     Ok(format!(
-        "wrote {} ({} samples, {:.1} s at {} Hz; gaze alternates every {} s between the surface \
-         point {:.3?} and the refracted point {:.3?}; {} blinks)",
+        "wrote {} ({} samples, {:.1} s at {} Hz; {gaze}; {} blinks)",
         out.display(),
         trace.samples.len(),
         params.duration_s,
         params.rate_hz,
-        params.switch_period_s,
-        params.targets[SURFACE_TARGET].point_m.to_array(),
-        params.targets[REFRACTED_TARGET].point_m.to_array(),
         trace.blinks.len()
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The report says what the trace holds: alternating gaze, or, with no switch period,
+    /// the gaze staying on the surface point.
+    #[test]
+    fn synth_reports_whether_the_gaze_switches() {
+        let scene =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/visual-effects.toml");
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("s.trace");
+        let options = |switch_period_s| SynthOptions {
+            duration_s: 2.0,
+            rate_hz: 30.0,
+            switch_period_s,
+            seed: 1,
+        };
+        let report = synth(&scene, &options(0.5), &out).unwrap();
+        assert!(report.contains("gaze alternates every 0.5 s"), "{report}");
+        for still in [0.0, -1.0] {
+            let report = synth(&scene, &options(still), &out).unwrap();
+            assert!(
+                report.contains("gaze stays on the surface point"),
+                "{report}"
+            );
+            assert!(!report.contains("alternates"), "{report}");
+        }
+    }
 }

@@ -173,6 +173,13 @@ fn absurd_sizes_are_refused() {
         dir.path(),
     );
     assert_clean_failure(&out, &["WIDTHxHEIGHT"]);
+    // `run` refuses one before it starts the runtime (there is none here).
+    let out = vitreous(
+        &["run", &scene("glass-sphere.toml"), "--size", "5x5"],
+        dir.path(),
+    );
+    let message = assert_clean_failure(&out, &["eye image size 5x5 is outside 16..=8192"]);
+    assert!(!message.contains("OpenXR"), "{message}");
     assert!(!dir.path().join("out").exists());
 }
 

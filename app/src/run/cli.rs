@@ -40,7 +40,8 @@ pub struct RunArgs {
     /// Blend mode instead of the automatic choice: additive, alpha-blend, opaque.
     #[arg(long, value_parser = parse_blend)]
     pub blend: Option<vitreous_xr::openxr::Blend>,
-    /// Eye image size instead of the runtime's recommended one, e.g. 640x480.
+    /// Eye image size instead of the runtime's recommended one, e.g. 640x480 (16-8192 per
+    /// side; the runtime's maximum bounds it).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Effects, overriding the scene's (as for replay).
@@ -65,6 +66,10 @@ pub struct RunArgs {
 
 /// Runs the session `args` describe and prints its report.
 pub fn run_command(args: RunArgs) -> Result<()> {
+    // Before the runtime starts (which would clamp it to what it offers, silently).
+    if let Some((w, h)) = args.size {
+        crate::replay::check_size(w, h)?;
+    }
     if let Some(record) = &args.record {
         let mut inputs = vec![args.scene.as_path()];
         inputs.extend(args.gaze_trace.as_deref());

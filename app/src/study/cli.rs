@@ -170,6 +170,9 @@ pub fn run(command: StudyCommand) -> Result<()> {
             if trials == Some(0) {
                 bail!("--trials must be at least 1");
             }
+            if let Some((w, h)) = size {
+                crate::replay::check_size(w, h)?;
+            }
             if trace.is_some() && !(dry_run || view) {
                 bail!(
                     "--trace is for --dry-run or --view (on a headset, --gaze-trace replays gaze)"

@@ -282,6 +282,11 @@ fn run_with(
     .context("starting OpenXR")?;
     let info = runtime.info().clone();
     let (width, height) = info.size;
+    if let Some((w, h)) = options.size.filter(|&wanted| wanted != info.size) {
+        tracing::warn!(
+            "--size {w}x{h} is beyond what the runtime offers: eye images {width}x{height}"
+        );
+    }
     tracing::info!(
         "eye images {width}x{height} (recommended {}x{}, max {}x{})",
         info.recommended_size.0,

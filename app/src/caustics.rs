@@ -198,20 +198,6 @@ pub fn read_bake(path: &Path, expected_scene_hash: &str) -> std::result::Result<
 
 /// Reads a bake without checking which scene it belongs to (for comparisons).
 pub fn read_bake_unchecked(path: &Path) -> std::result::Result<Bake, BakeError> {
-    match std::fs::metadata(path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(BakeError::Missing {
-                path: path.to_path_buf(),
-            });
-        }
-        Err(source) => {
-            return Err(BakeError::Io {
-                path: path.to_path_buf(),
-                source,
-            });
-        }
-        Ok(_) => {}
-    }
     let corrupt = |reason: String| BakeError::Corrupt {
         path: path.to_path_buf(),
         reason,
@@ -219,6 +205,9 @@ pub fn read_bake_unchecked(path: &Path) -> std::result::Result<Bake, BakeError> 
     let bytes = DiskFiles
         .read_bounded(path, MAX_BAKE_BYTES, "the largest bake is smaller")
         .map_err(|source| match source.kind() {
+            std::io::ErrorKind::NotFound => BakeError::Missing {
+                path: path.to_path_buf(),
+            },
             std::io::ErrorKind::InvalidData => corrupt(source.to_string()),
             _ => BakeError::Io {
                 path: path.to_path_buf(),

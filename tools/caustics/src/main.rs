@@ -110,8 +110,8 @@ fn main() -> Result<()> {
             }
             if let Some(dir) = dump_raw {
                 let raw = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-                std::fs::write(dir.join("test.f32"), raw(&t.gain))?;
-                std::fs::write(dir.join("reference.f32"), raw(&r.gain))?;
+                vitreous::output::write_atomic(&dir.join("test.f32"), &raw(&t.gain))?;
+                vitreous::output::write_atomic(&dir.join("reference.f32"), &raw(&r.gain))?;
             }
             if t.scene_hash != r.scene_hash {
                 eprintln!("warning: the two bakes were made for different scenes");

@@ -8,6 +8,8 @@
 //!   order; `none` for none): the blend modes listed before the runtime's own.
 //! - `VITREOUS_SIM_SUBMITTED`: a CSV file that gets one line per submitted frame.
 //! - `VITREOUS_SIM_BUTTONS`: a script of controller button presses (`crate::controller`).
+//! - `VITREOUS_SIM_EYE_MAX`: `WxH`, the largest eye image the headset offers (each view's
+//!   recommended and largest image rectangle are clamped to it).
 
 use std::ffi::CStr;
 use std::fmt;
@@ -25,6 +27,10 @@ pub const BLEND_VAR: &str = "VITREOUS_SIM_BLEND";
 pub const SUBMITTED_VAR: &str = "VITREOUS_SIM_SUBMITTED";
 /// Environment variable naming the controller button script.
 pub const BUTTONS_VAR: &str = "VITREOUS_SIM_BUTTONS";
+/// Environment variable giving the largest eye image, `WxH` pixels.
+pub const EYE_MAX_VAR: &str = "VITREOUS_SIM_EYE_MAX";
+/// The sides `VITREOUS_SIM_EYE_MAX` takes, pixels.
+pub const EYE_MAX_RANGE: std::ops::RangeInclusive<u32> = 16..=16384;
 
 /// An eye-tracking extension the layer can provide.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -108,6 +114,8 @@ pub struct Config {
     pub submitted: Option<PathBuf>,
     /// The controller button script.
     pub buttons: Option<PathBuf>,
+    /// The largest eye image offered, width and height in pixels (`None`: the runtime's).
+    pub eye_max: Option<(u32, u32)>,
 }
 
 impl Config {
@@ -126,6 +134,7 @@ impl Config {
             trace: get(TRACE_VAR).map(PathBuf::from),
             submitted: get(SUBMITTED_VAR).map(PathBuf::from),
             buttons: get(BUTTONS_VAR).map(PathBuf::from),
+            eye_max: get(EYE_MAX_VAR).map(|v| parse_eye_max(&v)).transpose()?,
         })
     }
 
@@ -197,6 +206,25 @@ pub fn parse_blend(value: Option<&str>) -> Result<Vec<sys::EnvironmentBlendMode>
     Ok(out)
 }
 
+/// Parses `VITREOUS_SIM_EYE_MAX`: `WxH`, each side within [`EYE_MAX_RANGE`].
+pub fn parse_eye_max(value: &str) -> Result<(u32, u32), ConfigError> {
+    let side = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|n| EYE_MAX_RANGE.contains(n))
+    };
+    value
+        .trim()
+        .split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((side(w)?, side(h)?)))
+        .ok_or_else(|| ConfigError {
+            var: EYE_MAX_VAR,
+            value: value.to_owned(),
+            expected: "WxH in pixels, each side 16 to 16384 (e.g. 1440x1760)",
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,6 +281,28 @@ mod tests {
         let c = config(&[(TRACE_VAR, "/tmp/a.trace"), (SUBMITTED_VAR, "/tmp/s.csv")]).unwrap();
         assert_eq!(c.trace, Some(PathBuf::from("/tmp/a.trace")));
         assert_eq!(c.submitted, Some(PathBuf::from("/tmp/s.csv")));
+    }
+
+    #[test]
+    fn the_largest_eye_image_is_parsed_and_checked() {
+        assert_eq!(config(&[]).unwrap().eye_max, None);
+        let c = config(&[(EYE_MAX_VAR, " 320x240 ")]).unwrap();
+        assert_eq!(c.eye_max, Some((320, 240)));
+        assert_eq!(parse_eye_max("1440X1760"), Ok((1440, 1760)));
+        for bad in [
+            "320",
+            "320x",
+            "x240",
+            "0x240",
+            "15x240",
+            "320x16385",
+            "-1x5",
+            "axb",
+        ] {
+            let e = config(&[(EYE_MAX_VAR, bad)]).unwrap_err();
+            assert_eq!(e.var, EYE_MAX_VAR, "{bad}");
+            assert!(e.to_string().contains("16 to 16384"), "{e}");
+        }
     }
 
     #[test]

@@ -379,6 +379,13 @@ fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::VoidF
                 pfn::EnumerateEnvironmentBlendModes
             ),
         ),
+        b"xrEnumerateViewConfigurationViews" => (
+            None,
+            entry!(
+                calls::instance::enumerate_view_configuration_views,
+                pfn::EnumerateViewConfigurationViews
+            ),
+        ),
         b"xrSuggestInteractionProfileBindings" => (
             None,
             entry!(

@@ -16,6 +16,8 @@ pub struct NextTable {
     pub get_system_properties: pfn::GetSystemProperties,
     /// `xrEnumerateEnvironmentBlendModes`.
     pub enumerate_environment_blend_modes: pfn::EnumerateEnvironmentBlendModes,
+    /// `xrEnumerateViewConfigurationViews`.
+    pub enumerate_view_configuration_views: pfn::EnumerateViewConfigurationViews,
     /// `xrStringToPath`.
     pub string_to_path: pfn::StringToPath,
     /// `xrCreateSession`.
@@ -102,6 +104,12 @@ impl NextTable {
                 instance,
                 c"xrEnumerateEnvironmentBlendModes",
                 pfn::EnumerateEnvironmentBlendModes
+            ),
+            enumerate_view_configuration_views: load!(
+                gipa,
+                instance,
+                c"xrEnumerateViewConfigurationViews",
+                pfn::EnumerateViewConfigurationViews
             ),
             string_to_path: load!(gipa, instance, c"xrStringToPath", pfn::StringToPath),
             create_session: load!(gipa, instance, c"xrCreateSession", pfn::CreateSession),

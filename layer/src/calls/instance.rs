@@ -165,6 +165,64 @@ pub unsafe extern "system" fn enumerate_environment_blend_modes(
     })
 }
 
+/// `xrEnumerateViewConfigurationViews`: the runtime's views, each one's recommended and
+/// largest image rectangle clamped to `VITREOUS_SIM_EYE_MAX` when it is set.
+///
+/// # Safety
+/// As `xrEnumerateViewConfigurationViews`.
+pub unsafe extern "system" fn enumerate_view_configuration_views(
+    instance: sys::Instance,
+    system: sys::SystemId,
+    view: sys::ViewConfigurationType,
+    capacity: u32,
+    count: *mut u32,
+    views: *mut sys::ViewConfigurationView,
+) -> sys::Result {
+    guard("xrEnumerateViewConfigurationViews", || {
+        let Some((next, eye_max)) = registry()
+            .instances
+            .get(&instance.into_raw())
+            .map(|i| (i.next.clone(), i.config.eye_max))
+        else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the next layer's function with the app's arguments.
+        let r = unsafe {
+            (next.enumerate_view_configuration_views)(
+                instance, system, view, capacity, count, views,
+            )
+        };
+        let Some(max) = eye_max else {
+            return r;
+        };
+        if r != sys::Result::SUCCESS || count.is_null() {
+            return r;
+        }
+        // SAFETY: `count` is the app's non-null output, which the runtime wrote.
+        let filled = unsafe { *count }.min(capacity);
+        // SAFETY: the app's array holds `capacity` elements (null when it asked for the
+        // count), of which the runtime filled the first `count` when it had room for them.
+        if let Some(slice) = unsafe { two_call::out_slice(filled, views) } {
+            for v in slice {
+                clamp_view(v, max);
+            }
+        }
+        r
+    })
+}
+
+/// Clamps a view's recommended and largest image rectangle to `max` (width, height).
+pub fn clamp_view(view: &mut sys::ViewConfigurationView, max: (u32, u32)) {
+    view.max_image_rect_width = view.max_image_rect_width.min(max.0);
+    view.max_image_rect_height = view.max_image_rect_height.min(max.1);
+    view.recommended_image_rect_width = view
+        .recommended_image_rect_width
+        .min(view.max_image_rect_width);
+    view.recommended_image_rect_height = view
+        .recommended_image_rect_height
+        .min(view.max_image_rect_height);
+}
+
 /// `xrSuggestInteractionProfileBindings`: suggestions for the eye-gaze profile are taken
 /// here (their actions become gaze actions); the rest go on.
 ///
@@ -231,4 +289,43 @@ pub unsafe extern "system" fn suggest_interaction_profile_bindings(
             }
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view(recommended: (u32, u32), max: (u32, u32)) -> sys::ViewConfigurationView {
+        sys::ViewConfigurationView {
+            ty: sys::ViewConfigurationView::TYPE,
+            next: std::ptr::null_mut(),
+            recommended_image_rect_width: recommended.0,
+            max_image_rect_width: max.0,
+            recommended_image_rect_height: recommended.1,
+            max_image_rect_height: max.1,
+            recommended_swapchain_sample_count: 1,
+            max_swapchain_sample_count: 4,
+        }
+    }
+
+    fn sizes(v: &sys::ViewConfigurationView) -> [u32; 4] {
+        [
+            v.recommended_image_rect_width,
+            v.recommended_image_rect_height,
+            v.max_image_rect_width,
+            v.max_image_rect_height,
+        ]
+    }
+
+    #[test]
+    fn views_are_clamped_to_the_largest_eye_image_and_never_grown() {
+        let mut v = view((1440, 1760), (2880, 3520));
+        clamp_view(&mut v, (320, 240));
+        assert_eq!(sizes(&v), [320, 240, 320, 240]);
+        // Within the limit: untouched, a limit above the runtime's does not raise it.
+        let mut v = view((640, 480), (1024, 768));
+        clamp_view(&mut v, (2048, 600));
+        assert_eq!(sizes(&v), [640, 480, 1024, 600]);
+        assert_eq!(v.max_swapchain_sample_count, 4);
+    }
 }

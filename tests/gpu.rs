@@ -6,6 +6,7 @@ mod caustics;
 mod defocus;
 mod inducer;
 mod live_caustics;
+mod live_caustics_sweep;
 mod motion;
 mod refraction;
 mod refraction_scene;

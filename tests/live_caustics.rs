@@ -14,7 +14,7 @@ use vitreous_render::{FrameParams, Look, Renderer, ScenePose};
 use vitreous_tests::{shipped_scene, workspace};
 
 /// The shipped scene `name` with its bake loaded.
-fn baked_scene(name: &str) -> Scene {
+pub(crate) fn baked_scene(name: &str) -> Scene {
     let mut scene = shipped_scene(name);
     scene.load_caustics().unwrap_or_else(|e| panic!("{e}"));
     scene
@@ -24,7 +24,7 @@ fn baked_scene(name: &str) -> Scene {
 /// shipped bake averaged down to that map: the mean of the bake's texels each live texel
 /// covers, the same light over the same area (smoothed alike, within 0.5 % of the baker's map
 /// at 990 x 990 for the sphere and within 1 % for the diamond; docs/caustics.md).
-fn live_scene(name: &str, side: Option<u32>) -> (Scene, Vec<f32>) {
+pub(crate) fn live_scene(name: &str, side: Option<u32>) -> (Scene, Vec<f32>) {
     let baked = baked_scene(name);
     let bake = baked.caustics.gain.as_ref().expect("the bake is loaded");
     let mut live = baked.clone();
@@ -46,7 +46,7 @@ fn live_scene(name: &str, side: Option<u32>) -> (Scene, Vec<f32>) {
 
 /// The offline baker's map of `scene`'s object, light and floor at `side` x `side` texels, with
 /// `budget` grid rays (the shipped bakes': 2^18).
-fn baked_at(scene: &Scene, side: u32, budget: u64) -> Vec<f32> {
+pub(crate) fn baked_at(scene: &Scene, side: u32, budget: u64) -> Vec<f32> {
     let params = vitreous_caustics::BakeParams {
         width_px: side,
         height_px: side,
@@ -64,11 +64,11 @@ fn baked_at(scene: &Scene, side: u32, budget: u64) -> Vec<f32> {
 }
 
 /// One frame's live caustic map.
-struct LiveFrame {
+pub(crate) struct LiveFrame {
     /// The gain map.
-    gain: Vec<f32>,
+    pub gain: Vec<f32>,
     /// Wall-clock milliseconds of the frame.
-    wall_ms: f64,
+    pub wall_ms: f64,
     /// The smoothing's tiles written, and the map's.
     tiles: [u32; 2],
 }
@@ -76,7 +76,7 @@ struct LiveFrame {
 /// Renders one frame with the caustics on for each light position (`None`: the scene's) and
 /// returns the live maps. With `fields_first`, the inducer's fields are read back before the
 /// first frame.
-fn live_gains(
+pub(crate) fn live_gains(
     scene: &Scene,
     live: LiveCausticsDesc,
     lights: &[Option<Vec3>],
@@ -175,7 +175,7 @@ fn live_gains_at(
 
 /// docs/caustics.md's quality figure: sqrt(sum (G - G_ref)^2 / sum G_ref^2) over the texels
 /// where the reference is visibly brighter than the bare floor (G_ref > 0.1).
-fn relative_rms(gain: &[f32], reference: &[f32]) -> f64 {
+pub(crate) fn relative_rms(gain: &[f32], reference: &[f32]) -> f64 {
     let (mut diff, mut norm) = (0.0f64, 0.0f64);
     for (&g, &r) in gain.iter().zip(reference) {
         if r > 0.1 {
@@ -189,7 +189,7 @@ fn relative_rms(gain: &[f32], reference: &[f32]) -> f64 {
 /// `gain` (`width` texels a row) convolved along rows, then columns, with the kernel of a box
 /// of 2 `radius` + 1 texels applied three times, texels beyond the edge taken as 0:
 /// docs/caustics.md's smoothing, written out on the CPU as one direct convolution per axis.
-fn smoothed(gain: &[f32], width: usize, radius: u32) -> Vec<f32> {
+pub(crate) fn smoothed(gain: &[f32], width: usize, radius: u32) -> Vec<f32> {
     let r = radius as usize;
     let boxed = vec![1.0 / (2 * r + 1) as f64; 2 * r + 1];
     let convolve = |a: &[f64], b: &[f64]| {
@@ -264,7 +264,7 @@ fn nonzero_box(gain: &[f32], width: u32) -> Option<[u32; 4]> {
 }
 
 /// The texel (column, row) with the largest gain.
-fn peak(gain: &[f32], width: u32) -> (u32, u32) {
+pub(crate) fn peak(gain: &[f32], width: u32) -> (u32, u32) {
     let i = gain
         .iter()
         .enumerate()
@@ -276,7 +276,7 @@ fn peak(gain: &[f32], width: u32) -> (u32, u32) {
 
 /// The texel (continuous, pixel centres at half-integers) where the line from `light` through
 /// the sphere's centre meets the floor, for a `w` x `h` map.
-fn axis_texel(scene: &Scene, light: Vec3, w: u32, h: u32) -> Vec2 {
+pub(crate) fn axis_texel(scene: &Scene, light: Vec3, w: u32, h: u32) -> Vec2 {
     let center = scene.object.center_m;
     let floor_y = scene.floor.pose.position.y;
     let dir = center - light;
@@ -650,58 +650,4 @@ fn block_mean(gain: &[f32], width: usize, f: usize) -> Vec<f32> {
         *texel = (sum / (f * f) as f64) as f32;
     }
     out
-}
-
-/// The measurements behind docs/caustics.md's tables of live maps (run it with
-/// `cargo test --release -p vitreous-tests --test gpu -- --ignored --nocapture sweep`): for
-/// map sizes, smoothing radii and photon counts, the relative RMS against the shipped bake
-/// averaged down to the live map's resolution and smoothed alike, and against the baker's
-/// own map at that resolution (baked here, once per size), smoothed alike.
-#[test]
-#[ignore]
-fn sweep() {
-    for name in ["glass-sphere", "diamond"] {
-        let base = baked_scene(&format!("{name}.toml"));
-        let full = base.caustics.gain.as_ref().expect("the bake").width_px as usize;
-        let mut own_bakes: Vec<(usize, Vec<f32>)> = Vec::new();
-        for (factor, radius, photons) in [
-            (1usize, 5u32, 128u32),
-            (2, 2, 128),
-            (2, 3, 128),
-            (3, 2, 128),
-            (4, 1, 128),
-            (4, 2, 128),
-            (2, 2, 96),
-            (2, 2, 64),
-            (3, 2, 96),
-            (4, 1, 96),
-        ] {
-            let side = full / factor;
-            let (live_scene, averaged) = live_scene(&format!("{name}.toml"), Some(side as u32));
-            if !own_bakes.iter().any(|(s, _)| *s == side) {
-                own_bakes.push((side, baked_at(&live_scene, side as u32, 1 << 18)));
-            }
-            let own = &own_bakes.iter().find(|(s, _)| *s == side).expect("baked").1;
-            let live = LiveCausticsDesc {
-                photons_per_side: photons,
-                smoothing_px: radius,
-                ..LiveCausticsDesc::default()
-            };
-            let LiveFrame { gain, wall_ms, .. } = &live_gains(&live_scene, live, &[None], false)[0];
-            let reference = smoothed(&averaged, side, radius);
-            let own_smoothed = smoothed(own, side, radius);
-            let (px, py) = peak(gain, side as u32);
-            let axis = axis_texel(&base, base.light.position_m, side as u32, side as u32);
-            eprintln!(
-                "{name} {side}x{side} r = {radius} {photons}^2 photons: relative RMS {:.2} % over \
-                 {} texels (the baker's own map: {:.2} %; it against the averaged bake {:.2} %), \
-                 peak G {:.1} at ({px}, {py}) (light axis at {axis}), {wall_ms:.0} ms",
-                relative_rms(gain, &reference) * 100.0,
-                reference.iter().filter(|&&g| g > 0.1).count(),
-                relative_rms(gain, &own_smoothed) * 100.0,
-                relative_rms(&own_smoothed, &reference) * 100.0,
-                gain[py as usize * side + px as usize],
-            );
-        }
-    }
 }

@@ -263,6 +263,16 @@ fn nonzero_box(gain: &[f32], width: u32) -> Option<[u32; 4]> {
     b
 }
 
+/// The largest difference of `gain` from `reference` outside the caustic region (where
+/// `reference` is at most 0.1, as `relative_rms` leaves out): speckles of thinly spread light.
+pub(crate) fn speckle(gain: &[f32], reference: &[f32]) -> f32 {
+    gain.iter()
+        .zip(reference)
+        .filter(|&(_, r)| *r <= 0.1)
+        .map(|(g, r)| (g - r).abs())
+        .fold(0.0f32, f32::max)
+}
+
 /// The texel (column, row) with the largest gain.
 pub(crate) fn peak(gain: &[f32], width: u32) -> (u32, u32) {
     let i = gain
@@ -370,12 +380,7 @@ fn check_sphere(side: Option<u32>, live: LiveCausticsDesc) {
     // below 0.1 there), too few photons show as speckles: single texels of thinly spread light
     // well off the baker's map. The defaults are at most 0.19 off, the moving-light scene's
     // settings 0.13; with 48 x 48 photons on its 495 x 495 map 0.28, with 32 x 32 0.72.
-    let speckle = gain
-        .iter()
-        .zip(&reference)
-        .filter(|&(_, r)| *r <= 0.1)
-        .map(|(g, r)| (g - r).abs())
-        .fold(0.0f32, f32::max);
+    let speckle = speckle(gain, &reference);
     eprintln!("outside the caustic region at most {speckle:.3} off the baker's map");
     assert!(speckle <= 0.25, "a speckle {speckle} off the baker's map");
 }

@@ -5,7 +5,7 @@ use vitreous_render::floor::LiveCausticsDesc;
 
 use crate::live_caustics::{
     LiveFrame, axis_texel, baked_at, baked_scene, live_gains, live_scene, peak, relative_rms,
-    smoothed,
+    smoothed, speckle,
 };
 
 /// The measurements behind docs/caustics.md's tables of live maps (run it with
@@ -54,12 +54,7 @@ fn sweep() {
             let (px, py) = peak(gain, side as u32);
             // Speckles: the largest difference from the baker's map outside the caustic
             // region, where the relative figure does not look.
-            let speckle = gain
-                .iter()
-                .zip(own_smoothed.iter())
-                .filter(|&(_, r)| *r <= 0.1)
-                .map(|(g, r)| (g - r).abs())
-                .fold(0.0f32, f32::max);
+            let speckle = speckle(gain, &own_smoothed);
             let axis = axis_texel(&base, base.light.position_m, side as u32, side as u32);
             eprintln!(
                 "{name} {side}x{side} r = {radius} {photons}^2 photons: relative RMS {:.2} % over \

@@ -3,10 +3,12 @@
 // where the fields can change (render/src/floor/pass.rs):
 //
 // 1. (shaders/inducer_distance.wgsl) every texel of the region gets its nearest shadow texel.
-// 2. fs_distance: d, the distance from a lit texel to the shadow edge in metres; -1 inside
-//    the shadow; FAR_M outside `region` (the pass also draws where the region was before).
-// 3. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain, which the floor overlay
-//    (shaders/floor_overlay.wgsl) filters and adds to the caustic gain G.
+// 2. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain, which the floor overlay
+//    (shaders/floor_overlay.wgsl) filters and adds to the caustic gain G; d, the distance
+//    from a lit texel to the shadow edge in metres, from its nearest shadow texel (the pass
+//    also draws where the region was before, where d is FAR_M).
+// 3. fs_distance: d itself, -1 inside the shadow and FAR_M outside `region`: drawn only
+//    when the fields are read back (nothing else reads it).
 //
 // Every fetch is a textureLoad of one texel.
 
@@ -25,12 +27,10 @@ struct Field {
 };
 
 var<push_constant> field: Field;
-// The pass's input: the distances (fs_ramp).
-@group(0) @binding(0) var source: texture_2d<f32>;
-// The shadow mask, for fs_distance.
-@group(0) @binding(1) var shadow_mask: texture_2d<f32>;
-// fs_distance: each texel's nearest shadow texel, packed as x | y << 16, NO_SEED if none.
-@group(0) @binding(2) var<storage, read> nearest: array<u32>;
+// The shadow mask.
+@group(0) @binding(0) var shadow_mask: texture_2d<f32>;
+// Each texel's nearest shadow texel, packed as x | y << 16, NO_SEED if none.
+@group(0) @binding(1) var<storage, read> nearest: array<u32>;
 
 // No shadow texel in the region.
 const NO_SEED: u32 = 0xffffffffu;
@@ -62,20 +62,24 @@ fn edge_distance_m(offset: vec2<f32>) -> f32 {
     return length(offset * field.texel_m) * (1.0 - 0.5 / texels);
 }
 
-@fragment
-fn fs_distance(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(frag.xy);
+// d of texel p: -1 inside the shadow, FAR_M outside the region or without a shadow texel.
+fn distance_at(p: vec2<i32>) -> f32 {
     if !in_region(p) {
-        return vec4<f32>(FAR_M, 0.0, 0.0, 0.0);
+        return FAR_M;
     }
     if textureLoad(shadow_mask, p, 0).r > 0.5 {
-        return vec4<f32>(-1.0, 0.0, 0.0, 0.0);
+        return -1.0;
     }
     let seed = nearest[p.y * field.nearest_pitch + p.x];
     if seed == NO_SEED {
-        return vec4<f32>(FAR_M, 0.0, 0.0, 0.0);
+        return FAR_M;
     }
-    return vec4<f32>(edge_distance_m(unpack(seed) - vec2<f32>(p)), 0.0, 0.0, 0.0);
+    return edge_distance_m(unpack(seed) - vec2<f32>(p));
+}
+
+@fragment
+fn fs_distance(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(distance_at(vec2<i32>(frag.xy)), 0.0, 0.0, 0.0);
 }
 
 // eq. 2: alpha(d) = (D - d) / D for 0 <= d < D, 0 beyond D and inside the shadow (d < 0).
@@ -88,7 +92,7 @@ fn ramp(d_m: f32, width_m: f32) -> f32 {
 
 @fragment
 fn fs_ramp(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let d_m = textureLoad(source, vec2<i32>(frag.xy), 0).r;
+    let d_m = distance_at(vec2<i32>(frag.xy));
     // eq. 4: alpha'(d) = k alpha(d).
     return vec4<f32>(field.k * ramp(d_m, field.ramp_width_m), 0.0, 0.0, 0.0);
 }

@@ -104,9 +104,7 @@ pub struct FieldPassesMedians {
     pub mask_ms: f64,
     /// The nearest shadow texel of every texel (distance transform).
     pub nearest_ms: f64,
-    /// The distance to the shadow edge.
-    pub distance_ms: f64,
-    /// The inducer's gain (ramp).
+    /// The inducer's gain (ramp), with the distance to the shadow edge.
     pub ramp_ms: f64,
     /// The live caustic map's photons (clearing, tracing, splatting).
     pub caustic_photons_ms: f64,
@@ -123,7 +121,6 @@ impl FieldPassesMedians {
         (!frames.is_empty()).then(|| FieldPassesMedians {
             mask_ms: median(|f| f.mask_ms),
             nearest_ms: median(|f| f.nearest_ms),
-            distance_ms: median(|f| f.distance_ms),
             ramp_ms: median(|f| f.ramp_ms),
             caustic_photons_ms: median(|f| f.caustic_photons_ms),
             caustic_smoothing_ms: median(|f| f.caustic_smoothing_ms),
@@ -550,11 +547,10 @@ impl BenchReport {
         for (effects, f) in stages {
             let _ = writeln!(
                 out,
-                "  {effects:<24} mask {:.2}, nearest {:.2}, distance {:.2}, ramp {:.2}, \
+                "  {effects:<24} mask {:.2}, nearest {:.2}, ramp {:.2}, \
                  live caustics {:.2} (photons {:.2}, smoothing {:.2})",
                 f.mask_ms,
                 f.nearest_ms,
-                f.distance_ms,
                 f.ramp_ms,
                 f.caustic_photons_ms + f.caustic_smoothing_ms,
                 f.caustic_photons_ms,

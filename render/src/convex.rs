@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 
 /// Most facet planes a convex object may have for the exact exit (a round brilliant has 73
 /// with its girdle band): each internal reflection tests every plane once.
@@ -260,10 +260,93 @@ pub fn is_convex(positions: &[Vec3], indices: &[u32]) -> bool {
     connected && volume > 0.0
 }
 
+/// The convex hull of `points`: its corners counter-clockwise (x right, y up) from the
+/// lowest-leftmost one, without points on its edges. Fewer than three corners when the points
+/// are fewer or collinear; empty when a coordinate is not finite. Andrew's monotone chain,
+/// with the turn of each corner in f64 (exact for f32 inputs up to rounding of one product).
+pub fn hull_2d(points: &[Vec2]) -> Vec<Vec2> {
+    if points.iter().any(|p| !p.is_finite()) {
+        return Vec::new();
+    }
+    let mut sorted = points.to_vec();
+    sorted.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    sorted.dedup();
+    if sorted.len() < 3 {
+        return sorted;
+    }
+    // Twice the signed area of (o, a, b): positive for a left (counter-clockwise) turn.
+    let turn = |o: Vec2, a: Vec2, b: Vec2| {
+        let (o, a, b) = (o.as_dvec2(), a.as_dvec2(), b.as_dvec2());
+        (a - o).perp_dot(b - o)
+    };
+    let mut hull: Vec<Vec2> = Vec::with_capacity(sorted.len() + 1);
+    // Adds `p` after popping the corners it does not turn left from, keeping the first `keep`.
+    let add = |hull: &mut Vec<Vec2>, p: Vec2, keep: usize| {
+        while hull.len() >= keep + 2 && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
+            hull.pop();
+        }
+        hull.push(p);
+    };
+    // The lower chain left to right, then the upper chain back from the rightmost point.
+    for &p in &sorted {
+        add(&mut hull, p, 0);
+    }
+    let lower = hull.len() - 1;
+    for &p in sorted.iter().rev().skip(1) {
+        add(&mut hull, p, lower);
+    }
+    // The last point is the first again.
+    hull.pop();
+    hull
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::solid::flat_cube as cube;
+
+    /// Twice the signed area of (o, a, b), in f64.
+    fn turn(o: Vec2, a: Vec2, b: Vec2) -> f64 {
+        (a.as_dvec2() - o.as_dvec2()).perp_dot(b.as_dvec2() - o.as_dvec2())
+    }
+
+    #[test]
+    fn hull_of_a_square_drops_the_points_inside_and_on_its_edges() {
+        let mut points = vec![
+            Vec2::new(0.5, 0.5),
+            Vec2::new(0.5, 0.0),
+            Vec2::new(1.0, 0.5),
+        ];
+        points.extend([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]].map(Vec2::from));
+        points.push(Vec2::new(1.0, 1.0));
+        let hull = hull_2d(&points);
+        let expected = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]].map(Vec2::from);
+        assert_eq!(hull, expected);
+        assert!(hull_2d(&[Vec2::ZERO, Vec2::ONE, Vec2::splat(2.0)]).len() < 3);
+        assert!(hull_2d(&[Vec2::ZERO, Vec2::X, Vec2::new(f32::NAN, 1.0)]).is_empty());
+    }
+
+    proptest::proptest! {
+        /// Every point lies inside or on the hull, whose corners are input points turning left
+        /// at every corner.
+        #[test]
+        fn hull_holds_every_point_and_turns_left(
+            raw in proptest::collection::vec((-1.0f32..1.0, -1.0f32..1.0), 3..200)
+        ) {
+            let points: Vec<Vec2> = raw.iter().map(|&(x, y)| Vec2::new(x, y)).collect();
+            let hull = hull_2d(&points);
+            proptest::prop_assume!(hull.len() >= 3);
+            let n = hull.len();
+            for (i, &corner) in hull.iter().enumerate() {
+                proptest::prop_assert!(points.contains(&corner));
+                let (next, after) = (hull[(i + 1) % n], hull[(i + 2) % n]);
+                proptest::prop_assert!(turn(corner, next, after) > 0.0);
+                for &p in &points {
+                    proptest::prop_assert!(turn(corner, next, p) >= -1e-12, "{p} outside");
+                }
+            }
+        }
+    }
 
     #[test]
     fn a_cube_has_six_outward_planes_and_rays_leave_it_where_geometry_says() {

@@ -1,8 +1,8 @@
 //! The nearest shadow texel of every texel of the fields' region (shaders/inducer_distance.wgsl):
 //! an exact Euclidean distance transform of the shadow mask, separable, in two compute passes
-//! (one invocation per column of the region, then one per row), into a buffer that
-//! `fs_distance` turns into the distance d to the shadow edge (`edge_distance_m` in
-//! [`super::reference`] on the CPU). Each texel of the mask is read twice, where a jump flood
+//! (one invocation per column of the region, then one per row), into a buffer from which
+//! `fs_ramp` (and `fs_distance`, for a read back) find the distance d to the shadow edge
+//! (`edge_distance_m` in [`super::reference`] on the CPU). Each texel of the mask is read twice, where a jump flood
 //! reads nine seeds per texel and pass.
 //!
 //! Also the indices of the floor pass's full-screen pipelines.
@@ -61,7 +61,7 @@ pub(crate) struct DistanceTransform {
     /// Scratch: the nearest shadow row per texel in its column, the rows' envelopes.
     _scratch: [Buffer; 3],
     /// The nearest shadow texel per texel, x | y << 16, rows [`pitch`] texels apart (read by
-    /// `fs_distance`).
+    /// `fs_ramp` and `fs_distance`).
     pub nearest: Buffer,
     /// Side of the fields, texels.
     size: u32,

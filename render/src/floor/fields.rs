@@ -8,11 +8,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::Image;
 use crate::owned::Owned;
-use crate::pipeline::{
-    self, Blend, FieldStart, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec,
-};
-use crate::scene::MeshRef;
-use crate::shaders;
+use crate::pipeline::{self, FieldStart};
 
 /// Indices into the pass's field targets.
 pub(crate) const MASK: usize = 0;
@@ -168,8 +164,8 @@ pub(crate) struct FieldPush {
     pub k: f32,
     /// Padding (the region is 16-byte aligned).
     pub _pad: [f32; 3],
-    /// The texels the fields are computed in (`[x0, y0, x1, y1]`, ends excluded): the
-    /// distance pass writes "beyond the ramp" outside.
+    /// The texels the fields are computed in (`[x0, y0, x1, y1]`, ends excluded): d is
+    /// "beyond the ramp" outside.
     pub region: [i32; 4],
 }
 
@@ -255,10 +251,10 @@ impl InducerFields {
 }
 
 /// Timestamps the floor passes write after each of their stages, in this order: the mask, the
-/// nearest shadow texels, the distance, the ramp, the live caustics' photons, their smoothing.
-pub const FIELD_STAMPS: u32 = 6;
+/// nearest shadow texels, the ramp, the live caustics' photons, their smoothing.
+pub const FIELD_STAMPS: u32 = 5;
 /// The stamp written after the live caustics' photons (the one after their smoothing follows).
-pub(crate) const CAUSTIC_PHOTONS_STAMP: u32 = 4;
+pub(crate) const CAUSTIC_PHOTONS_STAMP: u32 = 3;
 
 /// GPU milliseconds of each stage of the floor passes in one frame (0 for a stage that did
 /// not run: nothing moved, or no live caustics).
@@ -268,9 +264,7 @@ pub struct FieldPassesMs {
     pub mask_ms: f64,
     /// The nearest shadow texel of every texel (the distance transform's compute passes).
     pub nearest_ms: f64,
-    /// The distance to the shadow edge.
-    pub distance_ms: f64,
-    /// The gain k alpha(d) (eq. 2, 4).
+    /// The gain k alpha(d) (eq. 2, 4), with the distance d to the shadow edge.
     pub ramp_ms: f64,
     /// The live caustic map's photons: clearing the sums, tracing and splatting.
     pub caustic_photons_ms: f64,
@@ -291,10 +285,9 @@ impl FieldPassesMs {
         FieldPassesMs {
             mask_ms: ms[0],
             nearest_ms: ms[1],
-            distance_ms: ms[2],
-            ramp_ms: ms[3],
-            caustic_photons_ms: ms[4],
-            caustic_smoothing_ms: ms[5],
+            ramp_ms: ms[2],
+            caustic_photons_ms: ms[3],
+            caustic_smoothing_ms: ms[4],
         }
     }
 
@@ -305,7 +298,7 @@ impl FieldPassesMs {
 
     /// Their sum.
     pub fn total_ms(&self) -> f64 {
-        self.mask_ms + self.nearest_ms + self.distance_ms + self.ramp_ms + self.live_caustics_ms()
+        self.mask_ms + self.nearest_ms + self.ramp_ms + self.live_caustics_ms()
     }
 }
 
@@ -343,36 +336,4 @@ impl Stamps {
             };
         }
     }
-}
-
-/// The shadow mask's pipeline (shaders/inducer_mask.wgsl) in `render_pass` with `layout` (the
-/// projection as push constant), drawing `mesh`'s positions from the scene's vertex buffer. A
-/// closed mesh's shadow is drawn whole by the triangles facing either way alone
-/// (`convex::is_closed`), so one kind is culled: half the triangles the rasteriser sets up
-/// after every move.
-pub(super) fn mask_pipeline(
-    ctx: &GpuContext,
-    render_pass: vk::RenderPass,
-    layout: vk::PipelineLayout,
-    mesh: &MeshRef,
-) -> Result<Owned<vk::Pipeline>> {
-    let cull = if crate::convex::is_closed(mesh.positions, mesh.indices) {
-        vk::CullModeFlags::BACK
-    } else {
-        vk::CullModeFlags::NONE
-    };
-    pipeline::create(
-        ctx,
-        &PipelineSpec {
-            render_pass,
-            layout,
-            vertex: (shaders::MASK_VS, c"vs_main"),
-            fragment: (shaders::MASK_FS, c"fs_main"),
-            bindings: &[MESH_POSITION_BINDING],
-            attributes: &[MESH_POSITION_ATTRIBUTE],
-            cull,
-            depth: false,
-            blend: Blend::Replace,
-        },
-    )
 }

@@ -8,22 +8,26 @@
 //! floor photo's area (the unit square of [`crate::PlaneDesc::world_from_plane`], texel
 //! (0, 0) at the photo's top-left, so texture uv equals photo uv). Once per pose of the object
 //! and the light (on the first frame that asks for the inducer after a move, or on
-//! [`crate::Renderer::inducer_fields`]) four kinds of fragment passes run, each drawing only
-//! the region that can change (the overlay's rectangle, and where the last computation drew):
+//! [`crate::Renderer::inducer_fields`]) these passes run, each drawing only the region that
+//! can change (the overlay's rectangle, and where the last computation drew):
 //!
-//! 1. **Shadow mask** (eq. 1, shaders/inducer_mask.wgsl): the mesh projected from the point
-//!    light onto the floor plane by a homogeneous planar projection ([`planar_shadow`] in
-//!    geometry.rs) and rasterised straight into floor space; covered texels are in shadow.
+//! 1. **Shadow mask** (eq. 1, mask.rs; shaders/inducer_mask.wgsl): the mesh projected from the
+//!    point light onto the floor plane by a homogeneous planar projection ([`planar_shadow`]
+//!    in geometry.rs) and rasterised straight into floor space; covered texels are in shadow.
 //!    For an opaque occluder this equals a conventional shadow-map lookup at each floor
 //!    texel, without the map's resolution and depth-bias artefacts. A closed mesh is drawn
-//!    from the triangles facing one way only (the same texels, half the triangles).
+//!    from the triangles facing one way only (the same texels, half the triangles); a convex
+//!    one as the convex hull of its projected vertices, found on the CPU (the same texels,
+//!    a fan of a few hundred triangles at most).
 //! 2. **Nearest shadow texel** (distance_transform.rs; shaders/inducer_distance.wgsl): an
 //!    exact Euclidean distance transform of the mask in two compute passes (per column, then
 //!    per row), nearest in metres.
-//! 3. **Distance to the edge** (`fs_distance`, [`edge_distance_m`]): d in metres for every
-//!    lit texel, -1 inside the shadow.
-//! 4. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the texture the
-//!    overlay filters.
+//! 3. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the texture the
+//!    overlay filters, with d, the distance in metres from a lit texel to the shadow edge
+//!    ([`edge_distance_m`]), from its nearest shadow texel.
+//! 4. **Distance to the edge** (`fs_distance`): d itself for every texel, -1 inside the
+//!    shadow, into its own field, drawn only when the fields are read back (nothing else
+//!    reads it).
 //!
 //! Per eye, the floor overlay (overlay.rs; shaders/floor_overlay.wgsl) is a world-anchored
 //! rectangle on the floor plane covering only the shadow plus the ramp (bounded on the CPU
@@ -44,6 +48,7 @@
 //! - `geometry`: the floor's frame, the shadow projection (eq. 1) and the overlay's rectangles;
 //! - `reference`: eq. 2-5 and the exact distance field on the CPU;
 //! - `fields`: the floor-space images, the push constants and the fields read back;
+//! - `mask`: the shadow mask's pipelines, and the hull of a convex mesh's shadow;
 //! - `distance_transform`: the nearest shadow texel of every texel (compute);
 //! - `overlay`: the per-eye overlay pipeline;
 //! - `live`: the caustic gain map computed per pose on the GPU (photon splatting, then
@@ -60,6 +65,7 @@ mod distance_transform;
 mod fields;
 mod geometry;
 mod live;
+mod mask;
 mod overlay;
 mod pass;
 mod progress;

@@ -8,10 +8,11 @@ use glam::{Mat4, Vec2, Vec3};
 use super::distance_transform::{self, DIST, DistanceTransform, RAMP};
 use super::fields::{
     CAUSTIC_PHOTONS_STAMP, CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN,
-    MASK, Stamps, TexelRect, mask_pipeline,
+    MASK, Stamps, TexelRect,
 };
 use super::geometry::{Floor, caustic_rect, shadow_of, texel_rect, texels_plane_rect, union_rect};
 use super::live::{LiveCaustics, LiveCausticsDesc};
+use super::mask::MaskPass;
 use super::overlay::{NO_RECT, OverlayArea, OverlayPass};
 use super::progress::{Prepared, Progress, Written};
 use crate::camera::EyeParams;
@@ -39,8 +40,6 @@ pub(crate) struct InducerPass {
     positions: Vec<Vec3>,
     /// The object's transform and the light the fields are (or are due to be) computed for.
     pose: ScenePose,
-    /// Model space to the mask's clip space; `None` when the light is not above the floor.
-    mask_clip_from_model: Option<Mat4>,
     /// Plane-local rectangle the inducer's light covers; `None` when nothing can be lit.
     pub(super) rect: Option<[f32; 4]>,
     /// Plane-local rectangle of the caustics' non-zero extent; `None` without caustics or
@@ -49,34 +48,29 @@ pub(crate) struct InducerPass {
     /// A live map is computed for the current pose and the host has not yet read its bounds:
     /// the overlay takes them from the GPU ([`OverlayPass::live_bounds`]).
     live_rect_on_gpu: bool,
-    /// Triangle indices of the mesh.
-    index_count: u32,
     /// What has really been computed.
     pub(super) progress: Progress,
     /// The overlay drawn in the eye passes.
     overlay: OverlayPass,
-    /// The mask pipeline.
-    mask_pipeline: Owned<vk::Pipeline>,
-    /// Layout of the mask pass (push constants only).
-    mask_layout: Owned<vk::PipelineLayout>,
+    /// The shadow mask's pipelines and what the current pose draws.
+    mask: MaskPass,
     /// Distance and ramp pipelines (`DIST`, `RAMP`).
     field_pipelines: Vec<Owned<vk::Pipeline>>,
     /// Their pipeline layout.
     field_layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets below.
     _pool: Owned<vk::DescriptorPool>,
-    /// Set layout of the full-screen passes: source and mask textures and the nearest shadow
-    /// texels (fs_distance).
+    /// Set layout of the full-screen passes: the mask and the nearest shadow texels.
     _field_set_layout: Owned<vk::DescriptorSetLayout>,
-    /// The set reading each field image as the source (null for images never read so).
-    source_sets: [vk::DescriptorSet; FIELDS.len()],
+    /// Their set.
+    field_set: vk::DescriptorSet,
     /// The caustic gain G (R32F, filtered by the overlay; zeros without a map).
     caustic: Image,
     /// Its size: the bake's, or the fields' without one.
     caustic_extent: vk::Extent2D,
     /// Caustics computed per pose into `caustic`, once enabled.
     live: Option<LiveCaustics>,
-    /// The nearest shadow texel of every texel (read by the distance pass).
+    /// The nearest shadow texel of every texel (read by the distance and ramp passes).
     transform: DistanceTransform,
     /// Mask, distance and gain, in the order of [`FIELDS`].
     pub(super) targets: Vec<FieldTarget>,
@@ -124,22 +118,18 @@ impl InducerPass {
             targets.push(FieldTarget::new(ctx, name, format, field_extent)?);
         }
 
-        let vertex = vk::ShaderStageFlags::VERTEX;
         let fragment = vk::ShaderStageFlags::FRAGMENT;
-        let mask_layout = pipeline::layout(ctx, None, vertex, size_of::<[f32; 16]>() as u32)?;
-        let mask_pipeline = mask_pipeline(
-            ctx,
-            targets[MASK].render_pass(),
-            mask_layout.raw(),
-            &desc.mesh,
-        )?;
+        let (positions, indices) = (desc.mesh.positions, desc.mesh.indices);
+        let convex = crate::convex::is_convex(positions, indices);
+        let closed = convex || crate::convex::is_closed(positions, indices);
+        let mut mask = MaskPass::new(ctx, targets[MASK].render_pass(), &desc.mesh, convex, closed)?;
+        mask.set_pose(mask_clip_from_model, positions);
 
         let field_set_layout = pipeline::set_layout(
             ctx,
             &[
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
-                (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
-                (2, vk::DescriptorType::STORAGE_BUFFER, fragment),
+                (1, vk::DescriptorType::STORAGE_BUFFER, fragment),
             ],
         )?;
         let field_layout = pipeline::layout(
@@ -180,28 +170,17 @@ impl InducerPass {
         )?;
         let mask_view = targets[MASK].image.view;
         let transform = DistanceTransform::new(ctx, mask_view, n, floor.size_m / n as f32)?;
-        let sources = [MASK, DISTANCE];
-        let sets = sources.len() as u32;
         let pool = pipeline::pool(
             ctx,
-            sets,
+            1,
             &[
-                (vk::DescriptorType::SAMPLED_IMAGE, 2 * sets),
-                (vk::DescriptorType::STORAGE_BUFFER, sets),
+                (vk::DescriptorType::SAMPLED_IMAGE, 1),
+                (vk::DescriptorType::STORAGE_BUFFER, 1),
             ],
         )?;
-        let mut source_sets = [vk::DescriptorSet::null(); FIELDS.len()];
-        // Every binding of every set is written, though each pass reads only some: lavapipe
-        // reads every binding of a bound set.
-        let nearest = transform.nearest.buffer;
-        for source in sources {
-            let set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
-            let view = targets[source].image.view;
-            pipeline::write_image(ctx, set, 0, view);
-            pipeline::write_image(ctx, set, 1, mask_view);
-            pipeline::write_storage_buffer(ctx, set, 2, nearest);
-            source_sets[source] = set;
-        }
+        let field_set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
+        pipeline::write_image(ctx, field_set, 0, mask_view);
+        pipeline::write_storage_buffer(ctx, field_set, 1, transform.nearest.buffer);
         let overlay = OverlayPass::new(
             ctx,
             eye_render_pass,
@@ -217,20 +196,17 @@ impl InducerPass {
             floor,
             positions: desc.mesh.positions.to_vec(),
             pose,
-            mask_clip_from_model,
             rect,
             caustic_rect,
             live_rect_on_gpu: false,
-            index_count: scene.index_count,
             progress: Progress::default(),
             overlay,
-            mask_pipeline,
-            mask_layout,
+            mask,
             field_pipelines,
             field_layout,
             _pool: pool,
             _field_set_layout: field_set_layout,
-            source_sets,
+            field_set,
             caustic,
             caustic_extent,
             transform,
@@ -247,7 +223,7 @@ impl InducerPass {
             return;
         }
         let (clip, rect) = shadow_of(&self.floor, &self.desc, &self.positions, &pose);
-        self.mask_clip_from_model = clip;
+        self.mask.set_pose(clip, &self.positions);
         self.rect = rect;
         self.pose = pose;
         if self.live.is_some() {
@@ -453,6 +429,9 @@ impl InducerPass {
         // bound (this pass's pipelines, sets and targets, the scene's buffers) outlives it;
         // the `Keep` starts are used only once submitted work drew the images.
         unsafe {
+            if region.is_some() {
+                self.mask.record_upload(d, cmd);
+            }
             let mask = &self.targets[MASK];
             mask.begin(
                 d,
@@ -462,65 +441,83 @@ impl InducerPass {
                 CLEAR[MASK],
                 region.unwrap_or(area),
             );
-            if let (Some(_), Some(clip_from_model)) = (region, self.mask_clip_from_model) {
-                d.cmd_bind_pipeline(
-                    cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    self.mask_pipeline.raw(),
-                );
-                d.cmd_push_constants(
-                    cmd,
-                    self.mask_layout.raw(),
-                    vk::ShaderStageFlags::VERTEX,
-                    0,
-                    bytemuck::bytes_of(&clip_from_model.to_cols_array()),
-                );
-                d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
-                d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
-                d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+            if region.is_some() {
+                self.mask.record_draw(d, cmd, scene);
             }
             d.cmd_end_render_pass(cmd);
             stamp(0..1);
             let Some(region) = region else {
                 // No shadow: no light either; only where the last computation drew is cleared.
                 stamp(1..2);
-                for (target, k) in [(DISTANCE, 2), (GAIN, 3)] {
-                    self.targets[target].begin(d, cmd, clear_start, area, CLEAR[target], area);
-                    d.cmd_end_render_pass(cmd);
-                    stamp(k..k + 1);
-                }
+                self.targets[GAIN].begin(d, cmd, clear_start, area, CLEAR[GAIN], area);
+                d.cmd_end_render_pass(cmd);
+                stamp(2..3);
                 return None;
             };
             self.transform.record(ctx, cmd, region);
             stamp(1..2);
             let push = self.push(region);
-            for (target, pipeline, source, k) in
-                [(DISTANCE, DIST, MASK, 2), (GAIN, RAMP, DISTANCE, 3)]
-            {
-                let set = self.source_sets[source];
-                self.full_screen(ctx, cmd, target, pipeline, draw_start, area, set, &push);
-                stamp(k..k + 1);
-            }
+            self.full_screen(ctx, cmd, (GAIN, RAMP), draw_start, area, &push);
+            stamp(2..3);
         }
         region
     }
 
-    /// One full-screen pass of `pipeline` into field `target` starting as `start` says,
-    /// drawing every texel of `area` and nothing else.
+    /// Records the distance field's pass over the whole image (d of eq. 2 per texel: -1 in
+    /// the shadow, [`super::FAR_M`] beyond the fields' region), from the mask and the nearest
+    /// shadow texels of the last computation recorded, for a read back: the frames' ramp
+    /// computes d itself and nothing else reads the field.
     ///
     /// # Safety
-    /// As [`InducerPass::prepare`]; `set` must be one of this pass's sets; for the `Keep`
-    /// starts the target must be in SHADER_READ_ONLY_OPTIMAL.
-    #[allow(clippy::too_many_arguments)]
+    /// As [`InducerPass::prepare`], after the pose's fields were recorded into `cmd` or into
+    /// a command buffer submitted earlier.
+    pub(super) unsafe fn record_distance(&self, ctx: &GpuContext, cmd: vk::CommandBuffer) {
+        let n = self.desc.resolution_px;
+        let whole = [0, 0, n, n];
+        // SAFETY: the caller's contract; every texel is drawn or cleared, so the image's
+        // earlier contents do not matter.
+        unsafe {
+            match self.rect.map(|r| texel_rect(r, n, n)) {
+                Some(region) => {
+                    let push = self.push(region);
+                    self.full_screen(
+                        ctx,
+                        cmd,
+                        (DISTANCE, DIST),
+                        FieldStart::Discard,
+                        whole,
+                        &push,
+                    );
+                }
+                None => {
+                    let target = &self.targets[DISTANCE];
+                    target.begin(
+                        &ctx.device,
+                        cmd,
+                        FieldStart::Clear,
+                        whole,
+                        CLEAR[DISTANCE],
+                        whole,
+                    );
+                    ctx.device.cmd_end_render_pass(cmd);
+                }
+            }
+        }
+    }
+
+    /// One full-screen pass of `pipeline` into field `target` (`(target, pipeline)`) starting
+    /// as `start` says, drawing every texel of `area` and nothing else.
+    ///
+    /// # Safety
+    /// As [`InducerPass::prepare`]; for the `Keep` starts the target must be in
+    /// SHADER_READ_ONLY_OPTIMAL.
     unsafe fn full_screen(
         &self,
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
-        target: usize,
-        pipeline: usize,
+        (target, pipeline): (usize, usize),
         start: FieldStart,
         area: TexelRect,
-        set: vk::DescriptorSet,
         push: &FieldPush,
     ) {
         let d = &ctx.device;
@@ -538,7 +535,7 @@ impl InducerPass {
                 vk::PipelineBindPoint::GRAPHICS,
                 self.field_layout.raw(),
                 0,
-                &[set],
+                &[self.field_set],
                 &[],
             );
             d.cmd_push_constants(

@@ -11,8 +11,9 @@ use crate::memory::{Buffer, layout_barrier, subresource_range};
 use crate::scene::GpuScene;
 
 impl InducerPass {
-    /// Computes the fields if no submitted work has, then copies the mask, the distance
-    /// field and the gain back to the CPU. Waits for the GPU (at most the fence timeout).
+    /// Computes the fields if no submitted work has, draws the distance field (frames do not:
+    /// [`InducerPass::record_distance`]), then copies the mask, the distance field and the
+    /// gain back to the CPU. Waits for the GPU (at most the fence timeout).
     pub fn read_back(&mut self, ctx: &GpuContext, scene: &GpuScene) -> Result<InducerFields> {
         let n = self.desc.resolution_px;
         let texels = u64::from(n) * u64::from(n);
@@ -37,6 +38,7 @@ impl InducerPass {
                 // The live caustic map with them: the pose's work counts as done after this.
                 prepared.fields_within = this.record_pose_work(ctx, cmd, scene, None);
             }
+            this.record_distance(ctx, cmd);
             this.record_copies(d, cmd, &offsets, &buffer);
         });
         if let Err(e) = result {

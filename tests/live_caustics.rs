@@ -314,6 +314,7 @@ fn the_moving_light_scenes_settings_match_the_bake_too() {
     let live = LiveCausticsDesc {
         photons_per_side: c.photons_per_side,
         smoothing_px: c.smoothing_px,
+        min_path_weight: c.min_path_weight,
         ..LiveCausticsDesc::default()
     };
     assert!(
@@ -321,6 +322,68 @@ fn the_moving_light_scenes_settings_match_the_bake_too() {
         "the scene's own, fewer photons"
     );
     check_sphere(Some(c.resolution_px), live);
+    // The paths its larger least weight ends carry little light: the map's total is lower
+    // than with the default weight, by less than 1 %.
+    let (scene, _) = live_scene("glass-sphere.toml", Some(c.resolution_px));
+    let total = |min_path_weight| -> f64 {
+        let desc = LiveCausticsDesc {
+            min_path_weight,
+            ..live
+        };
+        let frames = live_gains(&scene, desc, &[None], false);
+        frames[0].gain.iter().map(|&g| f64::from(g)).sum()
+    };
+    let default = LiveCausticsDesc::default().min_path_weight;
+    assert!(
+        live.min_path_weight > default,
+        "the scene's own, larger weight"
+    );
+    let (cut, full) = (total(live.min_path_weight), total(default));
+    eprintln!(
+        "total G {cut:.1} with paths ending below {}, {full:.1} below {default}",
+        live.min_path_weight
+    );
+    assert!(cut < full && cut > 0.99 * full, "{cut} against {full}");
+}
+
+/// Live settings outside their ranges are refused with an error, and the renderer still
+/// draws with its bake.
+#[test]
+fn live_settings_out_of_range_are_refused() {
+    let scene = baked_scene("glass-sphere.toml");
+    let desc = views::scene_desc(&scene, None);
+    let mut renderer =
+        Renderer::new(vitreous_tests::validated_context(), &desc, 32, 32).expect("renderer");
+    let good = LiveCausticsDesc::default();
+    let bad = [
+        LiveCausticsDesc {
+            photons_per_side: 0,
+            ..good
+        },
+        LiveCausticsDesc {
+            max_interactions: 0,
+            ..good
+        },
+        LiveCausticsDesc {
+            smoothing_px: 65,
+            ..good
+        },
+    ]
+    .into_iter()
+    .chain(
+        [0.0, 1.0, -0.1, f32::NAN].map(|min_path_weight| LiveCausticsDesc {
+            min_path_weight,
+            ..good
+        }),
+    );
+    for live in bad {
+        let error = renderer.enable_live_caustics(&desc, live).unwrap_err();
+        assert!(
+            matches!(error, vitreous_render::RenderError::InvalidInput(_)),
+            "{live:?}: {error}"
+        );
+    }
+    assert_eq!(renderer.live_caustic_gain().expect("no map"), None);
 }
 
 /// The glass sphere's live map on a `side` x `side` map (`None`: the default) with `live`:

@@ -67,15 +67,17 @@ pub fn enable_live_caustics(
     let live = vitreous_render::floor::LiveCausticsDesc {
         photons_per_side: scene.caustics.photons_per_side,
         smoothing_px: scene.caustics.smoothing_px,
+        min_path_weight: scene.caustics.min_path_weight,
         ..Default::default()
     };
     renderer.enable_live_caustics(&scene_desc(scene, None), live)?;
     let side = scene.caustics.resolution_px;
     tracing::info!(
         "caustics computed on the GPU for each pose: a {side} x {side} map, {n} x {n} photons, \
-         smoothed over {r} texels",
+         smoothed over {r} texels, paths ending below {w} of a photon",
         n = live.photons_per_side,
-        r = live.smoothing_px
+        r = live.smoothing_px,
+        w = live.min_path_weight
     );
     Ok(())
 }

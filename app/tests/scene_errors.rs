@@ -636,6 +636,24 @@ fn caustics_mode_and_live_sizes_are_checked() {
     let text = text.replace("-1", "3");
     let (_dir, _path, result) = load_text(&text);
     assert_eq!(result.unwrap().caustics.smoothing_px, 3);
+    for weight in ["0.0", "1.0", "-0.5", "nan"] {
+        let text = format!(
+            "{}\n[caustics]\nmode = \"live\"\nmin_path_weight = {weight}\n",
+            good_text()
+        );
+        let msg = expect_error(
+            &text,
+            line_of(&text, "min_path_weight"),
+            "caustics.min_path_weight",
+        );
+        assert!(msg.contains("> 0 and < 1"), "{msg}");
+    }
+    let text = format!(
+        "{}\n[caustics]\nmode = \"live\"\nmin_path_weight = 0.05\n",
+        good_text()
+    );
+    let (_dir, _path, result) = load_text(&text);
+    assert_eq!(result.unwrap().caustics.min_path_weight, 0.05);
     let text = format!(
         "{}\n[caustics]\nmode = \"live\"\nresolution_px = 8\n",
         good_text()

@@ -72,6 +72,7 @@ pub(crate) struct CausticsToml {
     pub resolution_px: Option<Spanned<i64>>,
     pub photons_per_side: Option<Spanned<i64>>,
     pub smoothing_px: Option<Spanned<i64>>,
+    pub min_path_weight: Option<Spanned<f32>>,
 }
 
 /// `[gaze]`: how the gaze image is chosen for defocus.

@@ -368,6 +368,13 @@ impl Loader<'_> {
                 live_default.smoothing_px,
                 0..=MAX_SMOOTHING_PX,
             )?,
+            min_path_weight: self.number(
+                "caustics.min_path_weight",
+                raw.caustics.min_path_weight.as_ref(),
+                live_default.min_path_weight,
+                (0.0, 1.0),
+                (true, true),
+            )?,
         };
         let gaze = GazeChoice {
             filter: match &raw.gaze.filter {

@@ -105,6 +105,8 @@ pub struct Caustics {
     pub photons_per_side: u32,
     /// Radius of the box the live map is smoothed with, texels (live mode; 0: none).
     pub smoothing_px: u32,
+    /// Light paths carrying less than this share of their photon's light end (live mode).
+    pub min_path_weight: f32,
 }
 
 impl Scene {

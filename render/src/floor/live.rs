@@ -24,12 +24,15 @@ use crate::scene::MeshRef;
 use crate::shaders;
 
 /// How caustics are computed live.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LiveCausticsDesc {
     /// Photons along each side of the emission grid (its square is the photon count).
     pub photons_per_side: u32,
     /// Most reflections and refractions on one light path (the bake's default: 12).
     pub max_interactions: u32,
+    /// Light paths carrying less than this share of their photon's light end (greater than
+    /// 0, less than 1; the bake follows them to 1e-4).
+    pub min_path_weight: f32,
     /// Radius of the box the map is smoothed with, texels of the map (0: not smoothed): each
     /// texel becomes the mean of the 2 r + 1 texels around it, three times along the rows,
     /// then three times along the columns, a kernel close to a Gaussian of standard deviation
@@ -41,7 +44,8 @@ pub struct LiveCausticsDesc {
 }
 
 impl Default for LiveCausticsDesc {
-    /// 128 x 128 photons, 12 interactions, a smoothing box of radius 2 texels (on the default
+    /// 128 x 128 photons, 12 interactions, paths ending below [`MIN_WEIGHT`], a smoothing box
+    /// of radius 2 texels (on the default
     /// [`DEFAULT_RESOLUTION_PX`] map, the glass sphere's map within 0.6 % of its bake and the
     /// diamond's within 3.3 %, both bakes averaged to that resolution and smoothed alike;
     /// docs/caustics.md).
@@ -49,6 +53,7 @@ impl Default for LiveCausticsDesc {
         LiveCausticsDesc {
             photons_per_side: 128,
             max_interactions: 12,
+            min_path_weight: MIN_WEIGHT,
             smoothing_px: 2,
             skip_tiles: true,
         }
@@ -68,7 +73,7 @@ pub const MAX_SMOOTHING_PX: u32 = 64;
 /// Fixed-point units per unit of gain in the sums (integer atomics keep the result the same
 /// whatever order photons land in).
 pub(super) const FIXED_POINT: f32 = 65536.0;
-/// Paths below this weight end. The bake follows them to 1e-4; the live maps of the sphere,
+/// Paths below this weight end by default. The bake follows them to 1e-4; the live maps of the sphere,
 /// the diamond and the torus are as close to their bakes with 1e-2 (0.52 %, 3.23 % and 3.38 %
 /// against 0.51 %, 3.23 % and 3.40 %), and the sphere's stage after a move costs about 10 ms
 /// less on lavapipe (a ball's second internal reflection, 0.16 % of the light, is one more
@@ -176,14 +181,18 @@ impl LiveCaustics {
         desc: LiveCausticsDesc,
         bounds: vk::Buffer,
     ) -> Result<LiveCaustics> {
+        let weight = desc.min_path_weight;
         if !(1..=MAX_PHOTONS_PER_SIDE).contains(&desc.photons_per_side)
             || desc.max_interactions == 0
             || desc.smoothing_px > MAX_SMOOTHING_PX
+            || weight.is_nan()
+            || weight <= 0.0
+            || weight >= 1.0
         {
             return Err(RenderError::InvalidInput(format!(
                 "live caustics need 1..={MAX_PHOTONS_PER_SIDE} photons per side, at least \
-                 one interaction and a smoothing of 0..={MAX_SMOOTHING_PX} texels, got {}, {} \
-                 and {}",
+                 one interaction, a smoothing of 0..={MAX_SMOOTHING_PX} texels and a least \
+                 path weight above 0 and below 1, got {}, {}, {} and {weight}",
                 desc.photons_per_side, desc.max_interactions, desc.smoothing_px
             )));
         }
@@ -389,6 +398,7 @@ impl LiveCaustics {
                 solid_angle * (n * n) as f32,
                 texel_area,
                 n,
+                self.desc.min_path_weight,
             );
         // Rounding room for the shell's radii and the stretches of a ray inside it.
         let slack = self.model_radius * SHELL_SLACK;
@@ -409,7 +419,13 @@ impl LiveCaustics {
                 self.desc.max_interactions,
                 self.desc.smoothing_px,
             ],
-            misc: Vec4::new(self.model_radius * 2e-5, FIXED_POINT, MIN_WEIGHT, MIN_GAIN).to_array(),
+            misc: Vec4::new(
+                self.model_radius * 2e-5,
+                FIXED_POINT,
+                self.desc.min_path_weight,
+                MIN_GAIN,
+            )
+            .to_array(),
             shell: self
                 .model_center
                 .extend((self.model_inner_radius - slack).max(0.0))

@@ -15,7 +15,7 @@ use ash::vk;
 use glam::{Mat4, Vec3};
 use gpu_allocator::MemoryLocation;
 
-use super::live::{FIXED_POINT, MIN_WEIGHT};
+use super::live::FIXED_POINT;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::Buffer;
@@ -272,14 +272,16 @@ const MASS_UNIT: f32 = 16.0;
 /// (`cell_mass` in shaders/shared/caustics_maps.wgsl, a u32 sum) can wrap round. A photon's paths split its
 /// light, so its shares sum to at most one share at the floor's point where G per unit of
 /// light, r^2 / cos theta = r^3 / height, is largest: the corner farthest from the light.
-/// Each path's rounding adds at most 3 units, and paths end below MIN_WEIGHT, so a photon has
-/// at most 1 / MIN_WEIGHT of them. The shipped scenes stay below it by a factor of about 30.
+/// Each path's rounding adds at most 3 units, and paths end below `min_path_weight`, so a
+/// photon has at most 1 / `min_path_weight` of them. The shipped scenes stay below it by a
+/// factor of about 30.
 pub(super) fn shares_fit(
     world_from_plane: Mat4,
     light: Vec3,
     cone_sr: f32,
     texel_area: f32,
     photons_per_side: u32,
+    min_path_weight: f32,
 ) -> bool {
     let p = world_from_plane;
     let normal = p.x_axis.truncate().cross(p.y_axis.truncate()).normalize();
@@ -294,7 +296,7 @@ pub(super) fn shares_fit(
         .fold(0.0f32, f32::max);
     let photons = photons_per_side as f32 * photons_per_side as f32;
     let most = cone_sr * farthest.powi(3) / (height * texel_area) * FIXED_POINT / MASS_UNIT
-        + photons * 3.0 / MIN_WEIGHT;
+        + photons * 3.0 / min_path_weight;
     most < 2f32.powi(31)
 }
 
@@ -336,6 +338,7 @@ mod tests {
 
     #[test]
     fn the_shares_fit_unless_the_light_is_nearly_level_with_the_floor() {
+        use crate::floor::live::MIN_WEIGHT;
         // The shipped 1 m floor facing up, 990 x 990 texels, and an 80 mm ball 1.4 m from a
         // light 1 m above it: a cone of about 2.5e-3 sr.
         let floor = Mat4::from_rotation_translation(
@@ -345,7 +348,7 @@ mod tests {
         let texel = 1.0 / (990.0 * 990.0);
         let cone = 2.5e-3;
         let above = Vec3::new(0.0, 0.7, -2.5);
-        assert!(shares_fit(floor, above, cone, texel, 128));
+        assert!(shares_fit(floor, above, cone, texel, 128, MIN_WEIGHT));
         // A light as far off, 0.1 m above the floor: G per unit of light at the far corner is
         // six times larger, within the room the mass unit leaves.
         assert!(shares_fit(
@@ -353,20 +356,25 @@ mod tests {
             Vec3::new(0.0, -0.2, -2.5),
             cone,
             texel,
-            128
+            128,
+            MIN_WEIGHT
         ));
         // 1 mm above the floor's plane: a thousand times larger.
         let level = Vec3::new(0.0, -0.299, -2.5);
-        assert!(!shares_fit(floor, level, cone, texel, 128));
+        assert!(!shares_fit(floor, level, cone, texel, 128, MIN_WEIGHT));
         // Below it: nothing lands.
         assert!(shares_fit(
             floor,
             Vec3::new(0.0, -1.0, -1.5),
             cone,
             texel,
-            128
+            128,
+            MIN_WEIGHT
         ));
-        // Enough photons alone exceed it through their rounding.
-        assert!(!shares_fit(floor, above, cone, texel, 4096));
+        // Enough photons alone exceed it through their rounding, and fewer when their paths
+        // end at a smaller weight.
+        assert!(!shares_fit(floor, above, cone, texel, 4096, MIN_WEIGHT));
+        assert!(shares_fit(floor, above, cone, texel, 1024, MIN_WEIGHT));
+        assert!(!shares_fit(floor, above, cone, texel, 1024, 1e-4));
     }
 }

@@ -19,6 +19,19 @@ pub enum OpenXrError {
          point XR_RUNTIME_JSON at its manifest"
     )]
     NoRuntime(String),
+    /// `xrCreateInstance` failed with API layers enabled: a layer may have refused its
+    /// settings, or the runtime failed.
+    #[error(
+        "xrCreateInstance failed ({error}) with the OpenXR API layers {layers} enabled: a layer \
+         may have refused its settings (see its message above) or the runtime failed; run \
+         without the layers (XR_ENABLE_API_LAYERS unset, no --validate) to tell which"
+    )]
+    LayersOrRuntime {
+        /// What xrCreateInstance returned.
+        error: String,
+        /// The layers enabled, by the environment and by vitreous.
+        layers: String,
+    },
     /// The runtime lacks XR_KHR_vulkan_enable2.
     #[error(
         "the OpenXR runtime does not offer XR_KHR_vulkan_enable2, which vitreous needs to render \
@@ -55,6 +68,33 @@ pub enum OpenXrError {
     FrameOrder(String),
 }
 
+/// Why `xrCreateInstance` failed with `error`, given the layers vitreous asked for and the
+/// value of `XR_ENABLE_API_LAYERS`: with any layer enabled, a layer may be what refused.
+pub(super) fn instance_error(
+    error: &str,
+    requested: &[&str],
+    from_env: Option<&str>,
+) -> OpenXrError {
+    let mut enabled: Vec<&str> = from_env
+        .unwrap_or("")
+        .split([':', ';', ','])
+        .filter(|l| !l.is_empty())
+        .collect();
+    for layer in requested {
+        if !enabled.contains(layer) {
+            enabled.push(layer);
+        }
+    }
+    if enabled.is_empty() {
+        OpenXrError::NoRuntime(format!("xrCreateInstance: {error}"))
+    } else {
+        OpenXrError::LayersOrRuntime {
+            error: error.to_owned(),
+            layers: enabled.join(", "),
+        }
+    }
+}
+
 /// Shorthand for results of this module.
 pub type Result<T, E = OpenXrError> = std::result::Result<T, E>;
 
@@ -67,5 +107,34 @@ pub(crate) trait XrContext<T> {
 impl<T> XrContext<T> for std::result::Result<T, xr::sys::Result> {
     fn xr(self, call: &'static str) -> Result<T> {
         self.map_err(|result| OpenXrError::Call { call, result })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_refused_instance_names_the_enabled_layers() {
+        let error = "XR_ERROR_INITIALIZATION_FAILED";
+        let message = |requested: &[&str], env| instance_error(error, requested, env).to_string();
+        // No layer: the runtime is what failed.
+        let none = message(&[], None);
+        assert!(none.starts_with("no usable OpenXR runtime"), "{none}");
+        assert_eq!(message(&[], Some("")), none);
+        // Layers from the environment and from --validate, each named once.
+        let both = message(
+            &["XR_APILAYER_LUNARG_core_validation"],
+            Some("XR_APILAYER_VITREOUS_sim:XR_APILAYER_LUNARG_core_validation"),
+        );
+        assert!(
+            both.contains(
+                "layers XR_APILAYER_VITREOUS_sim, XR_APILAYER_LUNARG_core_validation enabled"
+            ) && both.contains(error)
+                && !both.contains("Install"),
+            "{both}"
+        );
+        let requested = message(&["XR_APILAYER_LUNARG_core_validation"], None);
+        assert!(requested.contains("may have refused"), "{requested}");
     }
 }

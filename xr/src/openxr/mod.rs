@@ -165,7 +165,10 @@ impl Runtime {
         };
         let instance = entry
             .create_instance(&app, &wanted, &layers, &())
-            .map_err(|e| OpenXrError::NoRuntime(format!("xrCreateInstance: {e}")))?;
+            .map_err(|e| {
+                let from_env = std::env::var("XR_ENABLE_API_LAYERS").ok();
+                error::instance_error(&e.to_string(), &layers, from_env.as_deref())
+            })?;
         let props = instance.properties().xr("xrGetInstanceProperties")?;
         let system = instance
             .system(xr::FormFactor::HEAD_MOUNTED_DISPLAY)

@@ -88,7 +88,10 @@ fn main() {
         });
         let info = naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::PUSH_CONSTANT,
+            // Half floats packed two to a word (pack2x16float) are core SPIR-V for Vulkan
+            // (GLSL.std.450 PackHalf2x16).
+            naga::valid::Capabilities::PUSH_CONSTANT
+                | naga::valid::Capabilities::SHADER_FLOAT16_IN_FLOAT32,
         )
         .validate(&module)
         .unwrap_or_else(|e| {

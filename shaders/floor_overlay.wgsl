@@ -21,7 +21,7 @@ struct Overlay {
 };
 
 var<push_constant> overlay: Overlay;
-// k alpha(d) (fs_ramp of inducer_field.wgsl, R16F) over the floor's unit square.
+// k alpha(d) (`gain_of` in inducer_distance.wgsl, R16F) over the floor's unit square.
 @group(0) @binding(0) var gain: texture_2d<f32>;
 // The registered photo of the real floor: L_r, decoded to linear light by the sRGB format.
 @group(0) @binding(1) var floor_photo: texture_2d<f32>;

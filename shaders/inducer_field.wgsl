@@ -1,16 +1,10 @@
-// Distance to the shadow edge and the inducer's gain, in floor space (METHOD.md section 1,
-// eq. 2-4; render/src/floor/). Full-screen passes over the floor-space textures, drawn only
-// where the fields can change (render/src/floor/pass.rs):
-//
-// 1. (shaders/inducer_distance.wgsl) every texel of the region gets its nearest shadow texel.
-// 2. fs_ramp: k alpha(d) (eq. 2 and 4), the inducer's gain, which the floor overlay
-//    (shaders/floor_overlay.wgsl) filters and adds to the caustic gain G; d, the distance
-//    from a lit texel to the shadow edge in metres, from its nearest shadow texel (the pass
-//    also draws where the region was before, where d is FAR_M).
-// 3. fs_distance: d itself, -1 inside the shadow and FAR_M outside `region`: drawn only
-//    when the fields are read back (nothing else reads it).
-//
-// Every fetch is a textureLoad of one texel.
+// The distance to the shadow edge in floor space (METHOD.md section 1, the d of eq. 2;
+// render/src/floor/), for a read back of the fields: a full-screen pass over the distance
+// field. The frames do not draw it: the rows pass of the distance transform
+// (shaders/inducer_distance.wgsl) finds each texel's nearest shadow texel and writes the gain
+// k alpha(d) itself. fs_distance writes d, -1 inside the shadow and FAR_M outside `region`.
+
+// #include shared/inducer_ramp.wgsl
 
 struct Field {
     // Floor metres per texel along the texture's x (u) and y (v).
@@ -18,10 +12,6 @@ struct Field {
     // Texels per row of `nearest` (the side of the floor-space textures rounded up to a
     // multiple of 4).
     nearest_pitch: i32,
-    // D of eq. 2, metres.
-    ramp_width_m: f32,
-    // k of eq. 4.
-    k: f32,
     // The texels the fields are computed in: x0, y0, x1, y1 (ends excluded).
     region: vec4<i32>,
 };
@@ -53,15 +43,6 @@ fn unpack(seed: u32) -> vec2<f32> {
     return vec2<f32>(f32(seed & 0xffffu), f32(seed >> 16u));
 }
 
-// Distance from a lit texel to the shadow edge, metres, given the offset (texels) to its
-// nearest shadow texel: the edge is taken halfway between that texel's centre and its lit
-// neighbour's, i.e. half a texel short of the shadow texel's centre along the offset.
-// Same formula as inducer::edge_distance_m on the CPU.
-fn edge_distance_m(offset: vec2<f32>) -> f32 {
-    let texels = length(offset);
-    return length(offset * field.texel_m) * (1.0 - 0.5 / texels);
-}
-
 // d of texel p: -1 inside the shadow, FAR_M outside the region or without a shadow texel.
 fn distance_at(p: vec2<i32>) -> f32 {
     if !in_region(p) {
@@ -74,25 +55,10 @@ fn distance_at(p: vec2<i32>) -> f32 {
     if seed == NO_SEED {
         return FAR_M;
     }
-    return edge_distance_m(unpack(seed) - vec2<f32>(p));
+    return edge_distance_m(unpack(seed) - vec2<f32>(p), field.texel_m);
 }
 
 @fragment
 fn fs_distance(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     return vec4<f32>(distance_at(vec2<i32>(frag.xy)), 0.0, 0.0, 0.0);
-}
-
-// eq. 2: alpha(d) = (D - d) / D for 0 <= d < D, 0 beyond D and inside the shadow (d < 0).
-fn ramp(d_m: f32, width_m: f32) -> f32 {
-    if d_m < 0.0 || d_m >= width_m {
-        return 0.0;
-    }
-    return (width_m - d_m) / width_m;
-}
-
-@fragment
-fn fs_ramp(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let d_m = distance_at(vec2<i32>(frag.xy));
-    // eq. 4: alpha'(d) = k alpha(d).
-    return vec4<f32>(field.k * ramp(d_m, field.ramp_width_m), 0.0, 0.0, 0.0);
 }

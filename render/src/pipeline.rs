@@ -278,8 +278,6 @@ pub enum FieldStart {
     /// The image is in SHADER_READ_ONLY_OPTIMAL and keeps its texels outside the render
     /// area; inside it they are cleared.
     KeepClear,
-    /// As `KeepClear`, but every texel of the render area is drawn, so none is cleared.
-    KeepDraw,
 }
 
 /// A render pass with one colour attachment of `format`, starting as `start` says, left for
@@ -297,10 +295,6 @@ pub fn field_render_pass(
         FieldStart::Clear => (vk::AttachmentLoadOp::CLEAR, vk::ImageLayout::UNDEFINED),
         FieldStart::KeepClear => (
             vk::AttachmentLoadOp::CLEAR,
-            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-        ),
-        FieldStart::KeepDraw => (
-            vk::AttachmentLoadOp::DONT_CARE,
             vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
         ),
     };

@@ -60,7 +60,6 @@ pub const FIELD_VS: &[u8] = spirv!("inducer_field.vs_main");
 pub const COLUMNS_CS: &[u8] = spirv!("inducer_distance.cs_columns");
 pub const ROWS_CS: &[u8] = spirv!("inducer_distance.cs_rows");
 pub const DISTANCE_FS: &[u8] = spirv!("inducer_field.fs_distance");
-pub const RAMP_FS: &[u8] = spirv!("inducer_field.fs_ramp");
 pub const OVERLAY_VS: &[u8] = spirv!("floor_overlay.vs_main");
 /// The floor overlay's fragment shader: the inducer's gain alone, with the caustic gain G
 /// (`CAUSTICS`), and with G filtered by the sampler (`FILTERED_CAUSTICS`).

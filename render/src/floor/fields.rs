@@ -28,11 +28,10 @@ pub(crate) const FIELDS: [(&str, vk::Format); 3] = [
 pub(crate) const CLEAR: [f32; 3] = [0.0, 1.0e9, 0.0];
 
 /// The ways a field's render pass may start, in the order of [`FieldTarget`]'s render passes.
-const STARTS: [FieldStart; 4] = [
+const STARTS: [FieldStart; 3] = [
     FieldStart::Discard,
     FieldStart::Clear,
     FieldStart::KeepClear,
-    FieldStart::KeepDraw,
 ];
 
 /// A rectangle of texels `[x0, y0, x1, y1]`, ends excluded.
@@ -68,7 +67,8 @@ impl FieldTarget {
             1,
             vk::ImageUsageFlags::COLOR_ATTACHMENT
                 | vk::ImageUsageFlags::SAMPLED
-                | vk::ImageUsageFlags::TRANSFER_SRC,
+                | vk::ImageUsageFlags::TRANSFER_SRC
+                | vk::ImageUsageFlags::TRANSFER_DST,
         )?;
         let mut render_passes = Vec::with_capacity(STARTS.len());
         for start in STARTS {
@@ -125,7 +125,6 @@ impl FieldTarget {
             FieldStart::Discard => 0,
             FieldStart::Clear => 1,
             FieldStart::KeepClear => 2,
-            FieldStart::KeepDraw => 3,
         };
         let begin = vk::RenderPassBeginInfo::default()
             .render_pass(self.render_passes[index].raw())
@@ -158,12 +157,8 @@ pub(crate) struct FieldPush {
     pub texel_m: [f32; 2],
     /// Texels per row of the nearest shadow texels ([`super::distance_transform::pitch`]).
     pub nearest_pitch: i32,
-    /// D of eq. 2, metres.
-    pub ramp_width_m: f32,
-    /// k of eq. 4.
-    pub k: f32,
     /// Padding (the region is 16-byte aligned).
-    pub _pad: [f32; 3],
+    pub _pad: f32,
     /// The texels the fields are computed in (`[x0, y0, x1, y1]`, ends excluded): d is
     /// "beyond the ramp" outside.
     pub region: [i32; 4],

@@ -22,9 +22,10 @@
 //! 2. **Nearest shadow texel** (distance_transform.rs; shaders/inducer_distance.wgsl): an
 //!    exact Euclidean distance transform of the mask in two compute passes (per column, then
 //!    per row), nearest in metres.
-//! 3. **Gain** (`fs_ramp`, eq. 2 and 4): k alpha(d) in one R16F channel, the texture the
-//!    overlay filters, with d, the distance in metres from a lit texel to the shadow edge
-//!    ([`edge_distance_m`]), from its nearest shadow texel.
+//! 3. **Gain** (eq. 2 and 4): k alpha(d) in one R16F channel, the texture the overlay
+//!    filters, with d, the distance in metres from a lit texel to the shadow edge
+//!    ([`edge_distance_m`]), from its nearest shadow texel: computed by the transform's row
+//!    pass as half floats and copied into the texture.
 //! 4. **Distance to the edge** (`fs_distance`): d itself for every texel, -1 inside the
 //!    shadow, into its own field, drawn only when the fields are read back (nothing else
 //!    reads it).
@@ -38,11 +39,12 @@
 //! L_o = (1 + k alpha(d)) L_r (eq. 5).
 //!
 //! # Synchronisation
-//! Each floor-space pass is its own render pass whose subpass dependencies order it after the
-//! previous pass's colour writes and fragment reads and make its writes visible to fragment
-//! shaders and transfers; its image ends in SHADER_READ_ONLY_OPTIMAL. A recomputation (a
-//! moving light, later) recorded in a frame's command buffer therefore also waits for earlier
-//! frames' overlay reads.
+//! Each floor-space render pass's subpass dependencies order it after the previous pass's
+//! colour writes and fragment reads and make its writes visible to fragment shaders and
+//! transfers; its image ends in SHADER_READ_ONLY_OPTIMAL. The compute passes and the gain's
+//! copy are ordered by pipeline barriers the same way (distance_transform.rs), the gain image
+//! moved to TRANSFER_DST_OPTIMAL for the copy and back. A recomputation recorded in a frame's
+//! command buffer therefore also waits for earlier frames' overlay reads.
 //!
 //! # Modules
 //! - `geometry`: the floor's frame, the shadow projection (eq. 1) and the overlay's rectangles;

@@ -5,7 +5,7 @@
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 
-use super::distance_transform::{self, DIST, DistanceTransform, RAMP};
+use super::distance_transform::{self, DIST, DistanceTransform, Ramp};
 use super::fields::{
     CAUSTIC_PHOTONS_STAMP, CLEAR, DISTANCE, FIELD_STAMPS, FIELDS, FieldPush, FieldTarget, GAIN,
     MASK, Stamps, TexelRect,
@@ -54,7 +54,7 @@ pub(crate) struct InducerPass {
     overlay: OverlayPass,
     /// The shadow mask's pipelines and what the current pose draws.
     mask: MaskPass,
-    /// Distance and ramp pipelines (`DIST`, `RAMP`).
+    /// The distance field's pipeline (`DIST`), for read backs.
     field_pipelines: Vec<Owned<vk::Pipeline>>,
     /// Their pipeline layout.
     field_layout: Owned<vk::PipelineLayout>,
@@ -138,11 +138,8 @@ impl InducerPass {
             fragment,
             size_of::<FieldPush>() as u32,
         )?;
-        // In the order DIST, RAMP, with the field each writes.
-        let field_stages = [
-            (shaders::DISTANCE_FS, c"fs_distance", DISTANCE),
-            (shaders::RAMP_FS, c"fs_ramp", GAIN),
-        ];
+        // In the order of their indices (DIST), with the field each writes.
+        let field_stages = [(shaders::DISTANCE_FS, c"fs_distance", DISTANCE)];
         let mut field_pipelines = Vec::with_capacity(field_stages.len());
         for (spirv, entry, target) in field_stages {
             field_pipelines.push(pipeline::create(
@@ -169,7 +166,12 @@ impl InducerPass {
             bytemuck::cast_slice(caustic_gain),
         )?;
         let mask_view = targets[MASK].image.view;
-        let transform = DistanceTransform::new(ctx, mask_view, n, floor.size_m / n as f32)?;
+        let ramp = Ramp {
+            k: params.k,
+            width_m: params.ramp_width_m,
+            texel_m: floor.size_m / n as f32,
+        };
+        let transform = DistanceTransform::new(ctx, mask_view, n, ramp)?;
         let pool = pipeline::pool(
             ctx,
             1,
@@ -286,14 +288,12 @@ impl InducerPass {
         self.progress.computations
     }
 
-    /// The push constants shared by the full-screen passes.
+    /// The push constants of the full-screen pass.
     fn push(&self, region: TexelRect) -> FieldPush {
         FieldPush {
             texel_m: self.texel_m.to_array(),
             nearest_pitch: distance_transform::pitch(self.desc.resolution_px) as i32,
-            ramp_width_m: self.desc.ramp_width_m,
-            k: self.desc.k,
-            _pad: [0.0; 3],
+            _pad: 0.0,
             region: region.map(|v| v as i32),
         }
     }
@@ -416,9 +416,9 @@ impl InducerPass {
         };
         let n = self.desc.resolution_px;
         let region = self.rect.map(|r| texel_rect(r, n, n));
-        let (before, clear_start, draw_start) = match self.progress.fields_written {
-            Written::Anywhere => (Some([0, 0, n, n]), FieldStart::Clear, FieldStart::Discard),
-            Written::Within(before) => (before, FieldStart::KeepClear, FieldStart::KeepDraw),
+        let (before, clear_start) = match self.progress.fields_written {
+            Written::Anywhere => (Some([0, 0, n, n]), FieldStart::Clear),
+            Written::Within(before) => (before, FieldStart::KeepClear),
         };
         // Nothing drawn before nor now: every field already holds its cleared value.
         let Some(area) = union_rect(before, region) else {
@@ -454,10 +454,11 @@ impl InducerPass {
                 stamp(2..3);
                 return None;
             };
-            self.transform.record(ctx, cmd, region);
+            self.transform.record(ctx, cmd, region, area);
             stamp(1..2);
-            let push = self.push(region);
-            self.full_screen(ctx, cmd, (GAIN, RAMP), draw_start, area, &push);
+            let discard = clear_start == FieldStart::Clear;
+            let gain = self.targets[GAIN].image.image;
+            self.transform.record_gain_copy(d, cmd, gain, area, discard);
             stamp(2..3);
         }
         region

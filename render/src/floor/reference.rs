@@ -1,5 +1,5 @@
 //! The floor passes' equations on the CPU (METHOD.md section 1, paper eq. 2-5): each in one
-//! function, which the GPU passes mirror (shaders/inducer_field.wgsl, floor_overlay.wgsl) and
+//! function, which the GPU passes mirror (shaders/shared/inducer_ramp.wgsl, floor_overlay.wgsl) and
 //! are tested against, and which CPU code computing the same quantity calls. Eq. 1, the
 //! shadow region, is the planar projection in [`super::geometry::planar_shadow`].
 
@@ -20,7 +20,7 @@ pub fn ramp(d_m: f32, ramp_width_m: f32) -> f32 {
 }
 
 /// eq. 4: the inducer's gain alpha'(d) = k alpha(d), relative to the floor's luminance (what
-/// the overlay's gain texture holds, shaders/inducer_field.wgsl `fs_ramp`).
+/// the overlay's gain texture holds, shaders/inducer_distance.wgsl `gain_of`).
 pub fn inducer_gain(k: f32, alpha: f32) -> f32 {
     k * alpha
 }
@@ -40,7 +40,7 @@ pub fn perceived_floor(k: f32, alpha: f32, floor_luminance: f32) -> f32 {
 /// to its nearest shadow texel and the texel size in metres: the edge is taken halfway
 /// between the shadow texel's centre and its lit neighbour's, half a texel short of the
 /// shadow texel's centre along the offset. Same formula as `edge_distance_m` in
-/// shaders/inducer_field.wgsl.
+/// shaders/shared/inducer_ramp.wgsl.
 pub fn edge_distance_m(offset_texels: Vec2, texel_m: Vec2) -> f32 {
     let texels = offset_texels.length();
     (offset_texels * texel_m).length() * (1.0 - 0.5 / texels)

@@ -417,6 +417,34 @@ pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
     }
 }
 
+/// Records a global memory barrier: the accesses `src` of the stages `src_stage` before the
+/// accesses `dst` of the stages `dst_stage`.
+///
+/// # Safety
+/// `cmd` must be recording outside any render pass.
+pub unsafe fn memory_barrier(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    (src_stage, src): (vk::PipelineStageFlags, vk::AccessFlags),
+    (dst_stage, dst): (vk::PipelineStageFlags, vk::AccessFlags),
+) {
+    let memory = [vk::MemoryBarrier::default()
+        .src_access_mask(src)
+        .dst_access_mask(dst)];
+    // SAFETY: the caller's contract; the barrier holds no handles.
+    unsafe {
+        d.cmd_pipeline_barrier(
+            cmd,
+            src_stage,
+            dst_stage,
+            vk::DependencyFlags::empty(),
+            &memory,
+            &[],
+            &[],
+        )
+    };
+}
+
 /// A layout transition of `range` of `image` for `vkCmdPipelineBarrier`: from `old` after
 /// accesses `src` to `new` before accesses `dst`, on one queue (no ownership transfer).
 pub fn layout_barrier(

@@ -15,7 +15,7 @@ use gpu_allocator::MemoryLocation;
 use super::fields::TexelRect;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::memory::{Buffer, layout_barrier, subresource_range};
+use crate::memory::{Buffer, layout_barrier, memory_barrier, subresource_range};
 use crate::owned::Owned;
 use crate::pipeline;
 use crate::shaders;
@@ -202,19 +202,13 @@ impl DistanceTransform {
             _pad: 0.0,
         };
         let barrier = |src_stage, src, dst| {
-            let memory = [vk::MemoryBarrier::default()
-                .src_access_mask(src)
-                .dst_access_mask(dst)];
             // SAFETY: the caller's contract (recording outside a render pass).
             unsafe {
-                d.cmd_pipeline_barrier(
+                memory_barrier(
+                    d,
                     cmd,
-                    src_stage,
-                    vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::DependencyFlags::empty(),
-                    &memory,
-                    &[],
-                    &[],
+                    (src_stage, src),
+                    (vk::PipelineStageFlags::COMPUTE_SHADER, dst),
                 )
             };
         };

@@ -16,7 +16,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::memory::Buffer;
+use crate::memory::{Buffer, memory_barrier};
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec};
 use crate::scene::{GpuScene, MeshRef};
@@ -148,49 +148,28 @@ impl MaskPass {
         if self.hull.is_empty() || !self.draws() {
             return;
         }
-        let barrier = |src_stage, src, dst_stage, dst| {
-            let memory = [vk::MemoryBarrier::default()
-                .src_access_mask(src)
-                .dst_access_mask(dst)];
-            // SAFETY: the caller's contract (outside a render pass).
-            unsafe {
-                d.cmd_pipeline_barrier(
-                    cmd,
-                    src_stage,
-                    dst_stage,
-                    vk::DependencyFlags::empty(),
-                    &memory,
-                    &[],
-                    &[],
-                )
-            };
-        };
-        let (input, transfer) = (
+        let input = (
             vk::PipelineStageFlags::VERTEX_INPUT,
-            vk::PipelineStageFlags::TRANSFER,
+            vk::AccessFlags::VERTEX_ATTRIBUTE_READ,
         );
-        barrier(
-            input,
-            vk::AccessFlags::empty(),
-            transfer,
+        let transfer = (
+            vk::PipelineStageFlags::TRANSFER,
             vk::AccessFlags::TRANSFER_WRITE,
         );
-        // SAFETY: the caller's contract; the data is a multiple of 4 bytes and at most
-        // HULL_BYTES (`hull_triangles`), the buffer's size, which allows transfers into it.
+        // SAFETY: the caller's contract (outside a render pass); the data is a multiple of 4
+        // bytes and at most HULL_BYTES (`hull_triangles`), the buffer's size, which allows
+        // transfers into it; the barriers order the write after earlier draws' reads and
+        // before later ones.
         unsafe {
+            memory_barrier(d, cmd, (input.0, vk::AccessFlags::empty()), transfer);
             d.cmd_update_buffer(
                 cmd,
                 self.hull_buffer.buffer,
                 0,
                 bytemuck::cast_slice(&self.hull),
-            )
-        };
-        barrier(
-            transfer,
-            vk::AccessFlags::TRANSFER_WRITE,
-            input,
-            vk::AccessFlags::VERTEX_ATTRIBUTE_READ,
-        );
+            );
+            memory_barrier(d, cmd, transfer, input);
+        }
     }
 
     /// Records the mask's draw for the current pose (nothing when the light is not above the

@@ -32,6 +32,13 @@ var<private> floor_normal_world: vec3<f32>;
 // Per triangle its first corner and two edges (xyz, model units), gathered once so that a
 // test reads three vectors instead of three indices and three positions.
 @group(0) @binding(8) var<storage, read> corners: array<vec4<f32>>;
+// The planes of a convex flat-faceted body's facets, `params.facets.x` of them (0 for any other
+// mesh): xyz the outward unit normal, w the distance from the shell's centre. A ray inside
+// such a body leaves it through the nearest plane ahead (`facet_exit`).
+@group(0) @binding(13) var<storage, read> facet_planes: array<vec4<f32>>;
+// A hit's `tri` when it was found on a facet plane: its normal is the facet's, which the
+// shading takes too (the mesh is flat-shaded).
+const FACET: u32 = 0xfffffffeu;
 const PI: f32 = 3.14159265358979;
 const STACK: u32 = 16u;
 
@@ -184,6 +191,25 @@ fn closest_hit(o: vec3<f32>, d: vec3<f32>, t_max: f32, past_inner: bool) -> Hit 
     return best;
 }
 
+// Where a ray from inside a convex flat-faceted body (unit `d`) leaves it: the nearest facet
+// plane ahead. Every lane reads the same plane at each step, so on a CPU device each plane
+// is one load for all of them, where the grid's cells are loads per lane.
+fn facet_exit(o: vec3<f32>, d: vec3<f32>) -> Hit {
+    var best = Hit(1e30, NONE, 0.0, 0.0, vec3<f32>(0.0));
+    let q = o - params.shell.xyz;
+    for (var i = 0u; i < params.facets.x; i++) {
+        let plane = facet_planes[i];
+        let along = dot(plane.xyz, d);
+        if along > 1e-7 {
+            let t = max((plane.w - dot(plane.xyz, q)) / along, 0.0);
+            if t < best.t {
+                best = Hit(t, FACET, 0.0, 0.0, plane.xyz);
+            }
+        }
+    }
+    return best;
+}
+
 // Sets the floor's plane from the parameters (once per invocation, not per segment).
 fn floor_once() {
     let plane = params.world_from_plane;
@@ -314,9 +340,12 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
                 let tri = hit.tri;
                 let point = ray.origin + ray.dir * hit.t;
                 let geometric = normalize(hit.normal);
-                let shading = normalize((1.0 - hit.u - hit.v) * vertex_normals[3u * tri].xyz
-                    + hit.u * vertex_normals[3u * tri + 1u].xyz
-                    + hit.v * vertex_normals[3u * tri + 2u].xyz);
+                var shading = geometric;
+                if tri != FACET {
+                    shading = normalize((1.0 - hit.u - hit.v) * vertex_normals[3u * tri].xyz
+                        + hit.u * vertex_normals[3u * tri + 1u].xyz
+                        + hit.v * vertex_normals[3u * tri + 2u].xyz);
+                }
                 let entering = dot(ray.dir, geometric) < 0.0;
                 let side_g = select(-geometric, geometric, entering);
                 var side_s = select(-shading, shading, entering);
@@ -391,8 +420,12 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
         if ray.inside == 0u {
             to_floor = floor_t(ray.origin, ray.dir);
         }
-        hit = closest_hit(ray.origin, ray.dir, select(1e30, to_floor, to_floor > 0.0),
-            ray.inside == 1u && params.shell_outer.w > 0.0);
+        if ray.inside == 1u && params.facets.x > 0u {
+            hit = facet_exit(ray.origin, ray.dir);
+        } else {
+            hit = closest_hit(ray.origin, ray.dir, select(1e30, to_floor, to_floor > 0.0),
+                ray.inside == 1u && params.shell_outer.w > 0.0);
+        }
         if hit.tri == NONE && to_floor > 0.0 {
             deposit(ray.origin + ray.dir * to_floor, ray.weight);
         }

@@ -665,12 +665,14 @@ fn live_torus_caustics_match_a_bake_of_it() {
 
 #[test]
 fn the_shipped_sphere_and_diamond_are_convex_the_torus_is_not() {
-    // Photons leaving a convex mesh outward skip the search for another surface; the shadow
-    // mask of a closed one (all three) is drawn from one side's triangles.
-    for (name, convex) in [
-        ("glass-sphere.toml", true),
-        ("diamond.toml", true),
-        ("torus.toml", false),
+    // Photons leaving a convex mesh outward skip the search for another surface, and inside
+    // the diamond (flat facets) they leave through its facet planes without the grid; the
+    // shadow mask of a closed one (all three) is drawn from one side's triangles, of a convex
+    // one as the hull of its projected vertices.
+    for (name, convex, faceted) in [
+        ("glass-sphere.toml", true, false),
+        ("diamond.toml", true, true),
+        ("torus.toml", false, false),
     ] {
         let path = workspace().join("config/scenes").join(name);
         let scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
@@ -680,6 +682,13 @@ fn the_shipped_sphere_and_diamond_are_convex_the_torus_is_not() {
             convex,
             "{name}"
         );
+        let planes = vitreous_render::convex::facet_planes(
+            &mesh.positions,
+            &mesh.normals,
+            &mesh.indices,
+            glam::Vec3::ZERO,
+        );
+        assert_eq!(planes.is_some(), faceted, "{name}");
         assert!(
             vitreous_render::convex::is_closed(&mesh.positions, &mesh.indices),
             "{name}"

@@ -41,6 +41,9 @@ struct Params {
     // buffers; z: words of tile bits per tile row; w: 1 when the smoothing skips the tiles
     // whose smoothed gains are certain to be below MIN_GAIN, else 0 (every texel smoothed).
     tiles: vec4<u32>,
+    // x: the planes of a convex flat-faceted body's facets in `facet_planes`
+    // (shaders/caustics_live.wgsl), 0 for any other mesh.
+    facets: vec4<u32>,
 };
 
 @group(0) @binding(0) var<storage, read> p: Params;

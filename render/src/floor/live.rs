@@ -105,6 +105,7 @@ struct Params {
     shell: [f32; 4],
     shell_outer: [f32; 4],
     tiles: [u32; 4],
+    facets: [u32; 4],
 }
 
 /// The compute passes, their buffers and what they need of the mesh; freed on drop.
@@ -126,6 +127,9 @@ pub(crate) struct LiveCaustics {
     params: Buffer,
     /// Mesh and grid buffers, read by the trace pass.
     _mesh: [Buffer; 4],
+    /// The facet planes of a convex flat-faceted mesh ([`crate::convex::facet_planes`]; one
+    /// unused entry for any other mesh).
+    _facets: Buffer,
     /// Fixed-point sums per texel.
     sums: Buffer,
     /// The fixed-point map smoothed along the rows.
@@ -162,6 +166,9 @@ pub(crate) struct LiveCaustics {
     /// ([`behind_every_plane`]): a photon inside it then meets no surface before it has
     /// passed the ball.
     inner_ball_inside: bool,
+    /// How many facet planes a ray inside the body is tested against instead of walking the
+    /// grid (0: it walks the grid).
+    facet_count: u32,
     /// Floor unit square to world.
     world_from_plane: Mat4,
     /// Relative index of refraction.
@@ -215,6 +222,33 @@ impl LiveCaustics {
             .fold(0.0f32, f32::max);
         let model_inner_radius = inner_radius(mesh.positions, mesh.indices, model_center);
         let convex = crate::convex::is_convex(mesh.positions, mesh.indices);
+        // A ray inside a convex body with flat facets leaves through the nearest facet plane
+        // ahead of it: every lane tests the same planes in turn (one load each for all of
+        // them), where walking the grid through the body's empty middle loads per lane.
+        let planes = convex
+            .then(|| {
+                crate::convex::facet_planes(
+                    mesh.positions,
+                    mesh.normals,
+                    mesh.indices,
+                    model_center,
+                )
+            })
+            .flatten()
+            .unwrap_or_default();
+        let facets = Buffer::with_data(
+            ctx,
+            "caustics facet planes",
+            bytemuck::cast_slice(
+                &planes
+                    .iter()
+                    .map(|p| p.to_array())
+                    // One entry at least, read by no ray.
+                    .chain(planes.is_empty().then_some([0.0; 4]))
+                    .collect::<Vec<_>>(),
+            ),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
         let inner_ball_inside =
             convex && behind_every_plane(mesh.positions, mesh.indices, model_center);
         let vec4s =
@@ -287,7 +321,7 @@ impl LiveCaustics {
         // The parameters in a storage buffer, not a uniform one: on lavapipe, which can inline
         // uniform values into a shader's loops and compile it again when they change, that
         // took about 1 ms off a moved frame's stage at the defaults and 6 ms with one photon.
-        let bindings: Vec<_> = (0..=12)
+        let bindings: Vec<_> = (0..=13)
             .map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute))
             .collect();
         let set_layout = pipeline::set_layout(ctx, &bindings)?;
@@ -295,7 +329,7 @@ impl LiveCaustics {
         let layout = pipeline::layout(ctx, Some(set_layout.raw()), compute, 4)?;
         let trace = pipeline::compute(ctx, layout.raw(), shaders::CAUSTICS_TRACE_CS, c"cs_trace")?;
         let smooth = SmoothPass::pipelines(ctx, layout.raw())?;
-        let pool = pipeline::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 13)])?;
+        let pool = pipeline::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 14)])?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
         buffers.extend(mesh_buffers[..3].iter().map(|b| b.buffer));
@@ -306,6 +340,7 @@ impl LiveCaustics {
         // The cells' masses, then again four at a time.
         let [cell_mass, tile_bits] = tiles.buffers();
         buffers.extend([cell_mass, tile_bits, cell_mass]);
+        buffers.push(facets.buffer);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|&buffer| {
@@ -338,6 +373,7 @@ impl LiveCaustics {
             set,
             params,
             _mesh: mesh_buffers,
+            _facets: facets,
             sums,
             _scratch: scratch,
             tiles,
@@ -353,6 +389,7 @@ impl LiveCaustics {
             model_inner_radius,
             convex,
             inner_ball_inside,
+            facet_count: planes.len() as u32,
             world_from_plane,
             ior,
         })
@@ -437,6 +474,7 @@ impl LiveCaustics {
                 if self.inner_ball_inside { 1.0 } else { 0.0 },
             ],
             tiles: [across, down, words, u32::from(skip_tiles)],
+            facets: [self.facet_count, 0, 0, 0],
         }
     }
 

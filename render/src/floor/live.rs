@@ -10,10 +10,10 @@ use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
 use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
+use super::live_mesh::LiveMesh;
 use super::smoothing::{
     SHORT_KERNEL_PX, SmoothPass, SmoothTiles, record_smoothing, row_pitch, shares_fit, smooth_steps,
 };
-use super::triangle_grid::{Grid, behind_every_plane, corner_and_edges, inner_radius};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::memory::{Buffer, Image, layout_barrier, subresource_range};
@@ -125,11 +125,8 @@ pub(crate) struct LiveCaustics {
     set: vk::DescriptorSet,
     /// `Params`, rewritten before each computation.
     params: Buffer,
-    /// Mesh and grid buffers, read by the trace pass.
-    _mesh: [Buffer; 4],
-    /// The facet planes of a convex flat-faceted mesh ([`crate::convex::facet_planes`]; one
-    /// unused entry for any other mesh).
-    _facets: Buffer,
+    /// What the trace reads of the mesh.
+    mesh: LiveMesh,
     /// Fixed-point sums per texel.
     sums: Buffer,
     /// The fixed-point map smoothed along the rows.
@@ -146,29 +143,6 @@ pub(crate) struct LiveCaustics {
     size: [u32; 2],
     /// Photons and path length.
     desc: LiveCausticsDesc,
-    /// The grid's placement, model units.
-    grid_origin: Vec3,
-    /// Its cell side.
-    grid_side: f32,
-    /// Its cells per axis.
-    grid_dims: [u32; 3],
-    /// Centre of the mesh's bounding box, model units.
-    model_center: Vec3,
-    /// Largest distance of a vertex from it, model units.
-    model_radius: f32,
-    /// Smallest distance from it to a triangle's plane, model units: no surface point lies
-    /// nearer the centre.
-    model_inner_radius: f32,
-    /// Whether the mesh bounds one convex body ([`crate::convex::is_convex`]): a photon
-    /// leaving it outward then meets no more of it.
-    convex: bool,
-    /// Whether, besides, the shell's inner ball lies inside that body
-    /// ([`behind_every_plane`]): a photon inside it then meets no surface before it has
-    /// passed the ball.
-    inner_ball_inside: bool,
-    /// How many facet planes a ray inside the body is tested against instead of walking the
-    /// grid (0: it walks the grid).
-    facet_count: u32,
     /// Floor unit square to world.
     world_from_plane: Mat4,
     /// Relative index of refraction.
@@ -203,90 +177,8 @@ impl LiveCaustics {
                 desc.photons_per_side, desc.max_interactions, desc.smoothing_px
             )));
         }
-        let grid = Grid::new(mesh.positions, mesh.indices);
-        let lo = mesh
-            .positions
-            .iter()
-            .copied()
-            .fold(Vec3::INFINITY, Vec3::min);
-        let hi = mesh
-            .positions
-            .iter()
-            .copied()
-            .fold(Vec3::NEG_INFINITY, Vec3::max);
-        let model_center = (lo + hi) / 2.0;
-        let model_radius = mesh
-            .positions
-            .iter()
-            .map(|p| p.distance(model_center))
-            .fold(0.0f32, f32::max);
-        let model_inner_radius = inner_radius(mesh.positions, mesh.indices, model_center);
-        let convex = crate::convex::is_convex(mesh.positions, mesh.indices);
-        // A ray inside a convex body with flat facets leaves through the nearest facet plane
-        // ahead of it: every lane tests the same planes in turn (one load each for all of
-        // them), where walking the grid through the body's empty middle loads per lane.
-        let planes = convex
-            .then(|| {
-                crate::convex::facet_planes(
-                    mesh.positions,
-                    mesh.normals,
-                    mesh.indices,
-                    model_center,
-                )
-            })
-            .flatten()
-            .unwrap_or_default();
-        let facets = Buffer::with_data(
-            ctx,
-            "caustics facet planes",
-            bytemuck::cast_slice(
-                &planes
-                    .iter()
-                    .map(|p| p.to_array())
-                    // One entry at least, read by no ray.
-                    .chain(planes.is_empty().then_some([0.0; 4]))
-                    .collect::<Vec<_>>(),
-            ),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-        )?;
-        let inner_ball_inside =
-            convex && behind_every_plane(mesh.positions, mesh.indices, model_center);
-        let vec4s =
-            |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.extend(0.0).to_array()).collect() };
+        let live_mesh = LiveMesh::new(ctx, mesh)?;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let cells: Vec<u32> = grid.cells.iter().flatten().copied().collect();
-        // Each triangle's three vertex normals, so that a hit reads them without its indices.
-        let vertex_normals: Vec<Vec3> = mesh
-            .indices
-            .iter()
-            .map(|&i| mesh.normals[i as usize])
-            .collect();
-        let mesh_buffers = [
-            Buffer::with_data(
-                ctx,
-                "caustics vertex normals",
-                bytemuck::cast_slice(&vec4s(&vertex_normals)),
-                storage,
-            )?,
-            Buffer::with_data(
-                ctx,
-                "caustics grid cells",
-                bytemuck::cast_slice(&cells),
-                storage,
-            )?,
-            Buffer::with_data(
-                ctx,
-                "caustics grid triangles",
-                bytemuck::cast_slice(&grid.triangles),
-                storage,
-            )?,
-            Buffer::with_data(
-                ctx,
-                "caustics triangle corners",
-                bytemuck::cast_slice(&vec4s(&corner_and_edges(mesh.positions, mesh.indices))),
-                storage,
-            )?,
-        ];
         let texels = u64::from(row_pitch(size[0])) * u64::from(size[1]);
         let sums = Buffer::new(
             ctx,
@@ -332,15 +224,15 @@ impl LiveCaustics {
         let pool = pipeline::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 14)])?;
         let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
-        buffers.extend(mesh_buffers[..3].iter().map(|b| b.buffer));
+        buffers.extend(live_mesh.buffers[..3].iter().map(|b| b.buffer));
         buffers.extend([sums.buffer, gain.buffer, bounds, scratch.buffer]);
-        buffers.push(mesh_buffers[3].buffer);
+        buffers.push(live_mesh.buffers[3].buffer);
         // The sums again, read four texels at a time by the smoothing.
         buffers.push(sums.buffer);
         // The cells' masses, then again four at a time.
         let [cell_mass, tile_bits] = tiles.buffers();
         buffers.extend([cell_mass, tile_bits, cell_mass]);
-        buffers.push(facets.buffer);
+        buffers.push(live_mesh.facets.buffer);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|&buffer| {
@@ -372,8 +264,7 @@ impl LiveCaustics {
             _set_layout: set_layout,
             set,
             params,
-            _mesh: mesh_buffers,
-            _facets: facets,
+            mesh: live_mesh,
             sums,
             _scratch: scratch,
             tiles,
@@ -381,15 +272,6 @@ impl LiveCaustics {
             bounds,
             size,
             desc,
-            grid_origin: grid.origin,
-            grid_side: grid.side,
-            grid_dims: grid.dims,
-            model_center,
-            model_radius,
-            model_inner_radius,
-            convex,
-            inner_ball_inside,
-            facet_count: planes.len() as u32,
             world_from_plane,
             ior,
         })
@@ -398,8 +280,9 @@ impl LiveCaustics {
     /// The shader's parameters for `pose`.
     fn params(&self, pose: &ScenePose) -> Params {
         let m = pose.world_from_model;
-        let center = m.transform_point3(self.model_center);
-        let radius = self.model_radius * m.x_axis.truncate().length();
+        let mesh = &self.mesh;
+        let center = m.transform_point3(mesh.center);
+        let radius = mesh.radius * m.x_axis.truncate().length();
         let light = pose.light_position_m;
         let to_center = center - light;
         let dist = to_center.length();
@@ -425,7 +308,7 @@ impl LiveCaustics {
             .cross(self.world_from_plane.y_axis.truncate())
             .length();
         let texel_area = floor_area / (self.size[0] as f32 * self.size[1] as f32);
-        let [gx, gy, gz] = self.grid_dims;
+        let [gx, gy, gz] = mesh.grid_dims;
         let [across, down, words] = self.tiles.layout();
         let skip_tiles = self.desc.skip_tiles
             && self.desc.smoothing_px <= SHORT_KERNEL_PX
@@ -438,7 +321,7 @@ impl LiveCaustics {
                 self.desc.min_path_weight,
             );
         // Rounding room for the shell's radii and the stretches of a ray inside it.
-        let slack = self.model_radius * SHELL_SLACK;
+        let slack = mesh.radius * SHELL_SLACK;
         Params {
             model_from_world: m.inverse().to_cols_array(),
             world_from_model: m.to_cols_array(),
@@ -448,7 +331,7 @@ impl LiveCaustics {
             axis: axis.extend(one_minus_cos).to_array(),
             basis_u: u.extend(self.ior).to_array(),
             basis_v: v.extend(texel_area).to_array(),
-            grid_origin: self.grid_origin.extend(self.grid_side).to_array(),
+            grid_origin: mesh.grid_origin.extend(mesh.grid_side).to_array(),
             grid_dims: [gx, gy, gz, n],
             map: [
                 self.size[0],
@@ -457,24 +340,24 @@ impl LiveCaustics {
                 self.desc.smoothing_px,
             ],
             misc: Vec4::new(
-                self.model_radius * 2e-5,
+                mesh.radius * 2e-5,
                 FIXED_POINT,
                 self.desc.min_path_weight,
                 MIN_GAIN,
             )
             .to_array(),
-            shell: self
-                .model_center
-                .extend((self.model_inner_radius - slack).max(0.0))
+            shell: mesh
+                .center
+                .extend((mesh.inner_radius - slack).max(0.0))
                 .to_array(),
             shell_outer: [
-                self.model_radius + slack,
+                mesh.radius + slack,
                 slack,
-                if self.convex { 1.0 } else { 0.0 },
-                if self.inner_ball_inside { 1.0 } else { 0.0 },
+                if mesh.convex { 1.0 } else { 0.0 },
+                if mesh.inner_ball_inside { 1.0 } else { 0.0 },
             ],
             tiles: [across, down, words, u32::from(skip_tiles)],
-            facets: [self.facet_count, 0, 0, 0],
+            facets: [mesh.facet_count, 0, 0, 0],
         }
     }
 

@@ -54,8 +54,8 @@
 //! - `distance_transform`: the nearest shadow texel of every texel (compute);
 //! - `overlay`: the per-eye overlay pipeline;
 //! - `live`: the caustic gain map computed per pose on the GPU (photon splatting, then
-//!   smoothing), instead of a bake; `triangle_grid`: the grid of triangle lists its photons
-//!   walk; `smoothing`: which smoothing passes run for a radius, and the map's row layout;
+//!   smoothing), instead of a bake; `live_mesh`: what its photons read of the mesh;
+//!   `triangle_grid`: the grid of triangle lists they walk; `smoothing`: which smoothing passes run for a radius, and the map's row layout;
 //! - `pass`: the pass that builds all of it and records it once per pose;
 //! - `progress`: whether that computation has really run (set only after its fence);
 //! - `readback`: copying the fields back to the CPU.
@@ -67,6 +67,7 @@ mod distance_transform;
 mod fields;
 mod geometry;
 mod live;
+mod live_mesh;
 mod mask;
 mod overlay;
 mod pass;

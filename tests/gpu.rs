@@ -7,6 +7,7 @@ mod defocus;
 mod inducer;
 mod live_caustics;
 mod live_caustics_sweep;
+mod live_maps;
 mod motion;
 mod refraction;
 mod refraction_scene;

@@ -1,9 +1,9 @@
 //! The sweep of live-map settings behind docs/caustics.md's tables, with the helpers of
-//! tests/live_caustics.rs.
+//! tests/live_maps.rs.
 
 use vitreous_render::floor::LiveCausticsDesc;
 
-use crate::live_caustics::{
+use crate::live_maps::{
     LiveFrame, axis_texel, baked_at, baked_scene, live_gains, live_scene, peak, relative_rms,
     smoothed, speckle,
 };

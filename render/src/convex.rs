@@ -210,19 +210,26 @@ pub fn is_closed(positions: &[Vec3], indices: &[u32]) -> bool {
 /// (flat-shaded meshes repeat them per facet, seams repeat them rounded); a triangle with
 /// two corners at one position makes the answer no.
 pub fn is_convex(positions: &[Vec3], indices: &[u32]) -> bool {
-    let Some(welded) = Welded::new(positions, indices) else {
-        return false;
-    };
-    if !welded.closed() {
-        return false;
+    closed_and_convex(positions, indices).1
+}
+
+/// [`is_closed`] and [`is_convex`] of the mesh, welding its vertices once.
+pub fn closed_and_convex(positions: &[Vec3], indices: &[u32]) -> (bool, bool) {
+    match Welded::new(positions, indices) {
+        Some(welded) if welded.closed() => (true, convex_when_closed(&welded)),
+        _ => (false, false),
     }
+}
+
+/// [`is_convex`] of a welded mesh already known to be closed.
+fn convex_when_closed(welded: &Welded) -> bool {
     let Welded {
         unique,
         triangles,
         edges,
         tolerance,
         lo,
-    } = &welded;
+    } = welded;
     let corner = |id: u32| unique[id as usize];
     let normal = |t: usize| {
         let [a, b, c] = triangles[t].map(corner);
@@ -425,5 +432,9 @@ mod tests {
         assert!(!is_closed(&p, &flipped));
         // Nothing at all.
         assert!(!is_closed(&p, &[]));
+        // Both answers from one weld: closed and convex, closed only, neither.
+        assert_eq!(closed_and_convex(&p, &i), (true, true));
+        assert_eq!(closed_and_convex(&p, &inward), (true, false));
+        assert_eq!(closed_and_convex(&p, &i[..i.len() - 3]), (false, false));
     }
 }

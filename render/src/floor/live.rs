@@ -20,7 +20,6 @@ use crate::memory::{Buffer, Image, layout_barrier, subresource_range};
 use crate::owned::Owned;
 use crate::pipeline;
 use crate::pose::ScenePose;
-use crate::scene::MeshRef;
 use crate::shaders;
 
 /// How caustics are computed live.
@@ -57,6 +56,28 @@ impl Default for LiveCausticsDesc {
             smoothing_px: 2,
             skip_tiles: true,
         }
+    }
+}
+
+impl LiveCausticsDesc {
+    /// An error naming the settings unless each is within its range.
+    pub(super) fn check(&self) -> Result<()> {
+        let weight = self.min_path_weight;
+        if !(1..=MAX_PHOTONS_PER_SIDE).contains(&self.photons_per_side)
+            || self.max_interactions == 0
+            || self.smoothing_px > MAX_SMOOTHING_PX
+            || weight.is_nan()
+            || weight <= 0.0
+            || weight >= 1.0
+        {
+            return Err(RenderError::InvalidInput(format!(
+                "live caustics need 1..={MAX_PHOTONS_PER_SIDE} photons per side, at least \
+                 one interaction, a smoothing of 0..={MAX_SMOOTHING_PX} texels and a least \
+                 path weight above 0 and below 1, got {}, {}, {} and {weight}",
+                self.photons_per_side, self.max_interactions, self.smoothing_px
+            )));
+        }
+        Ok(())
     }
 }
 
@@ -150,34 +171,19 @@ pub(crate) struct LiveCaustics {
 }
 
 impl LiveCaustics {
-    /// Prepares the passes for `mesh` (model units, outward normals, closed) over a floor
-    /// mapped by `world_from_plane`, writing a `size` gain map and the box of its non-zero
-    /// texels into `bounds` (16 bytes, a storage buffer that outlives the passes).
+    /// Prepares the passes for `live_mesh` over a floor mapped by `world_from_plane`, writing
+    /// a `size` gain map and the box of its non-zero texels into `bounds` (16 bytes, a storage
+    /// buffer that outlives the passes); `desc` must pass [`LiveCausticsDesc::check`].
     pub fn new(
         ctx: &GpuContext,
-        mesh: &MeshRef,
+        live_mesh: LiveMesh,
         ior: f32,
         world_from_plane: Mat4,
         size: [u32; 2],
         desc: LiveCausticsDesc,
         bounds: vk::Buffer,
     ) -> Result<LiveCaustics> {
-        let weight = desc.min_path_weight;
-        if !(1..=MAX_PHOTONS_PER_SIDE).contains(&desc.photons_per_side)
-            || desc.max_interactions == 0
-            || desc.smoothing_px > MAX_SMOOTHING_PX
-            || weight.is_nan()
-            || weight <= 0.0
-            || weight >= 1.0
-        {
-            return Err(RenderError::InvalidInput(format!(
-                "live caustics need 1..={MAX_PHOTONS_PER_SIDE} photons per side, at least \
-                 one interaction, a smoothing of 0..={MAX_SMOOTHING_PX} texels and a least \
-                 path weight above 0 and below 1, got {}, {}, {} and {weight}",
-                desc.photons_per_side, desc.max_interactions, desc.smoothing_px
-            )));
-        }
-        let live_mesh = LiveMesh::new(ctx, mesh)?;
+        debug_assert!(desc.check().is_ok(), "{desc:?}");
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let texels = u64::from(row_pitch(size[0])) * u64::from(size[1]);
         let sums = Buffer::new(

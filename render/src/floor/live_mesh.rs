@@ -48,8 +48,9 @@ pub(super) struct LiveMesh {
 }
 
 impl LiveMesh {
-    /// The buffers and shape of `mesh` (model units, outward normals, closed).
-    pub fn new(ctx: &GpuContext, mesh: &MeshRef) -> Result<LiveMesh> {
+    /// The buffers and shape of `mesh` (model units, outward normals, closed), which bounds
+    /// one convex body when `convex` ([`crate::convex::is_convex`]).
+    pub fn new(ctx: &GpuContext, mesh: &MeshRef, convex: bool) -> Result<LiveMesh> {
         let grid = Grid::new(mesh.positions, mesh.indices);
         let lo = mesh
             .positions
@@ -68,7 +69,6 @@ impl LiveMesh {
             .map(|p| p.distance(model_center))
             .fold(0.0f32, f32::max);
         let model_inner_radius = inner_radius(mesh.positions, mesh.indices, model_center);
-        let convex = crate::convex::is_convex(mesh.positions, mesh.indices);
         // A ray inside a convex body with flat facets leaves through the nearest facet plane
         // ahead of it: every lane tests the same planes in turn (one load each for all of
         // them), where walking the grid through the body's empty middle loads per lane.

@@ -87,7 +87,7 @@ impl MaskPass {
         };
         // A closed mesh's shadow is drawn whole by the triangles facing either way alone, so
         // one kind is culled: half the triangles the rasteriser sets up after every move.
-        let cull = if closed || convex {
+        let cull = if closed {
             vk::CullModeFlags::BACK
         } else {
             vk::CullModeFlags::NONE
@@ -132,6 +132,11 @@ impl MaskPass {
             Some(m) if self.convex => hull_triangles(m, positions).unwrap_or_default(),
             _ => Vec::new(),
         };
+    }
+
+    /// Whether the mesh bounds one convex body.
+    pub fn convex(&self) -> bool {
+        self.convex
     }
 
     /// Whether the current pose draws anything.

@@ -12,6 +12,7 @@ use super::fields::{
 };
 use super::geometry::{Floor, caustic_rect, shadow_of, texel_rect, texels_plane_rect, union_rect};
 use super::live::{LiveCaustics, LiveCausticsDesc};
+use super::live_mesh::LiveMesh;
 use super::mask::MaskPass;
 use super::overlay::{NO_RECT, OverlayArea, OverlayPass};
 use super::progress::{Prepared, Progress, Written};
@@ -120,8 +121,7 @@ impl InducerPass {
 
         let fragment = vk::ShaderStageFlags::FRAGMENT;
         let (positions, indices) = (desc.mesh.positions, desc.mesh.indices);
-        let convex = crate::convex::is_convex(positions, indices);
-        let closed = convex || crate::convex::is_closed(positions, indices);
+        let (closed, convex) = crate::convex::closed_and_convex(positions, indices);
         let mut mask = MaskPass::new(ctx, targets[MASK].render_pass(), &desc.mesh, convex, closed)?;
         mask.set_pose(mask_clip_from_model, positions);
 
@@ -246,9 +246,11 @@ impl InducerPass {
         live: LiveCausticsDesc,
     ) -> Result<()> {
         let extent = self.caustic_extent;
+        live.check()?;
+        let mesh = LiveMesh::new(ctx, &desc.mesh, self.mask.convex())?;
         self.live = Some(LiveCaustics::new(
             ctx,
-            &desc.mesh,
+            mesh,
             desc.ior,
             self.world_from_plane,
             [extent.width, extent.height],

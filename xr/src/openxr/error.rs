@@ -1,5 +1,7 @@
 //! Errors of the OpenXR backend.
 
+use std::fmt::Write as _;
+
 use ash::vk;
 use openxr as xr;
 use thiserror::Error;
@@ -93,6 +95,23 @@ pub(super) fn instance_error(
             layers: enabled.join(", "),
         }
     }
+}
+
+/// A short list of the graphics extensions a runtime offers, for the no-Vulkan message.
+pub(super) fn extension_list(set: &xr::ExtensionSet) -> String {
+    let mut s = String::new();
+    for (on, name) in [
+        (set.khr_vulkan_enable, "XR_KHR_vulkan_enable"),
+        (set.khr_opengl_enable, "XR_KHR_opengl_enable"),
+    ] {
+        if on {
+            let _ = write!(s, "{}{name}", if s.is_empty() { "" } else { ", " });
+        }
+    }
+    if s.is_empty() {
+        s.push_str("no graphics API extension");
+    }
+    s
 }
 
 /// Shorthand for results of this module.

@@ -32,8 +32,6 @@ pub mod ml_eye_tracker;
 mod session;
 pub mod state;
 
-use std::fmt::Write as _;
-
 use ash::vk;
 use ash::vk::Handle;
 use openxr as xr;
@@ -124,7 +122,7 @@ impl Runtime {
             .enumerate_extensions()
             .map_err(|e| OpenXrError::NoRuntime(format!("listing extensions: {e}")))?;
         if !available.khr_vulkan_enable2 {
-            return Err(OpenXrError::NoVulkan(extension_list(&available)));
+            return Err(OpenXrError::NoVulkan(error::extension_list(&available)));
         }
         let mut wanted = xr::ExtensionSet::default();
         wanted.khr_vulkan_enable2 = true;
@@ -581,21 +579,4 @@ fn enabled_names(set: &xr::ExtensionSet) -> Vec<String> {
         names.push(String::from_utf8_lossy(other.strip_suffix(&[0]).unwrap_or(other)).into_owned());
     }
     names
-}
-
-/// A short list of the graphics extensions a runtime offers, for the no-Vulkan message.
-fn extension_list(set: &xr::ExtensionSet) -> String {
-    let mut s = String::new();
-    for (on, name) in [
-        (set.khr_vulkan_enable, "XR_KHR_vulkan_enable"),
-        (set.khr_opengl_enable, "XR_KHR_opengl_enable"),
-    ] {
-        if on {
-            let _ = write!(s, "{}{name}", if s.is_empty() { "" } else { ", " });
-        }
-    }
-    if s.is_empty() {
-        s.push_str("no graphics API extension");
-    }
-    s
 }

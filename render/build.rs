@@ -3,10 +3,15 @@
 //! constants take their defaults, and the entry points of [`VARIANTS`] are compiled again with
 //! some set, for the pipelines that need (or can skip) the code they guard. Code shared by
 //! several shaders lives in `../shaders/shared` and is appended to each that names it in a
-//! `// #include shared/<file>.wgsl` line ([`with_includes`]).
+//! `// #include shared/<file>.wgsl` line ([`with_includes`]). Beside each entry point's SPIR-V
+//! it writes the static cost of one invocation (`<name>.cost.rs`, build/shader_cost.rs), which
+//! the renderer's counted work multiplies by the invocations a frame ran.
 
 use std::path::{Path, PathBuf};
 use std::{env, fs};
+
+#[path = "build/shader_cost.rs"]
+mod shader_cost;
 
 /// `source` with the files its `// #include <path>` lines name (relative to `shader_dir`)
 /// appended in order. WGSL declarations may follow their use, so the shader's own lines keep
@@ -138,6 +143,11 @@ fn main() {
                 fs::write(
                     out_dir.join(format!("{name}.{}{suffix}.spv", entry.name)),
                     bytes,
+                )
+                .unwrap();
+                fs::write(
+                    out_dir.join(format!("{name}.{}{suffix}.cost.rs", entry.name)),
+                    shader_cost::entry_cost(&module, &entry.function).to_rust(),
                 )
                 .unwrap();
             }

@@ -233,6 +233,7 @@ fn run(cli: Cli) -> Result<()> {
                 effects,
                 size,
                 frames,
+                warm_up: vitreous::bench::WARM_UP_FRAMES,
                 reflection: reflection.into(),
                 validate,
                 device,

@@ -16,6 +16,7 @@ use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use crate::error::{RenderError, Result, VkContext};
 pub use crate::validation::ValidationLog;
 use crate::validation::debug_callback;
+use crate::work::WorkTally;
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
@@ -194,6 +195,10 @@ pub struct GpuContext {
     pub driver: String,
     /// Nanoseconds per timestamp tick; `None` when the queue cannot write timestamps.
     pub timestamp_period_ns: Option<f32>,
+    /// Whether the device counts shader invocations (pipeline-statistics queries, enabled).
+    pub pipeline_statistics: bool,
+    /// The work recorded into command buffers, counted as it is recorded.
+    pub(crate) work: WorkTally,
 }
 
 impl GpuContext {
@@ -292,9 +297,17 @@ impl GpuContext {
             .queue_priorities(&priorities)];
         let device_exts: Vec<*const c_char> =
             extra_device_extensions.iter().map(|e| e.as_ptr()).collect();
+        // Pipeline-statistics queries count the shader invocations of each pass (the frame's
+        // counted work, `work.rs`) where the device has them; nothing else is optional.
+        // SAFETY: `physical` belongs to the live `instance`.
+        let supported = unsafe { instance.get_physical_device_features(physical) };
+        let pipeline_statistics = supported.pipeline_statistics_query == vk::TRUE;
+        let features =
+            vk::PhysicalDeviceFeatures::default().pipeline_statistics_query(pipeline_statistics);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
-            .enabled_extension_names(&device_exts);
+            .enabled_extension_names(&device_exts)
+            .enabled_features(&features);
         // SAFETY: `physical` was picked from `instance`, and `device_info` names one queue of
         // a family it has; the device is destroyed below on any later failure, or by the
         // context's drop.
@@ -378,6 +391,8 @@ impl GpuContext {
             upload_pool,
             driver,
             timestamp_period_ns,
+            pipeline_statistics,
+            work: WorkTally::default(),
         };
         tracing::info!(
             device = %ctx.device_name,

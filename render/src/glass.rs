@@ -17,6 +17,7 @@ use crate::pose::ScenePose;
 use crate::radial_map::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, mesh_center, radial_map};
 use crate::scene::{GpuScene, Refraction, SceneDesc, VERTEX_STRIDE};
 use crate::shaders;
+use crate::work::ShaderCost;
 
 /// Phong exponent of the highlight: a sharp highlight, as on polished glass.
 const PHONG_EXPONENT: f32 = 200.0;
@@ -161,6 +162,8 @@ pub struct GlassPass {
     /// One pipeline per variant, in [`GlassVariant::index`] order, for the scene's
     /// refraction model.
     pipelines: Vec<Owned<vk::Pipeline>>,
+    /// The static cost of one invocation of each pipeline's fragment shader.
+    costs: [ShaderCost; 4],
     /// Pipeline layout (set + eye push constants).
     layout: Owned<vk::PipelineLayout>,
     /// Pool the set lives in.
@@ -334,6 +337,7 @@ impl GlassPass {
         pipeline::write_storage_buffer(ctx, set, 7, planes.buffer);
         Ok(GlassPass {
             pipelines,
+            costs: shaders::GLASS_FS_COST[model],
             layout,
             _pool: pool,
             _set_layout: set_layout,
@@ -388,6 +392,7 @@ impl GlassPass {
                 0,
                 bytemuck::bytes_of(&globals),
             );
+            ctx.work.upload(std::mem::size_of_val(&globals));
             d.cmd_pipeline_barrier(
                 cmd,
                 vk::PipelineStageFlags::TRANSFER,
@@ -401,6 +406,11 @@ impl GlassPass {
                 &[],
             );
         }
+    }
+
+    /// The static cost of one fragment drawn with the pipeline of `variant`.
+    pub fn cost(&self, variant: GlassVariant) -> ShaderCost {
+        self.costs[variant.index()]
     }
 
     /// Records the draw of the object for one eye with the pipeline of `variant`, inside that
@@ -442,6 +452,8 @@ impl GlassPass {
             d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
             d.cmd_draw_indexed(cmd, scene.index_count, 1, 0, 0, 0);
         }
+        ctx.work.upload(std::mem::size_of::<EyePush>());
+        ctx.work.draw(scene.index_count);
     }
 }
 

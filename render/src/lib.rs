@@ -44,6 +44,7 @@ pub mod solid;
 mod target;
 pub mod two_surface;
 mod validation;
+pub mod work;
 mod world;
 
 pub use absorption::Attenuation;
@@ -55,8 +56,9 @@ pub use floor as inducer;
 pub use floor::InducerFields;
 pub use memory::{color_copy_region, layout_barrier, subresource_range};
 pub use pose::ScenePose;
-pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
+pub use renderer::{Composition, FrameResult, FrameTiming, FrameWork, Readback, Renderer, Want};
 pub use scene::{
     BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, Refraction,
     RefractionParseError, SceneDesc, TexelData, TextureDesc,
 };
+pub use work::{Invocations, PassInvocations, RecordedWork, ShaderCost};

@@ -387,7 +387,7 @@ pub fn framebuffer(
 /// `cmd` must be recording outside any render pass; the render pass and framebuffer must be
 /// live, compatible, and outlive the command buffer's execution.
 pub unsafe fn begin_render_pass(
-    device: &ash::Device,
+    ctx: &GpuContext,
     cmd: vk::CommandBuffer,
     render_pass: vk::RenderPass,
     framebuffer: vk::Framebuffer,
@@ -413,6 +413,8 @@ pub unsafe fn begin_render_pass(
     };
     // SAFETY: the caller's contract: `cmd` records outside a render pass, the handles are
     // live; the pipelines bound inside set viewport and scissor dynamically.
+    let device = &ctx.device;
+    ctx.work.render_pass();
     unsafe {
         device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
         device.cmd_set_viewport(cmd, 0, &[viewport]);

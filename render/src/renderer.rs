@@ -20,6 +20,7 @@ use crate::pipeline;
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, SceneDesc};
 use crate::target::{self, StereoTarget};
+use crate::work::{self, PassInvocations, RecordedWork, ShaderCost};
 use crate::world::WorldPass;
 
 mod composition;
@@ -77,6 +78,21 @@ pub struct FrameTiming {
     pub cpu_submit_ms: f64,
 }
 
+/// The work of one frame, counted (`work.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameWork {
+    /// What was recorded into its command buffer: the same on every device.
+    pub recorded: RecordedWork,
+    /// The shader invocations of each pass as the device ran them; `None` unless
+    /// [`Renderer::count_invocations`] turned counting on before the frame (and the device
+    /// can).
+    pub invocations: Option<PassInvocations>,
+    /// The static cost of one fragment of the glass's pipeline, when the glass was drawn.
+    pub glass_shader: Option<ShaderCost>,
+    /// The static cost of one fragment of the floor overlay's pipeline, when it was drawn.
+    pub overlay_shader: Option<ShaderCost>,
+}
+
 /// A finished frame.
 #[derive(Clone, Debug)]
 pub struct FrameResult {
@@ -84,6 +100,8 @@ pub struct FrameResult {
     pub sequence: u64,
     /// Its timing.
     pub timing: FrameTiming,
+    /// Its counted work.
+    pub work: FrameWork,
     /// Its pixels, when asked for.
     pub readback: Option<Readback>,
 }
@@ -98,6 +116,10 @@ struct Pending {
     cpu_submit_ms: f64,
     /// The floor fields' work recorded into it, confirmed once its fence signalled.
     prepared: Prepared,
+    /// The work recorded into it, and the shaders it drew with (as [`FrameWork`]).
+    recorded: FrameWork,
+    /// Whether it counted its passes' invocations (in the slot's statistics pool).
+    counted: bool,
 }
 
 /// Per-frame resources, used round-robin; freed on drop.
@@ -109,6 +131,9 @@ struct FrameSlot {
     /// Timestamps (start of the floor fields' work, start and end of the eye passes, then
     /// the floor passes' [`FIELD_STAMPS`]), when supported.
     queries: Option<Owned<vk::QueryPool>>,
+    /// Pipeline statistics of each pass (`work.rs`), once [`Renderer::count_invocations`]
+    /// made them.
+    statistics: Option<Owned<vk::QueryPool>>,
     /// Host-visible copy of both eye layers, then both world layers.
     readback: Buffer,
     /// What the slot's in-flight frame is.
@@ -230,6 +255,7 @@ impl Renderer {
                 cmd,
                 fence,
                 queries,
+                statistics: None,
                 readback,
                 pending: None,
             });
@@ -309,6 +335,29 @@ impl Renderer {
         self.inducer.live_tiles()
     }
 
+    /// Counts the shader invocations of each pass of every frame submitted from now on
+    /// ([`FrameWork::invocations`]), with pipeline-statistics queries. Returns `false`, and
+    /// counts nothing, on a device without them.
+    pub fn count_invocations(&mut self) -> Result<bool> {
+        if !self.ctx.pipeline_statistics {
+            return Ok(false);
+        }
+        for slot in &mut self.slots {
+            if slot.statistics.is_none() {
+                // SAFETY: a valid create info (the device has pipeline-statistics queries
+                // enabled); owned right away.
+                let pool = unsafe {
+                    self.ctx
+                        .device
+                        .create_query_pool(&work::statistics_pool_info(), None)
+                }
+                .vk("vkCreateQueryPool")?;
+                slot.statistics = Some(Owned::new(&self.ctx, pool));
+            }
+        }
+        Ok(true)
+    }
+
     /// How many times the shadow inducer's fields (mask, distance, gain) were computed: once
     /// for the first frame that drew them, then once per frame after the object or light moved.
     pub fn inducer_computations(&self) -> u64 {
@@ -368,14 +417,24 @@ impl Renderer {
                 .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             d.begin_command_buffer(slot.cmd, &begin)
                 .vk("vkBeginCommandBuffer")?;
+            self.ctx.work.take();
             let prepared = self.record(slot, params, want, draw);
+            let look = &params.look;
+            let recorded = FrameWork {
+                recorded: self.ctx.work.take(),
+                invocations: None,
+                glass_shader: (!look.blank).then(|| self.glass.cost(GlassVariant::of(look))),
+                overlay_shader: ((look.inducer || look.caustics) && !look.blank)
+                    .then(|| self.inducer.overlay_cost(look.caustics)),
+            };
             d.end_command_buffer(slot.cmd).vk("vkEndCommandBuffer")?;
             let cmds = [slot.cmd];
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
             d.queue_submit(self.ctx.queue, &submit, fence)
                 .vk("vkQueueSubmit")?;
-            prepared
+            (prepared, recorded)
         };
+        let (prepared, recorded) = prepared;
         // Only now, with the work on the queue, do later frames rely on what it computes.
         self.inducer.submitted(prepared);
         self.glass_pose = self.pose;
@@ -384,6 +443,8 @@ impl Renderer {
             want,
             cpu_submit_ms: started.elapsed().as_secs_f64() * 1e3,
             prepared,
+            recorded,
+            counted: self.slots[slot_index].statistics.is_some(),
         });
         self.next_sequence += 1;
         Ok(previous)
@@ -446,6 +507,14 @@ impl Renderer {
                 }
                 _ => (None, None, None),
             };
+        let invocations = match (&slot.statistics, pending.counted) {
+            // SAFETY: the frame began and ended every query of the pool (`counted`), and it
+            // finished (its fence signalled above).
+            (Some(pool), true) => {
+                Some(unsafe { work::read_statistics(d, pool.raw()) }.vk("vkGetQueryPoolResults")?)
+            }
+            _ => None,
+        };
         let bytes = if pending.want.eyes {
             Some(slot.readback.mapped()?)
         } else {
@@ -470,6 +539,10 @@ impl Renderer {
                 prepare_gpu_ms,
                 field_passes,
                 cpu_submit_ms: pending.cpu_submit_ms,
+            },
+            work: FrameWork {
+                invocations,
+                ..pending.recorded
             },
             readback,
         }))
@@ -524,12 +597,22 @@ impl Renderer {
                 d.cmd_reset_query_pool(cmd, pool, 0, QUERIES);
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 0);
             }
+            let statistics = slot.statistics.as_ref().map(Owned::raw);
+            if let Some(pool) = statistics {
+                d.cmd_reset_query_pool(cmd, pool, 0, work::STATISTICS_QUERIES);
+                // The first floor stage's; each stage's end begins the next.
+                d.cmd_begin_query(cmd, pool, 0, vk::QueryControlFlags::empty());
+            }
             let blank = params.look.blank;
             let (inducer, caustics) = (
                 params.look.inducer && !blank,
                 params.look.caustics && !blank,
             );
-            let stamps = queries.map(|pool| Stamps { pool, first: 3 });
+            let stamps = (queries.is_some() || statistics.is_some()).then_some(Stamps {
+                pool: queries,
+                first: 3,
+                statistics,
+            });
             if inducer || caustics {
                 // Once per pose, timed on its own.
                 prepared = self.inducer.prepare(&self.ctx, cmd, &self.scene, stamps);
@@ -546,12 +629,20 @@ impl Renderer {
                     eye_framebuffers[index],
                     composition.clear_alpha(),
                 );
+                let query = work::eye_query(index);
+                if let Some(pool) = statistics {
+                    d.cmd_begin_query(cmd, pool, query, vk::QueryControlFlags::empty());
+                }
                 if world_behind {
                     self.world.record(&self.ctx, cmd, eye);
                 }
                 if inducer || caustics {
                     // Added before the glass, which covers it where the object is.
                     self.inducer.record(&self.ctx, cmd, eye, inducer, caustics);
+                }
+                if let Some(pool) = statistics {
+                    d.cmd_end_query(cmd, pool, query);
+                    d.cmd_begin_query(cmd, pool, query + 1, vk::QueryControlFlags::empty());
                 }
                 if !blank {
                     self.glass.record(
@@ -567,6 +658,9 @@ impl Renderer {
                             self.scene.stack_steps,
                         ),
                     );
+                }
+                if let Some(pool) = statistics {
+                    d.cmd_end_query(cmd, pool, query + 1);
                 }
                 d.cmd_end_render_pass(cmd);
             }
@@ -644,7 +738,7 @@ impl Renderer {
         // SAFETY: the caller's contract.
         unsafe {
             pipeline::begin_render_pass(
-                &self.ctx.device,
+                &self.ctx,
                 cmd,
                 render_pass,
                 framebuffer,

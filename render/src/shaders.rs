@@ -1,4 +1,7 @@
-//! SPIR-V compiled from `shaders/*.wgsl` by build.rs, one constant per entry point.
+//! SPIR-V compiled from `shaders/*.wgsl` by build.rs, one constant per entry point, and the
+//! static cost of an invocation of those whose work a frame counts (`work.rs`).
+
+use crate::work::ShaderCost;
 
 /// SPIR-V bytes of one entry point, named `<file>.<entry>`.
 macro_rules! spirv {
@@ -17,6 +20,31 @@ macro_rules! glass_row {
             glass_entry!($model, "environment_phong", $suffix),
             glass_entry!($model, "background_fresnel", $suffix),
             glass_entry!($model, "background_phong", $suffix),
+        ]
+    };
+}
+
+/// The static cost of one invocation of an entry point named `<file>.<entry>[.<suffix>]`
+/// (build.rs).
+macro_rules! cost {
+    ($name:expr) => {
+        include!(concat!(env!("OUT_DIR"), "/", $name, ".cost.rs"))
+    };
+}
+
+/// The costs of [`glass_row!`]'s entry points.
+macro_rules! glass_cost_row {
+    ($model:literal, $suffix:literal) => {
+        [
+            cost!(concat!(
+                "glass.fs_",
+                $model,
+                "_environment_fresnel",
+                $suffix
+            )),
+            cost!(concat!("glass.fs_", $model, "_environment_phong", $suffix)),
+            cost!(concat!("glass.fs_", $model, "_background_fresnel", $suffix)),
+            cost!(concat!("glass.fs_", $model, "_background_phong", $suffix)),
         ]
     };
 }
@@ -52,6 +80,16 @@ pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 7] = [
     glass_row!("two_surface", ".convex"),
     glass_row!("two_surface", ".absorbing.convex"),
 ];
+/// The static cost of one invocation of each of [`GLASS_FS`]'s entry points.
+pub const GLASS_FS_COST: [[ShaderCost; 4]; 7] = [
+    glass_cost_row!("paper", ""),
+    glass_cost_row!("two_surface", ""),
+    glass_cost_row!("two_surface", ".absorbing"),
+    glass_cost_row!("two_surface", ".ball"),
+    glass_cost_row!("two_surface", ".absorbing.ball"),
+    glass_cost_row!("two_surface", ".convex"),
+    glass_cost_row!("two_surface", ".absorbing.convex"),
+];
 pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
 pub const MASK_VS: &[u8] = spirv!("inducer_mask.vs_main");
@@ -67,6 +105,12 @@ pub const OVERLAY_FS: [&[u8]; 3] = [
     spirv!("floor_overlay.fs_main"),
     spirv!("floor_overlay.fs_main.caustics"),
     spirv!("floor_overlay.fs_main.caustics.filtered"),
+];
+/// The static cost of one invocation of each of [`OVERLAY_FS`]'s entry points.
+pub const OVERLAY_FS_COST: [ShaderCost; 3] = [
+    cost!("floor_overlay.fs_main"),
+    cost!("floor_overlay.fs_main.caustics"),
+    cost!("floor_overlay.fs_main.caustics.filtered"),
 ];
 pub const CAUSTICS_TRACE_CS: &[u8] = spirv!("caustics_live.cs_trace");
 /// The smoothing's passes: the short kernel along the rows and along the columns, the ring

@@ -127,6 +127,8 @@ impl WorldPass {
                     bytemuck::bytes_of(&push),
                 );
                 d.cmd_draw(cmd, 6, 1, 0, 0);
+                ctx.work.upload(std::mem::size_of::<PlanePush>());
+                ctx.work.draw(6);
             }
         }
     }

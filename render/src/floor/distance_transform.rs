@@ -240,6 +240,8 @@ impl DistanceTransform {
             d.cmd_bind_pipeline(cmd, bind, self.columns.raw());
             d.cmd_dispatch(cmd, groups(x1 - x0), 1, 1);
         }
+        ctx.work.upload(std::mem::size_of::<TransformPush>());
+        ctx.work.dispatch(groups(x1 - x0), 1, 1);
         barrier(
             compute,
             vk::AccessFlags::SHADER_WRITE,
@@ -249,6 +251,7 @@ impl DistanceTransform {
         unsafe {
             d.cmd_bind_pipeline(cmd, bind, self.rows.raw());
             d.cmd_dispatch(cmd, groups(area[3] - area[1]), 1, 1);
+            ctx.work.dispatch(groups(area[3] - area[1]), 1, 1);
             let memory = [vk::MemoryBarrier::default()
                 .src_access_mask(vk::AccessFlags::SHADER_WRITE)
                 .dst_access_mask(vk::AccessFlags::SHADER_READ)];

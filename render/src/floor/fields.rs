@@ -99,7 +99,7 @@ impl FieldTarget {
     /// the `Keep` starts the image must be in SHADER_READ_ONLY_OPTIMAL when it executes.
     pub unsafe fn begin(
         &self,
-        device: &ash::Device,
+        ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         start: FieldStart,
         area: TexelRect,
@@ -141,6 +141,8 @@ impl FieldTarget {
         };
         // SAFETY: the caller's contract; the render pass and framebuffer are this target's
         // and compatible; the pipelines bound inside set viewport and scissor dynamically.
+        let device = &ctx.device;
+        ctx.work.render_pass();
         unsafe {
             device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
             device.cmd_set_viewport(cmd, 0, &[viewport]);
@@ -297,22 +299,27 @@ impl FieldPassesMs {
     }
 }
 
-/// Where a frame's floor passes write their [`FIELD_STAMPS`] timestamps: a pool and the
-/// first query.
+/// Where a frame's floor passes mark the end of each of their [`FIELD_STAMPS`] stages: a
+/// timestamp, and the stage's pipeline-statistics query ended and the next one begun
+/// (`work.rs`; the first is begun before the floor passes).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Stamps {
-    /// The frame's timestamp pool (reset before).
-    pub pool: vk::QueryPool,
+    /// The frame's timestamp pool (reset before), when the device writes timestamps.
+    pub pool: Option<vk::QueryPool>,
     /// The query of the first stamp.
     pub first: u32,
+    /// The frame's pipeline-statistics pool (reset before; its query 0 begun), when the
+    /// frame counts invocations.
+    pub statistics: Option<vk::QueryPool>,
 }
 
 impl Stamps {
-    /// Writes stamps `range` (indices from 0 to [`FIELD_STAMPS`]), once all earlier work is
-    /// done.
+    /// Marks the end of stages `range` (indices from 0 to [`FIELD_STAMPS`]), once all
+    /// earlier work is done.
     ///
     /// # Safety
-    /// `cmd` must be recording, outside a render pass, and the pool must hold the queries.
+    /// `cmd` must be recording, outside a render pass, and the pools must hold the queries;
+    /// the statistics query of `range.start` must be active.
     pub unsafe fn write(
         &self,
         device: &ash::Device,
@@ -320,15 +327,29 @@ impl Stamps {
         range: std::ops::Range<u32>,
     ) {
         for i in range {
-            // SAFETY: the caller's contract.
+            // SAFETY: the caller's contract; query i is active, i + 1 was reset and not yet
+            // begun this frame.
             unsafe {
-                device.cmd_write_timestamp(
-                    cmd,
-                    vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-                    self.pool,
-                    self.first + i,
-                )
-            };
+                if let Some(pool) = self.pool {
+                    device.cmd_write_timestamp(
+                        cmd,
+                        vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                        pool,
+                        self.first + i,
+                    );
+                }
+                if let Some(statistics) = self.statistics {
+                    device.cmd_end_query(cmd, statistics, i);
+                    if i + 1 < FIELD_STAMPS {
+                        device.cmd_begin_query(
+                            cmd,
+                            statistics,
+                            i + 1,
+                            vk::QueryControlFlags::empty(),
+                        );
+                    }
+                }
+            }
         }
     }
 }

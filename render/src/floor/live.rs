@@ -429,6 +429,8 @@ impl LiveCaustics {
             }
             let empty: [u32; 4] = [u32::MAX, u32::MAX, 0, 0];
             d.cmd_update_buffer(cmd, self.bounds, 0, bytemuck::bytes_of(&empty));
+            ctx.work
+                .upload(std::mem::size_of_val(&params) + std::mem::size_of_val(&empty));
             d.cmd_pipeline_barrier(
                 cmd,
                 transfer,
@@ -446,11 +448,12 @@ impl LiveCaustics {
             let n = self.desc.photons_per_side;
             d.cmd_bind_pipeline(cmd, bind, self.trace.raw());
             d.cmd_dispatch(cmd, groups(n), groups(n), 1);
+            ctx.work.dispatch(groups(n), groups(n), 1);
             if let Some(stamps) = stamps {
                 stamps.write(d, cmd, CAUSTIC_PHOTONS_STAMP..CAUSTIC_PHOTONS_STAMP + 1);
             }
             record_smoothing(
-                d,
+                ctx,
                 cmd,
                 self.layout.raw(),
                 &self.smooth,

@@ -149,10 +149,13 @@ impl MaskPass {
     ///
     /// # Safety
     /// `cmd` must be recording outside any render pass; `self` must outlive its execution.
-    pub unsafe fn record_upload(&self, d: &ash::Device, cmd: vk::CommandBuffer) {
+    pub unsafe fn record_upload(&self, ctx: &GpuContext, cmd: vk::CommandBuffer) {
         if self.hull.is_empty() || !self.draws() {
             return;
         }
+        let d = &ctx.device;
+        let data: &[u8] = bytemuck::cast_slice(&self.hull);
+        ctx.work.upload(data.len());
         let input = (
             vk::PipelineStageFlags::VERTEX_INPUT,
             vk::AccessFlags::VERTEX_ATTRIBUTE_READ,
@@ -167,12 +170,7 @@ impl MaskPass {
         // before later ones.
         unsafe {
             memory_barrier(d, cmd, (input.0, vk::AccessFlags::empty()), transfer);
-            d.cmd_update_buffer(
-                cmd,
-                self.hull_buffer.buffer,
-                0,
-                bytemuck::cast_slice(&self.hull),
-            );
+            d.cmd_update_buffer(cmd, self.hull_buffer.buffer, 0, data);
             memory_barrier(d, cmd, transfer, input);
         }
     }
@@ -184,10 +182,13 @@ impl MaskPass {
     /// `cmd` must be recording inside the mask's render pass, after `record_upload` in the
     /// same command buffer; `self` and `scene` (the scene the pass was made for) must outlive
     /// its execution.
-    pub unsafe fn record_draw(&self, d: &ash::Device, cmd: vk::CommandBuffer, scene: &GpuScene) {
+    pub unsafe fn record_draw(&self, ctx: &GpuContext, cmd: vk::CommandBuffer, scene: &GpuScene) {
         let Some(clip_from_model) = self.clip_from_model else {
             return;
         };
+        let d = &ctx.device;
+        // The push constant: one matrix.
+        ctx.work.upload(std::mem::size_of::<[f32; 16]>());
         let (pipeline, projection) = if self.hull.is_empty() {
             (&self.mesh_pipeline, clip_from_model)
         } else {
@@ -208,9 +209,11 @@ impl MaskPass {
                 d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
                 d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
                 d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+                ctx.work.draw(self.index_count);
             } else {
                 d.cmd_bind_vertex_buffers(cmd, 0, &[self.hull_buffer.buffer], &[0]);
                 d.cmd_draw(cmd, self.hull.len() as u32, 1, 0, 0);
+                ctx.work.draw(self.hull.len() as u32);
             }
         }
     }

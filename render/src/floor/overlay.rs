@@ -15,7 +15,8 @@ use crate::memory::Buffer;
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, PipelineSpec};
 use crate::scene::GpuScene;
-use crate::shaders::{OVERLAY_FS, OVERLAY_VS};
+use crate::shaders::{OVERLAY_FS, OVERLAY_FS_COST, OVERLAY_VS};
+use crate::work::ShaderCost;
 
 /// Push constants of the overlay, as `Overlay` in shaders/floor_overlay.wgsl.
 #[repr(C)]
@@ -36,6 +37,8 @@ pub(crate) struct OverlayPass {
     /// The pipelines (additive, in the eye render pass): the inducer's gain alone, and with
     /// the caustic gain added.
     pipelines: Vec<Owned<vk::Pipeline>>,
+    /// The static cost of one invocation of each pipeline's fragment shader.
+    costs: [ShaderCost; 2],
     /// Their layout.
     layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets.
@@ -108,11 +111,9 @@ impl OverlayPass {
         )?;
         // G through the sampler's filter where the device filters R32_SFLOAT, else four loads.
         let filtered = ctx.filters_r32_float();
-        let caustic_shader = if filtered {
-            OVERLAY_FS[2]
-        } else {
-            OVERLAY_FS[1]
-        };
+        let caustic = usize::from(filtered) + 1;
+        let caustic_shader = OVERLAY_FS[caustic];
+        let costs = [OVERLAY_FS_COST[0], OVERLAY_FS_COST[caustic]];
         tracing::debug!(
             "floor overlay: G {}",
             if filtered {
@@ -159,12 +160,18 @@ impl OverlayPass {
         pipeline::write_storage_buffer(ctx, set, 4, live_bounds.buffer);
         Ok(OverlayPass {
             pipelines,
+            costs,
             layout,
             _pool: pool,
             _set_layout: set_layout,
             set,
             live_bounds,
         })
+    }
+
+    /// The static cost of one fragment of the overlay, with or without the caustic gain.
+    pub fn cost(&self, caustics: bool) -> ShaderCost {
+        self.costs[usize::from(caustics)]
     }
 
     /// The buffer the live computation writes its map's bounds to.
@@ -229,6 +236,8 @@ impl OverlayPass {
             );
             d.cmd_draw(cmd, 6, 1, 0, 0);
         }
+        ctx.work.upload(std::mem::size_of::<OverlayPush>());
+        ctx.work.draw(6);
     }
 }
 

@@ -432,11 +432,11 @@ impl InducerPass {
         // the `Keep` starts are used only once submitted work drew the images.
         unsafe {
             if region.is_some() {
-                self.mask.record_upload(d, cmd);
+                self.mask.record_upload(ctx, cmd);
             }
             let mask = &self.targets[MASK];
             mask.begin(
-                d,
+                ctx,
                 cmd,
                 clear_start,
                 area,
@@ -444,14 +444,14 @@ impl InducerPass {
                 region.unwrap_or(area),
             );
             if region.is_some() {
-                self.mask.record_draw(d, cmd, scene);
+                self.mask.record_draw(ctx, cmd, scene);
             }
             d.cmd_end_render_pass(cmd);
             stamp(0..1);
             let Some(region) = region else {
                 // No shadow: no light either; only where the last computation drew is cleared.
                 stamp(1..2);
-                self.targets[GAIN].begin(d, cmd, clear_start, area, CLEAR[GAIN], area);
+                self.targets[GAIN].begin(ctx, cmd, clear_start, area, CLEAR[GAIN], area);
                 d.cmd_end_render_pass(cmd);
                 stamp(2..3);
                 return None;
@@ -494,14 +494,7 @@ impl InducerPass {
                 }
                 None => {
                     let target = &self.targets[DISTANCE];
-                    target.begin(
-                        &ctx.device,
-                        cmd,
-                        FieldStart::Clear,
-                        whole,
-                        CLEAR[DISTANCE],
-                        whole,
-                    );
+                    target.begin(ctx, cmd, FieldStart::Clear, whole, CLEAR[DISTANCE], whole);
                     ctx.device.cmd_end_render_pass(cmd);
                 }
             }
@@ -527,7 +520,7 @@ impl InducerPass {
         // SAFETY: the caller's contract; the pipeline, layout, set and target are this
         // pass's.
         unsafe {
-            self.targets[target].begin(d, cmd, start, area, CLEAR[target], area);
+            self.targets[target].begin(ctx, cmd, start, area, CLEAR[target], area);
             d.cmd_bind_pipeline(
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,
@@ -551,6 +544,13 @@ impl InducerPass {
             d.cmd_draw(cmd, 3, 1, 0, 0);
             d.cmd_end_render_pass(cmd);
         }
+        ctx.work.upload(std::mem::size_of::<FieldPush>());
+        ctx.work.draw(3);
+    }
+
+    /// The static cost of one fragment of the overlay drawn with the caustics or without.
+    pub fn overlay_cost(&self, caustics: bool) -> crate::work::ShaderCost {
+        self.overlay.cost(caustics)
     }
 
     /// Records the floor overlay for one eye, inside that eye's render pass: the inducer's

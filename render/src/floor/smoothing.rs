@@ -124,13 +124,14 @@ impl SmoothPass {
 /// `cmd` must be recording outside a render pass with the live caustics' set bound in
 /// `layout`; the pipelines and everything the set holds must outlive its execution.
 pub(super) unsafe fn record_smoothing(
-    d: &ash::Device,
+    ctx: &GpuContext,
     cmd: vk::CommandBuffer,
     layout: vk::PipelineLayout,
     pipelines: &[Owned<vk::Pipeline>; 4],
     steps: &[(SmoothPass, u32)],
     size: [u32; 2],
 ) {
+    let d = &ctx.device;
     let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
     let written = [vk::MemoryBarrier::default()
         .src_access_mask(vk::AccessFlags::SHADER_WRITE)
@@ -161,6 +162,8 @@ pub(super) unsafe fn record_smoothing(
             );
             let groups = pass.invocations(step, size).div_ceil(SMOOTH_GROUP);
             d.cmd_dispatch(cmd, groups, 1, 1);
+            ctx.work.upload(std::mem::size_of_val(&step));
+            ctx.work.dispatch(groups, 1, 1);
         }
     }
 }

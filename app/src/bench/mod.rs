@@ -1,7 +1,10 @@
 //! `vitreous bench`: the baseline and each requested effect set, alternated frame by frame in
-//! one process on one device, so their ratio is meaningful on a shared, noisy machine.
+//! one process on one device, so their ratio is meaningful on a shared, noisy machine; and each
+//! variant's counted work (`counts.rs`), which is the same run after run.
 
-use std::fmt::Write as _;
+mod counts;
+mod table;
+
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -9,7 +12,9 @@ use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use vitreous_render::floor::FieldPassesMs;
 use vitreous_render::renderer::Want;
-use vitreous_render::{ContextOptions, GpuContext, Look, Reflection, Refraction, Renderer};
+use vitreous_render::{
+    ContextOptions, FrameWork, GpuContext, Look, Reflection, Refraction, Renderer,
+};
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::{Backend, FrameInput};
 
@@ -21,6 +26,8 @@ use crate::look::{DefocusModel, LookPlanner};
 use crate::replay::{Spread, check_size};
 use crate::scene::{CausticsMode, load_scene, synth_params_for};
 use crate::views;
+
+pub use counts::{WorkCounts, mean_counts};
 
 /// Frames of each variant rendered before timing starts (shaders compile on first use on
 /// some drivers, lavapipe among them).
@@ -37,6 +44,9 @@ pub struct BenchOptions {
     pub size: (u32, u32),
     /// Timed frames per variant.
     pub frames: usize,
+    /// Frames of each variant rendered before timing and counting start
+    /// ([`WARM_UP_FRAMES`] for timings; counts need none).
+    pub warm_up: usize,
     /// Reflected image with per-eye refraction.
     pub reflection: Reflection,
     /// Turn on validation (slows everything down; for checking, not timing).
@@ -94,6 +104,8 @@ pub struct VariantResult {
     /// Two-surface variants: median GPU time over the same variant's under the paper's
     /// refraction.
     pub gpu_over_paper: Option<f64>,
+    /// Counted work, mean per timed frame ([`WorkCounts`]).
+    pub work: WorkCounts,
 }
 
 /// Median GPU milliseconds per frame of each stage of the floor fields' work (0 where it
@@ -143,6 +155,12 @@ pub struct BenchReport {
     pub height_px: u32,
     /// Timed frames per variant.
     pub frames: usize,
+    /// Whether each variant also ran with the light moving (`--moving`).
+    pub moving: bool,
+    /// Whether each variant also ran with two-surface refraction (`--two-surface`).
+    pub two_surface: bool,
+    /// Whether the device counted shader invocations (pipeline-statistics queries).
+    pub invocations_counted: bool,
     /// The baseline first, then each requested set.
     pub variants: Vec<VariantResult>,
 }
@@ -243,7 +261,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(&scene))
         .context("synthesising the benchmark's views")?
         .samples;
-    let total = WARM_UP_FRAMES + options.frames;
+    let total = options.warm_up + options.frames;
     let mut backend = NullBackend::new(
         samples,
         NullConfig {
@@ -313,6 +331,13 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         None
     };
     drop(setup);
+    let mut invocations_counted = true;
+    for r in std::iter::once(&mut renderer)
+        .chain(live_renderer.as_mut())
+        .chain(two_renderer.as_mut())
+    {
+        invocations_counted &= r.count_invocations()?;
+    }
 
     // With --moving every variant runs twice in a row per frame: the light moved, then the
     // same pose again (nothing moved since the frame before).
@@ -328,6 +353,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     let mut gpu = vec![Vec::new(); n];
     let mut cpu = vec![Vec::new(); n];
     let mut wall = vec![Vec::new(); n];
+    let mut work: Vec<Vec<FrameWork>> = vec![Vec::new(); n];
     let mut looks = vec![Look::default(); n];
     for (k, input) in inputs.iter().enumerate() {
         for (v, variant) in variants.iter_mut().enumerate() {
@@ -354,7 +380,8 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             renderer.submit(&params, Want::default())?;
             let result = renderer.flush()?.pop().expect("one frame in flight");
             let wall_ms = started.elapsed().as_secs_f64() * 1e3;
-            if k >= WARM_UP_FRAMES {
+            if k >= options.warm_up {
+                work[v].push(result.work);
                 if let Some(g) = result.timing.gpu_ms {
                     gpu[v].push(g);
                 }
@@ -415,9 +442,11 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 .two_surface
                 .then(|| variants.iter().position(|v| v.label == paper))
                 .flatten();
+            let fetches = fetches_per_pixel(&looks[i]) + u32::from(variant.two_surface);
             VariantResult {
                 effects: variant.label.clone(),
-                fetches_per_pixel: fetches_per_pixel(&looks[i]) + u32::from(variant.two_surface),
+                fetches_per_pixel: fetches,
+                work: mean_counts(&work[i]),
                 moving: variant.moving,
                 gpu_ms: g,
                 prepare_gpu_ms: Spread::of(prepare[i].iter().copied()),
@@ -440,6 +469,9 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         width_px: w,
         height_px: h,
         frames: options.frames,
+        moving: options.moving,
+        two_surface: options.two_surface,
+        invocations_counted,
         variants: results,
     })
 }
@@ -482,81 +514,4 @@ fn with_twins(
         out.push(variant);
     }
     out
-}
-
-impl BenchReport {
-    /// The report as a text table.
-    pub fn table(&self) -> String {
-        let mut out = String::new();
-        let _ = writeln!(
-            out,
-            "{} at {}x{} per eye on {} ({}), {} frames per variant, alternated",
-            self.scene, self.width_px, self.height_px, self.device, self.driver, self.frames
-        );
-        let _ = writeln!(
-            out,
-            "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8} {:>9}",
-            "effects",
-            "fetch",
-            "GPU ms (p10-p90)",
-            "ratio",
-            "CPU ms (p10-p90)",
-            "ratio",
-            "wall ms (p10-p90)",
-            "ratio",
-            "fields GPU ms",
-            "GPU/still",
-            "wall/still",
-            "GPU/paper"
-        );
-        let cell = |s: Option<Spread>| {
-            s.map_or("n/a".to_string(), |s| {
-                format!("{:.2} ({:.2}-{:.2})", s.median_ms, s.p10_ms, s.p90_ms)
-            })
-        };
-        let r = |x: Option<f64>| x.map_or("n/a".to_string(), |x| format!("{x:.3}"));
-        for v in &self.variants {
-            let _ = writeln!(
-                out,
-                "{:<26} {:>6} {:>22} {:>7} {:>22} {:>7} {:>22} {:>7} {:>22} {:>8} {:>8} {:>9}",
-                v.effects,
-                v.fetches_per_pixel,
-                cell(v.gpu_ms),
-                r(v.gpu_ratio),
-                cell(v.cpu_ms),
-                r(v.cpu_ratio),
-                cell(v.wall_ms),
-                r(v.wall_ratio),
-                cell(v.prepare_gpu_ms),
-                r(v.gpu_over_static),
-                r(v.wall_over_static),
-                r(v.gpu_over_paper)
-            );
-        }
-        // The variants whose frames have floor work (a still frame's stamps alone take a few
-        // hundredths of a millisecond each on lavapipe).
-        let stages: Vec<_> = self
-            .variants
-            .iter()
-            .filter(|v| v.prepare_gpu_ms.is_some_and(|p| p.median_ms > 0.5))
-            .filter_map(|v| v.field_passes_gpu_ms.map(|f| (&v.effects, f)))
-            .collect();
-        if !stages.is_empty() {
-            let _ = writeln!(out, "fields GPU ms per stage (medians):");
-        }
-        for (effects, f) in stages {
-            let _ = writeln!(
-                out,
-                "  {effects:<24} mask {:.2}, nearest {:.2}, ramp {:.2}, \
-                 live caustics {:.2} (photons {:.2}, smoothing {:.2})",
-                f.mask_ms,
-                f.nearest_ms,
-                f.ramp_ms,
-                f.caustic_photons_ms + f.caustic_smoothing_ms,
-                f.caustic_photons_ms,
-                f.caustic_smoothing_ms
-            );
-        }
-        out
-    }
 }

@@ -1,0 +1,137 @@
+//! The bench's counted work: for each variant, the mean per timed frame of what the renderer
+//! recorded and of each pass's shader invocations (`vitreous_render::work`). Timings on a
+//! shared machine scatter by tens of percent; these counts are the same run after run, so a
+//! test can hold them to a committed expectation (tests/cost.rs).
+
+use std::collections::BTreeMap;
+
+use vitreous_render::{FrameWork, Invocations};
+
+/// Named counts, mean per frame, in a stable order. Names: `render_passes`, `draws`,
+/// `vertices`, `dispatches`, `workgroups`, `uploaded_bytes` (recorded, the same on every
+/// device); where the device counts invocations, `<pass>.<stage>_invocations` for each pass
+/// (`mask`, `nearest`, `ramp`, `caustic_photons`, `caustic_smoothing`, `eye_floor`,
+/// `eye_glass`) and shader stage (`vertex`, `fragment`, `compute`), and the work of the eye
+/// passes' fragments, their invocations times the static cost of one
+/// (`vitreous_render::work::ShaderCost`): `glass_fetches`, `glass_texels`,
+/// `glass_instructions`, and the same for the floor overlay (`floor_*`).
+pub type WorkCounts = BTreeMap<String, f64>;
+
+/// The mean per frame of `frames`' work; empty without frames.
+pub fn mean_counts(frames: &[FrameWork]) -> WorkCounts {
+    let mut sums = WorkCounts::new();
+    for frame in frames {
+        for (name, value) in frame_counts(frame) {
+            *sums.entry(name).or_default() += value;
+        }
+    }
+    let n = frames.len().max(1) as f64;
+    sums.values_mut().for_each(|sum| *sum /= n);
+    sums
+}
+
+/// One frame's counts, named as [`WorkCounts`].
+fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
+    let r = &frame.recorded;
+    let mut counts: Vec<(String, f64)> = [
+        ("render_passes", r.render_passes),
+        ("draws", r.draws),
+        ("vertices", r.vertices),
+        ("dispatches", r.dispatches),
+        ("workgroups", r.workgroups),
+        ("uploaded_bytes", r.uploaded_bytes),
+    ]
+    .into_iter()
+    .map(|(name, value)| (name.to_owned(), value as f64))
+    .collect();
+    if let Some(p) = &frame.invocations {
+        let passes: [(&str, Invocations); 7] = [
+            ("mask", p.mask),
+            ("nearest", p.nearest),
+            ("ramp", p.ramp),
+            ("caustic_photons", p.caustic_photons),
+            ("caustic_smoothing", p.caustic_smoothing),
+            ("eye_floor", p.eye_floor),
+            ("eye_glass", p.eye_glass),
+        ];
+        for (pass, i) in passes {
+            for (stage, value) in [
+                ("vertex", i.vertex),
+                ("fragment", i.fragment),
+                ("compute", i.compute),
+            ] {
+                counts.push((format!("{pass}.{stage}_invocations"), value as f64));
+            }
+        }
+        let shaded = [
+            ("glass", p.eye_glass.fragment, frame.glass_shader),
+            ("floor", p.eye_floor.fragment, frame.overlay_shader),
+        ];
+        for (pass, fragments, cost) in shaded {
+            let cost = cost.unwrap_or_default();
+            for (what, per_fragment) in [
+                ("fetches", cost.fetches),
+                ("texels", cost.texels),
+                ("instructions", cost.instructions),
+            ] {
+                let total = fragments * u64::from(per_fragment);
+                counts.push((format!("{pass}_{what}"), total as f64));
+            }
+        }
+    }
+    counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vitreous_render::{PassInvocations, RecordedWork, ShaderCost};
+
+    #[test]
+    fn counts_are_means_per_frame_and_fetches_follow_the_glass_fragments() {
+        let frame = |draws: u64, fragments: u64| FrameWork {
+            recorded: RecordedWork {
+                draws,
+                ..RecordedWork::default()
+            },
+            invocations: Some(PassInvocations {
+                eye_glass: Invocations {
+                    fragment: fragments,
+                    ..Invocations::default()
+                },
+                ..PassInvocations::default()
+            }),
+            glass_shader: Some(ShaderCost {
+                fetches: 3,
+                texels: 16,
+                instructions: 100,
+            }),
+            overlay_shader: None,
+        };
+        let counts = mean_counts(&[frame(2, 100), frame(4, 300)]);
+        assert_eq!(counts["draws"], 3.0);
+        assert_eq!(counts["eye_glass.fragment_invocations"], 200.0);
+        assert_eq!(counts["glass_fetches"], 600.0);
+        assert_eq!(counts["glass_texels"], 3200.0);
+        assert_eq!(counts["glass_instructions"], 20_000.0);
+        assert_eq!(counts["floor_texels"], 0.0);
+        assert_eq!(counts["mask.compute_invocations"], 0.0);
+    }
+
+    #[test]
+    fn without_invocation_counts_only_the_recorded_work_is_named() {
+        let frame = FrameWork {
+            recorded: RecordedWork {
+                dispatches: 5,
+                ..RecordedWork::default()
+            },
+            invocations: None,
+            glass_shader: None,
+            overlay_shader: None,
+        };
+        let counts = mean_counts(&[frame]);
+        assert_eq!(counts["dispatches"], 5.0);
+        assert!(!counts.contains_key("glass_fetches"));
+        assert_eq!(counts.len(), 6);
+    }
+}

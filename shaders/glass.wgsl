@@ -421,16 +421,14 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
     } else if to_background {
         let from_origin = normalize(world_pos - eye.refraction_origin.xyz);
         let t = refract_heckbert(from_origin, n, ior);
-        if t.w == 0.0 {
-            refracted_image = environment(reflected);
+        // Total internal reflection (t.w = 0) sees the environment the mirror way.
+        let away = select(reflected, t.xyz, t.w != 0.0);
+        let uv = background_uv(world_pos, away);
+        if uv.z * t.w > 0.0 {
+            refracted_image = textureSampleLevel(
+                background, clamp_sampler, vec3<f32>(uv.xy, eye.blur.x), 0.0).rgb;
         } else {
-            let uv = background_uv(world_pos, t.xyz);
-            if uv.z > 0.0 {
-                refracted_image = textureSampleLevel(
-                    background, clamp_sampler, vec3<f32>(uv.xy, eye.blur.x), 0.0).rgb;
-            } else {
-                refracted_image = environment(t.xyz);
-            }
+            refracted_image = environment(away);
         }
     } else {
         var t = refract(incident, n, 1.0 / ior);

@@ -3,6 +3,7 @@
 
 mod absorption;
 mod caustics;
+mod cost;
 mod defocus;
 mod inducer;
 mod live_caustics;

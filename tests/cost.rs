@@ -1,0 +1,231 @@
+//! The cost guard: every condition's counted work per frame (`vitreous bench`'s `work`: passes,
+//! draws, dispatches, uploaded bytes, each pass's shader invocations and the glass's and
+//! floor's fetches, texels and instructions) held to the expectation committed in
+//! `tests/cost-expected.json`, with 5 % margin; and each condition's work over the baseline's
+//! (O2, or a) held to its committed ratio the same way, so that a cheaper baseline the method
+//! does not follow fails too. Counts, not times: the same run after run on one driver.
+//!
+//! After a deliberate change of cost, write the new expectation with
+//! `VITREOUS_UPDATE_COST=1 cargo test -p vitreous-tests --test gpu cost` and say why in the
+//! commit. Invocation counts hold for the driver that recorded them (the file names it); on
+//! another device only the recorded counts, which are the same everywhere, are compared.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde_json::{Value, json};
+use vitreous::bench::{BenchOptions, BenchReport, bench};
+use vitreous::effects::EffectSet;
+use vitreous_render::Reflection;
+
+use vitreous_tests::workspace;
+
+/// How much a count may grow over its expectation.
+const MARGIN: f64 = 1.05;
+
+/// Counts of the recorded work, the same on every device.
+const RECORDED: [&str; 6] = [
+    "render_passes",
+    "draws",
+    "vertices",
+    "dispatches",
+    "workgroups",
+    "uploaded_bytes",
+];
+
+/// Counts whose ratio to the baseline's is held too: the work that decides a condition's
+/// cost over the conventional method's.
+const RATIOS: [&str; 4] = [
+    "glass_texels",
+    "glass_instructions",
+    "floor_texels",
+    "floor_instructions",
+];
+
+/// One benchmarked case: a name, the scene and the bench's switches.
+struct Case {
+    name: &'static str,
+    scene: &'static str,
+    effects: &'static [&'static str],
+    moving: bool,
+    two_surface: bool,
+}
+
+/// The study's conditions (with two-surface O5), the floor's, and the live scene's moving
+/// light.
+const CASES: [Case; 3] = [
+    Case {
+        name: "visual-effects O3 O4 O5",
+        scene: "visual-effects.toml",
+        effects: &["O3", "O4", "O5"],
+        moving: false,
+        two_surface: true,
+    },
+    Case {
+        name: "glass-sphere b c",
+        scene: "glass-sphere.toml",
+        effects: &["b", "c"],
+        moving: false,
+        two_surface: false,
+    },
+    Case {
+        name: "moving-light c moving",
+        scene: "moving-light.toml",
+        effects: &["c"],
+        moving: true,
+        two_surface: false,
+    },
+];
+
+fn expectation_path() -> PathBuf {
+    workspace().join("tests/cost-expected.json")
+}
+
+/// The case's bench: small eye images (counts scale with the area, ratios do not), frames
+/// enough for the gaze pipeline to decide an image first, validation on.
+fn run(case: &Case) -> BenchReport {
+    bench(&BenchOptions {
+        scene: workspace().join("config/scenes").join(case.scene),
+        effects: case
+            .effects
+            .iter()
+            .map(|e| EffectSet::parse(e).unwrap())
+            .collect(),
+        size: (320, 240),
+        frames: 4,
+        warm_up: 40,
+        reflection: Reflection::Phong,
+        validate: true,
+        device: None,
+        pupils_mm: Vec::new(),
+        moving: case.moving,
+        live_caustics: false,
+        two_surface: case.two_surface,
+    })
+    .unwrap_or_else(|e| panic!("{}: {e:#}", case.name))
+}
+
+/// The case's counts, variant by variant, with each [`RATIOS`] count over the baseline's (the
+/// conventional method standing still under the paper's refraction) as `<count>/baseline`.
+fn counts(report: &BenchReport) -> BTreeMap<String, BTreeMap<String, f64>> {
+    let baseline = &report
+        .variants
+        .iter()
+        .find(|v| v.effects == "none")
+        .expect("the baseline's variant")
+        .work;
+    report
+        .variants
+        .iter()
+        .map(|v| {
+            let mut counts = v.work.clone();
+            for name in RATIOS {
+                if let (Some(&mine), Some(&base)) = (v.work.get(name), baseline.get(name))
+                    && base > 0.0
+                {
+                    counts.insert(format!("{name}/baseline"), mine / base);
+                }
+            }
+            (v.effects.clone(), counts)
+        })
+        .collect()
+}
+
+#[test]
+fn every_conditions_counted_work_stays_within_its_expectation() {
+    let mut driver = String::new();
+    let mut measured = serde_json::Map::new();
+    for case in &CASES {
+        let report = run(case);
+        assert!(
+            report.invocations_counted,
+            "{}: lavapipe counts invocations; this device did not",
+            case.name
+        );
+        driver = report.driver.clone();
+        measured.insert(case.name.to_owned(), json!(counts(&report)));
+    }
+    let measured = json!({ "driver": driver, "cases": measured });
+    if std::env::var_os("VITREOUS_UPDATE_COST").is_some() {
+        let text = serde_json::to_string_pretty(&measured).unwrap() + "\n";
+        std::fs::write(expectation_path(), text).unwrap();
+        eprintln!("wrote {}", expectation_path().display());
+        return;
+    }
+    let text = std::fs::read_to_string(expectation_path()).unwrap();
+    let expected: Value = serde_json::from_str(&text).unwrap();
+    let failures = compare(&expected, &measured);
+    assert!(
+        failures.is_empty(),
+        "counted work above its expectation ({}, margin {:.0} %):\n{}\nIf the change is \
+         meant, write the new expectation with VITREOUS_UPDATE_COST=1 and say why.",
+        expectation_path().display(),
+        (MARGIN - 1.0) * 100.0,
+        failures.join("\n")
+    );
+}
+
+/// Every expected count that `measured` lacks or exceeds by more than [`MARGIN`], as lines;
+/// invocation-based counts only when the driver is the one that recorded them.
+fn compare(expected: &Value, measured: &Value) -> Vec<String> {
+    let same_driver = expected["driver"] == measured["driver"];
+    let mut failures = Vec::new();
+    let Some(cases) = expected["cases"].as_object() else {
+        return vec!["the expectation file has no cases".into()];
+    };
+    for (case, variants) in cases {
+        for (variant, counts) in variants.as_object().into_iter().flatten() {
+            for (name, want) in counts.as_object().into_iter().flatten() {
+                if !same_driver && !RECORDED.contains(&name.as_str()) {
+                    continue;
+                }
+                let want = want.as_f64().unwrap_or(f64::NAN);
+                match measured["cases"][case][variant][name].as_f64() {
+                    None => failures.push(format!("{case} / {variant}: no {name}")),
+                    Some(got) if got > want * MARGIN + 1e-9 => failures.push(format!(
+                        "{case} / {variant}: {name} {got:.4} > {want:.4} expected (+{:.1} %)",
+                        (got / want - 1.0) * 100.0
+                    )),
+                    Some(_) => {}
+                }
+            }
+        }
+    }
+    failures
+}
+
+#[test]
+fn the_guard_fails_a_count_that_grows_and_a_baseline_that_gets_cheaper_alone() {
+    let expected = json!({
+        "driver": "d",
+        "cases": { "c": {
+            "none": { "glass_texels": 100.0, "draws": 2.0 },
+            "disparity": { "glass_texels": 100.0, "glass_texels/baseline": 1.0 }
+        } }
+    });
+    let same = expected.clone();
+    assert!(compare(&expected, &same).is_empty());
+    // 4 % more is within the margin; 6 % more is not.
+    let mut grown = expected.clone();
+    grown["cases"]["c"]["none"]["glass_texels"] = json!(104.0);
+    assert!(compare(&expected, &grown).is_empty());
+    grown["cases"]["c"]["none"]["glass_texels"] = json!(106.0);
+    assert_eq!(compare(&expected, &grown).len(), 1);
+    // The baseline halves, the condition stays: its ratio doubles.
+    let mut cheaper = expected.clone();
+    cheaper["cases"]["c"]["none"]["glass_texels"] = json!(50.0);
+    cheaper["cases"]["c"]["disparity"]["glass_texels/baseline"] = json!(2.0);
+    let failures = compare(&expected, &cheaper);
+    assert_eq!(failures.len(), 1, "{failures:?}");
+    assert!(failures[0].contains("glass_texels/baseline"));
+    // A count that disappears fails; on another driver only the recorded counts are held.
+    let mut missing = expected.clone();
+    missing["cases"]["c"]["none"]
+        .as_object_mut()
+        .unwrap()
+        .remove("draws");
+    assert_eq!(compare(&expected, &missing).len(), 1);
+    let mut elsewhere = grown.clone();
+    elsewhere["driver"] = json!("another");
+    assert!(compare(&expected, &elsewhere).is_empty());
+}

@@ -12,8 +12,9 @@
 //
 // The surface image (texture with its transmittance) is blended by eq. 9.
 //
-// Gaze-dependent defocus (eq. 9-14): the refracted and surface images are read from blur stacks
-// at the blur the frame asks for; one (trilinear) fetch each, whatever the blur.
+// Gaze-dependent defocus (eq. 9-14): the refracted and surface images are read from the frame's
+// blend of their blur stacks at the blur it asks for (render/src/blur_blend.rs); one bilinear
+// fetch each, whatever the blur.
 //
 // Two-surface refraction (`[object] refraction = "two-surface"`, beyond the paper,
 // docs/equations.md): the ray refracts in at the front, crosses the glass and refracts out at
@@ -39,9 +40,6 @@ struct Eye {
     // xyz: where refraction to the background plane is seen from: this eye (disparity), or
     // the point between the eyes (defocus without disparity).
     refraction_origin: vec4<f32>,
-    // Blur-stack coordinates (0..1 along the stack's depth) of x: the refracted image
-    // (background photo), y: the surface image (surface texture).
-    blur: vec4<f32>,
 };
 
 struct Globals {
@@ -94,11 +92,11 @@ var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(0) @binding(1) var env_map: texture_2d<f32>;
 @group(0) @binding(2) var wrap_sampler: sampler;
-// Blur stacks (eq. 10-14): slice i holds the image blurred with K_g = i * step; trilinear
-// filtering between slices gives any K_g in one fetch.
-@group(0) @binding(3) var background: texture_3d<f32>;
+// The background photo and the surface texture at the frame's blur (eq. 10-14), blended from
+// their blur stacks before the eye passes (shaders/blur_blend.wgsl).
+@group(0) @binding(3) var background: texture_2d<f32>;
 @group(0) @binding(4) var clamp_sampler: sampler;
-@group(0) @binding(5) var surface: texture_3d<f32>;
+@group(0) @binding(5) var surface: texture_2d<f32>;
 // The object's surface seen from its centre (two-surface refraction; 1 texel otherwise): rgb
 // the outward normal minus the direction, a the radius minus the reference radius.
 @group(0) @binding(6) var radial_map: texture_2d<f32>;
@@ -251,6 +249,12 @@ fn find_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     // sphere of the last radius where a secant step would go backwards.
     var t = sphere_exit(p, d, length(p));
     var s = radial_surface(p + d * t);
+    if BALL {
+        // The entry lies on the ball (`front_surface`): the first estimate is its exit. The
+        // search below would stop at once, but a device that runs a loop's first pass for
+        // every lane (lavapipe) would still pay for a secant step.
+        return vec4<f32>(t, s.yzw);
+    }
     var f = length(p + d * t) - s.x;
     var t_prev = t;
     var f_prev = f;
@@ -413,7 +417,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         var seen: vec3<f32>;
         if uv.z > 0.0 {
             seen = textureSampleLevel(
-                background, clamp_sampler, vec3<f32>(uv.xy, eye.blur.x), 0.0).rgb;
+                background, clamp_sampler, uv.xy, 0.0).rgb;
         } else {
             seen = environment(passage.direction);
         }
@@ -426,7 +430,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         let uv = background_uv(world_pos, away);
         if uv.z * t.w > 0.0 {
             refracted_image = textureSampleLevel(
-                background, clamp_sampler, vec3<f32>(uv.xy, eye.blur.x), 0.0).rgb;
+                background, clamp_sampler, uv.xy, 0.0).rgb;
         } else {
             refracted_image = environment(away);
         }
@@ -450,7 +454,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
     }
 
     // eq. 9: C_o = alpha C_s + (1 - alpha) C_b, alpha the surface's opacity.
-    let surface_texel = textureSample(surface, wrap_sampler, vec3<f32>(in.uv, eye.blur.y));
+    let surface_texel = textureSample(surface, wrap_sampler, in.uv);
     let alpha = g.shading.y * surface_texel.a;
     let colour = alpha * surface_texel.rgb + (1.0 - alpha) * (1.0 - fresnel) * refracted_image
         + reflected_image;

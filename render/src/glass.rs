@@ -73,51 +73,24 @@ pub struct EyePush {
     pub position: [f32; 4],
     /// Where refraction to the background plane is seen from (xyz, metres).
     pub refraction_origin: [f32; 4],
-    /// Blur-stack coordinates of the refracted (x) and surface (y) images.
-    pub blur: [f32; 4],
 }
 
 impl EyePush {
-    /// The push constants of eye `index` of `eyes` drawn with `look`, sampling blur stacks
-    /// of `slices` (background, surface) with `k_g_steps` (pixels) between slices.
-    pub fn new(
-        eyes: &[EyeParams; 2],
-        index: usize,
-        look: &Look,
-        slices: [u32; 2],
-        k_g_steps: [f32; 2],
-    ) -> EyePush {
+    /// The push constants of eye `index` of `eyes` drawn with `look` (its blur is in the
+    /// images the frame blended, `blur_blend.rs`).
+    pub fn new(eyes: &[EyeParams; 2], index: usize, look: &Look) -> EyePush {
         let eye = &eyes[index];
         let refraction_origin = if look.disparity {
             eye.position_m
         } else {
             (eyes[0].position_m + eyes[1].position_m) / 2.0
         };
-        let defocus = look.defocus.unwrap_or_default();
-        let blur = [
-            stack_coordinate(defocus.refracted_k_g_px, k_g_steps[0], slices[0]),
-            stack_coordinate(defocus.surface_k_g_px, k_g_steps[1], slices[1]),
-            0.0,
-            0.0,
-        ];
         EyePush {
             clip_from_world: eye.clip_from_world().to_cols_array(),
             position: eye.position_m.extend(index as f32).to_array(),
             refraction_origin: refraction_origin.extend(1.0).to_array(),
-            blur,
         }
     }
-}
-
-/// The texture coordinate along a blur stack of `slices` slices, `step` K_g apart, that blends
-/// the two slices around `k_g` (clamped to the stack): slice centres sit at (i + 0.5) / slices.
-pub fn stack_coordinate(k_g: f32, step: f32, slices: u32) -> f32 {
-    let position = if step > 0.0 {
-        (k_g / step).clamp(0.0, (slices - 1) as f32)
-    } else {
-        0.0
-    };
-    (position + 0.5) / slices as f32
 }
 
 /// Uniform block matching `Globals` in glass.wgsl.
@@ -189,6 +162,7 @@ impl GlassPass {
         render_pass: vk::RenderPass,
         scene: &GpuScene,
         desc: &SceneDesc,
+        blurred: [vk::ImageView; 2],
     ) -> Result<GlassPass> {
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let fragment = vk::ShaderStageFlags::FRAGMENT;
@@ -324,15 +298,9 @@ impl GlassPass {
         // SAFETY: the set was just allocated and no GPU work uses it; the buffer is live.
         unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
         pipeline::write_texture(ctx, set, 1, 2, scene.environment.view, scene.env_sampler());
-        pipeline::write_texture(
-            ctx,
-            set,
-            3,
-            4,
-            scene.background_stack.view,
-            scene.photo_sampler(),
-        );
-        pipeline::write_image(ctx, set, 5, scene.surface.view);
+        let [background, surface] = blurred;
+        pipeline::write_texture(ctx, set, 3, 4, background, scene.photo_sampler());
+        pipeline::write_image(ctx, set, 5, surface);
         pipeline::write_image(ctx, set, 6, radial_map.view);
         pipeline::write_storage_buffer(ctx, set, 7, planes.buffer);
         Ok(GlassPass {

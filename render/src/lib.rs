@@ -24,6 +24,7 @@
 //! Knows nothing about OpenXR: device creation is an injected step ([`context::DeviceCreator`]).
 
 pub mod absorption;
+mod blur_blend;
 pub mod camera;
 pub mod context;
 pub mod convex;
@@ -56,9 +57,9 @@ pub use floor as inducer;
 pub use floor::InducerFields;
 pub use memory::{color_copy_region, layout_barrier, subresource_range};
 pub use pose::ScenePose;
-pub use renderer::{Composition, FrameResult, FrameTiming, FrameWork, Readback, Renderer, Want};
+pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
     BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, Refraction,
     RefractionParseError, SceneDesc, TexelData, TextureDesc,
 };
-pub use work::{Invocations, PassInvocations, RecordedWork, ShaderCost};
+pub use work::{FrameWork, Invocations, PassInvocations, RecordedWork, ShaderCost};

@@ -1,14 +1,16 @@
 //! The renderer: owns the GPU context, the scene's resources, the passes and the frame slots.
 //!
-//! Just over 600 lines: the passes live in their own modules; what stays here is the one idea
-//! of a frame (slot choice, recording every pass in order, submission for each composition and
-//! target), which reads best in one place.
+//! Over 600 lines: the passes and the counting of work live in their own modules; what stays
+//! here is the one idea of a frame (slot choice, recording every pass in order with its
+//! queries, submission for each composition and target, collecting what it measured), which
+//! reads best in one place.
 
 use std::time::Instant;
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
+use crate::blur_blend::{self, BlurBlend};
 use crate::camera::FrameParams;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
@@ -20,7 +22,7 @@ use crate::pipeline;
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, SceneDesc};
 use crate::target::{self, StereoTarget};
-use crate::work::{self, PassInvocations, RecordedWork, ShaderCost};
+use crate::work::{self, FrameWork, Statistics};
 use crate::world::WorldPass;
 
 mod composition;
@@ -76,21 +78,6 @@ pub struct FrameTiming {
     pub field_passes: Option<FieldPassesMs>,
     /// CPU time spent recording and submitting the frame, milliseconds.
     pub cpu_submit_ms: f64,
-}
-
-/// The work of one frame, counted (`work.rs`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct FrameWork {
-    /// What was recorded into its command buffer: the same on every device.
-    pub recorded: RecordedWork,
-    /// The shader invocations of each pass as the device ran them; `None` unless
-    /// [`Renderer::count_invocations`] turned counting on before the frame (and the device
-    /// can).
-    pub invocations: Option<PassInvocations>,
-    /// The static cost of one fragment of the glass's pipeline, when the glass was drawn.
-    pub glass_shader: Option<ShaderCost>,
-    /// The static cost of one fragment of the floor overlay's pipeline, when it was drawn.
-    pub overlay_shader: Option<ShaderCost>,
 }
 
 /// A finished frame.
@@ -161,6 +148,8 @@ pub struct Renderer {
     world_target: StereoTarget,
     /// The glass pass.
     glass: GlassPass,
+    /// The frame's blur of the background and surface, blended from their stacks.
+    blur: BlurBlend,
     /// The real-world pass for previews.
     world: WorldPass,
     /// The shadow inducer's fields and floor overlay.
@@ -193,7 +182,8 @@ impl Renderer {
         // locals), so the device never goes under live objects.
         let gpu_scene = GpuScene::new(&ctx, scene)?;
         let render_pass = target::create_render_pass(&ctx)?;
-        let glass = GlassPass::new(&ctx, render_pass.raw(), &gpu_scene, scene)?;
+        let blur = BlurBlend::new(&ctx, &gpu_scene)?;
+        let glass = GlassPass::new(&ctx, render_pass.raw(), &gpu_scene, scene, blur.views())?;
         let world = WorldPass::new(
             &ctx,
             render_pass.raw(),
@@ -268,6 +258,7 @@ impl Renderer {
             eye_target,
             world_target,
             glass,
+            blur,
             world,
             inducer,
             render_pass,
@@ -344,15 +335,7 @@ impl Renderer {
         }
         for slot in &mut self.slots {
             if slot.statistics.is_none() {
-                // SAFETY: a valid create info (the device has pipeline-statistics queries
-                // enabled); owned right away.
-                let pool = unsafe {
-                    self.ctx
-                        .device
-                        .create_query_pool(&work::statistics_pool_info(), None)
-                }
-                .vk("vkCreateQueryPool")?;
-                slot.statistics = Some(Owned::new(&self.ctx, pool));
+                slot.statistics = Some(work::statistics_pool(&self.ctx)?);
             }
         }
         Ok(true)
@@ -427,11 +410,20 @@ impl Renderer {
                 overlay_shader: ((look.inducer || look.caustics) && !look.blank)
                     .then(|| self.inducer.overlay_cost(look.caustics)),
             };
-            d.end_command_buffer(slot.cmd).vk("vkEndCommandBuffer")?;
             let cmds = [slot.cmd];
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
-            d.queue_submit(self.ctx.queue, &submit, fence)
-                .vk("vkQueueSubmit")?;
+            let submitted = d
+                .end_command_buffer(slot.cmd)
+                .vk("vkEndCommandBuffer")
+                .and_then(|()| {
+                    d.queue_submit(self.ctx.queue, &submit, fence)
+                        .vk("vkQueueSubmit")
+                });
+            if let Err(e) = submitted {
+                // The blends recorded into it never ran.
+                self.blur.forget();
+                return Err(e);
+            }
             (prepared, recorded)
         };
         let (prepared, recorded) = prepared;
@@ -597,21 +589,17 @@ impl Renderer {
                 d.cmd_reset_query_pool(cmd, pool, 0, QUERIES);
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 0);
             }
-            let statistics = slot.statistics.as_ref().map(Owned::raw);
-            if let Some(pool) = statistics {
-                d.cmd_reset_query_pool(cmd, pool, 0, work::STATISTICS_QUERIES);
-                // The first floor stage's; each stage's end begins the next.
-                d.cmd_begin_query(cmd, pool, 0, vk::QueryControlFlags::empty());
-            }
+            let statistics = Statistics(slot.statistics.as_ref().map(Owned::raw));
+            statistics.start(d, cmd);
             let blank = params.look.blank;
             let (inducer, caustics) = (
                 params.look.inducer && !blank,
                 params.look.caustics && !blank,
             );
-            let stamps = (queries.is_some() || statistics.is_some()).then_some(Stamps {
+            let stamps = (queries.is_some() || statistics.0.is_some()).then_some(Stamps {
                 pool: queries,
                 first: 3,
-                statistics,
+                statistics: statistics.0,
             });
             if inducer || caustics {
                 // Once per pose, timed on its own.
@@ -619,6 +607,14 @@ impl Renderer {
             } else if let Some(stamps) = stamps {
                 stamps.write(d, cmd, 0..FIELD_STAMPS);
             }
+            // Every query is begun and ended each frame, so all have results.
+            statistics.around(d, cmd, work::BLUR_QUERY, || {
+                if !blank {
+                    let (look, scene) = (&params.look, &self.scene);
+                    let depths = blur_blend::depths(look, scene.stack_slices, scene.stack_steps);
+                    self.blur.record(&self.ctx, cmd, depths);
+                }
+            });
             if let Some(pool) = queries {
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 1);
             }
@@ -630,38 +626,23 @@ impl Renderer {
                     composition.clear_alpha(),
                 );
                 let query = work::eye_query(index);
-                if let Some(pool) = statistics {
-                    d.cmd_begin_query(cmd, pool, query, vk::QueryControlFlags::empty());
-                }
-                if world_behind {
-                    self.world.record(&self.ctx, cmd, eye);
-                }
-                if inducer || caustics {
-                    // Added before the glass, which covers it where the object is.
-                    self.inducer.record(&self.ctx, cmd, eye, inducer, caustics);
-                }
-                if let Some(pool) = statistics {
-                    d.cmd_end_query(cmd, pool, query);
-                    d.cmd_begin_query(cmd, pool, query + 1, vk::QueryControlFlags::empty());
-                }
-                if !blank {
-                    self.glass.record(
-                        &self.ctx,
-                        cmd,
-                        &self.scene,
-                        GlassVariant::of(&params.look),
-                        &EyePush::new(
-                            &params.eyes,
-                            index,
-                            &params.look,
-                            self.scene.stack_slices,
-                            self.scene.stack_steps,
-                        ),
-                    );
-                }
-                if let Some(pool) = statistics {
-                    d.cmd_end_query(cmd, pool, query + 1);
-                }
+                statistics.around(d, cmd, query, || {
+                    if world_behind {
+                        self.world.record(&self.ctx, cmd, eye);
+                    }
+                    if inducer || caustics {
+                        // Added before the glass, which covers it where the object is.
+                        self.inducer.record(&self.ctx, cmd, eye, inducer, caustics);
+                    }
+                });
+                statistics.around(d, cmd, query + 1, || {
+                    if !blank {
+                        let push = EyePush::new(&params.eyes, index, &params.look);
+                        let variant = GlassVariant::of(&params.look);
+                        self.glass
+                            .record(&self.ctx, cmd, &self.scene, variant, &push);
+                    }
+                });
                 d.cmd_end_render_pass(cmd);
             }
             if let Some(pool) = queries {

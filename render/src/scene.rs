@@ -224,8 +224,11 @@ pub(crate) struct GpuScene {
     pub photos: [Image; 2],
     /// The surface texture's blur stack (3-D, sRGB); a white texel when the scene has none.
     pub surface: Image,
-    /// The background photo's blur stack (3-D, sRGB), sampled by the glass pass.
+    /// The background photo's blur stack (3-D, sRGB), which the frame's blur is blended from
+    /// (`blur_blend.rs`).
     pub background_stack: Image,
+    /// The size of a slice of the background and surface stacks, texels.
+    pub stack_extents: [vk::Extent2D; 2],
     /// Slices of the background and surface stacks.
     pub stack_slices: [u32; 2],
     /// K_g between slices of the background and surface stacks, pixels.
@@ -269,13 +272,14 @@ impl GpuScene {
             height: 1,
             data: TexelData::Srgb8(&white),
         });
-        let (background_stack, background_slices, background_step) = upload_stack(
-            ctx,
-            "background blur stack",
-            &desc.background.photo,
-            desc.background_stack,
-        )?;
-        let (surface, surface_slices, surface_step) = upload_stack(
+        let (background_stack, background_extent, background_slices, background_step) =
+            upload_stack(
+                ctx,
+                "background blur stack",
+                &desc.background.photo,
+                desc.background_stack,
+            )?;
+        let (surface, surface_extent, surface_slices, surface_step) = upload_stack(
             ctx,
             "surface blur stack",
             &surface_photo,
@@ -289,6 +293,7 @@ impl GpuScene {
             photos: [floor, background],
             surface,
             background_stack,
+            stack_extents: [background_extent, surface_extent],
             stack_slices: [background_slices, surface_slices],
             stack_steps: [background_step, surface_step],
             env_sampler: sampler(ctx, vk::SamplerAddressMode::REPEAT)?,
@@ -497,14 +502,15 @@ fn upload(ctx: &GpuContext, name: &str, t: &TextureDesc) -> Result<Image> {
     }
 }
 
-/// Uploads a blur stack as a 3-D texture; without one, the plain image twice (a 3-D texture
-/// needs two slices to be one), which samples as the unblurred image at any slice position.
+/// Uploads a blur stack as a 3-D texture, with the size of its slices; without one, the plain
+/// image twice (a 3-D texture needs two slices to be one), which samples as the unblurred
+/// image at any slice position.
 fn upload_stack(
     ctx: &GpuContext,
     name: &str,
     plain: &TextureDesc,
     stack: Option<BlurStackDesc>,
-) -> Result<(Image, u32, f32)> {
+) -> Result<(Image, vk::Extent2D, u32, f32)> {
     let extent = |w, h| vk::Extent2D {
         width: w,
         height: h,
@@ -519,6 +525,7 @@ fn upload_stack(
                 s.slices,
                 s.srgb8,
             )?,
+            extent(s.width, s.height),
             s.slices,
             s.k_g_step_px,
         )),
@@ -537,7 +544,7 @@ fn upload_stack(
                 2,
                 &twice,
             )?;
-            Ok((image, 2, 1.0))
+            Ok((image, extent(plain.width, plain.height), 2, 1.0))
         }
     }
 }

@@ -91,6 +91,8 @@ pub const GLASS_FS_COST: [[ShaderCost; 4]; 7] = [
     glass_cost_row!("two_surface", ".absorbing.convex"),
 ];
 pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
+pub const BLUR_BLEND_VS: &[u8] = spirv!("blur_blend.vs_main");
+pub const BLUR_BLEND_FS: &[u8] = spirv!("blur_blend.fs_main");
 pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
 pub const MASK_VS: &[u8] = spirv!("inducer_mask.vs_main");
 pub const MASK_FS: &[u8] = spirv!("inducer_mask.fs_main");

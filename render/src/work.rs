@@ -20,7 +20,25 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use ash::vk;
 
+use crate::context::GpuContext;
+use crate::error::{Result, VkContext};
 use crate::floor::FIELD_STAMPS;
+use crate::owned::Owned;
+
+/// The work of one frame, counted (`work.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameWork {
+    /// What was recorded into its command buffer: the same on every device.
+    pub recorded: RecordedWork,
+    /// The shader invocations of each pass as the device ran them; `None` unless
+    /// [`crate::Renderer::count_invocations`] turned counting on before the frame (and the device
+    /// can).
+    pub invocations: Option<PassInvocations>,
+    /// The static cost of one fragment of the glass's pipeline, when the glass was drawn.
+    pub glass_shader: Option<ShaderCost>,
+    /// The static cost of one fragment of the floor overlay's pipeline, when it was drawn.
+    pub overlay_shader: Option<ShaderCost>,
+}
 
 /// Work recorded into one frame's command buffer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -156,6 +174,8 @@ pub struct PassInvocations {
     pub caustic_photons: Invocations,
     /// The live caustic map's smoothing, clamp, bound and copy.
     pub caustic_smoothing: Invocations,
+    /// The blur's blends of the background photo and surface texture (when it changed).
+    pub blur: Invocations,
     /// In the eye passes, everything before the glass: the real world behind (for a display
     /// that shows none of its own) and the floor overlay.
     pub eye_floor: Invocations,
@@ -170,21 +190,75 @@ const STATISTICS: vk::QueryPipelineStatisticFlags = vk::QueryPipelineStatisticFl
         | vk::QueryPipelineStatisticFlags::COMPUTE_SHADER_INVOCATIONS.as_raw(),
 );
 
-/// Queries per frame: one per floor stage ([`FIELD_STAMPS`], in their order), then for each
-/// eye one before the glass and one for it.
-pub(crate) const STATISTICS_QUERIES: u32 = FIELD_STAMPS + 4;
+/// Queries per frame: one per floor stage ([`FIELD_STAMPS`], in their order), the blur's
+/// blends ([`BLUR_QUERY`]), then for each eye one before the glass and one for it.
+pub(crate) const STATISTICS_QUERIES: u32 = FIELD_STAMPS + 5;
+
+/// The query of the blur's blends (`blur_blend.rs`).
+pub(crate) const BLUR_QUERY: u32 = FIELD_STAMPS;
 
 /// The query of eye `eye`'s part before the glass; the glass's is the next.
 pub(crate) fn eye_query(eye: usize) -> u32 {
-    FIELD_STAMPS + 2 * eye as u32
+    BLUR_QUERY + 1 + 2 * eye as u32
 }
 
-/// A pool of [`STATISTICS_QUERIES`] pipeline-statistics queries.
-pub(crate) fn statistics_pool_info() -> vk::QueryPoolCreateInfo<'static> {
-    vk::QueryPoolCreateInfo::default()
+/// A frame's pipeline-statistics queries, when it counts invocations: each call does
+/// nothing on `None`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Statistics(pub Option<vk::QueryPool>);
+
+impl Statistics {
+    /// Resets the pool and begins the first floor stage's query (each stage's end begins the
+    /// next, `floor::Stamps`).
+    ///
+    /// # Safety
+    /// `cmd` must be recording outside a render pass; the pool must hold
+    /// [`STATISTICS_QUERIES`] queries and outlive the command buffer's execution.
+    pub unsafe fn start(self, device: &ash::Device, cmd: vk::CommandBuffer) {
+        if let Some(pool) = self.0 {
+            // SAFETY: the caller's contract.
+            unsafe {
+                device.cmd_reset_query_pool(cmd, pool, 0, STATISTICS_QUERIES);
+                device.cmd_begin_query(cmd, pool, 0, vk::QueryControlFlags::empty());
+            }
+        }
+    }
+
+    /// Counts what `record` records into `cmd` in query `query`.
+    ///
+    /// # Safety
+    /// As [`Statistics::start`], after it; `query` not yet begun this frame, and `record`
+    /// must end any render pass it begins (or begin none when called inside one).
+    pub unsafe fn around(
+        self,
+        device: &ash::Device,
+        cmd: vk::CommandBuffer,
+        query: u32,
+        record: impl FnOnce(),
+    ) {
+        if let Some(pool) = self.0 {
+            // SAFETY: the caller's contract.
+            unsafe { device.cmd_begin_query(cmd, pool, query, vk::QueryControlFlags::empty()) };
+        }
+        record();
+        if let Some(pool) = self.0 {
+            // SAFETY: the caller's contract; the query was begun above.
+            unsafe { device.cmd_end_query(cmd, pool, query) };
+        }
+    }
+}
+
+/// A pool of [`STATISTICS_QUERIES`] pipeline-statistics queries (the device must have them
+/// enabled: [`GpuContext::pipeline_statistics`]).
+pub(crate) fn statistics_pool(ctx: &GpuContext) -> Result<Owned<vk::QueryPool>> {
+    let info = vk::QueryPoolCreateInfo::default()
         .query_type(vk::QueryType::PIPELINE_STATISTICS)
         .query_count(STATISTICS_QUERIES)
-        .pipeline_statistics(STATISTICS)
+        .pipeline_statistics(STATISTICS);
+    // SAFETY: a valid create info for a device with pipeline-statistics queries; owned right
+    // away.
+    let pool = unsafe { ctx.device.create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
+    Ok(Owned::new(ctx, pool))
 }
 
 /// The frame's invocations from its pool's results, as [`read_statistics`] returns them.
@@ -199,6 +273,7 @@ pub(crate) fn pass_invocations(
         ramp: at(2),
         caustic_photons: at(3),
         caustic_smoothing: at(4),
+        blur: at(BLUR_QUERY),
         eye_floor: eyes(0),
         eye_glass: eyes(1),
     }
@@ -212,7 +287,7 @@ pub(crate) fn pass_invocations(
 pub(crate) unsafe fn read_statistics(
     device: &ash::Device,
     pool: vk::QueryPool,
-) -> Result<PassInvocations, vk::Result> {
+) -> std::result::Result<PassInvocations, vk::Result> {
     let mut results = [[0u64; 3]; STATISTICS_QUERIES as usize];
     // SAFETY: the caller's contract; each query's three 64-bit results fill one element.
     unsafe {

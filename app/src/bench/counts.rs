@@ -10,7 +10,7 @@ use vitreous_render::{FrameWork, Invocations};
 /// Named counts, mean per frame, in a stable order. Names: `render_passes`, `draws`,
 /// `vertices`, `dispatches`, `workgroups`, `uploaded_bytes` (recorded, the same on every
 /// device); where the device counts invocations, `<pass>.<stage>_invocations` for each pass
-/// (`mask`, `nearest`, `ramp`, `caustic_photons`, `caustic_smoothing`, `eye_floor`,
+/// (`mask`, `nearest`, `ramp`, `caustic_photons`, `caustic_smoothing`, `blur`, `eye_floor`,
 /// `eye_glass`) and shader stage (`vertex`, `fragment`, `compute`), and the work of the eye
 /// passes' fragments, their invocations times the static cost of one
 /// (`vitreous_render::work::ShaderCost`): `glass_fetches`, `glass_texels`,
@@ -45,12 +45,13 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
     .map(|(name, value)| (name.to_owned(), value as f64))
     .collect();
     if let Some(p) = &frame.invocations {
-        let passes: [(&str, Invocations); 7] = [
+        let passes: [(&str, Invocations); 8] = [
             ("mask", p.mask),
             ("nearest", p.nearest),
             ("ramp", p.ramp),
             ("caustic_photons", p.caustic_photons),
             ("caustic_smoothing", p.caustic_smoothing),
+            ("blur", p.blur),
             ("eye_floor", p.eye_floor),
             ("eye_glass", p.eye_glass),
         ];

@@ -81,8 +81,8 @@ pub use crate::scene::{
     MAX_CAUSTIC_GAIN, MAX_K, MAX_RAMP_WIDTH_M, MAX_RESOLUTION_PX, MIN_RESOLUTION_PX,
     validate_caustics, validate_inducer as validate,
 };
-pub(crate) use fields::Stamps;
 pub use fields::{FIELD_STAMPS, FieldPassesMs, InducerFields};
+pub(crate) use fields::{FieldTarget, Stamps};
 pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
 pub use live::{
     DEFAULT_RESOLUTION_PX as DEFAULT_LIVE_RESOLUTION_PX, LiveCausticsDesc, MAX_PHOTONS_PER_SIDE,

@@ -64,13 +64,12 @@ impl Bake {
 #[derive(Debug, Error)]
 pub enum BakeError {
     /// No file at the path.
-    #[error(
-        "no caustics bake at {path}; bake it with \
-         `cargo run --release -p vitreous-caustics -- bake <scene.toml> -o {path}`"
-    )]
+    #[error("no caustics bake at {path}{}; bake it with `{}`", named_by(.scene), rebake(.scene, .path))]
     Missing {
         /// The path looked for.
         path: PathBuf,
+        /// The scene that names it, when known.
+        scene: Option<PathBuf>,
     },
     /// The file exists but cannot be read.
     #[error("cannot read the caustics bake {path}: {source}")]
@@ -81,18 +80,26 @@ pub enum BakeError {
         source: std::io::Error,
     },
     /// The file is not a valid gain EXR.
-    #[error("the caustics bake {path} is corrupt or not a caustics bake: {reason}")]
+    #[error(
+        "the caustics bake {path}{} is corrupt or not a caustics bake: {reason}; bake it again \
+         with `{}`",
+        named_by(.scene),
+        rebake(.scene, .path)
+    )]
     Corrupt {
         /// The file.
         path: PathBuf,
         /// What is wrong with it.
         reason: String,
+        /// The scene that names it, when known.
+        scene: Option<PathBuf>,
     },
     /// Baked for another scene (or the scene or its assets changed since).
     #[error(
-        "the caustics bake {path} was made for a different scene (hash {found}, the scene's \
-         is {expected}); the scene or one of its assets changed since: re-bake with \
-         `cargo run --release -p vitreous-caustics -- bake <scene.toml> -o {path}`"
+        "the caustics bake {path}{} was made for a different scene (hash {found}, the scene's \
+         is {expected}); the scene or one of its assets changed since: re-bake with `{}`",
+        named_by(.scene),
+        rebake(.scene, .path)
     )]
     WrongScene {
         /// The file.
@@ -101,6 +108,8 @@ pub enum BakeError {
         expected: String,
         /// The hash stored in the file.
         found: String,
+        /// The scene that names it, when known.
+        scene: Option<PathBuf>,
     },
     /// The scene names no bake (`[caustics] bake`) but the caustics were asked for.
     #[error(
@@ -183,6 +192,52 @@ pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError
     crate::output::write_atomic(path, bytes.get_ref()).map_err(|e| write_err(format!("{e:#}")))
 }
 
+/// ` (named by <scene>)` when the scene is known.
+fn named_by(scene: &Option<PathBuf>) -> String {
+    scene
+        .as_ref()
+        .map_or(String::new(), |s| format!(" (named by {})", s.display()))
+}
+
+/// The command that bakes `path` for `scene` (a placeholder when the scene is not known).
+fn rebake(scene: &Option<PathBuf>, path: &Path) -> String {
+    let scene = scene
+        .as_ref()
+        .map_or("<scene.toml>".to_owned(), |s| s.display().to_string());
+    format!(
+        "cargo run --release -p vitreous-caustics -- bake {scene} -o {}",
+        path.display()
+    )
+}
+
+impl BakeError {
+    /// The error with the scene that names the bake, so that its message names the scene and
+    /// gives the exact command that bakes it again.
+    pub fn in_scene(self, scene: &Path) -> BakeError {
+        let named = Some(scene.to_path_buf());
+        match self {
+            BakeError::Missing { path, .. } => BakeError::Missing { path, scene: named },
+            BakeError::Corrupt { path, reason, .. } => BakeError::Corrupt {
+                path,
+                reason,
+                scene: named,
+            },
+            BakeError::WrongScene {
+                path,
+                expected,
+                found,
+                ..
+            } => BakeError::WrongScene {
+                path,
+                expected,
+                found,
+                scene: named,
+            },
+            other => other,
+        }
+    }
+}
+
 /// Reads a bake and checks it belongs to the scene with hash `expected_scene_hash`.
 pub fn read_bake(path: &Path, expected_scene_hash: &str) -> std::result::Result<Bake, BakeError> {
     let bake = read_bake_unchecked(path)?;
@@ -191,6 +246,7 @@ pub fn read_bake(path: &Path, expected_scene_hash: &str) -> std::result::Result<
             path: path.to_path_buf(),
             expected: expected_scene_hash.to_owned(),
             found: bake.scene_hash,
+            scene: None,
         });
     }
     Ok(bake)
@@ -201,12 +257,14 @@ pub fn read_bake_unchecked(path: &Path) -> std::result::Result<Bake, BakeError> 
     let corrupt = |reason: String| BakeError::Corrupt {
         path: path.to_path_buf(),
         reason,
+        scene: None,
     };
     let bytes = DiskFiles
         .read_bounded(path, MAX_BAKE_BYTES, "the largest bake is smaller")
         .map_err(|source| match source.kind() {
             std::io::ErrorKind::NotFound => BakeError::Missing {
                 path: path.to_path_buf(),
+                scene: None,
             },
             std::io::ErrorKind::InvalidData => corrupt(source.to_string()),
             _ => BakeError::Io {
@@ -343,6 +401,28 @@ mod tests {
         let err = read_bake(&path, "other").unwrap_err();
         assert!(matches!(err, BakeError::WrongScene { .. }), "{err}");
         assert!(err.to_string().contains("abc123") && err.to_string().contains("other"));
+    }
+
+    #[test]
+    fn errors_in_a_scene_name_it_and_give_the_exact_command() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("b.exr");
+        let scene = Path::new("config/scenes/s.toml");
+        let command = format!(
+            "`cargo run --release -p vitreous-caustics -- bake config/scenes/s.toml -o {}`",
+            path.display()
+        );
+        let missing = read_bake(&path, "x").unwrap_err().in_scene(scene);
+        std::fs::write(&path, b"not an exr").unwrap();
+        let corrupt = read_bake(&path, "x").unwrap_err().in_scene(scene);
+        write_bake(&path, &sample()).unwrap();
+        let stale = read_bake(&path, "other").unwrap_err().in_scene(scene);
+        for err in [missing, corrupt, stale] {
+            let text = err.to_string();
+            assert!(text.contains("(named by config/scenes/s.toml)"), "{text}");
+            assert!(text.contains(&command), "{text}");
+            assert!(!text.contains("<scene.toml>"), "{text}");
+        }
     }
 
     /// A header claiming an absurd layer is refused before any sample is read, and so is a

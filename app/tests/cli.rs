@@ -398,3 +398,32 @@ fn a_missing_scene_says_the_os_error_once() {
     let message = assert_clean_failure(&out, &["nowhere.toml"]);
     assert_eq!(message.matches("os error 2").count(), 1, "{message}");
 }
+
+#[test]
+fn a_corrupt_bake_names_its_scene_and_the_command_that_bakes_it_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = workspace().join("config");
+    let broken = write(dir.path(), "broken.exr", "not an exr");
+    let text = std::fs::read_to_string(config.join("scenes/glass-sphere.toml"))
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", config.display()))
+        .replace(
+            &format!("\"{}/bakes/glass-sphere.exr\"", config.display()),
+            &format!("{broken:?}"),
+        );
+    let scene = write(dir.path(), "copy.toml", &text);
+    let out = vitreous(
+        &["replay", &scene, "--effects", "c", "--frames", "1"],
+        dir.path(),
+    );
+    let command = format!("`cargo run --release -p vitreous-caustics -- bake {scene} -o {broken}`");
+    assert_clean_failure(
+        &out,
+        &[
+            "is corrupt or not a caustics bake",
+            &format!("(named by {scene})"),
+            &command,
+        ],
+    );
+    assert!(!dir.path().join("out").exists());
+}

@@ -117,3 +117,17 @@ fn study_analyze_bad_file_names_the_line() {
         "{stderr}"
     );
 }
+
+#[test]
+fn study_analyze_refuses_a_file_with_a_header_and_no_answers() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "empty.csv", "");
+    let output = analyze(&file, true);
+    assert!(!output.status.success());
+    assert!(output.stdout.is_empty(), "{output:?}");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("empty.csv: no responses (the file has no lines after the header)"),
+        "{stderr}"
+    );
+}

@@ -155,7 +155,9 @@ impl Scene {
                 .ok_or_else(|| crate::caustics::BakeError::NotNamed {
                     scene: self.path.clone(),
                 })?;
-        self.caustics.gain = Some(crate::caustics::read_bake(path, &self.hash)?);
+        let bake =
+            crate::caustics::read_bake(path, &self.hash).map_err(|e| e.in_scene(&self.path))?;
+        self.caustics.gain = Some(bake);
         Ok(())
     }
 }

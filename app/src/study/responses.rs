@@ -112,6 +112,11 @@ impl Responses {
             source,
         })?;
         let rows = parse_rows(path, file)?;
+        if rows.is_empty() {
+            return Err(ResponsesError::Empty {
+                path: path.to_path_buf(),
+            });
+        }
         let names: BTreeSet<String> = rows.iter().map(|r| r.stimulus.clone()).collect();
         names
             .into_iter()

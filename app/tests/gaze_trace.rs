@@ -228,3 +228,33 @@ fn plot_lines_stay_inside_the_chart_and_far_samples_are_drawn() {
     assert!(count([200, 60, 60]) > 50, "{}", count([200, 60, 60]));
     assert!(count([150, 150, 150]) > 50);
 }
+
+/// With the glass-sphere scene's images (1.48 and 2.03 m, 0.68 and 0.49 D) a real recording's
+/// vergence reaches far above 1.6 times the nearer image's: the axis holds nearly all of it, and
+/// each sample beyond is marked on the top edge, none left unmarked there.
+#[test]
+fn plot_holds_or_marks_every_finite_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = ImageDistances {
+        surface_m: 1.48,
+        refracted_m: 2.03,
+    };
+    let samples =
+        vitreous_xr::sranipal::import_sranipal(sranipal("TESTNA05_360VR_Spread7.csv")).unwrap();
+    let out = dir.path().join("sphere.png");
+    let layout = plot(&samples, Truth::FromRawDepth, &AnalyzeConfig::new(d), &out).unwrap();
+    let rgb = image::open(&out).unwrap().to_rgb8();
+    // The raw samples' grey markers: none pressed against the chart's top edge.
+    let top = layout.chart_y_px.start as u32;
+    let grey_at_top = (layout.chart_x_px.start as u32..layout.chart_x_px.end as u32)
+        .flat_map(|x| (top..top + 3).map(move |y| (x, y)))
+        .filter(|&(x, y)| rgb.get_pixel(x, y).0 == [150, 150, 150])
+        .count();
+    assert_eq!(grey_at_top, 0);
+    // The samples beyond are there, as purple triangles on that edge.
+    let beyond_at_top = (layout.chart_x_px.start as u32..layout.chart_x_px.end as u32)
+        .flat_map(|x| (top..top + 8).map(move |y| (x, y)))
+        .filter(|&(x, y)| rgb.get_pixel(x, y).0 == [128, 60, 160])
+        .count();
+    assert!(beyond_at_top > 20, "{beyond_at_top}");
+}

@@ -14,6 +14,7 @@ use std::sync::Once;
 
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use vitreous_xr::TraceSample;
 
 use super::{
@@ -80,11 +81,61 @@ pub const FILTER_COLOURS: [RGBColor; 5] = [
 /// Colour of the fixation shading.
 const FIXATION_SHADE: RGBColor = RGBColor(236, 236, 228);
 
-/// Vergence at which diverging samples are drawn, dioptres (a band below 0 D).
-const DIVERGING_D: f64 = -0.2;
+/// Where diverging samples are drawn: a band this share of the axis's height below 0 D.
+const DIVERGING_SHARE: f64 = 0.1;
 
 /// Radius of the raw-sample markers, pixels.
 const MARKER_PX: i32 = 2;
+
+/// Colour of the markers of samples beyond the vergence axis.
+const BEYOND: RGBColor = RGBColor(128, 60, 160);
+
+/// Most vergence the axis reaches, dioptres (5 cm): nearer samples are marked on its top edge.
+const MOST_D: f64 = 20.0;
+
+/// Share of the finite samples the axis holds at least, unless that takes it past [`MOST_D`]
+/// (a tracker's near spikes would otherwise squeeze the images' range into a few pixels).
+const HELD_SHARE: f64 = 0.9;
+
+/// The top of the vergence axis, dioptres: 1.6 times the nearer image's vergence and 1 D at
+/// least, raised to hold [`HELD_SHARE`] of `vergences` (up to [`MOST_D`]).
+fn axis_top_d(nearer_image_d: f64, vergences: &[f64]) -> f64 {
+    let mut sorted: Vec<f64> = vergences
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    sorted.sort_by(f64::total_cmp);
+    let held = sorted
+        .get(((sorted.len() as f64 * HELD_SHARE).ceil() as usize).saturating_sub(1))
+        .map_or(0.0, |v| (v * 1.05).min(MOST_D));
+    (nearer_image_d * 1.6).max(1.0).max(held)
+}
+
+/// A tick label of the vergence axis: dioptres with the distance, `0 (far)`, and nothing
+/// below 0 D (the diverging band is labelled once, beside it).
+fn y_label(v: f64) -> String {
+    if v < -1e-9 {
+        String::new()
+    } else if v < 1e-9 {
+        "0 (far)".to_owned()
+    } else {
+        format!("{v:.1} ({:.2} m)", 1.0 / v)
+    }
+}
+
+/// The times of the samples (not diverging) whose vergence lies above `top_d`.
+fn vergences_beyond(
+    raw: &[RawSample],
+    top_d: f64,
+    dioptres: impl Fn(f32) -> f64,
+) -> impl Iterator<Item = i64> {
+    raw.iter()
+        .filter(|r| !r.divergent && r.depth_m.is_some_and(|d| dioptres(d) > top_d))
+        .map(|r| r.time_ns)
+        .collect::<Vec<_>>()
+        .into_iter()
+}
 
 /// Draws raw and filtered fixation depth over time with the gaze-image decisions (like the
 /// paper's Fig. 11) as a PNG at `out_png`, written to `out_png.partial` then renamed; returns
@@ -119,8 +170,15 @@ pub fn plot(
         .collect();
     let d = config.distances;
     let dioptres = |depth_m: f32| 1.0 / f64::from(depth_m.max(1e-3));
-    let y_top = (dioptres(d.surface_m.min(d.refracted_m)) * 1.6).max(1.0);
-    let y_bottom = DIVERGING_D * 2.0;
+    let vergences: Vec<f64> = raw
+        .iter()
+        .filter(|r| !r.divergent)
+        .filter_map(|r| r.depth_m.map(dioptres))
+        .collect();
+    let y_top = axis_top_d(dioptres(d.surface_m.min(d.refracted_m)), &vergences);
+    let beyond = vergences.iter().filter(|&&v| v > y_top).count();
+    let diverging_d = -DIVERGING_SHARE * y_top;
+    let y_bottom = diverging_d * 2.0;
     let layout;
 
     let (w, h) = PLOT_SIZE_PX;
@@ -154,18 +212,20 @@ pub fn plot(
             .configure_mesh()
             .x_desc("time (s)")
             .y_desc("vergence (dioptres = 1 / depth in m)")
-            .y_label_formatter(&|v: &f64| {
-                if *v < -1e-9 {
-                    "diverging".to_owned()
-                } else if *v < 1e-9 {
-                    "0 (far)".to_owned()
-                } else {
-                    format!("{v:.1} ({:.2} m)", 1.0 / v)
-                }
-            })
+            .y_label_formatter(&|v: &f64| y_label(*v))
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| draw_err(&e))?;
+        // The diverging band's one label, beside it (a tick label would repeat it for every
+        // tick below 0 D).
+        let (x_axis_px, band_px) = chart.backend_coord(&(0.0, diverging_d));
+        root.draw(&Text::new(
+            "diverging",
+            (x_axis_px - 10, band_px),
+            TextStyle::from(("sans-serif", 14).into_font())
+                .pos(Pos::new(HPos::Right, VPos::Center)),
+        ))
+        .map_err(|e| draw_err(&e))?;
         let (x_px, y_px) = chart.plotting_area().get_pixel_range();
         layout = PlotLayout {
             chart_x_px: x_px.clone(),
@@ -212,10 +272,12 @@ pub fn plot(
                         .filter(|r| r.divergent == divergent)
                         .filter_map(|r| {
                             let v = if divergent {
-                                DIVERGING_D
+                                diverging_d
                             } else {
                                 dioptres(r.depth_m?)
                             };
+                            // Beyond the axis: marked on its edge below.
+                            (v <= y_top).then_some(())?;
                             Some(Circle::new(
                                 (clamp_t(secs(r.time_ns)), clamp_y(v)),
                                 MARKER_PX,
@@ -226,6 +288,25 @@ pub fn plot(
                 .map_err(|e| draw_err(&e))?
                 .label(label)
                 .legend(move |(x, y)| Circle::new((x + 10, y), 3, colour.filled()));
+        }
+        if beyond > 0 {
+            // Samples nearer than the axis reaches: a triangle on its top edge each.
+            let largest = vergences.iter().copied().fold(y_top, f64::max);
+            let triangle = |(x, y): (i32, i32)| {
+                Polygon::new(
+                    vec![(x, y - 4), (x - 4, y + 3), (x + 4, y + 3)],
+                    BEYOND.filled(),
+                )
+            };
+            chart
+                .draw_series(vergences_beyond(&raw, y_top, dioptres).map(|t| {
+                    EmptyElement::at((clamp_t(secs(t)), y_top - pad_y)) + triangle((0, 0))
+                }))
+                .map_err(|e| draw_err(&e))?
+                .label(format!(
+                    "{beyond} samples beyond the axis (up to {largest:.1} D)"
+                ))
+                .legend(move |(x, y)| triangle((x + 10, y)));
         }
         for (image, dist) in [
             (GazeImage::Surface, d.surface_m),
@@ -353,4 +434,35 @@ pub fn plot(
     let png = crate::output::encode_png(&rgba, w, h)?;
     crate::output::write_atomic(out_png, &png)?;
     Ok(layout)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_axis_holds_nine_tenths_of_the_samples_up_to_5_cm() {
+        // The images alone: 1.6 times the nearer one's vergence, 1 D at least.
+        assert_eq!(axis_top_d(0.675, &[]), 1.08);
+        assert_eq!(axis_top_d(0.2, &[0.1, 0.3]), 1.0);
+        // 900 samples from 0.5 to 2.5 D and a hundred at 100 D: the axis holds the 900, with
+        // room, and no more.
+        let mut v: Vec<f64> = (0..900).map(|i| 0.5 + 2.0 * f64::from(i) / 899.0).collect();
+        v.extend([100.0; 100]);
+        let top = axis_top_d(0.675, &v);
+        let held = v.iter().filter(|&&x| x <= top).count();
+        assert_eq!(held, 900, "{top}");
+        assert!((2.5..3.0).contains(&top), "{top}");
+        // Never past 20 D, whatever the samples.
+        assert_eq!(axis_top_d(0.675, &[50.0; 100]), MOST_D);
+        assert!(axis_top_d(0.675, &[f64::NAN, f64::INFINITY]) >= 1.0);
+    }
+
+    #[test]
+    fn no_tick_below_0_d_says_diverging() {
+        assert_eq!(y_label(-0.2), "");
+        assert_eq!(y_label(-0.4), "");
+        assert_eq!(y_label(0.0), "0 (far)");
+        assert_eq!(y_label(0.5), "0.5 (2.00 m)");
+    }
 }

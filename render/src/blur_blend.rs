@@ -14,6 +14,7 @@ use ash::vk;
 
 use crate::camera::Look;
 use crate::context::GpuContext;
+use crate::descriptors::{self, TextureSets};
 use crate::error::Result;
 use crate::floor::FieldTarget;
 use crate::owned::Owned;
@@ -53,12 +54,8 @@ pub(crate) struct BlurBlend {
     pipeline: Owned<vk::Pipeline>,
     /// Its layout (one set, the depth as a push constant).
     layout: Owned<vk::PipelineLayout>,
-    /// Pool of the sets.
-    _pool: Owned<vk::DescriptorPool>,
-    /// Layout of a set: the stack and its sampler.
-    _set_layout: Owned<vk::DescriptorSetLayout>,
     /// One set per stack, in `targets`' order.
-    sets: [vk::DescriptorSet; 2],
+    stacks: TextureSets<2>,
     /// The stack coordinate each image's last recorded blend used (NaN: none, or one that may
     /// not have run).
     recorded: Cell<[f32; 2]>,
@@ -72,24 +69,15 @@ impl BlurBlend {
             FieldTarget::new(ctx, "blurred background", FORMAT, background)?,
             FieldTarget::new(ctx, "blurred surface", FORMAT, surface)?,
         ];
-        let set_layout = pipeline::set_layout(
+        let stacks = descriptors::texture_sets(
             ctx,
-            &[
-                (
-                    0,
-                    vk::DescriptorType::SAMPLED_IMAGE,
-                    vk::ShaderStageFlags::FRAGMENT,
-                ),
-                (
-                    1,
-                    vk::DescriptorType::SAMPLER,
-                    vk::ShaderStageFlags::FRAGMENT,
-                ),
-            ],
+            vk::ShaderStageFlags::FRAGMENT,
+            [scene.background_stack.view, scene.surface.view],
+            scene.photo_sampler(),
         )?;
         let layout = pipeline::layout(
             ctx,
-            Some(set_layout.raw()),
+            Some(stacks.layout.raw()),
             vk::ShaderStageFlags::FRAGMENT,
             size_of::<f32>() as u32,
         )?;
@@ -107,29 +95,11 @@ impl BlurBlend {
                 blend: Blend::ReplaceColor,
             },
         )?;
-        let pool = pipeline::pool(
-            ctx,
-            2,
-            &[
-                (vk::DescriptorType::SAMPLED_IMAGE, 2),
-                (vk::DescriptorType::SAMPLER, 2),
-            ],
-        )?;
-        let mut sets = [vk::DescriptorSet::null(); 2];
-        for (set, stack) in sets
-            .iter_mut()
-            .zip([&scene.background_stack, &scene.surface])
-        {
-            *set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
-            pipeline::write_texture(ctx, *set, 0, 1, stack.view, scene.photo_sampler());
-        }
         Ok(BlurBlend {
             targets,
             pipeline,
             layout,
-            _pool: pool,
-            _set_layout: set_layout,
-            sets,
+            stacks,
             recorded: Cell::new([f32::NAN; 2]),
         })
     }
@@ -167,7 +137,7 @@ impl BlurBlend {
                     vk::PipelineBindPoint::GRAPHICS,
                     self.layout.raw(),
                     0,
-                    &[self.sets[i]],
+                    &[self.stacks.sets[i]],
                     &[],
                 );
                 d.cmd_push_constants(

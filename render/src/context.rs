@@ -4,6 +4,9 @@
 //! only difference is who creates the instance and device: OpenXR's XR_KHR_vulkan_enable2 must
 //! do it itself, so creation is injected through [`DeviceCreator`]; [`PlainVulkan`] is the
 //! headless implementation.
+//!
+//! Just over 600 lines: the context's creation, which gives back what it made at every step
+//! that can fail, reads best as one function.
 
 use std::ffi::{CStr, c_char, c_void};
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -297,13 +300,12 @@ impl GpuContext {
             .queue_priorities(&priorities)];
         let device_exts: Vec<*const c_char> =
             extra_device_extensions.iter().map(|e| e.as_ptr()).collect();
-        // Pipeline-statistics queries count the shader invocations of each pass (the frame's
-        // counted work, `work.rs`) where the device has them; nothing else is optional.
+        // Pipeline-statistics queries (counted work, `work.rs`) where the device has them.
         // SAFETY: `physical` belongs to the live `instance`.
-        let supported = unsafe { instance.get_physical_device_features(physical) };
-        let pipeline_statistics = supported.pipeline_statistics_query == vk::TRUE;
-        let features =
-            vk::PhysicalDeviceFeatures::default().pipeline_statistics_query(pipeline_statistics);
+        let features = unsafe { instance.get_physical_device_features(physical) };
+        let features = vk::PhysicalDeviceFeatures::default()
+            .pipeline_statistics_query(features.pipeline_statistics_query == vk::TRUE);
+        let pipeline_statistics = features.pipeline_statistics_query == vk::TRUE;
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&device_exts)

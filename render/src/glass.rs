@@ -8,6 +8,7 @@ use glam::Vec4;
 use crate::camera::{EyeParams, Look, Reflection};
 use crate::context::GpuContext;
 use crate::convex;
+use crate::descriptors;
 use crate::error::Result;
 use crate::memory::{Buffer, Image, upload_texture};
 use crate::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
@@ -170,7 +171,7 @@ impl GlassPass {
             vk::DescriptorType::SAMPLED_IMAGE,
             vk::DescriptorType::SAMPLER,
         );
-        let set_layout = pipeline::set_layout(
+        let set_layout = descriptors::set_layout(
             ctx,
             &[
                 (0, vk::DescriptorType::UNIFORM_BUFFER, stages),
@@ -246,7 +247,7 @@ impl GlassPass {
                 )
             })
             .collect::<Result<Vec<_>>>()?;
-        let pool = pipeline::pool(
+        let pool = descriptors::pool(
             ctx,
             1,
             &[
@@ -256,7 +257,7 @@ impl GlassPass {
                 (vk::DescriptorType::STORAGE_BUFFER, 1),
             ],
         )?;
-        let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+        let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let surface_opacity = if desc.surface.is_some() {
             1.0 - desc.surface_transmittance
         } else {
@@ -297,12 +298,12 @@ impl GlassPass {
             .buffer_info(&buffer_info)];
         // SAFETY: the set was just allocated and no GPU work uses it; the buffer is live.
         unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
-        pipeline::write_texture(ctx, set, 1, 2, scene.environment.view, scene.env_sampler());
+        descriptors::write_texture(ctx, set, 1, 2, scene.environment.view, scene.env_sampler());
         let [background, surface] = blurred;
-        pipeline::write_texture(ctx, set, 3, 4, background, scene.photo_sampler());
-        pipeline::write_image(ctx, set, 5, surface);
-        pipeline::write_image(ctx, set, 6, radial_map.view);
-        pipeline::write_storage_buffer(ctx, set, 7, planes.buffer);
+        descriptors::write_texture(ctx, set, 3, 4, background, scene.photo_sampler());
+        descriptors::write_image(ctx, set, 5, surface);
+        descriptors::write_image(ctx, set, 6, radial_map.view);
+        descriptors::write_storage_buffer(ctx, set, 7, planes.buffer);
         Ok(GlassPass {
             pipelines,
             costs: shaders::GLASS_FS_COST[model],

@@ -28,6 +28,7 @@ mod blur_blend;
 pub mod camera;
 pub mod context;
 pub mod convex;
+mod descriptors;
 pub mod error;
 pub mod floor;
 mod glass;

@@ -6,6 +6,7 @@ use glam::Mat4;
 
 use crate::camera::EyeParams;
 use crate::context::GpuContext;
+use crate::descriptors::{self, TextureSets};
 use crate::error::Result;
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, PipelineSpec};
@@ -26,12 +27,8 @@ pub struct WorldPass {
     pipeline: Owned<vk::Pipeline>,
     /// Pipeline layout.
     layout: Owned<vk::PipelineLayout>,
-    /// Pool of the sets.
-    _pool: Owned<vk::DescriptorPool>,
-    /// Layout of a plane's descriptor set.
-    _set_layout: Owned<vk::DescriptorSetLayout>,
-    /// Floor then background.
-    sets: [vk::DescriptorSet; 2],
+    /// The photos' sets: floor then background.
+    sets: TextureSets<2>,
     /// Floor then background plane transforms.
     planes: [Mat4; 2],
 }
@@ -44,17 +41,15 @@ impl WorldPass {
         scene: &GpuScene,
         planes: [Mat4; 2],
     ) -> Result<WorldPass> {
-        let fs = vk::ShaderStageFlags::FRAGMENT;
-        let set_layout = pipeline::set_layout(
+        let photos = descriptors::texture_sets(
             ctx,
-            &[
-                (0, vk::DescriptorType::SAMPLED_IMAGE, fs),
-                (1, vk::DescriptorType::SAMPLER, fs),
-            ],
+            vk::ShaderStageFlags::FRAGMENT,
+            [scene.photos[0].view, scene.photos[1].view],
+            scene.photo_sampler(),
         )?;
         let layout = pipeline::layout(
             ctx,
-            Some(set_layout.raw()),
+            Some(photos.layout.raw()),
             vk::ShaderStageFlags::VERTEX,
             size_of::<PlanePush>() as u32,
         )?;
@@ -72,25 +67,10 @@ impl WorldPass {
                 blend: Blend::ReplaceColor,
             },
         )?;
-        let pool = pipeline::pool(
-            ctx,
-            2,
-            &[
-                (vk::DescriptorType::SAMPLED_IMAGE, 2),
-                (vk::DescriptorType::SAMPLER, 2),
-            ],
-        )?;
-        let mut sets = [vk::DescriptorSet::null(); 2];
-        for (set, photo) in sets.iter_mut().zip(&scene.photos) {
-            *set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
-            pipeline::write_texture(ctx, *set, 0, 1, photo.view, scene.photo_sampler());
-        }
         Ok(WorldPass {
             pipeline,
             layout,
-            _pool: pool,
-            _set_layout: set_layout,
-            sets,
+            sets: photos,
             planes,
         })
     }
@@ -106,7 +86,7 @@ impl WorldPass {
         // waits for its frames before dropping them.
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw());
-            for (set, plane) in self.sets.iter().zip(&self.planes) {
+            for (set, plane) in self.sets.sets.iter().zip(&self.planes) {
                 let push = PlanePush {
                     clip_from_world: eye.clip_from_world().to_cols_array(),
                     world_from_plane: plane.to_cols_array(),

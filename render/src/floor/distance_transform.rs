@@ -14,6 +14,7 @@ use gpu_allocator::MemoryLocation;
 
 use super::fields::TexelRect;
 use crate::context::GpuContext;
+use crate::descriptors;
 use crate::error::Result;
 use crate::memory::{Buffer, layout_barrier, memory_barrier, subresource_range};
 use crate::owned::Owned;
@@ -129,7 +130,7 @@ impl DistanceTransform {
         let compute = vk::ShaderStageFlags::COMPUTE;
         let mut bindings = vec![(0, vk::DescriptorType::SAMPLED_IMAGE, compute)];
         bindings.extend((1..=5).map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute)));
-        let set_layout = pipeline::set_layout(ctx, &bindings)?;
+        let set_layout = descriptors::set_layout(ctx, &bindings)?;
         let layout = pipeline::layout(
             ctx,
             Some(set_layout.raw()),
@@ -138,7 +139,7 @@ impl DistanceTransform {
         )?;
         let columns = pipeline::compute(ctx, layout.raw(), shaders::COLUMNS_CS, c"cs_columns")?;
         let rows_pipeline = pipeline::compute(ctx, layout.raw(), shaders::ROWS_CS, c"cs_rows")?;
-        let pool = pipeline::pool(
+        let pool = descriptors::pool(
             ctx,
             1,
             &[
@@ -146,8 +147,8 @@ impl DistanceTransform {
                 (vk::DescriptorType::STORAGE_BUFFER, 5),
             ],
         )?;
-        let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
-        pipeline::write_image(ctx, set, 0, mask_view);
+        let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+        descriptors::write_image(ctx, set, 0, mask_view);
         let buffers = [
             scratch[0].buffer,
             scratch[1].buffer,
@@ -156,7 +157,7 @@ impl DistanceTransform {
             gains.buffer,
         ];
         for (binding, buffer) in (1..).zip(buffers) {
-            pipeline::write_storage_buffer(ctx, set, binding, buffer);
+            descriptors::write_storage_buffer(ctx, set, binding, buffer);
         }
         Ok(DistanceTransform {
             columns,

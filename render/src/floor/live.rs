@@ -15,6 +15,7 @@ use super::smoothing::{
     SHORT_KERNEL_PX, SmoothPass, SmoothTiles, record_smoothing, row_pitch, shares_fit, smooth_steps,
 };
 use crate::context::GpuContext;
+use crate::descriptors;
 use crate::error::{RenderError, Result};
 use crate::memory::{Buffer, Image, layout_barrier, subresource_range};
 use crate::owned::Owned;
@@ -222,13 +223,13 @@ impl LiveCaustics {
         let bindings: Vec<_> = (0..=13)
             .map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute))
             .collect();
-        let set_layout = pipeline::set_layout(ctx, &bindings)?;
+        let set_layout = descriptors::set_layout(ctx, &bindings)?;
         // The smoothing step; the trace pass reads none.
         let layout = pipeline::layout(ctx, Some(set_layout.raw()), compute, 4)?;
         let trace = pipeline::compute(ctx, layout.raw(), shaders::CAUSTICS_TRACE_CS, c"cs_trace")?;
         let smooth = SmoothPass::pipelines(ctx, layout.raw())?;
-        let pool = pipeline::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 14)])?;
-        let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+        let pool = descriptors::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 14)])?;
+        let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
         buffers.extend(live_mesh.buffers[..3].iter().map(|b| b.buffer));
         buffers.extend([sums.buffer, gain.buffer, bounds, scratch.buffer]);

@@ -10,6 +10,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::camera::EyeParams;
 use crate::context::GpuContext;
+use crate::descriptors;
 use crate::error::Result;
 use crate::memory::Buffer;
 use crate::owned::Owned;
@@ -78,7 +79,7 @@ impl OverlayPass {
         caustic_view: vk::ImageView,
     ) -> Result<OverlayPass> {
         let fragment = vk::ShaderStageFlags::FRAGMENT;
-        let set_layout = pipeline::set_layout(
+        let set_layout = descriptors::set_layout(
             ctx,
             &[
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
@@ -144,7 +145,7 @@ impl OverlayPass {
                 )
             })
             .collect::<Result<Vec<_>>>()?;
-        let pool = pipeline::pool(
+        let pool = descriptors::pool(
             ctx,
             1,
             &[
@@ -153,11 +154,11 @@ impl OverlayPass {
                 (vk::DescriptorType::STORAGE_BUFFER, 1),
             ],
         )?;
-        let set = pipeline::allocate_set(ctx, pool.raw(), set_layout.raw())?;
-        pipeline::write_image(ctx, set, 0, gain_view);
-        pipeline::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
-        pipeline::write_image(ctx, set, 3, caustic_view);
-        pipeline::write_storage_buffer(ctx, set, 4, live_bounds.buffer);
+        let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+        descriptors::write_image(ctx, set, 0, gain_view);
+        descriptors::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
+        descriptors::write_image(ctx, set, 3, caustic_view);
+        descriptors::write_storage_buffer(ctx, set, 4, live_bounds.buffer);
         Ok(OverlayPass {
             pipelines,
             costs,

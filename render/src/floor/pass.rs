@@ -18,6 +18,7 @@ use super::overlay::{NO_RECT, OverlayArea, OverlayPass};
 use super::progress::{Prepared, Progress, Written};
 use crate::camera::EyeParams;
 use crate::context::GpuContext;
+use crate::descriptors;
 use crate::error::Result;
 use crate::memory::{Image, upload_texture};
 use crate::owned::Owned;
@@ -125,7 +126,7 @@ impl InducerPass {
         let mut mask = MaskPass::new(ctx, targets[MASK].render_pass(), &desc.mesh, convex, closed)?;
         mask.set_pose(mask_clip_from_model, positions);
 
-        let field_set_layout = pipeline::set_layout(
+        let field_set_layout = descriptors::set_layout(
             ctx,
             &[
                 (0, vk::DescriptorType::SAMPLED_IMAGE, fragment),
@@ -172,7 +173,7 @@ impl InducerPass {
             texel_m: floor.size_m / n as f32,
         };
         let transform = DistanceTransform::new(ctx, mask_view, n, ramp)?;
-        let pool = pipeline::pool(
+        let pool = descriptors::pool(
             ctx,
             1,
             &[
@@ -180,9 +181,9 @@ impl InducerPass {
                 (vk::DescriptorType::STORAGE_BUFFER, 1),
             ],
         )?;
-        let field_set = pipeline::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
-        pipeline::write_image(ctx, field_set, 0, mask_view);
-        pipeline::write_storage_buffer(ctx, field_set, 1, transform.nearest.buffer);
+        let field_set = descriptors::allocate_set(ctx, pool.raw(), field_set_layout.raw())?;
+        descriptors::write_image(ctx, field_set, 0, mask_view);
+        descriptors::write_storage_buffer(ctx, field_set, 1, transform.nearest.buffer);
         let overlay = OverlayPass::new(
             ctx,
             eye_render_pass,

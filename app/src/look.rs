@@ -380,6 +380,7 @@ mod tests {
                 combined: None,
                 fixation: None,
                 pupil_diameter_m: [None, None],
+                report: None,
             },
         }
     }

@@ -343,6 +343,7 @@ mod tests {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         };
         let (o, d) = place_ray(&frame(head, Some(gaze)));
         let hit = ray_meets_plane(o, d, floor.0, floor.1).unwrap();

@@ -26,6 +26,7 @@ fn looking_at(time_ns: i64, depth_m: f32) -> GazeSample {
         combined: None,
         fixation: None,
         pupil_diameter_m: [None, None],
+        report: None,
     }
 }
 

@@ -24,6 +24,7 @@ fn sample(time_ns: i64, left: GazeRay, right: GazeRay) -> GazeSample {
         combined: None,
         fixation: None,
         pupil_diameter_m: [None, None],
+        report: None,
     }
 }
 

@@ -40,6 +40,7 @@ fn sample(t_ms: i64, depth_m: Option<f32>) -> TraceSample {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         },
     }
 }

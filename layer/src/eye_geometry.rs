@@ -208,6 +208,7 @@ mod tests {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         };
         let c = combined_ray(&s);
         assert!(c.valid && close(c.origin, Vec3::ZERO) && close(c.direction, Vec3::NEG_Z));
@@ -234,6 +235,7 @@ mod tests {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         };
         assert!(close(fixation_point(&s).unwrap(), target));
         s.fixation = Some(Vec3::new(0.0, 0.0, -2.0));

@@ -118,6 +118,7 @@ fn interpolate(a: &GazeSample, b: &GazeSample, w: f32, time_ns: i64) -> GazeSamp
             lerp_f(a.pupil_diameter_m[0], b.pupil_diameter_m[0]),
             lerp_f(a.pupil_diameter_m[1], b.pupil_diameter_m[1]),
         ],
+        report: None,
     }
 }
 
@@ -171,6 +172,7 @@ mod tests {
                 combined: None,
                 fixation: None,
                 pupil_diameter_m: [pupil, None],
+                report: None,
             },
         }
     }

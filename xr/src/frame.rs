@@ -102,6 +102,47 @@ pub struct GazeSample {
     pub fixation: Option<Vec3>,
     /// Measured pupil diameters (left, right), metres, when the source reports them.
     pub pupil_diameter_m: [Option<f32>; 2],
+    /// What the tracker itself says about this sample (its confidence and its classification
+    /// of the eye movement), when the source reports it (Magic Leap 2's `XR_ML_eye_tracker`).
+    pub report: Option<TrackerReport>,
+}
+
+/// How sure a tracker is of a sample's fixation (vergence) estimate, in its own three steps
+/// (`XrEyeTrackerConfidenceML`: LOW, MEDIUM, HIGH).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum TrackerConfidence {
+    /// The estimate should not be relied on.
+    Low,
+    /// Usable with caution.
+    Medium,
+    /// Reliable.
+    High,
+}
+
+/// What the eyes are doing, as the tracker classifies it (`XrEyeTrackerGazeBehaviorTypeML`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GazeBehaviour {
+    /// The tracker does not say.
+    Unknown,
+    /// Both eyes closed.
+    EyesClosed,
+    /// A blink (of both eyes, or of one: `BLINK_LEFT` and `BLINK_RIGHT` read as this too).
+    Blink,
+    /// A fixation.
+    Fixation,
+    /// A smooth pursuit.
+    Pursuit,
+    /// A saccade.
+    Saccade,
+}
+
+/// The tracker's own account of one sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TrackerReport {
+    /// Confidence of the fixation (vergence) estimate.
+    pub confidence: TrackerConfidence,
+    /// The eye movement the sample belongs to.
+    pub behaviour: GazeBehaviour,
 }
 
 impl GazeSample {
@@ -116,6 +157,7 @@ impl GazeSample {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         }
     }
 }

@@ -17,6 +17,9 @@ pub mod sranipal;
 pub mod synth;
 pub mod trace;
 
-pub use frame::{Backend, EyeView, Fov, FrameInput, FrameTarget, GazeRay, GazeSample, Pose};
+pub use frame::{
+    Backend, EyeView, Fov, FrameInput, FrameTarget, GazeBehaviour, GazeRay, GazeSample, Pose,
+    TrackerConfidence, TrackerReport,
+};
 pub use null::{NullBackend, NullConfig, NullError};
 pub use trace::{TraceError, TraceReader, TraceSample, TraceWriter, read_trace};

@@ -311,6 +311,7 @@ pub fn synthesize_with_truth(params: &SynthParams) -> Result<SynthTrace, SynthEr
                     left.valid.then_some(pupils[0]),
                     right.valid.then_some(pupils[1]),
                 ],
+                report: None,
             },
         });
     }

@@ -288,6 +288,7 @@ mod tests {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         }
     }
 

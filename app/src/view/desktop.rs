@@ -503,6 +503,7 @@ impl Backend for DesktopBackend {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         };
         Ok(Some(self.frame(head, Some(gaze), time_ns)))
     }

@@ -371,6 +371,7 @@ mod tests {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         };
         let [gaze, left, right, fixation] = head_frame_poses(&s);
         let (p, c) = fixation;
@@ -392,6 +393,7 @@ mod tests {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         };
         let [gaze, _, right, fixation] = head_frame_poses(&s);
         assert_eq!(gaze.1, ConfidenceML::MEDIUM);

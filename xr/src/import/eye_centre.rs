@@ -63,6 +63,7 @@ mod tests {
                 combined: Some(ray(Vec3::ZERO)),
                 fixation: Some(Vec3::new(0.0, 0.0, -1.0)),
                 pupil_diameter_m: [None, None],
+                report: None,
             },
         }
     }

@@ -211,6 +211,7 @@ impl FbTracker {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         })
     }
 }
@@ -358,6 +359,7 @@ impl MlTracker {
             combined: Some(ray(&poses.gaze_pose)),
             fixation,
             pupil_diameter_m: self.pupils(),
+            report: None,
         })
     }
 
@@ -566,6 +568,7 @@ mod tests {
                 combined: None,
                 fixation: None,
                 pupil_diameter_m: [None, None],
+                report: None,
             },
         }
     }

@@ -275,6 +275,7 @@ impl Importer {
                 combined: None,
                 fixation: None,
                 pupil_diameter_m: [None, None],
+                report: None,
             },
         });
         Ok(())

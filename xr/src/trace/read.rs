@@ -103,6 +103,7 @@ fn parse_record(record: &Record<'_>, version: TraceVersion) -> Result<TraceSampl
             combined,
             fixation,
             pupil_diameter_m,
+            report: None,
         },
     })
 }

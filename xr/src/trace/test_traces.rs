@@ -27,6 +27,7 @@ pub(super) fn sample(time_ns: i64) -> TraceSample {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
+            report: None,
         },
     }
 }

@@ -337,6 +337,7 @@ mod tests {
                             combined,
                             fixation,
                             pupil_diameter_m: [lp, rp],
+                            report: None,
                         },
                     };
                     (dt, lag, sample)

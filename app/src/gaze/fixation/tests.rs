@@ -24,6 +24,7 @@ fn looking(t_ns: i64, depth_m: f32, offset_deg: f32) -> GazeSample {
         combined: None,
         fixation: None,
         pupil_diameter_m: [None, None],
+        report: None,
     }
 }
 

@@ -344,6 +344,7 @@ impl Inputs {
                     combined: Some(combined),
                     fixation: None,
                     pupil_diameter_m: pupils,
+                    report: None,
                 },
             });
         }

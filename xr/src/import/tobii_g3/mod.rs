@@ -151,6 +151,7 @@ pub fn parse_tobii_g3(
                 combined: None,
                 fixation: r.fixation,
                 pupil_diameter_m: r.pupils_m,
+                report: None,
             },
         });
     }

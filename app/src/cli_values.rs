@@ -49,6 +49,18 @@ pub fn parse_pupil_mm(s: &str) -> Result<f32, String> {
         .map_err(|e| e.to_string())
 }
 
+/// An angle kappa for `--kappa-deg`, degrees: -15 to 15 (measured adult values lie within
+/// about -5 to 10: beyond 15 the number is more likely a typo than an eye).
+pub fn parse_kappa_deg(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(deg) if (-15.0..=15.0).contains(&deg) => Ok(deg),
+        Ok(deg) => Err(format!(
+            "expected an angle kappa from -15 to 15 degrees, got {deg}"
+        )),
+        Err(_) => Err(format!("expected an angle kappa in degrees, got '{s}'")),
+    }
+}
+
 /// An OpenXR environment blend mode by its command-line name.
 pub fn parse_blend(s: &str) -> Result<vitreous_xr::openxr::Blend, String> {
     vitreous_xr::openxr::Blend::parse(s)
@@ -94,6 +106,15 @@ mod tests {
         assert!(parse_frame_count("0").unwrap_err().contains("at least 1"));
         assert!(parse_frame_count("-1").unwrap_err().contains("at least 1"));
         assert!(parse_frame_count("x").unwrap_err().contains("whole number"));
+    }
+
+    #[test]
+    fn kappa_angles_are_degrees_within_fifteen() {
+        assert_eq!(parse_kappa_deg("5"), Ok(5.0));
+        assert_eq!(parse_kappa_deg("-2.5"), Ok(-2.5));
+        assert!(parse_kappa_deg("20").unwrap_err().contains("-15 to 15"));
+        assert!(parse_kappa_deg("NaN").unwrap_err().contains("-15 to 15"));
+        assert!(parse_kappa_deg("five").unwrap_err().contains("in degrees"));
     }
 
     #[test]

@@ -10,15 +10,15 @@ use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
 use vitreous::bench::{BenchOptions, bench};
 use vitreous::cli_values::{
-    ReflectionArg, parse_effects, parse_frame_count, parse_frame_count_usize, parse_pupil_mm,
-    parse_size,
+    ReflectionArg, parse_effects, parse_frame_count, parse_frame_count_usize, parse_kappa_deg,
+    parse_pupil_mm, parse_size,
 };
 use vitreous::effects::EffectSet;
 use vitreous::error_report::error_text;
 use vitreous::gaze::FilterKind;
 use vitreous::output::ensure_not_input;
 use vitreous::trace_analyze::{analyze_trace_file, plot_trace_file};
-use vitreous::trace_cmd::{self, SynthOptions};
+use vitreous::trace_cmd::{self, ImportOptions, SynthOptions};
 
 /// Perception-based virtual glass for optical see-through headsets.
 #[derive(Parser, Debug)]
@@ -175,7 +175,8 @@ enum TraceCommand {
     Import {
         /// Recording format: sranipal (HTC Vive Pro Eye SRanipal CSV export), tobii-g3
         /// (Tobii Pro Glasses 3 recording folder or its gazedata.gz), neon (Pupil Labs Neon
-        /// native recording folder). See docs/trace-import.md.
+        /// native recording folder; its gaze stream, or without one its eye states' optical
+        /// axes). See docs/trace-import.md.
         #[arg(long)]
         from: String,
         /// The recording (file or folder, by format).
@@ -183,6 +184,16 @@ enum TraceCommand {
         /// Output trace file.
         #[arg(short, long)]
         out: PathBuf,
+        /// Neon, gaze from the eye states (a recording without a gaze stream, or
+        /// --eye-state-gaze): the angle kappa, degrees, by which each eye's optical axis is
+        /// turned toward the nose to give its line of sight. Default 5, a population mean
+        /// for adults, not the wearer's.
+        #[arg(long, value_name = "DEGREES", value_parser = parse_kappa_deg, allow_negative_numbers = true)]
+        kappa_deg: Option<f64>,
+        /// Neon: take the gaze from the eye states' optical axes (turned by kappa) even when
+        /// the recording has a gaze stream.
+        #[arg(long)]
+        eye_state_gaze: bool,
     },
     /// Synthesise a trace for a scene: the head at the viewer's position, the gaze
     /// alternating between the object's surface and the refracted background, tracker noise
@@ -306,9 +317,19 @@ fn run(cli: Cli) -> Result<()> {
                 println!("wrote {}", out.display());
                 Ok(())
             }
-            TraceCommand::Import { from, file, out } => {
+            TraceCommand::Import {
+                from,
+                file,
+                out,
+                kappa_deg,
+                eye_state_gaze,
+            } => {
                 ensure_not_input(&out, "-o", &[&file])?;
-                println!("{}", trace_cmd::import(&from, &file, &out)?);
+                let options = ImportOptions {
+                    kappa_deg,
+                    eye_state_gaze,
+                };
+                println!("{}", trace_cmd::import(&from, &file, &out, &options)?);
                 Ok(())
             }
             TraceCommand::Synth {

@@ -26,9 +26,28 @@ pub fn write_trace_file(samples: &[TraceSample], out: &Path) -> Result<()> {
 /// The recording formats `vitreous trace import --from` takes.
 pub const IMPORT_FORMATS: &str = "sranipal, tobii-g3, neon";
 
+/// Options of `vitreous trace import` that only some formats take.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ImportOptions {
+    /// Neon: angle kappa, degrees, for gaze from the eye states (`None`: the default, 5).
+    pub kappa_deg: Option<f64>,
+    /// Neon: gaze from the eye states even when the recording has a gaze stream.
+    pub eye_state_gaze: bool,
+}
+
 /// `vitreous trace import --from FORMAT FILE -o OUT`: `sranipal` (a CSV), `tobii-g3` (a
 /// recording folder or its gazedata.gz) or `neon` (a native recording folder).
-pub fn import(from: &str, file: &Path, out: &Path) -> Result<String> {
+pub fn import(from: &str, file: &Path, out: &Path, options: &ImportOptions) -> Result<String> {
+    if from != "neon" {
+        for (given, option) in [
+            (options.kappa_deg.is_some(), "--kappa-deg"),
+            (options.eye_state_gaze, "--eye-state-gaze"),
+        ] {
+            if given {
+                bail!("{option} applies to --from neon only, not to --from {from}");
+            }
+        }
+    }
     let inputs = recording_files(from, file);
     let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     ensure_not_input(out, "-o", &inputs)?;
@@ -46,8 +65,19 @@ pub fn import(from: &str, file: &Path, out: &Path) -> Result<String> {
             (samples, report.to_string(), rows)
         }
         "neon" => {
-            let (samples, report) = vitreous_xr::import::neon::import_neon(file)
-                .context("importing the Neon recording")?;
+            use vitreous_xr::import::neon::{GazeSource, NeonOptions, import_neon_with};
+            let neon = NeonOptions {
+                gaze: if options.eye_state_gaze {
+                    GazeSource::EyeState
+                } else {
+                    GazeSource::Auto
+                },
+                kappa_deg: options
+                    .kappa_deg
+                    .unwrap_or(NeonOptions::default().kappa_deg),
+            };
+            let (samples, report) =
+                import_neon_with(file, &neon).context("importing the Neon recording")?;
             let rows = report.records;
             (samples, report.to_string(), rows)
         }
@@ -132,6 +162,45 @@ pub fn synth(scene_path: &Path, options: &SynthOptions, out: &Path) -> Result<St
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn neon_data(name: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../xr/tests/data")
+            .join(name)
+    }
+
+    /// A Neon recording without a gaze stream imports from its eye states, with the kappa
+    /// asked for named in the report; the Neon options are refused for other formats.
+    #[test]
+    fn neon_without_gaze_imports_from_the_eye_states_with_the_kappa_given() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("n.trace");
+        let report = import(
+            "neon",
+            &neon_data("neon-eye-state"),
+            &out,
+            &ImportOptions::default(),
+        )
+        .unwrap();
+        assert!(
+            report.contains("turned 5.0 degrees toward the nose") && report.contains("unreliable"),
+            "{report}"
+        );
+        assert_eq!(vitreous_xr::read_trace(&out).unwrap().len(), 200);
+        let options = ImportOptions {
+            kappa_deg: Some(3.5),
+            eye_state_gaze: true,
+        };
+        let report = import("neon", &neon_data("neon"), &out, &options).unwrap();
+        assert!(
+            report.contains("turned 3.5 degrees toward the nose"),
+            "{report}"
+        );
+        let e = import("tobii-g3", &neon_data("tobii_g3"), &out, &options)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--kappa-deg applies to --from neon only"), "{e}");
+    }
 
     /// The report says what the trace holds: alternating gaze, or, with no switch period,
     /// the gaze staying on the surface point.

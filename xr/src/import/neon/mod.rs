@@ -6,6 +6,7 @@
 //! |---|---|---|
 //! | `gaze psN` | `x`, `y` (float32, scene-image pixels) | the visual gaze direction |
 //! | `eye_state psN` | `eyeball_center_{left,right}_{x,y,z}` (mm), `pupil_diameter_{left,right}_mm` | eye ray origins, pupils |
+//! | `eye_state psN`, without a gaze stream | also `optical_axis_{left,right}_{x,y,z}` (unit vectors) | each eye's gaze direction |
 //! | `blinks psN` (optional) | `start_timestamp_ns`, `end_timestamp_ns` (int64) | eyes invalid inside a blink |
 //! | `imu psN` (optional) | `quaternion_{w,x,y,z}` (float32) | head orientation |
 //!
@@ -20,23 +21,35 @@
 //!   from the scene camera to the middle of the eyes (the median midpoint of the two eyeball
 //!   centres over the recording).
 //! - **Gaze**: the gaze point (pixels) is undistorted into a direction from the scene camera.
-//!   That is the *visual* gaze. The eye-state optical axes are not used: the optical axis is
-//!   about 5 degrees from the visual axis, so their vergence says nothing about depth.
+//!   That is the *visual* gaze. The eye-state optical axes are not used when there is a gaze
+//!   stream: the optical axis is about 5 degrees from the visual axis, by an angle Neon does
+//!   not measure per wearer.
 //! - **Depth is not measured**: Neon gives one gaze point, not a binocular one. Each eye's
 //!   ray starts at its eyeball centre and runs parallel to the visual gaze direction, so the
 //!   two rays meet at infinity; the combined ray is the visual gaze from the scene camera.
+//! - **Without a gaze stream** (or with [`GazeSource::EyeState`]), the samples are the
+//!   eye-state records instead: each eye's ray runs from its eyeball centre along its optical
+//!   axis turned toward the nose by the angle kappa ([`kappa`]; 5 degrees unless
+//!   [`NeonOptions::kappa_deg`] says otherwise). The two rays then verge at a depth, but an
+//!   unreliable one: kappa is a population mean, not the wearer's, and a degree in either
+//!   eye moves a 2 m depth by metres. There is no combined ray.
 //! - **Validity**: an eye is invalid inside a marked blink, when the gaze point is not finite
-//!   or not invertible, or when no eye-state record lies within 25 ms of the gaze sample.
-//!   Pupil diameters outside 1-10 mm are left out and counted.
+//!   or not invertible, or when no eye-state record lies within 25 ms of the gaze sample
+//!   (eye-state gaze: when its optical axis or eyeball centre is not finite; a finite axis
+//!   that is not a unit vector fails the import). Pupil diameters outside 1-10 mm are left out
+//!   and counted.
 //! - **Head**: position is not recorded (kept at the origin). The rotation is the IMU's own
 //!   orientation (IMU frame: +x right, +y forward, +z up; world: +z up, +y magnetic north)
 //!   turned into the scene camera frame (fixed 102-degree turn about x between the two, the
 //!   module's mounting), then into OpenXR axes, re-anchored so the first sample faces -z.
-//! - **Time**: nanoseconds since the first gaze sample (the `.time` files hold Unix-epoch
-//!   nanoseconds). Gaze samples whose time is not after the previous kept one are dropped
-//!   and counted; the trace limits (10-minute gap, 24-hour span) fail the import.
+//! - **Time**: nanoseconds since the first sample (gaze, or eye state without a gaze stream;
+//!   the `.time` files hold Unix-epoch nanoseconds). Samples whose time is not after the
+//!   previous kept one are dropped and counted; the trace limits (10-minute gap, 24-hour
+//!   span) fail the import.
 
 pub mod camera;
+mod eye_state_gaze;
+pub mod kappa;
 mod raw;
 #[cfg(test)]
 mod tests;
@@ -51,6 +64,8 @@ use super::{HeadSource, RecordingError, RecordingReport};
 use crate::frame::{GazeRay, GazeSample, Pose};
 use crate::trace::{PUPIL_RANGE_M, TraceSample, check_span, clean_ray};
 pub use camera::SceneCamera;
+use eye_state_gaze::EYE_AXIS_FIELDS;
+pub use kappa::DEFAULT_KAPPA_DEG;
 use raw::{Scalar, Stream, read_stream};
 
 /// The recording format, as reports name it.
@@ -138,9 +153,47 @@ pub fn imu_to_head_orientation(imu: Quat) -> Quat {
     (Quat::from_rotation_x(-90f32.to_radians()) * imu * head_to_imu).normalize()
 }
 
-/// Imports the Neon native recording in `folder`.
+/// Where a Neon import takes the gaze from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GazeSource {
+    /// The gaze stream, or the eye states' optical axes when the recording has no gaze
+    /// stream.
+    #[default]
+    Auto,
+    /// The eye states' optical axes, turned by kappa, even when there is a gaze stream.
+    EyeState,
+}
+
+/// What a Neon import may choose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NeonOptions {
+    /// Where the gaze comes from.
+    pub gaze: GazeSource,
+    /// Horizontal angle kappa between each eye's optical and visual axes, degrees, positive
+    /// nasal (see [`kappa`]); used only when the gaze comes from the eye states.
+    pub kappa_deg: f64,
+}
+
+impl Default for NeonOptions {
+    fn default() -> Self {
+        NeonOptions {
+            gaze: GazeSource::Auto,
+            kappa_deg: DEFAULT_KAPPA_DEG,
+        }
+    }
+}
+
+/// Imports the Neon native recording in `folder` with the default options.
 pub fn import_neon(
     folder: impl AsRef<Path>,
+) -> Result<(Vec<TraceSample>, RecordingReport), RecordingError> {
+    import_neon_with(folder, &NeonOptions::default())
+}
+
+/// Imports the Neon native recording in `folder`.
+pub fn import_neon_with(
+    folder: impl AsRef<Path>,
+    options: &NeonOptions,
 ) -> Result<(Vec<TraceSample>, RecordingReport), RecordingError> {
     let folder = folder.as_ref();
     let name = folder.display().to_string();
@@ -173,26 +226,57 @@ pub fn import_neon(
         })?;
         SceneCamera::from_calibration(&bytes, &calibration.display().to_string())?
     } else {
-        notes.push(
-            "no calibration.bin: the nominal scene camera (891 px focal length, no lens \
-             distortion) turns gaze pixels into directions, off by degrees near the image edges"
-                .to_owned(),
-        );
         SceneCamera::NOMINAL
     };
     let missing = |base: &str, why: &'static str| RecordingError::Missing {
         file: folder.join(format!("{base} ps1.raw")).display().to_string(),
         why,
     };
-    let gaze = read_stream(folder, "gaze", GAZE_LAYOUT, GAZE_LAYOUT)?
-        .ok_or_else(|| missing("gaze", "the gaze stream is needed"))?;
-    let eyes =
-        read_stream(folder, "eye_state", EYE_FIELDS, EYE_STATE_LAYOUT)?.ok_or_else(|| {
-            missing(
-                "eye_state",
-                "the eye-state stream (eyeball centres, pupils) is needed",
-            )
-        })?;
+    let gaze = match options.gaze {
+        GazeSource::Auto => read_stream(folder, "gaze", GAZE_LAYOUT, GAZE_LAYOUT)?,
+        GazeSource::EyeState => None,
+    };
+    let eyes = match &gaze {
+        Some(_) => {
+            read_stream(folder, "eye_state", EYE_FIELDS, EYE_STATE_LAYOUT)?.ok_or_else(|| {
+                missing(
+                    "eye_state",
+                    "the eye-state stream (eyeball centres, pupils) is needed",
+                )
+            })?
+        }
+        None => {
+            let why = match options.gaze {
+                GazeSource::Auto => "the recording has no gaze stream",
+                GazeSource::EyeState => "the eye-state gaze was asked for",
+            };
+            read_stream(folder, "eye_state", EYE_AXIS_FIELDS, EYE_STATE_LAYOUT)
+                .map_err(|e| match e {
+                    RecordingError::Dtype { file, message } => RecordingError::Dtype {
+                        file,
+                        message: format!(
+                            "{message} (the gaze is taken from the eye states' optical axes: \
+                             {why})"
+                        ),
+                    },
+                    e => e,
+                })?
+                .ok_or_else(|| {
+                    missing(
+                        "gaze",
+                        "the gaze stream is needed, or, without it, the eye-state stream \
+                         (`eye_state ps1.raw`, whose optical axes give the gaze)",
+                    )
+                })?
+        }
+    };
+    if gaze.is_some() && !calibration.is_file() {
+        notes.push(
+            "no calibration.bin: the nominal scene camera (891 px focal length, no lens \
+             distortion) turns gaze pixels into directions, off by degrees near the image edges"
+                .to_owned(),
+        );
+    }
     let blinks = read_stream(folder, "blinks", BLINK_FIELDS, BLINK_FIELDS)?.unwrap_or_default();
     let imu = read_stream(folder, "imu", IMU_FIELDS, IMU_LAYOUT)?;
     let inputs = Inputs {
@@ -203,7 +287,7 @@ pub fn import_neon(
         blinks,
         imu,
     };
-    inputs.convert(notes)
+    inputs.convert(notes, options.kappa_deg)
 }
 
 /// Everything read from a recording folder.
@@ -212,9 +296,9 @@ struct Inputs {
     name: String,
     /// The scene camera model.
     camera: SceneCamera,
-    /// Gaze: x, y pixels.
-    gaze: Stream,
-    /// Eye state: [`EYE_FIELDS`].
+    /// Gaze: x, y pixels; `None` when the gaze comes from the eye states.
+    gaze: Option<Stream>,
+    /// Eye state: [`EYE_FIELDS`], or [`EYE_AXIS_FIELDS`] without a gaze stream.
     eyes: Stream,
     /// Blinks: start, end (ns); possibly empty.
     blinks: Stream,
@@ -222,18 +306,68 @@ struct Inputs {
     imu: Option<Stream>,
 }
 
+/// The head track and blinks of a recording, on the clock of the stream that times the
+/// samples.
+struct Timeline {
+    /// The first sample's time, Unix nanoseconds: trace time 0.
+    t0: i64,
+    /// The head orientations (identity throughout without an IMU).
+    track: OrientationTrack,
+    /// The turn that makes the first sample face -z.
+    anchor: Quat,
+    /// Blink starts (sorted), each with the latest end of the blinks up to it.
+    blinks: Vec<(i64, i64)>,
+}
+
+impl Timeline {
+    /// The head pose at `t` (Unix nanoseconds).
+    fn head(&self, t: i64) -> Pose {
+        Pose {
+            position: Vec3::ZERO,
+            orientation: (self.anchor * self.track.at(t)).normalize(),
+        }
+    }
+
+    /// Whether `t` lies inside a marked blink.
+    fn in_blink(&self, t: i64) -> bool {
+        in_blink(&self.blinks, t)
+    }
+}
+
+/// What a conversion counted, for the report.
+#[derive(Default)]
+struct Counts {
+    /// Records dropped: time not after the last kept sample's.
+    dropped: usize,
+    /// Samples inside a marked blink.
+    in_blinks: usize,
+    /// Pupil diameters outside [`PUPIL_RANGE_M`].
+    pupils_out: usize,
+    /// Gaze samples without an eye-state record near them (gaze stream only).
+    no_eye_state: usize,
+    /// Eyes whose optical axis is not finite (eye-state gaze only).
+    no_axis: usize,
+}
+
 impl Inputs {
-    /// Builds the trace.
+    /// Builds the trace; `kappa_deg` turns the optical axes when the gaze comes from the eye
+    /// states.
     fn convert(
         self,
         mut notes: Vec<String>,
+        kappa_deg: f64,
     ) -> Result<(Vec<TraceSample>, RecordingReport), RecordingError> {
-        let Some(&t0) = self.gaze.times_ns.first() else {
+        let (clock, what) = match &self.gaze {
+            Some(gaze) => (gaze, "gaze"),
+            None => (&self.eyes, "eye-state"),
+        };
+        let Some(&t0) = clock.times_ns.first() else {
             return Err(RecordingError::Empty {
-                file: self.gaze.locate(0).0.to_owned(),
-                what: "gaze",
+                file: clock.locate(0).0.to_owned(),
+                what,
             });
         };
+        let records = clock.len();
         let (track, head) = match &self.imu {
             Some(imu) if imu.len() > 0 => {
                 let track = OrientationTrack::new((0..imu.len()).map(|i| {
@@ -255,103 +389,74 @@ impl Inputs {
                 (OrientationTrack::default(), HeadSource::None)
             }
         };
-        notes.push(
-            "fixation depth is not measured (one gaze point, no binocular depth): both eye rays \
-             run parallel to the visual gaze, meeting at infinity"
-                .to_owned(),
-        );
         let anchor = if track.is_empty() {
             Quat::IDENTITY
         } else {
             unyaw(track.at(t0))
         };
-        let eye_order = sorted_by_time(&self.eyes.times_ns);
-        let mut blink_spans: Vec<(i64, i64)> = (0..self.blinks.len())
+        let mut blinks: Vec<(i64, i64)> = (0..self.blinks.len())
             .map(|i| {
                 let r = self.blinks.record(i);
                 (r[0] as i64, r[1] as i64)
             })
             .collect();
-        blink_spans.sort_unstable();
+        blinks.sort_unstable();
         // Each start paired with the latest end so far, so overlapping blinks are found too.
         let mut latest_end = i64::MIN;
-        for span in &mut blink_spans {
+        for span in &mut blinks {
             latest_end = latest_end.max(span.1);
             span.1 = latest_end;
         }
+        let timeline = Timeline {
+            t0,
+            track,
+            anchor,
+            blinks,
+        };
 
-        let mut samples: Vec<TraceSample> = Vec::with_capacity(self.gaze.len());
-        let (mut dropped, mut in_blinks, mut no_eye_state, mut pupils_out) = (0, 0, 0, 0);
-        for i in 0..self.gaze.len() {
-            let t = self.gaze.times_ns[i];
-            let time_ns = t - t0;
-            if let Some(last) = samples.last() {
-                if time_ns <= last.time_ns {
-                    dropped += 1;
-                    continue;
-                }
-                let (file, record) = self.gaze.locate(i);
-                check_span(file, record, time_ns, last.time_ns, 0)?;
+        let mut counts = Counts::default();
+        let mut samples = match &self.gaze {
+            Some(gaze) => {
+                notes.push(
+                    "fixation depth is not measured (one gaze point, no binocular depth): both \
+                     eye rays run parallel to the visual gaze, meeting at infinity"
+                        .to_owned(),
+                );
+                self.samples_from_gaze(gaze, &timeline, &mut counts)?
             }
-            let blink = in_blink(&blink_spans, t);
-            in_blinks += usize::from(blink);
-            let px = self.gaze.record(i);
-            let direction = self
-                .camera
-                .direction(px[0], px[1])
-                .map(|d| neon_to_openxr(d.as_vec3()))
-                .filter(|_| !blink);
-            let eye = nearest(&eye_order, &self.eyes.times_ns, t).map(|k| self.eyes.record(k));
-            no_eye_state += usize::from(eye.is_none());
-            let mut rays = [GazeRay::INVALID; 2];
-            let mut pupils = [None; 2];
-            if let Some(e) = eye.filter(|_| !blink) {
-                for side in 0..2 {
-                    let v = &e[4 * side..4 * side + 4];
-                    let centre = DVec3::new(v[0], v[1], v[2]).as_vec3();
-                    if let Some(d) = direction {
-                        rays[side] = clean_ray(GazeRay {
-                            origin: neon_to_openxr(centre) / 1000.0,
-                            direction: d,
-                            valid: true,
-                        });
-                    }
-                    let pupil_m = (v[3] / 1000.0) as f32;
-                    if PUPIL_RANGE_M.contains(&pupil_m) {
-                        pupils[side] = Some(pupil_m);
-                    } else if pupil_m.is_finite() {
-                        pupils_out += 1;
-                    }
-                }
+            None => {
+                let kappa_from = if kappa_deg == DEFAULT_KAPPA_DEG {
+                    "the default, a population mean for adults, not this wearer's"
+                } else {
+                    "as given, not measured for this wearer"
+                };
+                notes.push(format!(
+                    "the gaze comes from the eye states' optical axes (no gaze stream is \
+                     used), each turned {kappa_deg:.1} degrees toward the nose for angle kappa \
+                     ({kappa_from}; Neon does not calibrate kappa)"
+                ));
+                notes.push(
+                    "fixation depth from the vergence of these two rays is unreliable: with no \
+                     per-wearer kappa each eye may be off by degrees, and for eyes 64 mm apart \
+                     one degree in either eye moves a 2 m vergence depth to 1.3 m or 4.4 m \
+                     (0.5 m to 0.44 m or 0.58 m)"
+                        .to_owned(),
+                );
+                self.samples_from_eye_states(&timeline, kappa_deg.to_radians(), &mut counts)?
             }
-            let combined = direction.map_or(GazeRay::INVALID, |d| {
-                clean_ray(GazeRay {
-                    origin: Vec3::ZERO,
-                    direction: d,
-                    valid: true,
-                })
-            });
-            samples.push(TraceSample {
-                time_ns,
-                head: Pose {
-                    position: Vec3::ZERO,
-                    orientation: (anchor * track.at(t)).normalize(),
-                },
-                gaze: GazeSample {
-                    sample_time_ns: time_ns,
-                    left: rays[0],
-                    right: rays[1],
-                    combined: Some(combined),
-                    fixation: None,
-                    pupil_diameter_m: pupils,
-                    report: None,
-                },
-            });
-        }
-        if no_eye_state > 0 {
+        };
+        if counts.no_eye_state > 0 {
             notes.push(format!(
-                "{no_eye_state} gaze samples have no eye-state record within 25 ms: their eyes \
-                 are written as invalid"
+                "{} gaze samples have no eye-state record within 25 ms: their eyes are written \
+                 as invalid",
+                counts.no_eye_state
+            ));
+        }
+        if counts.no_axis > 0 {
+            notes.push(format!(
+                "{} eyes have no optical axis (not finite) in their eye-state record: those \
+                 eyes are written as invalid",
+                counts.no_axis
             ));
         }
         let head_origin = centre_on_eyes(&mut samples);
@@ -363,13 +468,117 @@ impl Inputs {
         }
         let mut report = RecordingReport::from_samples(FORMAT, self.name, &samples);
         report.head_origin_m = head_origin;
-        report.records = self.gaze.len();
-        report.dropped_records = dropped;
-        report.blink_samples = in_blinks;
-        report.pupils_out_of_range = pupils_out;
+        report.records = records;
+        report.dropped_records = counts.dropped;
+        report.blink_samples = counts.in_blinks;
+        report.pupils_out_of_range = counts.pupils_out;
         report.head = head;
         report.approximations = notes;
         Ok((samples, report))
+    }
+
+    /// The samples of the gaze stream: the visual gaze direction from each eyeball centre.
+    fn samples_from_gaze(
+        &self,
+        gaze: &Stream,
+        timeline: &Timeline,
+        counts: &mut Counts,
+    ) -> Result<Vec<TraceSample>, RecordingError> {
+        let eye_order = sorted_by_time(&self.eyes.times_ns);
+        let mut samples: Vec<TraceSample> = Vec::with_capacity(gaze.len());
+        for i in 0..gaze.len() {
+            let t = gaze.times_ns[i];
+            let Some(time_ns) = sample_time(gaze, i, timeline.t0, samples.last(), counts)? else {
+                continue;
+            };
+            let blink = timeline.in_blink(t);
+            counts.in_blinks += usize::from(blink);
+            let px = gaze.record(i);
+            let direction = self
+                .camera
+                .direction(px[0], px[1])
+                .map(|d| neon_to_openxr(d.as_vec3()))
+                .filter(|_| !blink);
+            let eye = nearest(&eye_order, &self.eyes.times_ns, t).map(|k| self.eyes.record(k));
+            counts.no_eye_state += usize::from(eye.is_none());
+            let mut rays = [GazeRay::INVALID; 2];
+            let mut pupils = [None; 2];
+            if let Some(e) = eye.filter(|_| !blink) {
+                for side in 0..2 {
+                    let v = &e[4 * side..4 * side + 4];
+                    if let Some(d) = direction {
+                        rays[side] = eye_ray(v, d);
+                    }
+                    pupils[side] = pupil_m(v[3], &mut counts.pupils_out);
+                }
+            }
+            let combined = direction.map_or(GazeRay::INVALID, |d| {
+                clean_ray(GazeRay {
+                    origin: Vec3::ZERO,
+                    direction: d,
+                    valid: true,
+                })
+            });
+            samples.push(TraceSample {
+                time_ns,
+                head: timeline.head(t),
+                gaze: GazeSample {
+                    sample_time_ns: time_ns,
+                    left: rays[0],
+                    right: rays[1],
+                    combined: Some(combined),
+                    fixation: None,
+                    pupil_diameter_m: pupils,
+                    report: None,
+                },
+            });
+        }
+        Ok(samples)
+    }
+}
+
+/// The trace time of record `i` of `stream` (timing the samples from `t0`), or `None`,
+/// counted as dropped, when it is not after the `last` sample's; a gap past the trace limits
+/// fails the import.
+fn sample_time(
+    stream: &Stream,
+    i: usize,
+    t0: i64,
+    last: Option<&TraceSample>,
+    counts: &mut Counts,
+) -> Result<Option<i64>, RecordingError> {
+    let time_ns = stream.times_ns[i] - t0;
+    if let Some(last) = last {
+        if time_ns <= last.time_ns {
+            counts.dropped += 1;
+            return Ok(None);
+        }
+        let (file, record) = stream.locate(i);
+        check_span(file, record, time_ns, last.time_ns, 0)?;
+    }
+    Ok(Some(time_ns))
+}
+
+/// The ray of an eye from its eye-state values `v` (eyeball centre x, y, z in mm, then the
+/// pupil) along `direction` (OpenXR head frame); invalid when either is not finite.
+fn eye_ray(v: &[f64], direction: Vec3) -> GazeRay {
+    let centre = DVec3::new(v[0], v[1], v[2]).as_vec3();
+    clean_ray(GazeRay {
+        origin: neon_to_openxr(centre) / 1000.0,
+        direction,
+        valid: true,
+    })
+}
+
+/// A pupil diameter in metres from `mm`, `None` when unknown or outside [`PUPIL_RANGE_M`]
+/// (counted in `out`).
+fn pupil_m(mm: f64, out: &mut usize) -> Option<f32> {
+    let pupil_m = (mm / 1000.0) as f32;
+    if PUPIL_RANGE_M.contains(&pupil_m) {
+        Some(pupil_m)
+    } else {
+        *out += usize::from(pupil_m.is_finite());
+        None
     }
 }
 

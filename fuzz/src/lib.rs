@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use vitreous::scene::{Scene, SceneError, SceneFiles};
-use vitreous_xr::trace::{TraceReader, TraceSample, TraceWriter};
+use vitreous_xr::trace::{TraceReader, TraceSample, TraceVersion, TraceWriter};
 
 /// Names of the targets, as in `fuzz_targets/` and `corpus/`.
 pub const TARGETS: [&str; 8] = [
@@ -306,9 +306,16 @@ fn read_all(data: &[u8]) -> Result<Vec<TraceSample>, String> {
         .map_err(|e| e.to_string())
 }
 
-/// Writes samples as a trace; every one must be accepted.
+/// Writes samples as a trace (version 1.3 when any carries the tracker's report, so that a
+/// report after a first sample without one is kept); every one must be accepted.
 fn write_all(samples: &[TraceSample]) -> Vec<u8> {
-    let mut writer = TraceWriter::new(Vec::new()).expect("writing to memory");
+    let version = if samples.iter().any(|s| s.gaze.report.is_some()) {
+        TraceVersion::V1_3
+    } else {
+        TraceVersion::V1_1
+    };
+    let mut writer =
+        TraceWriter::with_version(Vec::new(), "<output>", version).expect("writing to memory");
     for (i, sample) in samples.iter().enumerate() {
         if let Err(e) = writer.write(sample) {
             panic!("sample {i} was accepted but cannot be written: {e}\n{sample:?}");

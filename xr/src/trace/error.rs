@@ -67,7 +67,7 @@ pub enum TraceError {
     },
     /// The version line names a version this reader does not know.
     #[error(
-        "{file}:{line}: unsupported trace version `{version}`; this reader understands v1, v1.1 and v1.2"
+        "{file}:{line}: unsupported trace version `{version}`; this reader understands v1, v1.1, v1.2 and v1.3"
     )]
     UnsupportedVersion {
         /// File name.
@@ -267,7 +267,7 @@ pub enum TraceError {
         /// The previous sample's gaze time.
         previous_ns: i64,
     },
-    /// An optional group (combined ray, fixation) is only partly filled.
+    /// An optional group (combined ray, fixation, tracker report) is only partly filled.
     #[error(
         "{file}:{line}: the {group} columns must be either all empty or all filled; column `{column}` is empty"
     )]
@@ -276,7 +276,7 @@ pub enum TraceError {
         file: String,
         /// Line number (1-based).
         line: usize,
-        /// `combined` or `fixation`.
+        /// `combined`, `fixation` or `tracker report`.
         group: &'static str,
         /// The first empty column of the group.
         column: &'static str,

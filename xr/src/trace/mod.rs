@@ -1,6 +1,6 @@
 //! The vitreous trace format, version 1 (and its minor versions: 1.1 adds the per-eye pupil
-//! diameters, 1.2 the scene-edit lines of live controls): head poses and eye-tracker samples
-//! as UTF-8 text.
+//! diameters, 1.2 the scene-edit lines of live controls, 1.3 the tracker's own report of each
+//! sample): head poses and eye-tracker samples as UTF-8 text.
 //!
 //! One sample per line, comma-separated, after a version line and a column header line. The
 //! full description (every column, its unit and axes) is in `docs/trace-format.md`; the short
@@ -16,10 +16,13 @@
 //! what trackers really produce: a gaze ray with a NaN/infinite value or a zero direction is
 //! read as an invalid ray of that eye instead of failing the whole trace.
 //!
-//! The reader takes all three versions; the writer writes v1.1 (its pupil columns are empty
-//! where a sample has no measurement), or v1.2 when asked for a trace that may hold edits
-//! ([`TraceWriter::create_with_edits`]); edit lines come out of the reader beside the samples
-//! ([`TraceReader::take_edits`], [`read_trace_with_edits`]).
+//! The reader takes all four versions (before 1.3 a sample has no report); the writer writes
+//! v1.1 (its pupil columns are empty where a sample has no measurement), or v1.2 when asked
+//! for a trace that may hold edits ([`TraceWriter::create_with_edits`]); edit lines come out of
+//! the reader beside the samples ([`TraceReader::take_edits`], [`read_trace_with_edits`]). It
+//! writes v1.3, which may hold edits too, when asked ([`TraceWriter::with_version`]) or when
+//! the first sample carries a tracker report: the header lines wait for the first sample,
+//! which decides the version, so a trace without reports stays byte for byte what it was.
 //!
 //! The writer runs the same checks before writing, so it never produces a file the reader
 //! refuses, and flushes after every sample so a crash loses at most the sample being written.
@@ -28,6 +31,7 @@
 mod edit;
 mod error;
 mod read;
+mod report;
 #[cfg(test)]
 mod test_traces;
 mod validate;
@@ -39,6 +43,7 @@ pub use crate::atomic_file::AtomicFile;
 pub use edit::{EDIT_FIELDS, EDIT_TAG, EditRecord, MAX_ACTION_BYTES, valid_action};
 pub use error::TraceError;
 pub use read::{TraceReader, read_trace, read_trace_with_edits};
+pub use report::{behaviour_name, confidence_name};
 pub(crate) use validate::check_span;
 pub use validate::clean_ray;
 pub use write::TraceWriter;
@@ -52,6 +57,9 @@ pub const VERSION_LINE_V1_1: &str = "# vitreous-trace v1.1";
 
 /// The first line of a version-1.2 trace (version 1.1 plus scene-edit lines).
 pub const VERSION_LINE_V1_2: &str = "# vitreous-trace v1.2";
+
+/// The first line of a version-1.3 trace (version 1.2 plus the tracker report columns).
+pub const VERSION_LINE_V1_3: &str = "# vitreous-trace v1.3";
 
 /// What the version line starts with, whatever the version.
 const VERSION_PREFIX: &str = "# vitreous-trace ";
@@ -107,6 +115,20 @@ pub const COLUMNS_V1_1: [&str; 35] = {
     out
 };
 
+/// The column names of version 1.3, in file order: those of version 1.1, then the tracker's
+/// report of the sample (`tracker_confidence`, `gaze_behaviour`).
+pub const COLUMNS_V1_3: [&str; 37] = {
+    let mut out = [""; 37];
+    let mut i = 0;
+    while i < COLUMNS_V1_1.len() {
+        out[i] = COLUMNS_V1_1[i];
+        i += 1;
+    }
+    out[REPORT] = "tracker_confidence";
+    out[REPORT + 1] = "gaze_behaviour";
+    out
+};
+
 /// The versions of the format this crate reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TraceVersion {
@@ -117,6 +139,9 @@ pub enum TraceVersion {
     /// `# vitreous-trace v1.2`: version 1.1's columns, and scene-edit lines
     /// ([`EditRecord`]) between the samples.
     V1_2,
+    /// `# vitreous-trace v1.3`: version 1.2 with 37 columns, the last two the tracker's
+    /// report of the sample ([`crate::TrackerReport`]).
+    V1_3,
 }
 
 impl TraceVersion {
@@ -125,6 +150,7 @@ impl TraceVersion {
         match self {
             TraceVersion::V1 => &COLUMNS,
             TraceVersion::V1_1 | TraceVersion::V1_2 => &COLUMNS_V1_1,
+            TraceVersion::V1_3 => &COLUMNS_V1_3,
         }
     }
 
@@ -134,12 +160,18 @@ impl TraceVersion {
             TraceVersion::V1 => VERSION_LINE,
             TraceVersion::V1_1 => VERSION_LINE_V1_1,
             TraceVersion::V1_2 => VERSION_LINE_V1_2,
+            TraceVersion::V1_3 => VERSION_LINE_V1_3,
         }
     }
 
     /// Whether lines of this version may be scene edits.
     pub fn has_edits(self) -> bool {
-        self == TraceVersion::V1_2
+        matches!(self, TraceVersion::V1_2 | TraceVersion::V1_3)
+    }
+
+    /// Whether the samples of this version carry the tracker's report.
+    pub fn has_reports(self) -> bool {
+        self == TraceVersion::V1_3
     }
 }
 
@@ -147,12 +179,14 @@ impl TraceVersion {
 /// unit mistake or a tracker's placeholder, refused like any other bad field.
 pub const PUPIL_RANGE_M: std::ops::RangeInclusive<f32> = 0.001..=0.010;
 
-/// Index of the first column of each group in [`COLUMNS`] ([`COLUMNS_V1_1`] for the pupils).
+/// Index of the first column of each group in [`COLUMNS`] ([`COLUMNS_V1_1`] for the pupils,
+/// [`COLUMNS_V1_3`] for the report).
 const LEFT: usize = 9;
 const RIGHT: usize = 16;
 const COMBINED: usize = 23;
 const FIXATION: usize = 30;
 const PUPILS: usize = 33;
+const REPORT: usize = 35;
 
 /// How far the head quaternion's norm may be from 1 before the sample is refused; within it
 /// the quaternion is normalised (text round-off, other tools' rounding).

@@ -7,6 +7,7 @@ use std::path::Path;
 use glam::{Quat, Vec3};
 
 use super::edit::{EDIT_TAG, EditRecord, check_edit, parse_edit};
+use super::report::parse_report;
 use super::validate::{Preceding, check_sample};
 use super::{
     COLUMNS, COLUMNS_V1_1, COMBINED, FIXATION, LEFT, PUPILS, RIGHT, TraceError, TraceSample,
@@ -85,10 +86,15 @@ fn parse_record(record: &Record<'_>, version: TraceVersion) -> Result<TraceSampl
     };
     let pupil_diameter_m = match version {
         TraceVersion::V1 => [None, None],
-        TraceVersion::V1_1 | TraceVersion::V1_2 => [
+        TraceVersion::V1_1 | TraceVersion::V1_2 | TraceVersion::V1_3 => [
             parse_pupil(record, PUPILS)?,
             parse_pupil(record, PUPILS + 1)?,
         ],
+    };
+    let report = if version.has_reports() {
+        parse_report(record)?
+    } else {
+        None
     };
     Ok(TraceSample {
         time_ns,
@@ -103,7 +109,7 @@ fn parse_record(record: &Record<'_>, version: TraceVersion) -> Result<TraceSampl
             combined,
             fixation,
             pupil_diameter_m,
-            report: None,
+            report,
         },
     })
 }
@@ -133,7 +139,7 @@ fn optional_group(
     Ok(true)
 }
 
-/// Streams [`TraceSample`]s out of a version-1 or version-1.1 trace.
+/// Streams [`TraceSample`]s out of a trace of any version this crate reads.
 ///
 /// The version and column header lines are checked by the constructor; samples are parsed
 /// and checked one line at a time as the iterator is advanced. After the first error the
@@ -147,7 +153,7 @@ pub struct TraceReader<R: Read> {
     done: bool,
     /// The version named by the first line.
     version: TraceVersion,
-    /// The edit lines read so far (version 1.2), in file order.
+    /// The edit lines read so far (version 1.2 and later), in file order.
     edits: Vec<EditRecord>,
 }
 
@@ -211,6 +217,7 @@ impl<R: Read> TraceReader<R> {
             Some("v1") => self.version = TraceVersion::V1,
             Some("v1.1") => self.version = TraceVersion::V1_1,
             Some("v1.2") => self.version = TraceVersion::V1_2,
+            Some("v1.3") => self.version = TraceVersion::V1_3,
             Some(version) => {
                 return Err(TraceError::UnsupportedVersion {
                     file: name,
@@ -522,6 +529,42 @@ mod tests {
             [Some(0.0042), Some(0.0041)]
         );
         assert_eq!(samples[1].gaze.pupil_diameter_m, [None, Some(0.0041)]);
+    }
+
+    #[test]
+    fn version_1_3_example_in_the_format_doc_reads_with_reports() {
+        use crate::frame::{GazeBehaviour, TrackerConfidence, TrackerReport};
+        let doc = include_str!("../../../docs/trace-format.md");
+        let at = doc.find("```text\n# vitreous-trace v1.3").unwrap() + "```text\n".len();
+        let end = at + doc[at..].find("```").unwrap();
+        let mut reader = TraceReader::new(&doc.as_bytes()[at..end], "doc").unwrap();
+        assert_eq!(reader.version(), TraceVersion::V1_3);
+        let samples: Vec<_> = reader.by_ref().collect::<Result<_, _>>().unwrap();
+        let reports: Vec<_> = samples.iter().map(|s| s.gaze.report).collect();
+        assert_eq!(
+            reports,
+            [
+                Some(TrackerReport {
+                    confidence: TrackerConfidence::High,
+                    behaviour: GazeBehaviour::Fixation,
+                }),
+                Some(TrackerReport {
+                    confidence: TrackerConfidence::Low,
+                    behaviour: GazeBehaviour::Blink,
+                }),
+                None,
+            ]
+        );
+        assert_eq!(samples[1].gaze.combined, Some(GazeRay::INVALID));
+    }
+
+    #[test]
+    fn older_versions_read_without_reports() {
+        for version in ["v1.1", "v1.2"] {
+            let text = good_text(2).replacen("v1.1", version, 1);
+            let samples = read_str(&text).unwrap();
+            assert!(samples.iter().all(|s| s.gaze.report.is_none()), "{version}");
+        }
     }
 
     #[test]

@@ -3,7 +3,7 @@
 use glam::{Quat, Vec3};
 
 use super::*;
-use crate::frame::GazeRay;
+use crate::frame::{GazeBehaviour, GazeRay, TrackerConfidence, TrackerReport};
 
 pub(super) fn ray(origin: Vec3, direction: Vec3) -> GazeRay {
     GazeRay {
@@ -32,8 +32,14 @@ pub(super) fn sample(time_ns: i64) -> TraceSample {
     }
 }
 
+/// The samples as trace text: version 1.1, or 1.3 when any sample carries a report.
 pub(super) fn to_text(samples: &[TraceSample]) -> String {
-    let mut w = TraceWriter::new(Vec::new()).unwrap();
+    let version = if samples.iter().any(|s| s.gaze.report.is_some()) {
+        TraceVersion::V1_3
+    } else {
+        TraceVersion::V1_1
+    };
+    let mut w = TraceWriter::with_version(Vec::new(), "<output>", version).unwrap();
     for s in samples {
         w.write(s).unwrap();
     }
@@ -47,6 +53,22 @@ pub(super) fn read_str(text: &str) -> Result<Vec<TraceSample>, TraceError> {
 /// A valid trace text with `n` samples, for corrupting one line in the tests.
 pub(super) fn good_text(n: i64) -> String {
     to_text(&(1..=n).map(|i| sample(i * 1000)).collect::<Vec<_>>())
+}
+
+/// A valid version-1.3 trace text with `n` samples, each with a report (high confidence, a
+/// fixation).
+pub(super) fn good_text_v1_3(n: i64) -> String {
+    let samples: Vec<_> = (1..=n)
+        .map(|i| {
+            let mut s = sample(i * 1000);
+            s.gaze.report = Some(TrackerReport {
+                confidence: TrackerConfidence::High,
+                behaviour: GazeBehaviour::Fixation,
+            });
+            s
+        })
+        .collect();
+    to_text(&samples)
 }
 
 /// Replaces field `col` of physical line `line` (1-based).

@@ -1,29 +1,24 @@
 //! Gaze sources of a live session: XR_ML_eye_tracker (per-eye poses, fixation point, pupil
-//! diameters), XR_FB_eye_tracking_social (per-eye poses), XR_EXT_eye_gaze_interaction (a
-//! combined ray with its sample time), a recorded trace replayed by time since the session's
-//! first frame, or none (manual). All give rays in the head (VIEW) frame, as [`GazeSample`]
-//! wants.
-//!
-//! Over 600 lines because the four sources share one enum and the ray/pose conversion, and the
-//! ML tracker's raw calls (function loading, poses, two-call pupils) take about 150 lines; it
-//! is the next to move into its own module when a source is added.
+//! diameters, the tracker's report; its raw calls in [`super::ml_tracker`]),
+//! XR_FB_eye_tracking_social (per-eye poses), XR_EXT_eye_gaze_interaction (a combined ray with
+//! its sample time), a recorded trace replayed by time since the session's first frame, or none
+//! (manual). All give rays in the head (VIEW) frame, as [`GazeSample`] wants.
 //!
 //! The combined EXT ray has no depth, so it cannot drive the gaze image: with it, the frame's
 //! per-eye gaze comes from the trace (when one is given; else there is none and the gaze image
 //! is chosen by hand), and the EXT ray is carried as the sample's combined ray, so a recording
 //! holds exactly what decided each frame.
 
-use std::ffi::CStr;
 use std::path::Path;
 
 use glam::{Quat, Vec3};
 use openxr as xr;
 
 use super::choose::GazeSource;
-use super::ml_eye_tracker as ml;
+use super::ml_tracker::MlTracker;
 use super::{OpenXrError, Result, XrContext};
 use crate::frame::{GazeRay, GazeSample};
-use crate::trace::{PUPIL_RANGE_M, TraceSample, read_trace};
+use crate::trace::{TraceSample, read_trace};
 
 /// A gaze source, ready to sample.
 pub(super) enum Gaze {
@@ -137,7 +132,7 @@ impl GazeTally {
 }
 
 /// A ray along a pose's forward axis (-z).
-fn ray_of(pose: &xr::Posef) -> GazeRay {
+pub(super) fn ray_of(pose: &xr::Posef) -> GazeRay {
     let q = Quat::from_xyzw(
         pose.orientation.x,
         pose.orientation.y,
@@ -223,195 +218,6 @@ impl Drop for FbTracker {
             // used after this drop.
             unsafe { (fp.destroy_eye_tracker)(self.tracker) };
         }
-    }
-}
-
-/// An XR_ML_eye_tracker tracker and the functions it is used with (loaded through
-/// xrGetInstanceProcAddr: the `openxr` crate does not carry the extension).
-pub(super) struct MlTracker {
-    /// The tracker handle; destroyed on drop.
-    tracker: ml::EyeTrackerML,
-    /// `xrDestroyEyeTrackerML`.
-    destroy: ml::DestroyEyeTrackerML,
-    /// `xrGetEyeTrackerPosesML`.
-    get_poses: ml::GetEyeTrackerPosesML,
-    /// `xrGetEyeTrackerPupilDataML`.
-    get_pupils: ml::GetEyeTrackerPupilDataML,
-}
-
-/// Loads an instance function by name.
-///
-/// # Safety
-/// `T` must be the function pointer type of the function named `name`.
-unsafe fn load<T: Copy>(instance: &xr::Instance, name: &CStr) -> Result<T> {
-    let mut f: Option<xr::sys::pfn::VoidFunction> = None;
-    // SAFETY: a live instance and a nul-terminated name; `f` outlives the call.
-    let r = unsafe {
-        (instance.entry().fp().get_instance_proc_addr)(instance.as_raw(), name.as_ptr(), &mut f)
-    };
-    match f {
-        Some(f) if r == xr::sys::Result::SUCCESS => {
-            const {
-                assert!(
-                    std::mem::size_of::<T>() == std::mem::size_of::<xr::sys::pfn::VoidFunction>()
-                )
-            };
-            // SAFETY: the runtime returned the function named `name`, whose type is `T` (this
-            // function's contract); both are plain function pointers of the same size.
-            Ok(unsafe { std::mem::transmute_copy::<xr::sys::pfn::VoidFunction, T>(&f) })
-        }
-        _ => Err(OpenXrError::Call {
-            call: "xrGetInstanceProcAddr",
-            result: if r == xr::sys::Result::SUCCESS {
-                xr::sys::Result::ERROR_FUNCTION_UNSUPPORTED
-            } else {
-                r
-            },
-        }),
-    }
-}
-
-impl MlTracker {
-    /// Loads the extension's functions and creates the tracker (the extension must be enabled
-    /// on the session's instance).
-    pub(super) fn new(session: &xr::Session<xr::Vulkan>) -> Result<MlTracker> {
-        let instance = session.instance();
-        // SAFETY: each name is paired with its function pointer type from the extension's
-        // declarations (ml_eye_tracker).
-        let (create, destroy, get_poses, get_pupils) = unsafe {
-            (
-                load::<ml::CreateEyeTrackerML>(instance, c"xrCreateEyeTrackerML")?,
-                load::<ml::DestroyEyeTrackerML>(instance, c"xrDestroyEyeTrackerML")?,
-                load::<ml::GetEyeTrackerPosesML>(instance, c"xrGetEyeTrackerPosesML")?,
-                load::<ml::GetEyeTrackerPupilDataML>(instance, c"xrGetEyeTrackerPupilDataML")?,
-            )
-        };
-        let info = ml::EyeTrackerCreateInfoML {
-            ty: xr::sys::StructureType::from_raw(ml::structure_type::CREATE_INFO),
-            next: std::ptr::null(),
-        };
-        let mut tracker = ml::EyeTrackerML::NULL;
-        // SAFETY: `create` is the runtime's xrCreateEyeTrackerML; the session is live and
-        // `info`, `tracker` are valid for the call.
-        let r = unsafe { create(session.as_raw(), &info, &mut tracker) };
-        if r != xr::sys::Result::SUCCESS {
-            return Err(r).xr("xrCreateEyeTrackerML");
-        }
-        Ok(MlTracker {
-            tracker,
-            destroy,
-            get_poses,
-            get_pupils,
-        })
-    }
-
-    /// Per-eye rays, the combined ray and the fixation point in the head frame, and the pupil
-    /// diameters; the sample time is the newest valid pose's.
-    fn sample(&mut self, view_space: &xr::Space, display: xr::Time) -> Option<GazeSample> {
-        let info = ml::EyeTrackerPosesGetInfoML {
-            ty: xr::sys::StructureType::from_raw(ml::structure_type::POSES_GET_INFO),
-            next: std::ptr::null(),
-            base_space: view_space.as_raw(),
-            time: display,
-            pose_flags: ml::pose_flags::ALL,
-        };
-        let mut poses = ml::EyeTrackerPosesML::empty();
-        // SAFETY: the tracker is live until drop; `info` and `poses` are typed and outlive the
-        // call.
-        let r = unsafe { (self.get_poses)(self.tracker, &info, &mut poses) };
-        if r != xr::sys::Result::SUCCESS {
-            return None;
-        }
-        let valid = |p: &ml::EyeTrackerPoseML| p.valid == xr::sys::TRUE;
-        let ray = |p: &ml::EyeTrackerPoseML| {
-            if valid(p) {
-                ray_of(&p.pose)
-            } else {
-                GazeRay::INVALID
-            }
-        };
-        let all = [
-            &poses.left_pose,
-            &poses.right_pose,
-            &poses.gaze_pose,
-            &poses.fixation_pose,
-        ];
-        // A blink (no valid pose) is a sample too: the filters hold through it. Its time is the
-        // newest the runtime stamped, else the display time asked for.
-        let newest = |only_valid: bool| {
-            all.iter()
-                .filter(|p| !only_valid || valid(p))
-                .map(|p| p.time.as_nanos())
-                .filter(|&t| t > 0)
-                .max()
-        };
-        let sample_time_ns = newest(true)
-            .or_else(|| newest(false))
-            .unwrap_or(display.as_nanos());
-        let fixation = valid(&poses.fixation_pose).then(|| {
-            let p = poses.fixation_pose.pose.position;
-            Vec3::new(p.x, p.y, p.z)
-        });
-        Some(GazeSample {
-            sample_time_ns,
-            left: ray(&poses.left_pose),
-            right: ray(&poses.right_pose),
-            combined: Some(ray(&poses.gaze_pose)),
-            fixation,
-            pupil_diameter_m: self.pupils(),
-            report: None,
-        })
-    }
-
-    /// The pupil diameters (left, right), metres, where the tracker measured them.
-    fn pupils(&mut self) -> [Option<f32>; 2] {
-        let info = ml::EyeTrackerGetInfoML {
-            ty: xr::sys::StructureType::from_raw(ml::structure_type::PUPIL_DATA_GET_INFO),
-            next: std::ptr::null(),
-        };
-        let mut data = [ml::EyeTrackerPupilDataML::empty(); 2];
-        let mut count = 0u32;
-        // SAFETY: the tracker is live; `data` has room for the capacity given and outlives
-        // the call, every element typed.
-        let r = unsafe {
-            (self.get_pupils)(
-                self.tracker,
-                &info,
-                data.len() as u32,
-                &mut count,
-                data.as_mut_ptr(),
-            )
-        };
-        let mut out = [None, None];
-        if r != xr::sys::Result::SUCCESS {
-            return out;
-        }
-        for d in data.iter().take(count as usize) {
-            let eye = match d.eye {
-                ml::EyeML::LEFT => 0,
-                ml::EyeML::RIGHT => 1,
-                _ => continue,
-            };
-            if let Some(diameter_m) = measured_pupil(d.valid, d.pupil_diameter) {
-                out[eye] = Some(diameter_m);
-            }
-        }
-        out
-    }
-}
-
-/// A pupil diameter the tracker marked valid, when it is one a trace can hold
-/// ([`PUPIL_RANGE_M`]); anything else (0, NaN, a value in millimetres) is no measurement, so
-/// that `run --record` never writes a sample the trace reader would refuse.
-fn measured_pupil(valid: xr::sys::Bool32, diameter_m: f32) -> Option<f32> {
-    (valid == xr::sys::TRUE && PUPIL_RANGE_M.contains(&diameter_m)).then_some(diameter_m)
-}
-
-impl Drop for MlTracker {
-    fn drop(&mut self) {
-        // SAFETY: the tracker was created by this table's runtime and is not used after this
-        // drop.
-        unsafe { (self.destroy)(self.tracker) };
     }
 }
 
@@ -542,15 +348,6 @@ impl TraceGaze {
 mod tests {
     use super::*;
     use crate::frame::Pose;
-
-    #[test]
-    fn only_valid_plausible_pupils_are_measurements() {
-        assert_eq!(measured_pupil(xr::sys::TRUE, 0.004), Some(0.004));
-        assert_eq!(measured_pupil(xr::sys::FALSE, 0.004), None);
-        for odd in [0.0, -0.004, f32::NAN, f32::INFINITY, 4.0, 0.0004, 0.02] {
-            assert_eq!(measured_pupil(xr::sys::TRUE, odd), None, "{odd}");
-        }
-    }
 
     fn sample(time_ns: i64, gaze_ns: i64, x: f32) -> TraceSample {
         let ray = GazeRay {

@@ -3,8 +3,9 @@
 //! laid out as Magic Leap's SDK declares them (C layout, `XrStructureType` values
 //! 1000484000-1000484014).
 //!
-//! The app reads per-eye, fixation (vergence) and pupil data through them
-//! ([`super::gaze`]); the simulated headset layer (`vitreous-sim-layer`) answers the same calls.
+//! The app reads per-eye, fixation (vergence) and pupil data, the fixation pose's confidence
+//! and the gaze behaviour through them ([`super::ml_tracker`]); the simulated headset layer
+//! (`vitreous-sim-layer`) answers the same calls.
 //!
 //! Units: poses in metres in the base space given per call; pupil diameters in metres; times
 //! are `XrTime` nanoseconds.
@@ -331,6 +332,21 @@ impl EyeTrackerPupilDataML {
     }
 }
 
+impl EyeTrackerGazeBehaviorML {
+    /// An empty output structure with its structure type set, for the runtime to fill.
+    pub fn empty() -> EyeTrackerGazeBehaviorML {
+        EyeTrackerGazeBehaviorML {
+            ty: sys::StructureType::from_raw(structure_type::GAZE_BEHAVIOR),
+            next: std::ptr::null_mut(),
+            time: sys::Time::from_nanos(0),
+            valid: sys::FALSE,
+            gaze_behavior_type: GazeBehaviorTypeML::UNKNOWN,
+            onset_time: sys::Time::from_nanos(0),
+            duration: 0,
+        }
+    }
+}
+
 /// `xrCreateEyeTrackerML`.
 pub type CreateEyeTrackerML = unsafe extern "system" fn(
     session: sys::Session,
@@ -398,5 +414,11 @@ mod tests {
             std::mem::offset_of!(EyeTrackerPupilDataML, pupil_diameter),
             36
         );
+        assert_eq!(std::mem::size_of::<EyeTrackerGazeBehaviorML>(), 48);
+        assert_eq!(
+            std::mem::offset_of!(EyeTrackerGazeBehaviorML, gaze_behavior_type),
+            28
+        );
+        assert_eq!(std::mem::offset_of!(EyeTrackerGazeBehaviorML, duration), 40);
     }
 }

@@ -29,6 +29,7 @@ pub mod choose;
 mod error;
 mod gaze;
 pub mod ml_eye_tracker;
+mod ml_tracker;
 mod session;
 pub mod state;
 

@@ -9,7 +9,8 @@ use openxr as xr;
 
 use super::super::actions::Controls;
 use super::super::choose::{self, Blend, GazeChoice, GazeOffer, GazeSource, SpaceChoice};
-use super::super::gaze::{ExtGaze, FbTracker, Gaze, MlTracker, TraceGaze};
+use super::super::gaze::{ExtGaze, FbTracker, Gaze, TraceGaze};
+use super::super::ml_tracker::MlTracker;
 use super::super::state::State;
 use super::super::{
     DepthOptions, OpenXrError, Result, Runtime, SessionOptions, SwapchainImages, VulkanHandles,

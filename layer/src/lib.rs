@@ -12,6 +12,7 @@
 //! `tools/sim-layer`) and calls the one exported symbol,
 //! [`entry::xrNegotiateLoaderApiLayerInterface`].
 
+pub mod behaviour;
 pub mod bindings;
 pub mod blend;
 pub mod calls;

@@ -4,12 +4,16 @@
 //! time of the session's first `xrWaitFrame` ([`TimeBase`]). Between two eye-tracker samples
 //! (by their own `gaze_time_ns`) the data is interpolated: ray origins, fixation points and
 //! pupil diameters linearly, ray directions by normalised linear interpolation; whether a ray
-//! is valid, and anything only one of the two samples has, comes from the nearer sample.
-//! Before the first sample the first is used, after the last the last, each with its own time.
+//! is valid, and anything only one of the two samples has (the tracker's report too), comes
+//! from the nearer sample. Before the first sample the first is used, after the last the last,
+//! each with its own time. The gaze behaviour at a time is that of the nearer sample's episode
+//! ([`crate::behaviour`]), so a blink is answered exactly while the eye rays are invalid.
 
 use glam::Vec3;
 use vitreous_xr::trace::TraceSample;
 use vitreous_xr::{GazeRay, GazeSample};
+
+use crate::behaviour::{Behaviour, Episode, classify};
 
 /// Maps runtime time (`XrTime`, ns) to trace time and back.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,6 +44,8 @@ impl TimeBase {
 pub struct GazeTimeline {
     /// The samples; never empty.
     samples: Vec<GazeSample>,
+    /// The gaze behaviour of each sample.
+    episodes: Vec<Episode>,
     /// The first trace line's `time_ns`: trace time zero of the time base.
     start_ns: i64,
 }
@@ -56,7 +62,12 @@ impl GazeTimeline {
                 _ => samples.push(s.gaze),
             }
         }
-        Some(GazeTimeline { samples, start_ns })
+        let episodes = classify(&samples);
+        Some(GazeTimeline {
+            samples,
+            episodes,
+            start_ns,
+        })
     }
 
     /// The first trace line's `time_ns`.
@@ -91,6 +102,25 @@ impl GazeTimeline {
         let w = (t_ns - a.sample_time_ns) as f64 / (b.sample_time_ns - a.sample_time_ns) as f64;
         interpolate(a, b, w as f32, t_ns)
     }
+
+    /// The gaze behaviour at trace time `t_ns`: the nearer sample's (the first before the
+    /// trace, the last after it), its onset on the trace clock.
+    pub fn behaviour_at(&self, t_ns: i64) -> Behaviour {
+        // The first sample later than t, 0..=len.
+        let i = self.samples.partition_point(|s| s.sample_time_ns <= t_ns);
+        let nearer = match i {
+            0 => 0,
+            i if i == self.samples.len() => i - 1,
+            i => {
+                let (a, b) = (&self.samples[i - 1], &self.samples[i]);
+                // Weighed as `at` weighs them: b from half-way on.
+                let w =
+                    (t_ns - a.sample_time_ns) as f64 / (b.sample_time_ns - a.sample_time_ns) as f64;
+                if w as f32 >= 0.5 { i } else { i - 1 }
+            }
+        };
+        self.episodes[nearer].at(t_ns)
+    }
 }
 
 /// `a` to `b` at weight `w` in [0, 1], stamped with `time_ns`.
@@ -118,7 +148,7 @@ fn interpolate(a: &GazeSample, b: &GazeSample, w: f32, time_ns: i64) -> GazeSamp
             lerp_f(a.pupil_diameter_m[0], b.pupil_diameter_m[0]),
             lerp_f(a.pupil_diameter_m[1], b.pupil_diameter_m[1]),
         ],
-        report: None,
+        report: nearer(b_nearer, a.report, b.report),
     }
 }
 
@@ -265,5 +295,44 @@ mod tests {
         assert_eq!(base.to_trace(5_000_500), 1500);
         assert_eq!(base.to_runtime(1500), 5_000_500);
         assert_eq!(base.to_runtime(base.to_trace(123_456_789)), 123_456_789);
+    }
+
+    #[test]
+    fn behaviour_and_report_come_from_the_nearer_sample() {
+        use vitreous_xr::{GazeBehaviour, TrackerConfidence, TrackerReport};
+        // Steady gaze, then the eyes lost from 200 ns to 400 ns.
+        let mut lines = vec![
+            line(0, 0, ray(-0.03, Vec3::NEG_Z), None),
+            line(100, 100, ray(-0.03, Vec3::NEG_Z), None),
+            line(200, 200, GazeRay::INVALID, None),
+            line(300, 300, GazeRay::INVALID, None),
+            line(400, 400, ray(-0.03, Vec3::NEG_Z), None),
+        ];
+        for l in &mut lines[2..4] {
+            l.gaze.right = GazeRay::INVALID;
+        }
+        let report = TrackerReport {
+            confidence: TrackerConfidence::Low,
+            behaviour: GazeBehaviour::Saccade,
+        };
+        lines[4].gaze.report = Some(report);
+        let t = GazeTimeline::new(&lines).unwrap();
+        assert_eq!(t.behaviour_at(149).behaviour, GazeBehaviour::Fixation);
+        let blink = t.behaviour_at(150);
+        assert_eq!(blink.behaviour, GazeBehaviour::Blink);
+        assert_eq!(
+            (blink.onset_ns, blink.duration_ns),
+            (150, 0),
+            "begun at the time asked"
+        );
+        let blink = t.behaviour_at(320);
+        assert_eq!((blink.onset_ns, blink.duration_ns), (200, 120));
+        assert!(!t.at(320).left.valid && !t.at(320).right.valid);
+        // The report rides with the nearer sample, and its behaviour is the answer.
+        assert_eq!(t.at(349).report, None);
+        assert_eq!(t.at(350).report, Some(report));
+        assert_eq!(t.behaviour_at(350).behaviour, GazeBehaviour::Saccade);
+        assert_eq!(t.behaviour_at(10_000).onset_ns, 400);
+        assert_eq!(t.behaviour_at(-5).behaviour, GazeBehaviour::Fixation);
     }
 }

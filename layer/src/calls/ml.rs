@@ -1,13 +1,19 @@
 //! `XR_ML_eye_tracker` (Magic Leap 2): combined, per-eye and fixation poses with confidence,
-//! pupil diameters, and the simplest honest answers for what a trace does not hold.
+//! pupil diameters, gaze behaviour, and the simplest honest answers for what a trace does not
+//! hold.
 //!
 //! - Fixation pose: its position is the vergence point (the trace's fixation column when
 //!   present, else the closest point between the two eye rays), its -z axis looks there from
-//!   the mid-point of the eyes; HIGH confidence with both eyes valid, else LOW.
+//!   the mid-point of the eyes; HIGH confidence with both eyes valid, else LOW, or the
+//!   confidence of the trace's own report (trace v1.3) when the sample carries one.
 //! - Pupil data: the trace's per-eye pupil diameter, else `valid = FALSE`.
 //! - Geometric data: openness 1 for a valid eye ray, 0 otherwise; the eye-in-skull position
 //!   is not simulated (0, 0).
-//! - Gaze behaviour: `valid = FALSE`, type UNKNOWN.
+//! - Gaze behaviour: the trace's own report (v1.3) where a sample carries one, else the layer's
+//!   stand-in classifier ([`crate::behaviour`]: blink while no eye is valid, eyes closed after
+//!   500 ms of it, else saccade above 30 deg/s, pursuit from 5 deg/s, fixation below, from the
+//!   gaze's angular velocity between trace samples; not Magic Leap's classifier); onset when
+//!   the behaviour began, duration since. `valid = FALSE` (type UNKNOWN) only without a trace.
 //! - Static data: a maximum eye width and height of 1 (the layer's openness is already 0..1).
 //!
 //! The calls without a time (pupil, geometric, behaviour) answer for the display time of the
@@ -20,7 +26,7 @@ use vitreous_xr::openxr::ml_eye_tracker::{
     EyeTrackerPosesGetInfoML, EyeTrackerPosesML, EyeTrackerPupilDataML, EyeTrackerStaticDataML,
     GazeBehaviorTypeML, pose_flags, structure_type,
 };
-use vitreous_xr::{GazeRay, GazeSample, Pose};
+use vitreous_xr::{GazeBehaviour, GazeRay, GazeSample, Pose, TrackerConfidence};
 
 use super::{SessionContext, in_base};
 use crate::config::GazeExtension;
@@ -121,7 +127,7 @@ pub unsafe extern "system" fn get_static_data(
 }
 
 /// The four poses of a sample in the head frame, with validity and confidence:
-/// gaze, left, right, fixation.
+/// gaze, left, right, fixation (its confidence the sample's report's when it has one).
 pub fn head_frame_poses(sample: &GazeSample) -> [(Option<Pose>, ConfidenceML); 4] {
     let both = sample.left.valid && sample.right.valid;
     let either = sample.left.valid || sample.right.valid;
@@ -153,16 +159,37 @@ pub fn head_frame_poses(sample: &GazeSample) -> [(Option<Pose>, ConfidenceML); 4
             };
             let mut pose = pose_along(from, point - from);
             pose.position = point;
-            let confidence = if both {
-                ConfidenceML::HIGH
-            } else {
-                ConfidenceML::LOW
+            let confidence = match sample.report {
+                Some(report) => confidence_ml(report.confidence),
+                None if both => ConfidenceML::HIGH,
+                None => ConfidenceML::LOW,
             };
             (Some(pose), confidence)
         }
         None => (None, ConfidenceML::LOW),
     };
     [gaze, eye(&sample.left), eye(&sample.right), fixation]
+}
+
+/// The extension's value of a confidence.
+fn confidence_ml(confidence: TrackerConfidence) -> ConfidenceML {
+    match confidence {
+        TrackerConfidence::Low => ConfidenceML::LOW,
+        TrackerConfidence::Medium => ConfidenceML::MEDIUM,
+        TrackerConfidence::High => ConfidenceML::HIGH,
+    }
+}
+
+/// The extension's type of a gaze behaviour.
+fn behaviour_type_ml(behaviour: GazeBehaviour) -> GazeBehaviorTypeML {
+    match behaviour {
+        GazeBehaviour::Unknown => GazeBehaviorTypeML::UNKNOWN,
+        GazeBehaviour::EyesClosed => GazeBehaviorTypeML::EYES_CLOSED,
+        GazeBehaviour::Blink => GazeBehaviorTypeML::BLINK,
+        GazeBehaviour::Fixation => GazeBehaviorTypeML::FIXATION,
+        GazeBehaviour::Pursuit => GazeBehaviorTypeML::PURSUIT,
+        GazeBehaviour::Saccade => GazeBehaviorTypeML::SACCADE,
+    }
 }
 
 /// `xrGetEyeTrackerPosesML`: the requested poses in `baseSpace` at `time`.
@@ -314,7 +341,8 @@ pub unsafe extern "system" fn get_geometric_data(
     })
 }
 
-/// `xrGetEyeTrackerGazeBehaviorML`: the trace holds no classification: `valid = FALSE`.
+/// `xrGetEyeTrackerGazeBehaviorML`: the behaviour at the newest frame's display time (see the
+/// module doc); `valid = FALSE` without a trace.
 ///
 /// # Safety
 /// As `xrGetEyeTrackerGazeBehaviorML`.
@@ -337,11 +365,22 @@ pub unsafe extern "system" fn get_gaze_behavior(
         }
         // SAFETY: checked non-null and typed above.
         let out = unsafe { &mut *behavior };
-        out.time = sys::Time::from_nanos(ctx.latest_display_ns.unwrap_or(0));
-        out.valid = sys::FALSE;
-        out.gaze_behavior_type = GazeBehaviorTypeML::UNKNOWN;
-        out.onset_time = sys::Time::from_nanos(0);
-        out.duration = 0;
+        let now_ns = ctx.latest_display_ns.unwrap_or(0);
+        out.time = sys::Time::from_nanos(now_ns);
+        match ctx.behaviour_at(now_ns) {
+            Some(b) => {
+                out.valid = sys::TRUE;
+                out.gaze_behavior_type = behaviour_type_ml(b.behaviour);
+                out.onset_time = sys::Time::from_nanos(b.onset_ns);
+                out.duration = b.duration_ns.max(0) as u64;
+            }
+            None => {
+                out.valid = sys::FALSE;
+                out.gaze_behavior_type = GazeBehaviorTypeML::UNKNOWN;
+                out.onset_time = sys::Time::from_nanos(0);
+                out.duration = 0;
+            }
+        }
         sys::Result::SUCCESS
     })
 }
@@ -398,5 +437,40 @@ mod tests {
         let [gaze, _, right, fixation] = head_frame_poses(&s);
         assert_eq!(gaze.1, ConfidenceML::MEDIUM);
         assert!(right.0.is_none() && fixation.0.is_none());
+    }
+
+    #[test]
+    fn a_trace_report_sets_the_fixation_confidence() {
+        let target = Vec3::new(0.0, 0.0, -0.5);
+        let mut s = GazeSample {
+            sample_time_ns: 0,
+            left: ray(Vec3::new(-0.032, 0.0, 0.0), target),
+            right: ray(Vec3::new(0.032, 0.0, 0.0), target),
+            combined: None,
+            fixation: None,
+            pupil_diameter_m: [None, None],
+            report: Some(vitreous_xr::TrackerReport {
+                confidence: TrackerConfidence::Medium,
+                behaviour: GazeBehaviour::Pursuit,
+            }),
+        };
+        let [gaze, left, _, fixation] = head_frame_poses(&s);
+        assert_eq!(fixation.1, ConfidenceML::MEDIUM);
+        // The other poses keep the layer's own confidence.
+        assert_eq!((gaze.1, left.1), (ConfidenceML::HIGH, ConfidenceML::HIGH));
+        // No fixation point (one eye lost): no pose, whatever the report says.
+        s.right = GazeRay::INVALID;
+        let [.., fixation] = head_frame_poses(&s);
+        assert_eq!(fixation, (None, ConfidenceML::LOW));
+    }
+
+    #[test]
+    fn every_behaviour_has_its_extension_type() {
+        use GazeBehaviour::*;
+        let types: Vec<i32> = [Unknown, EyesClosed, Blink, Fixation, Pursuit, Saccade]
+            .into_iter()
+            .map(|b| behaviour_type_ml(b).0)
+            .collect();
+        assert_eq!(types, [0, 1, 2, 5, 6, 7]);
     }
 }

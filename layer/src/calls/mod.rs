@@ -16,6 +16,7 @@ use std::sync::Arc;
 use openxr::sys::{self, Handle};
 use vitreous_xr::{GazeSample, Pose};
 
+use crate::behaviour::Behaviour;
 use crate::config::{Config, GazeExtension};
 use crate::eye_geometry::{from_posef, inverse};
 use crate::next::NextTable;
@@ -119,6 +120,24 @@ impl SessionContext {
     /// The eye data at the newest frame's display time (for the calls that name no time).
     pub fn gaze_now(&self) -> Option<GazeSample> {
         self.gaze_at(self.latest_display_ns.unwrap_or(0))
+    }
+
+    /// The gaze behaviour at runtime time `time_ns`, its onset on the runtime clock. Before the
+    /// session's first frame: the trace's first sample's, begun at `time_ns`.
+    pub fn behaviour_at(&self, time_ns: i64) -> Option<Behaviour> {
+        let timeline = self.timeline.as_ref()?;
+        Some(match self.time_base {
+            Some(base) => {
+                let mut b = timeline.behaviour_at(base.to_trace(time_ns));
+                b.onset_ns = base.to_runtime(b.onset_ns);
+                b
+            }
+            None => Behaviour {
+                onset_ns: time_ns,
+                duration_ns: 0,
+                ..timeline.behaviour_at(i64::MIN)
+            },
+        })
     }
 
     /// Where `space` is in the head (VIEW) frame at `time`, located by the next layer, with

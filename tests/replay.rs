@@ -255,4 +255,16 @@ fn frames_csv_follows_the_synthetic_traces_alternating_fixation() {
         serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(json["gaze_image_switches"], changes);
     assert_eq!(json["pupil"]["source"], "measured");
+    // The images 0.125 m and 0.4 m away, 19-20 degree apart in vergence; the shipped trace's
+    // noise (0.5 degree per eye and axis) is about 0.7 degree of vergence.
+    let s = &json["separability"];
+    assert_eq!(s["noise_estimated"], true, "{json}");
+    let noise = s["vergence_noise_deg"].as_f64().unwrap();
+    assert!((0.6..0.9).contains(&noise), "{s}");
+    let gap = s["vergence_gap_deg"].as_f64().unwrap();
+    assert!((18.0..21.0).contains(&gap), "{s}");
+    assert!(
+        (s["d_prime"].as_f64().unwrap() - gap / noise).abs() < 1e-3,
+        "{s}"
+    );
 }

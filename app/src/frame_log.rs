@@ -17,7 +17,8 @@ use serde::Serialize;
 use tempfile::NamedTempFile;
 use vitreous_xr::FrameInput;
 
-use crate::gaze::{GazeImage, PupilSource};
+use crate::gaze::separability::SeparabilitySummary;
+use crate::gaze::{GazeImage, PupilSource, Separability};
 use crate::look::DefocusFrame;
 
 /// File name of the per-frame log in an output folder.
@@ -50,6 +51,8 @@ pub struct FrameLog {
     line: String,
     /// The newest known gaze image (surface or refracted).
     last_image: Option<GazeImage>,
+    /// The newest separability of the images.
+    separability: Option<Separability>,
     /// Changes between surface and refracted.
     switches: u64,
     /// Smallest, sum and largest A_p of the frames with defocus, metres, and their count.
@@ -63,6 +66,7 @@ impl FrameLog {
             file: None,
             line: String::new(),
             last_image: None,
+            separability: None,
             switches: 0,
             pupil: (f64::INFINITY, 0.0, f64::NEG_INFINITY, 0),
         }
@@ -108,6 +112,9 @@ impl FrameLog {
             }
             self.last_image = Some(image);
         }
+        if let Some(s) = defocus.and_then(|d| d.separability) {
+            self.separability = Some(s);
+        }
         if let Some(d) = defocus {
             let p = f64::from(d.pupil_m);
             let (min, sum, max, n) = &mut self.pupil;
@@ -146,6 +153,12 @@ impl FrameLog {
     /// is unknown are skipped: a blink that ends on the same image is no change).
     pub fn gaze_image_switches(&self) -> u64 {
         self.switches
+    }
+
+    /// How far apart the images were in the tracker's vergence noise at the end (the noise
+    /// estimated over the whole session); `None` without defocus or a sample with a depth.
+    pub fn separability_summary(&self) -> Option<SeparabilitySummary> {
+        self.separability.map(|s| s.summary())
     }
 
     /// The pupil statistics, given where A_p came from and how many tracker samples had a
@@ -207,6 +220,7 @@ mod tests {
             }),
             pupil_m,
             pupil_measured: false,
+            separability: None,
         }
     }
 

@@ -21,7 +21,7 @@ use crate::effects::EffectSet;
 use crate::gaze::blur::{check_pupil_diameter_m, image_blur, px_per_m};
 use crate::gaze::{
     FilterKind, GazeConfig, GazeImage, GazeOverride, GazePipeline, GazeState, ImageDistances,
-    PupilFilter, PupilSource,
+    ObjectInView, PupilFilter, PupilSource, Separability,
 };
 use crate::scene::{Scene, ViewingGeometry};
 use crate::views;
@@ -121,6 +121,8 @@ pub struct DefocusFrame {
     pub pupil_m: f32,
     /// Whether A_p is a measurement (false: the fixed value).
     pub pupil_measured: bool,
+    /// How far apart the images are in the tracker's vergence noise, at the newest sample.
+    pub separability: Option<Separability>,
 }
 
 /// The per-frame state of defocus: the gaze pipeline, the model and the pupil filter.
@@ -133,6 +135,8 @@ struct DefocusPlan {
     pupil: PupilFilter,
     /// The newest frame's decision.
     last: Option<DefocusFrame>,
+    /// Whether the tracker was found unable to separate the images (warned once).
+    warned_inseparable: bool,
 }
 
 impl DefocusPlan {
@@ -142,6 +146,7 @@ impl DefocusPlan {
             pupil: PupilFilter::new(model.pupil_source, model.pupil_m),
             model,
             last: None,
+            warned_inseparable: false,
         }
     }
 }
@@ -208,6 +213,13 @@ impl LookPlanner {
             Some(d) => {
                 let distances = d.model.distances_from(viewing_position_m(input));
                 d.pipeline.set_distances(distances);
+                let g = &d.model.geometry;
+                d.pipeline.set_object(ObjectInView::from_head(
+                    input.head.position,
+                    input.head.orientation,
+                    g.center_m,
+                    g.radius_m,
+                ));
                 let state = d.pipeline.update(input.gaze.as_ref(), input.time_ns);
                 let pupil = d.pupil.update(input.gaze.as_ref());
                 let defocus = d
@@ -219,7 +231,14 @@ impl LookPlanner {
                     defocus,
                     pupil_m: pupil.diameter_m,
                     pupil_measured: pupil.measured,
+                    separability: state.separability,
                 });
+                if !d.warned_inseparable
+                    && let Some(warning) = state.separability.and_then(|s| s.warning())
+                {
+                    tracing::warn!("{warning}");
+                    d.warned_inseparable = true;
+                }
                 let look = Look {
                     defocus,
                     ..self.base

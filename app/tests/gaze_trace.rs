@@ -99,6 +99,7 @@ fn blinks_produce_no_spurious_switch() {
                     filter,
                     ..GazeConfig::new(d)
                 },
+                None,
             );
             let first = frames
                 .iter()
@@ -125,7 +126,7 @@ fn override_forces_the_image_and_its_focus_distance() {
         override_image: GazeOverride::Refracted,
         ..GazeConfig::new(d)
     };
-    for (_, s) in replay(&trace.samples[..200], config) {
+    for (_, s) in replay(&trace.samples[..200], config, None) {
         assert_eq!(s.image, GazeImage::Refracted);
         assert_eq!(s.focus_distance_m, Some(d.refracted_m));
     }
@@ -159,7 +160,7 @@ fn real_sranipal_traces_replay_without_panics() {
             "{text}"
         );
         // Every frame's focus distance is that of its image.
-        for (_, s) in replay(&samples, GazeConfig::new(d)) {
+        for (_, s) in replay(&samples, GazeConfig::new(d), None) {
             assert_eq!(s.focus_distance_m, d.of(s.image));
         }
     }

@@ -193,17 +193,17 @@ fn layouts() -> [(Vec3, Vec3); 3] {
     ]
 }
 
-/// The quality bar of docs/gaze.md for the default filter (`fixation`) on synthetic traces:
-/// over 10 seeds of 60 s on each layout no false or missed switch, and on the changes not
-/// hidden by a blink a mean latency of at most 100 ms and a worst one of at most 150 ms. The
-/// changes that fall into a blink take 333-367 ms (the first sample after the blink comes
-/// 167 ms after the change, and no switch is allowed in the 150 ms after a blink).
+/// The quality bar of docs/gaze.md for the default filter (`evidence`) on synthetic traces:
+/// over 10 seeds of 60 s on each layout no false or missed switch; on the changes not hidden
+/// by a blink a mean latency of at most 100 ms and a worst one of at most 150 ms; on the
+/// changes a blink hides, at most 300 ms from the blink's end (the first sample after the
+/// blink comes 167 ms after the change, and no switch is allowed in the 150 ms after a blink).
 #[test]
 fn default_filter_meets_the_synthetic_bar_over_ten_seeds_and_three_layouts() {
     let default = FilterKind::default();
-    assert_eq!(default, "fixation".parse().unwrap());
+    assert_eq!(default, "evidence".parse().unwrap());
     for (surface, refracted) in layouts() {
-        let (mut clear, mut all) = (Vec::new(), Vec::new());
+        let (mut clear, mut all, mut hidden) = (Vec::new(), Vec::new(), Vec::new());
         for seed in 1..=10 {
             let p = SynthParams {
                 duration_s: 60.0,
@@ -232,15 +232,25 @@ fn default_filter_meets_the_synthetic_bar_over_ten_seeds_and_three_layouts() {
             assert_eq!(r.episodes_under_settle(), 0, "seed {seed}:\n{report}");
             clear.extend(&r.clear_latencies_ns);
             all.extend(&r.latencies_ns);
+            hidden.extend(&r.hidden_latencies_from_gap_end_ns);
         }
         let mean_ms = |v: &[i64]| v.iter().sum::<i64>() as f64 / v.len() as f64 / 1e6;
         let max_ms = |v: &[i64]| *v.iter().max().unwrap() as f64 / 1e6;
-        assert_eq!((clear.len(), all.len()), (150, 190));
+        assert_eq!((clear.len(), all.len(), hidden.len()), (150, 190, 40));
         let at = format!("{surface} {refracted}");
+        eprintln!(
+            "{at}: clear {:.0} / {:.0} ms, all {:.0} / {:.0} ms, hidden from the blink's end \
+             {:.0} / {:.0} ms",
+            mean_ms(&clear),
+            max_ms(&clear),
+            mean_ms(&all),
+            max_ms(&all),
+            mean_ms(&hidden),
+            max_ms(&hidden)
+        );
         assert!(mean_ms(&clear) <= 100.0, "{at}: {}", mean_ms(&clear));
         assert!(max_ms(&clear) <= 150.0, "{at}: {}", max_ms(&clear));
-        assert!(mean_ms(&all) <= 125.0, "{at}: {}", mean_ms(&all));
-        assert!(max_ms(&all) <= 370.0, "{at}: {}", max_ms(&all));
+        assert!(max_ms(&hidden) <= 300.0, "{at}: {}", max_ms(&hidden));
     }
 }
 
@@ -307,6 +317,64 @@ fn default_filter_meets_the_real_recording_bar_on_the_import_fixtures() {
     let (neon, _) = vitreous_xr::import::neon::import_neon(data.join("neon")).unwrap();
     let report = analyze(&neon, Truth::FromRawDepth, &config);
     assert_eq!(report.filters[0].switches, 0, "{report}");
+}
+
+/// The shipped real recordings (SRanipal, and the Tobii and Neon fixtures) in the shipped
+/// scenes, each with its own image distances and object: in the study scene
+/// (visual-effects.toml) the default decision makes no false switch; in glass-sphere.toml,
+/// whose images lie 0.6-0.7 degree apart in vergence, it makes at most one switch per minute
+/// of recording, and where the tracker's noise puts `d'` under 1 the report says so. On every
+/// recording it makes no more false switches than eq. 15, no decision episode under 150 ms
+/// and no switch within 150 ms after a gap.
+#[test]
+fn default_decision_holds_on_real_recordings_in_the_shipped_scenes() {
+    let data = workspace().join("xr/tests/data");
+    let mut recordings = Vec::new();
+    for name in [
+        "TESTNA01_2D_Fist3.csv",
+        "TESTNA05_360VR_Spread7.csv",
+        "TESTNA10_360VR_Fist3.csv",
+    ] {
+        let samples = vitreous_xr::sranipal::import_sranipal(sranipal(name)).unwrap();
+        recordings.push((name.to_owned(), samples));
+    }
+    let (tobii, _) = vitreous_xr::import::tobii_g3::import_tobii_g3(data.join("tobii_g3")).unwrap();
+    recordings.push(("tobii_g3".to_owned(), tobii));
+    let (neon, _) = vitreous_xr::import::neon::import_neon(data.join("neon")).unwrap();
+    recordings.push(("neon".to_owned(), neon));
+    for scene_name in ["visual-effects.toml", "glass-sphere.toml"] {
+        let scene =
+            vitreous::scene::load_scene(&workspace().join("config/scenes").join(scene_name))
+                .unwrap();
+        let (mut switches, mut minutes) = (0, 0.0);
+        for (name, samples) in &recordings {
+            let mut config = AnalyzeConfig::for_scene(&scene);
+            config.filters = vec![FilterKind::default(), FilterKind::PAPER];
+            let report = analyze(samples, Truth::FromRawDepth, &config);
+            let (default, mean20) = (&report.filters[0], &report.filters[1]);
+            let at = format!("{scene_name} {name}:\n{report}");
+            assert!(default.false_switches <= mean20.false_switches, "{at}");
+            assert_eq!(default.episodes_under_settle(), 0, "{at}");
+            assert_eq!(default.switches_after_gap, 0, "{at}");
+            if scene_name == "visual-effects.toml" {
+                assert_eq!(default.false_switches, 0, "{at}");
+            } else {
+                switches += default.switches;
+                minutes += report.duration_s / 60.0;
+                let d = report.separability.unwrap().d_prime();
+                if name.starts_with("TESTNA05") || name.starts_with("TESTNA10") {
+                    assert!(d < 1.0, "{at}");
+                    assert!(report.to_string().contains("cannot tell"), "{at}");
+                }
+            }
+        }
+        if scene_name == "glass-sphere.toml" {
+            assert!(
+                switches as f64 <= minutes,
+                "{switches} switches in {minutes} min"
+            );
+        }
+    }
 }
 
 /// A fallback note (here: samples with no valid eye ray but a fixation point) is printed once

@@ -9,25 +9,31 @@
 //! 3. [`image`]: the gaze image (surface or refracted) with hysteresis, or the experimenter's
 //!    override; the focus distance d_f is that image's distance.
 //!
-//! With the `fixation` filter (the default), stages 2 and 3 are [`fixation`] instead: the
-//! samples are classified into fixations, saccades and gaps, and the image is decided per
-//! fixation.
+//! With the `evidence` filter (the default), stages 2 and 3 are [`evidence`] instead: each
+//! sample adds evidence for one image, weighed by the tracker's noise, and the image changes
+//! when the evidence for the other one has piled up; with `fixation` they are [`fixation`]:
+//! the image is decided per classified fixation. Whatever decides, [`separability`] estimates
+//! the tracker's vergence noise and how far apart the two images are in it (`d'`).
 //!
 //! [`blur`] then turns d_f into the blur of the image not looked at (eq. 10-14).
 //! `docs/gaze.md` maps each equation to its function.
 
 pub mod blur;
+pub mod evidence;
 pub mod filter;
 pub mod fixation;
 pub mod image;
 pub mod pupil;
+pub mod separability;
 pub mod vergence;
 
 pub use blur::{DefocusError, GaussianKernel, ImageBlur, blur_reference, image_blur};
+pub use evidence::{EvidenceFilter, EvidenceParams, ObjectInView, Withheld};
 pub use filter::{DepthFilter, FilterKind, FilterParseError, OneEuroParams, SampleFilter};
 pub use fixation::{FixationFilter, FixationParams, SampleClass};
 pub use image::{GazeImage, GazeOverride, ImageDistances, ImageSelector};
 pub use pupil::{PupilEstimate, PupilFilter, PupilSource, PupilSourceParseError};
+pub use separability::{Separability, SeparabilityMonitor};
 pub use vergence::{FixationDepth, VergenceConfig, VergenceEstimator};
 
 use vitreous_xr::GazeSample;
@@ -73,6 +79,9 @@ pub struct GazeState {
     /// d_f: the distance of the gaze image from the head, metres; `None` while unknown (no
     /// defocus then).
     pub focus_distance_m: Option<f32>,
+    /// How far apart the two images are in the tracker's vergence noise, at the newest sample
+    /// with a depth; `None` before the first.
+    pub separability: Option<Separability>,
 }
 
 /// Vergence, filter and gaze-image selection, run once per frame.
@@ -84,6 +93,9 @@ pub struct GazePipeline {
     vergence: VergenceEstimator,
     /// Stages 2 and 3.
     decision: Decision,
+    /// The separability, for the decisions that do not estimate it themselves, with the time
+    /// of the last sample it saw.
+    monitor: Option<(SeparabilityMonitor, Option<i64>)>,
 }
 
 /// How the gaze image is decided from the fixation depths.
@@ -98,6 +110,8 @@ enum Decision {
     },
     /// Per fixation ([`fixation`]).
     Fixation(FixationFilter),
+    /// By accumulated evidence ([`evidence`]).
+    Evidence(EvidenceFilter),
 }
 
 impl GazePipeline {
@@ -110,10 +124,23 @@ impl GazePipeline {
                 FilterKind::Fixation(params) => {
                     Decision::Fixation(FixationFilter::new(params, config.distances, config.band))
                 }
+                FilterKind::Evidence(params) => {
+                    Decision::Evidence(EvidenceFilter::new(params, config.distances))
+                }
                 kind => Decision::Depth {
                     filter: SampleFilter::new(kind),
                     selector: ImageSelector::new(config.distances, config.band),
                 },
+            },
+            monitor: match config.filter {
+                FilterKind::Evidence(_) => None,
+                _ => Some((
+                    SeparabilityMonitor::new(
+                        fixation::DEFAULT_VELOCITY_DEG_S,
+                        evidence::DEFAULT_PRIOR_NOISE_DEG,
+                    ),
+                    None,
+                )),
             },
         }
     }
@@ -136,6 +163,15 @@ impl GazePipeline {
         match &mut self.decision {
             Decision::Depth { selector, .. } => selector.distances = distances,
             Decision::Fixation(f) => f.set_distances(distances),
+            Decision::Evidence(f) => f.set_distances(distances),
+        }
+    }
+
+    /// Where the glass object is in the head frame this frame (`None`: unknown). Only the
+    /// `evidence` decision uses it: a gaze that misses the object gives no evidence.
+    pub fn set_object(&mut self, object: Option<ObjectInView>) {
+        if let Decision::Evidence(f) = &mut self.decision {
+            f.set_object(object);
         }
     }
 
@@ -150,6 +186,26 @@ impl GazePipeline {
                 (filtered, selector.update(filtered.depth_m()))
             }
             Decision::Fixation(f) => f.update(gaze, &raw_depth, self.vergence.measurement()),
+            Decision::Evidence(f) => f.update(gaze, &raw_depth, self.vergence.measurement()),
+        };
+        let separability = match (&mut self.monitor, &self.decision) {
+            (Some((monitor, last)), _) => {
+                if raw_depth == FixationDepth::Unknown {
+                    monitor.reset();
+                    *last = None;
+                } else if let Some(g) = gaze.filter(|g| last.is_none_or(|l| g.sample_time_ns > l)) {
+                    *last = Some(g.sample_time_ns);
+                    let depth = self
+                        .vergence
+                        .measurement()
+                        .filter(|m| m.sample_time_ns == g.sample_time_ns)
+                        .map(|m| m.depth_m);
+                    monitor.push(g, depth, &self.config.distances);
+                }
+                monitor.separability()
+            }
+            (None, Decision::Evidence(f)) => f.separability(),
+            (None, _) => None,
         };
         let image = self.config.override_image.apply(tracked);
         GazeState {
@@ -157,6 +213,7 @@ impl GazePipeline {
             filtered_depth,
             image,
             focus_distance_m: self.config.distances.of(image),
+            separability,
         }
     }
 }

@@ -129,6 +129,9 @@ pub fn replay_command(a: ReplayArgs) -> Result<()> {
         },
     })?;
     println!("{}", summary.summary_line());
+    if let Some(s) = &summary.separability {
+        println!("{}", s.line());
+    }
     println!(
         "wrote {} images and summary.json to {}",
         summary.saved.len(),

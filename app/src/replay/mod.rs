@@ -437,6 +437,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         gpu_ms: Spread::of(records.iter().filter_map(|r| r.gpu_ms)),
         saved: saver.saved,
         gaze_image_switches: saver.log.gaze_image_switches(),
+        separability: saver.log.separability_summary(),
         pupil: saver.log.pupil_summary(saver.planner.pupil_source()),
         moved_frames: saver.motion.moved_frames,
         inducer_computations: renderer.inducer_computations(),

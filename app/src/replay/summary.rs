@@ -6,6 +6,7 @@ use vitreous_render::GpuContext;
 
 use crate::frame_log::PupilSummary;
 use crate::frame_loop::FrameRecord;
+use crate::gaze::separability::SeparabilitySummary;
 use crate::motion_clock::FinalPlacement;
 use crate::spread::Spread;
 
@@ -127,6 +128,9 @@ pub struct ReplaySummary {
     pub saved: Vec<String>,
     /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
     pub gaze_image_switches: u64,
+    /// How far apart the two images are in the tracker's vergence noise, the noise estimated
+    /// over the trace (`null` without defocus or without a sample with a depth).
+    pub separability: Option<SeparabilitySummary>,
     /// Where A_p came from and the values used (`null` without defocus).
     pub pupil: Option<PupilSummary>,
     /// Frames whose object or light pose differed from the previous frame's (`[motion]`).

@@ -504,6 +504,7 @@ fn run_with(
             .map(|f| format!("{:?}", vk::Format::from_raw(f))),
         frames_with_depth: report.frames_with_depth,
         gaze_image_switches: sink.log.gaze_image_switches(),
+        separability: sink.log.separability_summary(),
         pupil: sink.log.pupil_summary(sink.looks.pupil_source()),
         scene_edits: sink.motion.edit_count,
         moved_frames: sink.motion.moved_frames,

@@ -4,6 +4,7 @@
 use serde::Serialize;
 
 use crate::frame_log::PupilSummary;
+use crate::gaze::separability::SeparabilitySummary;
 use crate::replay::{Spread, ValidationSummary};
 
 use super::{ReadbackCheck, ReplayCheck};
@@ -100,6 +101,10 @@ pub struct RunSummary {
     pub frames_with_depth: u64,
     /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
     pub gaze_image_switches: u64,
+    /// How far apart the two images are in the tracker's vergence noise, the noise estimated
+    /// over the session (`null` when no condition has defocus, or without a sample with a
+    /// depth).
+    pub separability: Option<SeparabilitySummary>,
     /// Where A_p came from and the values used (`null` when no condition has defocus).
     pub pupil: Option<PupilSummary>,
     /// Live-control edits made (keyboard, controllers), re-registrations included.
@@ -186,6 +191,14 @@ impl RunSummary {
                 c.away_fraction * 100.0,
                 c.away_px,
                 c.alpha_nonzero_px
+            );
+        }
+        if let Some(s) = &self.separability {
+            let _ = writeln!(
+                out,
+                "gaze-image switches: {}; {}",
+                self.gaze_image_switches,
+                s.line()
             );
         }
         if let Some(r) = &self.replay_check {

@@ -36,14 +36,19 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use glam::Vec3;
 use serde::Serialize;
 use vitreous_xr::TraceSample;
 use vitreous_xr::synth::GazePhase;
 
+use crate::gaze::evidence::DEFAULT_PRIOR_NOISE_DEG;
 pub use crate::gaze::fixation::DROPOUT_NS;
 use crate::gaze::fixation::{DEFAULT_VELOCITY_DEG_S, Step, VelocityClassifier, combined_direction};
 use crate::gaze::vergence::{VergenceConfig, VergenceEstimator};
-use crate::gaze::{FilterKind, GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances};
+use crate::gaze::{
+    FilterKind, GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances, ObjectInView,
+    Separability, SeparabilityMonitor,
+};
 use crate::scene::{gaze_image_of_target, load_scene};
 
 pub(crate) mod plot;
@@ -77,6 +82,10 @@ pub struct AnalyzeConfig {
     /// How long a raw-depth crossing must persist to count as a gaze change when there is
     /// no ground truth, nanoseconds.
     pub persist_ns: i64,
+    /// The glass object's bounding sphere in the world frame (centre, radius; metres), so the
+    /// `evidence` decision knows, from each sample's head pose, whether the gaze meets it.
+    /// `None`: every gaze direction counts.
+    pub object: Option<(Vec3, f32)>,
 }
 
 impl AnalyzeConfig {
@@ -89,6 +98,17 @@ impl AnalyzeConfig {
             band: g.band,
             filters: FilterKind::all_default(),
             persist_ns: DEFAULT_PERSIST_NS,
+            object: None,
+        }
+    }
+
+    /// [`AnalyzeConfig::new`] with a scene's image distances (from its viewer's position) and
+    /// its object, whose projection the `evidence` decision checks the gaze against.
+    pub fn for_scene(scene: &crate::scene::Scene) -> Self {
+        let geometry = scene.viewing_geometry();
+        AnalyzeConfig {
+            object: Some((geometry.center_m, geometry.radius_m)),
+            ..Self::new(scene.image_distances())
         }
     }
 
@@ -150,13 +170,61 @@ impl TruthTimeline {
 /// One frame of a replay: the trace time and the pipeline's state.
 pub type ReplayedFrame = (i64, GazeState);
 
-/// Replays a trace through a pipeline, one update per sample.
-pub fn replay(samples: &[TraceSample], config: GazeConfig) -> Vec<ReplayedFrame> {
+/// Replays a trace through a pipeline, one update per sample; with `object` (the glass
+/// object's centre and radius, world frame) the pipeline knows where it is from each sample's
+/// head pose.
+pub fn replay(
+    samples: &[TraceSample],
+    config: GazeConfig,
+    object: Option<(Vec3, f32)>,
+) -> Vec<ReplayedFrame> {
     let mut pipeline = GazePipeline::new(config);
     samples
         .iter()
-        .map(|s| (s.time_ns, pipeline.update(Some(&s.gaze), s.time_ns)))
+        .map(|s| {
+            pipeline.set_object(object.and_then(|(center_m, radius_m)| {
+                ObjectInView::from_head(s.head.position, s.head.orientation, center_m, radius_m)
+            }));
+            (s.time_ns, pipeline.update(Some(&s.gaze), s.time_ns))
+        })
         .collect()
+}
+
+/// The separability of the images at `distances` for the tracker of a trace: the vergence
+/// noise estimated over all its fixations, at the median eye baseline of its samples.
+pub fn separability_of(
+    samples: &[TraceSample],
+    vergence: VergenceConfig,
+    distances: &ImageDistances,
+) -> Option<Separability> {
+    let mut estimator = VergenceEstimator::new(vergence);
+    let mut monitor = SeparabilityMonitor::new(DEFAULT_VELOCITY_DEG_S, DEFAULT_PRIOR_NOISE_DEG);
+    let mut baselines = Vec::new();
+    let mut last: Option<i64> = None;
+    for s in samples {
+        let t = s.gaze.sample_time_ns;
+        estimator.update(Some(&s.gaze), s.time_ns);
+        if last.is_some_and(|l| t <= l) {
+            continue;
+        }
+        last = Some(t);
+        let depth = estimator
+            .measurement()
+            .filter(|m| m.sample_time_ns == t)
+            .map(|m| m.depth_m);
+        if let Some(r) = monitor.push(&s.gaze, depth, distances).reading {
+            baselines.push(r.baseline_m);
+        }
+    }
+    let sep = monitor.separability()?;
+    baselines.sort_by(f32::total_cmp);
+    let baseline_m = baselines[baselines.len() / 2];
+    Some(Separability::new(
+        distances,
+        baseline_m,
+        sep.noise_deg,
+        sep.estimated,
+    ))
 }
 
 /// One tracker sample as the analysis sees it.
@@ -354,6 +422,11 @@ pub fn score(
         gaps.iter()
             .any(|g| g.start_ns < t + SETTLE_NS && g.end_ns > t)
     };
+    let hiding_gap = |t: i64| {
+        gaps.iter()
+            .find(|g| g.start_ns < t + SETTLE_NS && g.end_ns > t)
+    };
+    let mut hidden_latencies_from_gap_end_ns = Vec::new();
     let mut clear_latencies_ns = Vec::new();
     let mut matched = vec![false; switches.len()];
     let mut latencies_ns = Vec::new();
@@ -369,6 +442,9 @@ pub fn score(
                 latencies_ns.push(switches[i].0 - change.time_ns);
                 if !hidden(change.time_ns) {
                     clear_latencies_ns.push(switches[i].0 - change.time_ns);
+                }
+                if let Some(g) = hiding_gap(change.time_ns) {
+                    hidden_latencies_from_gap_end_ns.push(switches[i].0 - g.end_ns);
                 }
             }
             // The trace ended before the decision could follow: not counted.
@@ -395,6 +471,7 @@ pub fn score(
         episodes_ns,
         switches_after_gap,
         clear_latencies_ns,
+        hidden_latencies_from_gap_end_ns,
     }
 }
 
@@ -409,7 +486,10 @@ pub fn analyze(samples: &[TraceSample], truth: Truth<'_>, config: &AnalyzeConfig
     let filters = config
         .filters
         .iter()
-        .map(|&f| score(&replay(samples, config.gaze_config(f)), &timeline, &gaps, f))
+        .map(|&f| {
+            let frames = replay(samples, config.gaze_config(f), config.object);
+            score(&frames, &timeline, &gaps, f)
+        })
         .collect();
     let selector = crate::gaze::ImageSelector::new(config.distances, config.band);
     let duration_s = match (samples.first(), samples.last()) {
@@ -427,6 +507,7 @@ pub fn analyze(samples: &[TraceSample], truth: Truth<'_>, config: &AnalyzeConfig
         persist_ns: config.persist_ns,
         truth: timeline,
         gaps,
+        separability: separability_of(samples, config.vergence, &config.distances),
         filters,
     }
 }
@@ -454,7 +535,7 @@ pub(super) fn load_inputs(
     let scene = load_scene(scene).context("loading the scene")?;
     // The trace's errors name its file and line.
     let samples = vitreous_xr::read_trace(trace).context("reading the trace")?;
-    let mut config = AnalyzeConfig::new(scene.image_distances());
+    let mut config = AnalyzeConfig::for_scene(&scene);
     if !filters.is_empty() {
         config.filters = filters.to_vec();
     }

@@ -166,7 +166,7 @@ pub fn plot(
     let replays: Vec<(FilterKind, Vec<ReplayedFrame>)> = config
         .filters
         .iter()
-        .map(|&f| (f, replay(samples, config.gaze_config(f))))
+        .map(|&f| (f, replay(samples, config.gaze_config(f), config.object)))
         .collect();
     let d = config.distances;
     let dioptres = |depth_m: f32| 1.0 / f64::from(depth_m.max(1e-3));

@@ -7,7 +7,8 @@ use std::fmt;
 use serde::Serialize;
 
 use super::{Gap, SETTLE_NS, TruthTimeline};
-use crate::gaze::{FilterKind, ImageDistances};
+use crate::gaze::separability::SEPARABLE;
+use crate::gaze::{FilterKind, ImageDistances, Separability};
 
 /// The figures of one filter on one trace.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,6 +33,9 @@ pub struct FilterReport {
     /// Switch latency of each matched gaze change with no gap in the [`SETTLE_NS`] after it,
     /// nanoseconds (a change hidden by a blink cannot be seen before the blink ends).
     pub clear_latencies_ns: Vec<i64>,
+    /// For each matched gaze change that a gap hides (a gap in the [`SETTLE_NS`] after it),
+    /// the time from the end of that gap to the switch, nanoseconds.
+    pub hidden_latencies_from_gap_end_ns: Vec<i64>,
 }
 
 impl FilterReport {
@@ -76,8 +80,11 @@ impl FilterReport {
         };
         let (mean_ms, max_ms) = ms(&self.latencies_ns);
         let (clear_mean_ms, clear_max_ms) = ms(&self.clear_latencies_ns);
+        let (hidden_mean_ms_from_gap_end, hidden_max_ms_from_gap_end) =
+            ms(&self.hidden_latencies_from_gap_end_ns);
         FilterJson {
             filter: self.filter.to_string(),
+            default: self.filter == FilterKind::default(),
             switches: self.switches,
             false_switches: self.false_switches,
             missed: self.missed,
@@ -86,6 +93,8 @@ impl FilterReport {
             max_ms,
             clear_mean_ms,
             clear_max_ms,
+            hidden_mean_ms_from_gap_end,
+            hidden_max_ms_from_gap_end,
             agree: self.agreement,
             episodes: self.episodes_ns.len(),
             min_episode_ms: self.min_episode_ms(),
@@ -100,6 +109,8 @@ impl FilterReport {
 pub struct FilterJson {
     /// The filter's name.
     pub filter: String,
+    /// Whether it is the default decision (a scene without `[gaze] filter`).
+    pub default: bool,
     /// Switches between surface and refracted.
     pub switches: usize,
     /// Switches matched to no gaze change.
@@ -117,6 +128,10 @@ pub struct FilterJson {
     pub clear_mean_ms: Option<f64>,
     /// Largest latency over the changes with no gap in the 150 ms after them, milliseconds.
     pub clear_max_ms: Option<f64>,
+    /// Mean time from the end of the gap that hides a change to the switch, milliseconds.
+    pub hidden_mean_ms_from_gap_end: Option<f64>,
+    /// Largest time from the end of the gap that hides a change to the switch, milliseconds.
+    pub hidden_max_ms_from_gap_end: Option<f64>,
     /// Fraction of samples whose decision is the true image, 0..1.
     pub agree: Option<f64>,
     /// Complete decision episodes.
@@ -152,6 +167,16 @@ pub struct AnalyzeJson {
     pub gaze_changes: usize,
     /// Blinks and dropouts.
     pub gaps: usize,
+    /// How far apart the two images are in the tracker's vergence noise (`d'`; `null`
+    /// without a sample with a depth).
+    pub separability: Option<f32>,
+    /// The tracker's vergence noise (standard deviation), degrees.
+    pub vergence_noise_deg: Option<f32>,
+    /// Whether the noise was estimated from the trace's fixations (false: the 1 degree prior,
+    /// too few fixation samples).
+    pub vergence_noise_estimated: Option<bool>,
+    /// Vergence of the surface image minus that of the refracted image, degrees.
+    pub vergence_gap_deg: Option<f32>,
     /// One entry per filter, in the configured order.
     pub filters: Vec<FilterJson>,
 }
@@ -179,6 +204,8 @@ pub struct AnalyzeReport {
     pub truth: TruthTimeline,
     /// Blinks and dropouts of the trace.
     pub gaps: Vec<Gap>,
+    /// The separability of the images for this trace's tracker.
+    pub separability: Option<Separability>,
     /// One report per filter, in the configured order.
     pub filters: Vec<FilterReport>,
 }
@@ -203,6 +230,10 @@ impl AnalyzeReport {
             ground_truth: self.ground_truth,
             gaze_changes: self.truth.changes.len(),
             gaps: self.gaps.len(),
+            separability: self.separability.map(|s| s.d_prime()),
+            vergence_noise_deg: self.separability.map(|s| s.noise_deg),
+            vergence_noise_estimated: self.separability.map(|s| s.estimated),
+            vergence_gap_deg: self.separability.map(|s| s.gap_deg),
             filters: self.filters.iter().map(FilterReport::to_json).collect(),
         }
     }
@@ -243,7 +274,36 @@ impl fmt::Display for AnalyzeReport {
                 self.persist_ns / 1_000_000
             )?;
         }
+        if let Some(sep) = &self.separability {
+            writeln!(
+                f,
+                "separability d' = {:.2}: the images are {:.2} degree apart in vergence, the \
+                 tracker's vergence noise is {:.2} degree ({})",
+                sep.d_prime(),
+                sep.gap_deg.abs(),
+                sep.noise_deg,
+                if sep.estimated {
+                    "estimated from the trace's fixations"
+                } else {
+                    "assumed: too few fixation samples to estimate it"
+                }
+            )?;
+            if sep.d_prime() < SEPARABLE {
+                writeln!(
+                    f,
+                    "warning: d' below {SEPARABLE}: the eye tracker cannot tell the surface from \
+                     the refracted image apart in this scene"
+                )?;
+            }
+        }
         let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.0}"));
+        let name = |k: &FilterKind| {
+            if *k == FilterKind::default() {
+                format!("{k} (default)")
+            } else {
+                k.to_string()
+            }
+        };
         writeln!(
             f,
             "{:<44} {:>8} {:>6} {:>6} {:>9} {:>9} {:>8} {:>6}",
@@ -253,7 +313,7 @@ impl fmt::Display for AnalyzeReport {
             writeln!(
                 f,
                 "{:<44} {:>8} {:>6} {:>6} {:>9} {:>9} {:>8} {:>6}",
-                r.filter.to_string(),
+                name(&r.filter),
                 r.switches,
                 r.false_switches,
                 r.missed,
@@ -278,7 +338,7 @@ impl fmt::Display for AnalyzeReport {
             writeln!(
                 f,
                 "{:<44} {:>8} {:>14} {:>15} {:>26}",
-                r.filter.to_string(),
+                name(&r.filter),
                 r.episodes_ns.len(),
                 ms(r.min_episode_ms()),
                 r.episodes_under_settle(),

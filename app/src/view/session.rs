@@ -436,6 +436,9 @@ impl ViewSink {
                     ),
                     None => "K_g: none (gaze image unknown)".into(),
                 });
+                if let Some(s) = state.separability {
+                    lines.push(s.summary().line());
+                }
             }
             _ => lines.push("no defocus in this condition (gaze image not used)".into()),
         }

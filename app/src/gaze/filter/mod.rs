@@ -37,6 +37,7 @@ use std::str::FromStr;
 
 use thiserror::Error;
 
+use super::evidence::EvidenceParams;
 use super::fixation::FixationParams;
 use super::vergence::FixationDepth;
 
@@ -102,13 +103,15 @@ pub enum FilterKind {
     OneEuro(OneEuroParams),
     /// The gaze image decided per fixation ([`super::fixation`]).
     Fixation(FixationParams),
+    /// The gaze image decided by accumulated evidence ([`super::evidence`]).
+    Evidence(EvidenceParams),
 }
 
 impl Default for FilterKind {
-    /// The decision per fixation (`fixation`, module docs); the paper's eq. 15 is
+    /// The decision by accumulated evidence (`evidence`, module docs); the paper's eq. 15 is
     /// [`FilterKind::PAPER`].
     fn default() -> Self {
-        FilterKind::Fixation(FixationParams::default())
+        FilterKind::Evidence(EvidenceParams::default())
     }
 }
 
@@ -121,6 +124,7 @@ impl FilterKind {
             },
             FilterKind::OneEuro(OneEuroParams::default()),
             FilterKind::Fixation(FixationParams::default()),
+            FilterKind::Evidence(EvidenceParams::default()),
         ]
     }
 
@@ -144,7 +148,7 @@ impl FilterKind {
             FilterKind::Mean { window } => Some(Box::new(MeanFilter::new(window))),
             FilterKind::Median { window } => Some(Box::new(MedianFilter::new(window))),
             FilterKind::OneEuro(p) => Some(Box::new(OneEuroFilter::new(p))),
-            FilterKind::Fixation(_) => None,
+            FilterKind::Fixation(_) | FilterKind::Evidence(_) => None,
         }
     }
 }
@@ -167,6 +171,19 @@ impl fmt::Display for FilterKind {
                 "fixation:velocity={},min_fixation={},window={},max_window={},settle={}",
                 p.velocity_deg_s, p.min_fixation_ms, p.window_ms, p.max_window_ms, p.settle_ms
             ),
+            FilterKind::Evidence(p) if *p == EvidenceParams::default() => write!(f, "evidence"),
+            FilterKind::Evidence(p) => write!(
+                f,
+                "evidence:velocity={},threshold={},step={},settle={},min_separability={},\
+                 noise={},margin={}",
+                p.velocity_deg_s,
+                p.threshold,
+                p.step_ms,
+                p.settle_ms,
+                p.min_separability,
+                p.prior_noise_deg,
+                p.margin_deg
+            ),
         }
     }
 }
@@ -176,7 +193,9 @@ impl fmt::Display for FilterKind {
 #[error(
     "depth filter `{text}`: {reason}; expected `mean20` (eq. 15), `mean:N`, `median`, \
      `median:N`, `one-euro[:min_cutoff=HZ,beta=M,d_cutoff=HZ,pre_median=N]` or \
-     `fixation[:velocity=DEG_S,min_fixation=MS,window=MS,max_window=MS,settle=MS]`"
+     `fixation[:velocity=DEG_S,min_fixation=MS,window=MS,max_window=MS,settle=MS]` or \
+     `evidence[:velocity=DEG_S,threshold=N,step=MS,settle=MS,min_separability=D,noise=DEG,\
+     margin=DEG]`"
 )]
 pub struct FilterParseError {
     /// The text given.
@@ -262,6 +281,31 @@ impl FromStr for FilterKind {
                 }
             }
             return Ok(FilterKind::Fixation(p));
+        }
+        if name == "evidence" {
+            let mut p = EvidenceParams::default();
+            for (key, value) in pairs()? {
+                match key {
+                    "velocity" | "velocity_deg_s" if value > 0.0 => p.velocity_deg_s = value,
+                    "threshold" if value > 0.0 => p.threshold = value,
+                    "step" | "step_ms" if value > 0.0 => p.step_ms = value,
+                    "settle" | "settle_ms" => p.settle_ms = value,
+                    "min_separability" | "min_d" => p.min_separability = value,
+                    "noise" | "noise_deg" if value > 0.0 => p.prior_noise_deg = value,
+                    "margin" | "margin_deg" => p.margin_deg = value,
+                    "velocity" | "velocity_deg_s" | "threshold" | "step" | "step_ms" | "noise"
+                    | "noise_deg" => {
+                        return Err(err(format!("{key} must be > 0")));
+                    }
+                    other => {
+                        return Err(err(format!(
+                            "unknown parameter `{other}` (velocity, threshold, step, settle, \
+                             min_separability, noise, margin)"
+                        )));
+                    }
+                }
+            }
+            return Ok(FilterKind::Evidence(p));
         }
         if matches!(name, "one-euro" | "one_euro" | "oneeuro" | "1euro") {
             let mut p = OneEuroParams::default();

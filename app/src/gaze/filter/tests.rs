@@ -55,6 +55,9 @@ fn names_round_trip_and_bad_names_are_refused() {
         "one-euro:min_cutoff=2,beta=0.1,d_cutoff=1,pre_median=1",
         "fixation",
         "fixation:velocity=40,min_fixation=80,window=120,max_window=160,settle=200",
+        "evidence",
+        "evidence:velocity=40,threshold=4,step=20,settle=200,min_separability=1.5,noise=0.7,\
+         margin=2",
     ] {
         let kind: FilterKind = text.parse().unwrap();
         assert_eq!(kind.to_string(), text);
@@ -62,9 +65,16 @@ fn names_round_trip_and_bad_names_are_refused() {
     }
     assert_eq!("mean".parse::<FilterKind>().unwrap(), FilterKind::PAPER);
     assert_eq!(
-        "fixation".parse::<FilterKind>().unwrap(),
+        "evidence".parse::<FilterKind>().unwrap(),
         FilterKind::default()
     );
+    for bad in [
+        "evidence:threshold=0",
+        "evidence:noise=0",
+        "evidence:speed=3",
+    ] {
+        assert!(bad.parse::<FilterKind>().is_err(), "{bad}");
+    }
     assert_eq!(
         "MEDIAN:9".parse::<FilterKind>().unwrap(),
         FilterKind::Median { window: 9 }

@@ -1,0 +1,595 @@
+//! How well an eye tracker can tell the two images of a glass apart by vergence alone.
+//!
+//! The two candidate depths (surface and refracted image) differ in vergence angle by
+//! `gap = v(d_s) - v(d_r)`, with `v(d) = 2 atan(b / 2d)` for an eye baseline `b`. A tracker
+//! measures vergence with noise of standard deviation `sigma`; the separability is the
+//! signal-detection index `d' = |gap| / sigma`. Below `d' = 1` a single fixation's vergence
+//! says little about which image the wearer looks at: in `config/scenes/glass-sphere.toml`
+//! (1.48 m and 2.03 m) the gap is 0.66 degree at a 63 mm baseline, against 0.5-1 degree of
+//! noise for a head-worn tracker.
+//!
+//! # Vergence of a sample
+//! With both eyes valid, the signed angle between the two gaze directions in the plane of the
+//! baseline, `2 asin(((d_l - d_r) . e) / 2)` with `e` the unit vector from the left eye to the
+//! right one: positive when the rays converge, negative when they diverge (so the tail of far
+//! fixations is not folded onto the depth cap). Otherwise it is the vergence of the sample's
+//! depth, `v(depth)`, at the default baseline.
+//!
+//! # Noise
+//! What decides is how far one sample's vergence lies from the true vergence. A head-worn
+//! tracker's error is not white: besides sample-to-sample noise it has a bias that wanders
+//! with the gaze direction and over seconds, and within one fixation that bias hardly
+//! changes. So the spread of a fixation's samples about their own mean misses most of it
+//! (on the shipped SRanipal recordings it gives 0.15-0.2 degree where the whole recording,
+//! at a constant true vergence, spreads by 0.8-1.3 degree).
+//!
+//! [`VergenceNoise`] estimates `sigma` from the data, robustly, over the time scale on which a
+//! decision stands: each fixation sample's deviation from the MEDIAN vergence of the samples
+//! within [`WINDOW_NS`] (1.5 s) on either side of it. A median over a centred window keeps a
+//! vergence step (the wearer looking from one image to the other) on its own side, so true
+//! changes that last longer than the window add little; the window is shrunk symmetrically
+//! near the ends of a stretch of tracking (a gap longer than [`BREAK_NS`] ends one), so a
+//! step near the end of a stretch is not folded in either. Samples in saccades are left out;
+//! a window needs [`MIN_WINDOW`] samples. `sigma = 1.4826 * median(|deviation|)` (the median
+//! absolute deviation of a normal distribution) over the newest [`MAX_RESIDUALS`] deviations,
+//! so a spike disturbs only its own deviation. Until [`MIN_RESIDUALS`] deviations are pooled
+//! there is no estimate. Each deviation is taken once its window has passed: the online
+//! estimate runs 1.5 s behind the newest sample.
+
+use std::collections::VecDeque;
+
+use vitreous_xr::{GazeBehaviour, GazeSample};
+
+use super::fixation::{Step, VelocityClassifier, combined_direction};
+use super::image::ImageDistances;
+
+/// Eye baseline used when a sample does not give one, metres (the scenes' default IPD).
+pub const DEFAULT_BASELINE_M: f32 = 0.063;
+
+/// Half the width of the window whose median a sample's deviation is taken from,
+/// nanoseconds.
+pub const WINDOW_NS: i64 = 1_500_000_000;
+
+/// A stretch without a sample longer than this ends a stretch of tracking, nanoseconds (the
+/// vergence hold).
+pub const BREAK_NS: i64 = 300_000_000;
+
+/// Fewest samples in a window that give a deviation.
+pub const MIN_WINDOW: usize = 7;
+
+/// Fewest pooled deviations that give an estimate.
+pub const MIN_RESIDUALS: usize = 30;
+
+/// Most deviations pooled (the newest are kept): about 40 s of fixations at 30 Hz.
+pub const MAX_RESIDUALS: usize = 1200;
+
+/// Least vergence noise any figure is computed with, degrees: a tracker is never exact, and a
+/// noiseless synthetic trace would otherwise give an infinite separability.
+pub const MIN_NOISE_DEG: f32 = 0.05;
+
+/// Below this separability the vergence cannot tell the two images apart (`d' < 1`).
+pub const SEPARABLE: f32 = 1.0;
+
+/// Scale from the median absolute deviation to the standard deviation of a normal
+/// distribution.
+const MAD_TO_SIGMA: f32 = 1.4826;
+
+/// A sample's vergence and the baseline it was measured with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VergenceReading {
+    /// Vergence angle, degrees; negative when the rays diverge.
+    pub vergence_deg: f32,
+    /// The eye baseline, metres.
+    pub baseline_m: f32,
+}
+
+/// The vergence angle of a fixation at `depth_m` for eyes `baseline_m` apart, degrees.
+pub fn vergence_deg(depth_m: f32, baseline_m: f32) -> f32 {
+    (2.0 * (baseline_m / (2.0 * depth_m.max(1e-4))).atan()).to_degrees()
+}
+
+/// The vergence of a tracker sample whose depth is `depth_m` (module docs).
+pub fn reading(g: &GazeSample, depth_m: f32) -> VergenceReading {
+    if g.left.valid && g.right.valid {
+        let axis = g.right.origin - g.left.origin;
+        let baseline_m = axis.length();
+        if baseline_m.is_finite() && baseline_m > 0.01 {
+            let e = axis / baseline_m;
+            let half = ((g.left.direction - g.right.direction).dot(e) / 2.0).clamp(-1.0, 1.0);
+            let v = (2.0 * half.asin()).to_degrees();
+            if v.is_finite() {
+                return VergenceReading {
+                    vergence_deg: v,
+                    baseline_m,
+                };
+            }
+        }
+    }
+    VergenceReading {
+        vergence_deg: vergence_deg(depth_m, DEFAULT_BASELINE_M),
+        baseline_m: DEFAULT_BASELINE_M,
+    }
+}
+
+/// The separability of a scene's two images for a tracker.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Separability {
+    /// Vergence of the surface image minus that of the refracted image, degrees.
+    pub gap_deg: f32,
+    /// The tracker's vergence noise (standard deviation), degrees.
+    pub noise_deg: f32,
+    /// Whether `noise_deg` was estimated from the data (false: the prior).
+    pub estimated: bool,
+}
+
+impl Separability {
+    /// The separability of images at `distances` for eyes `baseline_m` apart and vergence
+    /// noise `noise_deg`.
+    pub fn new(
+        distances: &ImageDistances,
+        baseline_m: f32,
+        noise_deg: f32,
+        estimated: bool,
+    ) -> Self {
+        Separability {
+            gap_deg: vergence_deg(distances.surface_m, baseline_m)
+                - vergence_deg(distances.refracted_m, baseline_m),
+            noise_deg,
+            estimated,
+        }
+    }
+
+    /// `d' = |gap| / noise`, the noise no less than [`MIN_NOISE_DEG`].
+    pub fn d_prime(&self) -> f32 {
+        self.gap_deg.abs() / self.noise_deg.max(MIN_NOISE_DEG)
+    }
+
+    /// Whether the vergence can tell the images apart (`d' >= 1`).
+    pub fn separable(&self) -> bool {
+        self.d_prime() >= SEPARABLE
+    }
+}
+
+/// The separability as the summaries of `run` and `replay` write it.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct SeparabilitySummary {
+    /// `d'`: the images' vergence difference over the tracker's vergence noise.
+    pub d_prime: f32,
+    /// Vergence of the surface image minus that of the refracted image, degrees.
+    pub vergence_gap_deg: f32,
+    /// The tracker's vergence noise (standard deviation), degrees.
+    pub vergence_noise_deg: f32,
+    /// Whether the noise was estimated from the session's fixations (false: the prior).
+    pub noise_estimated: bool,
+}
+
+impl SeparabilitySummary {
+    /// One line for a summary: `d'`, the gap and the noise.
+    pub fn line(&self) -> String {
+        format!(
+            "gaze images {:.2} degree apart in vergence, tracker noise {:.2} degree ({}): d' = \
+             {:.2}{}",
+            self.vergence_gap_deg.abs(),
+            self.vergence_noise_deg,
+            if self.noise_estimated {
+                "estimated"
+            } else {
+                "assumed"
+            },
+            self.d_prime,
+            if self.d_prime >= SEPARABLE {
+                ""
+            } else {
+                ", below 1: the tracker cannot tell them apart"
+            }
+        )
+    }
+}
+
+impl Separability {
+    /// The figures a summary writes.
+    pub fn summary(&self) -> SeparabilitySummary {
+        SeparabilitySummary {
+            d_prime: self.d_prime(),
+            vergence_gap_deg: self.gap_deg,
+            vergence_noise_deg: self.noise_deg,
+            noise_estimated: self.estimated,
+        }
+    }
+
+    /// The warning `run`, `replay` and `view` give once when the tracker cannot separate the
+    /// images; `None` while it can, or while the noise is only the prior.
+    pub fn warning(&self) -> Option<String> {
+        (self.estimated && !self.separable()).then(|| {
+            format!(
+                "the eye tracker cannot tell the surface from the refracted image apart in this \
+                 scene: d' = {:.2} (the images are {:.2} degree apart in vergence, the tracker's \
+                 vergence noise is {:.2} degree); the gaze-image decision holds where it cannot \
+                 know",
+                self.d_prime(),
+                self.gap_deg.abs(),
+                self.noise_deg
+            )
+        })
+    }
+}
+
+/// The robust online estimate of a tracker's vergence noise (module docs).
+#[derive(Clone, Debug, Default)]
+pub struct VergenceNoise {
+    /// Time of the current stretch's first sample, nanoseconds.
+    start_ns: Option<i64>,
+    /// The current stretch's fixation samples still needed: time and vergence, degrees.
+    stretch: VecDeque<(i64, f32)>,
+    /// Index in `stretch` of the first sample whose deviation is not yet taken.
+    next: usize,
+    /// Pooled absolute deviations, degrees, newest last.
+    deviations: VecDeque<f32>,
+    /// The estimate from the pooled deviations, degrees.
+    sigma_deg: Option<f32>,
+}
+
+impl VergenceNoise {
+    /// An estimator with nothing pooled.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// One tracker sample: its time, its vergence (`None`: no depth, a gap) and whether it
+    /// belongs to a fixation (a saccade's samples are left out). Samples come once each, in
+    /// time order.
+    pub fn push(&mut self, time_ns: i64, vergence_deg: Option<f32>, in_fixation: bool) {
+        let Some(v) = vergence_deg.filter(|v| v.is_finite()) else {
+            self.close();
+            return;
+        };
+        if !in_fixation {
+            return;
+        }
+        if self
+            .stretch
+            .back()
+            .is_some_and(|&(last, _)| time_ns - last > BREAK_NS)
+        {
+            self.close();
+        }
+        self.start_ns.get_or_insert(time_ns);
+        self.stretch.push_back((time_ns, v));
+        let mut taken = false;
+        while self
+            .stretch
+            .get(self.next)
+            .is_some_and(|&(t, _)| t + WINDOW_NS <= time_ns)
+        {
+            taken |= self.take(self.next, time_ns);
+            self.next += 1;
+        }
+        // Samples no later window reaches.
+        if let Some(&(oldest_needed, _)) = self.stretch.get(self.next) {
+            while self
+                .stretch
+                .front()
+                .is_some_and(|&(t, _)| t < oldest_needed - WINDOW_NS)
+            {
+                self.stretch.pop_front();
+                self.next -= 1;
+            }
+        }
+        if taken {
+            self.estimate();
+        }
+    }
+
+    /// Ends the current stretch of tracking (a gap, or the end of the data): the samples whose
+    /// deviation is still pending are taken with windows that end with the stretch.
+    pub fn close(&mut self) {
+        let end_ns = self.stretch.back().map(|s| s.0);
+        let mut taken = false;
+        if let Some(end_ns) = end_ns {
+            for i in self.next..self.stretch.len() {
+                taken |= self.take(i, end_ns);
+            }
+        }
+        self.stretch.clear();
+        self.next = 0;
+        self.start_ns = None;
+        if taken {
+            self.estimate();
+        }
+    }
+
+    /// Pools the deviation of sample `i` from the median of its window, the stretch ending at
+    /// `end_ns` so far; whether there was one.
+    fn take(&mut self, i: usize, end_ns: i64) -> bool {
+        let (t, v) = self.stretch[i];
+        let start_ns = self.start_ns.unwrap_or(t);
+        let half = WINDOW_NS.min(t - start_ns).min(end_ns - t);
+        let mut window: Vec<f32> = self
+            .stretch
+            .iter()
+            .filter(|s| (s.0 - t).abs() <= half)
+            .map(|s| s.1)
+            .collect();
+        if window.len() < MIN_WINDOW {
+            return false;
+        }
+        let deviation = (v - median(&mut window)).abs();
+        if self.deviations.len() == MAX_RESIDUALS {
+            self.deviations.pop_front();
+        }
+        self.deviations.push_back(deviation);
+        true
+    }
+
+    /// Updates the estimate from the pooled deviations.
+    fn estimate(&mut self) {
+        if self.deviations.len() >= MIN_RESIDUALS {
+            let mut all: Vec<f32> = self.deviations.iter().copied().collect();
+            self.sigma_deg = Some(MAD_TO_SIGMA * median(&mut all));
+        }
+    }
+
+    /// The estimated noise (standard deviation), degrees; `None` until enough is pooled.
+    pub fn sigma_deg(&self) -> Option<f32> {
+        self.sigma_deg
+    }
+
+    /// How many deviations are pooled.
+    pub fn pooled(&self) -> usize {
+        self.deviations.len()
+    }
+}
+
+/// What [`SeparabilityMonitor::push`] saw in one tracker sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Observed {
+    /// How the I-VT classifier sees it ([`Step::Gap`] for a blink or closed eyes the tracker
+    /// reports, too).
+    pub step: Step,
+    /// Whether it is part of a saccade, by I-VT or by the tracker's own call.
+    pub moving: bool,
+    /// Its combined gaze direction (head frame), unless a gap.
+    pub direction: Option<glam::Vec3>,
+    /// Its vergence, unless a gap.
+    pub reading: Option<VergenceReading>,
+}
+
+/// Classifies the samples (I-VT), estimates the vergence noise from the fixations and gives
+/// the separability of the images at each sample; used by every gaze-image decision, so that
+/// `run`, `replay`, `view` and `trace analyze` report it whichever decides.
+#[derive(Clone, Debug)]
+pub struct SeparabilityMonitor {
+    /// Sample classifier.
+    classifier: VelocityClassifier,
+    /// The noise estimate; kept across resets (it is the tracker's, not the gaze's).
+    noise: VergenceNoise,
+    /// The noise assumed until there is an estimate, degrees.
+    prior_noise_deg: f32,
+    /// The separability at the newest sample with a depth.
+    last: Option<Separability>,
+}
+
+impl SeparabilityMonitor {
+    /// A monitor with I-VT threshold `velocity_deg_s` that assumes `prior_noise_deg` until
+    /// the data give an estimate.
+    pub fn new(velocity_deg_s: f32, prior_noise_deg: f32) -> Self {
+        SeparabilityMonitor {
+            classifier: VelocityClassifier::new(velocity_deg_s),
+            noise: VergenceNoise::new(),
+            prior_noise_deg,
+            last: None,
+        }
+    }
+
+    /// One new tracker sample (each once, in time order) whose own depth is `depth_m`
+    /// (`None`: none measured), with the images at `distances`.
+    pub fn push(
+        &mut self,
+        g: &GazeSample,
+        depth_m: Option<f32>,
+        distances: &ImageDistances,
+    ) -> Observed {
+        let t = g.sample_time_ns;
+        let behaviour = g.report.map(|r| r.behaviour);
+        let closed = matches!(
+            behaviour,
+            Some(GazeBehaviour::Blink | GazeBehaviour::EyesClosed)
+        );
+        let direction = depth_m
+            .filter(|_| !closed)
+            .and_then(|_| combined_direction(g));
+        let step = self.classifier.step(t, direction);
+        let (Some(depth_m), Some(_), false) = (depth_m, direction, step == Step::Gap) else {
+            self.noise.close();
+            return Observed {
+                step: Step::Gap,
+                moving: false,
+                direction: None,
+                reading: None,
+            };
+        };
+        let reading = reading(g, depth_m);
+        let moving = step == Step::Moving || behaviour == Some(GazeBehaviour::Saccade);
+        self.noise.push(t, Some(reading.vergence_deg), !moving);
+        let (noise_deg, estimated) = match self.noise.sigma_deg() {
+            Some(s) => (s, true),
+            None => (self.prior_noise_deg, false),
+        };
+        self.last = Some(Separability::new(
+            distances,
+            reading.baseline_m,
+            noise_deg,
+            estimated,
+        ));
+        Observed {
+            step,
+            moving,
+            direction,
+            reading: Some(reading),
+        }
+    }
+
+    /// The separability at the newest sample with a depth.
+    pub fn separability(&self) -> Option<Separability> {
+        self.last
+    }
+
+    /// The tracker was lost for longer than the hold: the classifier starts again; the noise
+    /// estimate and the last separability are kept.
+    pub fn reset(&mut self) {
+        self.classifier.reset();
+        self.noise.close();
+    }
+}
+
+/// The median of some values (reordered); 0 for none.
+fn median(values: &mut [f32]) -> f32 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f32::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        (values[n / 2 - 1] + values[n / 2]) / 2.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use vitreous_xr::GazeRay;
+    use vitreous_xr::synth::SplitMix64;
+
+    use super::*;
+
+    fn sample(left_dir: Vec3, right_dir: Vec3, baseline_m: f32) -> GazeSample {
+        let ray = |x: f32, d: Vec3| GazeRay {
+            origin: Vec3::new(x, 0.0, 0.0),
+            direction: d.normalize(),
+            valid: true,
+        };
+        GazeSample {
+            left: ray(-baseline_m / 2.0, left_dir),
+            right: ray(baseline_m / 2.0, right_dir),
+            ..GazeSample::none(0)
+        }
+    }
+
+    #[test]
+    fn a_symmetric_fixation_reads_the_geometric_vergence() {
+        for depth in [0.125f32, 0.4, 1.48, 2.03, 10.0] {
+            let b = 0.064;
+            let target = Vec3::new(0.0, 0.0, -depth);
+            let s = sample(
+                target - Vec3::new(-b / 2.0, 0.0, 0.0),
+                target - Vec3::new(b / 2.0, 0.0, 0.0),
+                b,
+            );
+            let r = reading(&s, depth);
+            assert!((r.baseline_m - b).abs() < 1e-6);
+            let expected = vergence_deg(depth, b);
+            assert!(
+                (r.vergence_deg - expected).abs() < 1e-3,
+                "{depth} m: {} against {expected}",
+                r.vergence_deg
+            );
+        }
+    }
+
+    #[test]
+    fn diverging_rays_read_negative() {
+        let turn = 0.5f32.to_radians();
+        let s = sample(
+            Vec3::new(-turn.sin(), 0.0, -turn.cos()),
+            Vec3::new(turn.sin(), 0.0, -turn.cos()),
+            0.063,
+        );
+        let r = reading(&s, 10.0);
+        assert!((r.vergence_deg + 1.0).abs() < 1e-3, "{}", r.vergence_deg);
+    }
+
+    #[test]
+    fn glass_sphere_images_are_two_thirds_of_a_degree_apart() {
+        let d = ImageDistances {
+            surface_m: 1.48,
+            refracted_m: 2.03,
+        };
+        let s = Separability::new(&d, 0.063, 0.7, true);
+        assert!((s.gap_deg - 0.66).abs() < 0.01, "{}", s.gap_deg);
+        assert!(!s.separable());
+        let paper = ImageDistances {
+            surface_m: 0.125,
+            refracted_m: 0.4,
+        };
+        assert!(Separability::new(&paper, 0.063, 0.7, true).d_prime() > 25.0);
+    }
+
+    /// Normal noise of known sigma on fixations whose vergence changes in steps (the wearer
+    /// looking from one depth to another every 3-5 s), with saccades and gaps between them:
+    /// the estimate is within 15 % of sigma (a window that straddles a step leans toward the
+    /// other side: the estimate runs a little high, never low).
+    #[test]
+    fn noise_estimate_recovers_the_sigma_of_normal_noise() {
+        for (seed, sigma) in [(1u64, 0.3f32), (2, 0.7), (3, 1.5)] {
+            let mut rng = SplitMix64(seed);
+            let mut est = VergenceNoise::new();
+            let mut t = 0i64;
+            for _ in 0..40 {
+                // A stretch of tracking: dwells of 3-5 s at one depth each, then a blink.
+                for _ in 0..(1 + rng.below(4)) {
+                    let centre = 10.0 * rng.unit() as f32;
+                    let n = 90 + rng.below(60);
+                    for _ in 0..n {
+                        let v = centre + sigma * rng.gaussian() as f32;
+                        est.push(t, Some(v), true);
+                        t += 33_333_333;
+                    }
+                    // A saccade's samples are left out.
+                    est.push(t, Some(50.0), false);
+                    t += 33_333_333;
+                }
+                est.push(t, None, false);
+                t += 150_000_000;
+            }
+            est.close();
+            let got = est.sigma_deg().unwrap();
+            assert!(
+                (0.97..1.15).contains(&(got / sigma)),
+                "seed {seed}: {got} for {sigma}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_warning_comes_only_from_an_estimated_noise_too_large() {
+        let d = ImageDistances {
+            surface_m: 1.48,
+            refracted_m: 2.03,
+        };
+        assert_eq!(Separability::new(&d, 0.063, 1.0, false).warning(), None);
+        assert_eq!(Separability::new(&d, 0.063, 0.3, true).warning(), None);
+        let warning = Separability::new(&d, 0.063, 0.8, true).warning().unwrap();
+        assert!(warning.contains("cannot tell the surface from the refracted image apart"));
+        assert!(warning.contains("d' = 0.83"), "{warning}");
+        let line = Separability::new(&d, 0.063, 0.8, true).summary().line();
+        assert!(line.contains("d' = 0.83, below 1"), "{line}");
+    }
+
+    #[test]
+    fn no_estimate_from_too_little_or_from_saccades() {
+        let mut est = VergenceNoise::new();
+        for k in 0..(MIN_WINDOW as i64 - 1) {
+            est.push(k * 10_000_000, Some(k as f32), true);
+        }
+        est.close();
+        assert_eq!(est.sigma_deg(), None);
+        for k in 0..100 {
+            est.push(k * 10_000_000, Some(k as f32), false);
+        }
+        est.close();
+        assert_eq!(est.sigma_deg(), None);
+        assert_eq!(est.pooled(), 0);
+    }
+}

@@ -149,7 +149,9 @@ enum TraceCommand {
         scene: PathBuf,
         /// Filters to compare (repeatable): mean20, mean:N, median5, median:N,
         /// one-euro[:min_cutoff=..,beta=..,d_cutoff=..,pre_median=..],
-        /// fixation[:velocity=..,min_fixation=..,window=..,max_window=..,settle=..]; default all.
+        /// fixation[:velocity=..,min_fixation=..,window=..,max_window=..,settle=..],
+        /// evidence[:threshold=..,step=..,settle=..,min_separability=..,noise=..,margin=..];
+        /// default all.
         #[arg(long = "filter", value_name = "FILTER")]
         filters: Vec<FilterKind>,
         /// Write the figures as JSON on stdout instead of the tables.

@@ -117,7 +117,7 @@ proptest! {
 fn filters_parse_from_scene_style_names() {
     assert_eq!("mean20".parse::<FilterKind>().unwrap(), FilterKind::PAPER);
     assert_eq!(
-        "fixation".parse::<FilterKind>().unwrap(),
+        "evidence".parse::<FilterKind>().unwrap(),
         FilterKind::default()
     );
     for name in [
@@ -126,6 +126,8 @@ fn filters_parse_from_scene_style_names() {
         "mean:10",
         "fixation",
         "Fixation:settle=200",
+        "evidence",
+        "Evidence:threshold=3",
     ] {
         assert!(name.parse::<FilterKind>().is_ok(), "{name}");
     }

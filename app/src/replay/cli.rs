@@ -75,9 +75,9 @@ pub struct ReplayArgs {
     /// refracted, as the paper's experimenter did; default: the scene's `[gaze] image`.
     #[arg(long, value_name = "IMAGE")]
     pub gaze_image: Option<GazeOverride>,
-    /// Fixation-depth filter: mean20 (eq. 15), median5, one-euro, fixation (the gaze image
-    /// decided per fixation), ...; default: the scene's `[gaze] filter` (fixation if it
-    /// names none).
+    /// Gaze-image decision: evidence (accumulated evidence weighed by the tracker's noise),
+    /// fixation (decided per fixation), or a fixation-depth filter: mean20 (eq. 15), median5,
+    /// one-euro, ...; default: the scene's `[gaze] filter` (evidence if it names none).
     #[arg(long, value_name = "FILTER")]
     pub filter: Option<FilterKind>,
     /// Pupil diameter A_p overriding the scene's, millimetres (1-9).

@@ -42,10 +42,10 @@ use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
 use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::ash::vk;
 use vitreous_xr::openxr::{
-    Blend, Command, DepthOptions, GazeChoice, OpenXrOptions, Runtime, SessionOptions,
-    SessionReport, State, VulkanHandles,
+    Blend, Command, DepthOptions, GazeChoice, GazeSource, OpenXrOptions, Runtime,
+    SessionOptions, SessionReport, State, VulkanHandles,
 };
-use vitreous_xr::trace::TraceWriter;
+use vitreous_xr::trace::{TraceVersion, TraceWriter};
 
 pub use cli::{RunArgs, run_command};
 pub use device::XrDeviceCreator;
@@ -365,9 +365,15 @@ fn run_with(
     }
     .context("using the swapchain images")?;
 
+    // A tracker that reports its confidence and gaze behaviour records version 1.3 from the
+    // first line, even if its first frame brings no sample.
+    let version = match session.report().gaze_source {
+        Some(GazeSource::MlEyeTracker) => TraceVersion::V1_3,
+        _ => TraceVersion::V1_2,
+    };
     let writer = match &options.record {
         Some(path) => Some(
-            TraceWriter::create_with_edits(path)
+            TraceWriter::create_version(path, version)
                 .with_context(|| format!("creating {}", path.display()))?,
         ),
         None => None,

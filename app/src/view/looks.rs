@@ -15,7 +15,7 @@ use crate::views;
 pub const CONDITION_KEYS: [&str; 7] = ["none", "O3", "O4", "O5", "b", "c", "inducer"];
 
 /// The gaze filters G steps through.
-pub const FILTERS: [&str; 4] = ["fixation", "mean20", "median20", "one-euro"];
+pub const FILTERS: [&str; 5] = ["evidence", "fixation", "mean20", "median20", "one-euro"];
 
 /// The viewer's conditions and planners.
 pub struct Looks {
@@ -272,7 +272,7 @@ mod tests {
             l.next_filter().unwrap();
             seen.push(l.settings().0.to_string());
         }
-        assert_eq!(seen.last().map(String::as_str), Some("fixation"));
+        assert_eq!(seen.last().map(String::as_str), Some("evidence"));
         assert!(seen.contains(&"mean20".to_string()));
     }
 }

@@ -42,8 +42,8 @@ use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
 use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::ash::vk;
 use vitreous_xr::openxr::{
-    Blend, Command, DepthOptions, GazeChoice, GazeSource, OpenXrOptions, Runtime,
-    SessionOptions, SessionReport, State, VulkanHandles,
+    Blend, Command, DepthOptions, GazeChoice, GazeSource, OpenXrOptions, Runtime, SessionOptions,
+    SessionReport, State, VulkanHandles,
 };
 use vitreous_xr::trace::{TraceVersion, TraceWriter};
 

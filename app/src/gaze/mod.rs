@@ -25,6 +25,8 @@ pub mod fixation;
 pub mod image;
 pub mod pupil;
 pub mod separability;
+#[cfg(test)]
+mod test_samples;
 pub mod vergence;
 
 pub use blur::{DefocusError, GaussianKernel, ImageBlur, blur_reference, image_blur};
@@ -193,8 +195,7 @@ impl GazePipeline {
                 if raw_depth == FixationDepth::Unknown {
                     monitor.reset();
                     *last = None;
-                } else if let Some(g) = gaze.filter(|g| last.is_none_or(|l| g.sample_time_ns > l)) {
-                    *last = Some(g.sample_time_ns);
+                } else if let Some(g) = vergence::newer_sample(gaze, last) {
                     let depth = self
                         .vergence
                         .measurement()

@@ -123,6 +123,17 @@ pub struct Measurement {
     pub divergent: bool,
 }
 
+/// The frame's tracker sample when it is newer than `last` (the sample time last ingested),
+/// which it then becomes: each tracker sample is ingested once, however many frames see it.
+pub fn newer_sample<'a>(
+    gaze: Option<&'a GazeSample>,
+    last: &mut Option<i64>,
+) -> Option<&'a GazeSample> {
+    let g = gaze.filter(|g| last.is_none_or(|l| g.sample_time_ns > l))?;
+    *last = Some(g.sample_time_ns);
+    Some(g)
+}
+
 /// Which fallback a sample needed; each is logged once per process.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Fallback {

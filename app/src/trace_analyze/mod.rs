@@ -44,7 +44,7 @@ use vitreous_xr::synth::GazePhase;
 use crate::gaze::evidence::DEFAULT_PRIOR_NOISE_DEG;
 pub use crate::gaze::fixation::DROPOUT_NS;
 use crate::gaze::fixation::{DEFAULT_VELOCITY_DEG_S, Step, VelocityClassifier, combined_direction};
-use crate::gaze::vergence::{VergenceConfig, VergenceEstimator};
+use crate::gaze::vergence::{Measurement, VergenceConfig, VergenceEstimator};
 use crate::gaze::{
     FilterKind, GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances, ObjectInView,
     Separability, SeparabilityMonitor,
@@ -197,21 +197,10 @@ pub fn separability_of(
     vergence: VergenceConfig,
     distances: &ImageDistances,
 ) -> Option<Separability> {
-    let mut estimator = VergenceEstimator::new(vergence);
     let mut monitor = SeparabilityMonitor::new(DEFAULT_VELOCITY_DEG_S, DEFAULT_PRIOR_NOISE_DEG);
     let mut baselines = Vec::new();
-    let mut last: Option<i64> = None;
-    for s in samples {
-        let t = s.gaze.sample_time_ns;
-        estimator.update(Some(&s.gaze), s.time_ns);
-        if last.is_some_and(|l| t <= l) {
-            continue;
-        }
-        last = Some(t);
-        let depth = estimator
-            .measurement()
-            .filter(|m| m.sample_time_ns == t)
-            .map(|m| m.depth_m);
+    for (s, measured) in tracker_samples(samples, vergence) {
+        let depth = measured.map(|m| m.depth_m);
         if let Some(r) = monitor.push(&s.gaze, depth, distances).reading {
             baselines.push(r.baseline_m);
         }
@@ -225,6 +214,25 @@ pub fn separability_of(
         sep.noise_deg,
         sep.estimated,
     ))
+}
+
+/// Each tracker sample of a trace once (a sample that several trace lines repeat, or a depth
+/// held through a blink, is skipped), with what it measured itself (`None`: no depth).
+fn tracker_samples(
+    samples: &[TraceSample],
+    vergence: VergenceConfig,
+) -> impl Iterator<Item = (&TraceSample, Option<Measurement>)> {
+    let mut estimator = VergenceEstimator::new(vergence);
+    let mut last: Option<i64> = None;
+    samples.iter().filter_map(move |s| {
+        let t = s.gaze.sample_time_ns;
+        estimator.update(Some(&s.gaze), s.time_ns);
+        if last.is_some_and(|l| t <= l) {
+            return None;
+        }
+        last = Some(t);
+        Some((s, estimator.measurement().filter(|m| m.sample_time_ns == t)))
+    })
 }
 
 /// One tracker sample as the analysis sees it.
@@ -247,27 +255,19 @@ pub fn raw_samples(
     vergence: VergenceConfig,
     velocity_deg_s: f32,
 ) -> Vec<RawSample> {
-    let mut estimator = VergenceEstimator::new(vergence);
     let mut classifier = VelocityClassifier::new(velocity_deg_s);
-    let mut last: Option<i64> = None;
-    let mut out = Vec::new();
-    for s in samples {
-        let t = s.gaze.sample_time_ns;
-        estimator.update(Some(&s.gaze), s.time_ns);
-        if last.is_some_and(|l| t <= l) {
-            continue;
-        }
-        last = Some(t);
-        let fresh = estimator.measurement().filter(|m| m.sample_time_ns == t);
-        let direction = fresh.and_then(|_| combined_direction(&s.gaze));
-        out.push(RawSample {
-            time_ns: t,
-            depth_m: fresh.map(|m| m.depth_m),
-            divergent: fresh.is_some_and(|m| m.divergent),
-            step: classifier.step(t, direction),
-        });
-    }
-    out
+    tracker_samples(samples, vergence)
+        .map(|(s, fresh)| {
+            let t = s.gaze.sample_time_ns;
+            let direction = fresh.and_then(|_| combined_direction(&s.gaze));
+            RawSample {
+                time_ns: t,
+                depth_m: fresh.map(|m| m.depth_m),
+                divergent: fresh.is_some_and(|m| m.divergent),
+                step: classifier.step(t, direction),
+            }
+        })
+        .collect()
 }
 
 /// The raw depth of each tracker sample (each sample once, held depths skipped), with the

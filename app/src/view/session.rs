@@ -436,9 +436,7 @@ impl ViewSink {
                     ),
                     None => "K_g: none (gaze image unknown)".into(),
                 });
-                if let Some(s) = state.separability {
-                    lines.push(s.summary().line());
-                }
+                lines.extend(state.separability.map(|s| s.summary().line()));
             }
             _ => lines.push("no defocus in this condition (gaze image not used)".into()),
         }

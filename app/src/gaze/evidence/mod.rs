@@ -58,7 +58,7 @@ use vitreous_xr::{GazeSample, TrackerConfidence};
 use super::fixation::{DEFAULT_VELOCITY_DEG_S, Step};
 use super::image::{GazeImage, ImageDistances};
 use super::separability::{MIN_NOISE_DEG, Separability, SeparabilityMonitor, vergence_deg};
-use super::vergence::{FixationDepth, Measurement};
+use super::vergence::{FixationDepth, Measurement, newer_sample};
 
 /// Default decision threshold of the accumulated evidence (clear samples).
 pub const DEFAULT_THRESHOLD: f32 = 2.0;
@@ -252,11 +252,7 @@ impl EvidenceFilter {
     ) -> (FixationDepth, GazeImage) {
         if *raw == FixationDepth::Unknown {
             self.reset();
-        } else if let Some(g) = gaze.filter(|g| {
-            self.last_sample_ns
-                .is_none_or(|last| g.sample_time_ns > last)
-        }) {
-            self.last_sample_ns = Some(g.sample_time_ns);
+        } else if let Some(g) = newer_sample(gaze, &mut self.last_sample_ns) {
             let measured = measurement.filter(|m| m.sample_time_ns == g.sample_time_ns);
             self.ingest(g, measured);
         }

@@ -1,6 +1,7 @@
 //! Tests of the evidence decision.
 
 use super::*;
+use crate::gaze::test_samples::looking;
 use vitreous_xr::{GazeBehaviour, GazeRay, TrackerReport};
 
 const D: ImageDistances = ImageDistances {
@@ -9,22 +10,6 @@ const D: ImageDistances = ImageDistances {
 };
 
 const MS: i64 = 1_000_000;
-
-/// A sample looking at a point `depth_m` ahead, `offset_deg` to the right.
-fn looking(t_ns: i64, depth_m: f32, offset_deg: f32) -> GazeSample {
-    let a = offset_deg.to_radians();
-    let target = Vec3::new(depth_m * a.sin(), 0.0, -depth_m * a.cos());
-    let eye = |x: f32| GazeRay {
-        origin: Vec3::new(x, 0.0, 0.0),
-        direction: (target - Vec3::new(x, 0.0, 0.0)).normalize(),
-        valid: true,
-    };
-    GazeSample {
-        left: eye(-0.0315),
-        right: eye(0.0315),
-        ..GazeSample::none(t_ns)
-    }
-}
 
 /// Runs samples through the vergence estimator and an evidence filter set up by `setup`;
 /// the decisions.

@@ -63,7 +63,7 @@ use glam::Vec3;
 use vitreous_xr::GazeSample;
 
 use super::image::{GazeImage, ImageDistances, ImageSelector};
-use super::vergence::{FixationDepth, Measurement};
+use super::vergence::{FixationDepth, Measurement, newer_sample};
 
 /// Default I-VT threshold on the combined direction's angular velocity, degrees per second.
 pub const DEFAULT_VELOCITY_DEG_S: f32 = 30.0;
@@ -367,12 +367,8 @@ impl FixationFilter {
     ) -> (FixationDepth, GazeImage) {
         if *raw == FixationDepth::Unknown {
             self.reset();
-        } else if let Some(g) = gaze.filter(|g| {
-            self.last_sample_ns
-                .is_none_or(|last| g.sample_time_ns > last)
-        }) {
+        } else if let Some(g) = newer_sample(gaze, &mut self.last_sample_ns) {
             let t = g.sample_time_ns;
-            self.last_sample_ns = Some(t);
             let measured = measurement.filter(|m| m.sample_time_ns == t);
             let direction = measured.and_then(|_| combined_direction(g));
             self.ingest(t, direction, measured);

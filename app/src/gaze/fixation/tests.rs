@@ -1,32 +1,13 @@
 //! Tests of the classifier and the fixation filter.
 
 use super::*;
+use crate::gaze::test_samples::looking;
 use vitreous_xr::GazeRay;
 
 const D: ImageDistances = ImageDistances {
     surface_m: 0.6,
     refracted_m: 1.5,
 };
-
-/// A sample looking at a point `depth_m` ahead, `offset_deg` to the right.
-fn looking(t_ns: i64, depth_m: f32, offset_deg: f32) -> GazeSample {
-    let a = offset_deg.to_radians();
-    let target = Vec3::new(depth_m * a.sin(), 0.0, -depth_m * a.cos());
-    let eye = |x: f32| GazeRay {
-        origin: Vec3::new(x, 0.0, 0.0),
-        direction: (target - Vec3::new(x, 0.0, 0.0)).normalize(),
-        valid: true,
-    };
-    GazeSample {
-        sample_time_ns: t_ns,
-        left: eye(-0.0315),
-        right: eye(0.0315),
-        combined: None,
-        fixation: None,
-        pupil_diameter_m: [None, None],
-        report: None,
-    }
-}
 
 fn blink(t_ns: i64) -> GazeSample {
     GazeSample {

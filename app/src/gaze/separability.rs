@@ -33,7 +33,13 @@
 //! a window needs [`MIN_WINDOW`] samples. `sigma = 1.4826 * median(|deviation|)` (the median
 //! absolute deviation of a normal distribution) over the newest [`MAX_RESIDUALS`] deviations,
 //! so a spike disturbs only its own deviation. Until [`MIN_RESIDUALS`] deviations are pooled
-//! there is no estimate. Each deviation is taken once its window has passed: the online
+//! there is no estimate, and the noise is the prior (1 degree, a head-worn tracker's).
+//!
+//! The estimate is then shrunk toward the prior, which counts as [`PRIOR_WEIGHT`] deviations
+//! (10 s of fixations at 30 Hz): `sigma^2 = (300 prior^2 + n s^2) / (300 + n)` with `s` the
+//! estimate from `n` deviations. A short recording, or the first seconds of a session, then
+//! does not stake the decision on a few dozen samples (the importers' test fixtures, for one,
+//! are noiseless: 0 degree from their own data). Each deviation is taken once its window has passed: the online
 //! estimate runs 1.5 s behind the newest sample.
 
 use std::collections::VecDeque;
@@ -59,6 +65,9 @@ pub const MIN_WINDOW: usize = 7;
 
 /// Fewest pooled deviations that give an estimate.
 pub const MIN_RESIDUALS: usize = 30;
+
+/// How many deviations the prior noise counts as when the estimate is shrunk toward it.
+pub const PRIOR_WEIGHT: usize = 300;
 
 /// Most deviations pooled (the newest are kept): about 40 s of fixations at 30 Hz.
 pub const MAX_RESIDUALS: usize = 1200;
@@ -118,7 +127,8 @@ pub struct Separability {
     pub gap_deg: f32,
     /// The tracker's vergence noise (standard deviation), degrees.
     pub noise_deg: f32,
-    /// Whether `noise_deg` was estimated from the data (false: the prior).
+    /// Whether `noise_deg` rests on the data (their estimate shrunk toward the prior; false:
+    /// the prior alone).
     pub estimated: bool,
 }
 
@@ -411,9 +421,13 @@ impl SeparabilityMonitor {
         let reading = reading(g, depth_m);
         let moving = step == Step::Moving || behaviour == Some(GazeBehaviour::Saccade);
         self.noise.push(t, Some(reading.vergence_deg), !moving);
+        let prior = self.prior_noise_deg;
         let (noise_deg, estimated) = match self.noise.sigma_deg() {
-            Some(s) => (s, true),
-            None => (self.prior_noise_deg, false),
+            Some(s) => {
+                let (n0, n) = (PRIOR_WEIGHT as f32, self.noise.pooled() as f32);
+                (((n0 * prior * prior + n * s * s) / (n0 + n)).sqrt(), true)
+            }
+            None => (prior, false),
         };
         self.last = Some(Separability::new(
             distances,

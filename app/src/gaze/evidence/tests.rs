@@ -112,8 +112,8 @@ fn no_decision_while_the_images_are_inside_the_noise() {
     };
     let trace = |sigma_deg: f32| {
         let mut rng = vitreous_xr::synth::SplitMix64(7);
-        let mut s = fixating(0, 90, 33, 1.48);
-        s.extend(fixating(3000, 90, 33, 2.03));
+        let mut s = fixating(0, 600, 33, 1.48);
+        s.extend(fixating(20_000, 300, 33, 2.03));
         s.into_iter()
             .map(|g| noisy(&mut rng, g, sigma_deg))
             .collect::<Vec<_>>()
@@ -129,7 +129,8 @@ fn no_decision_while_the_images_are_inside_the_noise() {
         let raw = v.update(Some(g), g.sample_time_ns);
         images.push(f.update(Some(g), &raw, v.measurement()).1);
     }
-    // A tracker six times as precise separates them, and follows the change.
+    // A tracker six times as precise separates them once its noise outweighs the prior (about
+    // 400 deviations, 14 s at 30 Hz), and follows the change.
     let sep = f.separability().unwrap();
     assert!(sep.estimated && sep.separable(), "{sep:?}");
     assert_eq!(images.last(), Some(&GazeImage::Refracted));

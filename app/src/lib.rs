@@ -2,7 +2,8 @@
 //!
 //! The library behind the `vitreous` command: scene files, the frame loop shared by every XR
 //! backend, trace replay and trace tools. Rendering lives in `vitreous-render`, XR backends and
-//! the trace format in `vitreous-xr`.
+//! the trace format in `vitreous-xr`, the gaze pipeline (vergence, the gaze-image decisions,
+//! defocus maths) in `vitreous-gaze`, re-exported here as [`gaze`].
 
 pub mod bench;
 pub mod blur_stack;
@@ -12,7 +13,7 @@ pub mod effects;
 pub mod error_report;
 pub mod frame_log;
 pub mod frame_loop;
-pub mod gaze;
+pub use vitreous_gaze as gaze;
 pub mod interrupt;
 pub mod look;
 pub mod motion_clock;

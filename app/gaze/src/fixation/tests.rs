@@ -1,7 +1,7 @@
 //! Tests of the classifier and the fixation filter.
 
 use super::*;
-use crate::gaze::test_samples::looking;
+use crate::test_samples::looking;
 use vitreous_xr::GazeRay;
 
 const D: ImageDistances = ImageDistances {

@@ -1,7 +1,7 @@
 //! Tests of the evidence decision.
 
 use super::*;
-use crate::gaze::test_samples::looking;
+use crate::test_samples::looking;
 use vitreous_xr::{GazeBehaviour, GazeRay, TrackerReport};
 
 const D: ImageDistances = ImageDistances {

@@ -116,7 +116,7 @@ struct VertexOut {
 };
 
 // Cosine above which a vertex normal counts as pointing away from the object's centre (twin
-// of render/src/radial_map.rs RADIAL_NORMAL_COS).
+// of render/src/two_surface.rs RADIAL_NORMAL_COS).
 const RADIAL_NORMAL_COS: f32 = 0.9999;
 
 @vertex

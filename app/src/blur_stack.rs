@@ -4,9 +4,9 @@
 
 use rayon::prelude::*;
 
+use crate::defocus_model::DefocusModel;
 use crate::gaze::GazeImage;
 use crate::gaze::blur::{PUPIL_MAX_MM, gaussian_kernel};
-use crate::look::DefocusModel;
 use crate::output::{linear_to_srgb, srgb_to_linear};
 use crate::scene::{Image, PixelData, Scene};
 

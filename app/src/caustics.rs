@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use exr::prelude::*;
 use thiserror::Error;
 
-use crate::scene::{DiskFiles, SceneFiles};
+use crate::files::{DiskFiles, SceneFiles};
 
 /// Name of the header attribute holding the scene hash.
 pub const SCENE_HASH_ATTRIBUTE: &str = "vitreous_scene_hash";

@@ -3,7 +3,6 @@
 
 use std::collections::{HashMap, HashSet};
 use std::ffi::{CStr, c_char};
-use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::{Arc, Mutex};
 
 use openxr::sys::{self, pfn};
@@ -14,6 +13,7 @@ use crate::calls;
 use crate::config::{BUTTONS_VAR, Config, GazeExtension, TRACE_VAR};
 use crate::controller::{ButtonScript, Buttons, HANDS};
 use crate::extensions;
+use crate::guard::{guard, report};
 use crate::next::NextTable;
 use crate::registry::{InstanceState, registry};
 use crate::submitted::SubmittedLog;
@@ -21,25 +21,6 @@ use crate::timeline::GazeTimeline;
 
 /// The layer's name, as its manifest gives it.
 pub const LAYER_NAME: &CStr = c"XR_APILAYER_VITREOUS_simulated_ost";
-
-/// Prints a message for the user on stderr, prefixed with the layer's name.
-pub fn report(message: impl std::fmt::Display) {
-    eprintln!("vitreous-sim-layer: {message}");
-}
-
-/// Runs an entry point's body, turning a panic into `XR_ERROR_RUNTIME_FAILURE` so it never
-/// unwinds into the caller's C frames.
-pub fn guard(call: &str, body: impl FnOnce() -> sys::Result) -> sys::Result {
-    match catch_unwind(AssertUnwindSafe(body)) {
-        Ok(r) => r,
-        Err(_) => {
-            report(format!(
-                "{call} panicked; returning XR_ERROR_RUNTIME_FAILURE"
-            ));
-            sys::Result::ERROR_RUNTIME_FAILURE
-        }
-    }
-}
 
 /// The loader calls this first, to agree on the interface version and learn the layer's
 /// `xrGetInstanceProcAddr` and `xrCreateApiLayerInstance`.

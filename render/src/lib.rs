@@ -43,6 +43,7 @@ pub mod renderer;
 pub mod scene;
 mod shaders;
 pub mod solid;
+pub(crate) mod statistics;
 mod target;
 pub mod two_surface;
 mod validation;

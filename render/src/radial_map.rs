@@ -1,22 +1,12 @@
 //! The radial map (`[object] refraction = "two-surface"` on the GPU): the object's surface seen
-//! from its centre, built once on the CPU with the mesh tracer of [`crate::two_surface`], and
-//! the rule shared with the glass shader for a ball's surface between its vertices.
+//! from its centre, built once on the CPU with the mesh tracer of [`crate::two_surface`], which
+//! also holds the rule shared with the glass shader for a ball's surface between its vertices
+//! ([`crate::two_surface::RADIAL_NORMAL_COS`]).
 
 use glam::Vec3;
 
 use crate::solid::SolidError;
 use crate::two_surface::MeshBody;
-
-/// Cosine above which a vertex normal counts as pointing away from the object's centre, so
-/// that the surface around the vertex is taken as the sphere about the centre through it (twin
-/// of shaders/glass.wgsl RADIAL_NORMAL_COS).
-pub const RADIAL_NORMAL_COS: f32 = 0.9999;
-
-/// Whether the unit `normal` at `corner` (relative to the object's centre) points away from
-/// the centre.
-pub(crate) fn radial_normal(corner: Vec3, normal: Vec3) -> bool {
-    normal.dot(corner) > RADIAL_NORMAL_COS * corner.length()
-}
 
 /// The object's centre: the middle of its bounding box (model units).
 pub fn mesh_center(positions: &[Vec3]) -> Vec3 {

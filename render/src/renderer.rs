@@ -21,8 +21,9 @@ use crate::owned::Owned;
 use crate::pipeline;
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, SceneDesc};
+use crate::statistics::{self, Statistics};
 use crate::target::{self, StereoTarget};
-use crate::work::{self, FrameWork, Statistics};
+use crate::work::FrameWork;
 use crate::world::WorldPass;
 
 mod composition;
@@ -335,7 +336,7 @@ impl Renderer {
         }
         for slot in &mut self.slots {
             if slot.statistics.is_none() {
-                slot.statistics = Some(work::statistics_pool(&self.ctx)?);
+                slot.statistics = Some(statistics::statistics_pool(&self.ctx)?);
             }
         }
         Ok(true)
@@ -502,9 +503,10 @@ impl Renderer {
         let invocations = match (&slot.statistics, pending.counted) {
             // SAFETY: the frame began and ended every query of the pool (`counted`), and it
             // finished (its fence signalled above).
-            (Some(pool), true) => {
-                Some(unsafe { work::read_statistics(d, pool.raw()) }.vk("vkGetQueryPoolResults")?)
-            }
+            (Some(pool), true) => Some(
+                unsafe { statistics::read_statistics(d, pool.raw()) }
+                    .vk("vkGetQueryPoolResults")?,
+            ),
             _ => None,
         };
         let bytes = if pending.want.eyes {
@@ -608,7 +610,7 @@ impl Renderer {
                 stamps.write(d, cmd, 0..FIELD_STAMPS);
             }
             // Every query is begun and ended each frame, so all have results.
-            statistics.around(d, cmd, work::BLUR_QUERY, || {
+            statistics.around(d, cmd, statistics::BLUR_QUERY, || {
                 if !blank {
                     let (look, scene) = (&params.look, &self.scene);
                     let depths = blur_blend::depths(look, scene.stack_slices, scene.stack_steps);
@@ -625,7 +627,7 @@ impl Renderer {
                     eye_framebuffers[index],
                     composition.clear_alpha(),
                 );
-                let query = work::eye_query(index);
+                let query = statistics::eye_query(index);
                 statistics.around(d, cmd, query, || {
                     if world_behind {
                         self.world.record(&self.ctx, cmd, eye);

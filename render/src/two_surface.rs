@@ -10,9 +10,19 @@ use glam::Vec3;
 
 use crate::absorption::Attenuation;
 use crate::optics::{fresnel_reflectance, ray_sphere, reflect, refract};
-use crate::radial_map::radial_normal;
 use crate::solid::bvh::Bvh;
 use crate::solid::{Solid, SolidError};
+
+/// Cosine above which a vertex normal counts as pointing away from the object's centre, so
+/// that the surface around the vertex is taken as the sphere about the centre through it (twin
+/// of shaders/glass.wgsl RADIAL_NORMAL_COS).
+pub const RADIAL_NORMAL_COS: f32 = 0.9999;
+
+/// Whether the unit `normal` at `corner` (relative to the object's centre) points away from
+/// the centre.
+pub(crate) fn radial_normal(corner: Vec3, normal: Vec3) -> bool {
+    normal.dot(corner) > RADIAL_NORMAL_COS * corner.length()
+}
 
 /// Internal reflections followed at most before a ray still inside is given up to the
 /// environment (a brilliant sends most light out within three).

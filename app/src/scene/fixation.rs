@@ -11,8 +11,9 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 use vitreous_render::Refraction;
-use vitreous_render::radial_map::RADIAL_NORMAL_COS;
-use vitreous_render::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, MeshBody, pass_through};
+use vitreous_render::two_surface::{
+    Ball, MAX_INTERNAL_REFLECTIONS, MeshBody, RADIAL_NORMAL_COS, pass_through,
+};
 use vitreous_xr::synth::{FixationTarget, SynthParams};
 
 use super::{Object, Scene};

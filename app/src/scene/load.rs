@@ -18,7 +18,7 @@ use vitreous_render::floor::{
 use vitreous_xr::{Fov, Pose};
 
 use super::error::Source;
-use super::file::{DiskFiles, LightFrame, PlaneToml, SceneFile, SceneFiles};
+use super::file::{LightFrame, PlaneToml, SceneFile};
 use super::mesh::VolumeAttenuation;
 use super::{
     Caustics, CausticsMode, Environment, GazeChoice, Image, Inducer, IorSource, Light, MeshLens,
@@ -26,6 +26,7 @@ use super::{
 };
 use super::{file, image, mesh};
 use crate::effects::EffectSet;
+use crate::files::{DiskFiles, SceneFiles};
 use crate::gaze::{FilterKind, FilterParseError, GazeOverride, PupilSource};
 
 /// Loads a scene file and every asset it names, checking ranges and decoding everything.

@@ -30,8 +30,8 @@ use vitreous_xr::{Fov, Pose};
 use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, GazeOverride, PupilSource};
 
+pub use crate::files::{DiskFiles, SceneFiles};
 pub use error::{Location, SceneError};
-pub use file::{DiskFiles, SceneFiles};
 pub use fixation::{
     FixationPoints, MeshLens, REFRACTED_TARGET, SURFACE_TARGET, ViewingGeometry,
     gaze_image_of_target, synth_params_for,

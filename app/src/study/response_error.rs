@@ -3,8 +3,6 @@
 
 use std::path::PathBuf;
 
-use super::responses::COLUMNS;
-
 /// Why a responses file cannot be analysed.
 #[derive(Debug, thiserror::Error)]
 pub enum ResponsesError {
@@ -27,12 +25,14 @@ pub enum ResponsesError {
         message: String,
     },
     /// The header lacks a required column.
-    #[error("{path}: line 1: the header has no `{column}` column (expected {expected})", expected = COLUMNS.join(","))]
+    #[error("{path}: line 1: the header has no `{column}` column (expected {expected})")]
     MissingColumn {
         /// The file.
         path: PathBuf,
         /// The missing column.
         column: &'static str,
+        /// The columns a responses file must have, comma-separated.
+        expected: String,
     },
     /// No answers after the header.
     #[error("{path}: no responses (the file has no lines after the header)")]

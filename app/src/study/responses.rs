@@ -187,6 +187,7 @@ fn parse_rows(path: &Path, reader: impl Read) -> Result<Vec<Response>, Responses
             .ok_or_else(|| ResponsesError::MissingColumn {
                 path: path.to_path_buf(),
                 column,
+                expected: COLUMNS.join(","),
             })?;
     }
     let stimulus_index = header.iter().position(|name| name == STIMULUS_COLUMN);

@@ -5,7 +5,7 @@
 
 use openxr::sys::{self, Handle};
 
-use crate::entry::guard;
+use crate::guard::guard;
 use crate::registry::registry;
 
 /// Nanoseconds per second.

@@ -5,8 +5,8 @@ use openxr::sys::{self, Handle};
 
 use super::{SessionContext, in_base};
 use crate::config::GazeExtension;
-use crate::entry::guard;
 use crate::eye_geometry::ray_pose;
+use crate::guard::guard;
 use crate::registry::registry;
 
 /// The session context of an FB tracker the layer made.

@@ -10,7 +10,7 @@ use super::chain;
 use crate::bindings::{self, Plan};
 use crate::blend;
 use crate::config::GazeExtension;
-use crate::entry::guard;
+use crate::guard::guard;
 use crate::registry::registry;
 use crate::two_call;
 

@@ -30,8 +30,8 @@ use vitreous_xr::{GazeBehaviour, GazeRay, GazeSample, Pose, TrackerConfidence};
 
 use super::{SessionContext, in_base};
 use crate::config::GazeExtension;
-use crate::entry::guard;
 use crate::eye_geometry::{combined_ray, fixation_point, pose_along, ray_pose};
+use crate::guard::guard;
 use crate::registry::registry;
 use crate::two_call;
 

@@ -1,7 +1,7 @@
 //! The layer's OpenXR entry points, and what they share: the context of a session copied out
 //! of the registry, and locating spaces relative to the head.
 //!
-//! Every entry point runs its body in [`guard`](crate::entry::guard), takes what it needs
+//! Every entry point runs its body in [`guard`](crate::guard::guard), takes what it needs
 //! from the registry under the lock, and calls down the chain without it.
 
 pub mod controller;

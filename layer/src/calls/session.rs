@@ -5,8 +5,8 @@ use openxr::sys::{self, Handle};
 
 use super::{SessionContext, all_location_flags, chain};
 use crate::blend;
-use crate::entry::{guard, report};
 use crate::eye_geometry::{combined_ray, compose, from_posef, ray_pose, relative, to_posef};
+use crate::guard::{guard, report};
 use crate::registry::{SessionState, SpaceState, registry};
 use crate::submitted::{FrameInfo, LayerInfo};
 use vitreous_xr::Pose;

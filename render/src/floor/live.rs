@@ -12,7 +12,8 @@ use gpu_allocator::MemoryLocation;
 use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
 use super::live_mesh::LiveMesh;
 use super::smoothing::{
-    SHORT_KERNEL_PX, SmoothPass, SmoothTiles, record_smoothing, row_pitch, shares_fit, smooth_steps,
+    FIXED_POINT, SHORT_KERNEL_PX, SmoothPass, SmoothTiles, record_smoothing, row_pitch, shares_fit,
+    smooth_steps,
 };
 use crate::context::GpuContext;
 use crate::descriptors;
@@ -92,9 +93,6 @@ pub const DEFAULT_RESOLUTION_PX: u32 = 990;
 pub const MAX_PHOTONS_PER_SIDE: u32 = 4096;
 /// Largest smoothing box radius accepted, texels.
 pub const MAX_SMOOTHING_PX: u32 = 64;
-/// Fixed-point units per unit of gain in the sums (integer atomics keep the result the same
-/// whatever order photons land in).
-pub(super) const FIXED_POINT: f32 = 65536.0;
 /// Paths below this weight end by default. The bake follows them to 1e-4; the live maps of the sphere,
 /// the diamond and the torus are as close to their bakes with 1e-2 (0.52 %, 3.23 % and 3.38 %
 /// against 0.51 %, 3.23 % and 3.40 %), and the sphere's stage after a move costs about 10 ms

@@ -15,13 +15,15 @@ use ash::vk;
 use glam::{Mat4, Vec3};
 use gpu_allocator::MemoryLocation;
 
-use super::live::FIXED_POINT;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::Buffer;
 use crate::owned::Owned;
 use crate::{pipeline, shaders};
 
+/// Fixed-point units per unit of gain in the photons' sums the smoothing reads (`live.rs`
+/// splats into them; integer atomics keep the result the same whatever order photons land in).
+pub(super) const FIXED_POINT: f32 = 65536.0;
 /// Invocations per workgroup of the smoothing's passes.
 const SMOOTH_GROUP: u32 = 64;
 /// Largest radius the smoothing's short kernel takes (`SHORT_KERNEL_PX` in

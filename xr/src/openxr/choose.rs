@@ -3,52 +3,7 @@
 
 use std::fmt;
 
-/// How the display combines rendered light with the real world (OpenXR environment blend
-/// modes, as far as vitreous cares).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Blend {
-    /// Light added onto the real world: optical see-through (Magic Leap 2). What vitreous is for.
-    Additive,
-    /// Rendered pixels blended over a camera view of the world by their alpha.
-    AlphaBlend,
-    /// Only the rendered picture is shown (VR): vitreous draws the scene's real-world photos
-    /// behind the glass so the whole picture is visible.
-    Opaque,
-}
-
-impl Blend {
-    /// Whether the app must draw the real world itself.
-    pub fn needs_world_behind(self) -> bool {
-        self == Blend::Opaque
-    }
-
-    /// Whether the submitted image's alpha is used: ALPHA_BLEND shows premultiplied colour
-    /// over the real world by its alpha (vitreous submits alpha 0, so the light adds onto the
-    /// world); ADDITIVE and OPAQUE ignore alpha.
-    pub fn uses_source_alpha(self) -> bool {
-        self == Blend::AlphaBlend
-    }
-
-    /// Parses `additive`, `alpha-blend` (or `alpha`) and `opaque`.
-    pub fn parse(s: &str) -> Option<Blend> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "additive" => Some(Blend::Additive),
-            "alpha-blend" | "alpha_blend" | "alpha" => Some(Blend::AlphaBlend),
-            "opaque" => Some(Blend::Opaque),
-            _ => None,
-        }
-    }
-}
-
-impl fmt::Display for Blend {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Blend::Additive => "additive",
-            Blend::AlphaBlend => "alpha-blend",
-            Blend::Opaque => "opaque",
-        })
-    }
-}
+pub use crate::frame::Blend;
 
 /// Chooses the blend mode: `wanted` when the runtime offers it, else ADDITIVE, ALPHA_BLEND,
 /// OPAQUE in that order. `Err` names what was offered when nothing usable is (or when

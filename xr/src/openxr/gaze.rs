@@ -11,10 +11,10 @@
 
 use std::path::Path;
 
-use glam::{Quat, Vec3};
 use openxr as xr;
 
 use super::choose::GazeSource;
+use super::convert::ray_of;
 use super::ml_tracker::MlTracker;
 use super::{OpenXrError, Result, XrContext};
 use crate::frame::{GazeRay, GazeSample};
@@ -128,21 +128,6 @@ impl GazeTally {
             self.fresh += 1;
             self.newest_ns = Some(t);
         }
-    }
-}
-
-/// A ray along a pose's forward axis (-z).
-pub(super) fn ray_of(pose: &xr::Posef) -> GazeRay {
-    let q = Quat::from_xyzw(
-        pose.orientation.x,
-        pose.orientation.y,
-        pose.orientation.z,
-        pose.orientation.w,
-    );
-    GazeRay {
-        origin: Vec3::new(pose.position.x, pose.position.y, pose.position.z),
-        direction: (q * Vec3::NEG_Z).normalize_or(Vec3::NEG_Z),
-        valid: true,
     }
 }
 
@@ -348,6 +333,7 @@ impl TraceGaze {
 mod tests {
     use super::*;
     use crate::frame::Pose;
+    use glam::Vec3;
 
     fn sample(time_ns: i64, gaze_ns: i64, x: f32) -> TraceSample {
         let ray = GazeRay {

@@ -15,7 +15,7 @@ use std::ffi::CStr;
 use glam::Vec3;
 use openxr as xr;
 
-use super::gaze::ray_of;
+use super::convert::ray_of;
 use super::ml_eye_tracker as ml;
 use super::{OpenXrError, Result, XrContext};
 use crate::frame::{GazeBehaviour, GazeRay, GazeSample, TrackerConfidence, TrackerReport};

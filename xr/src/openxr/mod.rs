@@ -26,6 +26,7 @@
 
 pub mod actions;
 pub mod choose;
+mod convert;
 mod error;
 mod gaze;
 pub mod ml_eye_tracker;

@@ -13,9 +13,10 @@ use std::time::{Duration, Instant};
 
 use openxr as xr;
 
+use super::super::convert::pose_of;
 use super::super::state::{self, EndReason};
 use super::super::{DepthOptions, OpenXrError, Result, XrContext};
-use super::placement::{compose, place_scene, pose_of};
+use super::placement::{compose, place_scene};
 use super::scope::{Handed, Hold, OpenFrame, Unwind};
 use super::{INTERRUPTED, STATE_TIMEOUT, Session};
 use crate::frame::{Backend, EyeView, Fov, FrameInput, FrameTarget, Pose};

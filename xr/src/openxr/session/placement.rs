@@ -2,7 +2,6 @@
 //! re-registration commands, and the pose algebra both need.
 
 use glam::{Quat, Vec3};
-use openxr as xr;
 
 use super::super::actions::Command;
 use crate::frame::Pose;
@@ -31,20 +30,6 @@ pub(crate) fn re_register(world_from_space: &Pose, command: Command, head_m: Vec
         | Command::PlaceObject => return *world_from_space,
     };
     compose(&change, world_from_space)
-}
-
-/// A pose from OpenXR's.
-pub(super) fn pose_of(p: &xr::Posef) -> Pose {
-    Pose {
-        position: Vec3::new(p.position.x, p.position.y, p.position.z),
-        orientation: Quat::from_xyzw(
-            p.orientation.x,
-            p.orientation.y,
-            p.orientation.z,
-            p.orientation.w,
-        )
-        .normalize(),
-    }
 }
 
 /// `a` after `b`: maps `b`'s frame into `a`'s parent.

@@ -10,6 +10,7 @@ pub mod blur_stack;
 pub mod caustics;
 pub mod cli_values;
 pub mod defocus_model;
+pub mod director;
 pub mod effects;
 pub mod error_report;
 pub mod files;

@@ -43,7 +43,7 @@ pub fn stdin_edits() -> mpsc::Receiver<SceneEdit> {
     rx
 }
 
-impl RunSink {
+impl RunSink<'_> {
     /// Applies the live controls typed since the last frame; a re-registration goes to the
     /// session, which moves the world at the next frame and says so as a nudge.
     pub(super) fn apply_typed_controls(&mut self, input: &FrameInput) {

@@ -5,6 +5,7 @@
 use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::{Command, Cycle};
 
+use crate::director::Director;
 use crate::effects::EffectSet;
 use crate::gaze::GazeOverride;
 use crate::look::LookPlanner;
@@ -134,6 +135,28 @@ impl LiveLooks {
             | Command::TurnObject(_)
             | Command::PlaceObject => None,
         }
+    }
+
+    /// This frame's look as `director` decides it: its effect set (one of
+    /// [`Director::sets`], the order these looks were built in; nothing shown, a blank look,
+    /// for `None`) and its gaze image.
+    pub fn plan_directed(
+        &mut self,
+        director: &mut dyn Director,
+        input: &FrameInput,
+    ) -> vitreous_render::Look {
+        let (set, gaze) = director.next_shown(input);
+        if let Some(g) = gaze
+            && g != self.gaze()
+        {
+            self.set_gaze(g);
+        }
+        if let Some(i) = set.and_then(|s| director.sets().iter().position(|x| *x == s)) {
+            self.select(i);
+        }
+        let mut look = self.plan(input);
+        look.blank = set.is_none();
+        look
     }
 
     /// This frame's look: every planner sees the frame, the current one's look is used.

@@ -58,6 +58,7 @@ pub use summary::{GazeSamples, RunSummary};
 #[cfg(test)]
 pub(crate) use test_frame::test_frame;
 
+use crate::director::Director;
 use crate::effects::EffectSet;
 use crate::frame_log::FrameLog;
 use crate::frame_loop::{self, FramePlan, FrameSink};
@@ -67,7 +68,6 @@ use crate::output::write_atomic;
 use crate::replay::{Spread, ValidationSummary};
 use crate::scene::{CausticsMode, load_scene};
 use crate::scene_edit::SceneEdit;
-use crate::study::run::StudyStage;
 use crate::views;
 use readback::check_readback;
 use recording::{replay_check, trace_sample};
@@ -112,7 +112,7 @@ pub struct RunOptions {
 }
 
 /// Records frames and checks a readback.
-struct RunSink {
+struct RunSink<'d> {
     /// Decides each frame's look (effect condition, gaze-dependent defocus).
     looks: LiveLooks,
     /// Live commands from the session.
@@ -133,8 +133,9 @@ struct RunSink {
     recorded: Vec<FrameInput>,
     /// The per-frame log (`frames.csv` with `--out`).
     log: FrameLog,
-    /// A study's trials, deciding each frame's condition (`vitreous study run`).
-    study: Option<StudyStage>,
+    /// What decides each frame's condition and gaze image instead of the live controls (a
+    /// study's trials, `vitreous study run`).
+    director: Option<&'d mut dyn Director>,
     /// The first error writing the log, reported when the next frame finishes.
     log_error: Option<anyhow::Error>,
     /// The scene's motion (`[motion]`), from the session's first frame, with the edits.
@@ -145,7 +146,7 @@ struct RunSink {
     registrar: std::sync::mpsc::Sender<Command>,
 }
 
-impl FrameSink for RunSink {
+impl FrameSink for RunSink<'_> {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
         self.apply_typed_controls(input);
         let placement = self.motion.placement(input.time_ns)?;
@@ -172,14 +173,14 @@ impl FrameSink for RunSink {
         };
         for command in commands {
             self.record_command(command, input);
-            if let Some(study) = &mut self.study {
-                study.director.command(command);
+            if let Some(director) = &mut self.director {
+                director.command(command);
             } else if let Some(change) = self.looks.apply(command) {
                 tracing::info!("frame {}: {change}", input.index);
             }
         }
-        let mut look = match &mut self.study {
-            Some(study) => study.plan(&mut self.looks, input),
+        let mut look = match &mut self.director {
+            Some(director) => self.looks.plan_directed(*director, input),
             None => self.looks.plan(input),
         };
         look.caustics &= self.motion.caustics_valid();
@@ -203,7 +204,7 @@ impl FrameSink for RunSink {
         if let Some(e) = self.log_error.take() {
             return Err(e);
         }
-        if let Some(e) = self.study.as_mut().and_then(StudyStage::take_error) {
+        if let Some(e) = self.director.as_mut().and_then(|d| d.take_error()) {
             return Err(e);
         }
         if let Some(rb) = &result.readback {
@@ -222,22 +223,18 @@ impl FrameSink for RunSink {
 /// Runs the scene on the OpenXR runtime. Fails with a clear message when there is no runtime,
 /// no Vulkan support, a validation message, or a failed readback check.
 pub fn run(options: &RunOptions) -> Result<RunSummary> {
-    run_with(options, None).map(|(summary, _)| summary)
+    run_with(options, None)
 }
 
-/// Runs one block of a study's trials on the OpenXR runtime: the stage decides each frame's
-/// condition and gaze image, the controller's buttons answer, and the session ends once the
-/// block is answered. Returns the stage with its director's state.
-pub fn run_study_block(options: &RunOptions, stage: StudyStage) -> Result<StudyStage> {
-    let (_, stage) = run_with(options, Some(stage))?;
-    Ok(stage.expect("the study stage comes back"))
+/// Runs a session on the OpenXR runtime whose conditions and gaze images `director` decides
+/// (a block of a study's trials): the controller's buttons go to it instead of the live
+/// controls, and the session ends once it says so.
+pub fn run_directed(options: &RunOptions, director: &mut dyn Director) -> Result<()> {
+    run_with(options, Some(director)).map(|_| ())
 }
 
-/// [`run`], with a study's stage deciding the looks when given.
-fn run_with(
-    options: &RunOptions,
-    study: Option<StudyStage>,
-) -> Result<(RunSummary, Option<StudyStage>)> {
+/// [`run`], with a director deciding the looks when given.
+fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result<RunSummary> {
     let mut scene = load_scene(&options.scene)?;
     let effects = options.effects.unwrap_or(scene.effects);
     effects.ensure_implemented()?;
@@ -252,17 +249,17 @@ fn run_with(
                 .load_caustics()
                 .map_err(|e| tracing::warn!("caustic conditions not offered live: {e}"))
                 .is_ok());
-    let conditions = match &study {
-        Some(stage) => {
-            if stage.sets.iter().any(|s| s.caustics) && !caustics_loaded {
+    let conditions = match &director {
+        Some(director) => {
+            if director.sets().iter().any(|s| s.caustics) && !caustics_loaded {
                 scene.load_caustics().with_context(|| {
                     format!(
-                        "a study condition shows caustics in {}",
+                        "a directed condition (a study's) shows caustics in {}",
                         options.scene.display()
                     )
                 })?;
             }
-            stage.sets.clone()
+            director.sets().to_vec()
         }
         None => live_conditions(effects, caustics_loaded),
     };
@@ -341,7 +338,7 @@ fn run_with(
                 scene_origin: None,
                 viewer_position_m: scene.viewer.head_position_m,
                 handle_ctrl_c: true,
-                end: study.as_ref().map(StudyStage::end_flag),
+                end: director.as_ref().map(|d| d.end_flag()),
                 depth: Some(DepthOptions {
                     format: Renderer::DEPTH_FORMAT,
                     near_m: vitreous_render::camera::NEAR_M,
@@ -388,13 +385,15 @@ fn run_with(
     let world_behind = info.blend.needs_world_behind();
     let edits = {
         use std::io::IsTerminal;
-        (study.is_none() && (options.stdin_controls || std::io::stdin().is_terminal())).then(|| {
-            tracing::info!(
-                "keyboard controls on standard input, one a line: object x|y|z MM, turn DEG, \
+        (director.is_none() && (options.stdin_controls || std::io::stdin().is_terminal())).then(
+            || {
+                tracing::info!(
+                    "keyboard controls on standard input, one a line: object x|y|z MM, turn DEG, \
                  place, light x|y|z MM, register x|y|z MM"
-            );
-            controls::stdin_edits()
-        })
+                );
+                controls::stdin_edits()
+            },
+        )
     };
     let mut sink = RunSink {
         edits,
@@ -417,7 +416,7 @@ fn run_with(
         recorded: Vec::new(),
         log,
         log_error: None,
-        study,
+        director,
     };
     let started = Instant::now();
     let result = frame_loop::run(&mut session, &mut renderer, &mut sink);
@@ -554,7 +553,7 @@ fn run_with(
             None => bail!("readback check: no frame was read back (the session ended first)"),
         }
     }
-    Ok((summary, sink.study.take()))
+    Ok(summary)
 }
 
 /// `result`, unless it succeeded and `cleanup` (done after it) failed: the first error is the

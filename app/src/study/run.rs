@@ -13,13 +13,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result, bail};
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, GpuContext, Look, Reflection};
+use vitreous_render::{ContextOptions, GpuContext, Reflection};
+use vitreous_xr::openxr::Command;
 use vitreous_xr::{FrameInput, NullBackend, NullConfig};
 
 use super::answers::{Keyboard, SimulatedObserver};
 use super::plan::{PlannedTrial, read_plan};
 use super::protocol::{Protocol, Show};
 use super::session::{AnswerSources, ResponsesFile, StudyDirector, TimingLog, remaining_trials};
+use crate::director::Director;
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::gaze::GazeOverride;
@@ -83,7 +85,8 @@ pub struct StudyRunSummary {
     pub remaining: usize,
 }
 
-/// Drives a [`LiveLooks`] from a [`StudyDirector`]: the condition and gaze image of each frame.
+/// A study's trials as a session's [`Director`]: the condition and gaze image of each frame,
+/// from a [`StudyDirector`].
 pub struct StudyStage {
     /// The trials and answers.
     pub director: StudyDirector,
@@ -125,20 +128,14 @@ impl StudyStage {
             error: None,
         }
     }
+}
 
-    /// The flag set when the session should end.
-    pub fn end_flag(&self) -> Arc<AtomicBool> {
-        self.end.clone()
+impl Director for StudyStage {
+    fn sets(&self) -> &[EffectSet] {
+        &self.sets
     }
 
-    /// Whether the session should end.
-    pub fn ending(&self) -> bool {
-        self.end.load(Ordering::SeqCst)
-    }
-
-    /// What this frame shows: the effect set (`None`: nothing) and the gaze image cued
-    /// (`None` after an error, which [`StudyStage::take_error`] returns).
-    pub fn next_shown(&mut self, input: &FrameInput) -> (Option<EffectSet>, Option<GazeOverride>) {
+    fn next_shown(&mut self, input: &FrameInput) -> (Option<EffectSet>, Option<GazeOverride>) {
         let shown = match self
             .director
             .frame(input.index, input.time_ns as f64 * 1e-9)
@@ -158,24 +155,15 @@ impl StudyStage {
         (set, shown.map(|s| s.gaze))
     }
 
-    /// This frame's look, through `looks` (built for [`StudyStage::sets`], in order).
-    pub fn plan(&mut self, looks: &mut LiveLooks, input: &FrameInput) -> Look {
-        let (set, gaze) = self.next_shown(input);
-        if let Some(g) = gaze
-            && g != looks.gaze()
-        {
-            looks.set_gaze(g);
-        }
-        if let Some(i) = set.and_then(|s| self.sets.iter().position(|x| *x == s)) {
-            looks.select(i);
-        }
-        let mut look = looks.plan(input);
-        look.blank = set.is_none();
-        look
+    fn command(&mut self, command: Command) {
+        self.director.command(command);
     }
 
-    /// The first error of a frame, once.
-    pub fn take_error(&mut self) -> Option<anyhow::Error> {
+    fn end_flag(&self) -> Arc<AtomicBool> {
+        self.end.clone()
+    }
+
+    fn take_error(&mut self) -> Option<anyhow::Error> {
         self.error.take()
     }
 }
@@ -267,11 +255,11 @@ pub fn run_study(options: &StudyRunOptions) -> Result<StudyRunSummary> {
             responses,
             TimingLog::open(&timing_path)?,
         );
-        let stage = StudyStage::new(&protocol, director);
+        let mut stage = StudyStage::new(&protocol, director);
         let stage = if options.dry_run {
             dry_run_block(options, &protocol, &stimulus.scene, block.len(), stage)?
         } else if let Some(window) = options.view {
-            crate::view::view_study_block(
+            crate::view::view_directed(
                 &crate::view::ViewOptions {
                     scene: stimulus.scene.clone(),
                     window,
@@ -291,14 +279,16 @@ pub fn run_study(options: &StudyRunOptions) -> Result<StudyRunSummary> {
                     trace: options.trace.clone(),
                     record: None,
                 },
-                stage,
-            )?
+                &mut stage,
+            )?;
+            stage
         } else {
             let mut run = options.run.clone();
             run.scene = stimulus.scene.clone();
             run.frames = None;
             run.validate = options.validate;
-            crate::run::run_study_block(&run, stage)?
+            crate::run::run_directed(&run, &mut stage)?;
+            stage
         };
         let done = stage.director.done();
         summary.answered_now += stage.director.answers();
@@ -442,7 +432,7 @@ impl FrameSink for DryRunSink<'_> {
 
     fn plan(&mut self, input: &FrameInput) -> FramePlan {
         FramePlan {
-            look: self.stage.plan(&mut self.looks, input),
+            look: self.looks.plan_directed(self.stage, input),
             want: Want::default(),
         }
     }

@@ -45,6 +45,7 @@ pub use desktop::{FixationTarget, fixation_point};
 pub use input::{Action, EyesShown, InputEvent, KEYS};
 pub use script::{Script, ScriptError, Step};
 
+use crate::director::Director;
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FrameRecord};
 use crate::gaze::{FilterKind, GazeOverride};
@@ -164,25 +165,18 @@ impl ViewSummary {
 
 /// Runs a view session until the window closes, Esc, or `frames`.
 pub fn view(options: &ViewOptions) -> Result<ViewSummary> {
-    view_with(options, None).map(|(summary, _)| summary)
+    view_with(options, None)
 }
 
-/// Runs one block of a study's trials in the window (`vitreous study run --view`): the stage
-/// decides each frame's condition and gaze image, and the session ends once the block is
-/// answered (or the window closes). Returns the stage with its director's state.
-pub fn view_study_block(
-    options: &ViewOptions,
-    stage: crate::study::run::StudyStage,
-) -> Result<crate::study::run::StudyStage> {
-    let (_, stage) = view_with(options, Some(stage))?;
-    Ok(stage.expect("the study stage comes back"))
+/// Runs a view session whose conditions and gaze images `director` decides (a block of a
+/// study's trials, `vitreous study run --view`); it ends once the director says so (or the
+/// window closes).
+pub fn view_directed(options: &ViewOptions, director: &mut dyn Director) -> Result<()> {
+    view_with(options, Some(director)).map(|_| ())
 }
 
-/// [`view`], with a study's stage deciding the looks when given.
-fn view_with(
-    options: &ViewOptions,
-    study: Option<crate::study::run::StudyStage>,
-) -> Result<(ViewSummary, Option<crate::study::run::StudyStage>)> {
+/// [`view`], with a director deciding the looks when given.
+fn view_with(options: &ViewOptions, director: Option<&mut dyn Director>) -> Result<ViewSummary> {
     let script = match &options.script {
         Some(path) => Some(Script::load(path)?),
         None => None,
@@ -261,8 +255,8 @@ fn view_with(
         options.filter,
         GazeOverride::Auto,
     )?;
-    if let Some(stage) = study {
-        sink.set_study(stage);
+    if let Some(director) = director {
+        sink.set_director(director);
     }
     sink.play_edits(played_edits);
     let mut renderer = sink.make_renderer(&context_options)?;
@@ -334,5 +328,5 @@ fn view_with(
         write_atomic(&out.join("summary.json"), &json)?;
     }
     summary.validation.check(None)?;
-    Ok((summary, sink.take_study()))
+    Ok(summary)
 }

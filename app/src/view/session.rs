@@ -24,13 +24,13 @@ use super::looks::Looks;
 use super::picture::{Overlay, SeeThrough, compose};
 use super::reload::{Loaded, Watcher};
 use super::swapchain::{Presented, Presenter};
+use crate::director::Director;
 use crate::frame_loop::{FramePlan, FrameSink};
 use crate::gaze::{FilterKind, FixationDepth, GazeOverride};
 use crate::motion_clock::MotionClock;
 use crate::replay::ValidationSummary;
 use crate::scene::Scene;
 use crate::scene_edit::SceneEdit;
-use crate::study::run::StudyStage;
 
 /// How long a window keeps its new size before the renderer is made for it.
 const RESIZE_SETTLE: Duration = Duration::from_millis(200);
@@ -44,10 +44,10 @@ pub enum Request {
 }
 
 /// The sink (see the module docs).
-pub struct ViewSink {
-    /// A study's trials, deciding each frame's condition and gaze image (`vitreous study run
-    /// --view`).
-    study: Option<StudyStage>,
+pub struct ViewSink<'d> {
+    /// What decides each frame's condition and gaze image instead of the user (a study's
+    /// trials, `vitreous study run --view`).
+    director: Option<&'d mut dyn Director>,
     /// The scene shown.
     loaded: Loaded,
     /// Conditions and planners.
@@ -98,7 +98,7 @@ pub struct ViewSink {
     edits: ViewEdits,
 }
 
-impl ViewSink {
+impl<'d> ViewSink<'d> {
     /// A sink showing `loaded` in `presenter`'s window.
     pub fn new(
         options: &ViewOptions,
@@ -107,7 +107,7 @@ impl ViewSink {
         shared: Rc<RefCell<Shared>>,
         filter: Option<FilterKind>,
         gaze: GazeOverride,
-    ) -> Result<ViewSink> {
+    ) -> Result<ViewSink<'d>> {
         let looks = Looks::new(
             loaded.effects,
             loaded.caustics_loaded,
@@ -126,7 +126,7 @@ impl ViewSink {
         };
         Ok(ViewSink {
             edits: ViewEdits::new(&loaded.scene),
-            study: None,
+            director: None,
             writer,
             recorded_until_ns: None,
             gaze_images: Vec::new(),
@@ -305,19 +305,14 @@ impl ViewSink {
         self.looks.condition().to_string()
     }
 
-    /// Hands the frames' conditions and gaze images to a study's trials.
-    pub fn set_study(&mut self, stage: StudyStage) {
-        self.study = Some(stage);
-    }
-
-    /// The study's trials, once the session is over.
-    pub fn take_study(&mut self) -> Option<StudyStage> {
-        self.study.take()
+    /// Hands the frames' conditions and gaze images to `director`.
+    pub fn set_director(&mut self, director: &'d mut dyn Director) {
+        self.director = Some(director);
     }
 
     /// Applies one action of the user.
     fn act(&mut self, action: Action) -> Option<String> {
-        if self.study.is_some()
+        if self.director.is_some()
             && matches!(
                 action,
                 Action::Condition(_) | Action::NextCondition | Action::GazeOverride
@@ -461,7 +456,7 @@ impl ViewSink {
     }
 }
 
-impl FrameSink for ViewSink {
+impl FrameSink for ViewSink<'_> {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
         let keyed: Vec<SceneEdit> = {
             let mut shared = self.shared.borrow_mut();
@@ -525,8 +520,8 @@ impl FrameSink for ViewSink {
             }
         }
         let mut blank = false;
-        if let Some(study) = &mut self.study {
-            let (set, gaze) = study.next_shown(input);
+        if let Some(director) = &mut self.director {
+            let (set, gaze) = director.next_shown(input);
             if let Some(g) = gaze {
                 self.looks.set_gaze(g);
             }
@@ -557,7 +552,7 @@ impl FrameSink for ViewSink {
         if let Some(e) = self.edits.take_error() {
             return Err(e);
         }
-        if let Some(e) = self.study.as_mut().and_then(StudyStage::take_error) {
+        if let Some(e) = self.director.as_mut().and_then(|d| d.take_error()) {
             return Err(e);
         }
         let now = Instant::now();
@@ -603,6 +598,6 @@ impl FrameSink for ViewSink {
     fn stop_requested(&self) -> bool {
         self.request.is_some()
             || crate::interrupt::requested()
-            || self.study.as_ref().is_some_and(StudyStage::ending)
+            || self.director.as_ref().is_some_and(|d| d.ending())
     }
 }

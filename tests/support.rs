@@ -205,8 +205,9 @@ pub fn floor_uv(scene: &vitreous::scene::Scene, world: Vec3) -> Vec2 {
 pub struct FloorPixel {
     /// The eye (0 left, 1 right).
     pub eye: usize,
-    /// Column and row.
+    /// Column.
     pub x: u32,
+    /// Row.
     pub y: u32,
     /// Offset of its RGBA bytes in the eye image.
     pub offset: usize,

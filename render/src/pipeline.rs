@@ -412,10 +412,10 @@ pub unsafe fn begin_render_pass(
         min_depth: 0.0,
         max_depth: 1.0,
     };
-    // SAFETY: the caller's contract: `cmd` records outside a render pass, the handles are
-    // live; the pipelines bound inside set viewport and scissor dynamically.
     let device = &ctx.device;
     ctx.work.render_pass();
+    // SAFETY: the caller's contract: `cmd` records outside a render pass, the handles are
+    // live; the pipelines bound inside set viewport and scissor dynamically.
     unsafe {
         device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
         device.cmd_set_viewport(cmd, 0, &[viewport]);

@@ -139,10 +139,10 @@ impl FieldTarget {
             min_depth: 0.0,
             max_depth: 1.0,
         };
-        // SAFETY: the caller's contract; the render pass and framebuffer are this target's
-        // and compatible; the pipelines bound inside set viewport and scissor dynamically.
         let device = &ctx.device;
         ctx.work.render_pass();
+        // SAFETY: the caller's contract; the render pass and framebuffer are this target's
+        // and compatible; the pipelines bound inside set viewport and scissor dynamically.
         unsafe {
             device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
             device.cmd_set_viewport(cmd, 0, &[viewport]);

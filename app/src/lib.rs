@@ -7,16 +7,14 @@
 
 pub mod bench;
 pub mod blur_stack;
-pub mod caustics;
 pub mod cli_values;
 pub mod defocus_model;
 pub mod director;
-pub mod effects;
 pub mod error_report;
-pub mod files;
 pub mod frame_log;
 pub mod frame_loop;
 pub use vitreous_gaze as gaze;
+pub use vitreous_scene::{self as scene, caustics, effects, files};
 pub mod interrupt;
 pub mod look;
 pub mod motion_clock;
@@ -24,7 +22,6 @@ pub mod output;
 pub mod reference_view;
 pub mod replay;
 pub mod run;
-pub mod scene;
 pub mod scene_edit;
 pub mod soak;
 pub mod spread;

@@ -4,7 +4,6 @@
 //! interrupted run never leaves a half-written file under the final name.
 
 use std::fs;
-use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -16,27 +15,11 @@ use vitreous_render::Readback;
 pub const EYE_NAMES: [&str; 2] = ["left", "right"];
 
 /// Writes `bytes` to `path` through a temporary file in the same folder, renamed into place
-/// once complete and synced: an interrupted write leaves either the old file or none, never a
-/// half-written one (the temporary file is removed when the write fails).
+/// once complete and synced ([`vitreous_xr::atomic_file::write`]): an interrupted write leaves
+/// either the old file or none, never a half-written one.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    use std::os::unix::fs::PermissionsExt;
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let result = (|| -> std::io::Result<()> {
-        let mut file = tempfile::Builder::new()
-            .prefix(".vitreous-")
-            .suffix(".partial")
-            // Like a plain create: 0666 less the umask, not tempfile's private 0600.
-            .permissions(fs::Permissions::from_mode(0o666))
-            .tempfile_in(dir)?;
-        file.write_all(bytes)?;
-        file.as_file().sync_data()?;
-        file.persist(path).map_err(|e| e.error)?;
-        Ok(())
-    })();
-    result.with_context(|| format!("writing {}", path.display()))
+    vitreous_xr::atomic_file::write(path, bytes)
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 /// Refuses an output path that is one of the command's input files, before anything is

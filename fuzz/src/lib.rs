@@ -15,7 +15,7 @@ use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use vitreous::scene::{Scene, SceneError, SceneFiles};
+use vitreous_scene::{Scene, SceneError, SceneFiles};
 use vitreous_xr::trace::{TraceReader, TraceSample, TraceVersion, TraceWriter};
 
 /// Names of the targets, as in `fuzz_targets/` and `corpus/`.
@@ -60,7 +60,7 @@ pub fn trace_v1(data: &[u8]) {
 /// plan for three participants must write and read back to the same trials. The responses are
 /// parsed and, when accepted, analysed; the report (or the error) must format.
 pub fn study(data: &[u8]) {
-    use vitreous::study::{plan, protocol::Protocol, report, responses::Responses};
+    use vitreous_study::{plan, protocol::Protocol, report, responses::Responses};
     let split = data.iter().position(|&b| b == 0).unwrap_or(data.len());
     let (protocol_bytes, responses_bytes) = (&data[..split], data.get(split + 1..).unwrap_or(&[]));
     let studies = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/studies/fuzz.toml");
@@ -177,10 +177,10 @@ pub fn neon(data: &[u8]) {
     });
 }
 
-/// A caustic bake (OpenEXR): decoded with [`vitreous::caustics::decode_bake`]; an accepted
+/// A caustic bake (OpenEXR): decoded with [`vitreous_scene::caustics::decode_bake`]; an accepted
 /// bake has one finite, non-negative gain per texel.
 pub fn bake(data: &[u8]) {
-    match vitreous::caustics::decode_bake(data) {
+    match vitreous_scene::caustics::decode_bake(data) {
         Ok(bake) => {
             let texels = bake.width_px as usize * bake.height_px as usize;
             assert!(
@@ -215,7 +215,7 @@ fn check_import(
     }
 }
 
-/// Scene TOML text: loaded with [`vitreous::scene::load_scene_from`] as `scene.toml` in a
+/// Scene TOML text: loaded with [`vitreous_scene::load_scene_from`] as `scene.toml` in a
 /// folder holding the small assets of `assets/` (`model.glb`, `photo.png`, `env.hdr`). The
 /// scene and the assets are served from memory: writing and reading files each time took
 /// half of every execution.
@@ -233,7 +233,7 @@ pub fn load_scene(data: &[u8]) -> Result<Scene, SceneError> {
         scene: data,
         assets: assets(),
     };
-    vitreous::scene::load_scene_from(&files.scene_path, &files)
+    vitreous_scene::load_scene_from(&files.scene_path, &files)
 }
 
 /// The scene under test and the assets, by path.
@@ -280,10 +280,10 @@ fn assets() -> &'static HashMap<PathBuf, Vec<u8>> {
     })
 }
 
-/// glTF or GLB bytes: loaded with [`vitreous::scene::load_mesh`], external buffers resolved
+/// glTF or GLB bytes: loaded with [`vitreous_scene::load_mesh`], external buffers resolved
 /// against the same asset folder; an accepted mesh must be consistent.
 pub fn gltf(data: &[u8]) {
-    match vitreous::scene::load_mesh(data, asset_dir()) {
+    match vitreous_scene::load_mesh(data, asset_dir()) {
         Ok((mesh, _ior)) => {
             let n = mesh.positions.len();
             assert!(n > 0 && mesh.indices.len() % 3 == 0, "{mesh:?}");

@@ -223,7 +223,7 @@ fn bake_survives_its_corpus() {
 #[test]
 fn every_bake_seed_decodes() {
     every_seed("bake", |data| {
-        vitreous::caustics::decode_bake(data).map(drop)
+        vitreous_scene::caustics::decode_bake(data).map(drop)
     });
 }
 

@@ -114,6 +114,14 @@ impl Write for AtomicFile {
     }
 }
 
+/// Writes `bytes` to `path` through an [`AtomicFile`]: the old file or none is left under the
+/// name if anything fails, never a half-written one.
+pub fn write(path: impl AsRef<Path>, bytes: &[u8]) -> io::Result<()> {
+    let mut file = AtomicFile::create(path)?;
+    file.write_all(bytes)?;
+    file.commit()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

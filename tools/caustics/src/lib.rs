@@ -57,7 +57,7 @@ pub struct CausticScene {
     /// Floor: maps the unit square `[-0.5, 0.5]^2` (z = 0, local +y = photo top) onto the
     /// floor in the world; its local +z side is the visible side.
     pub world_from_floor: Mat4,
-    /// The scene's hash ([`vitreous::scene::Scene::hash`]), stored in the bake.
+    /// The scene's hash ([`vitreous_scene::Scene::hash`]), stored in the bake.
     pub scene_hash: String,
     /// Where the scene came from, for messages.
     pub source: PathBuf,
@@ -65,7 +65,7 @@ pub struct CausticScene {
 
 impl CausticScene {
     /// Takes the object (mesh placed in the world), light and floor from a loaded scene.
-    pub fn from_scene(scene: &vitreous::scene::Scene) -> Self {
+    pub fn from_scene(scene: &vitreous_scene::Scene) -> Self {
         let m = scene.object.world_from_model;
         let normal_matrix = glam::Mat3::from_mat4(m).inverse().transpose();
         let mesh = &scene.object.mesh;

@@ -110,8 +110,10 @@ fn main() -> Result<()> {
             }
             if let Some(dir) = dump_raw {
                 let raw = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-                vitreous::output::write_atomic(&dir.join("test.f32"), &raw(&t.gain))?;
-                vitreous::output::write_atomic(&dir.join("reference.f32"), &raw(&r.gain))?;
+                vitreous_xr::atomic_file::write(dir.join("test.f32"), &raw(&t.gain))
+                    .with_context(|| format!("writing {}", dir.join("test.f32").display()))?;
+                vitreous_xr::atomic_file::write(dir.join("reference.f32"), &raw(&r.gain))
+                    .with_context(|| format!("writing {}", dir.join("reference.f32").display()))?;
             }
             if t.scene_hash != r.scene_hash {
                 eprintln!("warning: the two bakes were made for different scenes");
@@ -174,7 +176,7 @@ fn run_bake(
     reference_factor: Option<u64>,
     self_check: bool,
 ) -> Result<()> {
-    let scene = vitreous::scene::load_scene(scene_path)
+    let scene = vitreous_scene::load_scene(scene_path)
         .with_context(|| format!("loading scene {}", scene_path.display()))?;
     let scene = CausticScene::from_scene(&scene);
     let out = bake_with_bar(&scene, params, "bake")?;

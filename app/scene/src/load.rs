@@ -27,7 +27,7 @@ use super::{
 use super::{file, image, mesh};
 use crate::effects::EffectSet;
 use crate::files::{DiskFiles, SceneFiles};
-use crate::gaze::{FilterKind, FilterParseError, GazeOverride, PupilSource};
+use vitreous_gaze::{FilterKind, FilterParseError, GazeOverride, PupilSource};
 
 mod object;
 

@@ -15,7 +15,7 @@ use super::plan::PlannedTrial;
 use super::protocol::{GazeCue, Protocol, Timing};
 use super::responses::{Answer, ResponseKind};
 use super::schedule::{Phase, TrialClock};
-use crate::gaze::GazeOverride;
+use vitreous_gaze::GazeOverride;
 
 /// The columns `vitreous study run` writes to a responses file.
 pub const RESPONSE_COLUMNS: &str = "participant,trial,first,second,response,stimulus";

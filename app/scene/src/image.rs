@@ -8,7 +8,7 @@ pub const MAX_IMAGE_SIZE_PX: u32 = 16384;
 
 /// Most pixels accepted in one image (2^24, e.g. 4096 x 4096 or 16384 x 1024): 64 MiB decoded
 /// as sRGB RGBA8, 256 MiB as float RGBA. The limit is by memory, not by side: with defocus on, a
-/// photo's blur stack is [`crate::defocus::STACK_SLICES`] times its decoded size (1 GiB at
+/// photo's blur stack is `STACK_SLICES` (16) times its decoded size (1 GiB at
 /// this limit).
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 24;
 

@@ -5,7 +5,7 @@ use std::io::Read;
 use std::path::Path;
 
 /// Where the scene loader reads the scene file and the assets it names
-/// ([`crate::scene::load_scene_from`]) and the caustic bake reader
+/// ([`crate::load_scene_from`]) and the caustic bake reader
 /// ([`crate::caustics::read_bake`]): the file system ([`DiskFiles`]) for every command; another
 /// implementation keeps the files in memory, as the fuzz target does.
 pub trait SceneFiles {
@@ -15,7 +15,7 @@ pub trait SceneFiles {
     fn read_bounded(&self, path: &Path, limit: u64, what: &str) -> std::io::Result<Vec<u8>>;
 }
 
-/// The file system: what [`crate::scene::load_scene`] and the bake reader read from.
+/// The file system: what [`crate::load_scene`] and the bake reader read from.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct DiskFiles;
 

@@ -27,7 +27,7 @@ pub struct Bake {
     /// Relative caustic gain G >= 0 per texel, row-major: the corrected caustic overlay is
     /// `G * L_r` (eq. 6) where `L_r` is the floor photo's linear luminance at that texel.
     pub gain: Vec<f32>,
-    /// [`crate::scene::Scene::hash`] of the scene it was baked for.
+    /// [`crate::Scene::hash`] of the scene it was baked for.
     pub scene_hash: String,
     /// The bake parameters, `key=value; ...` text.
     pub params: String,
@@ -189,7 +189,7 @@ pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError
         .non_parallel()
         .to_buffered(&mut bytes)
         .map_err(|e| write_err(e.to_string()))?;
-    crate::output::write_atomic(path, bytes.get_ref()).map_err(|e| write_err(format!("{e:#}")))
+    vitreous_xr::atomic_file::write(path, bytes.get_ref()).map_err(|e| write_err(e.to_string()))
 }
 
 /// ` (named by <scene>)` when the scene is known.

@@ -11,7 +11,7 @@ use thiserror::Error;
 use toml::Spanned;
 
 use super::responses::ResponseKind;
-use crate::effects::EffectSet;
+use vitreous_scene::effects::EffectSet;
 
 /// The longest duration any phase may have, seconds (an hour: beyond it a typo is likelier than
 /// a design).

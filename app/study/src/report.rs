@@ -274,7 +274,7 @@ pub const LEVEL_KEYS: [&str; 2] = ["0.05", "0.01"];
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::scheffe::LEVELS;
+    use crate::scheffe::LEVELS;
 
     #[test]
     fn level_keys_match_the_levels() {

@@ -7,7 +7,7 @@
 //! stimulus is shown for 3 s rounded up to whole frames.
 
 use super::protocol::{GazeCue, Timing};
-use crate::gaze::GazeOverride;
+use vitreous_gaze::GazeOverride;
 
 /// How far past a boundary a display time counts as past it, seconds.
 const PHASE_EPSILON_S: f64 = 1e-6;

@@ -1,4 +1,8 @@
-//! Scene files: TOML describing the virtual glass object, its light, the registered real
+//! vitreous-scene: scene files, their assets, effect sets and caustic bakes, loaded and
+//! checked; no device and no window, so the caustic baker and the fuzz targets read scenes
+//! and bakes without the application.
+//!
+//! A scene file is TOML describing the virtual glass object, its light, the registered real
 //! floor and background, the environment map, the viewer and the output, resolved into a
 //! [`Scene`] with every asset loaded and checked.
 //!
@@ -9,13 +13,25 @@
 //! Every error names the scene file, line, column and dotted field; asset errors also name
 //! the asset file and the decoder's reason. No input makes the loader panic.
 //!
-//! This file holds what a loaded scene is; `load.rs` reads and checks a file into one,
-//! `file.rs` is the file's raw TOML shape, `error.rs` its errors, `image.rs` and `mesh.rs`
-//! the assets, `fixation.rs` where a viewer of the scene looks.
+//! | module | what it is |
+//! |---|---|
+//! | this file | what a loaded scene is |
+//! | `load` | reads and checks a file into a [`Scene`] (`load/object.rs`: the glass object) |
+//! | `file` | the file's raw TOML shape |
+//! | `error` | the loader's errors, with file, line and field |
+//! | `image`, `mesh`, `accessor` | the assets: photos and HDRIs; glTF and OBJ meshes |
+//! | `motion` | keyframed object motion |
+//! | `fixation` | where a viewer of the scene looks (the synthetic traces' targets) |
+//! | [`effects`] | the effect sets a scene or a study condition turns on |
+//! | [`caustics`] | the caustic bake file format (eq. 6's gain map), read and written |
+//! | [`files`] | where a scene's files are read from (the disk, or a test's memory) |
 
 mod accessor;
+pub mod caustics;
+pub mod effects;
 mod error;
 mod file;
+pub mod files;
 mod fixation;
 mod image;
 mod load;
@@ -28,7 +44,7 @@ use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
 use vitreous_xr::{Fov, Pose};
 
 use crate::effects::EffectSet;
-use crate::gaze::{FilterKind, GazeOverride, PupilSource};
+use vitreous_gaze::{FilterKind, GazeOverride, PupilSource};
 
 pub use crate::files::{DiskFiles, SceneFiles};
 pub use error::{Location, SceneError};
@@ -129,7 +145,7 @@ impl Scene {
     /// for this scene (its stored hash equals [`Scene::hash`]). Errors name the file: no bake
     /// named, missing, corrupt, or made for another scene; a moving scene is refused. In live
     /// mode no file is read: the gain map is zeros of `[caustics] resolution_px`, which the
-    /// renderer fills for each pose ([`crate::views::enable_live_caustics`]).
+    /// renderer fills for each pose (`vitreous::views::enable_live_caustics`).
     pub fn load_caustics(&mut self) -> Result<(), crate::caustics::BakeError> {
         if self.caustics.mode == CausticsMode::Live {
             // The map's size; the renderer fills it for every pose.

@@ -17,7 +17,7 @@ use vitreous_render::two_surface::{
 use vitreous_xr::synth::{FixationTarget, SynthParams};
 
 use super::{Object, Scene};
-use crate::gaze::{GazeImage, ImageDistances};
+use vitreous_gaze::{GazeImage, ImageDistances};
 
 /// Index of the surface point among the targets of [`synth_params_for`] (fixated first).
 pub const SURFACE_TARGET: usize = 0;
@@ -332,9 +332,9 @@ mod tests {
 
     #[test]
     fn synthetic_targets_are_the_fixation_points_in_gaze_image_order() {
-        let scene = crate::scene::load_scene(
+        let scene = crate::load_scene(
             &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../config/scenes/visual-effects.toml"),
+                .join("../../config/scenes/visual-effects.toml"),
         )
         .expect("shipped scene");
         let p = scene.fixation_points();
@@ -458,11 +458,9 @@ mod tests {
 
     #[test]
     fn a_ball_uses_the_ball_lens_and_a_faceted_object_its_mesh() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes");
-        let mut sphere =
-            crate::scene::load_scene(&root.join("glass-sphere.toml")).expect("shipped scene");
-        let mut diamond =
-            crate::scene::load_scene(&root.join("diamond.toml")).expect("shipped scene");
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenes");
+        let mut sphere = crate::load_scene(&root.join("glass-sphere.toml")).expect("shipped scene");
+        let mut diamond = crate::load_scene(&root.join("diamond.toml")).expect("shipped scene");
         for scene in [&mut sphere, &mut diamond] {
             scene.object.refraction = Refraction::TwoSurface;
         }

@@ -7,8 +7,8 @@
 use glam::{Quat, Vec2, Vec3};
 use vitreous::caustics::{Bake, BakeError};
 use vitreous::effects::EffectSet;
+use vitreous::render_desc;
 use vitreous::scene::{CausticsMode, Image, PixelData, Scene};
-use vitreous::views;
 use vitreous_render::camera::EyeParams;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Readback, Reflection, Renderer, ScenePose};
@@ -66,7 +66,7 @@ fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], effects: &str) -> Readb
     let effects = EffectSet::parse(effects).unwrap();
     let params = FrameParams {
         eyes,
-        look: views::look(&effects, Reflection::EnvironmentFresnel),
+        look: vitreous::look::base_look(&effects, Reflection::EnvironmentFresnel),
     };
     let want = Want {
         eyes: true,
@@ -105,7 +105,7 @@ fn adds_inducer_and_caustic_gain(four_loads: bool) {
     if four_loads {
         ctx.pretend_r32_float_unfiltered();
     }
-    let mut r = Renderer::new(ctx, &views::scene_desc(&s, None), w, h).expect("renderer");
+    let mut r = Renderer::new(ctx, &render_desc::scene_desc(&s, None), w, h).expect("renderer");
     let eyes = top_down_eyes(&s);
     let none = render(&mut r, eyes, "a");
     // c, then b, then c again: the combined gain is recomputed on every switch change.
@@ -196,9 +196,9 @@ fn the_frame_that_computes_a_live_map_shows_it_as_the_next_frame_does() {
     s.load_caustics().unwrap_or_else(|e| panic!("{e}"));
     let (w, h) = (160u32, 120u32);
     let ctx = vitreous_tests::validated_context();
-    let desc = views::scene_desc(&s, None);
+    let desc = render_desc::scene_desc(&s, None);
     let mut r = Renderer::new(ctx, &desc, w, h).expect("renderer");
-    views::enable_live_caustics(&mut r, &s, true).expect("live caustics");
+    render_desc::enable_live_caustics(&mut r, &s, true).expect("live caustics");
     let eyes = top_down_eyes(&s);
     let lit = |frame: &Readback| {
         frame.eyes[0]

@@ -11,9 +11,9 @@ use vitreous::frame_loop::{self, FramePlan, FrameSink};
 use vitreous::gaze::blur::blur_reference;
 use vitreous::gaze::{GazeConfig, GazeImage};
 use vitreous::look::LookPlanner;
+use vitreous::render_desc;
 use vitreous::scene::{Image, PixelData, Scene, gaze_image_of_target, load_scene};
 use vitreous::trace_cmd::synth_params_for;
-use vitreous::views;
 use vitreous_render::reference::{RefractionSample, refraction_sample};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{Defocus, Look, Reflection, Renderer};
@@ -52,12 +52,13 @@ fn srgb_to_linear(b: u8) -> f32 {
 /// Renders one stereo frame of `scene` with `look`; returns the eye images.
 fn render(scene: &Scene, setup: &DefocusSetup, input: &FrameInput, look: Look) -> [Vec<u8>; 2] {
     let ctx = vitreous_tests::validated_context();
-    let mut renderer = Renderer::new(ctx, &views::scene_desc(scene, Some(setup)), W, H).unwrap();
+    let mut renderer =
+        Renderer::new(ctx, &render_desc::scene_desc(scene, Some(setup)), W, H).unwrap();
     let want = Want {
         eyes: true,
         world: false,
     };
-    let readback = render_once(&mut renderer, &views::frame_params(input, look), want);
+    let readback = render_once(&mut renderer, &render_desc::frame_params(input, look), want);
     let v = renderer.context().validation();
     assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
     readback.eyes
@@ -125,7 +126,7 @@ fn refracted_blur_matches_the_literal_convolution() {
             / grey.len() as f32;
         let sphere = vitreous::reference_view::sphere_of(&scene);
         let size = Vec2::new(W as f32, H as f32);
-        let camera = views::eye_params(&input.views[0]);
+        let camera = render_desc::eye_params(&input.views[0]);
         let (mut err, mut n) = (0.0f64, 0usize);
         for y in 0..H {
             for x in 0..W {
@@ -239,7 +240,7 @@ fn sharpness_by_gaze(scene: &Scene) -> Vec<(GazeImage, f64)> {
         .collect();
     assert!(images.contains(&GazeImage::Surface) && images.contains(&GazeImage::Refracted));
     let effects = vitreous::effects::EffectSet::parse("O5").unwrap();
-    let mut look = views::look(&effects, Reflection::EnvironmentFresnel);
+    let mut look = vitreous::look::base_look(&effects, Reflection::EnvironmentFresnel);
     look.reflection = Reflection::EnvironmentFresnel;
     // The scene's filter (eq. 15, whose 20-sample mean the frames above wait for).
     let config = GazeConfig {
@@ -264,7 +265,8 @@ fn sharpness_by_gaze(scene: &Scene) -> Vec<(GazeImage, f64)> {
     )
     .unwrap();
     let ctx = vitreous_tests::validated_context();
-    let mut renderer = Renderer::new(ctx, &views::scene_desc(scene, Some(&setup)), W, H).unwrap();
+    let mut renderer =
+        Renderer::new(ctx, &render_desc::scene_desc(scene, Some(&setup)), W, H).unwrap();
     frame_loop::run(&mut backend, &mut renderer, &mut sink).unwrap();
     let v = renderer.context().validation();
     assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());

@@ -10,8 +10,8 @@
 
 use glam::{Quat, Vec2, Vec3};
 use vitreous::output::see_through;
+use vitreous::render_desc;
 use vitreous::scene::{Image, PixelData, Scene};
-use vitreous::views;
 use vitreous_render::camera::EyeParams;
 use vitreous_render::floor::{self, InducerFields};
 use vitreous_render::renderer::Want;
@@ -297,7 +297,7 @@ fn glass_sphere_preview_shows_a_shadow_on_the_real_floor() {
     let (w, h) = (640u32, 480u32);
     let mut r = scene_renderer(&s, w, h);
     let head = s.viewer.head_position_m;
-    let fov = views::render_fov(s.output.fov);
+    let fov = render_desc::render_fov(s.output.fov);
     let eyes = s
         .viewer
         .eye_positions_m(&vitreous_xr::Pose {

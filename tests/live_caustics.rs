@@ -5,8 +5,8 @@
 use std::time::Instant;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
+use vitreous::render_desc;
 use vitreous::scene::load_scene;
-use vitreous::views;
 use vitreous_render::floor::LiveCausticsDesc;
 use vitreous_render::{Renderer, ScenePose};
 use vitreous_tests::{shipped_scene, workspace};
@@ -68,7 +68,7 @@ fn the_moving_light_scenes_settings_match_the_bake_too() {
 #[test]
 fn live_settings_out_of_range_are_refused() {
     let scene = baked_scene("glass-sphere.toml");
-    let desc = views::scene_desc(&scene, None);
+    let desc = render_desc::scene_desc(&scene, None);
     let mut renderer =
         Renderer::new(vitreous_tests::validated_context(), &desc, 32, 32).expect("renderer");
     let good = LiveCausticsDesc::default();
@@ -316,7 +316,7 @@ fn live_caustics_follow_the_object() {
     // object's model space, so a move that did not reach them would leave the map in place.
     let (scene, _) = live_scene("diamond.toml", None);
     let side = scene.caustics.resolution_px as usize;
-    let rest = ScenePose::of(&views::scene_desc(&scene, None));
+    let rest = ScenePose::of(&render_desc::scene_desc(&scene, None));
     let texels = 50;
     let shift = Vec3::X * scene.floor.size_m.x * texels as f32 / side as f32;
     let moved = ScenePose {

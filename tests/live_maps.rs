@@ -6,8 +6,8 @@
 use std::time::Instant;
 
 use glam::{Quat, Vec2, Vec3};
+use vitreous::render_desc;
 use vitreous::scene::Scene;
-use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::floor::LiveCausticsDesc;
 use vitreous_render::renderer::Want;
@@ -83,7 +83,7 @@ pub(crate) fn live_gains(
     lights: &[Option<Vec3>],
     fields_first: bool,
 ) -> Vec<LiveFrame> {
-    let rest = ScenePose::of(&views::scene_desc(scene, None));
+    let rest = ScenePose::of(&render_desc::scene_desc(scene, None));
     let poses: Vec<_> = lights
         .iter()
         .map(|light| {
@@ -104,7 +104,7 @@ pub(crate) fn live_gains_at(
     fields_first: bool,
 ) -> Vec<LiveFrame> {
     let ctx = vitreous_tests::validated_context();
-    let desc = views::scene_desc(scene, None);
+    let desc = render_desc::scene_desc(scene, None);
     let mut renderer = Renderer::new(ctx, &desc, 32, 32).expect("renderer");
     renderer
         .enable_live_caustics(&desc, live)

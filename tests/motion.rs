@@ -6,9 +6,9 @@
 
 use glam::{DVec2, Quat, Vec2, Vec3};
 use vitreous::effects::EffectSet;
+use vitreous::render_desc;
 use vitreous::replay::{ReplayOptions, replay};
 use vitreous::scene::{Placement, Scene, load_scene};
-use vitreous::views;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::floor::InducerFields;
 use vitreous_render::renderer::Want;
@@ -66,7 +66,7 @@ fn inducer_fields_follow_the_circling_light() {
     placements.push((4.5, moved));
     for (time_s, placement) in placements {
         let center = placement.object_position_m;
-        renderer.set_pose(views::scene_pose(&scene, &placement));
+        renderer.set_pose(render_desc::scene_pose(&scene, &placement));
         let fields: InducerFields = renderer.inducer_fields().expect("fields");
         let light = placement.light_position_m;
         let (gpu, gpu_count) = centroid(n, |x, y| fields.mask[fields.index(x, y)] == 1);
@@ -130,7 +130,7 @@ fn fields_and_eyes(
         object_position_m: position,
         ..scene.rest_placement()
     };
-    renderer.set_pose(views::scene_pose(scene, &placement));
+    renderer.set_pose(render_desc::scene_pose(scene, &placement));
     let above = scene.floor.pose.position + Vec3::Y;
     let fov = Fov {
         left_rad: -0.55,
@@ -217,7 +217,7 @@ fn fields_are_clear_while_the_light_is_below_the_floor_and_come_back_after() {
         ..rest
     };
     assert!(below.light_position_m.y < scene.floor.pose.position.y);
-    renderer.set_pose(views::scene_pose(&scene, &below));
+    renderer.set_pose(render_desc::scene_pose(&scene, &below));
     let dark = renderer.inducer_fields().expect("fields");
     assert!(dark.rect.is_none(), "{:?}", dark.rect);
     assert!(
@@ -234,7 +234,7 @@ fn fields_are_clear_while_the_light_is_below_the_floor_and_come_back_after() {
             .all(|&d| d == vitreous_render::floor::FAR_M),
         "distances without a shadow"
     );
-    renderer.set_pose(views::scene_pose(&scene, &rest));
+    renderer.set_pose(render_desc::scene_pose(&scene, &rest));
     let back = renderer.inducer_fields().expect("fields");
     assert!(back.mask == lit.mask && back.distance_m == lit.distance_m && back.gain == lit.gain);
     assert_eq!(renderer.inducer_computations(), 3);
@@ -259,7 +259,7 @@ fn glass_follows_the_object_from_the_frame_its_pose_is_set() {
     };
     for time_s in [0.0, 2.0, 4.0] {
         let placement = scene.placement_at(time_s);
-        renderer.set_pose(views::scene_pose(&scene, &placement));
+        renderer.set_pose(render_desc::scene_pose(&scene, &placement));
         let frame = render_once(
             &mut renderer,
             &params,

@@ -4,9 +4,9 @@
 use std::path::Path;
 
 use glam::Vec2;
+use vitreous::render_desc::eye_params;
 use vitreous::replay::{ReplayOptions, replay};
 use vitreous::scene::load_scene;
-use vitreous::views::eye_params;
 use vitreous_tests::{lit_centroid, workspace};
 use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};

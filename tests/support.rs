@@ -82,7 +82,7 @@ pub fn scene_renderer(
     width: u32,
     height: u32,
 ) -> vitreous_render::Renderer {
-    let desc = vitreous::views::scene_desc(scene, None);
+    let desc = vitreous::render_desc::scene_desc(scene, None);
     vitreous_render::Renderer::new(validated_context(), &desc, width, height).expect("renderer")
 }
 

@@ -6,27 +6,19 @@
 //! defocus maths) in `vitreous-gaze`, re-exported here as [`gaze`].
 
 pub mod bench;
-pub mod blur_stack;
 pub mod cli_values;
-pub mod defocus_model;
-pub mod director;
 pub mod error_report;
-pub mod frame_log;
-pub mod frame_loop;
+pub use vitreous_frames::{
+    blur_stack, conditions, defocus_model, director, frame_log, frame_loop, interrupt, look,
+    motion_clock, output, reference_view, render_desc, scene_edit, setup, spread, test_frame,
+    validation,
+};
 pub use vitreous_gaze as gaze;
 pub use vitreous_scene::{self as scene, caustics, effects, files};
-pub mod interrupt;
-pub mod look;
-pub mod motion_clock;
-pub mod output;
-pub mod reference_view;
 pub mod replay;
 pub mod run;
-pub mod scene_edit;
 pub mod soak;
-pub mod spread;
 pub mod study;
 pub mod trace_analyze;
 pub mod trace_cmd;
 pub mod view;
-pub mod views;

@@ -19,9 +19,9 @@ use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::look::LookPlanner;
 use crate::look::{GazeSettings, planner_for};
 use crate::motion_clock::MotionClock;
-use crate::replay::{check_size, load_trace};
+use crate::render_desc;
 use crate::scene::load_scene;
-use crate::views;
+use crate::setup::{check_size, load_trace};
 
 /// Passes left out of the memory comparison: the first passes grow the allocator's pools and
 /// the driver's shader caches.
@@ -287,12 +287,12 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
                 )?;
                 let mut renderer = Renderer::new(
                     ctx,
-                    &views::scene_desc(&scene, defocus.as_ref()),
+                    &render_desc::scene_desc(&scene, defocus.as_ref()),
                     options.size.0,
                     options.size.1,
                 )
                 .context("preparing the renderer")?;
-                views::enable_live_caustics(&mut renderer, &scene, effects.caustics)
+                render_desc::enable_live_caustics(&mut renderer, &scene, effects.caustics)
                     .context("preparing live caustics")?;
                 messages_before = 0;
                 current.insert((renderer, planner))

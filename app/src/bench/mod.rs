@@ -23,9 +23,10 @@ use crate::effects::EffectSet;
 use crate::gaze::GazeConfig;
 use crate::gaze::blur::check_pupil_diameter_m;
 use crate::look::{DefocusModel, LookPlanner};
-use crate::replay::{Spread, check_size};
+use crate::render_desc;
 use crate::scene::{CausticsMode, load_scene, synth_params_for};
-use crate::views;
+use crate::setup::check_size;
+use crate::spread::Spread;
 
 pub use counts::{WorkCounts, mean_counts};
 
@@ -219,7 +220,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     // gaze pipeline over the same views.
     let mut variants = Vec::new();
     for set in &sets {
-        let base = views::look(set, options.reflection);
+        let base = crate::look::base_look(set, options.reflection);
         let variant = |label: String, planner: LookPlanner| Variant {
             label,
             planner,
@@ -287,9 +288,9 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     let (device, driver) = (ctx.device_name.clone(), ctx.driver.clone());
     let (w, h) = options.size;
     let any_caustics = options.effects.iter().any(|set| set.caustics);
-    let mut renderer = Renderer::new(ctx, &views::scene_desc(&scene, setup.as_ref()), w, h)
+    let mut renderer = Renderer::new(ctx, &render_desc::scene_desc(&scene, setup.as_ref()), w, h)
         .context("preparing the renderer")?;
-    views::enable_live_caustics(&mut renderer, &scene, any_caustics)
+    render_desc::enable_live_caustics(&mut renderer, &scene, any_caustics)
         .context("preparing live caustics")?;
     // The same scene with caustics computed per pose, on the scene's live map
     // (`[caustics] resolution_px`, `smoothing_px`, `photons_per_side`).
@@ -303,9 +304,10 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 device_name: options.device.clone(),
             })
             .context("setting up the second Vulkan device")?;
-            let mut r = Renderer::new(ctx, &views::scene_desc(&live, setup.as_ref()), w, h)
+            let mut r = Renderer::new(ctx, &render_desc::scene_desc(&live, setup.as_ref()), w, h)
                 .context("preparing the live-caustics renderer")?;
-            views::enable_live_caustics(&mut r, &live, true).context("preparing live caustics")?;
+            render_desc::enable_live_caustics(&mut r, &live, true)
+                .context("preparing live caustics")?;
             Some(r)
         }
         (true, _) => bail!(
@@ -322,9 +324,9 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             device_name: options.device.clone(),
         })
         .context("setting up the second Vulkan device")?;
-        let mut r = Renderer::new(ctx, &views::scene_desc(&two, setup.as_ref()), w, h)
+        let mut r = Renderer::new(ctx, &render_desc::scene_desc(&two, setup.as_ref()), w, h)
             .context("preparing the two-surface renderer")?;
-        views::enable_live_caustics(&mut r, &two, any_caustics)
+        render_desc::enable_live_caustics(&mut r, &two, any_caustics)
             .context("preparing live caustics")?;
         Some(r)
     } else {
@@ -374,9 +376,9 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                     light_position_m: center + turn * (rest.light_position_m - center),
                     ..rest
                 };
-                renderer.set_pose(views::scene_pose(&scene, &placement));
+                renderer.set_pose(render_desc::scene_pose(&scene, &placement));
             }
-            let params = views::frame_params(input, look);
+            let params = render_desc::frame_params(input, look);
             renderer.submit(&params, Want::default())?;
             let result = renderer.flush()?.pop().expect("one frame in flight");
             let wall_ms = started.elapsed().as_secs_f64() * 1e3;

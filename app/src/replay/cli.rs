@@ -4,12 +4,13 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use super::{GazeSettings, ReplayOptions, check_size, replay};
+use super::{GazeSettings, ReplayOptions, replay};
 use crate::cli_values::{
     ReflectionArg, parse_effects, parse_frame_count, parse_pupil_mm, parse_size,
 };
 use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, GazeOverride, PupilSource};
+use crate::setup::check_size;
 
 /// Options of `vitreous replay` (docs/cli.md).
 #[derive(clap::Args, Debug)]

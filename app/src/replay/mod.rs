@@ -14,7 +14,7 @@ use vitreous_render::{
 };
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::trace::{EditRecord, TraceSample, read_trace_with_edits};
+use vitreous_xr::trace::{EditRecord, TraceSample};
 
 use crate::effects::EffectSet;
 use crate::frame_log::FrameLog;
@@ -24,12 +24,13 @@ use crate::look::LookPlanner;
 use crate::motion_clock::MotionClock;
 use crate::output::{self, write_atomic};
 use crate::reference_view::side_by_side;
+use crate::render_desc;
 use crate::scene::{Scene, load_scene};
-pub use crate::spread::Spread;
-use crate::trace_cmd::synth_params_for;
-use crate::views;
+use crate::setup::{check_size, load_trace_with_edits};
+use crate::spread::Spread;
+use crate::validation::ValidationSummary;
 use summary::UnfinishedSummary;
-pub use summary::{ReplaySummary, RunStatus, ValidationSummary};
+pub use summary::{ReplaySummary, RunStatus};
 
 mod cli;
 mod summary;
@@ -71,9 +72,6 @@ pub struct ReplayOptions {
     /// Depth filter and gaze-image override of the gaze pipeline (used with defocus).
     pub gaze: GazeSettings,
 }
-
-/// The largest eye image side accepted, pixels.
-pub const MAX_SIZE_PX: u32 = 8192;
 
 /// Saves chosen frames while the loop runs.
 struct Saver<'a> {
@@ -128,7 +126,7 @@ impl OtherRefraction {
             world: false,
         };
         self.renderer
-            .submit(&views::frame_params(input, look), want)
+            .submit(&render_desc::frame_params(input, look), want)
             .context("drawing the frame under the other refraction model")?;
         let results = self.renderer.flush()?;
         Ok(results
@@ -221,37 +219,6 @@ impl FrameSink for Saver<'_> {
     }
 }
 
-/// Loads the trace or synthesises one for the scene.
-pub(crate) fn load_trace(
-    scene: &Scene,
-    trace: Option<&Path>,
-) -> Result<(Vec<TraceSample>, String)> {
-    load_trace_with_edits(scene, trace).map(|(samples, _, name)| (samples, name))
-}
-
-/// Loads the trace, with its scene edits, or synthesises one (without edits) for the scene.
-pub(crate) fn load_trace_with_edits(
-    scene: &Scene,
-    trace: Option<&Path>,
-) -> Result<(Vec<TraceSample>, Vec<EditRecord>, String)> {
-    match trace {
-        Some(path) => {
-            let (samples, edits) = read_trace_with_edits(path).context("reading the trace")?;
-            if samples.is_empty() {
-                bail!("trace {} has no samples: nothing to replay", path.display());
-            }
-            Ok((samples, edits, path.display().to_string()))
-        }
-        None => {
-            tracing::info!("no --trace given: replaying a synthetic trace for the scene");
-            let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(scene))
-                .context("synthesising a trace for the scene")?
-                .samples;
-            Ok((samples, Vec::new(), "synthetic".into()))
-        }
-    }
-}
-
 /// Runs a replay. All input is checked before anything is written.
 pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     let mut scene = load_scene(&options.scene)?;
@@ -303,12 +270,12 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         crate::look::planner_for(&scene, &effects, options.reflection, &options.gaze)?;
     let mut renderer = Renderer::new(
         ctx,
-        &views::scene_desc(&scene, defocus.as_ref()),
+        &render_desc::scene_desc(&scene, defocus.as_ref()),
         width,
         height,
     )
     .context("preparing the renderer")?;
-    views::enable_live_caustics(&mut renderer, &scene, effects.caustics)
+    render_desc::enable_live_caustics(&mut renderer, &scene, effects.caustics)
         .context("preparing live caustics")?;
     let other = if options.reference {
         let mut other_scene = scene.clone();
@@ -323,12 +290,12 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         .context("setting up the second Vulkan device")?;
         let mut r = Renderer::new(
             ctx,
-            &views::scene_desc(&other_scene, defocus.as_ref()),
+            &render_desc::scene_desc(&other_scene, defocus.as_ref()),
             width,
             height,
         )
         .context("preparing the renderer of the other refraction model")?;
-        views::enable_live_caustics(&mut r, &other_scene, effects.caustics)
+        render_desc::enable_live_caustics(&mut r, &other_scene, effects.caustics)
             .context("preparing live caustics")?;
         Some(OtherRefraction {
             renderer: r,
@@ -458,14 +425,6 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         .validation
         .check(Some(&options.out.join("summary.json")))?;
     Ok(summary)
-}
-
-/// Refuses eye image sizes the renderer cannot or should not take.
-pub fn check_size(width: u32, height: u32) -> Result<()> {
-    if !(16..=MAX_SIZE_PX).contains(&width) || !(16..=MAX_SIZE_PX).contains(&height) {
-        bail!("eye image size {width}x{height} is outside 16..={MAX_SIZE_PX} pixels per side");
-    }
-    Ok(())
 }
 
 /// Most frames a replay renders without an explicit `--frames` (about 4.6 hours at 60 Hz): a

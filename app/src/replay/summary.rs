@@ -2,54 +2,13 @@
 //! after it failed, a short summary that says so.
 
 use serde::Serialize;
-use vitreous_render::GpuContext;
 
 use crate::frame_log::PupilSummary;
 use crate::frame_loop::FrameRecord;
 use crate::gaze::separability::SeparabilitySummary;
 use crate::motion_clock::FinalPlacement;
 use crate::spread::Spread;
-
-/// Validation layer results.
-#[derive(Clone, Debug, Serialize)]
-pub struct ValidationSummary {
-    /// Whether the layers were on.
-    pub enabled: bool,
-    /// Warning messages.
-    pub warnings: u32,
-    /// Error messages.
-    pub errors: u32,
-    /// The first messages' texts.
-    pub messages: Vec<String>,
-}
-
-impl ValidationSummary {
-    /// What the validation layers reported on `ctx`'s device so far.
-    pub fn of(ctx: &GpuContext) -> ValidationSummary {
-        let v = ctx.validation();
-        ValidationSummary {
-            enabled: ctx.validation_enabled(),
-            warnings: v.warnings(),
-            errors: v.errors(),
-            messages: v.messages(),
-        }
-    }
-
-    /// An error when the layers reported anything: the counts, the first message, and
-    /// `summary` (the file the rest is in), when there is one.
-    pub fn check(&self, summary: Option<&std::path::Path>) -> anyhow::Result<()> {
-        if self.errors + self.warnings == 0 {
-            return Ok(());
-        }
-        let see = summary.map_or(String::new(), |p| format!(" (see {})", p.display()));
-        anyhow::bail!(
-            "the Vulkan validation layers reported {} errors and {} warnings{see}, first: {}",
-            self.errors,
-            self.warnings,
-            self.messages.first().map(String::as_str).unwrap_or("")
-        )
-    }
-}
+use crate::validation::ValidationSummary;
 
 /// How a replay ended, as `summary.json` says it. Anything but `complete` means the output
 /// folder holds only part of the run.

@@ -68,7 +68,7 @@ pub struct RunArgs {
 pub fn run_command(args: RunArgs) -> Result<()> {
     // Before the runtime starts (which would clamp it to what it offers, silently).
     if let Some((w, h)) = args.size {
-        crate::replay::check_size(w, h)?;
+        crate::setup::check_size(w, h)?;
     }
     if let Some(record) = &args.record {
         let mut inputs = vec![args.scene.as_path()];

@@ -4,7 +4,7 @@
 //! renderer's Vulkan instance and device created *through* it ([`XrDeviceCreator`]), then the
 //! session on that device, whose swapchain images the renderer draws into. Teardown is the
 //! reverse: the renderer lets go of the swapchain images, the session goes, then the device,
-//! then the OpenXR instance.
+//! then the OpenXR instance; [`XrSession`] owns the four and keeps that order itself.
 //!
 //! The loop is the shared one ([`crate::frame_loop`]) plus one hook: each frame is drawn where
 //! [`Backend::frame_target`](vitreous_xr::Backend::frame_target) says (the renderer's own
@@ -13,24 +13,22 @@
 //! Live actions (controller buttons, see `vitreous_xr::openxr::actions`) re-register the scene
 //! in the session itself; the commands that change the look reach the sink through
 //! [`Session::take_commands`](vitreous_xr::openxr::Session::take_commands) and are applied
-//! by [`LiveLooks`]: the next effect condition among those this build implements, and the
+//! by [`LiveConditions`]: the next effect condition among those this build implements, and the
 //! forced gaze image (surface, refracted, auto).
 //!
-//! Parts: `cli.rs` (the command line), `device.rs` (Vulkan through the runtime), `live.rs`
-//! (conditions and live commands), `readback.rs` (the readback check), `recording.rs` (the
-//! recorded trace and its replay check), `summary.rs` (what the run reports), `test_frame.rs`
-//! (a frame for the crate's tests); this file sets the session up, runs it and writes the
-//! summary.
+//! Parts: `cli.rs` (the command line), `controls.rs` (keyboard edits), `device.rs` (Vulkan
+//! through the runtime), `xr_session.rs` (runtime, renderer and session owned together),
+//! `readback.rs` (the readback check), `recording.rs` (the recorded trace and its replay
+//! check), `summary.rs` (what the run reports); the conditions and live commands are
+//! `vitreous_frames::conditions`. This file sets the session up, runs it and writes the summary.
 
 mod cli;
 mod controls;
 mod device;
-mod live;
 mod readback;
 mod recording;
 mod summary;
-#[cfg(test)]
-mod test_frame;
+mod xr_session;
 
 use std::fs;
 use std::path::PathBuf;
@@ -38,25 +36,27 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer};
+use vitreous_render::{ContextOptions, Reflection, Renderer};
 use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::ash::vk;
 use vitreous_xr::openxr::{
     Blend, Command, DepthOptions, GazeChoice, GazeSource, OpenXrOptions, Runtime, SessionOptions,
-    SessionReport, State, VulkanHandles,
+    SessionReport, State,
 };
 use vitreous_xr::trace::{TraceVersion, TraceWriter};
 
+pub use crate::conditions::{
+    CONDITION_CYCLE, GAZE_IMAGE_CYCLE, LiveConditions, STUDY_CONDITIONS, live_conditions,
+};
+#[cfg(test)]
+pub(crate) use crate::test_frame::test_frame;
 pub use cli::{RunArgs, run_command};
 pub use device::XrDeviceCreator;
-pub use live::{CONDITION_CYCLE, GAZE_IMAGE_CYCLE, LiveLooks, STUDY_CONDITIONS, live_conditions};
 pub use readback::{
     AWAY_RADII, LIT_THRESHOLD, MIN_AWAY_FRACTION, MIN_OBJECT_FRACTION, ReadbackCheck,
 };
 pub use recording::ReplayCheck;
 pub use summary::{GazeSamples, RunSummary};
-#[cfg(test)]
-pub(crate) use test_frame::test_frame;
 
 use crate::director::Director;
 use crate::effects::EffectSet;
@@ -65,12 +65,14 @@ use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::look::{GazeSettings, planners_for};
 use crate::motion_clock::MotionClock;
 use crate::output::write_atomic;
-use crate::replay::{Spread, ValidationSummary};
+use crate::render_desc;
 use crate::scene::{CausticsMode, load_scene};
 use crate::scene_edit::SceneEdit;
-use crate::views;
+use crate::spread::Spread;
+use crate::validation::ValidationSummary;
 use readback::check_readback;
 use recording::{replay_check, trace_sample};
+pub use xr_session::{Closed, XrSession};
 
 /// Options of `vitreous run`.
 #[derive(Clone, Debug, Default)]
@@ -114,7 +116,7 @@ pub struct RunOptions {
 /// Records frames and checks a readback.
 struct RunSink<'d> {
     /// Decides each frame's look (effect condition, gaze-dependent defocus).
-    looks: LiveLooks,
+    looks: LiveConditions,
     /// Live commands from the session.
     commands: Option<std::sync::mpsc::Receiver<Command>>,
     /// Frame to read back, if any.
@@ -271,7 +273,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             .collect::<Vec<_>>()
             .join(" > ")
     );
-    let mut runtime = Runtime::new(&OpenXrOptions {
+    let runtime = Runtime::new(&OpenXrOptions {
         blend: options.blend,
         validation: options.validate,
         size: options.size,
@@ -291,26 +293,6 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         info.max_size.0,
         info.max_size.1
     );
-    let ctx = GpuContext::new(
-        &ContextOptions {
-            validation: options.validate,
-            device_name: None,
-        },
-        &mut XrDeviceCreator {
-            runtime: &mut runtime,
-        },
-        &[],
-        &[],
-    )
-    .context("setting up the Vulkan device through the OpenXR runtime")?;
-    let device = format!("{} ({})", ctx.device_name, ctx.driver);
-    let handles = VulkanHandles {
-        instance: ctx.instance.handle(),
-        physical: ctx.physical,
-        device: ctx.device.handle(),
-        queue_family: ctx.queue_family,
-        queue_index: 0,
-    };
     let (planners, defocus) = planners_for(
         &scene,
         &conditions,
@@ -321,50 +303,44 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             ..GazeSettings::default()
         },
     )?;
-    let mut renderer = views::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
-    views::enable_live_caustics(&mut renderer, &scene, caustics_loaded)
-        .context("preparing live caustics")?;
+    let mut xr = XrSession::start(
+        runtime,
+        &ContextOptions {
+            validation: options.validate,
+            device_name: None,
+        },
+        |ctx| {
+            let mut renderer =
+                render_desc::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
+            render_desc::enable_live_caustics(&mut renderer, &scene, caustics_loaded)
+                .context("preparing live caustics")?;
+            Ok(renderer)
+        },
+        &SessionOptions {
+            max_frames: options.frames,
+            gaze_trace: options.gaze_trace.clone(),
+            gaze: options.gaze,
+            scene_origin: None,
+            viewer_position_m: scene.viewer.head_position_m,
+            handle_ctrl_c: true,
+            end: director.as_ref().map(|d| d.end_flag()),
+            depth: Some(DepthOptions {
+                format: Renderer::DEPTH_FORMAT,
+                near_m: vitreous_render::camera::NEAR_M,
+                far_m: vitreous_render::camera::FAR_M,
+            }),
+        },
+    )?;
+    // The blur stacks are on the GPU now.
     drop(defocus);
-    // SAFETY: `handles` are the instance, device and queue this runtime created for the
-    // renderer's context (XrDeviceCreator); the renderer owns them and outlives `session`,
-    // which is dropped before it at the end of this function.
-    let (mut session, images) = unsafe {
-        runtime.start(
-            handles,
-            &SessionOptions {
-                max_frames: options.frames,
-                gaze_trace: options.gaze_trace.clone(),
-                gaze: options.gaze,
-                scene_origin: None,
-                viewer_position_m: scene.viewer.head_position_m,
-                handle_ctrl_c: true,
-                end: director.as_ref().map(|d| d.end_flag()),
-                depth: Some(DepthOptions {
-                    format: Renderer::DEPTH_FORMAT,
-                    near_m: vitreous_render::camera::NEAR_M,
-                    far_m: vitreous_render::camera::FAR_M,
-                }),
-            },
-        )
-    }
-    .context("starting the OpenXR session")?;
-    if !images.srgb {
-        bail!(
-            "the runtime offers only UNORM swapchain formats; vitreous renders into sRGB images \
-             only for now (VkFormat {:?})",
-            images.format
-        );
-    }
-    // SAFETY: the images are the session's swapchain images, made on the renderer's device;
-    // the session (which owns them) is dropped only after the renderer detaches them.
-    unsafe {
-        renderer.attach_external_with_depth(&images.images, images.format, &images.depth_images)
-    }
-    .context("using the swapchain images")?;
+    let device = {
+        let ctx = xr.parts().1.context();
+        format!("{} ({})", ctx.device_name, ctx.driver)
+    };
 
     // A tracker that reports its confidence and gaze behaviour records version 1.3 from the
     // first line, even if its first frame brings no sample.
-    let version = match session.report().gaze_source {
+    let version = match xr.session().report().gaze_source {
         Some(GazeSource::MlEyeTracker) => TraceVersion::V1_3,
         _ => TraceVersion::V1_2,
     };
@@ -397,12 +373,12 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
     };
     let mut sink = RunSink {
         edits,
-        registrar: session.command_sender(),
-        looks: LiveLooks::new(
+        registrar: xr.session().command_sender(),
+        looks: LiveConditions::new(
             conditions.iter().copied().zip(planners).collect(),
             scene.gaze.image,
         ),
-        commands: session.take_commands(),
+        commands: xr.session().take_commands(),
         // Late enough for the pipelines to be warm and the head to have moved.
         readback_frame: options
             .readback_check
@@ -419,28 +395,26 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         director,
     };
     let started = Instant::now();
-    let result = frame_loop::run(&mut session, &mut renderer, &mut sink);
+    let (session, renderer) = xr.parts();
+    let result = frame_loop::run(session, renderer, &mut sink);
     let wall_s = started.elapsed().as_secs_f64();
-    // Teardown order: images out of the renderer, then the session, then (at the end) the
-    // device with the renderer, then the OpenXR instance.
     // The loop's error is the one reported; a clean-up failing after it (releasing the images
     // of a lost device) is logged.
-    let detached = renderer
-        .detach_external()
-        .context("releasing the swapchain images");
-    let report: SessionReport = session.report().clone();
-    drop(session);
-    let closed = match sink.writer.take() {
+    let format = xr.format();
+    let closed = xr.close(|renderer| {
+        (
+            renderer.inducer_computations(),
+            ValidationSummary::of(renderer.context()),
+        )
+    });
+    let report: SessionReport = closed.report;
+    let (inducer_computations, validation) = closed.after;
+    let recording_closed = match sink.writer.take() {
         Some(w) => w.finish().map(drop).context("closing the recording"),
         None => Ok(()),
     };
-    let records = first_error(first_error(result, detached), closed)?;
+    let records = first_error(first_error(result, closed.detached), recording_closed)?;
     sink.log.finish()?;
-    let inducer_computations = renderer.inducer_computations();
-
-    let validation = ValidationSummary::of(renderer.context());
-    drop(renderer);
-    drop(runtime);
 
     let replay_check = match &options.record {
         Some(path) => Some(replay_check(path, &sink.recorded, &scene)?),
@@ -471,7 +445,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         },
         space_changes: report.space_changes,
         frames_abandoned: report.frames_abandoned,
-        swapchain_format: format!("{:?} (sRGB: {})", images.format, images.srgb),
+        swapchain_format: format!("{format:?} (sRGB: true)"),
         states: report.states.iter().map(ToString::to_string).collect(),
         reached_focused: report.reached(State::Focused),
         end_reason: report

@@ -5,7 +5,8 @@ use serde::Serialize;
 
 use crate::frame_log::PupilSummary;
 use crate::gaze::separability::SeparabilitySummary;
-use crate::replay::{Spread, ValidationSummary};
+use crate::spread::Spread;
+use crate::validation::ValidationSummary;
 
 use super::{ReadbackCheck, ReplayCheck};
 

@@ -171,7 +171,7 @@ pub fn run(command: StudyCommand) -> Result<()> {
                 bail!("--trials must be at least 1");
             }
             if let Some((w, h)) = size {
-                crate::replay::check_size(w, h)?;
+                crate::setup::check_size(w, h)?;
             }
             if trace.is_some() && !(dry_run || view) {
                 bail!(

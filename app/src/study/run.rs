@@ -27,9 +27,9 @@ use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::gaze::GazeOverride;
 use crate::look::{GazeSettings, planners_for};
 use crate::motion_clock::MotionClock;
-use crate::run::{LiveLooks, RunOptions};
+use crate::render_desc;
+use crate::run::{LiveConditions, RunOptions};
 use crate::scene::{Scene, load_scene};
-use crate::views;
 
 /// The shortest and longest time scale `--time-scale` accepts.
 pub const TIME_SCALE_RANGE: (f64, f64) = (0.001, 10.0);
@@ -340,7 +340,7 @@ fn dry_run_block(
     let (width, height) = options
         .size
         .unwrap_or((scene.output.width_px, scene.output.height_px));
-    crate::replay::check_size(width, height)?;
+    crate::setup::check_size(width, height)?;
     if !(options.frame_rate_hz.is_finite() && (1.0..=1000.0).contains(&options.frame_rate_hz)) {
         bail!(
             "--rate must be from 1 to 1000 Hz, got {}",
@@ -351,11 +351,11 @@ fn dry_run_block(
     let needed_s = trials as f64 * (t.first_s + t.blank_s + t.second_s + t.interval_s) + 1.0;
     let samples = match &options.trace {
         Some(path) => {
-            let (samples, _) = crate::replay::load_trace(&scene, Some(path))?;
+            let (samples, _) = crate::setup::load_trace(&scene, Some(path))?;
             samples
         }
         None => {
-            let mut params = crate::trace_cmd::synth_params_for(&scene);
+            let mut params = crate::scene::synth_params_for(&scene);
             params.duration_s = needed_s.min(4.0 * 3600.0) as f32;
             vitreous_xr::synth::synthesize_with_truth(&params)
                 .context("synthesising a trace for the dry run")?
@@ -384,11 +384,11 @@ fn dry_run_block(
         Reflection::default(),
         &GazeSettings::default(),
     )?;
-    let mut renderer = views::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
-    views::enable_live_caustics(&mut renderer, &scene, stage.sets.iter().any(|s| s.caustics))
+    let mut renderer = render_desc::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
+    render_desc::enable_live_caustics(&mut renderer, &scene, stage.sets.iter().any(|s| s.caustics))
         .context("preparing live caustics")?;
     drop(defocus);
-    let looks = LiveLooks::new(
+    let looks = LiveConditions::new(
         stage.sets.iter().copied().zip(planners).collect(),
         GazeOverride::Auto,
     );
@@ -416,7 +416,7 @@ struct DryRunSink<'a> {
     /// The study.
     stage: &'a mut StudyStage,
     /// A planner per effect set.
-    looks: LiveLooks,
+    looks: LiveConditions,
     /// The scene's motion (`[motion]`), from the first frame.
     motion: MotionClock,
 }

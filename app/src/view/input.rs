@@ -37,7 +37,7 @@ pub enum InputEvent {
 /// What the viewer does in answer to a key (movement keys are held, not actions).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Action {
-    /// Show the effect condition of this index of [`super::looks::CONDITION_KEYS`].
+    /// Show the effect condition of this index of [`super::conditions::CONDITION_KEYS`].
     Condition(usize),
     /// The next effect condition.
     NextCondition,

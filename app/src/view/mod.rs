@@ -12,15 +12,15 @@
 //!
 //! Parts: `desktop.rs` (the backend), `window.rs` (winit), `swapchain.rs` (surface, swapchain,
 //! presentation), `staging.rs` (its staging buffers and their copy to the screen), `input.rs`
-//! (events and keys), `script.rs` (`--script`), `looks.rs` (effect conditions), `picture.rs` (the window's picture
-//! and overlay), `reload.rs` (hot reload), `playback.rs` (`--trace`), `session.rs` (the sink
-//! and what the overlay shows), `cli.rs` (the options).
+//! (events and keys), `script.rs` (`--script`), `conditions.rs` (effect conditions),
+//! `picture.rs` (the window's picture and overlay), `reload.rs` (hot reload), `playback.rs`
+//! (`--trace`), `session.rs` (the sink and what the overlay shows), `cli.rs` (the options).
 
 mod cli;
+mod conditions;
 mod desktop;
 mod edits;
 mod input;
-mod looks;
 mod picture;
 mod playback;
 mod reload;
@@ -50,7 +50,8 @@ use crate::effects::EffectSet;
 use crate::frame_loop::{self, FrameRecord};
 use crate::gaze::{FilterKind, GazeOverride};
 use crate::output::{encode_png, write_atomic};
-use crate::replay::{Spread, ValidationSummary};
+use crate::spread::Spread;
+use crate::validation::ValidationSummary;
 use desktop::{DesktopBackend, Shared};
 use reload::Loaded;
 use session::{Request, ViewSink};

@@ -11,8 +11,8 @@ use vitreous_render::{ContextOptions, GpuContext, Renderer};
 
 use crate::blur_stack::DefocusSetup;
 use crate::effects::EffectSet;
+use crate::render_desc;
 use crate::scene::{CausticsMode, DiskFiles, Scene, SceneFiles, load_scene_from};
-use crate::views;
 
 /// A scene loaded with what its renderer needs.
 pub struct Loaded {
@@ -79,12 +79,12 @@ impl Loaded {
         let ctx = GpuContext::headless(options).context("setting up the Vulkan device")?;
         let mut renderer = Renderer::new(
             ctx,
-            &views::scene_desc(&self.scene, self.setup.as_ref()),
+            &render_desc::scene_desc(&self.scene, self.setup.as_ref()),
             size.0,
             size.1,
         )
         .context("preparing the renderer")?;
-        views::enable_live_caustics(&mut renderer, &self.scene, self.caustics_loaded)
+        render_desc::enable_live_caustics(&mut renderer, &self.scene, self.caustics_loaded)
             .context("preparing live caustics")?;
         Ok(renderer)
     }

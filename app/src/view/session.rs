@@ -3,7 +3,7 @@
 //!
 //! Just over 600 lines: it is the viewer's one `FrameSink`, and each of its parts (actions,
 //! reload requests, renderer hand-over, overlay lines, presentation) reads and writes the same
-//! session state; the state machines it drives live in `looks.rs`, `reload.rs` and
+//! session state; the state machines it drives live in `conditions.rs`, `reload.rs` and
 //! `swapchain.rs`.
 
 use std::cell::RefCell;
@@ -17,10 +17,10 @@ use vitreous_xr::trace::{AtomicFile, TraceSample, TraceWriter};
 use vitreous_xr::{FrameInput, GazeSample};
 
 use super::ViewOptions;
+use super::conditions::ViewConditions;
 use super::desktop::Shared;
 use super::edits::ViewEdits;
 use super::input::{Action, KEYS};
-use super::looks::Looks;
 use super::picture::{Overlay, SeeThrough, compose};
 use super::reload::{Loaded, Watcher};
 use super::swapchain::{Presented, Presenter};
@@ -28,9 +28,9 @@ use crate::director::Director;
 use crate::frame_loop::{FramePlan, FrameSink};
 use crate::gaze::{FilterKind, FixationDepth, GazeOverride};
 use crate::motion_clock::MotionClock;
-use crate::replay::ValidationSummary;
 use crate::scene::Scene;
 use crate::scene_edit::SceneEdit;
+use crate::validation::ValidationSummary;
 
 mod overlay;
 
@@ -53,7 +53,7 @@ pub struct ViewSink<'d> {
     /// The scene shown.
     loaded: Loaded,
     /// Conditions and planners.
-    looks: Looks,
+    looks: ViewConditions,
     /// The scene's files.
     watcher: Watcher,
     /// The window's swapchain.
@@ -110,7 +110,7 @@ impl<'d> ViewSink<'d> {
         filter: Option<FilterKind>,
         gaze: GazeOverride,
     ) -> Result<ViewSink<'d>> {
-        let looks = Looks::new(
+        let looks = ViewConditions::new(
             loaded.effects,
             loaded.caustics_loaded,
             loaded.setup.as_ref().map(|s| s.model.clone()),
@@ -189,7 +189,7 @@ impl<'d> ViewSink<'d> {
         } else {
             loaded.effects
         };
-        self.looks = Looks::new(
+        self.looks = ViewConditions::new(
             start,
             loaded.caustics_loaded,
             loaded.setup.as_ref().map(|s| s.model.clone()),
@@ -374,7 +374,7 @@ impl<'d> ViewSink<'d> {
         })
     }
 
-    /// Looks for a changed scene file and, when one changed, loads the scene anew.
+    /// ViewConditions for a changed scene file and, when one changed, loads the scene anew.
     fn check_reload(&mut self) {
         let touched = !std::mem::take(&mut self.shared.borrow_mut().touched).is_empty();
         let Some(file) = self.watcher.changed(touched) else {

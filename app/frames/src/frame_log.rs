@@ -17,9 +17,9 @@ use serde::Serialize;
 use tempfile::NamedTempFile;
 use vitreous_xr::FrameInput;
 
-use crate::gaze::separability::SeparabilitySummary;
-use crate::gaze::{GazeImage, PupilSource, Separability};
 use crate::look::DefocusFrame;
+use vitreous_gaze::separability::SeparabilitySummary;
+use vitreous_gaze::{GazeImage, PupilSource, Separability};
 
 /// File name of the per-frame log in an output folder.
 pub const FRAME_LOG_NAME: &str = "frames.csv";
@@ -204,7 +204,7 @@ impl FrameLog {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gaze::ImageDistances;
+    use vitreous_gaze::ImageDistances;
     use vitreous_render::Defocus;
 
     fn decision(image: GazeImage, pupil_m: f32) -> DefocusFrame {
@@ -230,7 +230,7 @@ mod tests {
         fs::write(dir.path().join(FRAME_LOG_NAME), "an earlier run's log").unwrap();
         let mut log = FrameLog::create(dir.path()).unwrap();
         assert!(!dir.path().join(FRAME_LOG_NAME).exists());
-        let mut input = crate::run::test_frame();
+        let mut input = crate::test_frame::test_frame();
         let images = [
             GazeImage::Unknown,
             GazeImage::Surface,
@@ -266,7 +266,8 @@ mod tests {
     fn an_abandoned_log_leaves_nothing() {
         let dir = tempfile::tempdir().unwrap();
         let mut log = FrameLog::create(dir.path()).unwrap();
-        log.record(&crate::run::test_frame(), "none", None).unwrap();
+        log.record(&crate::test_frame::test_frame(), "none", None)
+            .unwrap();
         drop(log);
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0);
     }

@@ -4,9 +4,9 @@
 use glam::Vec3;
 use vitreous_render::Defocus;
 
-use crate::gaze::blur::{image_blur, px_per_m};
-use crate::gaze::{GazeImage, ImageDistances, PupilSource};
-use crate::scene::{Scene, ViewingGeometry};
+use vitreous_gaze::blur::{image_blur, px_per_m};
+use vitreous_gaze::{GazeImage, ImageDistances, PupilSource};
+use vitreous_scene::{Scene, ViewingGeometry};
 
 /// The numbers eq. 13-14 need of a scene: where the images lie, pixels per metre of each
 /// image's photo, and the pupil.

@@ -8,8 +8,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::Command;
 
-use crate::effects::EffectSet;
-use crate::gaze::GazeOverride;
+use vitreous_gaze::GazeOverride;
+use vitreous_scene::effects::EffectSet;
 
 /// Decides each frame's condition and gaze image (see the module docs).
 pub trait Director {

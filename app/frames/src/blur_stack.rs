@@ -5,10 +5,10 @@
 use rayon::prelude::*;
 
 use crate::defocus_model::DefocusModel;
-use crate::gaze::GazeImage;
-use crate::gaze::blur::{PUPIL_MAX_MM, gaussian_kernel};
 use crate::output::{linear_to_srgb, srgb_to_linear};
-use crate::scene::{Image, PixelData, Scene};
+use vitreous_gaze::GazeImage;
+use vitreous_gaze::blur::{PUPIL_MAX_MM, gaussian_kernel};
+use vitreous_scene::{Image, PixelData, Scene};
 
 /// Slices of each blur stack (K_g = 0 included).
 pub const STACK_SLICES: u32 = 16;
@@ -190,7 +190,7 @@ pub fn to_linear(image: &Image) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gaze::blur::blur_reference;
+    use vitreous_gaze::blur::blur_reference;
 
     #[test]
     fn separable_blur_equals_the_literal_convolution() {

@@ -6,9 +6,9 @@ use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::{Command, Cycle};
 
 use crate::director::Director;
-use crate::effects::EffectSet;
-use crate::gaze::GazeOverride;
 use crate::look::LookPlanner;
+use vitreous_gaze::GazeOverride;
+use vitreous_scene::effects::EffectSet;
 
 /// The paper's study conditions, in the order the live action cycles through them (after the
 /// run's own effect set): O2 (none), O3 (defocus), O4 (disparity), O5 (disparity + defocus),
@@ -34,7 +34,7 @@ pub fn live_conditions(start: EffectSet, caustics_loaded: bool) -> Vec<EffectSet
 
 /// The looks the live actions switch between: a look planner per effect condition (all fed
 /// every frame, so switching keeps the gaze filters warm) and the forced gaze image.
-pub struct LiveLooks {
+pub struct LiveConditions {
     /// Each condition and its planner.
     conditions: Vec<(EffectSet, LookPlanner)>,
     /// Index of the condition shown.
@@ -43,11 +43,11 @@ pub struct LiveLooks {
     gaze: GazeOverride,
 }
 
-impl LiveLooks {
+impl LiveConditions {
     /// Starts at the first condition with gaze image `gaze`, applied to every planner.
-    pub fn new(conditions: Vec<(EffectSet, LookPlanner)>, gaze: GazeOverride) -> LiveLooks {
+    pub fn new(conditions: Vec<(EffectSet, LookPlanner)>, gaze: GazeOverride) -> LiveConditions {
         assert!(!conditions.is_empty(), "at least one condition");
-        let mut looks = LiveLooks {
+        let mut looks = LiveConditions {
             conditions,
             current: 0,
             gaze,
@@ -76,7 +76,7 @@ impl LiveLooks {
 
     /// Where A_p comes from and the tracker samples with a measurement, of the conditions with
     /// defocus (all share the scene's pupil source; the counts of the first one).
-    pub fn pupil_source(&self) -> Option<(crate::gaze::PupilSource, u64)> {
+    pub fn pupil_source(&self) -> Option<(vitreous_gaze::PupilSource, u64)> {
         self.conditions.iter().find_map(|(_, p)| p.pupil_source())
     }
 
@@ -85,7 +85,7 @@ impl LiveLooks {
         self.gaze
     }
 
-    /// Shows condition `index` (of those given to [`LiveLooks::new`]).
+    /// Shows condition `index` (of those given to [`LiveConditions::new`]).
     pub fn select(&mut self, index: usize) {
         assert!(index < self.conditions.len(), "condition {index} exists");
         self.current = index;
@@ -181,8 +181,7 @@ pub const CONDITION_CYCLE: Cycle = Cycle::Secondary;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::test_frame as frame;
-    use crate::views;
+    use crate::test_frame::test_frame as frame;
     use vitreous_render::Reflection;
 
     #[test]
@@ -206,9 +205,9 @@ mod tests {
         let sets = [EffectSet::NONE, EffectSet::parse("disparity").unwrap()];
         let planners = sets
             .iter()
-            .map(|e| LookPlanner::new(views::look(e, Reflection::default()), None))
+            .map(|e| LookPlanner::new(crate::look::base_look(e, Reflection::default()), None))
             .collect::<Vec<_>>();
-        let mut looks = LiveLooks::new(
+        let mut looks = LiveConditions::new(
             sets.iter().copied().zip(planners).collect(),
             GazeOverride::Auto,
         );

@@ -4,7 +4,7 @@
 //! Eq. 13-14 are evaluated every frame from where the wearer's eyes are: the image distances
 //! are those of the frame's viewing position (the midpoint of the two eye positions,
 //! [`viewing_position_m`]) to the scene's fixation points
-//! ([`ViewingGeometry`](crate::scene::ViewingGeometry), the same geometry the scene's fixed
+//! ([`ViewingGeometry`](vitreous_scene::ViewingGeometry), the same geometry the scene's fixed
 //! viewer uses), and the gaze-image decision compares the fixation depth with those distances. A_p is the fixed pupil diameter or the tracker's measurement,
 //! smoothed ([`PupilFilter`]).
 //!
@@ -18,14 +18,33 @@ use vitreous_xr::FrameInput;
 
 use crate::blur_stack::DefocusSetup;
 pub use crate::defocus_model::DefocusModel;
-use crate::effects::EffectSet;
-use crate::gaze::blur::check_pupil_diameter_m;
-use crate::gaze::{
+use vitreous_gaze::blur::check_pupil_diameter_m;
+use vitreous_gaze::{
     FilterKind, GazeConfig, GazeImage, GazeOverride, GazePipeline, GazeState, ImageDistances,
     ObjectInView, PupilFilter, PupilSource, Separability,
 };
-use crate::scene::Scene;
-use crate::views;
+use vitreous_scene::Scene;
+use vitreous_scene::effects::EffectSet;
+
+/// How an effect set is drawn. The baseline is the conventional method (environment map and
+/// Fresnel for both refraction and reflection); with the method's visual effects (disparity,
+/// defocus) the reflected image is drawn as `reflection` says (the paper used a Phong
+/// highlight). Defocus amounts are per frame: this gives none; the frame's gaze sets them.
+pub fn base_look(effects: &EffectSet, reflection: Reflection) -> Look {
+    let method = effects.disparity || effects.defocus;
+    Look {
+        disparity: effects.disparity,
+        defocus: None,
+        reflection: if method {
+            reflection
+        } else {
+            Reflection::EnvironmentFresnel
+        },
+        inducer: effects.inducer,
+        caustics: effects.caustics,
+        blank: false,
+    }
+}
 
 /// Where a frame is viewed from: the midpoint of its two eye positions (scene frame, metres).
 pub fn viewing_position_m(input: &FrameInput) -> Vec3 {
@@ -85,7 +104,7 @@ pub struct LookPlanner {
 }
 
 impl LookPlanner {
-    /// A planner for `base` (see `views::look`); with `defocus`, the gaze pipeline runs with
+    /// A planner for `base` (see [`base_look`]); with `defocus`, the gaze pipeline runs with
     /// `gaze` as its configuration.
     pub fn new(base: Look, defocus: Option<(GazeConfig, DefocusModel)>) -> LookPlanner {
         LookPlanner {
@@ -244,7 +263,7 @@ pub fn planners_for(
     let planners = sets
         .iter()
         .map(|effects| {
-            let base = views::look(effects, reflection);
+            let base = base_look(effects, reflection);
             let defocus = match (&setup, effects.defocus) {
                 (Some(setup), true) => {
                     let mut config = GazeConfig::new(setup.model.distances);
@@ -278,9 +297,9 @@ mod tests {
     const IPD_M: f32 = 0.063;
 
     fn scene() -> Scene {
-        crate::scene::load_scene(
+        vitreous_scene::load_scene(
             &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../config/scenes/visual-effects.toml"),
+                .join("../../config/scenes/visual-effects.toml"),
         )
         .expect("shipped scene")
     }
@@ -293,7 +312,7 @@ mod tests {
         config.filter = scene.gaze.filter;
         config.override_image = image;
         LookPlanner::new(
-            views::look(&effects, Reflection::default()),
+            base_look(&effects, Reflection::default()),
             Some((config, model)),
         )
     }
@@ -332,7 +351,7 @@ mod tests {
     fn at_the_fixed_viewing_position_frames_get_the_scenes_distances_and_blur() {
         let scene = scene();
         let head = scene.viewer.head_position_m;
-        let mut input = crate::run::test_frame();
+        let mut input = crate::test_frame::test_frame();
         input.head.position = head;
         input.views[0].pose.position = head - Vec3::X * scene.viewer.ipd_m / 2.0;
         input.views[1].pose.position = head + Vec3::X * scene.viewer.ipd_m / 2.0;

@@ -10,8 +10,8 @@ use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sampl
 use vitreous_xr::FrameInput;
 
 use crate::output::{linear_to_srgb, srgb_to_linear};
-use crate::scene::{PixelData, Scene};
-use crate::views::eye_params;
+use crate::render_desc::eye_params;
+use vitreous_scene::{PixelData, Scene};
 
 /// Grey level shown where the refracted ray misses the background photo (the renderer shows
 /// the environment map there).

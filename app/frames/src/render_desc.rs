@@ -3,14 +3,13 @@
 
 use vitreous_render::camera::{EyeParams, Fov as RenderFov};
 use vitreous_render::{
-    CausticsDesc, FrameParams, InducerDesc, LightDesc, Look, MeshRef, PlaneDesc, Reflection,
-    SceneDesc, ScenePose, TexelData, TextureDesc,
+    CausticsDesc, FrameParams, InducerDesc, LightDesc, Look, MeshRef, PlaneDesc, SceneDesc,
+    ScenePose, TexelData, TextureDesc,
 };
 use vitreous_xr::{EyeView, Fov, FrameInput};
 
 use crate::blur_stack::DefocusSetup;
-use crate::effects::EffectSet;
-use crate::scene::{CausticsMode, Image, PixelData, Placement, Scene};
+use vitreous_scene::{CausticsMode, Image, PixelData, Placement, Scene};
 
 /// Scale applied to environment radiance. The shipped HDR maps are in scene-referred units
 /// where 1.0 is a bright diffuse white; they are shown as they are.
@@ -86,26 +85,6 @@ pub fn enable_live_caustics(
 /// [`Scene::placement_at`] takes.
 pub fn seconds_since(start_ns: i64, time_ns: i64) -> f64 {
     time_ns.saturating_sub(start_ns) as f64 * 1e-9
-}
-
-/// How an effect set is drawn. The baseline is the conventional method (environment map and
-/// Fresnel for both refraction and reflection); with the method's visual effects (disparity,
-/// defocus) the reflected image is drawn as `reflection` says (the paper used a Phong
-/// highlight). Defocus amounts are per frame: this gives none; the frame's gaze sets them.
-pub fn look(effects: &EffectSet, reflection: Reflection) -> Look {
-    let method = effects.disparity || effects.defocus;
-    Look {
-        disparity: effects.disparity,
-        defocus: None,
-        reflection: if method {
-            reflection
-        } else {
-            Reflection::EnvironmentFresnel
-        },
-        inducer: effects.inducer,
-        caustics: effects.caustics,
-        blank: false,
-    }
 }
 
 /// The renderer's view of an image.

@@ -9,9 +9,9 @@ use vitreous_xr::FrameInput;
 use vitreous_xr::trace::EditRecord;
 
 use crate::look::LookPlanner;
-use crate::scene::{CausticsMode, Motion, Placement, Scene, model_placement};
+use crate::render_desc;
 use crate::scene_edit::{EditState, SceneEdit, place_ray, ray_meets_plane};
-use crate::views;
+use vitreous_scene::{CausticsMode, Motion, Placement, Scene, model_placement};
 
 /// Turns frame times into the scene's poses and counts the frames that moved. Owns what it
 /// needs of the scene (the keyframes, the rest placement, the object's scale and centre).
@@ -102,7 +102,7 @@ impl MotionClock {
         let start = *self.start_ns.get_or_insert(time_ns);
         match &self.motion {
             Some(motion) => motion.placement_at(
-                views::seconds_since(start, time_ns),
+                render_desc::seconds_since(start, time_ns),
                 self.rest,
                 self.light_in_frame_m,
             ),
@@ -297,7 +297,7 @@ mod tests {
     }
 
     fn input(time_ns: i64) -> FrameInput {
-        let mut f = crate::run::test_frame();
+        let mut f = crate::test_frame::test_frame();
         f.time_ns = time_ns;
         // Head 1 m above the floor at z = 0, looking 45 degrees down ahead.
         f.head = vitreous_xr::Pose {
@@ -309,7 +309,7 @@ mod tests {
 
     #[test]
     fn edits_offset_the_keyframed_pose_and_count_as_moves() {
-        use crate::scene::ObjectKey;
+        use vitreous_scene::ObjectKey;
         let motion = Motion {
             object: vec![
                 ObjectKey {

@@ -8,7 +8,6 @@ use vitreous_xr::FrameInput;
 use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, GazeConfig, GazeOverride, GazeState};
 use crate::look::{DefocusModel, LookPlanner};
-use crate::views;
 
 /// The conditions keys 1-7 choose: none (O2, a), O3, O4, O5, b, c, and the inducer alone
 /// (disparity, defocus and caustics alone are O4, O3 and b).
@@ -18,7 +17,7 @@ pub const CONDITION_KEYS: [&str; 7] = ["none", "O3", "O4", "O5", "b", "c", "indu
 pub const FILTERS: [&str; 5] = ["evidence", "fixation", "mean20", "median20", "one-euro"];
 
 /// The viewer's conditions and planners.
-pub struct Looks {
+pub struct ViewConditions {
     /// Each condition (None where this build or scene cannot show it), by key.
     conditions: Vec<Option<EffectSet>>,
     /// The planner of each available condition.
@@ -37,7 +36,7 @@ pub struct Looks {
     state: Option<GazeState>,
 }
 
-impl Looks {
+impl ViewConditions {
     /// The conditions of [`CONDITION_KEYS`] (with `start` first when it is not among them),
     /// leaving out those whose effects this build does not implement and, without a loaded
     /// caustic bake, those with caustics.
@@ -48,7 +47,7 @@ impl Looks {
         reflection: Reflection,
         filter: FilterKind,
         gaze: GazeOverride,
-    ) -> Looks {
+    ) -> ViewConditions {
         let mut sets: Vec<EffectSet> = CONDITION_KEYS
             .iter()
             .map(|n| EffectSet::parse(n).expect("condition names parse"))
@@ -66,7 +65,7 @@ impl Looks {
                 (s.ensure_implemented().is_ok() && (!s.caustics || caustics_loaded)).then_some(s)
             })
             .collect();
-        let mut looks = Looks {
+        let mut looks = ViewConditions {
             conditions,
             planners: Vec::new(),
             current,
@@ -96,7 +95,7 @@ impl Looks {
                         }
                         _ => None,
                     };
-                    LookPlanner::new(views::look(&set, self.reflection), defocus)
+                    LookPlanner::new(crate::look::base_look(&set, self.reflection), defocus)
                 })
             })
             .collect();
@@ -234,8 +233,8 @@ impl Looks {
 mod tests {
     use super::*;
 
-    fn looks(start: &str, caustics: bool) -> Looks {
-        Looks::new(
+    fn looks(start: &str, caustics: bool) -> ViewConditions {
+        ViewConditions::new(
             EffectSet::parse(start).unwrap(),
             caustics,
             None,

@@ -12,7 +12,7 @@ use vitreous_render::{Composition, Look, Renderer, ScenePose};
 use vitreous_xr::openxr::Blend;
 use vitreous_xr::{Backend, FrameInput, FrameTarget};
 
-use crate::views;
+use crate::render_desc;
 
 /// How one frame is drawn and what comes back of it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -117,7 +117,7 @@ fn draw<B: Backend>(
         renderer.set_pose(pose);
     }
     let plan = sink.plan(input);
-    let params = views::frame_params(input, plan.look);
+    let params = render_desc::frame_params(input, plan.look);
     let prepare_ms = started.elapsed().as_secs_f64() * 1e3;
     let done = match backend.frame_target() {
         FrameTarget::Own => renderer.submit(&params, plan.want),

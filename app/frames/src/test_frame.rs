@@ -4,7 +4,7 @@
 use vitreous_xr::FrameInput;
 
 /// A frame at time 5 ns with identity poses and no gaze.
-pub(crate) fn test_frame() -> FrameInput {
+pub fn test_frame() -> FrameInput {
     use vitreous_xr::{EyeView, Fov, Pose};
     let view = EyeView {
         pose: Pose::IDENTITY,

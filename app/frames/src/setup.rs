@@ -1,0 +1,47 @@
+//! What every command does before its frame loop: the eye image size check and the trace to
+//! replay (read with its scene edits, or synthesised for the scene).
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use vitreous_scene::{Scene, synth_params_for};
+use vitreous_xr::trace::{EditRecord, TraceSample, read_trace_with_edits};
+
+/// The largest eye image side accepted, pixels.
+pub const MAX_SIZE_PX: u32 = 8192;
+
+/// Refuses eye image sizes the renderer cannot or should not take.
+pub fn check_size(width: u32, height: u32) -> Result<()> {
+    if !(16..=MAX_SIZE_PX).contains(&width) || !(16..=MAX_SIZE_PX).contains(&height) {
+        bail!("eye image size {width}x{height} is outside 16..={MAX_SIZE_PX} pixels per side");
+    }
+    Ok(())
+}
+
+/// Loads the trace or synthesises one for the scene.
+pub fn load_trace(scene: &Scene, trace: Option<&Path>) -> Result<(Vec<TraceSample>, String)> {
+    load_trace_with_edits(scene, trace).map(|(samples, _, name)| (samples, name))
+}
+
+/// Loads the trace, with its scene edits, or synthesises one (without edits) for the scene.
+pub fn load_trace_with_edits(
+    scene: &Scene,
+    trace: Option<&Path>,
+) -> Result<(Vec<TraceSample>, Vec<EditRecord>, String)> {
+    match trace {
+        Some(path) => {
+            let (samples, edits) = read_trace_with_edits(path).context("reading the trace")?;
+            if samples.is_empty() {
+                bail!("trace {} has no samples: nothing to replay", path.display());
+            }
+            Ok((samples, edits, path.display().to_string()))
+        }
+        None => {
+            tracing::info!("no --trace given: replaying a synthetic trace for the scene");
+            let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(scene))
+                .context("synthesising a trace for the scene")?
+                .samples;
+            Ok((samples, Vec::new(), "synthetic".into()))
+        }
+    }
+}

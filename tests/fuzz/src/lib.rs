@@ -63,7 +63,7 @@ pub fn study(data: &[u8]) {
     use vitreous_study::{plan, protocol::Protocol, report, responses::Responses};
     let split = data.iter().position(|&b| b == 0).unwrap_or(data.len());
     let (protocol_bytes, responses_bytes) = (&data[..split], data.get(split + 1..).unwrap_or(&[]));
-    let studies = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/studies/fuzz.toml");
+    let studies = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/studies/fuzz.toml");
     if let Ok(text) = std::str::from_utf8(protocol_bytes) {
         match Protocol::parse(&studies, text) {
             Ok(protocol) => {

@@ -8,7 +8,7 @@
 //! a mode the runtime has and recording what each submitted frame asked for. See
 //! `docs/sim-layer.md` for how to enable it and what it approximates.
 //!
-//! The loader finds the layer through its manifest (`layer/manifest/`, written by
+//! The loader finds the layer through its manifest (`xr/sim-layer/manifest/`, written by
 //! `tools/sim-layer`) and calls the one exported symbol,
 //! [`entry::xrNegotiateLoaderApiLayerInterface`].
 

@@ -75,6 +75,7 @@ fn render(refraction: Refraction, attenuation: Attenuation) -> [Vec<u8>; 2] {
         light: LightDesc {
             position_m: Vec3::new(1.0, 1.0, 1.0),
             radiance: Vec3::ONE,
+            share: 1.0,
         },
         ..scene_desc(
             mesh_ref(&sphere),

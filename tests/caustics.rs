@@ -77,22 +77,30 @@ fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], effects: &str) -> Readb
 
 #[test]
 fn eye_image_adds_inducer_and_caustic_gain_times_a_uniform_floor() {
-    adds_inducer_and_caustic_gain(false);
+    adds_inducer_and_caustic_gain(false, 1.0);
+}
+
+/// `[light] share = 0.4`: the light gives 40 % of the floor's light, so only that share is
+/// focused and G is added times 0.4; the inducer is unchanged.
+#[test]
+fn eye_image_adds_only_the_lights_share_of_the_caustic_gain() {
+    adds_inducer_and_caustic_gain(false, 0.4);
 }
 
 /// As above on the overlay's other path, G filtered from four loads (devices that do not
 /// filter R32_SFLOAT, which Vulkan leaves optional; lavapipe filters it).
 #[test]
 fn eye_image_adds_the_gains_with_g_from_four_loads() {
-    adds_inducer_and_caustic_gain(true);
+    adds_inducer_and_caustic_gain(true, 1.0);
 }
 
-/// Each pixel of the floor in conditions c, b and inducer against k alpha(d) + G of the CPU
-/// reference times a uniform grey photo; with `four_loads` the overlay is built as on a device
-/// that does not filter R32_SFLOAT.
-fn adds_inducer_and_caustic_gain(four_loads: bool) {
+/// Each pixel of the floor in conditions c, b and inducer against k alpha(d) + share G of the
+/// CPU reference times a uniform grey photo; with `four_loads` the overlay is built as on a
+/// device that does not filter R32_SFLOAT.
+fn adds_inducer_and_caustic_gain(four_loads: bool, share: f32) {
     const GREY: u8 = 120;
     let mut s = shipped_scene("glass-sphere.toml");
+    s.light.share = share;
     s.floor.photo = Image::new(8, 8, PixelData::Srgb8([GREY, GREY, GREY, 255].repeat(64))).unwrap();
     let l_r = srgb_to_linear(GREY);
     // The spot straddles the shadow's edge towards the viewer (shadow, ramp and open floor).
@@ -137,7 +145,7 @@ fn adds_inducer_and_caustic_gain(four_loads: bool) {
                 0.0
             };
             let g = if caustics_on {
-                bake.sample(uv.x, uv.y)
+                share * bake.sample(uv.x, uv.y)
             } else {
                 0.0
             };

@@ -250,6 +250,7 @@ pub(crate) fn render_shot(shot: &Shot, mesh: SphereMesh) -> [Vec<u8>; 2] {
         light: LightDesc {
             position_m: Vec3::new(1.0, 1.0, 1.0),
             radiance: Vec3::ONE,
+            share: 1.0,
         },
         ..scene_desc(
             mesh_ref(&mesh),

@@ -177,6 +177,7 @@ pub fn scene_desc<'a>(
         light: vitreous_render::LightDesc {
             position_m: Vec3::new(0.0, 1.0, 0.0),
             radiance: Vec3::ONE,
+            share: 1.0,
         },
         background_stack: None,
         surface_stack: None,

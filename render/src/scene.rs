@@ -205,6 +205,9 @@ pub struct LightDesc {
     pub position_m: Vec3,
     /// Linear RGB colour times intensity.
     pub radiance: Vec3,
+    /// Fraction of the real floor's light that comes from this light, 0..=1: the caustic
+    /// gain G is added times it (eq. 6 with only this share of the floor's light focused).
+    pub share: f32,
 }
 
 /// Bytes per interleaved vertex: position, normal, uv.

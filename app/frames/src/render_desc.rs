@@ -141,6 +141,7 @@ pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> Sc
         light: LightDesc {
             position_m: scene.light.position_m,
             radiance: scene.light.color * scene.light.intensity,
+            share: scene.light.share,
         },
         background_stack: defocus.map(|d| d.background.desc()),
         surface_stack: defocus.and_then(|d| d.surface.as_ref()).map(|s| s.desc()),

@@ -118,6 +118,7 @@ pub(crate) struct LightToml {
     pub frame: LightFrame,
     pub intensity: Option<Spanned<f32>>,
     pub color: Option<Spanned<Vec<f32>>>,
+    pub share: Option<Spanned<f32>>,
 }
 
 /// `[floor]` and `[background]`: a registered real-world plane.

@@ -28,6 +28,7 @@
 
 mod accessor;
 pub mod caustics;
+pub mod consistency;
 pub mod effects;
 mod error;
 mod file;
@@ -93,6 +94,9 @@ pub struct Scene {
     /// `[light] position_m` as written: world, or an offset from the object's position when
     /// [`Motion::light_follows_object`].
     pub light_in_frame_m: Vec3,
+    /// Why the scene could not exist as a real room ([`consistency::warnings`]): each names
+    /// the fields to change; logged when the scene is loaded.
+    pub warnings: Vec<String>,
 }
 
 /// How the caustics are made (`[caustics] mode`).
@@ -287,6 +291,10 @@ pub struct Light {
     pub intensity: f32,
     /// Linear RGB colour.
     pub color: Vec3,
+    /// Fraction of the real floor's light that comes from this light (`[light] share`, 0..=1,
+    /// default 1: the paper's assumption that it gives all of it). Eq. 6's caustics add only
+    /// this share's concentration: the rest of the floor's light is not focused by the object.
+    pub share: f32,
 }
 
 /// A registered real-world plane: a photo of the real surface, its physical size and pose.

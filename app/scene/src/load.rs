@@ -72,7 +72,11 @@ pub fn load_scene_from(path: &Path, files: &dyn SceneFiles) -> Result<Scene, Sce
     };
     loader.hash_part("scene", &bytes);
     let raw: SceneFile = toml::from_str(text).map_err(|e| loader.src.toml_error(&e))?;
-    loader.resolve(raw)
+    let scene = loader.resolve(raw)?;
+    for warning in &scene.warnings {
+        tracing::warn!("{}: {warning}", path.display());
+    }
+    Ok(scene)
 }
 
 pub(super) struct Loader<'a> {
@@ -241,6 +245,13 @@ impl Loader<'_> {
                     v
                 }
             },
+            share: self.number(
+                "light.share",
+                raw.light.share.as_ref(),
+                1.0,
+                (0.0, 1.0),
+                CLOSED,
+            )?,
         };
 
         let motion = self.motion(&raw.motion, raw.light.frame, object.rotation)?;
@@ -417,6 +428,7 @@ impl Loader<'_> {
             .iter()
             .map(|b| format!("{b:02x}"))
             .collect();
+        let warnings = crate::consistency::warnings(&object, &light, &floor, &background);
         Ok(Scene {
             path: self.src.file.to_path_buf(),
             hash,
@@ -431,6 +443,7 @@ impl Loader<'_> {
             inducer,
             gaze,
             caustics,
+            warnings,
             motion,
             light_in_frame_m: light_offset,
         })

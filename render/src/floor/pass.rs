@@ -50,6 +50,8 @@ pub(crate) struct InducerPass {
     /// A live map is computed for the current pose and the host has not yet read its bounds:
     /// the overlay takes them from the GPU ([`OverlayPass::live_bounds`]).
     live_rect_on_gpu: bool,
+    /// The caustic gain's weight when caustics are on: the light's share of the floor's light.
+    caustic_share: f32,
     /// What has really been computed.
     pub(super) progress: Progress,
     /// The overlay drawn in the eye passes.
@@ -202,6 +204,7 @@ impl InducerPass {
             rect,
             caustic_rect,
             live_rect_on_gpu: false,
+            caustic_share: desc.light.share,
             progress: Progress::default(),
             overlay,
             mask,
@@ -573,7 +576,10 @@ impl InducerPass {
         let with_live_bounds = caustics && self.live_rect_on_gpu;
         let rect = self.overlay_rect(inducer, caustics);
         if rect.is_some() || with_live_bounds {
-            let switches = [inducer, caustics].map(|on| f32::from(u8::from(on)));
+            let switches = [
+                f32::from(u8::from(inducer)),
+                if caustics { self.caustic_share } else { 0.0 },
+            ];
             let area = OverlayArea {
                 rect: rect.unwrap_or(NO_RECT),
                 with_live_bounds,

@@ -1,0 +1,99 @@
+//! Scenes that could not exist as a real room are named (a plane between the light and the
+//! object, an object sunk into the floor), and `[light] share` is read and checked.
+
+use crate::scene_errors::{expect_error, good_text, line_of, load_text};
+
+/// The base scene with `from` replaced by `to` (which must be there).
+fn with(from: &str, to: &str) -> String {
+    let text = good_text();
+    assert!(text.contains(from), "{from} not in the base scene");
+    text.replace(from, to)
+}
+
+fn warnings(text: &str) -> Vec<String> {
+    let (_dir, _path, result) = load_text(text);
+    result.expect("the scene loads").warnings
+}
+
+#[test]
+fn a_wall_between_the_light_and_the_object_is_named_with_its_fields() {
+    // The base scene keeps the paper's light 1 m beyond the object, 0.5 m behind the wall.
+    let w = warnings(&good_text());
+    assert_eq!(w.len(), 1, "{w:?}");
+    for field in [
+        "background.position_m",
+        "background.size_m",
+        "light.position_m",
+        "object.position_m",
+    ] {
+        assert!(w[0].contains(field), "{} does not name {field}", w[0]);
+    }
+    assert!(w[0].contains("[0.00, 0.24, -2.00]"), "{}", w[0]);
+}
+
+#[test]
+fn a_wall_behind_the_light_or_beside_its_path_is_no_warning() {
+    for wall in [
+        "position_m = [0.0, 0.45, -2.6]",
+        // Moved aside: the light's path passes it by.
+        "position_m = [1.5, 0.45, -2.0]",
+    ] {
+        let text = with("position_m = [0.0, 0.45, -2.0]", wall);
+        assert_eq!(warnings(&text), Vec::<String>::new(), "{wall}");
+    }
+}
+
+#[test]
+fn a_light_under_the_floor_is_named() {
+    let text = with(
+        "position_m = [0.0, 1.0, -1.0]",
+        "position_m = [0.0, -1.0, 0.2]",
+    );
+    let w = warnings(&text);
+    assert!(
+        w.iter().any(|w| w.contains("the floor (floor.position_m")),
+        "{w:?}"
+    );
+}
+
+#[test]
+fn an_object_sunk_into_the_floor_is_named_and_one_resting_on_it_is_not() {
+    let rests = with(
+        "position_m = [0.0, 1.0, -1.0]",
+        "position_m = [0.0, 1.0, 1.0]",
+    );
+    assert_eq!(warnings(&rests), Vec::<String>::new());
+    let sunk = rests.replace(
+        "position_m = [0.0, -0.26, -1.5]",
+        "position_m = [0.0, -0.32, -1.5]",
+    );
+    let w = warnings(&sunk);
+    let sunk = w
+        .iter()
+        .find(|w| w.contains("into the floor"))
+        .unwrap_or_else(|| panic!("{w:?}"));
+    for field in ["object.position_m", "object.diameter_m", "floor.position_m"] {
+        assert!(sunk.contains(field), "{sunk} does not name {field}");
+    }
+}
+
+#[test]
+fn light_share_defaults_to_the_papers_one_and_is_read() {
+    let (_dir, _path, scene) = load_text(&good_text());
+    assert_eq!(scene.unwrap().light.share, 1.0);
+    let text = with("frame = \"object\"\n", "frame = \"object\"\nshare = 0.5\n");
+    let (_dir, _path, scene) = load_text(&text);
+    assert_eq!(scene.unwrap().light.share, 0.5);
+}
+
+#[test]
+fn a_light_share_outside_zero_to_one_names_the_field() {
+    for bad in ["1.5", "-0.1", "nan"] {
+        let text = with(
+            "frame = \"object\"\n",
+            &format!("frame = \"object\"\nshare = {bad}\n"),
+        );
+        let msg = expect_error(&text, line_of(&text, "share ="), "light.share");
+        assert!(msg.contains(">= 0 and <= 1"), "{msg}");
+    }
+}

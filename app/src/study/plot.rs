@@ -41,7 +41,7 @@ pub fn plot(report: &StudyReport) -> Result<Vec<u8>> {
 
 /// The figure as RGBA pixels (width, height) and where each condition was marked.
 pub fn draw(report: &StudyReport) -> Result<(Vec<u8>, u32, u32, Vec<Mark>)> {
-    crate::trace_analyze::plot::register_font()?;
+    crate::font::register_plot_font()?;
     let (w, h) = (WIDTH_PX, ROW_PX * report.groups.len().max(1) as u32);
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     let mut marks = Vec::new();

@@ -10,7 +10,6 @@
 
 use std::fmt;
 use std::path::Path;
-use std::sync::Once;
 
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
@@ -46,19 +45,6 @@ pub struct PlotLayout {
 
 /// Plot size, pixels.
 const PLOT_SIZE_PX: (u32, u32) = (1400, 800);
-/// The embedded font (DejaVu Sans, licence in `app/assets/fonts/LICENSE-DejaVu.txt`), so the
-/// plot needs no system fonts.
-static FONT_TTF: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
-
-pub(crate) fn register_font() -> Result<()> {
-    static ONCE: Once = Once::new();
-    let mut result = Ok(());
-    ONCE.call_once(|| {
-        result = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_TTF)
-            .map_err(|_| anyhow!("the embedded DejaVu Sans font could not be parsed"));
-    });
-    result
-}
 
 /// Colour of a gaze image in plots.
 fn image_colour(image: GazeImage) -> RGBColor {
@@ -151,7 +137,7 @@ pub fn plot(
     config: &AnalyzeConfig,
     out_png: &Path,
 ) -> Result<PlotLayout> {
-    register_font()?;
+    crate::font::register_plot_font()?;
     let raw: Vec<RawSample> = raw_samples(samples, config.vergence, DEFAULT_VELOCITY_DEG_S);
     let raw_depths: Vec<(i64, Option<f32>)> = raw.iter().map(|r| (r.time_ns, r.depth_m)).collect();
     let timeline = match truth {

@@ -6,10 +6,8 @@ use ab_glyph::{Font, FontRef, PxScale, ScaleFont, point};
 use vitreous_render::Readback;
 
 use super::input::EyesShown;
+use crate::font::FONT_TTF;
 use crate::output::{linear_to_srgb, srgb_to_linear};
-
-/// The embedded font (DejaVu Sans, licence in `app/assets/fonts/LICENSE-DejaVu.txt`).
-static FONT_TTF: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// Height of the overlay's text, pixels.
 const TEXT_PX: f32 = 14.0;

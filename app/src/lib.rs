@@ -7,6 +7,7 @@
 
 pub mod bench;
 pub mod cli_values;
+pub mod compare;
 pub mod error_report;
 pub mod font;
 pub use vitreous_frames::{

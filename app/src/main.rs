@@ -125,6 +125,9 @@ enum Command {
         #[arg(long)]
         no_validation: bool,
     },
+    /// How far an image is from a reference: FLIP and PSNR over the whole view and, with a
+    /// scene, per region (the object's disc, shadow and caustic, inducer ramp, rest).
+    Compare(vitreous::compare::CompareArgs),
     /// Trace tools.
     Trace {
         #[command(subcommand)]
@@ -360,6 +363,7 @@ fn run(cli: Cli) -> Result<()> {
             }
         },
         Command::Study { command } => vitreous::study::cli::run(command),
+        Command::Compare(args) => vitreous::compare::compare_command(args),
     }
 }
 

@@ -8,7 +8,7 @@ fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-fn vitreous(args: &[&str], cwd: &Path) -> Output {
+pub(crate) fn vitreous(args: &[&str], cwd: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_vitreous"))
         .args(args)
         .current_dir(cwd)
@@ -18,7 +18,7 @@ fn vitreous(args: &[&str], cwd: &Path) -> Output {
 }
 
 /// Asserts a failed run with one error paragraph that mentions every `needle`.
-fn assert_clean_failure(out: &Output, needles: &[&str]) -> String {
+pub(crate) fn assert_clean_failure(out: &Output, needles: &[&str]) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(!out.status.success(), "expected failure, stderr: {stderr}");
     assert!(!stderr.contains("panicked"), "panic: {stderr}");

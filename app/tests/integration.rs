@@ -2,6 +2,7 @@
 //! one subject.
 
 mod cli;
+mod compare;
 mod gaze_defocus;
 mod gaze_filter;
 mod gaze_trace;

@@ -1,0 +1,251 @@
+//! `vitreous compare REFERENCE TEST`: how far an image is from a reference, as ꟻLIP (NVIDIA's
+//! perceptual difference evaluator, `nv-flip`; mean over pixels, 0 identical, lower is
+//! closer) and PSNR (8-bit sRGB, all three channels), over the whole view and, with a scene,
+//! region by region (`regions.rs`: the object's disc, the shadow and caustic, the inducer's
+//! ramp, the rest); optionally the ꟻLIP error map as a PNG.
+
+mod regions;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use serde::Serialize;
+
+pub use regions::{Eye, Region, regions};
+
+use crate::output::{encode_png, ensure_not_input, write_atomic};
+
+/// Options of `vitreous compare` (docs/cli.md).
+#[derive(clap::Args, Debug)]
+pub struct CompareArgs {
+    /// The reference image (PNG, sRGB): what the eye should see.
+    pub reference: PathBuf,
+    /// The image to measure (PNG, sRGB, the reference's size).
+    pub test: PathBuf,
+    /// Split the figures by region of this scene (object's disc, shadow and caustic, inducer
+    /// ramp, rest), for an image of `--eye` at the scene's neutral head.
+    #[arg(long, value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+    /// The eye the images show, with --scene: left or right.
+    #[arg(long, value_name = "EYE", default_value = "left", value_parser = parse_eye)]
+    pub eye: Eye,
+    /// Pixels per degree of visual angle for ꟻLIP (default: the scene's, width over horizontal
+    /// field of view, with --scene; else ꟻLIP's default, 67, a 0.7 m viewing distance from a
+    /// 24-inch 4K monitor).
+    #[arg(long, value_name = "PPD", value_parser = parse_ppd)]
+    pub ppd: Option<f32>,
+    /// Write the ꟻLIP error map here (PNG, the magma colour map: black no error, yellow most).
+    #[arg(long, value_name = "FILE")]
+    pub map: Option<PathBuf>,
+    /// Print the figures as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_eye(s: &str) -> std::result::Result<Eye, String> {
+    match s {
+        "left" => Ok(Eye::Left),
+        "right" => Ok(Eye::Right),
+        _ => Err(format!("expected left or right, found {s:?}")),
+    }
+}
+
+fn parse_ppd(s: &str) -> std::result::Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && (1.0..=1000.0).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "expected pixels per degree between 1 and 1000, found {s:?}"
+        )),
+    }
+}
+
+/// The figures of one region.
+#[derive(Clone, Debug, Serialize)]
+pub struct RegionFigures {
+    /// The region (`whole` for the whole view).
+    pub region: String,
+    /// Pixels in it.
+    pub pixels: u64,
+    /// Mean ꟻLIP over its pixels (`None` when it has none).
+    pub flip_mean: Option<f64>,
+    /// PSNR over its pixels, dB (`None` when it has none or the images are equal there).
+    pub psnr_db: Option<f64>,
+}
+
+/// What `vitreous compare` reports.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    /// The reference image.
+    pub reference: String,
+    /// The measured image.
+    pub test: String,
+    /// Image size, pixels.
+    pub width_px: u32,
+    /// Image size, pixels.
+    pub height_px: u32,
+    /// Pixels per degree ꟻLIP was run at.
+    pub pixels_per_degree: f32,
+    /// The scene whose regions split the figures, if any.
+    pub scene: Option<String>,
+    /// The whole view first, then each region of the scene.
+    pub regions: Vec<RegionFigures>,
+}
+
+/// Most pixels an image may have (as the scene loader's images).
+const MAX_PIXELS: u64 = vitreous_scene::MAX_IMAGE_PIXELS;
+
+/// Reads a PNG as tightly packed sRGB RGB8, naming the file in every error.
+fn read_rgb(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let reader =
+        image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
+    let (w, h) = reader
+        .into_dimensions()
+        .with_context(|| format!("{}: not a PNG image", path.display()))?;
+    if w == 0 || h == 0 || u64::from(w) * u64::from(h) > MAX_PIXELS {
+        bail!(
+            "{}: {w}x{h} pixels is outside 1..={MAX_PIXELS} pixels",
+            path.display()
+        );
+    }
+    let decoded = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+        .with_context(|| format!("{}: not a PNG image", path.display()))?;
+    Ok((w, h, decoded.to_rgb8().into_raw()))
+}
+
+/// PSNR of 8-bit values, dB; `None` when they are equal.
+fn psnr(squared_error: f64, values: u64) -> Option<f64> {
+    (squared_error > 0.0 && values > 0)
+        .then(|| 10.0 * (255.0f64 * 255.0 / (squared_error / values as f64)).log10())
+}
+
+/// Compares `test` with `reference`: ꟻLIP's error map and the figures per region (`labels`:
+/// each pixel's region, or none for the whole view only).
+pub fn compare(
+    reference: &[u8],
+    test: &[u8],
+    (width, height): (u32, u32),
+    ppd: f32,
+    labels: Option<&[Region]>,
+) -> (Vec<f32>, Vec<RegionFigures>) {
+    let error = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(width, height, reference),
+        nv_flip::FlipImageRgb8::with_data(width, height, test),
+        ppd,
+    )
+    .to_vec();
+    let squared: Vec<f64> = reference
+        .chunks_exact(3)
+        .zip(test.chunks_exact(3))
+        .map(|(a, b)| {
+            a.iter()
+                .zip(b)
+                .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
+                .sum()
+        })
+        .collect();
+    let figures = |name: &str, keep: &dyn Fn(usize) -> bool| {
+        let (mut pixels, mut flip, mut se) = (0u64, 0f64, 0f64);
+        for i in (0..error.len()).filter(|&i| keep(i)) {
+            pixels += 1;
+            flip += f64::from(error[i]);
+            se += squared[i];
+        }
+        RegionFigures {
+            region: name.to_owned(),
+            pixels,
+            flip_mean: (pixels > 0).then(|| flip / pixels as f64),
+            psnr_db: psnr(se, pixels * 3),
+        }
+    };
+    let mut out = vec![figures("whole", &|_| true)];
+    if let Some(labels) = labels {
+        for region in Region::ALL {
+            out.push(figures(region.name(), &|i| labels[i] == region));
+        }
+    }
+    (error, out)
+}
+
+/// `vitreous compare`.
+pub fn compare_command(args: CompareArgs) -> Result<()> {
+    if let Some(map) = &args.map {
+        ensure_not_input(map, "--map", &[&args.reference, &args.test])?;
+    }
+    let (w, h, reference) = read_rgb(&args.reference)?;
+    let (tw, th, test) = read_rgb(&args.test)?;
+    if (w, h) != (tw, th) {
+        bail!(
+            "the images differ in size: {} is {w}x{h}, {} is {tw}x{th}",
+            args.reference.display(),
+            args.test.display()
+        );
+    }
+    let scene = match &args.scene {
+        Some(path) => Some(vitreous_scene::load_scene(path)?),
+        None => None,
+    };
+    let ppd = args.ppd.unwrap_or_else(|| match &scene {
+        Some(s) => {
+            let fov = s.output.fov;
+            w as f32 / (fov.angle_right_rad - fov.angle_left_rad).to_degrees()
+        }
+        None => nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    });
+    let labels = scene.as_ref().map(|s| regions(s, args.eye, w, h));
+    let (error, figures) = compare(&reference, &test, (w, h), ppd, labels.as_deref());
+    if let Some(map) = &args.map {
+        let rgb = nv_flip::FlipImageFloat::with_data(w, h, &error)
+            .apply_color_lut(&nv_flip::magma_lut())
+            .to_vec();
+        let rgba: Vec<u8> = rgb
+            .chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect();
+        write_atomic(map, &encode_png(&rgba, w, h)?)?;
+    }
+    let report = Comparison {
+        reference: args.reference.display().to_string(),
+        test: args.test.display().to_string(),
+        width_px: w,
+        height_px: h,
+        pixels_per_degree: ppd,
+        scene: args.scene.as_ref().map(|p| p.display().to_string()),
+        regions: figures,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", table(&report));
+    }
+    Ok(())
+}
+
+/// The report as a text table.
+fn table(report: &Comparison) -> String {
+    let mut out = format!(
+        "{} against {} ({}x{}, {:.1} pixels per degree)\n{:<16} {:>9} {:>10} {:>10}\n",
+        report.test,
+        report.reference,
+        report.width_px,
+        report.height_px,
+        report.pixels_per_degree,
+        "region",
+        "pixels",
+        "FLIP mean",
+        "PSNR dB"
+    );
+    for r in &report.regions {
+        let flip = r.flip_mean.map_or("-".to_owned(), |v| format!("{v:.4}"));
+        let psnr = match (r.pixels, r.psnr_db) {
+            (0, _) => "-".to_owned(),
+            (_, None) => "equal".to_owned(),
+            (_, Some(v)) => format!("{v:.2}"),
+        };
+        out += &format!(
+            "{:<16} {:>9} {:>10} {:>10}\n",
+            r.region, r.pixels, flip, psnr
+        );
+    }
+    out
+}

@@ -1,0 +1,185 @@
+//! Where in an eye image each part of a scene lies, for comparing images region by region: the
+//! object's disc, the floor's shadow and caustic, the shadow inducer's ramp around the shadow,
+//! and the rest. Computed on the CPU for one eye at the scene's neutral head from the object's
+//! bounding sphere (exact for a ball, a superset of any other object's outline), the point
+//! light and the floor; the caustic from the scene's bake, when it has one.
+
+use glam::{Quat, Vec2, Vec3};
+use serde::Serialize;
+use vitreous_render::camera::EyeParams;
+use vitreous_render::floor::{FAR_M, exact_edge_distances};
+use vitreous_scene::Scene;
+
+use crate::render_desc::render_fov;
+
+/// A region of the eye image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Region {
+    /// The object's disc (its bounding sphere's outline).
+    Disc,
+    /// The floor in the object's shadow or lit by its caustic.
+    ShadowCaustic,
+    /// The lit floor within the inducer's ramp width of the shadow.
+    InducerRamp,
+    /// Everything else.
+    Rest,
+}
+
+impl Region {
+    /// Every region, in report order.
+    pub const ALL: [Region; 4] = [
+        Region::Disc,
+        Region::ShadowCaustic,
+        Region::InducerRamp,
+        Region::Rest,
+    ];
+
+    /// The region's name in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Region::Disc => "disc",
+            Region::ShadowCaustic => "shadow_caustic",
+            Region::InducerRamp => "inducer_ramp",
+            Region::Rest => "rest",
+        }
+    }
+}
+
+/// Side of the floor grid the shadow and the ramp are found on, texels.
+const FLOOR_GRID: u32 = 256;
+
+/// Caustic gain above which a floor point counts as lit by the caustic.
+const CAUSTIC_GAIN: f32 = 0.01;
+
+/// Which eye of the scene's viewer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Eye {
+    /// The left eye.
+    Left,
+    /// The right eye.
+    Right,
+}
+
+/// The region of every pixel of a `width` x `height` image of `eye` at the scene's neutral
+/// head (looking down -z from `viewer.head_position_m`), row by row.
+pub fn regions(scene: &Scene, eye: Eye, width: u32, height: u32) -> Vec<Region> {
+    let head = vitreous_xr::Pose {
+        position: scene.viewer.head_position_m,
+        orientation: Quat::IDENTITY,
+    };
+    let [left, right] = scene.viewer.eye_positions_m(&head);
+    let position = if eye == Eye::Left { left } else { right };
+    let camera = EyeParams::new(position, Quat::IDENTITY, render_fov(scene.output.fov));
+    let floor = FloorRegions::new(scene);
+    let size = Vec2::new(width as f32, height as f32);
+    let mut out = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let dir = camera.pixel_ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), size);
+            out.push(classify(scene, &floor, position, dir));
+        }
+    }
+    out
+}
+
+/// The region a ray from `origin` along `dir` (unit) falls in.
+fn classify(scene: &Scene, floor: &FloorRegions, origin: Vec3, dir: Vec3) -> Region {
+    let center = scene.object.center_m;
+    let radius = scene.object.radius_m;
+    if ray_sphere(origin, dir, center, radius).is_some() {
+        return Region::Disc;
+    }
+    let normal = scene.floor.normal();
+    let along = dir.dot(normal);
+    if along.abs() < 1e-9 {
+        return Region::Rest;
+    }
+    let t = (scene.floor.pose.position - origin).dot(normal) / along;
+    if t <= 0.0 {
+        return Region::Rest;
+    }
+    let local = scene
+        .floor
+        .world_from_plane()
+        .inverse()
+        .transform_point3(origin + dir * t);
+    if local.x.abs() > 0.5 || local.y.abs() > 0.5 {
+        return Region::Rest;
+    }
+    floor.at(Vec2::new(local.x + 0.5, 0.5 - local.y))
+}
+
+/// The first crossing of the ray `origin + t dir` (t > 0, `dir` unit) with a sphere.
+fn ray_sphere(origin: Vec3, dir: Vec3, center: Vec3, radius: f32) -> Option<f32> {
+    let to = origin - center;
+    let b = to.dot(dir);
+    let c = to.length_squared() - radius * radius;
+    let disc = b * b - c;
+    if disc < 0.0 {
+        return None;
+    }
+    let t = -b - disc.sqrt();
+    let t = if t > 0.0 { t } else { -b + disc.sqrt() };
+    (t > 0.0).then_some(t)
+}
+
+/// The floor's regions on a grid over its photo (u right, v down, as the photo).
+struct FloorRegions {
+    regions: Vec<Region>,
+}
+
+impl FloorRegions {
+    fn new(scene: &Scene) -> FloorRegions {
+        let n = FLOOR_GRID;
+        let world_from_plane = scene.floor.world_from_plane();
+        let centre_of = |i: u32| {
+            let (x, y) = (i % n, i / n);
+            let uv = Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
+            world_from_plane.transform_point3(Vec3::new(uv.x - 0.5, 0.5 - uv.y, 0.0))
+        };
+        let light = scene.light.position_m;
+        let (center, radius) = (scene.object.center_m, scene.object.radius_m);
+        let mask: Vec<u8> = (0..n * n)
+            .map(|i| {
+                let p = centre_of(i);
+                let to_light = light - p;
+                let distance = to_light.length();
+                let shaded = distance > 0.0
+                    && ray_sphere(p, to_light / distance, center, radius)
+                        .is_some_and(|t| t < distance);
+                u8::from(shaded)
+            })
+            .collect();
+        let texel_m = scene.floor.size_m / n as f32;
+        let distances = exact_edge_distances(&mask, n, texel_m);
+        let ramp_m = scene.inducer.ramp_width_m;
+        let gain = scene.caustics.gain.as_ref();
+        let regions = (0..n * n)
+            .map(|i| {
+                let uv = Vec2::new(
+                    ((i % n) as f32 + 0.5) / n as f32,
+                    ((i / n) as f32 + 0.5) / n as f32,
+                );
+                let caustic = gain.is_some_and(|g| g.sample(uv.x, uv.y) > CAUSTIC_GAIN);
+                let d = distances[i as usize];
+                if mask[i as usize] != 0 || caustic {
+                    Region::ShadowCaustic
+                } else if d < FAR_M && d < ramp_m {
+                    Region::InducerRamp
+                } else {
+                    Region::Rest
+                }
+            })
+            .collect();
+        FloorRegions { regions }
+    }
+
+    /// The region at floor photo coordinate `uv` (0..1, v down).
+    fn at(&self, uv: Vec2) -> Region {
+        let n = FLOOR_GRID;
+        let x = ((uv.x * n as f32) as u32).min(n - 1);
+        let y = ((uv.y * n as f32) as u32).min(n - 1);
+        self.regions[(y * n + x) as usize]
+    }
+}

@@ -1,0 +1,194 @@
+//! `vitreous compare`: FLIP and PSNR over the whole view and per region of a scene, the error
+//! map, and bad input.
+
+use std::path::{Path, PathBuf};
+
+use vitreous::compare::{Eye, Region, regions};
+use vitreous::output::encode_png;
+use vitreous::scene::load_scene;
+
+use crate::cli::{assert_clean_failure, vitreous};
+
+fn scene_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/glass-sphere.toml")
+}
+
+/// Writes an RGB image as a PNG.
+fn write_png(path: &Path, rgb: &[u8], w: u32, h: u32) {
+    let rgba: Vec<u8> = rgb
+        .chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    std::fs::write(path, encode_png(&rgba, w, h).unwrap()).unwrap();
+}
+
+fn json(args: &[&str], cwd: &Path) -> serde_json::Value {
+    let out = vitreous(args, cwd);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn region<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    report["regions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["region"] == name)
+        .unwrap_or_else(|| panic!("no {name} in {report}"))
+}
+
+#[test]
+fn the_disc_matches_the_balls_projection_and_the_floor_regions_lie_under_it() {
+    let scene = load_scene(&scene_path()).unwrap();
+    let (w, h) = (640u32, 480u32);
+    let labels = regions(&scene, Eye::Left, w, h);
+    let count = |r: Region| labels.iter().filter(|&&l| l == r).count() as f32;
+    // The ball's outline from the left eye: the cone of half-angle alpha = asin(r / d) about
+    // the centre's direction, theta off the view axis, cuts the image plane (focal length f
+    // from the field of view) in an ellipse of semi-axes f sin(alpha) cos(alpha) / k and
+    // f sin(alpha) / sqrt(k), k = cos^2(theta) - sin^2(alpha).
+    let eye = scene.viewer.head_position_m - glam::Vec3::X * scene.viewer.ipd_m / 2.0;
+    let to_centre = scene.object.center_m - eye;
+    let d = to_centre.length();
+    let cos_theta = -to_centre.z / d;
+    let sin_alpha = scene.object.radius_m / d;
+    let k = cos_theta * cos_theta - sin_alpha * sin_alpha;
+    let f = (w as f32 / 2.0) / scene.output.fov.angle_right_rad.tan();
+    let major = f * sin_alpha * (1.0 - sin_alpha * sin_alpha).sqrt() / k;
+    let minor = f * sin_alpha / k.sqrt();
+    let expected = std::f32::consts::PI * major * minor;
+    assert!(
+        (count(Region::Disc) - expected).abs() < 0.05 * expected,
+        "{} disc pixels, expected {expected}",
+        count(Region::Disc)
+    );
+    // The shadow falls on the floor towards the viewer, ringed by the ramp (D = 140 mm, far
+    // wider than the shadow).
+    assert!(count(Region::ShadowCaustic) > 50.0);
+    assert!(count(Region::InducerRamp) > 4.0 * count(Region::ShadowCaustic));
+    let lowest_row = |r: Region| {
+        (0..labels.len())
+            .filter(|&i| labels[i] == r)
+            .map(|i| i as u32 / w)
+            .max()
+            .unwrap()
+    };
+    assert!(lowest_row(Region::ShadowCaustic) > lowest_row(Region::Disc));
+}
+
+#[test]
+fn identical_images_score_zero_and_a_uniform_step_gives_its_psnr() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (64u32, 48u32);
+    let grey = vec![100u8; (w * h * 3) as usize];
+    let brighter = vec![110u8; (w * h * 3) as usize];
+    write_png(&dir.path().join("a.png"), &grey, w, h);
+    write_png(&dir.path().join("b.png"), &brighter, w, h);
+    let same = json(&["compare", "a.png", "a.png", "--json"], dir.path());
+    let whole = region(&same, "whole");
+    assert_eq!(whole["flip_mean"], 0.0);
+    assert!(whole["psnr_db"].is_null());
+    assert_eq!(whole["pixels"], u64::from(w * h));
+    let step = json(&["compare", "a.png", "b.png", "--json"], dir.path());
+    let whole = region(&step, "whole");
+    // PSNR = 20 log10(255 / 10) for an error of 10 in every channel of every pixel.
+    let psnr = whole["psnr_db"].as_f64().unwrap();
+    assert!((psnr - 20.0 * (25.5f64).log10()).abs() < 1e-9, "{psnr}");
+    assert!(whole["flip_mean"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn a_change_inside_the_disc_is_charged_to_the_disc() {
+    let scene = load_scene(&scene_path()).unwrap();
+    let (w, h) = (320u32, 240u32);
+    let labels = regions(&scene, Eye::Left, w, h);
+    // A textured reference, and the test with the disc's inner pixels (every neighbour within
+    // 3 px also disc) turned bright.
+    let reference: Vec<u8> = (0..w * h)
+        .flat_map(|i| {
+            let v = (40 + (i * 7919) % 120) as u8;
+            [v, v, v]
+        })
+        .collect();
+    let inner = |i: u32| {
+        let (x, y) = ((i % w) as i32, (i / w) as i32);
+        (-3..=3).all(|dy| {
+            (-3..=3).all(|dx| {
+                let (nx, ny) = (x + dx, y + dy);
+                nx >= 0
+                    && ny >= 0
+                    && nx < w as i32
+                    && ny < h as i32
+                    && labels[(ny as u32 * w + nx as u32) as usize] == Region::Disc
+            })
+        })
+    };
+    let mut test = reference.clone();
+    let mut changed = 0;
+    for i in (0..w * h).filter(|&i| inner(i)) {
+        test[(i * 3) as usize..(i * 3 + 3) as usize].copy_from_slice(&[250, 240, 200]);
+        changed += 1;
+    }
+    assert!(changed > 20, "{changed}");
+    let dir = tempfile::tempdir().unwrap();
+    write_png(&dir.path().join("ref.png"), &reference, w, h);
+    write_png(&dir.path().join("test.png"), &test, w, h);
+    let scene = scene_path();
+    let report = json(
+        &[
+            "compare",
+            "ref.png",
+            "test.png",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--map",
+            "map.png",
+            "--json",
+        ],
+        dir.path(),
+    );
+    let flip = |name: &str| region(&report, name)["flip_mean"].as_f64().unwrap();
+    assert!(flip("disc") > 0.2, "{report}");
+    for other in ["shadow_caustic", "inducer_ramp", "rest"] {
+        assert!(flip(other) < flip("disc") / 20.0, "{other}: {report}");
+    }
+    // The regions and the whole view count every pixel once.
+    let pixels = |name: &str| region(&report, name)["pixels"].as_u64().unwrap();
+    assert_eq!(
+        ["disc", "shadow_caustic", "inducer_ramp", "rest"]
+            .map(pixels)
+            .iter()
+            .sum::<u64>(),
+        pixels("whole")
+    );
+    // The scene's pixels per degree: 320 px over 40 degrees.
+    assert_eq!(report["pixels_per_degree"], 8.0);
+    let map = image::open(dir.path().join("map.png")).unwrap();
+    assert_eq!((map.width(), map.height()), (w, h));
+}
+
+#[test]
+fn bad_images_are_named_and_no_map_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    write_png(&dir.path().join("a.png"), &[0; 16 * 8 * 3], 16, 8);
+    write_png(&dir.path().join("b.png"), &[0; 8 * 8 * 3], 8, 8);
+    std::fs::write(dir.path().join("text.png"), "not a png").unwrap();
+    let out = vitreous(&["compare", "a.png", "b.png", "--map", "m.png"], dir.path());
+    assert_clean_failure(&out, &["a.png is 16x8", "b.png is 8x8", "differ in size"]);
+    let out = vitreous(
+        &["compare", "a.png", "text.png", "--map", "m.png"],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["text.png", "not a PNG"]);
+    let out = vitreous(&["compare", "a.png", "gone.png"], dir.path());
+    assert_clean_failure(&out, &["gone.png"]);
+    let out = vitreous(&["compare", "a.png", "a.png", "--map", "a.png"], dir.path());
+    assert_clean_failure(&out, &["--map", "a.png"]);
+    let out = vitreous(&["compare", "a.png", "a.png", "--ppd", "nan"], dir.path());
+    assert_clean_failure(&out, &["--ppd", "pixels per degree"]);
+    assert!(!dir.path().join("m.png").exists());
+}

@@ -374,7 +374,7 @@ impl<'d> ViewSink<'d> {
         })
     }
 
-    /// ViewConditions for a changed scene file and, when one changed, loads the scene anew.
+    /// Looks for a changed scene file and, when one changed, loads the scene anew.
     fn check_reload(&mut self) {
         let touched = !std::mem::take(&mut self.shared.borrow_mut().touched).is_empty();
         let Some(file) = self.watcher.changed(touched) else {

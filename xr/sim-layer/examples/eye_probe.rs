@@ -32,7 +32,7 @@ fn check(call: &str, r: sys::Result) -> Probe<()> {
     }
 }
 
-/// ViewConditions up an extension function.
+/// Looks up an extension function.
 ///
 /// # Safety
 /// `T` must be the function pointer type OpenXR defines for `name`.

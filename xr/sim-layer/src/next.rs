@@ -48,7 +48,7 @@ pub struct NextTable {
     pub sync_actions: pfn::SyncActions,
 }
 
-/// ViewConditions up one function through `gipa`.
+/// Looks up one function through `gipa`.
 ///
 /// # Safety
 /// `gipa` must be a valid `xrGetInstanceProcAddr` and `instance` a live instance of its chain.

@@ -14,6 +14,8 @@ pub enum Plan {
     Absorb(Vec<sys::Action>),
     /// The eye-gaze profile with a binding path the profile does not have.
     Reject,
+    /// The eye-gaze profile with no binding at all (the spec requires at least one).
+    Empty,
 }
 
 /// The paths that identify the profile and its one input.
@@ -23,12 +25,16 @@ pub struct GazePaths {
     pub profile: sys::Path,
     /// `/user/eyes_ext/input/gaze_ext/pose`.
     pub pose: sys::Path,
+    /// `/user/eyes_ext`, the profile's top-level user path.
+    pub user: sys::Path,
 }
 
 /// The profile's path.
 pub const PROFILE: &std::ffi::CStr = c"/interaction_profiles/ext/eye_gaze_interaction";
 /// The gaze pose input's path.
 pub const POSE: &std::ffi::CStr = c"/user/eyes_ext/input/gaze_ext/pose";
+/// The profile's top-level user path.
+pub const USER: &std::ffi::CStr = c"/user/eyes_ext";
 
 /// Decides what to do with a suggestion of `bindings` for `profile`.
 pub fn plan(
@@ -38,6 +44,9 @@ pub fn plan(
 ) -> Plan {
     if profile != paths.profile {
         return Plan::Forward;
+    }
+    if bindings.is_empty() {
+        return Plan::Empty;
     }
     if bindings.iter().any(|b| b.binding != paths.pose) {
         return Plan::Reject;
@@ -60,6 +69,7 @@ mod tests {
         GazePaths {
             profile: sys::Path::from_raw(10),
             pose: sys::Path::from_raw(11),
+            user: sys::Path::from_raw(13),
         }
     }
 
@@ -88,6 +98,12 @@ mod tests {
             ),
             Plan::Absorb(vec![sys::Action::from_raw(1), sys::Action::from_raw(2)])
         );
+    }
+
+    #[test]
+    fn a_suggestion_with_no_binding_is_invalid() {
+        assert_eq!(plan(&paths(), paths().profile, &[]), Plan::Empty);
+        assert_eq!(plan(&paths(), sys::Path::from_raw(3), &[]), Plan::Forward);
     }
 
     #[test]

@@ -253,6 +253,7 @@ unsafe extern "system" fn create_api_layer_instance(
             submitted: prepared.submitted.map(|s| Arc::new(Mutex::new(s))),
             buttons,
             button_actions: HashMap::new(),
+            attached: false,
         };
         registry()
             .instances
@@ -297,6 +298,7 @@ fn gaze_paths(next: &NextTable, instance: sys::Instance) -> Result<GazePaths, sy
     Ok(GazePaths {
         profile: string_to_path(next, instance, bindings::PROFILE)?,
         pose: string_to_path(next, instance, bindings::POSE)?,
+        user: string_to_path(next, instance, bindings::USER)?,
     })
 }
 
@@ -413,6 +415,27 @@ fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::VoidF
             entry!(
                 calls::controller::get_action_state_boolean,
                 pfn::GetActionStateBoolean
+            ),
+        ),
+        b"xrAttachSessionActionSets" => (
+            None,
+            entry!(
+                calls::actions::attach_session_action_sets,
+                pfn::AttachSessionActionSets
+            ),
+        ),
+        b"xrGetCurrentInteractionProfile" => (
+            None,
+            entry!(
+                calls::actions::get_current_interaction_profile,
+                pfn::GetCurrentInteractionProfile
+            ),
+        ),
+        b"xrEnumerateBoundSourcesForAction" => (
+            None,
+            entry!(
+                calls::actions::enumerate_bound_sources_for_action,
+                pfn::EnumerateBoundSourcesForAction
             ),
         ),
         b"xrGetActionStatePose" => (

@@ -44,6 +44,12 @@ pub struct NextTable {
     pub get_action_state_pose: pfn::GetActionStatePose,
     /// `xrGetActionStateBoolean`.
     pub get_action_state_boolean: pfn::GetActionStateBoolean,
+    /// `xrAttachSessionActionSets`.
+    pub attach_session_action_sets: pfn::AttachSessionActionSets,
+    /// `xrGetCurrentInteractionProfile`.
+    pub get_current_interaction_profile: pfn::GetCurrentInteractionProfile,
+    /// `xrEnumerateBoundSourcesForAction`.
+    pub enumerate_bound_sources_for_action: pfn::EnumerateBoundSourcesForAction,
     /// `xrSyncActions`.
     pub sync_actions: pfn::SyncActions,
 }
@@ -150,6 +156,24 @@ impl NextTable {
                 pfn::GetActionStateBoolean
             ),
             sync_actions: load!(gipa, instance, c"xrSyncActions", pfn::SyncActions),
+            attach_session_action_sets: load!(
+                gipa,
+                instance,
+                c"xrAttachSessionActionSets",
+                pfn::AttachSessionActionSets
+            ),
+            get_current_interaction_profile: load!(
+                gipa,
+                instance,
+                c"xrGetCurrentInteractionProfile",
+                pfn::GetCurrentInteractionProfile
+            ),
+            enumerate_bound_sources_for_action: load!(
+                gipa,
+                instance,
+                c"xrEnumerateBoundSourcesForAction",
+                pfn::EnumerateBoundSourcesForAction
+            ),
         })
     }
 

@@ -35,6 +35,8 @@ pub struct InstanceState {
     pub buttons: Option<Arc<Buttons>>,
     /// Actions bound to scripted inputs: the inputs of each (indices into the script's).
     pub button_actions: HashMap<u64, Vec<usize>>,
+    /// Whether action sets were attached to any of its sessions (suggestions are then refused).
+    pub attached: bool,
 }
 
 impl InstanceState {
@@ -64,6 +66,8 @@ pub struct SessionState {
     /// The runtime's blend modes for the session's view configuration (known after
     /// `xrBeginSession`).
     pub runtime_blend: Option<Vec<sys::EnvironmentBlendMode>>,
+    /// Whether the app attached its action sets to the session.
+    pub attached: bool,
 }
 
 /// What the layer keeps per space it saw created.

@@ -278,9 +278,17 @@ pub unsafe extern "system" fn suggest_interaction_profile_bindings(
         let Some(paths) = paths else {
             return forward();
         };
+        let attached = registry()
+            .instances
+            .get(&instance.into_raw())
+            .is_some_and(|i| i.attached);
+        if attached && s.interaction_profile == paths.profile {
+            return sys::Result::ERROR_ACTIONSETS_ALREADY_ATTACHED;
+        }
         match bindings::plan(&paths, s.interaction_profile, list) {
             Plan::Forward => forward(),
             Plan::Reject => sys::Result::ERROR_PATH_UNSUPPORTED,
+            Plan::Empty => sys::Result::ERROR_VALIDATION_FAILURE,
             Plan::Absorb(actions) => {
                 if let Some(i) = registry().instances.get_mut(&instance.into_raw()) {
                     i.gaze_actions.extend(actions.iter().map(|a| a.into_raw()));

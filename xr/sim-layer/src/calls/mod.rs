@@ -4,6 +4,7 @@
 //! Every entry point runs its body in [`guard`](crate::guard::guard), takes what it needs
 //! from the registry under the lock, and calls down the chain without it.
 
+pub mod actions;
 pub mod controller;
 pub mod fb;
 pub mod instance;

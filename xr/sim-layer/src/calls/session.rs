@@ -61,6 +61,7 @@ pub unsafe extern "system" fn create_session(
                 frames_ended: 0,
                 syncs_ns: (None, None),
                 runtime_blend: None,
+                attached: false,
             },
         );
         r
@@ -367,17 +368,20 @@ pub unsafe extern "system" fn locate_space(
         let Some(loc) = (unsafe { location.as_mut() }) else {
             return sys::Result::ERROR_VALIDATION_FAILURE;
         };
+        if time.as_nanos() <= 0 {
+            return sys::Result::ERROR_TIME_INVALID;
+        }
         let (Some((a, fa)), Some((b, fb))) = (
             in_view(&ctx, space, a_offset, time),
             in_view(&ctx, base, b_offset, time),
         ) else {
             return sys::Result::ERROR_RUNTIME_FAILURE;
         };
-        let flags = if fa.is_empty() || fb.is_empty() {
+        let flags = gaze_location_flags(if fa.is_empty() || fb.is_empty() {
             sys::SpaceLocationFlags::EMPTY
         } else {
             fa & fb
-        };
+        });
         loc.location_flags = flags;
         loc.pose = if flags.is_empty() {
             sys::Posef::IDENTITY
@@ -404,6 +408,19 @@ pub unsafe extern "system" fn locate_space(
     })
 }
 
+/// A gaze space's location flags: XR_EXT_eye_gaze_interaction has position and orientation
+/// tracked together or neither (the head's flags, mixed in, may track only the orientation);
+/// the valid bits stay as they were.
+pub fn gaze_location_flags(flags: sys::SpaceLocationFlags) -> sys::SpaceLocationFlags {
+    let tracked =
+        sys::SpaceLocationFlags::POSITION_TRACKED | sys::SpaceLocationFlags::ORIENTATION_TRACKED;
+    if flags.contains(tracked) {
+        flags
+    } else {
+        flags & !tracked
+    }
+}
+
 /// `xrGetActionStatePose`: an eye-gaze action is active (the simulated tracker is always
 /// on); other actions go to the runtime.
 ///
@@ -423,10 +440,14 @@ pub unsafe extern "system" fn get_action_state_pose(
                     .get(&c.instance.into_raw())
                     .map(|i| i.gaze_actions.clone())
                     .unwrap_or_default();
-                (c, gaze)
+                let attached = reg
+                    .sessions
+                    .get(&session.into_raw())
+                    .is_some_and(|s| s.attached);
+                (c, gaze, attached)
             })
         };
-        let Some((ctx, gaze_actions)) = found else {
+        let Some((ctx, gaze_actions, attached)) = found else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the app's structures, null or valid.
@@ -434,10 +455,30 @@ pub unsafe extern "system" fn get_action_state_pose(
             return sys::Result::ERROR_VALIDATION_FAILURE;
         };
         if gaze_actions.contains(&get.action.into_raw()) {
+            if !attached {
+                return sys::Result::ERROR_ACTIONSET_NOT_ATTACHED;
+            }
             out.is_active = sys::TRUE;
             return sys::Result::SUCCESS;
         }
         // SAFETY: the next layer's function with the app's arguments.
         unsafe { (ctx.next.get_action_state_pose)(session, info, state) }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sys::SpaceLocationFlags as F;
+
+    #[test]
+    fn a_gaze_space_tracks_position_and_orientation_together_or_neither() {
+        let valid = F::POSITION_VALID | F::ORIENTATION_VALID;
+        let all = valid | F::POSITION_TRACKED | F::ORIENTATION_TRACKED;
+        assert_eq!(gaze_location_flags(all), all);
+        // The head tracks its orientation only: neither is tracked, both stay valid.
+        assert_eq!(gaze_location_flags(valid | F::ORIENTATION_TRACKED), valid);
+        assert_eq!(gaze_location_flags(valid | F::POSITION_TRACKED), valid);
+        assert_eq!(gaze_location_flags(F::EMPTY), F::EMPTY);
+    }
 }

@@ -11,6 +11,8 @@
 //! The argument is the number of frames (default 30). Exits with status 1, naming the call,
 //! when a call fails or an answer is not what the layer promises.
 
+mod spec;
+
 use std::ffi::c_void;
 use std::process::ExitCode;
 
@@ -195,6 +197,8 @@ fn probe(frames: u32) -> Probe<()> {
         ml_tracker.0,
         fb_tracker.into_raw()
     );
+    let gaze = spec::before_frames(&instance, session.as_raw())?;
+    let mut located = false;
     let mut static_data = ml::EyeTrackerStaticDataML {
         ty: sys::StructureType::from_raw(ml::structure_type::STATIC_DATA),
         next: std::ptr::null_mut(),
@@ -240,6 +244,10 @@ fn probe(frames: u32) -> Probe<()> {
         }
         let state = waiter.wait().map_err(|e| format!("xrWaitFrame: {e}"))?;
         let t = state.predicted_display_time;
+        if !located {
+            spec::locate(&instance, &gaze, local.as_raw(), t)?;
+            located = true;
+        }
 
         // ML poses in LOCAL.
         let get = ml::EyeTrackerPosesGetInfoML {
@@ -346,7 +354,7 @@ fn probe(frames: u32) -> Probe<()> {
                 gazes.gaze[0].gaze_confidence,
             );
         }
-        if n != 2 || g != 2 || behavior.valid != sys::FALSE {
+        if n != 2 || g != 2 || behavior.valid != sys::TRUE {
             return Err(
                 "pupil/geometric counts or behaviour validity are not as documented".into(),
             );

@@ -1,0 +1,143 @@
+//! The eye-gaze profile's action calls, answered as the spec orders them for a profile the
+//! runtime below does not know: attaching is passed on and remembered (a suggestion after it
+//! is refused, a gaze action's state before it too), `/user/eyes_ext`'s current interaction
+//! profile is the gaze profile once a gaze binding is attached, and a gaze action's bound
+//! source is the gaze pose. Everything else goes to the runtime.
+
+use openxr::sys::{self, Handle};
+
+use crate::guard::guard;
+use crate::registry::registry;
+use crate::two_call;
+
+/// `xrAttachSessionActionSets`: passed on; on success the session and its instance are marked
+/// attached.
+///
+/// # Safety
+/// As `xrAttachSessionActionSets`.
+pub unsafe extern "system" fn attach_session_action_sets(
+    session: sys::Session,
+    info: *const sys::SessionActionSetsAttachInfo,
+) -> sys::Result {
+    guard("xrAttachSessionActionSets", || {
+        let Some(next) = registry()
+            .session(session.into_raw())
+            .map(|(_, i)| i.next.clone())
+        else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the next layer's function with the app's arguments.
+        let r = unsafe { (next.attach_session_action_sets)(session, info) };
+        if r.into_raw() >= 0 {
+            let mut reg = registry();
+            if let Some(s) = reg.sessions.get_mut(&session.into_raw()) {
+                s.attached = true;
+                let instance = s.instance;
+                if let Some(i) = reg.instances.get_mut(&instance) {
+                    i.attached = true;
+                }
+            }
+        }
+        r
+    })
+}
+
+/// `xrGetCurrentInteractionProfile`: for `/user/eyes_ext` (XR_EXT_eye_gaze_interaction from
+/// the layer), the gaze profile once a gaze binding was suggested and the action sets
+/// attached, else `XR_NULL_PATH`; `XR_ERROR_ACTIONSET_NOT_ATTACHED` before attaching. Other
+/// paths go to the runtime.
+///
+/// # Safety
+/// As `xrGetCurrentInteractionProfile`.
+pub unsafe extern "system" fn get_current_interaction_profile(
+    session: sys::Session,
+    top_level_user_path: sys::Path,
+    state: *mut sys::InteractionProfileState,
+) -> sys::Result {
+    guard("xrGetCurrentInteractionProfile", || {
+        let Some((next, paths, bound, attached)) =
+            registry().session(session.into_raw()).map(|(s, i)| {
+                (
+                    i.next.clone(),
+                    i.gaze_paths,
+                    !i.gaze_actions.is_empty(),
+                    s.attached,
+                )
+            })
+        else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        let Some(paths) = paths.filter(|p| p.user == top_level_user_path) else {
+            // SAFETY: the next layer's function with the app's arguments.
+            return unsafe {
+                (next.get_current_interaction_profile)(session, top_level_user_path, state)
+            };
+        };
+        // SAFETY: the app's output structure, null or valid.
+        let Some(out) = (unsafe { state.as_mut() }) else {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        };
+        if !attached {
+            return sys::Result::ERROR_ACTIONSET_NOT_ATTACHED;
+        }
+        out.interaction_profile = if bound {
+            paths.profile
+        } else {
+            sys::Path::NULL
+        };
+        sys::Result::SUCCESS
+    })
+}
+
+/// `xrEnumerateBoundSourcesForAction`: a gaze action's one source is the gaze pose
+/// (`XR_ERROR_ACTIONSET_NOT_ATTACHED` before attaching); other actions go to the runtime.
+///
+/// # Safety
+/// As `xrEnumerateBoundSourcesForAction`.
+pub unsafe extern "system" fn enumerate_bound_sources_for_action(
+    session: sys::Session,
+    info: *const sys::BoundSourcesForActionEnumerateInfo,
+    capacity: u32,
+    count_out: *mut u32,
+    sources: *mut sys::Path,
+) -> sys::Result {
+    guard("xrEnumerateBoundSourcesForAction", || {
+        let Some((next, paths, gaze_actions, attached)) =
+            registry().session(session.into_raw()).map(|(s, i)| {
+                (
+                    i.next.clone(),
+                    i.gaze_paths,
+                    i.gaze_actions.clone(),
+                    s.attached,
+                )
+            })
+        else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the app's input structure, null or valid.
+        let action = unsafe { info.as_ref() }.map(|i| i.action.into_raw());
+        let (Some(paths), Some(action)) = (paths, action) else {
+            // SAFETY: the next layer's function with the app's arguments.
+            return unsafe {
+                (next.enumerate_bound_sources_for_action)(
+                    session, info, capacity, count_out, sources,
+                )
+            };
+        };
+        if !gaze_actions.contains(&action) {
+            // SAFETY: the next layer's function with the app's arguments.
+            return unsafe {
+                (next.enumerate_bound_sources_for_action)(
+                    session, info, capacity, count_out, sources,
+                )
+            };
+        }
+        if !attached {
+            return sys::Result::ERROR_ACTIONSET_NOT_ATTACHED;
+        }
+        // SAFETY: the app's count output and array of `capacity` paths, null or valid.
+        let (count_out, out) =
+            unsafe { (count_out.as_mut(), two_call::out_slice(capacity, sources)) };
+        two_call::answer(&[paths.pose], capacity, count_out, out)
+    })
+}

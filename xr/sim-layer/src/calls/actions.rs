@@ -116,7 +116,8 @@ pub unsafe extern "system" fn enumerate_bound_sources_for_action(
         };
         // SAFETY: the app's input structure, null or valid.
         let action = unsafe { info.as_ref() }.map(|i| i.action.into_raw());
-        let (Some(paths), Some(action)) = (paths, action) else {
+        let Some(paths) = paths.filter(|_| action.is_some_and(|a| gaze_actions.contains(&a)))
+        else {
             // SAFETY: the next layer's function with the app's arguments.
             return unsafe {
                 (next.enumerate_bound_sources_for_action)(
@@ -124,14 +125,6 @@ pub unsafe extern "system" fn enumerate_bound_sources_for_action(
                 )
             };
         };
-        if !gaze_actions.contains(&action) {
-            // SAFETY: the next layer's function with the app's arguments.
-            return unsafe {
-                (next.enumerate_bound_sources_for_action)(
-                    session, info, capacity, count_out, sources,
-                )
-            };
-        }
         if !attached {
             return sys::Result::ERROR_ACTIONSET_NOT_ATTACHED;
         }

@@ -192,3 +192,45 @@ fn bad_images_are_named_and_no_map_is_written() {
     assert_clean_failure(&out, &["--ppd", "pixels per degree"]);
     assert!(!dir.path().join("m.png").exists());
 }
+
+#[test]
+fn with_what_is_seen_the_nothing_drawn_and_additive_limit_rows_follow() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (32u32, 16u32);
+    let reference = vec![100u8; (w * h * 3) as usize];
+    // What the eye sees with nothing drawn: darker than the reference on the left half (a
+    // display can add the difference), brighter on the right (it cannot take light away).
+    let seen: Vec<u8> = (0..w * h)
+        .flat_map(|i| if i % w < w / 2 { [60u8; 3] } else { [140u8; 3] })
+        .collect();
+    write_png(&dir.path().join("r.png"), &reference, w, h);
+    write_png(&dir.path().join("s.png"), &seen, w, h);
+    write_png(&dir.path().join("t.png"), &reference, w, h);
+    let report = json(
+        &["compare", "r.png", "t.png", "--seen", "s.png", "--json"],
+        dir.path(),
+    );
+    let psnr = |rows: &str| report[rows][0]["psnr_db"].as_f64().unwrap();
+    // Nothing drawn: 40 off everywhere. The limit: exact on the left, 40 off on the right,
+    // so half the squared error.
+    let nothing = 20.0 * (255.0f64 / 40.0).log10();
+    assert!((psnr("nothing_drawn") - nothing).abs() < 1e-9, "{report}");
+    assert!(
+        (psnr("additive_limit") - (nothing + 10.0 * 2f64.log10())).abs() < 1e-9,
+        "{report}"
+    );
+    assert!(report["regions"][0]["psnr_db"].is_null());
+    let out = vitreous(
+        &["compare", "r.png", "t.png", "--seen", "s.png"],
+        dir.path(),
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("limit FLIP"), "{table}");
+    // A seen image of another size is refused, naming it.
+    write_png(&dir.path().join("small.png"), &[0; 8 * 8 * 3], 8, 8);
+    let out = vitreous(
+        &["compare", "r.png", "t.png", "--seen", "small.png"],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["small.png is 8x8", "differ in size"]);
+}

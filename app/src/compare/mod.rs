@@ -2,7 +2,8 @@
 //! perceptual difference evaluator, `nv-flip`; mean over pixels, 0 identical, lower is
 //! closer) and PSNR (8-bit sRGB, all three channels), over the whole view and, with a scene,
 //! region by region (`regions.rs`: the object's disc, the shadow and caustic, the inducer's
-//! ramp, the rest); optionally the ꟻLIP error map as a PNG.
+//! ramp, the rest); with what the eye sees when nothing is drawn, the same figures for it and
+//! for the additive limit beside the test's; optionally the ꟻLIP error map as a PNG.
 
 mod regions;
 
@@ -34,6 +35,11 @@ pub struct CompareArgs {
     /// 24-inch 4K monitor).
     #[arg(long, value_name = "PPD", value_parser = parse_ppd)]
     pub ppd: Option<f32>,
+    /// What the eye sees with nothing drawn (PNG, the reference's size): adds two rows, that
+    /// image itself and the additive limit, the per-pixel maximum of it and the reference (the
+    /// closest any display that only adds light can get).
+    #[arg(long, value_name = "PNG")]
+    pub seen: Option<PathBuf>,
     /// Write the ꟻLIP error map here (PNG, the magma colour map: black no error, yellow most).
     #[arg(long, value_name = "FILE")]
     pub map: Option<PathBuf>,
@@ -89,6 +95,20 @@ pub struct Comparison {
     pub scene: Option<String>,
     /// The whole view first, then each region of the scene.
     pub regions: Vec<RegionFigures>,
+    /// With `--seen`: the same figures for what the eye sees with nothing drawn.
+    pub nothing_drawn: Option<Vec<RegionFigures>>,
+    /// With `--seen`: the same figures for the additive limit, max(seen, reference) per pixel
+    /// and channel.
+    pub additive_limit: Option<Vec<RegionFigures>>,
+}
+
+/// The closest a display that only adds light can bring `seen` to `reference`: the larger of
+/// the two in every channel of every pixel (sRGB encoding keeps the order of linear light).
+pub fn additive_limit(seen: &[u8], reference: &[u8]) -> Vec<u8> {
+    seen.iter()
+        .zip(reference)
+        .map(|(&a, &b)| a.max(b))
+        .collect()
 }
 
 /// Most pixels an image may have (as the scene loader's images).
@@ -170,17 +190,24 @@ pub fn compare(
 /// `vitreous compare`.
 pub fn compare_command(args: CompareArgs) -> Result<()> {
     if let Some(map) = &args.map {
-        ensure_not_input(map, "--map", &[&args.reference, &args.test])?;
+        let mut inputs = vec![args.reference.as_path(), args.test.as_path()];
+        inputs.extend(args.seen.as_deref());
+        ensure_not_input(map, "--map", &inputs)?;
     }
     let (w, h, reference) = read_rgb(&args.reference)?;
-    let (tw, th, test) = read_rgb(&args.test)?;
-    if (w, h) != (tw, th) {
-        bail!(
-            "the images differ in size: {} is {w}x{h}, {} is {tw}x{th}",
-            args.reference.display(),
-            args.test.display()
-        );
-    }
+    let same_size = |path: &Path| -> Result<Vec<u8>> {
+        let (tw, th, image) = read_rgb(path)?;
+        if (w, h) != (tw, th) {
+            bail!(
+                "the images differ in size: {} is {w}x{h}, {} is {tw}x{th}",
+                args.reference.display(),
+                path.display()
+            );
+        }
+        Ok(image)
+    };
+    let test = same_size(&args.test)?;
+    let seen = args.seen.as_deref().map(same_size).transpose()?;
     let scene = match &args.scene {
         Some(path) => Some(vitreous_scene::load_scene(path)?),
         None => None,
@@ -194,6 +221,11 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
     });
     let labels = scene.as_ref().map(|s| regions(s, args.eye, w, h));
     let (error, figures) = compare(&reference, &test, (w, h), ppd, labels.as_deref());
+    let rows = |image: &[u8]| compare(&reference, image, (w, h), ppd, labels.as_deref()).1;
+    let nothing_drawn = seen.as_deref().map(rows);
+    let limit = seen
+        .as_deref()
+        .map(|s| rows(&additive_limit(s, &reference)));
     if let Some(map) = &args.map {
         let rgb = nv_flip::FlipImageFloat::with_data(w, h, &error)
             .apply_color_lut(&nv_flip::magma_lut())
@@ -212,6 +244,8 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         pixels_per_degree: ppd,
         scene: args.scene.as_ref().map(|p| p.display().to_string()),
         regions: figures,
+        nothing_drawn,
+        additive_limit: limit,
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -221,10 +255,11 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
     Ok(())
 }
 
-/// The report as a text table.
+/// The report as a text table: one line per region, with the nothing-drawn and additive-limit
+/// figures beside the test's when they were measured.
 fn table(report: &Comparison) -> String {
     let mut out = format!(
-        "{} against {} ({}x{}, {:.1} pixels per degree)\n{:<16} {:>9} {:>10} {:>10}\n",
+        "{} against {} ({}x{}, {:.1} pixels per degree)\n{:<16} {:>9} {:>10} {:>10}",
         report.test,
         report.reference,
         report.width_px,
@@ -235,17 +270,35 @@ fn table(report: &Comparison) -> String {
         "FLIP mean",
         "PSNR dB"
     );
-    for r in &report.regions {
+    let extra = report
+        .nothing_drawn
+        .as_ref()
+        .zip(report.additive_limit.as_ref());
+    if extra.is_some() {
+        out += &format!(
+            " {:>12} {:>12} {:>12} {:>12}",
+            "nothing FLIP", "nothing PSNR", "limit FLIP", "limit PSNR"
+        );
+    }
+    out.push('\n');
+    let cells = |r: &RegionFigures| {
         let flip = r.flip_mean.map_or("-".to_owned(), |v| format!("{v:.4}"));
         let psnr = match (r.pixels, r.psnr_db) {
             (0, _) => "-".to_owned(),
             (_, None) => "equal".to_owned(),
             (_, Some(v)) => format!("{v:.2}"),
         };
-        out += &format!(
-            "{:<16} {:>9} {:>10} {:>10}\n",
-            r.region, r.pixels, flip, psnr
-        );
+        (flip, psnr)
+    };
+    for (i, r) in report.regions.iter().enumerate() {
+        let (flip, psnr) = cells(r);
+        out += &format!("{:<16} {:>9} {:>10} {:>10}", r.region, r.pixels, flip, psnr);
+        if let Some((nothing, limit)) = extra {
+            let (nf, np) = cells(&nothing[i]);
+            let (lf, lp) = cells(&limit[i]);
+            out += &format!(" {nf:>12} {np:>12} {lf:>12} {lp:>12}");
+        }
+        out.push('\n');
     }
     out
 }

@@ -96,7 +96,9 @@ fn main() {
             // Half floats packed two to a word (pack2x16float) are core SPIR-V for Vulkan
             // (GLSL.std.450 PackHalf2x16).
             naga::valid::Capabilities::PUSH_CONSTANT
-                | naga::valid::Capabilities::SHADER_FLOAT16_IN_FLOAT32,
+                | naga::valid::Capabilities::SHADER_FLOAT16_IN_FLOAT32
+                // `@early_depth_test(force)` is SPIR-V's EarlyFragmentTests, core in Vulkan.
+                | naga::valid::Capabilities::EARLY_DEPTH_TEST,
         )
         .validate(&module)
         .unwrap_or_else(|e| {

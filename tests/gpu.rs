@@ -3,6 +3,7 @@
 
 mod absorption;
 mod caustics;
+mod compensation;
 mod cost;
 mod defocus;
 mod inducer;

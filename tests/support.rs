@@ -183,6 +183,7 @@ pub fn scene_desc<'a>(
         surface_stack: None,
         inducer: vitreous_render::InducerDesc::PAPER,
         caustics: None,
+        compensation: vitreous_render::Compensation::None,
     }
 }
 

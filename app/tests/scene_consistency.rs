@@ -97,3 +97,28 @@ fn a_light_share_outside_zero_to_one_names_the_field() {
         assert!(msg.contains(">= 0 and <= 1"), "{msg}");
     }
 }
+
+#[test]
+fn display_compensation_is_read_and_an_unknown_one_names_the_field() {
+    let (_dir, _path, scene) = load_text(&good_text());
+    assert_eq!(
+        scene.unwrap().compensation,
+        vitreous_render::Compensation::None
+    );
+    let text = format!(
+        "{}\n[display]\ncompensation = \"background\"\n",
+        good_text()
+    );
+    let (_dir, _path, scene) = load_text(&text);
+    assert_eq!(
+        scene.unwrap().compensation,
+        vitreous_render::Compensation::Background
+    );
+    let text = format!("{}\n[display]\ncompensation = \"half\"\n", good_text());
+    let msg = expect_error(
+        &text,
+        line_of(&text, "compensation ="),
+        "display.compensation",
+    );
+    assert!(msg.contains("\"none\" or \"background\""), "{msg}");
+}

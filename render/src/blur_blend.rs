@@ -18,7 +18,7 @@ use crate::descriptors::{self, TextureSets};
 use crate::error::Result;
 use crate::floor::FieldTarget;
 use crate::owned::Owned;
-use crate::pipeline::{self, Blend, FieldStart, PipelineSpec};
+use crate::pipeline::{self, Blend, Depth, FieldStart, PipelineSpec};
 use crate::scene::GpuScene;
 use crate::shaders;
 
@@ -91,7 +91,7 @@ impl BlurBlend {
                 bindings: &[],
                 attributes: &[],
                 cull: vk::CullModeFlags::NONE,
-                depth: false,
+                depth: Depth::Off,
                 blend: Blend::ReplaceColor,
             },
         )?;

@@ -13,7 +13,7 @@ use crate::error::Result;
 use crate::memory::{Buffer, Image, upload_texture};
 use crate::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
 use crate::owned::Owned;
-use crate::pipeline::{self, Blend, PipelineSpec};
+use crate::pipeline::{self, Blend, Depth, PipelineSpec};
 use crate::pose::ScenePose;
 use crate::radial_map::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, mesh_center, radial_map};
 use crate::scene::{GpuScene, Refraction, SceneDesc, VERTEX_STRIDE};
@@ -241,7 +241,7 @@ impl GlassPass {
                         bindings: &bindings,
                         attributes: &attributes,
                         cull: vk::CullModeFlags::BACK,
-                        depth: true,
+                        depth: Depth::Nearest,
                         blend: Blend::ReplaceColor,
                     },
                 )

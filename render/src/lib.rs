@@ -26,6 +26,7 @@
 pub mod absorption;
 mod blur_blend;
 pub mod camera;
+mod compensation;
 pub mod context;
 pub mod convex;
 mod descriptors;
@@ -52,6 +53,7 @@ mod world;
 
 pub use absorption::Attenuation;
 pub use camera::{Defocus, EyeParams, FrameParams, Look, Reflection};
+pub use compensation::Compensation;
 pub use context::{ContextOptions, DeviceCreator, GpuContext, PlainVulkan};
 pub use error::{RenderError, Result};
 /// The floor passes under their earlier name.

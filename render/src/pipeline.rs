@@ -27,6 +27,21 @@ pub enum Blend {
     ReplaceColor,
     /// Add to the target's colour (ONE, ONE) without touching alpha: light added on top.
     Add,
+    /// Take the colour away from the target's (target minus colour, which the attachment clamps
+    /// at 0) without touching alpha: eq. 6's light the eye already sees.
+    TakeAway,
+}
+
+/// How a pipeline uses the depth attachment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Depth {
+    /// Neither tests nor writes it.
+    Off,
+    /// Draws the nearest surface: tests LESS and writes.
+    Nearest,
+    /// Draws only where something nearer than the fragment was drawn (GREATER), writing
+    /// nothing: a full-screen pass at the far plane over what the frame drew.
+    Behind,
 }
 
 /// How a triangle-list pipeline with dynamic viewport and scissor draws.
@@ -45,8 +60,8 @@ pub struct PipelineSpec<'a> {
     pub attributes: &'a [vk::VertexInputAttributeDescription],
     /// Which faces to cull.
     pub cull: vk::CullModeFlags,
-    /// Test and write depth (LESS); otherwise neither.
-    pub depth: bool,
+    /// Depth test and write.
+    pub depth: Depth,
     /// Colour blending.
     pub blend: Blend,
 }
@@ -101,16 +116,36 @@ pub fn create(ctx: &GpuContext, spec: &PipelineSpec) -> Result<Owned<vk::Pipelin
         .line_width(1.0);
     let multisample = vk::PipelineMultisampleStateCreateInfo::default()
         .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(spec.depth)
-        .depth_write_enable(spec.depth)
-        .depth_compare_op(vk::CompareOp::LESS);
+    let depth = match spec.depth {
+        Depth::Off => vk::PipelineDepthStencilStateCreateInfo::default(),
+        Depth::Nearest => vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(true)
+            .depth_write_enable(true)
+            .depth_compare_op(vk::CompareOp::LESS),
+        Depth::Behind => vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(true)
+            .depth_write_enable(false)
+            .depth_compare_op(vk::CompareOp::GREATER),
+    };
     let blend_attachments = [match spec.blend {
         Blend::Add => vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(true)
             .src_color_blend_factor(vk::BlendFactor::ONE)
             .dst_color_blend_factor(vk::BlendFactor::ONE)
             .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ZERO)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+            .alpha_blend_op(vk::BlendOp::ADD)
+            .color_write_mask(
+                vk::ColorComponentFlags::R
+                    | vk::ColorComponentFlags::G
+                    | vk::ColorComponentFlags::B,
+            ),
+        Blend::TakeAway => vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(vk::BlendOp::REVERSE_SUBTRACT)
             .src_alpha_blend_factor(vk::BlendFactor::ZERO)
             .dst_alpha_blend_factor(vk::BlendFactor::ONE)
             .alpha_blend_op(vk::BlendOp::ADD)

@@ -12,6 +12,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::blur_blend::{self, BlurBlend};
 use crate::camera::FrameParams;
+use crate::compensation::{Compensation, CompensationPass};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
 use crate::floor::{FIELD_STAMPS, FieldPassesMs, InducerFields, InducerPass, Prepared, Stamps};
@@ -153,6 +154,8 @@ pub struct Renderer {
     blur: BlurBlend,
     /// The real-world pass for previews.
     world: WorldPass,
+    /// Eq. 6 over the glass, when the scene asks for it.
+    compensation: Option<CompensationPass>,
     /// The shadow inducer's fields and floor overlay.
     inducer: InducerPass,
     /// The render pass all passes draw in.
@@ -194,6 +197,15 @@ impl Renderer {
                 scene.background.world_from_plane,
             ],
         )?;
+        let compensation = match scene.compensation {
+            Compensation::None => None,
+            Compensation::Background => Some(CompensationPass::new(
+                &ctx,
+                render_pass.raw(),
+                &gpu_scene,
+                scene,
+            )?),
+        };
         let inducer = InducerPass::new(&ctx, render_pass.raw(), &gpu_scene, scene)?;
         let eye_target = StereoTarget::new(&ctx, "eye images", render_pass.raw(), extent)?;
         let world_target = StereoTarget::new(&ctx, "world views", render_pass.raw(), extent)?;
@@ -261,6 +273,7 @@ impl Renderer {
             glass,
             blur,
             world,
+            compensation,
             inducer,
             render_pass,
             scene: gpu_scene,
@@ -643,6 +656,11 @@ impl Renderer {
                         let variant = GlassVariant::of(&params.look);
                         self.glass
                             .record(&self.ctx, cmd, &self.scene, variant, &push);
+                        // What the eye already sees there, taken away (eq. 6), unless the
+                        // display shows the world itself.
+                        if let Some(c) = self.compensation.as_ref().filter(|_| !world_behind) {
+                            c.record(&self.ctx, cmd, eye, self.pose.world_from_model, self.extent);
+                        }
                     }
                 });
                 d.cmd_end_render_pass(cmd);

@@ -134,6 +134,8 @@ pub struct SceneDesc<'a> {
     /// [`crate::Look::caustics`] is on (nothing without a map).
     pub caustics: Option<CausticsDesc<'a>>,
     // --- end caustics ---
+    /// What the display takes away from the glass's light (eq. 6 over the glass).
+    pub compensation: crate::Compensation,
 }
 
 // --- caustics (issue 6; render/src/floor/) ---

@@ -94,6 +94,10 @@ pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const BLUR_BLEND_VS: &[u8] = spirv!("blur_blend.vs_main");
 pub const BLUR_BLEND_FS: &[u8] = spirv!("blur_blend.fs_main");
 pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
+/// Eq. 6 over the glass: the full-screen triangle at the far plane (shaders/compensation.wgsl).
+pub const COMPENSATION_VS: &[u8] = spirv!("compensation.vs_main");
+/// Eq. 6 over the glass: the real floor or background the eye sees, to take away.
+pub const COMPENSATION_FS: &[u8] = spirv!("compensation.fs_main");
 pub const MASK_VS: &[u8] = spirv!("inducer_mask.vs_main");
 pub const MASK_FS: &[u8] = spirv!("inducer_mask.fs_main");
 pub const FIELD_VS: &[u8] = spirv!("inducer_field.vs_main");

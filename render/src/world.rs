@@ -9,7 +9,7 @@ use crate::context::GpuContext;
 use crate::descriptors::{self, TextureSets};
 use crate::error::Result;
 use crate::owned::Owned;
-use crate::pipeline::{self, Blend, PipelineSpec};
+use crate::pipeline::{self, Blend, Depth, PipelineSpec};
 use crate::scene::GpuScene;
 use crate::shaders;
 
@@ -63,7 +63,7 @@ impl WorldPass {
                 bindings: &[],
                 attributes: &[],
                 cull: vk::CullModeFlags::NONE,
-                depth: true,
+                depth: Depth::Nearest,
                 blend: Blend::ReplaceColor,
             },
         )?;

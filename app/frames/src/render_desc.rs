@@ -156,5 +156,6 @@ pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> Sc
             height: bake.height_px,
             gain: &bake.gain,
         }),
+        compensation: scene.compensation,
     }
 }

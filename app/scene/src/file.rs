@@ -30,6 +30,15 @@ pub(crate) struct SceneFile {
     pub caustics: CausticsToml,
     #[serde(default)]
     pub motion: MotionToml,
+    #[serde(default)]
+    pub display: DisplayToml,
+}
+
+/// `[display]`: what the display does with the glass's light.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct DisplayToml {
+    pub compensation: Option<Spanned<String>>,
 }
 
 /// `[motion]`: keyframes of the object and the light.

@@ -84,6 +84,10 @@ pub struct Scene {
     pub effects: EffectSet,
     /// How the gaze image is chosen for defocus.
     pub gaze: GazeChoice,
+    /// What the display takes away from the glass's light (`[display] compensation`): nothing
+    /// (the paper's), or the real floor or background the eye already sees (eq. 6 over the
+    /// glass).
+    pub compensation: vitreous_render::Compensation,
     /// The shadow inducer's parameters.
     pub inducer: Inducer,
     /// The caustic bake (eq. 6): where it is and, once [`Scene::load_caustics`] ran, its

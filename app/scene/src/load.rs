@@ -428,6 +428,20 @@ impl Loader<'_> {
             .iter()
             .map(|b| format!("{b:02x}"))
             .collect();
+        let compensation = match &raw.display.compensation {
+            None => vitreous_render::Compensation::None,
+            Some(c) => match c.get_ref().as_str() {
+                "none" => vitreous_render::Compensation::None,
+                "background" => vitreous_render::Compensation::Background,
+                other => {
+                    return Err(self.src.invalid(
+                        c.span(),
+                        "display.compensation",
+                        format!("expected \"none\" or \"background\", found {other:?}"),
+                    ));
+                }
+            },
+        };
         let warnings = crate::consistency::warnings(&object, &light, &floor, &background);
         Ok(Scene {
             path: self.src.file.to_path_buf(),
@@ -442,6 +456,7 @@ impl Loader<'_> {
             effects,
             inducer,
             gaze,
+            compensation,
             caustics,
             warnings,
             motion,

@@ -18,7 +18,9 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::{Buffer, memory_barrier};
 use crate::owned::Owned;
-use crate::pipeline::{self, Blend, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec};
+use crate::pipeline::{
+    self, Blend, Depth, MESH_POSITION_ATTRIBUTE, MESH_POSITION_BINDING, PipelineSpec,
+};
 use crate::scene::{GpuScene, MeshRef};
 use crate::shaders;
 
@@ -82,7 +84,7 @@ impl MaskPass {
             bindings,
             attributes: &[MESH_POSITION_ATTRIBUTE],
             cull,
-            depth: false,
+            depth: Depth::Off,
             blend: Blend::Replace,
         };
         // A closed mesh's shadow is drawn whole by the triangles facing either way alone, so

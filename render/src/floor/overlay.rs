@@ -14,7 +14,7 @@ use crate::descriptors;
 use crate::error::Result;
 use crate::memory::Buffer;
 use crate::owned::Owned;
-use crate::pipeline::{self, Blend, PipelineSpec};
+use crate::pipeline::{self, Blend, Depth, PipelineSpec};
 use crate::scene::GpuScene;
 use crate::shaders::{OVERLAY_FS, OVERLAY_FS_COST, OVERLAY_VS};
 use crate::work::ShaderCost;
@@ -139,7 +139,7 @@ impl OverlayPass {
                         bindings: &[],
                         attributes: &[],
                         cull: vk::CullModeFlags::NONE,
-                        depth: false,
+                        depth: Depth::Off,
                         blend: Blend::Add,
                     },
                 )

@@ -22,7 +22,7 @@ use crate::descriptors;
 use crate::error::Result;
 use crate::memory::{Image, upload_texture};
 use crate::owned::Owned;
-use crate::pipeline::{self, Blend, FieldStart, PipelineSpec};
+use crate::pipeline::{self, Blend, Depth, FieldStart, PipelineSpec};
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, InducerDesc, SceneDesc};
 use crate::shaders;
@@ -155,7 +155,7 @@ impl InducerPass {
                     bindings: &[],
                     attributes: &[],
                     cull: vk::CullModeFlags::NONE,
-                    depth: false,
+                    depth: Depth::Off,
                     blend: Blend::Replace,
                 },
             )?);

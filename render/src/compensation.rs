@@ -1,0 +1,329 @@
+//! Eq. 6 over the glass (`[display] compensation = "background"`, shaders/compensation.wgsl):
+//! after the glass, each eye's glass pixels lose the light of the real floor or background the
+//! eye already sees there, `max(T - B, 0)`, so the display adds only what is missing. Drawn as
+//! one triangle at the far plane, scissored to the object's bounding sphere on screen, that
+//! passes the depth test only where the glass (the only depth writer of an additive frame) was
+//! drawn.
+
+use ash::vk;
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+use crate::camera::EyeParams;
+use crate::context::GpuContext;
+use crate::descriptors;
+use crate::error::{RenderError, Result};
+use crate::memory::{Buffer, Image, upload_texture};
+use crate::owned::Owned;
+use crate::pipeline::{self, Blend, Depth, PipelineSpec};
+use crate::scene::{GpuScene, PlaneDesc, SceneDesc, TexelData};
+use crate::shaders;
+
+/// What the display takes away from the glass's light (`[display] compensation`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Compensation {
+    /// Nothing: the glass's whole light is added (the paper's conditions).
+    #[default]
+    None,
+    /// The real floor or background the eye sees through the glass (eq. 6 over the glass).
+    Background,
+}
+
+/// Push constants: one eye.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct EyePush {
+    world_from_clip: [f32; 16],
+    position: [f32; 4],
+}
+
+/// The planes and where each photo lies in the packed texture (shaders/compensation.wgsl
+/// `Planes`).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Planes {
+    floor_from_world: [f32; 16],
+    background_from_world: [f32; 16],
+    floor_rect: [f32; 4],
+    background_rect: [f32; 4],
+}
+
+/// The pass, freed on drop.
+pub struct CompensationPass {
+    pipeline: Owned<vk::Pipeline>,
+    layout: Owned<vk::PipelineLayout>,
+    _pool: Owned<vk::DescriptorPool>,
+    _set_layout: Owned<vk::DescriptorSetLayout>,
+    set: vk::DescriptorSet,
+    _planes: Buffer,
+    _photos: Image,
+    /// The mesh's bounding sphere in model units: centre and radius.
+    bounds: (Vec3, f32),
+}
+
+/// The two photos side by side in one sRGB texture (floor left, background right), and each
+/// one's normalised rectangle.
+fn pack(floor: &PlaneDesc, background: &PlaneDesc) -> Result<(u32, u32, Vec<u8>, [Vec4; 2])> {
+    let photo = |p: &PlaneDesc| -> Result<(u32, u32, Vec<u8>)> {
+        match p.photo.data {
+            TexelData::Srgb8(bytes) => Ok((p.photo.width, p.photo.height, bytes.to_vec())),
+            TexelData::LinearF32(_) => Err(RenderError::Creation(
+                "a real plane's photo must be 8-bit sRGB".into(),
+            )),
+        }
+    };
+    let (fw, fh, f) = photo(floor)?;
+    let (bw, bh, b) = photo(background)?;
+    let (w, h) = (fw + bw, fh.max(bh));
+    let mut packed = vec![0u8; (w * h * 4) as usize];
+    for (x0, pw, ph, pixels) in [(0, fw, fh, &f), (fw, bw, bh, &b)] {
+        for y in 0..ph {
+            let src = &pixels[(y * pw * 4) as usize..((y + 1) * pw * 4) as usize];
+            let at = ((y * w + x0) * 4) as usize;
+            packed[at..at + src.len()].copy_from_slice(src);
+        }
+    }
+    let rect = |x0: u32, pw: u32, ph: u32| {
+        Vec4::new(
+            x0 as f32 / w as f32,
+            0.0,
+            (x0 + pw) as f32 / w as f32,
+            ph as f32 / h as f32,
+        )
+    };
+    Ok((w, h, packed, [rect(0, fw, fh), rect(fw, bw, bh)]))
+}
+
+impl CompensationPass {
+    /// Builds the pass for `desc`'s floor and background, drawing into `render_pass`.
+    pub fn new(
+        ctx: &GpuContext,
+        render_pass: vk::RenderPass,
+        scene: &GpuScene,
+        desc: &SceneDesc,
+    ) -> Result<CompensationPass> {
+        let fragment = vk::ShaderStageFlags::FRAGMENT;
+        let set_layout = descriptors::set_layout(
+            ctx,
+            &[
+                (0, vk::DescriptorType::UNIFORM_BUFFER, fragment),
+                (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+                (2, vk::DescriptorType::SAMPLER, fragment),
+            ],
+        )?;
+        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+        let layout = pipeline::layout(
+            ctx,
+            Some(set_layout.raw()),
+            stages,
+            size_of::<EyePush>() as u32,
+        )?;
+        let pipeline = pipeline::create(
+            ctx,
+            &PipelineSpec {
+                render_pass,
+                layout: layout.raw(),
+                vertex: (shaders::COMPENSATION_VS, c"vs_main"),
+                fragment: (shaders::COMPENSATION_FS, c"fs_main"),
+                bindings: &[],
+                attributes: &[],
+                cull: vk::CullModeFlags::NONE,
+                depth: Depth::Behind,
+                blend: Blend::TakeAway,
+            },
+        )?;
+        let (w, h, packed, [floor_rect, background_rect]) = pack(&desc.floor, &desc.background)?;
+        let photos = upload_texture(
+            ctx,
+            "compensation photos",
+            vk::Format::R8G8B8A8_SRGB,
+            vk::Extent2D {
+                width: w,
+                height: h,
+            },
+            &packed,
+        )?;
+        let planes = Planes {
+            floor_from_world: inverse(desc.floor.world_from_plane),
+            background_from_world: inverse(desc.background.world_from_plane),
+            floor_rect: floor_rect.to_array(),
+            background_rect: background_rect.to_array(),
+        };
+        let planes = Buffer::with_data(
+            ctx,
+            "compensation planes",
+            bytemuck::bytes_of(&planes),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let pool = descriptors::pool(
+            ctx,
+            1,
+            &[
+                (vk::DescriptorType::UNIFORM_BUFFER, 1),
+                (vk::DescriptorType::SAMPLED_IMAGE, 1),
+                (vk::DescriptorType::SAMPLER, 1),
+            ],
+        )?;
+        let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+        let buffer_info = [vk::DescriptorBufferInfo {
+            buffer: planes.buffer,
+            offset: 0,
+            range: vk::WHOLE_SIZE,
+        }];
+        let write = [vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(0)
+            .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
+            .buffer_info(&buffer_info)];
+        // SAFETY: the set was just allocated and no GPU work uses it; the buffer is live.
+        unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
+        descriptors::write_texture(ctx, set, 1, 2, photos.view, scene.photo_sampler());
+        Ok(CompensationPass {
+            pipeline,
+            layout,
+            _pool: pool,
+            _set_layout: set_layout,
+            set,
+            _planes: planes,
+            _photos: photos,
+            bounds: bounding_sphere(desc.mesh.positions),
+        })
+    }
+
+    /// Records the pass for one eye, inside that eye's render pass, after the glass.
+    ///
+    /// # Safety
+    /// `cmd` must be recording inside a render pass compatible with the one given to
+    /// [`CompensationPass::new`], after the glass was drawn in it; `self` must outlive the
+    /// command buffer's execution.
+    pub unsafe fn record(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        eye: &EyeParams,
+        world_from_model: Mat4,
+        extent: vk::Extent2D,
+    ) {
+        let Some(area) = screen_rect(eye, world_from_model, self.bounds, extent) else {
+            return;
+        };
+        let d = &ctx.device;
+        let push = EyePush {
+            world_from_clip: eye.clip_from_world().inverse().to_cols_array(),
+            position: eye.position_m.extend(1.0).to_array(),
+        };
+        // SAFETY: the caller's contract (inside a compatible render pass, `self` outliving
+        // the execution); the push constants match the layout's range.
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw());
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout.raw(),
+                0,
+                &[self.set],
+                &[],
+            );
+            d.cmd_push_constants(
+                cmd,
+                self.layout.raw(),
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                0,
+                bytemuck::bytes_of(&push),
+            );
+            d.cmd_set_scissor(cmd, 0, &[area]);
+            d.cmd_draw(cmd, 3, 1, 0, 0);
+        }
+    }
+}
+
+/// The bounding sphere of `positions` (about their bounding box's centre).
+fn bounding_sphere(positions: &[Vec3]) -> (Vec3, f32) {
+    let (lo, hi) = positions.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let center = (lo + hi) * 0.5;
+    let radius = positions
+        .iter()
+        .map(|p| p.distance(center))
+        .fold(0.0f32, f32::max);
+    (center, radius)
+}
+
+/// The pixels of an `extent` image that the sphere `bounds` (model units) placed by
+/// `world_from_model` can cover in `eye`'s view: the rectangle around its bounding cube's
+/// projected corners, the whole image when a corner lies behind the eye, `None` when off it.
+fn screen_rect(
+    eye: &EyeParams,
+    world_from_model: Mat4,
+    (center, radius): (Vec3, f32),
+    extent: vk::Extent2D,
+) -> Option<vk::Rect2D> {
+    let size = Vec2::new(extent.width as f32, extent.height as f32);
+    let whole = vk::Rect2D {
+        offset: vk::Offset2D { x: 0, y: 0 },
+        extent,
+    };
+    let c = world_from_model.transform_point3(center);
+    let r = world_from_model
+        .transform_vector3(Vec3::X * radius)
+        .length();
+    let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+    for i in 0..8 {
+        let corner = Vec3::new(
+            if i & 1 == 0 { -r } else { r },
+            if i & 2 == 0 { -r } else { r },
+            if i & 4 == 0 { -r } else { r },
+        );
+        let Some(p) = eye.project_to_pixel(c + corner, size) else {
+            return Some(whole);
+        };
+        (lo, hi) = (lo.min(p), hi.max(p));
+    }
+    let lo = lo.floor().max(Vec2::ZERO);
+    let hi = hi.ceil().min(size);
+    (hi.x > lo.x && hi.y > lo.y).then_some(vk::Rect2D {
+        offset: vk::Offset2D {
+            x: lo.x as i32,
+            y: lo.y as i32,
+        },
+        extent: vk::Extent2D {
+            width: (hi.x - lo.x) as u32,
+            height: (hi.y - lo.y) as u32,
+        },
+    })
+}
+
+/// A plane's world-to-plane transform, as the shader takes it.
+fn inverse(world_from_plane: Mat4) -> [f32; 16] {
+    world_from_plane.inverse().to_cols_array()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::TextureDesc;
+
+    #[test]
+    fn the_photos_are_packed_side_by_side_with_their_rectangles() {
+        let floor = [1u8, 2, 3, 4].repeat(2 * 2);
+        let wall = [9u8, 9, 9, 9].repeat(3);
+        let plane = |width, height, data| PlaneDesc {
+            world_from_plane: Mat4::IDENTITY,
+            photo: TextureDesc {
+                width,
+                height,
+                data: TexelData::Srgb8(data),
+            },
+        };
+        let (w, h, packed, [f, b]) = pack(&plane(2, 2, &floor), &plane(3, 1, &wall)).unwrap();
+        assert_eq!((w, h), (5, 2));
+        // Row 0: two floor texels, three wall texels; row 1: two floor texels, then nothing.
+        assert_eq!(&packed[..8], &[1, 2, 3, 4, 1, 2, 3, 4]);
+        assert_eq!(&packed[8..20], &[9; 12]);
+        assert_eq!(&packed[20..28], &[1, 2, 3, 4, 1, 2, 3, 4]);
+        assert_eq!(&packed[28..40], &[0; 12]);
+        assert_eq!(f, Vec4::new(0.0, 0.0, 0.4, 1.0));
+        assert_eq!(b, Vec4::new(0.4, 0.0, 1.0, 0.5));
+    }
+}

@@ -164,18 +164,7 @@ impl CompensationPass {
             ],
         )?;
         let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
-        let buffer_info = [vk::DescriptorBufferInfo {
-            buffer: planes.buffer,
-            offset: 0,
-            range: vk::WHOLE_SIZE,
-        }];
-        let write = [vk::WriteDescriptorSet::default()
-            .dst_set(set)
-            .dst_binding(0)
-            .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
-            .buffer_info(&buffer_info)];
-        // SAFETY: the set was just allocated and no GPU work uses it; the buffer is live.
-        unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
+        descriptors::write_uniform_buffer(ctx, set, 0, planes.buffer);
         descriptors::write_texture(ctx, set, 1, 2, photos.view, scene.photo_sampler());
         Ok(CompensationPass {
             pipeline,

@@ -156,6 +156,39 @@ pub fn write_storage_buffer(
     binding: u32,
     buffer: vk::Buffer,
 ) {
+    write_buffer(
+        ctx,
+        set,
+        binding,
+        vk::DescriptorType::STORAGE_BUFFER,
+        buffer,
+    );
+}
+
+/// Points a uniform-buffer binding of `set` at the whole of `buffer`.
+pub fn write_uniform_buffer(
+    ctx: &GpuContext,
+    set: vk::DescriptorSet,
+    binding: u32,
+    buffer: vk::Buffer,
+) {
+    write_buffer(
+        ctx,
+        set,
+        binding,
+        vk::DescriptorType::UNIFORM_BUFFER,
+        buffer,
+    );
+}
+
+/// Points a buffer binding of `set`, of `kind`, at the whole of `buffer`.
+fn write_buffer(
+    ctx: &GpuContext,
+    set: vk::DescriptorSet,
+    binding: u32,
+    kind: vk::DescriptorType,
+    buffer: vk::Buffer,
+) {
     let info = [vk::DescriptorBufferInfo {
         buffer,
         offset: 0,
@@ -164,7 +197,7 @@ pub fn write_storage_buffer(
     let writes = [vk::WriteDescriptorSet::default()
         .dst_set(set)
         .dst_binding(binding)
-        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+        .descriptor_type(kind)
         .buffer_info(&info)];
     // SAFETY: as in `write_texture`: the set is idle and the buffer live.
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };

@@ -286,18 +286,7 @@ impl GlassPass {
             bytemuck::bytes_of(&globals),
             vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
         )?;
-        let buffer_info = [vk::DescriptorBufferInfo {
-            buffer: globals_buffer.buffer,
-            offset: 0,
-            range: vk::WHOLE_SIZE,
-        }];
-        let write = [vk::WriteDescriptorSet::default()
-            .dst_set(set)
-            .dst_binding(0)
-            .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
-            .buffer_info(&buffer_info)];
-        // SAFETY: the set was just allocated and no GPU work uses it; the buffer is live.
-        unsafe { ctx.device.update_descriptor_sets(&write, &[]) };
+        descriptors::write_uniform_buffer(ctx, set, 0, globals_buffer.buffer);
         descriptors::write_texture(ctx, set, 1, 2, scene.environment.view, scene.env_sampler());
         let [background, surface] = blurred;
         descriptors::write_texture(ctx, set, 3, 4, background, scene.photo_sampler());

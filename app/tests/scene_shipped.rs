@@ -176,3 +176,24 @@ fn visual_effects_keeps_the_papers_distances() {
     assert!(!sphere_in_view(&scene, object.center_m, object.radius_m));
     assert!(sphere_in_view(&scene, object.center_m, 0.01));
 }
+
+#[test]
+fn the_real_glass_scene_refracts_the_room_and_the_papers_scenes_their_hdri() {
+    let real = load("glass-sphere-real.toml");
+    assert!(real.environment.room);
+    assert_eq!(real.compensation, vitreous_render::Compensation::Background);
+    assert_eq!(real.light.share, 0.5);
+    let paper = load("glass-sphere.toml");
+    assert!(!paper.environment.room);
+    // Straight down from the ball, the room's map holds the floor photo, the paper's the HDRI.
+    let texel = |s: &Scene| {
+        let PixelData::LinearF32(px) = &s.environment.latlong.data else {
+            panic!("linear map")
+        };
+        let (w, h) = s.environment.latlong.dimensions();
+        let i = (((h - 1) * w + w / 2) * 4) as usize;
+        [px[i], px[i + 1], px[i + 2]]
+    };
+    assert_ne!(texel(&real), texel(&paper));
+    assert!(texel(&real).iter().all(|&v| (0.0..=1.0).contains(&v)));
+}

@@ -146,6 +146,7 @@ pub(crate) struct PlaneToml {
 pub(crate) struct EnvironmentToml {
     pub map: Spanned<String>,
     pub cube_map: Option<Spanned<String>>,
+    pub room: Option<Spanned<bool>>,
 }
 
 /// `[viewer]`: the wearer.

@@ -22,6 +22,7 @@
 //! | `image`, `mesh`, `accessor` | the assets: photos and HDRIs; glTF and OBJ meshes |
 //! | `motion` | keyframed object motion |
 //! | `fixation` | where a viewer of the scene looks (the synthetic traces' targets) |
+//! | [`room`] | the environment map with the scene's floor and wall written in |
 //! | [`effects`] | the effect sets a scene or a study condition turns on |
 //! | [`caustics`] | the caustic bake file format (eq. 6's gain map), read and written |
 //! | [`files`] | where a scene's files are read from (the disk, or a test's memory) |
@@ -38,6 +39,7 @@ mod image;
 mod load;
 mod mesh;
 mod motion;
+pub mod room;
 
 use std::path::PathBuf;
 
@@ -338,6 +340,9 @@ pub struct Environment {
     pub path: PathBuf,
     /// `environment.cube_map`: reserved; checked to exist and hashed, not decoded.
     pub cube_map_path: Option<PathBuf>,
+    /// `environment.room`: the floor and background photos are written into `latlong` as
+    /// seen from the object's centre ([`room`]).
+    pub room: bool,
 }
 
 /// The wearer.

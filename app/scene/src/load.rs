@@ -267,10 +267,17 @@ impl Loader<'_> {
             Some(rel) => Some(self.read_asset("environment.cube_map", rel)?.0),
             None => None,
         };
+        let room = raw.environment.room.as_ref().is_some_and(|r| *r.get_ref());
+        let latlong = if room {
+            crate::room::with_room(&latlong, object.center_m, &floor, &background)
+        } else {
+            latlong
+        };
         let environment = Environment {
             latlong,
             path: env_path,
             cube_map_path,
+            room,
         };
 
         let v = &raw.viewer;

@@ -1,7 +1,8 @@
 //! Eq. 6 over the glass (`[display] compensation = "background"`, shaders/compensation.wgsl):
 //! after the glass, each eye's glass pixels lose the light of the real floor or background the
 //! eye already sees there, `max(T - B, 0)`, so the display adds only what is missing. Drawn as
-//! one triangle at the far plane, scissored to the object's bounding sphere on screen, that
+//! one triangle at the far plane, scissored to the rectangle around the outline of the object's
+//! bounding sphere on screen, that
 //! passes the depth test only where the glass (the only depth writer of an additive frame) was
 //! drawn.
 
@@ -239,9 +240,14 @@ fn bounding_sphere(positions: &[Vec3]) -> (Vec3, f32) {
     (center, radius)
 }
 
+/// Points on the outline of a sphere as the eye sees it: the circle where the sphere's tangent
+/// cone from the eye touches it.
+const OUTLINE_POINTS: usize = 32;
+
 /// The pixels of an `extent` image that the sphere `bounds` (model units) placed by
-/// `world_from_model` can cover in `eye`'s view: the rectangle around its bounding cube's
-/// projected corners, the whole image when a corner lies behind the eye, `None` when off it.
+/// `world_from_model` can cover in `eye`'s view: the rectangle around its outline (sampled
+/// at [`OUTLINE_POINTS`] points on a circle widened so the polygon holds the true one), the
+/// whole image when the eye is inside the sphere or a point lies behind it, `None` when off it.
 fn screen_rect(
     eye: &EyeParams,
     world_from_model: Mat4,
@@ -257,20 +263,32 @@ fn screen_rect(
     let r = world_from_model
         .transform_vector3(Vec3::X * radius)
         .length();
+    let to_center = c - eye.position_m;
+    let d = to_center.length();
+    if d <= r * 1.001 {
+        return Some(whole);
+    }
+    // The outline circle: centre r^2 / d nearer the eye than the sphere's, radius
+    // r sqrt(d^2 - r^2) / d, in the plane facing the eye; widened by 1 / cos(pi / n) so the
+    // n-gon through the sampled points encloses it.
+    let axis = to_center / d;
+    let circle_center = c - axis * (r * r / d);
+    let circle_radius =
+        r * (d * d - r * r).sqrt() / d / (std::f32::consts::PI / OUTLINE_POINTS as f32).cos();
+    let u = axis.any_orthonormal_vector();
+    let v = axis.cross(u);
     let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-    for i in 0..8 {
-        let corner = Vec3::new(
-            if i & 1 == 0 { -r } else { r },
-            if i & 2 == 0 { -r } else { r },
-            if i & 4 == 0 { -r } else { r },
-        );
-        let Some(p) = eye.project_to_pixel(c + corner, size) else {
+    for i in 0..OUTLINE_POINTS {
+        let a = i as f32 / OUTLINE_POINTS as f32 * std::f32::consts::TAU;
+        let point = circle_center + (u * a.cos() + v * a.sin()) * circle_radius;
+        let Some(p) = eye.project_to_pixel(point, size) else {
             return Some(whole);
         };
         (lo, hi) = (lo.min(p), hi.max(p));
     }
-    let lo = lo.floor().max(Vec2::ZERO);
-    let hi = hi.ceil().min(size);
+    // A pixel of margin for rasterisation's rounding.
+    let lo = (lo.floor() - Vec2::ONE).max(Vec2::ZERO);
+    let hi = (hi.ceil() + Vec2::ONE).min(size);
     (hi.x > lo.x && hi.y > lo.y).then_some(vk::Rect2D {
         offset: vk::Offset2D {
             x: lo.x as i32,
@@ -291,7 +309,62 @@ fn inverse(world_from_plane: Mat4) -> [f32; 16] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::camera::Fov;
     use crate::scene::TextureDesc;
+
+    #[test]
+    fn the_scissor_holds_every_point_of_the_sphere_and_little_else() {
+        let fov = Fov {
+            left_rad: -0.35,
+            right_rad: 0.35,
+            up_rad: 0.26,
+            down_rad: -0.26,
+        };
+        let eye = EyeParams::new(Vec3::new(-0.03, 0.0, 0.0), glam::Quat::IDENTITY, fov);
+        let extent = vk::Extent2D {
+            width: 320,
+            height: 240,
+        };
+        let size = Vec2::new(320.0, 240.0);
+        // Off the image: no rectangle.
+        let off = Mat4::from_translation(Vec3::new(0.3, 0.0, -0.5));
+        assert!(screen_rect(&eye, off, (Vec3::ZERO, 0.04), extent).is_none());
+        for center in [Vec3::new(0.0, -0.26, -1.5), Vec3::new(0.1, 0.05, -0.5)] {
+            let placed = Mat4::from_translation(center);
+            let rect = screen_rect(&eye, placed, (Vec3::ZERO, 0.04), extent).unwrap();
+            let (x0, y0) = (rect.offset.x as f32, rect.offset.y as f32);
+            let (x1, y1) = (
+                x0 + rect.extent.width as f32,
+                y0 + rect.extent.height as f32,
+            );
+            let mut outline = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+            for i in 0..64 {
+                for j in 0..=32 {
+                    let (a, b) = (
+                        i as f32 / 64.0 * std::f32::consts::TAU,
+                        j as f32 / 32.0 * std::f32::consts::PI,
+                    );
+                    let p =
+                        center + Vec3::new(b.sin() * a.cos(), b.cos(), b.sin() * a.sin()) * 0.04;
+                    let q = eye.project_to_pixel(p, size).unwrap();
+                    assert!(
+                        q.x >= x0 && q.x <= x1 && q.y >= y0 && q.y <= y1,
+                        "{q} outside {rect:?}"
+                    );
+                    outline = (outline.0.min(q), outline.1.max(q));
+                }
+            }
+            // Within 3 pixels of the outline's own bounds on every side.
+            assert!(
+                outline.0.x - x0 <= 3.0 && outline.0.y - y0 <= 3.0,
+                "{outline:?} {rect:?}"
+            );
+            assert!(
+                x1 - outline.1.x <= 3.0 && y1 - outline.1.y <= 3.0,
+                "{outline:?} {rect:?}"
+            );
+        }
+    }
 
     #[test]
     fn the_photos_are_packed_side_by_side_with_their_rectangles() {

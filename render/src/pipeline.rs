@@ -44,6 +44,22 @@ pub enum Depth {
     Behind,
 }
 
+/// Blending the output's colour with the target's by `op` (both weighted one), the target's
+/// alpha kept.
+fn onto_colour(op: vk::BlendOp) -> vk::PipelineColorBlendAttachmentState {
+    vk::PipelineColorBlendAttachmentState::default()
+        .blend_enable(true)
+        .src_color_blend_factor(vk::BlendFactor::ONE)
+        .dst_color_blend_factor(vk::BlendFactor::ONE)
+        .color_blend_op(op)
+        .src_alpha_blend_factor(vk::BlendFactor::ZERO)
+        .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+        .alpha_blend_op(vk::BlendOp::ADD)
+        .color_write_mask(
+            vk::ColorComponentFlags::R | vk::ColorComponentFlags::G | vk::ColorComponentFlags::B,
+        )
+}
+
 /// How a triangle-list pipeline with dynamic viewport and scissor draws.
 pub struct PipelineSpec<'a> {
     /// The render pass (subpass 0) it draws in.
@@ -128,32 +144,8 @@ pub fn create(ctx: &GpuContext, spec: &PipelineSpec) -> Result<Owned<vk::Pipelin
             .depth_compare_op(vk::CompareOp::GREATER),
     };
     let blend_attachments = [match spec.blend {
-        Blend::Add => vk::PipelineColorBlendAttachmentState::default()
-            .blend_enable(true)
-            .src_color_blend_factor(vk::BlendFactor::ONE)
-            .dst_color_blend_factor(vk::BlendFactor::ONE)
-            .color_blend_op(vk::BlendOp::ADD)
-            .src_alpha_blend_factor(vk::BlendFactor::ZERO)
-            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-            .alpha_blend_op(vk::BlendOp::ADD)
-            .color_write_mask(
-                vk::ColorComponentFlags::R
-                    | vk::ColorComponentFlags::G
-                    | vk::ColorComponentFlags::B,
-            ),
-        Blend::TakeAway => vk::PipelineColorBlendAttachmentState::default()
-            .blend_enable(true)
-            .src_color_blend_factor(vk::BlendFactor::ONE)
-            .dst_color_blend_factor(vk::BlendFactor::ONE)
-            .color_blend_op(vk::BlendOp::REVERSE_SUBTRACT)
-            .src_alpha_blend_factor(vk::BlendFactor::ZERO)
-            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-            .alpha_blend_op(vk::BlendOp::ADD)
-            .color_write_mask(
-                vk::ColorComponentFlags::R
-                    | vk::ColorComponentFlags::G
-                    | vk::ColorComponentFlags::B,
-            ),
+        Blend::Add => onto_colour(vk::BlendOp::ADD),
+        Blend::TakeAway => onto_colour(vk::BlendOp::REVERSE_SUBTRACT),
         Blend::Replace => vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(false)
             .color_write_mask(vk::ColorComponentFlags::RGBA),

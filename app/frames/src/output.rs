@@ -10,6 +10,8 @@ use anyhow::{Context, Result};
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::{ExtendedColorType, ImageEncoder};
 use vitreous_render::Readback;
+/// sRGB-encoded byte to linear light (where the photos are decoded, in the scene crate).
+pub use vitreous_scene::srgb_to_linear;
 
 /// Eye names in output file names, left then right.
 pub const EYE_NAMES: [&str; 2] = ["left", "right"];
@@ -52,16 +54,6 @@ pub fn encode_png(rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
         .write_image(rgba, width, height, ExtendedColorType::Rgba8)
         .context("encoding PNG")?;
     Ok(out)
-}
-
-/// sRGB-encoded byte to linear light.
-pub fn srgb_to_linear(v: u8) -> f32 {
-    let c = f32::from(v) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 /// Linear light (clamped to 0..1) to an sRGB-encoded byte.

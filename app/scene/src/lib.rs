@@ -55,7 +55,9 @@ pub use fixation::{
     FixationPoints, MeshLens, REFRACTED_TARGET, SURFACE_TARGET, ViewingGeometry,
     gaze_image_of_target, synth_params_for,
 };
-pub use image::{Image, ImageError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIZE_PX, PixelData};
+pub use image::{
+    Image, ImageError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIZE_PX, PixelData, srgb_to_linear,
+};
 pub use load::{load_scene, load_scene_from};
 pub use mesh::{Mesh, load_mesh};
 pub use motion::{LightKey, MAX_KEYFRAMES, MAX_TIME_S, Motion, ObjectKey, Placement};

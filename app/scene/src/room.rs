@@ -8,17 +8,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::{Image, PixelData, RealPlane};
-
-/// An sRGB-encoded 8-bit value as linear light.
-fn linear(v: u8) -> f32 {
-    let c = f32::from(v) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
+use crate::{Image, PixelData, RealPlane, srgb_to_linear as linear};
 
 /// The unit direction of texel centre `(x, y)` of a `w` x `h` latitude-longitude map: u = 0.5
 /// looks down -z, u grows towards +x, v = 0 straight up (shaders/glass.wgsl `latlong_uv`).

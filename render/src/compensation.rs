@@ -223,6 +223,8 @@ impl CompensationPass {
             d.cmd_set_scissor(cmd, 0, &[area]);
             d.cmd_draw(cmd, 3, 1, 0, 0);
         }
+        ctx.work.upload(size_of::<EyePush>());
+        ctx.work.draw(3);
     }
 }
 

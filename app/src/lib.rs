@@ -17,6 +17,7 @@ pub use vitreous_frames::{
 };
 pub use vitreous_gaze as gaze;
 pub use vitreous_scene::{self as scene, caustics, effects, files};
+pub mod reference_cmd;
 pub mod replay;
 pub mod run;
 pub mod soak;

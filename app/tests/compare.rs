@@ -22,7 +22,7 @@ fn write_png(path: &Path, rgb: &[u8], w: u32, h: u32) {
     std::fs::write(path, encode_png(&rgba, w, h).unwrap()).unwrap();
 }
 
-fn json(args: &[&str], cwd: &Path) -> serde_json::Value {
+pub(crate) fn json(args: &[&str], cwd: &Path) -> serde_json::Value {
     let out = vitreous(args, cwd);
     assert!(
         out.status.success(),

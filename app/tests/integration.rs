@@ -8,6 +8,7 @@ mod gaze_filter;
 mod gaze_trace;
 mod gaze_vergence;
 mod interrupted;
+mod reference;
 mod scene_asset_errors;
 mod scene_consistency;
 mod scene_edits;

@@ -54,10 +54,33 @@ impl EyeParams {
     /// Unit direction of the view ray through a pixel position (x right, y down, pixel centres
     /// at half-integers) of an image of `size` pixels.
     pub fn pixel_ray(&self, pixel: Vec2, size: Vec2) -> Vec3 {
-        let ndc = pixel / size * 2.0 - Vec2::ONE;
-        let world_from_clip = self.clip_from_world().inverse();
-        let near = world_from_clip.project_point3(ndc.extend(0.0));
-        let far = world_from_clip.project_point3(ndc.extend(1.0));
+        self.pixel_rays(size).direction(pixel)
+    }
+
+    /// The view rays of an image of `size` pixels, for many pixels at the cost of one matrix
+    /// inverse.
+    pub fn pixel_rays(&self, size: Vec2) -> PixelRays {
+        PixelRays {
+            world_from_clip: self.clip_from_world().inverse(),
+            size,
+        }
+    }
+}
+
+/// The view rays of one eye image ([`EyeParams::pixel_rays`]).
+#[derive(Clone, Copy, Debug)]
+pub struct PixelRays {
+    world_from_clip: Mat4,
+    size: Vec2,
+}
+
+impl PixelRays {
+    /// Unit direction of the view ray through a pixel position (x right, y down, pixel centres
+    /// at half-integers).
+    pub fn direction(&self, pixel: Vec2) -> Vec3 {
+        let ndc = pixel / self.size * 2.0 - Vec2::ONE;
+        let near = self.world_from_clip.project_point3(ndc.extend(0.0));
+        let far = self.world_from_clip.project_point3(ndc.extend(1.0));
         (far - near).normalize()
     }
 }

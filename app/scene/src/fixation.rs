@@ -11,9 +11,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 use vitreous_render::Refraction;
-use vitreous_render::two_surface::{
-    Ball, MAX_INTERNAL_REFLECTIONS, MeshBody, RADIAL_NORMAL_COS, pass_through,
-};
+use vitreous_render::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, MeshBody, pass_through};
 use vitreous_xr::synth::{FixationTarget, SynthParams};
 
 use super::{Object, Scene};
@@ -69,20 +67,10 @@ impl MeshLens {
         if object.refraction != Refraction::TwoSurface {
             return None;
         }
-        let m = &object.mesh;
-        let c = object.model_center;
-        let radius = m
-            .positions
-            .iter()
-            .map(|&p| p.distance(c))
-            .fold(0.0, f32::max);
-        let ball = m.positions.iter().zip(&m.normals).all(|(&p, &n)| {
-            (p.distance(c) - radius).abs() <= 1e-4 * radius
-                && n.normalize_or_zero().dot(p - c) > RADIAL_NORMAL_COS * p.distance(c)
-        });
-        if ball {
+        if object.is_ball() {
             return None;
         }
+        let m = &object.mesh;
         let body = MeshBody::new(&m.positions, &m.normals, &m.indices).ok()?;
         Some(Arc::new(MeshLens { body }))
     }

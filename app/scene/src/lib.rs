@@ -281,6 +281,24 @@ impl Object {
     pub fn world_from_model_at(&self, position_m: Vec3, rotation: Quat) -> Mat4 {
         model_placement(self.scale, self.model_center, position_m, rotation)
     }
+
+    /// Whether the mesh is a ball: every vertex at one distance from the bounding-box centre
+    /// (within 1e-4 of it) with a normal pointing away from the centre, so that the analytic
+    /// sphere of [`Object::radius_m`] stands for it exactly.
+    pub fn is_ball(&self) -> bool {
+        let m = &self.mesh;
+        let c = self.model_center;
+        let radius = m
+            .positions
+            .iter()
+            .map(|&p| p.distance(c))
+            .fold(0.0, f32::max);
+        m.positions.iter().zip(&m.normals).all(|(&p, &n)| {
+            (p.distance(c) - radius).abs() <= 1e-4 * radius
+                && n.normalize_or_zero().dot(p - c)
+                    > vitreous_render::two_surface::RADIAL_NORMAL_COS * p.distance(c)
+        })
+    }
 }
 
 /// Model to world for a mesh scaled by `scale` about its bounding-box centre `model_center`

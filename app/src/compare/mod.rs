@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 
-pub use regions::{Eye, Region, regions};
+pub use regions::{Eye, Region, regions, regions_of};
 
 use crate::output::{encode_png, ensure_not_input, write_atomic};
 
@@ -40,6 +40,11 @@ pub struct CompareArgs {
     /// closest any display that only adds light can get).
     #[arg(long, value_name = "PNG")]
     pub seen: Option<PathBuf>,
+    /// TEST is the display's light alone (an eye image such as a replay's `NNNNNN-left.png`),
+    /// not what the eye sees: it is added to --seen in linear light first, as an optical
+    /// see-through display adds it to the real world.
+    #[arg(long, requires = "seen")]
+    pub display: bool,
     /// Write the ꟻLIP error map here (PNG, the magma colour map: black no error, yellow most).
     #[arg(long, value_name = "FILE")]
     pub map: Option<PathBuf>,
@@ -93,6 +98,11 @@ pub struct Comparison {
     pub pixels_per_degree: f32,
     /// The scene whose regions split the figures, if any.
     pub scene: Option<String>,
+    /// Where the regions were seen from: `neutral head, left eye`, or the frame and eye of
+    /// the `reference.json` beside the reference image.
+    pub regions_from: Option<String>,
+    /// Whether TEST was the display's light, added to the seen image (`--display`).
+    pub display_added_to_seen: bool,
     /// The whole view first, then each region of the scene.
     pub regions: Vec<RegionFigures>,
     /// With `--seen`: the same figures for what the eye sees with nothing drawn.
@@ -108,6 +118,19 @@ pub fn additive_limit(seen: &[u8], reference: &[u8]) -> Vec<u8> {
     seen.iter()
         .zip(reference)
         .map(|(&a, &b)| a.max(b))
+        .collect()
+}
+
+/// What the eye sees with `display` (sRGB RGB8) shown over `seen`: their sum in linear light.
+fn add_light(display: &[u8], seen: &[u8]) -> Vec<u8> {
+    let rgba = |rgb: &[u8]| -> Vec<u8> {
+        rgb.chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect()
+    };
+    crate::output::see_through(&rgba(display), &rgba(seen))
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
         .collect()
 }
 
@@ -206,10 +229,23 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         }
         Ok(image)
     };
-    let test = same_size(&args.test)?;
+    let mut test = same_size(&args.test)?;
     let seen = args.seen.as_deref().map(same_size).transpose()?;
+    if args.display
+        && let Some(seen) = &seen
+    {
+        test = add_light(&test, seen);
+    }
     let scene = match &args.scene {
-        Some(path) => Some(vitreous_scene::load_scene(path)?),
+        Some(path) => {
+            let mut scene = vitreous_scene::load_scene(path)?;
+            if scene.caustics.bake.is_some()
+                && let Err(e) = scene.load_caustics()
+            {
+                tracing::warn!("the caustic is left out of the regions: {e}");
+            }
+            Some(scene)
+        }
         None => None,
     };
     let ppd = args.ppd.unwrap_or_else(|| match &scene {
@@ -219,7 +255,36 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         }
         None => nv_flip::DEFAULT_PIXELS_PER_DEGREE,
     });
-    let labels = scene.as_ref().map(|s| regions(s, args.eye, w, h));
+    let from_reference = crate::reference_cmd::frame_of_image(&args.reference);
+    let (labels, regions_from) = match (&scene, &from_reference) {
+        (Some(s), Some((frame, eye))) => (
+            Some(regions_of(
+                s,
+                &frame.eyes[*eye].view(),
+                &frame.placement(),
+                w,
+                h,
+            )),
+            Some(format!(
+                "frame {} {} eye of {}",
+                frame.frame,
+                crate::output::EYE_NAMES[*eye],
+                args.reference.with_file_name("reference.json").display()
+            )),
+        ),
+        (Some(s), None) => (
+            Some(regions(s, args.eye, w, h)),
+            Some(format!(
+                "neutral head, {} eye",
+                if args.eye == Eye::Left {
+                    "left"
+                } else {
+                    "right"
+                }
+            )),
+        ),
+        _ => (None, None),
+    };
     let (error, figures) = compare(&reference, &test, (w, h), ppd, labels.as_deref());
     let rows = |image: &[u8]| compare(&reference, image, (w, h), ppd, labels.as_deref()).1;
     let nothing_drawn = seen.as_deref().map(rows);
@@ -243,6 +308,8 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         height_px: h,
         pixels_per_degree: ppd,
         scene: args.scene.as_ref().map(|p| p.display().to_string()),
+        regions_from,
+        display_added_to_seen: args.display,
         regions: figures,
         nothing_drawn,
         additive_limit: limit,
@@ -259,12 +326,21 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
 /// figures beside the test's when they were measured.
 fn table(report: &Comparison) -> String {
     let mut out = format!(
-        "{} against {} ({}x{}, {:.1} pixels per degree)\n{:<16} {:>9} {:>10} {:>10}",
+        "{}{} against {} ({}x{}, {:.1} pixels per degree{})\n{:<16} {:>9} {:>10} {:>10}",
         report.test,
+        if report.display_added_to_seen {
+            " over the seen image"
+        } else {
+            ""
+        },
         report.reference,
         report.width_px,
         report.height_px,
         report.pixels_per_degree,
+        report
+            .regions_from
+            .as_ref()
+            .map_or(String::new(), |r| format!("; regions of the {r}")),
         "region",
         "pixels",
         "FLIP mean",

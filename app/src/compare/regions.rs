@@ -6,11 +6,11 @@
 
 use glam::{Quat, Vec2, Vec3};
 use serde::Serialize;
-use vitreous_render::camera::EyeParams;
 use vitreous_render::floor::{FAR_M, exact_edge_distances};
-use vitreous_scene::Scene;
+use vitreous_scene::{Placement, Scene};
+use vitreous_xr::frame::EyeView;
 
-use crate::render_desc::render_fov;
+use crate::render_desc::eye_params;
 
 /// A region of the eye image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -70,22 +70,48 @@ pub fn regions(scene: &Scene, eye: Eye, width: u32, height: u32) -> Vec<Region> 
     };
     let [left, right] = scene.viewer.eye_positions_m(&head);
     let position = if eye == Eye::Left { left } else { right };
-    let camera = EyeParams::new(position, Quat::IDENTITY, render_fov(scene.output.fov));
-    let floor = FloorRegions::new(scene);
-    let size = Vec2::new(width as f32, height as f32);
+    let view = EyeView {
+        pose: vitreous_xr::Pose {
+            position,
+            orientation: Quat::IDENTITY,
+        },
+        fov: scene.output.fov,
+    };
+    regions_of(scene, &view, &scene.rest_placement(), width, height)
+}
+
+/// The region of every pixel of a `width` x `height` image seen by `view`, with the object and
+/// the light at `placement`, row by row. The caustic counts only at the scene's resting
+/// placement, which its bake is for.
+pub fn regions_of(
+    scene: &Scene,
+    view: &EyeView,
+    placement: &Placement,
+    width: u32,
+    height: u32,
+) -> Vec<Region> {
+    let camera = eye_params(view);
+    let floor = FloorRegions::new(scene, placement);
+    let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
     let mut out = Vec::with_capacity((width * height) as usize);
     for y in 0..height {
         for x in 0..width {
-            let dir = camera.pixel_ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), size);
-            out.push(classify(scene, &floor, position, dir));
+            let dir = rays.direction(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            out.push(classify(scene, placement, &floor, view.pose.position, dir));
         }
     }
     out
 }
 
 /// The region a ray from `origin` along `dir` (unit) falls in.
-fn classify(scene: &Scene, floor: &FloorRegions, origin: Vec3, dir: Vec3) -> Region {
-    let center = scene.object.center_m;
+fn classify(
+    scene: &Scene,
+    placement: &Placement,
+    floor: &FloorRegions,
+    origin: Vec3,
+    dir: Vec3,
+) -> Region {
+    let center = placement.object_position_m;
     let radius = scene.object.radius_m;
     if ray_sphere(origin, dir, center, radius).is_some() {
         return Region::Disc;
@@ -130,7 +156,7 @@ struct FloorRegions {
 }
 
 impl FloorRegions {
-    fn new(scene: &Scene) -> FloorRegions {
+    fn new(scene: &Scene, placement: &Placement) -> FloorRegions {
         let n = FLOOR_GRID;
         let world_from_plane = scene.floor.world_from_plane();
         let centre_of = |i: u32| {
@@ -138,8 +164,8 @@ impl FloorRegions {
             let uv = Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
             world_from_plane.transform_point3(Vec3::new(uv.x - 0.5, 0.5 - uv.y, 0.0))
         };
-        let light = scene.light.position_m;
-        let (center, radius) = (scene.object.center_m, scene.object.radius_m);
+        let light = placement.light_position_m;
+        let (center, radius) = (placement.object_position_m, scene.object.radius_m);
         let mask: Vec<u8> = (0..n * n)
             .map(|i| {
                 let p = centre_of(i);
@@ -154,7 +180,11 @@ impl FloorRegions {
         let texel_m = scene.floor.size_m / n as f32;
         let distances = exact_edge_distances(&mask, n, texel_m);
         let ramp_m = scene.inducer.ramp_width_m;
-        let gain = scene.caustics.gain.as_ref();
+        let gain = scene
+            .caustics
+            .gain
+            .as_ref()
+            .filter(|_| *placement == scene.rest_placement());
         let regions = (0..n * n)
             .map(|i| {
                 let uv = Vec2::new(

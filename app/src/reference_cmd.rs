@@ -1,0 +1,465 @@
+//! `vitreous reference SCENE`: what a real glass object would look like in the scene, per eye
+//! and per saved frame of a trace, from the CPU ray tracer of `vitreous-reference`; beside each,
+//! what the eye sees with nothing there. `vitreous compare` then measures the display's
+//! see-through previews against it.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use glam::{Quat, Vec3};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::{Deserialize, Serialize};
+use vitreous_reference::{EyeImage, FloorLight, PhotonParams, Window, World, render_eye};
+use vitreous_scene::{Placement, Scene, load_scene};
+use vitreous_xr::frame::{Backend, EyeView, Fov};
+use vitreous_xr::null::{NullBackend, NullConfig};
+
+use crate::motion_clock::MotionClock;
+use crate::output::{EYE_NAMES, encode_png, linear_to_srgb, write_atomic};
+use crate::render_desc::eye_params;
+use crate::setup::{check_size, load_trace_with_edits};
+
+/// Most samples per pixel side.
+pub const MAX_SAMPLES_PER_SIDE: u32 = 16;
+
+/// Options of `vitreous reference` (docs/cli.md).
+#[derive(clap::Args, Debug)]
+pub struct ReferenceArgs {
+    /// The scene file (TOML).
+    pub scene: PathBuf,
+    /// A trace (head pose, gaze) to follow, as `vitreous replay --trace`: its frames at
+    /// --rate, every --save-every'th written. Without one: one frame at the scene's neutral head
+    /// (the viewer at `head_position_m`, looking down -z), as `vitreous compare` splits regions.
+    #[arg(long, value_name = "FILE")]
+    pub trace: Option<PathBuf>,
+    /// Output folder [default: out/<scene name>-reference].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// With --trace: stop after N frames [default: 1].
+    #[arg(long, value_name = "N", value_parser = crate::cli_values::parse_frame_count)]
+    pub frames: Option<u64>,
+    /// With --trace: write frames 0, K, 2K, ... (as `vitreous replay --save-every`).
+    #[arg(long, value_name = "K", default_value_t = 30)]
+    pub save_every: u64,
+    /// With --trace: the display's frame rate, hertz (as `vitreous replay --rate`).
+    #[arg(long, value_name = "HZ", default_value_t = 60.0)]
+    pub rate: f64,
+    /// Eye image size [default: the scene's `[output]`].
+    #[arg(long, value_name = "WxH", value_parser = crate::cli_values::parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Which eyes: left, right or both.
+    #[arg(long, value_name = "EYE", default_value = "both", value_parser = parse_eyes)]
+    pub eye: Eyes,
+    /// Samples along each side of a pixel (its light is the mean over N x N positions).
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = parse_samples)]
+    pub samples: u32,
+    /// Side of the floor light's texels, millimetres.
+    #[arg(long, value_name = "MM", default_value_t = 1.0, value_parser = parse_texel_mm)]
+    pub texel_mm: f32,
+    /// Photons traced from the light per texel of floor under the object's cone.
+    #[arg(long, value_name = "N", default_value_t = 64.0, value_parser = parse_photons)]
+    pub photons_per_texel: f32,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Which eyes are rendered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Eyes {
+    /// The left eye only.
+    Left,
+    /// The right eye only.
+    Right,
+    /// Both eyes.
+    Both,
+}
+
+impl Eyes {
+    fn indices(self) -> &'static [usize] {
+        match self {
+            Eyes::Left => &[0],
+            Eyes::Right => &[1],
+            Eyes::Both => &[0, 1],
+        }
+    }
+}
+
+fn parse_eyes(s: &str) -> std::result::Result<Eyes, String> {
+    match s {
+        "left" => Ok(Eyes::Left),
+        "right" => Ok(Eyes::Right),
+        "both" => Ok(Eyes::Both),
+        _ => Err(format!("expected left, right or both, found {s:?}")),
+    }
+}
+
+fn parse_samples(s: &str) -> std::result::Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n) if (1..=MAX_SAMPLES_PER_SIDE).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "expected samples per pixel side between 1 and {MAX_SAMPLES_PER_SIDE}, found {s:?}"
+        )),
+    }
+}
+
+fn parse_texel_mm(s: &str) -> std::result::Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && (0.05..=50.0).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "expected a texel side between 0.05 and 50 mm, found {s:?}"
+        )),
+    }
+}
+
+fn parse_photons(s: &str) -> std::result::Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && (1.0..=4096.0).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "expected photons per texel between 1 and 4096, found {s:?}"
+        )),
+    }
+}
+
+/// One eye's camera in `reference.json`.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct EyeRecord {
+    /// The eye's position, metres.
+    pub position_m: [f32; 3],
+    /// The view's orientation, quaternion x, y, z, w.
+    pub orientation_xyzw: [f32; 4],
+    /// Field of view: left, right, up, down edge angles, radians.
+    pub fov_rad: [f32; 4],
+}
+
+impl EyeRecord {
+    fn of(view: &EyeView) -> EyeRecord {
+        let f = view.fov;
+        EyeRecord {
+            position_m: view.pose.position.to_array(),
+            orientation_xyzw: view.pose.orientation.to_array(),
+            fov_rad: [
+                f.angle_left_rad,
+                f.angle_right_rad,
+                f.angle_up_rad,
+                f.angle_down_rad,
+            ],
+        }
+    }
+
+    /// The eye's view.
+    pub fn view(&self) -> EyeView {
+        let [l, r, u, d] = self.fov_rad;
+        EyeView {
+            pose: vitreous_xr::Pose {
+                position: Vec3::from_array(self.position_m),
+                orientation: Quat::from_array(self.orientation_xyzw).normalize(),
+            },
+            fov: Fov {
+                angle_left_rad: l,
+                angle_right_rad: r,
+                angle_up_rad: u,
+                angle_down_rad: d,
+            },
+        }
+    }
+}
+
+/// One written frame of `reference.json`.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct FrameReport {
+    /// Frame index (as the replay's of the same trace and rate).
+    pub frame: u64,
+    /// Display time, ns (0 without a trace).
+    pub time_ns: i64,
+    /// Left and right eye.
+    pub eyes: [EyeRecord; 2],
+    /// Object centre and light, metres.
+    pub object_position_m: [f32; 3],
+    /// The object's orientation, quaternion x, y, z, w.
+    pub object_rotation_xyzw: [f32; 4],
+    /// The light, metres.
+    pub light_position_m: [f32; 3],
+    /// Photons traced for the floor light (0: no floor light, e.g. share 0).
+    pub photons: u64,
+    /// Standard error of the floor light ratio where the object changes it.
+    pub floor_light_noise: f32,
+    /// Files written.
+    pub files: Vec<String>,
+    /// Seconds spent on the frame.
+    pub seconds: f64,
+}
+
+impl FrameReport {
+    /// Where the object and the light were.
+    pub fn placement(&self) -> Placement {
+        Placement {
+            object_position_m: Vec3::from_array(self.object_position_m),
+            object_rotation: Quat::from_array(self.object_rotation_xyzw).normalize(),
+            light_position_m: Vec3::from_array(self.light_position_m),
+        }
+    }
+}
+
+/// `reference.json`, written last: its absence means the run did not finish.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct Report {
+    /// The version of vitreous that wrote it.
+    pub vitreous_version: String,
+    /// The scene file.
+    pub scene: String,
+    /// [`Scene::hash`] of the scene.
+    pub scene_hash: String,
+    /// The trace, or `neutral head`.
+    pub trace: String,
+    /// Eye image size, pixels.
+    pub width_px: u32,
+    /// Eye image size, pixels.
+    pub height_px: u32,
+    /// Positions averaged per pixel.
+    pub samples_per_pixel: u32,
+    /// Side of the floor light's texels, mm.
+    pub texel_mm: f32,
+    /// Photons per texel of floor under the object's cone.
+    pub photons_per_texel: f32,
+    /// `[light] share`.
+    pub light_share: f32,
+    /// `analytic ball` or `closed mesh`.
+    pub object: String,
+    /// Every frame written.
+    pub frames: Vec<FrameReport>,
+}
+
+/// The frame and eye of a reference image, from the `reference.json` beside it (`None` when
+/// there is none, or it does not list the image).
+pub fn frame_of_image(image: &Path) -> Option<(FrameReport, usize)> {
+    let folder = image.parent()?;
+    let name = image.file_name()?.to_str()?;
+    let bytes = std::fs::read(folder.join("reference.json")).ok()?;
+    let report: Report = serde_json::from_slice(&bytes).ok()?;
+    report.frames.into_iter().find_map(|f| {
+        let eye = EYE_NAMES
+            .iter()
+            .position(|e| name == format!("{:06}-{e}.png", f.frame))?;
+        Some((f, eye))
+    })
+}
+
+/// Runs `vitreous reference`.
+pub fn reference_command(args: ReferenceArgs) -> Result<()> {
+    let scene = load_scene(&args.scene)?;
+    for warning in &scene.warnings {
+        tracing::warn!("{warning}");
+    }
+    let (width, height) = args
+        .size
+        .unwrap_or((scene.output.width_px, scene.output.height_px));
+    check_size(width, height)?;
+    if !(args.rate.is_finite() && (1.0..=1000.0).contains(&args.rate)) {
+        bail!("--rate must be between 1 and 1000 Hz, got {}", args.rate);
+    }
+    if args.trace.is_none() && args.frames.is_some() {
+        bail!("--frames needs --trace: without one the reference is the neutral head only");
+    }
+    let out = args.out.clone().unwrap_or_else(|| {
+        let name = args
+            .scene
+            .file_stem()
+            .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from("out").join(format!("{name}-reference"))
+    });
+    let frames = frames_to_render(&scene, &args)?;
+    std::fs::create_dir_all(&out)
+        .with_context(|| format!("creating output folder {}", out.display()))?;
+    let photons = PhotonParams {
+        texel_m: args.texel_mm / 1000.0,
+        photons_per_texel: args.photons_per_texel,
+        seed: 0,
+    };
+    let progress = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        let bar = ProgressBar::new((frames.len() * args.eye.indices().len()) as u64);
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} reference [{bar:30}] {pos}/{len} eyes {eta}")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar
+    };
+    let mut reports = Vec::new();
+    for frame in &frames {
+        let started = Instant::now();
+        let world = World::of(&scene, &frame.placement).with_context(|| {
+            format!(
+                "{}: the object {} is not a closed solid",
+                scene.path.display(),
+                scene.object.model_path.display()
+            )
+        })?;
+        let floor_light = if world.light_share > 0.0 {
+            FloorLight::trace(&world, &photons)
+        } else {
+            None
+        };
+        let (count, noise) = floor_light
+            .as_ref()
+            .map_or((0, 0.0), |l| (l.photons(), l.noise()));
+        let world = World {
+            floor_light,
+            ..world
+        };
+        let seen = world.without_object();
+        let mut files = Vec::new();
+        for &eye in args.eye.indices() {
+            let camera = &eye_params(&frame.views[eye]);
+            let whole = Window {
+                x: 0,
+                y: 0,
+                width,
+                height,
+            };
+            for (suffix, w) in [("", &world), ("-seen", &seen)] {
+                let image = render_eye(w, camera, (width, height), whole, args.samples);
+                let name = format!("{:06}-{}{suffix}.png", frame.index, EYE_NAMES[eye]);
+                write_png(&out.join(&name), &image)?;
+                files.push(name);
+            }
+            progress.inc(1);
+        }
+        reports.push(FrameReport {
+            frame: frame.index,
+            time_ns: frame.time_ns,
+            eyes: frame.views.each_ref().map(EyeRecord::of),
+            object_position_m: frame.placement.object_position_m.to_array(),
+            object_rotation_xyzw: frame.placement.object_rotation.to_array(),
+            light_position_m: frame.placement.light_position_m.to_array(),
+            photons: count,
+            floor_light_noise: noise,
+            files,
+            seconds: started.elapsed().as_secs_f64(),
+        });
+    }
+    progress.finish_and_clear();
+    let report = Report {
+        vitreous_version: env!("CARGO_PKG_VERSION").into(),
+        scene: args.scene.display().to_string(),
+        scene_hash: scene.hash.clone(),
+        trace: args
+            .trace
+            .as_ref()
+            .map_or("neutral head".into(), |t| t.display().to_string()),
+        width_px: width,
+        height_px: height,
+        samples_per_pixel: args.samples * args.samples,
+        texel_mm: args.texel_mm,
+        photons_per_texel: args.photons_per_texel,
+        light_share: scene.light.share,
+        object: if scene.object.is_ball() {
+            "analytic ball".into()
+        } else {
+            "closed mesh".into()
+        },
+        frames: reports,
+    };
+    let json = serde_json::to_vec_pretty(&report).context("encoding reference.json")?;
+    write_atomic(&out.join("reference.json"), &json)?;
+    for f in &report.frames {
+        println!(
+            "frame {}: {} photons, floor light noise {:.4}, {:.1} s",
+            f.frame, f.photons, f.floor_light_noise, f.seconds
+        );
+    }
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+/// A frame to render: its index and time, both eyes' cameras and where the object and light are.
+struct Frame {
+    index: u64,
+    time_ns: i64,
+    views: [EyeView; 2],
+    placement: Placement,
+}
+
+/// The frames the reference renders: the neutral head without a trace; else the trace's
+/// frames at the rate that are saved, placed as the replay places them.
+fn frames_to_render(scene: &Scene, args: &ReferenceArgs) -> Result<Vec<Frame>> {
+    let Some(trace) = &args.trace else {
+        let head = vitreous_xr::Pose {
+            position: scene.viewer.head_position_m,
+            orientation: Quat::IDENTITY,
+        };
+        let views = scene.viewer.eye_positions_m(&head).map(|p: Vec3| EyeView {
+            pose: vitreous_xr::Pose {
+                position: p,
+                orientation: Quat::IDENTITY,
+            },
+            fov: scene.output.fov,
+        });
+        return Ok(vec![Frame {
+            index: 0,
+            time_ns: 0,
+            views,
+            placement: scene.rest_placement(),
+        }]);
+    };
+    let (samples, edits, name) = load_trace_with_edits(scene, Some(trace.as_path()))?;
+    let mut backend = NullBackend::new(
+        samples,
+        NullConfig {
+            frame_rate_hz: args.rate,
+            max_frames: Some(args.frames.unwrap_or(1)),
+            fov: scene.output.fov,
+            ipd_m: scene.viewer.ipd_m,
+            at_samples: false,
+        },
+    )
+    .with_context(|| format!("replaying {name}"))?;
+    let mut motion = MotionClock::new(scene);
+    let mut edits = std::collections::VecDeque::from(edits);
+    let mut frames = Vec::new();
+    while let Some(input) = backend.wait_frame()? {
+        while let Some(edit) = edits.front()
+            && edit.time_ns <= input.time_ns
+        {
+            motion.replay_edit(edit, input.index);
+            edits.pop_front();
+        }
+        let placement = motion
+            .placement(input.time_ns)
+            .unwrap_or_else(|| scene.rest_placement());
+        if args.save_every > 0 && input.index.is_multiple_of(args.save_every) {
+            frames.push(Frame {
+                index: input.index,
+                time_ns: input.time_ns,
+                views: input.views,
+                placement,
+            });
+        }
+        backend.end_frame(&input)?;
+    }
+    if frames.is_empty() {
+        bail!("--save-every {} writes none of the frames", args.save_every);
+    }
+    Ok(frames)
+}
+
+/// Writes a linear eye image as an sRGB PNG.
+fn write_png(path: &Path, image: &EyeImage) -> Result<()> {
+    let rgba: Vec<u8> = image
+        .rgb
+        .iter()
+        .flat_map(|c| {
+            [
+                linear_to_srgb(c.x),
+                linear_to_srgb(c.y),
+                linear_to_srgb(c.z),
+                255,
+            ]
+        })
+        .collect();
+    let png = encode_png(&rgba, image.window.width, image.window.height)?;
+    write_atomic(path, &png)
+}

@@ -1,0 +1,198 @@
+//! `vitreous reference`: the physical reference's files, what it changes against the seen
+//! image (the ball's disc, its shadow), `compare` reading its frames, and bad input.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Quat, Vec2};
+use vitreous::render_desc::render_fov;
+use vitreous::scene::load_scene;
+use vitreous_render::camera::EyeParams;
+
+use crate::cli::{assert_clean_failure, vitreous};
+use crate::compare::json;
+
+fn scene_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/glass-sphere-real.toml")
+}
+
+/// Linear RGB of pixel `(x, y)` of an sRGB PNG.
+fn pixel(path: &Path, x: u32, y: u32) -> glam::Vec3 {
+    let image = image::open(path).unwrap().to_rgb8();
+    let p = image.get_pixel(x, y);
+    glam::Vec3::new(
+        vitreous::output::srgb_to_linear(p[0]),
+        vitreous::output::srgb_to_linear(p[1]),
+        vitreous::output::srgb_to_linear(p[2]),
+    )
+}
+
+#[test]
+fn the_reference_shows_the_ball_and_half_its_lights_shadow_and_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ref");
+    let run = vitreous(
+        &[
+            "reference",
+            scene_path().to_str().unwrap(),
+            "--size",
+            "320x240",
+            "--samples",
+            "2",
+            "--photons-per-texel",
+            "8",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for eye in ["left", "right"] {
+        for suffix in ["", "-seen"] {
+            assert!(out.join(format!("000000-{eye}{suffix}.png")).is_file());
+        }
+    }
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("reference.json")).unwrap()).unwrap();
+    assert_eq!(report["object"], "analytic ball");
+    assert_eq!(report["light_share"], 0.5);
+    let frame = &report["frames"][0];
+    assert!(frame["photons"].as_u64().unwrap() > 10_000, "{frame}");
+    assert!(
+        frame["floor_light_noise"].as_f64().unwrap() < 0.05,
+        "{frame}"
+    );
+
+    // Where the light's ray through the ball's centre meets the floor: the middle of the shadow,
+    // whose darkest part is lit by the room's half of the floor's light only.
+    let scene = load_scene(&scene_path()).unwrap();
+    let light = scene.light.position_m;
+    let centre = scene.object.center_m;
+    let floor_y = scene.floor.pose.position.y;
+    let towards = (centre - light).normalize();
+    let umbra = light + towards * ((floor_y - light.y) / towards.y);
+    let head = vitreous_xr::Pose {
+        position: scene.viewer.head_position_m,
+        orientation: Quat::IDENTITY,
+    };
+    let left = scene.viewer.eye_positions_m(&head)[0];
+    let camera = EyeParams::new(left, Quat::IDENTITY, render_fov(scene.output.fov));
+    let size = Vec2::new(320.0, 240.0);
+    let at = |p: glam::Vec3| {
+        let px = camera.project_to_pixel(p, size).unwrap();
+        (px.x as u32, px.y as u32)
+    };
+    let (ux, uy) = at(umbra);
+    let real = out.join("000000-left.png");
+    let seen = out.join("000000-left-seen.png");
+    let ratios: Vec<f32> = (ux - 12..=ux + 12)
+        .map(|x| pixel(&real, x, uy).element_sum() / pixel(&seen, x, uy).element_sum())
+        .collect();
+    let darkest = ratios.iter().copied().fold(f32::MAX, f32::min);
+    let brightest = ratios.iter().copied().fold(0.0, f32::max);
+    assert!(
+        (0.4..0.62).contains(&darkest),
+        "the shadow keeps {darkest} of the floor's light at its darkest, expected about 0.5 \
+         (the room's half): {ratios:?}"
+    );
+    // The ball focuses the light it lets through into the middle of its shadow.
+    assert!(brightest > 1.2, "no caustic: {ratios:?}");
+    // The ball's centre shows something else than the floor behind it; far from the ball and
+    // its shadow the two images are the same.
+    let (cx, cy) = at(centre);
+    assert_ne!(pixel(&real, cx, cy), pixel(&seen, cx, cy));
+    for (x, y) in [(5, 120), (300, 230), (160, 100)] {
+        assert_eq!(pixel(&real, x, y), pixel(&seen, x, y), "at {x},{y}");
+    }
+
+    // `compare` takes its regions from the frame in reference.json beside the reference.
+    let cmp = json(
+        &[
+            "compare",
+            real.to_str().unwrap(),
+            real.to_str().unwrap(),
+            "--scene",
+            scene_path().to_str().unwrap(),
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert!(
+        cmp["regions_from"]
+            .as_str()
+            .unwrap()
+            .starts_with("frame 0 left eye of"),
+        "{cmp}"
+    );
+    // A display that adds nothing, over the seen image, is the seen image.
+    let black = dir.path().join("black.png");
+    let rgba = vec![0u8; 320 * 240 * 4];
+    std::fs::write(
+        &black,
+        vitreous::output::encode_png(&rgba, 320, 240).unwrap(),
+    )
+    .unwrap();
+    let cmp = json(
+        &[
+            "compare",
+            real.to_str().unwrap(),
+            black.to_str().unwrap(),
+            "--display",
+            "--seen",
+            seen.to_str().unwrap(),
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        cmp["regions"][0]["flip_mean"],
+        cmp["nothing_drawn"][0]["flip_mean"]
+    );
+    assert!(cmp["regions"][0]["flip_mean"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn bad_reference_input_fails_cleanly_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ref");
+    let scene = scene_path();
+    let scene = scene.to_str().unwrap();
+    let o = out.to_str().unwrap();
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &["reference", "missing.toml", "--out", o],
+            &["missing.toml"],
+        ),
+        (
+            &["reference", scene, "--samples", "0", "--out", o],
+            &["--samples", "between 1 and 16"],
+        ),
+        (
+            &["reference", scene, "--photons-per-texel", "nan", "--out", o],
+            &["--photons-per-texel"],
+        ),
+        (
+            &["reference", scene, "--frames", "2", "--out", o],
+            &["--frames needs --trace"],
+        ),
+        (
+            &["reference", scene, "--trace", "nope.csv", "--out", o],
+            &["nope.csv"],
+        ),
+        (
+            &["reference", scene, "--size", "0x10", "--out", o],
+            &["0x10", "16..=8192"],
+        ),
+    ];
+    for (args, needles) in cases {
+        assert_clean_failure(&vitreous(args, dir.path()), needles);
+        assert!(
+            !out.join("reference.json").exists(),
+            "{args:?} wrote reference.json"
+        );
+    }
+}

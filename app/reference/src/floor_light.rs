@@ -25,11 +25,8 @@ use rayon::prelude::*;
 use vitreous_render::optics::{fresnel_reflectance, reflect, refract};
 use vitreous_render::two_surface::Body;
 
-use crate::trace::{MAX_INTERFACES, MIN_WEIGHT, PhotoHit};
-use crate::world::{Glass, World};
-
-/// Offset off a surface along a photon leaving it, metres.
-const EPS_M: f32 = 1e-6;
+use crate::light_map::FloorLight;
+use crate::world::{EPS_M, Glass, MAX_INTERFACES, MIN_WEIGHT, PhotoHit, World};
 
 /// The floor grid covers the floor under a cone this many times wider than the object's, so
 /// that the light the object bends sideways lands on it.
@@ -63,39 +60,7 @@ impl Default for PhotonParams {
     }
 }
 
-/// The ratio `T` of the floor's irradiance from the point light with the object to without it,
-/// on a texel grid over part of the floor (1 outside it).
-#[derive(Clone, Debug)]
-pub struct FloorLight {
-    /// The grid's floor photo coordinates: its top-left corner.
-    origin_uv: Vec2,
-    /// Photo coordinates per texel, u and v.
-    texel_uv: Vec2,
-    /// Texels along u and v.
-    width: u32,
-    height: u32,
-    /// `T` per texel and channel, row 0 at the smallest v.
-    ratio: Vec<Vec3>,
-    /// See [`FloorLight::noise`].
-    noise: f32,
-    /// Photons traced.
-    photons: u64,
-}
-
 impl FloorLight {
-    /// A floor light that scales the light's share by `ratio` everywhere (tests).
-    pub fn uniform(ratio: f32) -> FloorLight {
-        FloorLight {
-            origin_uv: Vec2::ZERO,
-            texel_uv: Vec2::ONE,
-            width: 1,
-            height: 1,
-            ratio: vec![Vec3::splat(ratio)],
-            noise: 0.0,
-            photons: 0,
-        }
-    }
-
     /// Traces the light of `world`'s point light onto its floor with its glass object there.
     /// `None` when the world has no floor or no object, or the light is inside the object's
     /// bounding sphere.
@@ -251,61 +216,6 @@ impl FloorLight {
             noise,
             photons: side * side,
         })
-    }
-
-    /// `T` at floor photo coordinate `uv`, bilinear between texel centres; 1 off the grid.
-    pub fn ratio(&self, uv: Vec2) -> Vec3 {
-        let p = (uv - self.origin_uv) / self.texel_uv - 0.5;
-        let (w, h) = (self.width as f32, self.height as f32);
-        if p.x < -0.5 || p.y < -0.5 || p.x > w - 0.5 || p.y > h - 0.5 {
-            return Vec3::ONE;
-        }
-        let (x0, y0) = (p.x.floor(), p.y.floor());
-        let (fx, fy) = (p.x - x0, p.y - y0);
-        let at = |x: f32, y: f32| {
-            let x = (x as i64).clamp(0, self.width as i64 - 1);
-            let y = (y as i64).clamp(0, self.height as i64 - 1);
-            self.ratio[(y * self.width as i64 + x) as usize]
-        };
-        let top = at(x0, y0).lerp(at(x0 + 1.0, y0), fx);
-        let bottom = at(x0, y0 + 1.0).lerp(at(x0 + 1.0, y0 + 1.0), fx);
-        top.lerp(bottom, fy)
-    }
-
-    /// The standard error of `T` (RMS over texels and channels) where the object changes it
-    /// by more than 0.001, from the difference of the even and odd photons' estimates.
-    pub fn noise(&self) -> f32 {
-        self.noise
-    }
-
-    /// Photons traced from the light.
-    pub fn photons(&self) -> u64 {
-        self.photons
-    }
-
-    /// The texel of largest `T` (the caustic's peak) and its centre's photo coordinate.
-    pub fn peak(&self) -> (Vec2, f32) {
-        let (i, t) = self
-            .ratio
-            .iter()
-            .enumerate()
-            .map(|(i, t)| (i, t.element_sum() / 3.0))
-            .fold((0, f32::MIN), |a, b| if b.1 > a.1 { b } else { a });
-        let (x, y) = (
-            (i as u32 % self.width) as f32,
-            (i as u32 / self.width) as f32,
-        );
-        (self.origin_uv + (Vec2::new(x, y) + 0.5) * self.texel_uv, t)
-    }
-
-    /// Texels of the grid, u and v.
-    pub fn size(&self) -> (u32, u32) {
-        (self.width, self.height)
-    }
-
-    /// Photo coordinates per texel.
-    pub fn texel_uv(&self) -> Vec2 {
-        self.texel_uv
     }
 }
 

@@ -29,14 +29,17 @@
 //! |---|---|
 //! | [`world`] | the real world: photos on their planes, the environment, the glass object |
 //! | [`trace`] | radiance along a ray, through the glass |
-//! | [`floor_light`] | the floor's light from the point light, with the object's shadow and caustic |
+//! | [`floor_light`] | the floor's light traced from the point light: the object's shadow and caustic |
+//! | [`light_map`] | that light as a map over the floor |
 //! | [`eye`] | an eye image: pixels supersampled over a stratified grid |
 
 pub mod eye;
 pub mod floor_light;
+pub mod light_map;
 pub mod trace;
 pub mod world;
 
 pub use eye::{EyeImage, Window, render_eye};
-pub use floor_light::{FloorLight, PhotonParams};
+pub use floor_light::PhotonParams;
+pub use light_map::FloorLight;
 pub use world::{Glass, Picture, Surface, World};

@@ -5,45 +5,9 @@ use glam::{Vec2, Vec3};
 use vitreous_render::optics::{fresnel_reflectance, reflect, refract};
 use vitreous_render::two_surface::Body;
 
-use crate::world::{Glass, World};
-
-/// Most interfaces one path meets; deeper branches carry no light.
-pub const MAX_INTERFACES: u32 = 16;
-
-/// Branches carrying less than this fraction of the ray's light are not followed.
-pub const MIN_WEIGHT: f32 = 1e-4;
-
-/// Offset off a surface along a ray leaving it, metres.
-const EPS_M: f32 = 1e-6;
-
-/// What a ray meets first among the registered photos.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum PhotoHit {
-    /// The floor at this photo coordinate.
-    Floor(Vec2),
-    /// The background at this photo coordinate.
-    Background(Vec2),
-}
+use crate::world::{EPS_M, Glass, MAX_INTERFACES, MIN_WEIGHT, PhotoHit, World};
 
 impl World {
-    /// The nearest photo along the ray from `origin` along unit `dir`, and its distance.
-    pub fn photo_hit(&self, origin: Vec3, dir: Vec3) -> Option<(f32, PhotoHit)> {
-        let floor = self
-            .floor
-            .as_ref()
-            .and_then(|f| f.hit(origin, dir))
-            .map(|(t, uv)| (t, PhotoHit::Floor(uv)));
-        let wall = self
-            .background
-            .as_ref()
-            .and_then(|b| b.hit(origin, dir))
-            .map(|(t, uv)| (t, PhotoHit::Background(uv)));
-        match (floor, wall) {
-            (Some(f), Some(w)) => Some(if f.0 <= w.0 { f } else { w }),
-            (f, w) => f.or(w),
-        }
-    }
-
     /// Linear radiance that reaches `origin` along the unit `dir` (the eye looking along
     /// `dir`). Where the ray meets neither photo nor glass, black: the real world beyond the
     /// registered photos is not known (as in the see-through preview). Rays that left the glass
@@ -245,7 +209,7 @@ mod tests {
         world.light_share = 0.25;
         let uv = Vec2::splat(0.5);
         assert_eq!(world.floor_radiance(uv), Vec3::splat(0.4));
-        world.floor_light = Some(crate::floor_light::FloorLight::uniform(0.0));
+        world.floor_light = Some(crate::light_map::FloorLight::uniform(0.0));
         // The light's quarter gone: three quarters left.
         assert!((world.floor_radiance(uv).x - 0.3).abs() < 1e-6);
     }

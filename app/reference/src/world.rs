@@ -10,7 +10,25 @@ use vitreous_render::solid::SolidError;
 use vitreous_render::two_surface::{Ball, Body, MeshBody};
 use vitreous_scene::{Image, PixelData, Placement, RealPlane, Scene, srgb_to_linear};
 
-use crate::floor_light::FloorLight;
+use crate::light_map::FloorLight;
+
+/// Most interfaces one path meets; deeper branches carry no light.
+pub const MAX_INTERFACES: u32 = 16;
+
+/// Branches carrying less than this fraction of the ray's light are not followed.
+pub const MIN_WEIGHT: f32 = 1e-4;
+
+/// Offset off a surface along a ray leaving it, metres.
+pub(crate) const EPS_M: f32 = 1e-6;
+
+/// What a ray meets first among the registered photos.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PhotoHit {
+    /// The floor at this photo coordinate.
+    Floor(Vec2),
+    /// The background at this photo coordinate.
+    Background(Vec2),
+}
 
 /// A picture in linear RGB: a photo (decoded from sRGB) or an environment map.
 #[derive(Clone, Debug)]
@@ -305,6 +323,24 @@ impl World {
             glass: None,
             floor_light: None,
             ..self.clone()
+        }
+    }
+
+    /// The nearest photo along the ray from `origin` along unit `dir`, and its distance.
+    pub fn photo_hit(&self, origin: Vec3, dir: Vec3) -> Option<(f32, PhotoHit)> {
+        let floor = self
+            .floor
+            .as_ref()
+            .and_then(|f| f.hit(origin, dir))
+            .map(|(t, uv)| (t, PhotoHit::Floor(uv)));
+        let wall = self
+            .background
+            .as_ref()
+            .and_then(|b| b.hit(origin, dir))
+            .map(|(t, uv)| (t, PhotoHit::Background(uv)));
+        match (floor, wall) {
+            (Some(f), Some(w)) => Some(if f.0 <= w.0 { f } else { w }),
+            (f, w) => f.or(w),
         }
     }
 

@@ -68,6 +68,39 @@ const VARIANTS: &[Variant] = &[
         &[("ABSORBING", 1.0), ("CONVEX", 1.0)],
         "absorbing.convex",
     ),
+    // Every glass model again with the room as its target (`ROOM`).
+    ("glass", "fs_paper_", &[("ROOM", 1.0)], "room"),
+    ("glass", "fs_two_surface_", &[("ROOM", 1.0)], "room"),
+    (
+        "glass",
+        "fs_two_surface_",
+        &[("ABSORBING", 1.0), ("ROOM", 1.0)],
+        "absorbing.room",
+    ),
+    (
+        "glass",
+        "fs_two_surface_",
+        &[("BALL", 1.0), ("ROOM", 1.0)],
+        "ball.room",
+    ),
+    (
+        "glass",
+        "fs_two_surface_",
+        &[("ABSORBING", 1.0), ("BALL", 1.0), ("ROOM", 1.0)],
+        "absorbing.ball.room",
+    ),
+    (
+        "glass",
+        "fs_two_surface_",
+        &[("CONVEX", 1.0), ("ROOM", 1.0)],
+        "convex.room",
+    ),
+    (
+        "glass",
+        "fs_two_surface_",
+        &[("ABSORBING", 1.0), ("CONVEX", 1.0), ("ROOM", 1.0)],
+        "absorbing.convex.room",
+    ),
 ];
 
 fn main() {

@@ -30,6 +30,11 @@
 // with background refraction (disparity and/or defocus) and Phong reflection 2 (background
 // stack or environment, surface stack); with environment reflection 3. Two-surface adds one
 // radial-map fetch per exit step (one for a ball).
+//
+// The room (`[environment] room`, beyond the paper): the floor and background photos are what
+// the glass refracts and reflects, exactly, in every variant: a ray leaving the glass takes the
+// photo it meets first (the floor sharp, the background at the frame's blur), the environment
+// map only where it meets neither. Still one fetch per image.
 
 // #include shared/fresnel.wgsl
 
@@ -70,6 +75,9 @@ struct Globals {
     // the coefficient per world metre times the model's scale over ln 2; 0 in a channel that
     // absorbs nothing, where 2^0 = 1 leaves it exactly as it was).
     absorption: vec4<f32>,
+    // Maps the world into the floor plane's frame, where its photo covers the unit square
+    // [-0.5, 0.5]^2 at z = 0 (top edge away from the viewer).
+    floor_from_world: mat4x4<f32>,
 };
 
 // The object absorbs (Beer-Lambert, two-surface refraction): a pipeline constant, so that the
@@ -88,6 +96,12 @@ override BALL: bool = false;
 // facet edge).
 override CONVEX: bool = false;
 
+// The floor and background photos are the room the glass refracts and reflects (`[environment]
+// room`): rays leaving the glass take the photo they meet first, the environment map only where
+// they meet neither. A pipeline constant (render/build.rs compiles every entry point with it set
+// too), so that the paper's pipelines keep their targets and their cost.
+override ROOM: bool = false;
+
 var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(0) @binding(1) var env_map: texture_2d<f32>;
@@ -103,6 +117,8 @@ var<push_constant> eye: Eye;
 // The facet planes of a convex object (model frame, about the radial map's centre): xyz the
 // outward unit normal, w the plane's distance from the centre. One unused plane otherwise.
 @group(0) @binding(7) var<storage, read> planes: array<vec4<f32>>;
+// The floor photo (sharp), seen through the glass when the room is a refraction target.
+@group(0) @binding(8) var floor_photo: texture_2d<f32>;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -169,20 +185,63 @@ fn refract_heckbert(incident: vec3<f32>, normal: vec3<f32>, n: f32) -> vec4<f32>
     return vec4<f32>(k_f * (normal + v) - normal, 1.0);
 }
 
-// Where the ray origin + t * dir (t > 0) meets the background plane: xy photo coordinates,
-// z: 1 on the photo, 0 on a miss (twin of render/src/optics.rs plane_uv).
-fn background_uv(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
-    let o = (g.background_from_world * vec4<f32>(origin, 1.0)).xyz;
-    let d = (g.background_from_world * vec4<f32>(dir, 0.0)).xyz;
+// Where the ray origin + t * dir (t > 0) meets the plane whose frame `plane_from_world` maps
+// the world into (its photo on the unit square at z = 0): xy photo coordinates, z the distance
+// t, w: 1 on the photo, 0 on a miss.
+fn plane_hit(plane_from_world: mat4x4<f32>, origin: vec3<f32>, dir: vec3<f32>) -> vec4<f32> {
+    let o = (plane_from_world * vec4<f32>(origin, 1.0)).xyz;
+    let d = (plane_from_world * vec4<f32>(dir, 0.0)).xyz;
     if abs(d.z) < 1e-12 {
-        return vec3<f32>(0.0);
+        return vec4<f32>(0.0);
     }
     let t = -o.z / d.z;
     let hit = o + d * t;
     if t <= 0.0 || abs(hit.x) > 0.5 || abs(hit.y) > 0.5 {
-        return vec3<f32>(0.0);
+        return vec4<f32>(0.0);
     }
-    return vec3<f32>(hit.x + 0.5, 0.5 - hit.y, 1.0);
+    return vec4<f32>(hit.x + 0.5, 0.5 - hit.y, t, 1.0);
+}
+
+// Where the ray origin + t * dir (t > 0) meets the background plane: xy photo coordinates,
+// z: 1 on the photo, 0 on a miss (twin of render/src/optics.rs plane_uv).
+fn background_uv(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    let hit = plane_hit(g.background_from_world, origin, dir);
+    return vec3<f32>(hit.xy, hit.w);
+}
+
+// What a ray leaving the glass sees of the room (`ROOM`): the floor or background photo
+// it meets first, else the environment map; one fetch either way. The background is read at
+// the frame's blur (defocus), the floor sharp.
+fn room(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    let wall = plane_hit(g.background_from_world, origin, dir);
+    let floor = plane_hit(g.floor_from_world, origin, dir);
+    if floor.w > 0.0 && (wall.w == 0.0 || floor.z < wall.z) {
+        return textureSampleLevel(floor_photo, clamp_sampler, floor.xy, 0.0).rgb;
+    }
+    if wall.w > 0.0 {
+        return textureSampleLevel(background, clamp_sampler, wall.xy, 0.0).rgb;
+    }
+    return environment(dir);
+}
+
+// What a two-surface passage sees beyond the glass where the background plane is not its
+// target: the room from where it left (`ROOM`), else, or when given up inside, the environment.
+fn beyond_passage(passage: Passage) -> vec3<f32> {
+    if ROOM {
+        if passage.escaped > 0.0 {
+            return room(passage.exit, passage.direction);
+        }
+    }
+    return environment(passage.direction);
+}
+
+// What a ray leaving the glass sees where the paper's model shows the environment map: the
+// room when the scene registers it as such, else the map.
+fn beyond(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    if ROOM {
+        return room(origin, dir);
+    }
+    return environment(dir);
 }
 
 const MAX_INTERNAL_REFLECTIONS: i32 = 4;
@@ -409,9 +468,10 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         let from_origin = normalize(world_pos - origin);
         let passage = two_surface(world_pos, from_origin, n, ior);
         fresnel = fresnel_exact(-dot(incident, n), 1.0 / ior);
-        // The background where the ray reaches it, else the environment (fetched only there).
+        // The background where the ray reaches it, else the environment (fetched only there);
+        // the room's photos, nearest first, when the scene registers them as the room.
         var uv = vec3<f32>(0.0);
-        if to_background && passage.escaped > 0.0 {
+        if to_background && passage.escaped > 0.0 && !ROOM {
             uv = background_uv(passage.exit, passage.direction);
         }
         var seen: vec3<f32>;
@@ -419,7 +479,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
             seen = textureSampleLevel(
                 background, clamp_sampler, uv.xy, 0.0).rgb;
         } else {
-            seen = environment(passage.direction);
+            seen = beyond_passage(passage);
         }
         refracted_image = seen * passage.transmission / max(1.0 - fresnel, 1e-6);
     } else if to_background {
@@ -428,7 +488,9 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         // Total internal reflection (t.w = 0) sees the environment the mirror way.
         let away = select(reflected, t.xyz, t.w != 0.0);
         let uv = background_uv(world_pos, away);
-        if uv.z * t.w > 0.0 {
+        if ROOM {
+            refracted_image = room(world_pos, away);
+        } else if uv.z * t.w > 0.0 {
             refracted_image = textureSampleLevel(
                 background, clamp_sampler, uv.xy, 0.0).rgb;
         } else {
@@ -439,7 +501,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         if dot(t, t) == 0.0 {
             t = reflected;
         }
-        refracted_image = environment(t);
+        refracted_image = beyond(world_pos, t);
     }
 
     // The reflected image.
@@ -450,7 +512,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         let specular = pow(max(dot(mirror, -incident), 0.0), g.light_colour.w);
         reflected_image = g.light_colour.rgb * g.light.w * g.shading.z * specular;
     } else {
-        reflected_image = fresnel * environment(reflected);
+        reflected_image = fresnel * beyond(world_pos, reflected);
     }
 
     // eq. 9: C_o = alpha C_s + (1 - alpha) C_b, alpha the surface's opacity.

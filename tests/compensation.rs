@@ -4,12 +4,10 @@
 //! preview's world view draws it), clamped at 0, in linear light; every other pixel is
 //! untouched; with the world drawn behind (an opaque display) nothing is taken away.
 
-use glam::Quat;
 use vitreous::effects::EffectSet;
-use vitreous_render::camera::Fov;
 use vitreous_render::renderer::Want;
-use vitreous_render::{Compensation, Composition, EyeParams, FrameParams, Reflection, Renderer};
-use vitreous_tests::{shipped_scene, validated_context};
+use vitreous_render::{Compensation, Composition, FrameParams, Reflection, Renderer};
+use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
 
 fn linear(v: u8) -> f32 {
     vitreous::output::srgb_to_linear(v)
@@ -19,25 +17,6 @@ fn linear(v: u8) -> f32 {
 fn step(v: u8) -> f32 {
     let below = v.min(254);
     linear(below + 1) - linear(below)
-}
-
-/// The scene's two eyes at its neutral head.
-fn eyes(scene: &vitreous::scene::Scene) -> [EyeParams; 2] {
-    let head = vitreous_xr::Pose {
-        position: scene.viewer.head_position_m,
-        orientation: Quat::IDENTITY,
-    };
-    let fov = scene.output.fov;
-    let fov = Fov {
-        left_rad: fov.angle_left_rad,
-        right_rad: fov.angle_right_rad,
-        up_rad: fov.angle_up_rad,
-        down_rad: fov.angle_down_rad,
-    };
-    scene
-        .viewer
-        .eye_positions_m(&head)
-        .map(|p| EyeParams::new(p, Quat::IDENTITY, fov))
 }
 
 fn frame(
@@ -51,28 +30,17 @@ fn frame(
     let mut r = Renderer::new(validated_context(), &desc, 320, 240).expect("renderer");
     let counted = r.count_invocations().unwrap();
     let params = FrameParams {
-        eyes: eyes(&scene),
+        eyes: neutral_eyes(&scene),
         look: vitreous::look::base_look(
             &EffectSet::parse("disparity").unwrap(),
             Reflection::EnvironmentFresnel,
         ),
     };
-    let mut done: Vec<_> = r
-        .submit_composed(
-            &params,
-            Want {
-                eyes: true,
-                world: true,
-            },
-            composition,
-        )
-        .unwrap()
-        .into_iter()
-        .collect();
-    done.extend(r.flush().unwrap());
-    let v = r.context().validation();
-    assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
-    let last = done.pop().expect("the frame finished");
+    let want = Want {
+        eyes: true,
+        world: true,
+    };
+    let last = compose_once(&mut r, &params, want, composition);
     let fragments = last
         .work
         .invocations

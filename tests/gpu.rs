@@ -15,3 +15,4 @@ mod refraction;
 mod refraction_scene;
 mod render_smoke;
 mod replay;
+mod room;

@@ -118,6 +118,19 @@ pub fn validated_context() -> vitreous_render::GpuContext {
     .expect("Vulkan device with validation")
 }
 
+/// The scene's two eyes at its neutral head (the viewer at `head_position_m`, looking down -z).
+pub fn neutral_eyes(scene: &vitreous::scene::Scene) -> [vitreous_render::EyeParams; 2] {
+    let head = vitreous_xr::Pose {
+        position: scene.viewer.head_position_m,
+        orientation: glam::Quat::IDENTITY,
+    };
+    let fov = vitreous::render_desc::render_fov(scene.output.fov);
+    scene
+        .viewer
+        .eye_positions_m(&head)
+        .map(|p| vitreous_render::EyeParams::new(p, glam::Quat::IDENTITY, fov))
+}
+
 /// Positions, normals, uvs and indices of a mesh, as [`uv_sphere`] makes them.
 pub type MeshData = (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<u32>);
 
@@ -184,6 +197,7 @@ pub fn scene_desc<'a>(
         inducer: vitreous_render::InducerDesc::PAPER,
         caustics: None,
         compensation: vitreous_render::Compensation::None,
+        room: false,
     }
 }
 
@@ -275,4 +289,23 @@ pub fn render_once(
     done.pop()
         .and_then(|frame| frame.readback)
         .expect("the frame was read back")
+}
+
+/// Draws one frame composed for `composition`, waits for it and returns what it finished with,
+/// failing on any validation message.
+pub fn compose_once(
+    renderer: &mut vitreous_render::Renderer,
+    params: &vitreous_render::FrameParams,
+    want: vitreous_render::Want,
+    composition: vitreous_render::Composition,
+) -> vitreous_render::FrameResult {
+    let mut done: Vec<_> = renderer
+        .submit_composed(params, want, composition)
+        .unwrap()
+        .into_iter()
+        .collect();
+    done.extend(renderer.flush().unwrap());
+    let v = renderer.context().validation();
+    assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
+    done.pop().expect("the frame finished")
 }

@@ -94,7 +94,8 @@ impl EyePush {
     }
 }
 
-/// Uniform block matching `Globals` in glass.wgsl.
+/// Uniform block matching `Globals` in glass.wgsl. Every field a pose changes
+/// ([`Globals::posed`]) comes before `absorption`: a new pose uploads only that part.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct Globals {
@@ -112,6 +113,8 @@ struct Globals {
     /// refraction: the coefficient per world metre times the model's uniform scale over ln 2,
     /// for the shader's exp2; 0 for clear glass); w unused.
     absorption: [f32; 4],
+    /// Maps the world into the floor plane's frame (its photo on the unit square at z = 0).
+    floor_from_world: [f32; 16],
 }
 
 impl Globals {
@@ -182,6 +185,7 @@ impl GlassPass {
                 (5, image, fragment),
                 (6, image, fragment),
                 (7, vk::DescriptorType::STORAGE_BUFFER, fragment),
+                (8, image, fragment),
             ],
         )?;
         let layout = pipeline::layout(
@@ -220,14 +224,15 @@ impl GlassPass {
         let (planes, convex) = upload_facet_planes(ctx, desc, radial)?;
         // Clear glass gets the two-surface pipelines without the absorption's exponentials, a
         // ball the ones without the radial map's fetch, a convex faceted object the ones that
-        // leave it through its facet planes.
+        // leave it through its facet planes; a scene whose photos are the room the ones that
+        // trace it.
         let clear = desc.attenuation.is_clear();
         let model = match (desc.refraction, ball, convex) {
             (Refraction::Paper, ..) => 0,
             (Refraction::TwoSurface, true, _) => 4 - usize::from(clear),
             (Refraction::TwoSurface, false, true) => 6 - usize::from(clear),
             (Refraction::TwoSurface, false, false) => 2 - usize::from(clear),
-        };
+        } + if desc.room { shaders::GLASS_MODELS } else { 0 };
         let pipelines = GlassVariant::ALL
             .iter()
             .map(|variant| {
@@ -252,7 +257,7 @@ impl GlassPass {
             1,
             &[
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
-                (vk::DescriptorType::SAMPLED_IMAGE, 4),
+                (vk::DescriptorType::SAMPLED_IMAGE, 5),
                 (vk::DescriptorType::SAMPLER, 2),
                 (vk::DescriptorType::STORAGE_BUFFER, 1),
             ],
@@ -278,6 +283,7 @@ impl GlassPass {
                 * (metres_per_model_unit(desc) * std::f32::consts::LOG2_E))
                 .extend(0.0)
                 .to_array(),
+            floor_from_world: desc.floor.world_from_plane.inverse().to_cols_array(),
         }
         .posed(&ScenePose::of(desc));
         let globals_buffer = Buffer::with_data(
@@ -293,6 +299,7 @@ impl GlassPass {
         descriptors::write_image(ctx, set, 5, surface);
         descriptors::write_image(ctx, set, 6, radial_map.view);
         descriptors::write_storage_buffer(ctx, set, 7, planes.buffer);
+        descriptors::write_image(ctx, set, 8, scene.photos[0].view);
         Ok(GlassPass {
             pipelines,
             costs: shaders::GLASS_FS_COST[model],
@@ -328,6 +335,8 @@ impl GlassPass {
                 .size(vk::WHOLE_SIZE)
         };
         let globals = self.globals.posed(pose);
+        // The fields a pose changes all come before the absorption; the rest stays as made.
+        let posed = &bytemuck::bytes_of(&globals)[..std::mem::offset_of!(Globals, absorption)];
         // SAFETY: the caller's contract (outside a render pass; the buffer outlives the
         // execution); the data is a multiple of 4 bytes and under 65536, as
         // vkCmdUpdateBuffer requires, and the buffer was made with TRANSFER_DST.
@@ -344,13 +353,8 @@ impl GlassPass {
                 )],
                 &[],
             );
-            d.cmd_update_buffer(
-                cmd,
-                self.globals_buffer.buffer,
-                0,
-                bytemuck::bytes_of(&globals),
-            );
-            ctx.work.upload(std::mem::size_of_val(&globals));
+            d.cmd_update_buffer(cmd, self.globals_buffer.buffer, 0, posed);
+            ctx.work.upload(posed.len());
             d.cmd_pipeline_barrier(
                 cmd,
                 vk::PipelineStageFlags::TRANSFER,

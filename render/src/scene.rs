@@ -136,6 +136,11 @@ pub struct SceneDesc<'a> {
     // --- end caustics ---
     /// What the display takes away from the glass's light (eq. 6 over the glass).
     pub compensation: crate::Compensation,
+    /// The floor and background photos are the room the glass refracts and reflects
+    /// (`[environment] room`): every ray leaving the glass takes the photo it meets first, the
+    /// environment map only where it meets neither. Off: the paper's targets (the background
+    /// plane with disparity or defocus, else the environment map).
+    pub room: bool,
 }
 
 // --- caustics (issue 6; render/src/floor/) ---

@@ -70,8 +70,8 @@ pub const GLASS_VS: &[u8] = spirv!("glass.vs_main");
 /// two-surface through a ball (3: `BALL`, no radial-map fetch) and through an absorbing ball
 /// (4: both), through a convex faceted object (5: `CONVEX`, the exit from its facet planes)
 /// and through an absorbing one (6: both), the variant as `glass::GlassVariant::index`
-/// numbers it.
-pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 7] = [
+/// numbers it; rows 7 to 13 are the same models with the room as the glass's target (`ROOM`).
+pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 2 * GLASS_MODELS] = [
     glass_row!("paper", ""),
     glass_row!("two_surface", ""),
     glass_row!("two_surface", ".absorbing"),
@@ -79,9 +79,18 @@ pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 7] = [
     glass_row!("two_surface", ".absorbing.ball"),
     glass_row!("two_surface", ".convex"),
     glass_row!("two_surface", ".absorbing.convex"),
+    glass_row!("paper", ".room"),
+    glass_row!("two_surface", ".room"),
+    glass_row!("two_surface", ".absorbing.room"),
+    glass_row!("two_surface", ".ball.room"),
+    glass_row!("two_surface", ".absorbing.ball.room"),
+    glass_row!("two_surface", ".convex.room"),
+    glass_row!("two_surface", ".absorbing.convex.room"),
 ];
+/// Glass models without the room; the same again with it (`ROOM`) follow them.
+pub const GLASS_MODELS: usize = 7;
 /// The static cost of one invocation of each of [`GLASS_FS`]'s entry points.
-pub const GLASS_FS_COST: [[ShaderCost; 4]; 7] = [
+pub const GLASS_FS_COST: [[ShaderCost; 4]; 2 * GLASS_MODELS] = [
     glass_cost_row!("paper", ""),
     glass_cost_row!("two_surface", ""),
     glass_cost_row!("two_surface", ".absorbing"),
@@ -89,6 +98,13 @@ pub const GLASS_FS_COST: [[ShaderCost; 4]; 7] = [
     glass_cost_row!("two_surface", ".absorbing.ball"),
     glass_cost_row!("two_surface", ".convex"),
     glass_cost_row!("two_surface", ".absorbing.convex"),
+    glass_cost_row!("paper", ".room"),
+    glass_cost_row!("two_surface", ".room"),
+    glass_cost_row!("two_surface", ".absorbing.room"),
+    glass_cost_row!("two_surface", ".ball.room"),
+    glass_cost_row!("two_surface", ".absorbing.ball.room"),
+    glass_cost_row!("two_surface", ".convex.room"),
+    glass_cost_row!("two_surface", ".absorbing.convex.room"),
 ];
 pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const BLUR_BLEND_VS: &[u8] = spirv!("blur_blend.vs_main");

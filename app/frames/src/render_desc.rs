@@ -157,5 +157,6 @@ pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> Sc
             gain: &bake.gain,
         }),
         compensation: scene.compensation,
+        room: scene.environment.room,
     }
 }

@@ -304,6 +304,7 @@ fn moving_light_replay_recomputes_the_inducer_only_when_something_moved() {
         progress: false,
         reflection: vitreous_render::Reflection::Phong,
         reference: false,
+        compare_reference: false,
         gaze: Default::default(),
     })
     .expect("replay");

@@ -28,6 +28,7 @@ fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOptions {
         progress: false,
         reflection: vitreous_render::Reflection::Phong,
         reference: false,
+        compare_reference: false,
         gaze: Default::default(),
     }
 }
@@ -268,4 +269,42 @@ fn frames_csv_follows_the_synthetic_traces_alternating_fixation() {
         (s["d_prime"].as_f64().unwrap() - gap / noise).abs() < 1e-3,
         "{s}"
     );
+}
+
+#[test]
+fn compare_reference_measures_every_saved_eye_against_the_physical_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = ReplayOptions {
+        frames: Some(16),
+        compare_reference: true,
+        ..options("glass-sphere-real.toml", None, dir.path())
+    };
+    let summary = replay(&opts).expect("replay succeeds with validation on");
+    // Two saved frames (0 and 15), each eye: its image, preview, reference and seen image.
+    assert_eq!(summary.saved.len(), 2 * 2 * 4, "{:?}", summary.saved);
+    for name in ["000015-left-real.png", "000015-right-seen.png"] {
+        assert!(dir.path().join("frames").join(name).is_file(), "{name}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    let figures = json["compare_reference"].as_array().unwrap();
+    assert_eq!(figures.len(), 4);
+    let flip = |rows: &serde_json::Value, region: &str| {
+        rows.as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["region"] == region)
+            .unwrap()["flip_mean"]
+            .as_f64()
+            .unwrap()
+    };
+    for f in figures {
+        // Away from the ball and its shadow the display adds nothing to the real scene.
+        assert!(flip(&f["regions"], "rest") < 1e-3, "{f}");
+        // In the ball's disc what the display adds brings the eye closer to the real ball than
+        // showing nothing, and no closer than any additive display could.
+        let disc = flip(&f["regions"], "disc");
+        assert!(disc < flip(&f["nothing_drawn"], "disc"), "{f}");
+        assert!(disc >= flip(&f["additive_limit"], "disc"), "{f}");
+    }
 }

@@ -272,10 +272,13 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
     let frames = frames_to_render(&scene, &args)?;
     std::fs::create_dir_all(&out)
         .with_context(|| format!("creating output folder {}", out.display()))?;
-    let photons = PhotonParams {
-        texel_m: args.texel_mm / 1000.0,
-        photons_per_texel: args.photons_per_texel,
-        seed: 0,
+    let settings = ReferenceSettings {
+        samples_per_side: args.samples,
+        photons: PhotonParams {
+            texel_m: args.texel_mm / 1000.0,
+            photons_per_texel: args.photons_per_texel,
+            seed: 0,
+        },
     };
     let progress = if args.quiet {
         ProgressBar::hidden()
@@ -291,43 +294,25 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
     let mut reports = Vec::new();
     for frame in &frames {
         let started = Instant::now();
-        let world = World::of(&scene, &frame.placement).with_context(|| {
-            format!(
-                "{}: the object {} is not a closed solid",
-                scene.path.display(),
-                scene.object.model_path.display()
-            )
-        })?;
-        let floor_light = if world.light_share > 0.0 {
-            FloorLight::trace(&world, &photons)
-        } else {
-            None
-        };
-        let (count, noise) = floor_light
-            .as_ref()
-            .map_or((0, 0.0), |l| (l.photons(), l.noise()));
-        let world = World {
-            floor_light,
-            ..world
-        };
-        let seen = world.without_object();
+        let eyes = args.eye.indices();
+        let rendered = render_reference(
+            &scene,
+            &frame.views,
+            &frame.placement,
+            (width, height),
+            eyes,
+            &settings,
+        )?;
         let mut files = Vec::new();
-        for &eye in args.eye.indices() {
-            let camera = &eye_params(&frame.views[eye]);
-            let whole = Window {
-                x: 0,
-                y: 0,
-                width,
-                height,
-            };
-            for (suffix, w) in [("", &world), ("-seen", &seen)] {
-                let image = render_eye(w, camera, (width, height), whole, args.samples);
+        for (k, &eye) in eyes.iter().enumerate() {
+            for (suffix, image) in [("", &rendered.real[k]), ("-seen", &rendered.seen[k])] {
                 let name = format!("{:06}-{}{suffix}.png", frame.index, EYE_NAMES[eye]);
-                write_png(&out.join(&name), &image)?;
+                write_png(&out.join(&name), image)?;
                 files.push(name);
             }
             progress.inc(1);
         }
+        let (count, noise) = (rendered.photons, rendered.noise);
         reports.push(FrameReport {
             frame: frame.index,
             time_ns: frame.time_ns,
@@ -373,6 +358,87 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
     }
     println!("wrote {}", out.display());
     Ok(())
+}
+
+/// How the physical reference is rendered.
+#[derive(Clone, Copy, Debug)]
+pub struct ReferenceSettings {
+    /// Positions along each side of a pixel averaged for its light.
+    pub samples_per_side: u32,
+    /// How the floor's light is traced.
+    pub photons: PhotonParams,
+}
+
+impl Default for ReferenceSettings {
+    fn default() -> Self {
+        ReferenceSettings {
+            samples_per_side: 3,
+            photons: PhotonParams::default(),
+        }
+    }
+}
+
+/// One frame of the physical reference, for some eyes.
+pub struct ReferenceFrame {
+    /// The real scene with the real object, per eye asked for (linear).
+    pub real: Vec<EyeImage>,
+    /// The real scene with nothing there, per eye asked for (linear).
+    pub seen: Vec<EyeImage>,
+    /// Photons traced for the floor's light (0 without).
+    pub photons: u64,
+    /// Standard error of the floor's light ratio where the object changes it.
+    pub noise: f32,
+}
+
+/// Renders the physical reference of `scene` with its object and light at `placement`, seen
+/// by `eyes` (indices into `views`) at `size`.
+pub fn render_reference(
+    scene: &Scene,
+    views: &[EyeView; 2],
+    placement: &Placement,
+    (width, height): (u32, u32),
+    eyes: &[usize],
+    settings: &ReferenceSettings,
+) -> Result<ReferenceFrame> {
+    let world = World::of(scene, placement).with_context(|| {
+        format!(
+            "{}: the object {} is not a closed solid",
+            scene.path.display(),
+            scene.object.model_path.display()
+        )
+    })?;
+    let floor_light = if world.light_share > 0.0 {
+        FloorLight::trace(&world, &settings.photons)
+    } else {
+        None
+    };
+    let (photons, noise) = floor_light
+        .as_ref()
+        .map_or((0, 0.0), |l| (l.photons(), l.noise()));
+    let world = World {
+        floor_light,
+        ..world
+    };
+    let seen = world.without_object();
+    let whole = Window {
+        x: 0,
+        y: 0,
+        width,
+        height,
+    };
+    let (mut real_images, mut seen_images) = (Vec::new(), Vec::new());
+    for &eye in eyes {
+        let camera = eye_params(&views[eye]);
+        let n = settings.samples_per_side;
+        real_images.push(render_eye(&world, &camera, (width, height), whole, n));
+        seen_images.push(render_eye(&seen, &camera, (width, height), whole, n));
+    }
+    Ok(ReferenceFrame {
+        real: real_images,
+        seen: seen_images,
+        photons,
+        noise,
+    })
 }
 
 /// A frame to render: its index and time, both eyes' cameras and where the object and light are.
@@ -446,9 +512,9 @@ fn frames_to_render(scene: &Scene, args: &ReferenceArgs) -> Result<Vec<Frame>> {
     Ok(frames)
 }
 
-/// Writes a linear eye image as an sRGB PNG.
-fn write_png(path: &Path, image: &EyeImage) -> Result<()> {
-    let rgba: Vec<u8> = image
+/// A linear eye image as sRGB RGBA8.
+pub fn srgb_rgba(image: &EyeImage) -> Vec<u8> {
+    image
         .rgb
         .iter()
         .flat_map(|c| {
@@ -459,7 +525,11 @@ fn write_png(path: &Path, image: &EyeImage) -> Result<()> {
                 255,
             ]
         })
-        .collect();
-    let png = encode_png(&rgba, image.window.width, image.window.height)?;
+        .collect()
+}
+
+/// Writes a linear eye image as an sRGB PNG.
+pub fn write_png(path: &Path, image: &EyeImage) -> Result<()> {
+    let png = encode_png(&srgb_rgba(image), image.window.width, image.window.height)?;
     write_atomic(path, &png)
 }

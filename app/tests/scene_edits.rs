@@ -70,6 +70,7 @@ fn recorded_edits_offset_the_keyframes_and_move_the_scene_once_each() {
         progress: false,
         reflection: vitreous_render::Reflection::Phong,
         reference: false,
+        compare_reference: false,
         gaze: Default::default(),
     })
     .expect("replay");

@@ -223,7 +223,12 @@ impl MotionClock {
         false
     }
 
-    /// The last placement handed out; `None` when nothing ever moved.
+    /// The placement of the last frame posed (`None` while the scene never moved).
+    pub fn last_placement(&self) -> Option<Placement> {
+        self.last_placement
+    }
+
+    /// Where the object and light were in the last frame posed, as `summary.json` gives it.
     pub fn final_placement(&self) -> Option<FinalPlacement> {
         self.last_placement.map(|p| FinalPlacement {
             object_position_m: p.object_position_m.to_array(),

@@ -128,10 +128,7 @@ fn add_light(display: &[u8], seen: &[u8]) -> Vec<u8> {
             .flat_map(|p| [p[0], p[1], p[2], 255])
             .collect()
     };
-    crate::output::see_through(&rgba(display), &rgba(seen))
-        .chunks_exact(4)
-        .flat_map(|p| [p[0], p[1], p[2]])
-        .collect()
+    rgb_of(&crate::output::see_through(&rgba(display), &rgba(seen)))
 }
 
 /// Most pixels an image may have (as the scene loader's images).
@@ -208,6 +205,51 @@ pub fn compare(
         }
     }
     (error, out)
+}
+
+/// The figures of one eye of one frame against the physical reference: what the eye sees with
+/// the display's light over the seen image, the seen image itself, and the additive limit.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReferenceFigures {
+    /// Frame index.
+    pub frame: u64,
+    /// `left` or `right`.
+    pub eye: &'static str,
+    /// The display's light over the seen image, whole view then each region.
+    pub regions: Vec<RegionFigures>,
+    /// The seen image (nothing drawn).
+    pub nothing_drawn: Vec<RegionFigures>,
+    /// The additive limit, max(seen, reference).
+    pub additive_limit: Vec<RegionFigures>,
+}
+
+/// Measures `display` (RGB8, the display's light) over `seen` (RGB8, what the eye sees with
+/// nothing drawn) against `real` (RGB8, the physical reference), region by region for `view`
+/// with the object and light at `placement`, at the scene's pixels per degree.
+pub fn against_reference(
+    scene: &vitreous_scene::Scene,
+    view: &vitreous_xr::frame::EyeView,
+    placement: &vitreous_scene::Placement,
+    images: [&[u8]; 3],
+    (w, h): (u32, u32),
+) -> [Vec<RegionFigures>; 3] {
+    let [real, seen, display] = images;
+    let fov = scene.output.fov;
+    let ppd = w as f32 / (fov.angle_right_rad - fov.angle_left_rad).to_degrees();
+    let labels = regions_of(scene, view, placement, w, h);
+    let rows = |image: &[u8]| compare(real, image, (w, h), ppd, Some(&labels)).1;
+    [
+        rows(&add_light(display, seen)),
+        rows(seen),
+        rows(&additive_limit(seen, real)),
+    ]
+}
+
+/// RGBA8 pixels without their alpha.
+pub fn rgb_of(rgba: &[u8]) -> Vec<u8> {
+    rgba.chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect()
 }
 
 /// `vitreous compare`.

@@ -72,6 +72,12 @@ pub struct ReplayArgs {
     /// object's bounding sphere is traced).
     #[arg(long)]
     pub reference: bool,
+    /// Also render the physical reference of every saved frame (as `vitreous reference`:
+    /// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`) and report in summary.json ꟻLIP and
+    /// PSNR per region of what the eye sees (the display's light over the seen image) against
+    /// it, beside the seen image's and the additive limit's.
+    #[arg(long)]
+    pub compare_reference: bool,
     /// Gaze image: auto (from the wearer's fixation depth), or forced to surface or
     /// refracted, as the paper's experimenter did; default: the scene's `[gaze] image`.
     #[arg(long, value_name = "IMAGE")]
@@ -122,6 +128,7 @@ pub fn replay_command(a: ReplayArgs) -> Result<()> {
         progress: !a.quiet,
         reflection: a.reflection.into(),
         reference: a.reference,
+        compare_reference: a.compare_reference,
         gaze: GazeSettings {
             filter: a.filter,
             image: a.gaze_image,

@@ -16,6 +16,7 @@ use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{EditRecord, TraceSample};
 
+use crate::compare::{ReferenceFigures, against_reference, rgb_of};
 use crate::effects::EffectSet;
 use crate::frame_log::FrameLog;
 use crate::frame_loop::{self, FramePlan, FrameSink};
@@ -23,9 +24,10 @@ pub use crate::look::GazeSettings;
 use crate::look::LookPlanner;
 use crate::motion_clock::MotionClock;
 use crate::output::{self, write_atomic};
+use crate::reference_cmd::{ReferenceSettings, render_reference, srgb_rgba};
 use crate::reference_view::side_by_side;
 use crate::render_desc;
-use crate::scene::{Scene, load_scene};
+use crate::scene::{Placement, Scene, load_scene};
 use crate::setup::{check_size, load_trace_with_edits};
 use crate::spread::Spread;
 use crate::validation::ValidationSummary;
@@ -69,6 +71,9 @@ pub struct ReplayOptions {
     pub reflection: Reflection,
     /// Also write each saved eye image beside the CPU reference of its refraction layer.
     pub reference: bool,
+    /// Also render the physical reference of every saved frame (`vitreous reference`) and
+    /// measure what the eye sees against it.
+    pub compare_reference: bool,
     /// Depth filter and gaze-image override of the gaze pipeline (used with defocus).
     pub gaze: GazeSettings,
 }
@@ -96,6 +101,72 @@ struct Saver<'a> {
     motion: MotionClock,
     /// The trace's scene edits not yet applied, in time order.
     edits: std::collections::VecDeque<EditRecord>,
+    /// With `--compare-reference`: the physical reference of each saved frame.
+    physical: Option<Physical>,
+}
+
+/// `--compare-reference`: the saved frames' placements until they finish, and the figures.
+struct Physical {
+    /// The scene, with its caustic bake read when it has one (the caustic is a region).
+    scene: Scene,
+    /// Saved frames in flight: index and where the object and light were.
+    pending: Vec<(u64, Placement)>,
+    /// Each finished saved frame's figures, per eye.
+    figures: Vec<ReferenceFigures>,
+}
+
+impl Physical {
+    /// Renders the reference of saved frame `input`, writes it and what the eye sees with
+    /// nothing drawn into `dir`, and measures the frame's display light over that against it;
+    /// returns the files written.
+    fn measure(
+        &mut self,
+        dir: &Path,
+        input: &FrameInput,
+        readback: &vitreous_render::Readback,
+    ) -> Result<Vec<String>> {
+        let Some(k) = self.pending.iter().position(|p| p.0 == input.index) else {
+            return Ok(Vec::new());
+        };
+        let (_, placement) = self.pending.swap_remove(k);
+        let size = (readback.width, readback.height);
+        let frame = render_reference(
+            &self.scene,
+            &input.views,
+            &placement,
+            size,
+            &[0, 1],
+            &ReferenceSettings::default(),
+        )?;
+        let mut files = Vec::new();
+        for (eye, name) in output::EYE_NAMES.iter().enumerate() {
+            let real = srgb_rgba(&frame.real[eye]);
+            let seen = srgb_rgba(&frame.seen[eye]);
+            for (suffix, image) in [("-real", &real), ("-seen", &seen)] {
+                let file = format!("{:06}-{name}{suffix}.png", input.index);
+                write_atomic(
+                    &dir.join(&file),
+                    &output::encode_png(image, size.0, size.1)?,
+                )?;
+                files.push(format!("frames/{file}"));
+            }
+            let [regions, nothing_drawn, additive_limit] = against_reference(
+                &self.scene,
+                &input.views[eye],
+                &placement,
+                [&rgb_of(&real), &rgb_of(&seen), &rgb_of(&readback.eyes[eye])],
+                size,
+            );
+            self.figures.push(ReferenceFigures {
+                frame: input.index,
+                eye: name,
+                regions,
+                nothing_drawn,
+                additive_limit,
+            });
+        }
+        Ok(files)
+    }
 }
 
 /// A second renderer with the scene under the refraction model the scene does not use, for
@@ -160,6 +231,13 @@ impl FrameSink for Saver<'_> {
         if save && let Some(other) = &mut self.other {
             other.pending.push((input.index, look, other.pose));
         }
+        if save && let Some(physical) = &mut self.physical {
+            let placement = self
+                .motion
+                .last_placement()
+                .unwrap_or_else(|| physical.scene.rest_placement());
+            physical.pending.push((input.index, placement));
+        }
         if let Err(e) = self
             .log
             .record(input, &self.condition, self.planner.last_defocus())
@@ -188,6 +266,10 @@ impl FrameSink for Saver<'_> {
             let names = output::write_frame(&self.dir, input.index, readback)?;
             self.saved
                 .extend(names.into_iter().map(|n| format!("frames/{n}")));
+            if let Some(physical) = &mut self.physical {
+                let files = physical.measure(&self.dir, input, readback)?;
+                self.saved.extend(files);
+            }
             if let Some(scene) = self.reference {
                 let size = (readback.width, readback.height);
                 let other = match &mut self.other {
@@ -354,6 +436,19 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         log_error: None,
         motion: MotionClock::new(&scene),
         edits: edits.into(),
+        physical: options.compare_reference.then(|| {
+            let mut scene = scene.clone();
+            if scene.caustics.bake.is_some()
+                && let Err(e) = scene.load_caustics()
+            {
+                tracing::warn!("the caustic is left out of the compared regions: {e}");
+            }
+            Physical {
+                scene,
+                pending: Vec::new(),
+                figures: Vec::new(),
+            }
+        }),
     };
     let started = Instant::now();
     let records = match frame_loop::run(&mut backend, &mut renderer, &mut saver) {
@@ -410,6 +505,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         inducer_computations: renderer.inducer_computations(),
         scene_edits: saver.motion.edit_count,
         final_placement: saver.motion.final_placement(),
+        compare_reference: saver.physical.map(|p| p.figures),
         per_frame: records,
     };
     let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;
@@ -477,7 +573,8 @@ fn remove_earlier_frames(frames_dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// `NNNNNN-left.png`, `NNNNNN-right-preview.png`, `NNNNNN-left-reference.png`, ... or a
+/// `NNNNNN-left.png`, `NNNNNN-right-preview.png`, `NNNNNN-left-reference.png`,
+/// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`, ... or a
 /// temporary file of an atomic write.
 fn is_replay_file_name(name: &str) -> bool {
     if name.starts_with(".vitreous-") && name.ends_with(".partial") {
@@ -492,7 +589,7 @@ fn is_replay_file_name(name: &str) -> bool {
     digits.len() >= 6
         && digits.bytes().all(|b| b.is_ascii_digit())
         && ["left", "right"].iter().any(|eye| {
-            ["", "-preview", "-reference"]
+            ["", "-preview", "-reference", "-real", "-seen"]
                 .iter()
                 .any(|k| rest == format!("{eye}{k}"))
         })
@@ -508,6 +605,8 @@ mod tests {
             "000000-left.png",
             "000030-right-preview.png",
             "000060-left-reference.png",
+            "000060-left-real.png",
+            "000060-right-seen.png",
             "1234567-right.png",
             ".vitreous-abc123.partial",
         ] {

@@ -101,6 +101,9 @@ pub struct ReplaySummary {
     pub scene_edits: u64,
     /// Where the object and light were in the last frame (`null` when nothing moved).
     pub final_placement: Option<FinalPlacement>,
+    /// With `--compare-reference`: each saved frame's eyes measured against the physical
+    /// reference (`null` without).
+    pub compare_reference: Option<Vec<crate::compare::ReferenceFigures>>,
     /// Every frame's timing.
     pub per_frame: Vec<FrameRecord>,
 }

@@ -11,7 +11,7 @@ pub mod compare;
 pub mod error_report;
 pub mod font;
 pub use vitreous_frames::{
-    blur_stack, conditions, defocus_model, director, frame_log, frame_loop, interrupt, look,
+    blur_stack, conditions, defocus_model, director, focus, frame_log, frame_loop, interrupt, look,
     motion_clock, output, reference_view, render_desc, scene_edit, setup, spread, test_frame,
     validation,
 };

@@ -1,11 +1,10 @@
 //! eq. 15 through the whole pipeline: tracker samples, not frames, are averaged.
 
-use glam::Vec3;
 use proptest::prelude::*;
 use vitreous::gaze::{
     FilterKind, FixationDepth, GazeConfig, GazePipeline, ImageDistances, SampleFilter,
 };
-use vitreous_xr::{GazeRay, GazeSample};
+use vitreous_xr::GazeSample;
 
 /// eq. 15 as printed: the mean of the 20 depths ending at index `n` (n >= 19).
 fn eq15(depths: &[f64], n: usize) -> f64 {
@@ -13,21 +12,7 @@ fn eq15(depths: &[f64], n: usize) -> f64 {
 }
 
 fn looking_at(time_ns: i64, depth_m: f32) -> GazeSample {
-    let target = Vec3::new(0.0, 0.0, -depth_m);
-    let eye = |x: f32| GazeRay {
-        origin: Vec3::new(x, 0.0, 0.0),
-        direction: (target - Vec3::new(x, 0.0, 0.0)).normalize(),
-        valid: true,
-    };
-    GazeSample {
-        sample_time_ns: time_ns,
-        left: eye(-0.0315),
-        right: eye(0.0315),
-        combined: None,
-        fixation: None,
-        pupil_diameter_m: [None, None],
-        report: None,
-    }
+    vitreous::test_frame::sample_looking_at(time_ns, depth_m)
 }
 
 proptest! {

@@ -122,3 +122,20 @@ fn display_compensation_is_read_and_an_unknown_one_names_the_field() {
     );
     assert!(msg.contains("\"none\" or \"background\""), "{msg}");
 }
+
+#[test]
+fn the_global_dimmer_is_a_level_from_0_to_1_or_not_asked_for() {
+    let (_dir, _path, scene) = load_text(&good_text());
+    assert_eq!(scene.unwrap().global_dimmer, None);
+    let text = format!("{}\n[display]\nglobal_dimmer = 0.25\n", good_text());
+    let (_dir, _path, scene) = load_text(&text);
+    assert_eq!(scene.unwrap().global_dimmer, Some(0.25));
+    for bad in ["1.5", "-0.1", "nan"] {
+        let text = format!("{}\n[display]\nglobal_dimmer = {bad}\n", good_text());
+        expect_error(
+            &text,
+            line_of(&text, "global_dimmer ="),
+            "display.global_dimmer",
+        );
+    }
+}

@@ -528,7 +528,7 @@ mod tests {
         for (position, variant) in GlassVariant::ALL.iter().enumerate() {
             assert_eq!(variant.index(), position);
             for model in 0..shaders::GLASS_FS.len() {
-                let prefix = if model == 0 {
+                let prefix = if model % shaders::GLASS_MODELS == 0 {
                     "fs_paper_"
                 } else {
                     "fs_two_surface_"

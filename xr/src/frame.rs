@@ -240,6 +240,11 @@ pub trait Backend {
     /// Tells the backend the frame handed out by the last `wait_frame` has been rendered.
     fn end_frame(&mut self, frame: &FrameInput) -> Result<(), Self::Error>;
 
+    /// What the app asks of the display for the frame handed out by the last `wait_frame`,
+    /// beyond its images, given before [`Backend::end_frame`]: backends whose display has no
+    /// such controls keep the default, which ignores it.
+    fn set_frame_end_hints(&mut self, _hints: FrameEndHints) {}
+
     /// Leaves the frame handed out by the last `wait_frame` without showing it, when the app
     /// failed before [`Backend::end_frame`]: whatever the frame holds (display images, the
     /// begun frame) is given back. Never fails: clean-up errors are the backend's to log, so
@@ -252,6 +257,18 @@ pub trait Backend {
     fn frame_target(&self) -> FrameTarget {
         FrameTarget::Own
     }
+}
+
+/// What the app asks of the display for one frame beyond its images (headset extensions; see
+/// [`Backend::set_frame_end_hints`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameEndHints {
+    /// The wearer's filtered fixation depth, metres: where a display with a movable focus
+    /// (reprojection) plane puts it (Magic Leap 2: `XrFrameEndInfoML::focusDistance`).
+    pub focus_distance_m: Option<f32>,
+    /// How much to darken the whole view, 0 none to 1 the most (Magic Leap 2:
+    /// `XrGlobalDimmerFrameEndInfoML`); `None`: the app does not ask.
+    pub global_dimmer: Option<f32>,
 }
 
 /// Where a frame is drawn (see [`Backend::frame_target`]).

@@ -18,8 +18,8 @@ pub mod synth;
 pub mod trace;
 
 pub use frame::{
-    Backend, Blend, EyeView, Fov, FrameInput, FrameTarget, GazeBehaviour, GazeRay, GazeSample,
-    Pose, TrackerConfidence, TrackerReport,
+    Backend, Blend, EyeView, Fov, FrameEndHints, FrameInput, FrameTarget, GazeBehaviour, GazeRay,
+    GazeSample, Pose, TrackerConfidence, TrackerReport,
 };
 pub use null::{NullBackend, NullConfig, NullError};
 pub use trace::{TraceError, TraceReader, TraceSample, TraceWriter, read_trace};

@@ -10,7 +10,7 @@ use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{Composition, Look, Renderer, ScenePose};
 use vitreous_xr::openxr::Blend;
-use vitreous_xr::{Backend, FrameInput, FrameTarget};
+use vitreous_xr::{Backend, FrameEndHints, FrameInput, FrameTarget};
 
 use crate::render_desc;
 
@@ -38,6 +38,12 @@ pub trait FrameSink {
 
     /// How to draw this frame and what to read back of it.
     fn plan(&mut self, input: &FrameInput) -> FramePlan;
+
+    /// What to ask of the display for this frame beyond its images (called after
+    /// [`FrameSink::plan`], before the backend ends the frame): none by default.
+    fn frame_end_hints(&mut self, _input: &FrameInput) -> FrameEndHints {
+        FrameEndHints::default()
+    }
 
     /// Handles a finished frame (its input and its results), in frame order.
     fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()>;
@@ -91,6 +97,7 @@ pub fn run<B: Backend>(
                 return Err(e);
             }
         };
+        backend.set_frame_end_hints(sink.frame_end_hints(&input));
         backend.end_frame(&input).context("ending a frame")?;
         in_flight.push_back((input, prepare_ms, plan.look));
         if let Some(result) = done {

@@ -15,6 +15,7 @@
 //! | [`render_desc`] | a loaded scene and a backend's views as the renderer's descriptions |
 //! | [`motion_clock`] | frame times to the scene's poses, with the live edits |
 //! | [`scene_edit`] | the live edits: moving, turning and placing the glass, the light, the floor |
+//! | [`focus`] | the filtered fixation depth a headset's focus plane follows |
 //! | [`director`] | who decides each frame's condition and gaze image: the user, or a study |
 //! | [`conditions`] | the effect conditions a live run cycles through, and its live commands |
 //! | [`frame_log`] | `frames.csv`: each frame's defocus decision |
@@ -24,12 +25,13 @@
 //! | [`validation`] | what the Vulkan validation layers reported |
 //! | [`spread`] | the median and spread of a timing |
 //! | [`interrupt`] | Ctrl-C and SIGTERM end a headless run after the current frame |
-//! | [`test_frame`] | a frame input for tests |
+//! | [`test_frame`] | frame inputs for tests |
 
 pub mod blur_stack;
 pub mod conditions;
 pub mod defocus_model;
 pub mod director;
+pub mod focus;
 pub mod frame_log;
 pub mod frame_loop;
 pub mod interrupt;

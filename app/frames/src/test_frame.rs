@@ -18,3 +18,40 @@ pub fn test_frame() -> FrameInput {
         gaze: None,
     }
 }
+
+/// A tracker sample taken at `time_ns` with both eyes (63 mm apart, identity head) fixating
+/// the point `depth_m` straight ahead.
+pub fn sample_looking_at(time_ns: i64, depth_m: f32) -> vitreous_xr::GazeSample {
+    use glam::Vec3;
+    use vitreous_xr::{GazeRay, GazeSample};
+    let target = Vec3::new(0.0, 0.0, -depth_m);
+    let eye = |x: f32| {
+        let origin = Vec3::new(x, 0.0, 0.0);
+        GazeRay {
+            origin,
+            direction: (target - origin).normalize(),
+            valid: true,
+        }
+    };
+    GazeSample {
+        sample_time_ns: time_ns,
+        left: eye(-0.0315),
+        right: eye(0.0315),
+        combined: None,
+        fixation: None,
+        pupil_diameter_m: [None, None],
+        report: None,
+    }
+}
+
+/// Frame `index` at 60 Hz (identity head) whose gaze sample, taken at the frame's time, has
+/// both eyes fixating the point `depth_m` straight ahead ([`sample_looking_at`]).
+pub fn frame_fixating(index: u64, depth_m: f32) -> FrameInput {
+    let time_ns = 1_000_000_000 + index as i64 * 16_666_667;
+    FrameInput {
+        index,
+        time_ns,
+        gaze: Some(sample_looking_at(time_ns, depth_m)),
+        ..test_frame()
+    }
+}

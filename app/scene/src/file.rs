@@ -39,6 +39,7 @@ pub(crate) struct SceneFile {
 #[serde(deny_unknown_fields)]
 pub(crate) struct DisplayToml {
     pub compensation: Option<Spanned<String>>,
+    pub global_dimmer: Option<Spanned<f32>>,
 }
 
 /// `[motion]`: keyframes of the object and the light.

@@ -92,6 +92,9 @@ pub struct Scene {
     /// (the paper's), or the real floor or background the eye already sees (eq. 6 over the
     /// glass).
     pub compensation: vitreous_render::Compensation,
+    /// How much the headset's global dimmer darkens the whole view (`[display] global_dimmer`,
+    /// 0 none to 1 the most; Magic Leap 2's `XR_ML_global_dimmer`), when the scene asks for it.
+    pub global_dimmer: Option<f32>,
     /// The shadow inducer's parameters.
     pub inducer: Inducer,
     /// The caustic bake (eq. 6): where it is and, once [`Scene::load_caustics`] ran, its

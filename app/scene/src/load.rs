@@ -429,6 +429,16 @@ impl Loader<'_> {
             },
         };
 
+        let global_dimmer = match &raw.display.global_dimmer {
+            None => None,
+            Some(v) => Some(self.number(
+                "display.global_dimmer",
+                Some(v),
+                0.0,
+                (0.0, 1.0),
+                (false, false),
+            )?),
+        };
         let hash = self
             .hasher
             .finalize()
@@ -464,6 +474,7 @@ impl Loader<'_> {
             inducer,
             gaze,
             compensation,
+            global_dimmer,
             caustics,
             warnings,
             motion,

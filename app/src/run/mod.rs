@@ -37,13 +37,13 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, Reflection, Renderer};
-use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::ash::vk;
 use vitreous_xr::openxr::{
     Blend, Command, DepthOptions, GazeChoice, GazeSource, OpenXrOptions, Runtime, SessionOptions,
     SessionReport, State,
 };
 use vitreous_xr::trace::{TraceVersion, TraceWriter};
+use vitreous_xr::{FrameEndHints, FrameInput};
 
 pub use crate::conditions::{
     CONDITION_CYCLE, GAZE_IMAGE_CYCLE, LiveConditions, STUDY_CONDITIONS, live_conditions,
@@ -60,6 +60,7 @@ pub use summary::{GazeSamples, RunSummary};
 
 use crate::director::Director;
 use crate::effects::EffectSet;
+use crate::focus::FocusFollower;
 use crate::frame_log::FrameLog;
 use crate::frame_loop::{self, FramePlan, FrameSink};
 use crate::look::{GazeSettings, planners_for};
@@ -146,6 +147,12 @@ struct RunSink<'d> {
     edits: Option<std::sync::mpsc::Receiver<SceneEdit>>,
     /// Where re-registrations go: the session, which moves the scene's placement.
     registrar: std::sync::mpsc::Sender<Command>,
+    /// The wearer's filtered fixation depth, which the display's focus plane follows.
+    focus: FocusFollower,
+    /// This frame's filtered fixation depth, metres.
+    focus_m: Option<f32>,
+    /// The scene's global dimmer level (`[display] global_dimmer`).
+    global_dimmer: Option<f32>,
 }
 
 impl FrameSink for RunSink<'_> {
@@ -186,6 +193,7 @@ impl FrameSink for RunSink<'_> {
             None => self.looks.plan(input),
         };
         look.caustics &= self.motion.caustics_valid();
+        self.focus_m = self.focus.update(input);
         let condition = self.looks.condition().to_string();
         if let Err(e) = self
             .log
@@ -199,6 +207,13 @@ impl FrameSink for RunSink<'_> {
                 eyes: read,
                 world: read,
             },
+        }
+    }
+
+    fn frame_end_hints(&mut self, _input: &FrameInput) -> FrameEndHints {
+        FrameEndHints {
+            focus_distance_m: self.focus_m,
+            global_dimmer: self.global_dimmer,
         }
     }
 
@@ -393,6 +408,9 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         log,
         log_error: None,
         director,
+        focus: FocusFollower::new(&scene, options.filter),
+        focus_m: None,
+        global_dimmer: scene.global_dimmer,
     };
     let started = Instant::now();
     let (session, renderer) = xr.parts();
@@ -482,6 +500,9 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             .depth_format
             .map(|f| format!("{:?}", vk::Format::from_raw(f))),
         frames_with_depth: report.frames_with_depth,
+        frames_with_focus_distance: report.frames_with_focus_distance,
+        last_focus_distance_m: report.last_focus_distance_m,
+        frames_with_global_dimmer: report.frames_with_global_dimmer,
         gaze_image_switches: sink.log.gaze_image_switches(),
         separability: sink.log.separability_summary(),
         pupil: sink.log.pupil_summary(sink.looks.pupil_source()),

@@ -100,6 +100,14 @@ pub struct RunSummary {
     pub depth_format: Option<String>,
     /// Frames submitted with depth.
     pub frames_with_depth: u64,
+    /// Frames submitted with `XrFrameEndInfoML` (XR_ML_frame_end_info): the focus plane at the
+    /// wearer's filtered fixation depth.
+    pub frames_with_focus_distance: u64,
+    /// The last focus distance submitted, metres (`null`: none).
+    pub last_focus_distance_m: Option<f32>,
+    /// Frames submitted with `XrGlobalDimmerFrameEndInfoML` (XR_ML_global_dimmer, the scene's
+    /// `[display] global_dimmer`).
+    pub frames_with_global_dimmer: u64,
     /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
     pub gaze_image_switches: u64,
     /// How far apart the two images are in the tracker's vergence noise, the noise estimated

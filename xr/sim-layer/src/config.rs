@@ -10,6 +10,8 @@
 //! - `VITREOUS_SIM_BUTTONS`: a script of controller button presses (`crate::controller`).
 //! - `VITREOUS_SIM_EYE_MAX`: `WxH`, the largest eye image the headset offers (each view's
 //!   recommended and largest image rectangle are clamped to it).
+//! - `VITREOUS_SIM_ML_FRAME`: `1` to offer Magic Leap 2's frame controls (XR_ML_frame_end_info,
+//!   XR_ML_global_dimmer): what the app chains to `xrEndFrame` is recorded, not passed on.
 
 use std::ffi::CStr;
 use std::fmt;
@@ -29,6 +31,9 @@ pub const SUBMITTED_VAR: &str = "VITREOUS_SIM_SUBMITTED";
 pub const BUTTONS_VAR: &str = "VITREOUS_SIM_BUTTONS";
 /// Environment variable giving the largest eye image, `WxH` pixels.
 pub const EYE_MAX_VAR: &str = "VITREOUS_SIM_EYE_MAX";
+/// Whether the layer offers Magic Leap 2's frame controls, XR_ML_frame_end_info and
+/// XR_ML_global_dimmer (`1` or `0`; unset: not).
+pub const ML_FRAME_VAR: &str = "VITREOUS_SIM_ML_FRAME";
 /// The sides `VITREOUS_SIM_EYE_MAX` takes, pixels.
 pub const EYE_MAX_RANGE: std::ops::RangeInclusive<u32> = 16..=16384;
 
@@ -116,6 +121,9 @@ pub struct Config {
     pub buttons: Option<PathBuf>,
     /// The largest eye image offered, width and height in pixels (`None`: the runtime's).
     pub eye_max: Option<(u32, u32)>,
+    /// XR_ML_frame_end_info and XR_ML_global_dimmer are the layer's: taken out of the
+    /// instance's extensions and each frame's `XrFrameEndInfo` chain, and recorded.
+    pub ml_frame: bool,
 }
 
 impl Config {
@@ -135,6 +143,17 @@ impl Config {
             submitted: get(SUBMITTED_VAR).map(PathBuf::from),
             buttons: get(BUTTONS_VAR).map(PathBuf::from),
             eye_max: get(EYE_MAX_VAR).map(|v| parse_eye_max(&v)).transpose()?,
+            ml_frame: match get(ML_FRAME_VAR).as_deref().map(str::trim) {
+                None | Some("0") => false,
+                Some("1") => true,
+                Some(other) => {
+                    return Err(ConfigError {
+                        var: ML_FRAME_VAR,
+                        value: other.to_owned(),
+                        expected: "1 (offer XR_ML_frame_end_info and XR_ML_global_dimmer) or 0",
+                    });
+                }
+            },
         })
     }
 

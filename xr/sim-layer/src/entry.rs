@@ -182,7 +182,7 @@ unsafe extern "system" fn create_api_layer_instance(
                 (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) })
             })
             .collect();
-        let split = extensions::split(&names, &prepared.config.gaze);
+        let split = extensions::split(&names, &prepared.config.gaze, prepared.config.ml_frame);
         // The layer's extensions it does not offer go on to the runtime, which may have them
         // (Monado lists XR_EXT_eye_gaze_interaction) or refuses them.
         let forwarded: Vec<*const c_char> = split.forwarded.iter().map(|n| n.as_ptr()).collect();

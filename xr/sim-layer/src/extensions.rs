@@ -6,6 +6,9 @@ use std::ffi::CStr;
 
 use crate::config::GazeExtension;
 
+/// Magic Leap 2's frame controls, which the layer owns with `VITREOUS_SIM_ML_FRAME=1`.
+pub const ML_FRAME_EXTENSIONS: [&CStr; 2] = [c"XR_ML_frame_end_info", c"XR_ML_global_dimmer"];
+
 /// The result of [`split`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Split<'a> {
@@ -18,16 +21,19 @@ pub struct Split<'a> {
     pub not_offered: Vec<GazeExtension>,
 }
 
-/// Splits `enabled` into what the layer handles (those in `offered`) and what goes on.
-/// An extension of the layer that is not offered is reported in `not_offered` and also
-/// passed on (the runtime may have it).
-pub fn split<'a>(enabled: &[&'a CStr], offered: &[GazeExtension]) -> Split<'a> {
+/// Splits `enabled` into what the layer handles (those in `offered`, and the ML frame
+/// controls when `ml_frame`) and what goes on. An eye extension of the layer that is not
+/// offered is reported in `not_offered` and also passed on (the runtime may have it).
+pub fn split<'a>(enabled: &[&'a CStr], offered: &[GazeExtension], ml_frame: bool) -> Split<'a> {
     let mut out = Split {
         forwarded: Vec::with_capacity(enabled.len()),
         owned: Vec::new(),
         not_offered: Vec::new(),
     };
     for &name in enabled {
+        if ml_frame && ML_FRAME_EXTENSIONS.contains(&name) {
+            continue;
+        }
         match GazeExtension::from_name(name) {
             Some(ext) if offered.contains(&ext) => {
                 if !out.owned.contains(&ext) {
@@ -60,7 +66,7 @@ mod tests {
             c"XR_FB_eye_tracking_social",
             c"XR_EXT_eye_gaze_interaction",
         ];
-        let s = split(&enabled, &GazeExtension::ALL);
+        let s = split(&enabled, &GazeExtension::ALL, false);
         assert_eq!(
             s.forwarded,
             vec![c"XR_KHR_vulkan_enable2", c"XR_KHR_composition_layer_depth"]
@@ -70,9 +76,22 @@ mod tests {
     }
 
     #[test]
+    fn the_ml_frame_controls_stay_with_the_layer_only_when_it_offers_them() {
+        let enabled = [
+            c"XR_ML_frame_end_info",
+            c"XR_KHR_vulkan_enable2",
+            c"XR_ML_global_dimmer",
+        ];
+        let s = split(&enabled, &[], true);
+        assert_eq!(s.forwarded, vec![c"XR_KHR_vulkan_enable2"]);
+        let s = split(&enabled, &[], false);
+        assert_eq!(s.forwarded, enabled.to_vec());
+    }
+
+    #[test]
     fn extensions_not_offered_are_passed_on_and_reported() {
         let enabled = [c"XR_ML_eye_tracker", c"XR_EXT_eye_gaze_interaction"];
-        let s = split(&enabled, &[Ext]);
+        let s = split(&enabled, &[Ext], false);
         assert_eq!(s.forwarded, vec![c"XR_ML_eye_tracker"]);
         assert_eq!(s.owned, vec![Ext]);
         assert_eq!(s.not_offered, vec![Ml]);
@@ -80,7 +99,7 @@ mod tests {
 
     #[test]
     fn nothing_enabled_gives_nothing() {
-        let s = split(&[], &GazeExtension::ALL);
+        let s = split(&[], &GazeExtension::ALL, false);
         assert!(s.forwarded.is_empty() && s.owned.is_empty());
     }
 }

@@ -3,14 +3,18 @@
 //! what the app submitted even if the session dies.
 //!
 //! ```text
-//! frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend
-//! 0,1234567890,additive,1,projection,0x0,opaque
+//! frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend,focus_distance_m,global_dimmer
+//! 0,1234567890,additive,1,projection,0x0,opaque,1.5,0.25
 //! ```
 //!
 //! `frame` counts the session's `xrEndFrame` calls from 0; `blend` is the app's
 //! `environmentBlendMode`, `runtime_blend` the one forwarded to the runtime; `layer_types`
 //! and `layer_flags` (hexadecimal `XrCompositionLayerFlags`) hold one entry per layer,
-//! `;`-separated, in submission order.
+//! `;`-separated, in submission order. `focus_distance_m` is the `XrFrameEndInfoML` and
+//! `global_dimmer` the `XrGlobalDimmerFrameEndInfoML` the app chained to `XrFrameEndInfo`
+//! (Magic Leap 2's XR_ML_frame_end_info and XR_ML_global_dimmer, offered with
+//! `VITREOUS_SIM_ML_FRAME=1`); empty when the frame had none (the dimmer also when its ENABLED
+//! flag was off).
 
 use std::fs::File;
 use std::io::{self, Write};
@@ -21,7 +25,7 @@ use openxr::sys;
 use crate::blend;
 
 /// The header line.
-pub const HEADER: &str = "frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend";
+pub const HEADER: &str = "frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend,focus_distance_m,global_dimmer";
 
 /// One submitted composition layer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,7 +37,7 @@ pub struct LayerInfo {
 }
 
 /// One submitted frame.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct FrameInfo {
     /// Index of the frame in its session.
     pub frame: u64,
@@ -45,6 +49,10 @@ pub struct FrameInfo {
     pub runtime_blend: sys::EnvironmentBlendMode,
     /// The layers.
     pub layers: Vec<LayerInfo>,
+    /// The focus distance chained (`XrFrameEndInfoML`), metres.
+    pub focus_distance_m: Option<f32>,
+    /// The global dimmer chained and enabled (`XrGlobalDimmerFrameEndInfoML`), 0..=1.
+    pub global_dimmer: Option<f32>,
 }
 
 /// A short name for a composition layer type.
@@ -66,15 +74,18 @@ fn layer_type_name(ty: sys::StructureType) -> String {
 pub fn line(f: &FrameInfo) -> String {
     let types: Vec<String> = f.layers.iter().map(|l| layer_type_name(l.ty)).collect();
     let flags: Vec<String> = f.layers.iter().map(|l| format!("{:#x}", l.flags)).collect();
+    let optional = |v: Option<f32>| v.map_or(String::new(), |v| v.to_string());
     format!(
-        "{},{},{},{},{},{},{}\n",
+        "{},{},{},{},{},{},{},{},{}\n",
         f.frame,
         f.display_time_ns,
         blend::name(f.blend),
         f.layers.len(),
         types.join(";"),
         flags.join(";"),
-        blend::name(f.runtime_blend)
+        blend::name(f.runtime_blend),
+        optional(f.focus_distance_m),
+        optional(f.global_dimmer)
     )
 }
 
@@ -121,16 +132,20 @@ mod tests {
                     flags: 0,
                 },
             ],
+            focus_distance_m: None,
+            global_dimmer: None,
         };
         assert_eq!(
             line(&f),
-            "3,42,alpha_blend,2,projection;quad,0x3;0x0,opaque\n"
+            "3,42,alpha_blend,2,projection;quad,0x3;0x0,opaque,,\n"
         );
         let empty = FrameInfo {
             layers: vec![],
+            focus_distance_m: Some(1.25),
+            global_dimmer: Some(0.5),
             ..f
         };
-        assert_eq!(line(&empty), "3,42,alpha_blend,0,,,opaque\n");
+        assert_eq!(line(&empty), "3,42,alpha_blend,0,,,opaque,1.25,0.5\n");
     }
 
     #[test]
@@ -147,13 +162,15 @@ mod tests {
                 ty: sys::StructureType::COMPOSITION_LAYER_PROJECTION,
                 flags: 0x2,
             }],
+            focus_distance_m: None,
+            global_dimmer: None,
         };
         log.write(&f).unwrap();
         // Read while the log is still open: the line is already there.
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(
             text,
-            format!("{HEADER}\n0,1,additive,1,projection,0x2,opaque\n")
+            format!("{HEADER}\n0,1,additive,1,projection,0x2,opaque,,\n")
         );
     }
 }

@@ -110,6 +110,10 @@ pub struct Runtime {
     fb_gaze: bool,
     /// XR_ML_eye_tracker is enabled.
     ml_gaze: bool,
+    /// XR_ML_frame_end_info is enabled: the focus distance is submitted with every frame.
+    ml_frame_end: bool,
+    /// XR_ML_global_dimmer is enabled: the global dimmer is submitted when asked for.
+    ml_dimmer: bool,
     /// The Vulkan instance made through the runtime, for the device steps.
     vk_instance: Option<vk::Instance>,
 }
@@ -131,6 +135,9 @@ impl Runtime {
         wanted.ext_eye_gaze_interaction = available.ext_eye_gaze_interaction;
         wanted.fb_eye_tracking_social = available.fb_eye_tracking_social;
         wanted.khr_composition_layer_depth = available.khr_composition_layer_depth;
+        // Magic Leap 2's frame controls: the focus plane and the global dimmer.
+        wanted.ml_frame_end_info = available.ml_frame_end_info;
+        wanted.ml_global_dimmer = available.ml_global_dimmer;
         // XR_ML_eye_tracker is unknown to the `openxr` crate: enabled by name when listed.
         let ml_name = ml_extension_name();
         let ml_gaze = available.other.contains(&ml_name);
@@ -277,6 +284,8 @@ impl Runtime {
             ext_gaze: wanted.ext_eye_gaze_interaction,
             fb_gaze: wanted.fb_eye_tracking_social,
             ml_gaze,
+            ml_frame_end: wanted.ml_frame_end_info,
+            ml_dimmer: wanted.ml_global_dimmer,
             vk_instance: None,
         })
     }
@@ -572,6 +581,8 @@ fn enabled_names(set: &xr::ExtensionSet) -> Vec<String> {
             set.khr_composition_layer_depth,
             "XR_KHR_composition_layer_depth",
         ),
+        (set.ml_frame_end_info, "XR_ML_frame_end_info"),
+        (set.ml_global_dimmer, "XR_ML_global_dimmer"),
     ] {
         if on {
             names.push(name.to_owned());

@@ -170,7 +170,7 @@ pub unsafe extern "system" fn end_frame(
         let found = {
             let mut reg = registry();
             let added = SessionContext::of(&reg, session.into_raw())
-                .map(|c| (c.next.clone(), c.config.blend.clone()));
+                .map(|c| (c.next.clone(), (c.config.blend.clone(), c.config.ml_frame)));
             let instance_log = reg
                 .session(session.into_raw())
                 .and_then(|(_, i)| i.submitted.clone());
@@ -182,12 +182,22 @@ pub unsafe extern "system" fn end_frame(
                 })
             })
         };
-        let Some((next, added, runtime_blend, frame, log)) = found else {
+        let Some((next, (added, ml_frame), runtime_blend, frame, log)) = found else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the app's structure, null or valid.
         let Some(app) = (unsafe { info.as_ref() }) else {
             return sys::Result::ERROR_VALIDATION_FAILURE;
+        };
+        let controls = if ml_frame {
+            // SAFETY: the app's `next` chain: null or valid structures (xrEndFrame's valid
+            // usage).
+            unsafe { ml_frame_controls(app.next) }
+        } else {
+            MlFrameControls {
+                rest: app.next,
+                ..MlFrameControls::default()
+            }
         };
         let runtime_mode = blend::for_runtime(
             app.environment_blend_mode,
@@ -219,6 +229,8 @@ pub unsafe extern "system" fn end_frame(
                 blend: app.environment_blend_mode,
                 runtime_blend: runtime_mode,
                 layers,
+                focus_distance_m: controls.focus_distance_m,
+                global_dimmer: controls.global_dimmer,
             };
             let mut log = log.lock().unwrap_or_else(|e| e.into_inner());
             if let Err(e) = log.write(&frame_info) {
@@ -227,9 +239,68 @@ pub unsafe extern "system" fn end_frame(
         }
         let mut forwarded = *app;
         forwarded.environment_blend_mode = runtime_mode;
+        forwarded.next = controls.rest;
         // SAFETY: a copy of the app's valid structure, pointing at the app's layers.
         unsafe { (next.end_frame)(session, &forwarded) }
     })
+}
+
+/// What an `XrFrameEndInfo` chain asks of Magic Leap 2's frame controls.
+#[derive(Clone, Copy, Debug)]
+struct MlFrameControls {
+    /// `XrFrameEndInfoML::focusDistance`, metres.
+    focus_distance_m: Option<f32>,
+    /// `XrGlobalDimmerFrameEndInfoML::dimmerValue`, when its ENABLED flag is set.
+    global_dimmer: Option<f32>,
+    /// The chain after the leading run of these structures: what goes on to the runtime.
+    rest: *const std::ffi::c_void,
+}
+
+impl Default for MlFrameControls {
+    fn default() -> Self {
+        MlFrameControls {
+            focus_distance_m: None,
+            global_dimmer: None,
+            rest: std::ptr::null(),
+        }
+    }
+}
+
+/// Reads the frame controls at the head of `chain` and steps past them (structures of these
+/// types further down, behind one the layer does not know, stay: the app's structures cannot be
+/// relinked, and a runtime ignores structures it does not know).
+///
+/// # Safety
+/// `chain` is null or a valid OpenXR structure chain.
+unsafe fn ml_frame_controls(mut chain: *const std::ffi::c_void) -> MlFrameControls {
+    let mut out = MlFrameControls::default();
+    // `chain` is null or a valid structure, which starts with the base header.
+    let header_of =
+        // SAFETY: the function's contract; each `next` of a valid chain is null or valid too.
+        |p: *const std::ffi::c_void| unsafe { (p as *const sys::BaseInStructure).as_ref() };
+    while let Some(header) = header_of(chain) {
+        match header.ty {
+            sys::StructureType::FRAME_END_INFO_ML => {
+                // SAFETY: the header says the structure is an XrFrameEndInfoML.
+                let info = unsafe { &*(chain as *const sys::FrameEndInfoML) };
+                out.focus_distance_m = Some(info.focus_distance);
+            }
+            sys::StructureType::GLOBAL_DIMMER_FRAME_END_INFO_ML => {
+                // SAFETY: the header says the structure is an XrGlobalDimmerFrameEndInfoML.
+                let info = unsafe { &*(chain as *const sys::GlobalDimmerFrameEndInfoML) };
+                if info
+                    .flags
+                    .contains(sys::GlobalDimmerFrameEndInfoFlagsML::ENABLED)
+                {
+                    out.global_dimmer = Some(info.dimmer_value);
+                }
+            }
+            _ => break,
+        }
+        chain = header.next as *const std::ffi::c_void;
+    }
+    out.rest = chain;
+    out
 }
 
 /// `xrCreateReferenceSpace`: passed on; the layer notes the space's session.
@@ -480,5 +551,46 @@ mod tests {
         assert_eq!(gaze_location_flags(valid | F::ORIENTATION_TRACKED), valid);
         assert_eq!(gaze_location_flags(valid | F::POSITION_TRACKED), valid);
         assert_eq!(gaze_location_flags(F::EMPTY), F::EMPTY);
+    }
+
+    #[test]
+    fn the_frame_controls_at_the_head_of_the_chain_are_read_and_stepped_past() {
+        let other = sys::FrameEndInfo {
+            ty: sys::StructureType::FRAME_END_INFO,
+            next: std::ptr::null(),
+            display_time: sys::Time::from_nanos(0),
+            environment_blend_mode: sys::EnvironmentBlendMode::ADDITIVE,
+            layer_count: 0,
+            layers: std::ptr::null(),
+        };
+        let dimmer = sys::GlobalDimmerFrameEndInfoML {
+            ty: sys::GlobalDimmerFrameEndInfoML::TYPE,
+            next: &other as *const sys::FrameEndInfo as *const _,
+            dimmer_value: 0.4,
+            flags: sys::GlobalDimmerFrameEndInfoFlagsML::ENABLED,
+        };
+        let focus = sys::FrameEndInfoML {
+            ty: sys::FrameEndInfoML::TYPE,
+            next: &dimmer as *const sys::GlobalDimmerFrameEndInfoML as *const _,
+            focus_distance: 1.5,
+            flags: sys::FrameEndInfoFlagsML::EMPTY,
+        };
+        // SAFETY: a valid chain of three structures on the stack.
+        let c = unsafe { ml_frame_controls(&focus as *const sys::FrameEndInfoML as *const _) };
+        assert_eq!(c.focus_distance_m, Some(1.5));
+        assert_eq!(c.global_dimmer, Some(0.4));
+        assert_eq!(c.rest, &other as *const sys::FrameEndInfo as *const _);
+        // A dimmer not enabled asks for nothing.
+        let off = sys::GlobalDimmerFrameEndInfoML {
+            flags: sys::GlobalDimmerFrameEndInfoFlagsML::EMPTY,
+            next: std::ptr::null(),
+            ..dimmer
+        };
+        // SAFETY: one valid structure.
+        let c = unsafe {
+            ml_frame_controls(&off as *const sys::GlobalDimmerFrameEndInfoML as *const _)
+        };
+        assert_eq!(c.global_dimmer, None);
+        assert!(c.rest.is_null());
     }
 }

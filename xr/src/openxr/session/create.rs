@@ -244,6 +244,9 @@ pub(in crate::openxr) unsafe fn start(
             open: None,
             options: options.clone(),
             report,
+            ml_frame_end: rt.ml_frame_end,
+            ml_dimmer: rt.ml_dimmer,
+            hints: crate::FrameEndHints::default(),
         },
         out,
     ))

@@ -88,6 +88,12 @@ pub struct SessionReport {
     /// XrEventDataReferenceSpaceChangePending events for the scene's space; each re-anchors
     /// the scene at the next located head pose.
     pub space_changes: u64,
+    /// Frames submitted with `XrFrameEndInfoML` (XR_ML_frame_end_info: the focus distance).
+    pub frames_with_focus_distance: u64,
+    /// The focus distance of the last such frame, metres.
+    pub last_focus_distance_m: Option<f32>,
+    /// Frames submitted with `XrGlobalDimmerFrameEndInfoML` (XR_ML_global_dimmer).
+    pub frames_with_global_dimmer: u64,
 }
 
 impl SessionReport {
@@ -162,6 +168,12 @@ pub struct Session {
     options: SessionOptions,
     /// What happened.
     report: SessionReport,
+    /// XR_ML_frame_end_info is enabled.
+    ml_frame_end: bool,
+    /// XR_ML_global_dimmer is enabled.
+    ml_dimmer: bool,
+    /// What the app asked of the display for the frame in flight.
+    hints: crate::FrameEndHints,
 }
 
 impl Session {

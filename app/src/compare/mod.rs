@@ -5,6 +5,7 @@
 //! ramp, the rest); with what the eye sees when nothing is drawn, the same figures for it and
 //! for the additive limit beside the test's; optionally the ꟻLIP error map as a PNG.
 
+mod flip;
 mod regions;
 
 use std::path::{Path, PathBuf};
@@ -167,13 +168,8 @@ pub fn compare(
     (width, height): (u32, u32),
     ppd: f32,
     labels: Option<&[Region]>,
-) -> (Vec<f32>, Vec<RegionFigures>) {
-    let error = nv_flip::flip(
-        nv_flip::FlipImageRgb8::with_data(width, height, reference),
-        nv_flip::FlipImageRgb8::with_data(width, height, test),
-        ppd,
-    )
-    .to_vec();
+) -> Result<(Vec<f32>, Vec<RegionFigures>)> {
+    let error = flip::error_map(reference, test, (width, height), ppd)?;
     let squared: Vec<f64> = reference
         .chunks_exact(3)
         .zip(test.chunks_exact(3))
@@ -204,7 +200,7 @@ pub fn compare(
             out.push(figures(region.name(), &|i| labels[i] == region));
         }
     }
-    (error, out)
+    Ok((error, out))
 }
 
 /// The figures of one eye of one frame against the physical reference: what the eye sees with
@@ -232,17 +228,17 @@ pub fn against_reference(
     placement: &vitreous_scene::Placement,
     images: [&[u8]; 3],
     (w, h): (u32, u32),
-) -> [Vec<RegionFigures>; 3] {
+) -> Result<[Vec<RegionFigures>; 3]> {
     let [real, seen, display] = images;
     let fov = scene.output.fov;
     let ppd = w as f32 / (fov.angle_right_rad - fov.angle_left_rad).to_degrees();
     let labels = regions_of(scene, view, placement, w, h);
-    let rows = |image: &[u8]| compare(real, image, (w, h), ppd, Some(&labels)).1;
-    [
-        rows(&add_light(display, seen)),
-        rows(seen),
-        rows(&additive_limit(seen, real)),
-    ]
+    let rows = |image: &[u8]| compare(real, image, (w, h), ppd, Some(&labels)).map(|r| r.1);
+    Ok([
+        rows(&add_light(display, seen))?,
+        rows(seen)?,
+        rows(&additive_limit(seen, real))?,
+    ])
 }
 
 /// RGBA8 pixels without their alpha.
@@ -295,7 +291,7 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
             let fov = s.output.fov;
             w as f32 / (fov.angle_right_rad - fov.angle_left_rad).to_degrees()
         }
-        None => nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+        None => flip::DEFAULT_PIXELS_PER_DEGREE,
     });
     let from_reference = crate::reference_cmd::frame_of_image(&args.reference);
     let (labels, regions_from) = match (&scene, &from_reference) {
@@ -327,16 +323,16 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         ),
         _ => (None, None),
     };
-    let (error, figures) = compare(&reference, &test, (w, h), ppd, labels.as_deref());
-    let rows = |image: &[u8]| compare(&reference, image, (w, h), ppd, labels.as_deref()).1;
-    let nothing_drawn = seen.as_deref().map(rows);
+    let (error, figures) = compare(&reference, &test, (w, h), ppd, labels.as_deref())?;
+    let rows =
+        |image: &[u8]| compare(&reference, image, (w, h), ppd, labels.as_deref()).map(|r| r.1);
+    let nothing_drawn = seen.as_deref().map(rows).transpose()?;
     let limit = seen
         .as_deref()
-        .map(|s| rows(&additive_limit(s, &reference)));
+        .map(|s| rows(&additive_limit(s, &reference)))
+        .transpose()?;
     if let Some(map) = &args.map {
-        let rgb = nv_flip::FlipImageFloat::with_data(w, h, &error)
-            .apply_color_lut(&nv_flip::magma_lut())
-            .to_vec();
+        let rgb = flip::magma(&error, (w, h));
         let rgba: Vec<u8> = rgb
             .chunks_exact(3)
             .flat_map(|p| [p[0], p[1], p[2], 255])

@@ -156,7 +156,7 @@ impl Physical {
                 &placement,
                 [&rgb_of(&real), &rgb_of(&seen), &rgb_of(&readback.eyes[eye])],
                 size,
-            );
+            )?;
             self.figures.push(ReferenceFigures {
                 frame: input.index,
                 eye: name,

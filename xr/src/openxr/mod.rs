@@ -121,9 +121,13 @@ pub struct Runtime {
 impl Runtime {
     /// Loads the OpenXR loader, creates the instance and finds the headset.
     pub fn new(options: &OpenXrOptions) -> Result<Runtime> {
-        // SAFETY: loading the OpenXR loader only runs its initialisation.
-        let entry =
-            unsafe { xr::Entry::load(&()) }.map_err(|e| OpenXrError::NoLoader(e.to_string()))?;
+        // Nothing on a desktop; the Java VM and activity on Android.
+        #[allow(clippy::let_unit_value)]
+        let platform = platform_info();
+        // SAFETY: loading the OpenXR loader only runs its initialisation (on Android with the
+        // activity's VM and context, XR_KHR_loader_init_android).
+        let entry = unsafe { xr::Entry::load(&platform) }
+            .map_err(|e| OpenXrError::NoLoader(e.to_string()))?;
         let available = entry
             .enumerate_extensions()
             .map_err(|e| OpenXrError::NoRuntime(format!("listing extensions: {e}")))?;
@@ -132,6 +136,12 @@ impl Runtime {
         }
         let mut wanted = xr::ExtensionSet::default();
         wanted.khr_vulkan_enable2 = true;
+        // Android: the instance is created for the NativeActivity (the loader's own
+        // requirement there).
+        #[cfg(target_os = "android")]
+        {
+            wanted.khr_android_create_instance = true;
+        }
         wanted.ext_eye_gaze_interaction = available.ext_eye_gaze_interaction;
         wanted.fb_eye_tracking_social = available.fb_eye_tracking_social;
         wanted.khr_composition_layer_depth = available.khr_composition_layer_depth;
@@ -171,7 +181,7 @@ impl Runtime {
             api_version: xr::Version::new(1, 0, 0),
         };
         let instance = entry
-            .create_instance(&app, &wanted, &layers, &())
+            .create_instance(&app, &wanted, &layers, &platform)
             .map_err(|e| {
                 let from_env = std::env::var("XR_ENABLE_API_LAYERS").ok();
                 error::instance_error(&e.to_string(), &layers, from_env.as_deref())
@@ -571,6 +581,22 @@ fn gaze_support(
 }
 
 /// The names of the extensions vitreous enables, for logs.
+/// What the OpenXR loader and instance are created with on this platform: nothing on a
+/// desktop.
+#[cfg(not(target_os = "android"))]
+fn platform_info() {}
+
+/// What the OpenXR loader and instance are created with on Android: the Java VM and the
+/// NativeActivity that the activity glue (android-activity, through winit) recorded in
+/// `ndk-context` before the app's main ran.
+#[cfg(target_os = "android")]
+fn platform_info() -> xr::AndroidPlatformInfo {
+    let context = ndk_context::android_context();
+    // SAFETY: the glue stores the process's JavaVM and the activity's global reference, both
+    // valid for as long as the activity lives, which outlives the app's main.
+    unsafe { xr::AndroidPlatformInfo::new(context.vm(), context.context()) }
+}
+
 fn enabled_names(set: &xr::ExtensionSet) -> Vec<String> {
     let mut names = Vec::new();
     for (on, name) in [
@@ -582,6 +608,11 @@ fn enabled_names(set: &xr::ExtensionSet) -> Vec<String> {
             "XR_KHR_composition_layer_depth",
         ),
         (set.ml_frame_end_info, "XR_ML_frame_end_info"),
+        #[cfg(target_os = "android")]
+        (
+            set.khr_android_create_instance,
+            "XR_KHR_android_create_instance",
+        ),
         (set.ml_global_dimmer, "XR_ML_global_dimmer"),
     ] {
         if on {

@@ -34,7 +34,10 @@
 // The room (`[environment] room`, beyond the paper): the floor and background photos are what
 // the glass refracts and reflects, exactly, in every variant: a ray leaving the glass takes the
 // photo it meets first (the floor sharp, the background at the frame's blur), the environment
-// map only where it meets neither. Still one fetch per image.
+// map only where it meets neither; one fetch per image. Two-surface refraction then also
+// follows the light the exit reflects back inside to the next meeting with the surface (one
+// partial internal reflection, the faint second image of a real ball): one more exit and one
+// more fetch of the room.
 
 // #include shared/fresnel.wgsl
 
@@ -294,6 +297,13 @@ struct Passage {
     transmission: vec3<f32>,
     // 1 when it left the object, 0 when given up inside (environment).
     escaped: f32,
+    // With the room (`ROOM`): the light the exit reflects back inside that leaves at the next
+    // meeting with the surface (one partial internal reflection, which a real ball shows as a
+    // faint second image): where and which way it leaves, world, and its transmittance (0 when
+    // there is none).
+    echo_exit: vec3<f32>,
+    echo_direction: vec3<f32>,
+    echo_transmission: vec3<f32>,
 };
 
 // Where the ray p + t d (from inside, d unit; model frame about the radial map's centre)
@@ -348,6 +358,10 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     let inside_world = refract(incident, normal, 1.0 / ior);
     var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
     var d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
+    // The light arriving at the exit, and the exit's reflectance, for the echo.
+    var arriving = 0.0;
+    var reflectance = 0.0;
+    var echo_d = d;
     for (var bounce = 0; bounce <= MAX_INTERNAL_REFLECTIONS; bounce++) {
         let exit = find_exit(p, d);
         p += d * exit.x;
@@ -355,7 +369,10 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
         let outward = exit.yzw;
         let leaving = refract(d, -outward, ior);
         if dot(leaving, leaving) > 0.0 {
-            fresnel_transmission *= 1.0 - fresnel_exact(dot(d, outward), ior);
+            arriving = fresnel_transmission;
+            reflectance = fresnel_exact(dot(d, outward), ior);
+            echo_d = reflect(d, outward);
+            fresnel_transmission *= 1.0 - reflectance;
             d = leaving;
             out.escaped = 1.0;
             break;
@@ -365,6 +382,21 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     out.transmission = vec3<f32>(fresnel_transmission);
     if ABSORBING {
         out.transmission *= exp2(-g.absorption.rgb * inside);
+    }
+    out.echo_transmission = vec3<f32>(0.0);
+    if ROOM && out.escaped > 0.0 {
+        let exit = find_exit(p, echo_d);
+        let p2 = p + echo_d * exit.x;
+        let leaving = refract(echo_d, -exit.yzw, ior);
+        if dot(leaving, leaving) > 0.0 {
+            out.echo_transmission = vec3<f32>(
+                arriving * reflectance * (1.0 - fresnel_exact(dot(echo_d, exit.yzw), ior)));
+            if ABSORBING {
+                out.echo_transmission *= exp2(-g.absorption.rgb * (inside + exit.x));
+            }
+            out.echo_exit = (g.world_from_model * vec4<f32>(p2 + g.radial.xyz, 1.0)).xyz;
+            out.echo_direction = normalize((g.world_from_model * vec4<f32>(leaving, 0.0)).xyz);
+        }
     }
     out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
     out.direction = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);
@@ -481,7 +513,16 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         } else {
             seen = beyond_passage(passage);
         }
-        refracted_image = seen * passage.transmission / max(1.0 - fresnel, 1e-6);
+        var light = seen * passage.transmission;
+        if ROOM {
+            // The real ball's faint second image: light reflected once inside.
+            if passage.echo_transmission.x + passage.echo_transmission.y
+                + passage.echo_transmission.z > 0.0 {
+                light += room(passage.echo_exit, passage.echo_direction)
+                    * passage.echo_transmission;
+            }
+        }
+        refracted_image = light / max(1.0 - fresnel, 1e-6);
     } else if to_background {
         let from_origin = normalize(world_pos - eye.refraction_origin.xyz);
         let t = refract_heckbert(from_origin, n, ior);

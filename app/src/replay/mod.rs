@@ -16,7 +16,6 @@ use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{EditRecord, TraceSample};
 
-use crate::compare::{ReferenceFigures, against_reference, rgb_of};
 use crate::effects::EffectSet;
 use crate::frame_log::FrameLog;
 use crate::frame_loop::{self, FramePlan, FrameSink};
@@ -24,17 +23,18 @@ pub use crate::look::GazeSettings;
 use crate::look::LookPlanner;
 use crate::motion_clock::MotionClock;
 use crate::output::{self, write_atomic};
-use crate::reference_cmd::{ReferenceSettings, render_reference, srgb_rgba};
 use crate::reference_view::side_by_side;
 use crate::render_desc;
-use crate::scene::{Placement, Scene, load_scene};
+use crate::scene::{Scene, load_scene};
 use crate::setup::{check_size, load_trace_with_edits};
 use crate::spread::Spread;
 use crate::validation::ValidationSummary;
+use physical::Physical;
 use summary::UnfinishedSummary;
 pub use summary::{ReplaySummary, RunStatus};
 
 mod cli;
+mod physical;
 mod summary;
 
 pub use cli::{ReplayArgs, replay_command};
@@ -103,70 +103,6 @@ struct Saver<'a> {
     edits: std::collections::VecDeque<EditRecord>,
     /// With `--compare-reference`: the physical reference of each saved frame.
     physical: Option<Physical>,
-}
-
-/// `--compare-reference`: the saved frames' placements until they finish, and the figures.
-struct Physical {
-    /// The scene, with its caustic bake read when it has one (the caustic is a region).
-    scene: Scene,
-    /// Saved frames in flight: index and where the object and light were.
-    pending: Vec<(u64, Placement)>,
-    /// Each finished saved frame's figures, per eye.
-    figures: Vec<ReferenceFigures>,
-}
-
-impl Physical {
-    /// Renders the reference of saved frame `input`, writes it and what the eye sees with
-    /// nothing drawn into `dir`, and measures the frame's display light over that against it;
-    /// returns the files written.
-    fn measure(
-        &mut self,
-        dir: &Path,
-        input: &FrameInput,
-        readback: &vitreous_render::Readback,
-    ) -> Result<Vec<String>> {
-        let Some(k) = self.pending.iter().position(|p| p.0 == input.index) else {
-            return Ok(Vec::new());
-        };
-        let (_, placement) = self.pending.swap_remove(k);
-        let size = (readback.width, readback.height);
-        let frame = render_reference(
-            &self.scene,
-            &input.views,
-            &placement,
-            size,
-            &[0, 1],
-            &ReferenceSettings::default(),
-        )?;
-        let mut files = Vec::new();
-        for (eye, name) in output::EYE_NAMES.iter().enumerate() {
-            let real = srgb_rgba(&frame.real[eye]);
-            let seen = srgb_rgba(&frame.seen[eye]);
-            for (suffix, image) in [("-real", &real), ("-seen", &seen)] {
-                let file = format!("{:06}-{name}{suffix}.png", input.index);
-                write_atomic(
-                    &dir.join(&file),
-                    &output::encode_png(image, size.0, size.1)?,
-                )?;
-                files.push(format!("frames/{file}"));
-            }
-            let [regions, nothing_drawn, additive_limit] = against_reference(
-                &self.scene,
-                &input.views[eye],
-                &placement,
-                [&rgb_of(&real), &rgb_of(&seen), &rgb_of(&readback.eyes[eye])],
-                size,
-            )?;
-            self.figures.push(ReferenceFigures {
-                frame: input.index,
-                eye: name,
-                regions,
-                nothing_drawn,
-                additive_limit,
-            });
-        }
-        Ok(files)
-    }
 }
 
 /// A second renderer with the scene under the refraction model the scene does not use, for

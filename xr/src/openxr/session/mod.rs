@@ -8,6 +8,7 @@
 
 mod create;
 mod frame;
+mod frame_end;
 mod placement;
 mod scope;
 mod state_machine;

@@ -92,22 +92,33 @@ pub fn regions_of(
 ) -> Vec<Region> {
     let camera = eye_params(view);
     let floor = FloorRegions::new(scene, placement);
+    let floor_from_world = scene.floor.world_from_plane().inverse();
     let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
     let mut out = Vec::with_capacity((width * height) as usize);
     for y in 0..height {
         for x in 0..width {
             let dir = rays.direction(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            out.push(classify(scene, placement, &floor, view.pose.position, dir));
+            let origin = view.pose.position;
+            out.push(classify(
+                scene,
+                placement,
+                &floor,
+                floor_from_world,
+                origin,
+                dir,
+            ));
         }
     }
     out
 }
 
-/// The region a ray from `origin` along `dir` (unit) falls in.
+/// The region a ray from `origin` along `dir` (unit) falls in; `floor_from_world` is the
+/// inverse of the floor's `world_from_plane`.
 fn classify(
     scene: &Scene,
     placement: &Placement,
     floor: &FloorRegions,
+    floor_from_world: glam::Mat4,
     origin: Vec3,
     dir: Vec3,
 ) -> Region {
@@ -125,11 +136,7 @@ fn classify(
     if t <= 0.0 {
         return Region::Rest;
     }
-    let local = scene
-        .floor
-        .world_from_plane()
-        .inverse()
-        .transform_point3(origin + dir * t);
+    let local = floor_from_world.transform_point3(origin + dir * t);
     if local.x.abs() > 0.5 || local.y.abs() > 0.5 {
         return Region::Rest;
     }

@@ -68,6 +68,25 @@ const VARIANTS: &[Variant] = &[
         &[("ABSORBING", 1.0), ("CONVEX", 1.0)],
         "absorbing.convex",
     ),
+    // The overlay again for a display with a segmented dimmer, writing the shadow's share as
+    // alpha (`SHADOW`).
+    ("floor_overlay", "fs_main", &[("SHADOW", 1.0)], "shadow"),
+    (
+        "floor_overlay",
+        "fs_main",
+        &[("SHADOW", 1.0), ("CAUSTICS", 1.0)],
+        "shadow.caustics",
+    ),
+    (
+        "floor_overlay",
+        "fs_main",
+        &[
+            ("SHADOW", 1.0),
+            ("CAUSTICS", 1.0),
+            ("FILTERED_CAUSTICS", 1.0),
+        ],
+        "shadow.caustics.filtered",
+    ),
     // Every glass model again with the room as its target (`ROOM`).
     ("glass", "fs_paper_", &[("ROOM", 1.0)], "room"),
     ("glass", "fs_two_surface_", &[("ROOM", 1.0)], "room"),

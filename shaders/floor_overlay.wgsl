@@ -16,7 +16,9 @@ struct Overlay {
     // nothing when min x > max x).
     rect: vec4<f32>,
     // x, y: weights of the inducer's gain and of the caustic gain G (1 on, 0 off); z: 1 to
-    // draw also over the live caustic map's box in `live_bounds`.
+    // draw also over the live caustic map's box in `live_bounds`; w: the share of the floor's
+    // light the object's shadow takes away, written as alpha for a segmented dimmer
+    // (render/src/dimmer; 0 without one).
     switches: vec4<f32>,
 };
 
@@ -32,6 +34,8 @@ var<push_constant> overlay: Overlay;
 // written by the live computation earlier in the frame (render/src/floor/live.rs): on the
 // frames that compute a map only the GPU knows it.
 @group(0) @binding(4) var<storage, read> live_bounds: array<u32, 4>;
+// The shadow mask (R8, 1 in the shadow) over the floor's unit square.
+@group(0) @binding(5) var shadow_mask: texture_2d<f32>;
 
 // The pipeline adds the caustic gain G (pipeline constant, so that the inducer's own pipeline
 // has no caustic code: a branch on a uniform costs both of its sides on a CPU device).
@@ -39,6 +43,9 @@ override CAUSTICS: bool = false;
 // G is sampled through the sampler's bilinear filter, where the device filters R32_SFLOAT
 // (optional in Vulkan; render/src/floor/overlay.rs checks it), instead of four loads.
 override FILTERED_CAUSTICS: bool = false;
+// The pipeline writes the shadow's share of the floor's light as alpha (a display with a
+// segmented dimmer: render/src/dimmer), so that the additive pipelines carry no mask code.
+override SHADOW: bool = false;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -112,6 +119,18 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     if CAUSTICS && overlay.switches.y > 0.0 {
         // eq. 6: L'_c = max(0, L_c - L_r) = G L_r; G >= 0 is checked on loading.
         overlay_gain += overlay.switches.y * caustic_gain(in.uv);
+    }
+    if SHADOW {
+        // The shadow's share of the floor's light, for the dimmer to take away.
+        var shadow = 0.0;
+        if overlay.switches.w > 0.0 {
+            shadow = overlay.switches.w * textureSampleLevel(shadow_mask, clamp_sampler, in.uv, 0.0).r;
+        }
+        if overlay_gain <= 0.0 && shadow <= 0.0 {
+            discard;
+        }
+        let l_r = textureSampleLevel(floor_photo, clamp_sampler, in.uv, 0.0).rgb;
+        return vec4<f32>(overlay_gain * l_r, shadow);
     }
     if overlay_gain <= 0.0 {
         discard;

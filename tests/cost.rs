@@ -51,9 +51,9 @@ struct Case {
     two_surface: bool,
 }
 
-/// The study's conditions (with two-surface O5), the floor's, and the live scene's moving
-/// light.
-const CASES: [Case; 3] = [
+/// The study's conditions (with two-surface O5), the floor's, the live scene's moving light,
+/// and the segmented dimmer's panel and resolve (glass-sphere-ml2.toml).
+const CASES: [Case; 4] = [
     Case {
         name: "visual-effects O3 O4 O5",
         scene: "visual-effects.toml",
@@ -74,6 +74,13 @@ const CASES: [Case; 3] = [
         effects: &["c"],
         moving: true,
         two_surface: false,
+    },
+    Case {
+        name: "glass-sphere-ml2 dimmer",
+        scene: "glass-sphere-ml2.toml",
+        effects: &["caustics"],
+        moving: false,
+        two_surface: true,
     },
 ];
 

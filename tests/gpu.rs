@@ -6,6 +6,7 @@ mod caustics;
 mod compensation;
 mod cost;
 mod defocus;
+mod dimmer;
 mod inducer;
 mod live_caustics;
 mod live_caustics_sweep;

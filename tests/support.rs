@@ -198,6 +198,7 @@ pub fn scene_desc<'a>(
         caustics: None,
         compensation: vitreous_render::Compensation::None,
         room: false,
+        dimmer: None,
     }
 }
 

@@ -13,7 +13,7 @@ pub mod font;
 pub use vitreous_frames::{
     blur_stack, conditions, defocus_model, director, focus, frame_log, frame_loop, interrupt, look,
     motion_clock, output, reference_view, render_desc, scene_edit, setup, spread, test_frame,
-    validation,
+    validation, wearer,
 };
 pub use vitreous_gaze as gaze;
 pub use vitreous_scene::{self as scene, caustics, effects, files};

@@ -139,3 +139,68 @@ fn the_global_dimmer_is_a_level_from_0_to_1_or_not_asked_for() {
         );
     }
 }
+
+#[test]
+fn a_dimmer_display_takes_magic_leap_2s_defaults_and_refuses_what_it_cannot_be() {
+    let (_dir, _path, scene) = load_text(&good_text());
+    assert_eq!(scene.unwrap().dimmer, None);
+    let text = format!("{}\n[display]\nmodel = \"dimmer\"\n", good_text());
+    let (_dir, _path, scene) = load_text(&text);
+    let dimmer = scene.unwrap().dimmer.expect("a dimmer");
+    assert_eq!(dimmer.cells, [64, 48]);
+    assert_eq!(dimmer.blur_deg, 1.5);
+    assert!((dimmer.max - (1.0 - 0.3 / 22.0)).abs() < 1e-6);
+    let text = format!(
+        "{}\n[display]\nmodel = \"dimmer\"\ndimmer_cells = [32, 24]\ndimmer_blur_deg = 2\ndimmer_max = 0.5\n",
+        good_text()
+    );
+    let (_dir, _path, scene) = load_text(&text);
+    let dimmer = scene.unwrap().dimmer.expect("a dimmer");
+    assert_eq!(
+        (dimmer.cells, dimmer.blur_deg, dimmer.max),
+        ([32, 24], 2.0, 0.5)
+    );
+    let cases = [
+        (
+            "model = \"lcd\"",
+            "model = \"lcd\"",
+            "display.model",
+            "\"additive\" or \"dimmer\"",
+        ),
+        (
+            "dimmer_blur_deg = 1",
+            "dimmer_blur_deg =",
+            "display.dimmer_blur_deg",
+            "model = \"dimmer\"",
+        ),
+        (
+            "model = \"dimmer\"\ndimmer_cells = [64.5, 48]",
+            "dimmer_cells =",
+            "display.dimmer_cells",
+            "whole numbers",
+        ),
+        (
+            "model = \"dimmer\"\ndimmer_cells = [64]",
+            "dimmer_cells =",
+            "display.dimmer_cells",
+            "2 numbers",
+        ),
+        (
+            "model = \"dimmer\"\ndimmer_max = 1.5",
+            "dimmer_max =",
+            "display.dimmer_max",
+            "<= 1",
+        ),
+        (
+            "model = \"dimmer\"\ndimmer_blur_deg = 10",
+            "dimmer_blur_deg =",
+            "display.dimmer_blur_deg",
+            "fewer cells or less blur",
+        ),
+    ];
+    for (fields, at, field, says) in cases {
+        let text = format!("{}\n[display]\n{fields}\n", good_text());
+        let msg = expect_error(&text, line_of(&text, at), field);
+        assert!(msg.contains(says), "{fields}: {msg}");
+    }
+}

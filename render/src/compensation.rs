@@ -37,7 +37,7 @@ struct EyePush {
     position: [f32; 4],
 }
 
-/// The planes and where each photo lies in the packed texture (shaders/compensation.wgsl
+/// The planes and where each photo lies in the packed texture (shaders/shared/seen.wgsl
 /// `Planes`).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -55,10 +55,53 @@ pub struct CompensationPass {
     _pool: Owned<vk::DescriptorPool>,
     _set_layout: Owned<vk::DescriptorSetLayout>,
     set: vk::DescriptorSet,
-    _planes: Buffer,
-    _photos: Image,
+    _seen: SeenPhotos,
     /// The mesh's bounding sphere in model units: centre and radius.
     bounds: (Vec3, f32),
+}
+
+/// The real floor and background as the eye sees them (shaders/shared/seen.wgsl): the planes'
+/// transforms and the photos packed side by side; freed on drop.
+pub(crate) struct SeenPhotos {
+    planes: Buffer,
+    photos: Image,
+}
+
+impl SeenPhotos {
+    /// Uploads `desc`'s floor and background photos and planes.
+    pub(crate) fn new(ctx: &GpuContext, desc: &SceneDesc) -> Result<SeenPhotos> {
+        let (w, h, packed, [floor_rect, background_rect]) = pack(&desc.floor, &desc.background)?;
+        let photos = upload_texture(
+            ctx,
+            "seen photos",
+            vk::Format::R8G8B8A8_SRGB,
+            vk::Extent2D {
+                width: w,
+                height: h,
+            },
+            &packed,
+        )?;
+        let planes = Planes {
+            floor_from_world: inverse(desc.floor.world_from_plane),
+            background_from_world: inverse(desc.background.world_from_plane),
+            floor_rect: floor_rect.to_array(),
+            background_rect: background_rect.to_array(),
+        };
+        let planes = Buffer::with_data(
+            ctx,
+            "seen planes",
+            bytemuck::bytes_of(&planes),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        Ok(SeenPhotos { planes, photos })
+    }
+
+    /// Writes the planes (binding 0), the photos (1) and the scene's photo sampler (2) into
+    /// `set`, which no pending command buffer uses.
+    pub(crate) fn write(&self, ctx: &GpuContext, set: vk::DescriptorSet, scene: &GpuScene) {
+        descriptors::write_uniform_buffer(ctx, set, 0, self.planes.buffer);
+        descriptors::write_texture(ctx, set, 1, 2, self.photos.view, scene.photo_sampler());
+    }
 }
 
 /// The two photos side by side in one sRGB texture (floor left, background right), and each
@@ -132,29 +175,7 @@ impl CompensationPass {
                 blend: Blend::TakeAway,
             },
         )?;
-        let (w, h, packed, [floor_rect, background_rect]) = pack(&desc.floor, &desc.background)?;
-        let photos = upload_texture(
-            ctx,
-            "compensation photos",
-            vk::Format::R8G8B8A8_SRGB,
-            vk::Extent2D {
-                width: w,
-                height: h,
-            },
-            &packed,
-        )?;
-        let planes = Planes {
-            floor_from_world: inverse(desc.floor.world_from_plane),
-            background_from_world: inverse(desc.background.world_from_plane),
-            floor_rect: floor_rect.to_array(),
-            background_rect: background_rect.to_array(),
-        };
-        let planes = Buffer::with_data(
-            ctx,
-            "compensation planes",
-            bytemuck::bytes_of(&planes),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        )?;
+        let seen = SeenPhotos::new(ctx, desc)?;
         let pool = descriptors::pool(
             ctx,
             1,
@@ -165,16 +186,14 @@ impl CompensationPass {
             ],
         )?;
         let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
-        descriptors::write_uniform_buffer(ctx, set, 0, planes.buffer);
-        descriptors::write_texture(ctx, set, 1, 2, photos.view, scene.photo_sampler());
+        seen.write(ctx, set, scene);
         Ok(CompensationPass {
             pipeline,
             layout,
             _pool: pool,
             _set_layout: set_layout,
             set,
-            _planes: planes,
-            _photos: photos,
+            _seen: seen,
             bounds: bounding_sphere(desc.mesh.positions),
         })
     }
@@ -204,22 +223,14 @@ impl CompensationPass {
         // SAFETY: the caller's contract (inside a compatible render pass, `self` outliving
         // the execution); the push constants match the layout's range.
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw());
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout.raw(),
-                0,
-                &[self.set],
-                &[],
-            );
-            d.cmd_push_constants(
-                cmd,
-                self.layout.raw(),
-                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                0,
-                bytemuck::bytes_of(&push),
-            );
+            pipeline::Binding {
+                point: vk::PipelineBindPoint::GRAPHICS,
+                pipeline: self.pipeline.raw(),
+                layout: self.layout.raw(),
+                set: self.set,
+                push_stages: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+            }
+            .record(d, cmd, bytemuck::bytes_of(&push));
             d.cmd_set_scissor(cmd, 0, &[area]);
             d.cmd_draw(cmd, 3, 1, 0, 0);
         }

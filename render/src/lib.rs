@@ -30,6 +30,7 @@ mod compensation;
 pub mod context;
 pub mod convex;
 mod descriptors;
+pub mod dimmer;
 pub mod error;
 pub mod floor;
 mod glass;
@@ -63,7 +64,7 @@ pub use memory::{color_copy_region, layout_barrier, subresource_range};
 pub use pose::ScenePose;
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
-    BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, Refraction,
-    RefractionParseError, SceneDesc, TexelData, TextureDesc,
+    BlurStackDesc, CausticsDesc, DimmerDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc,
+    Refraction, RefractionParseError, SceneDesc, TexelData, TextureDesc,
 };
 pub use work::{FrameWork, Invocations, PassInvocations, RecordedWork, ShaderCost};

@@ -27,6 +27,9 @@ pub enum Blend {
     ReplaceColor,
     /// Add to the target's colour (ONE, ONE) without touching alpha: light added on top.
     Add,
+    /// Add to the target's colour and alpha (ONE, ONE): light added on top, and a share of
+    /// the real world's light to take away (a segmented dimmer's, render/src/dimmer).
+    AddWithAlpha,
     /// Take the colour away from the target's (target minus colour, which the attachment clamps
     /// at 0) without touching alpha: eq. 6's light the eye already sees.
     TakeAway,
@@ -145,6 +148,9 @@ pub fn create(ctx: &GpuContext, spec: &PipelineSpec) -> Result<Owned<vk::Pipelin
     };
     let blend_attachments = [match spec.blend {
         Blend::Add => onto_colour(vk::BlendOp::ADD),
+        Blend::AddWithAlpha => onto_colour(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .color_write_mask(vk::ColorComponentFlags::RGBA),
         Blend::TakeAway => onto_colour(vk::BlendOp::REVERSE_SUBTRACT),
         Blend::Replace => vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(false)
@@ -470,4 +476,36 @@ pub fn layout(
     let layout =
         unsafe { ctx.device.create_pipeline_layout(&info, None) }.vk("vkCreatePipelineLayout")?;
     Ok(Owned::new(ctx, layout))
+}
+
+/// A pipeline with its layout and its one descriptor set, as a pass binds it.
+#[derive(Clone, Copy, Debug)]
+pub struct Binding {
+    /// Graphics or compute.
+    pub point: vk::PipelineBindPoint,
+    /// The pipeline.
+    pub pipeline: vk::Pipeline,
+    /// Its layout.
+    pub layout: vk::PipelineLayout,
+    /// The set bound at index 0.
+    pub set: vk::DescriptorSet,
+    /// The stages of the layout's push-constant range.
+    pub push_stages: vk::ShaderStageFlags,
+}
+
+impl Binding {
+    /// Records the pipeline's and the set's binding and the push constants `push` (from offset
+    /// 0).
+    ///
+    /// # Safety
+    /// `cmd` must be recording (inside a render pass for a graphics pipeline compatible with
+    /// it); the objects must outlive its execution; `push` must fit the layout's range.
+    pub unsafe fn record(&self, d: &ash::Device, cmd: vk::CommandBuffer, push: &[u8]) {
+        // SAFETY: the caller's contract.
+        unsafe {
+            d.cmd_bind_pipeline(cmd, self.point, self.pipeline);
+            d.cmd_bind_descriptor_sets(cmd, self.point, self.layout, 0, &[self.set], &[]);
+            d.cmd_push_constants(cmd, self.layout, self.push_stages, 0, push);
+        }
+    }
 }

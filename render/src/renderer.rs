@@ -14,6 +14,7 @@ use crate::blur_blend::{self, BlurBlend};
 use crate::camera::FrameParams;
 use crate::compensation::{Compensation, CompensationPass};
 use crate::context::GpuContext;
+use crate::dimmer::DimmerPass;
 use crate::error::{RenderError, Result, VkContext};
 use crate::floor::{FIELD_STAMPS, FieldPassesMs, InducerFields, InducerPass, Prepared, Stamps};
 use crate::glass::{EyePush, GlassPass, GlassVariant};
@@ -156,6 +157,8 @@ pub struct Renderer {
     world: WorldPass,
     /// Eq. 6 over the glass, when the scene asks for it.
     compensation: Option<CompensationPass>,
+    /// The segmented dimmer's panel and eye image, when the display has one.
+    dimmer: Option<DimmerPass>,
     /// The shadow inducer's fields and floor overlay.
     inducer: InducerPass,
     /// The render pass all passes draw in.
@@ -207,6 +210,17 @@ impl Renderer {
             )?),
         };
         let inducer = InducerPass::new(&ctx, render_pass.raw(), &gpu_scene, scene)?;
+        let dimmer = match scene.dimmer {
+            Some(d) => Some(DimmerPass::new(
+                &ctx,
+                render_pass.raw(),
+                &gpu_scene,
+                scene,
+                d,
+                extent,
+            )?),
+            None => None,
+        };
         let eye_target = StereoTarget::new(&ctx, "eye images", render_pass.raw(), extent)?;
         let world_target = StereoTarget::new(&ctx, "world views", render_pass.raw(), extent)?;
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -274,6 +288,7 @@ impl Renderer {
             blur,
             world,
             compensation,
+            dimmer,
             inducer,
             render_pass,
             scene: gpu_scene,
@@ -340,6 +355,15 @@ impl Renderer {
         self.inducer.live_tiles()
     }
 
+    /// How [`Renderer::submit`] composes: for the scene's own display.
+    fn own_composition(&self) -> Composition {
+        if self.dimmer.is_some() {
+            Composition::AlphaBlend
+        } else {
+            Composition::Additive
+        }
+    }
+
     /// Counts the shader invocations of each pass of every frame submitted from now on
     /// ([`FrameWork::invocations`]), with pipeline-statistics queries. Returns `false`, and
     /// counts nothing, on a device without them.
@@ -361,7 +385,9 @@ impl Renderer {
         self.inducer.computations()
     }
 
-    /// Records and submits a frame. Returns the frame that last used the same slot
+    /// Records and submits a frame, composed for the scene's own display: with a segmented
+    /// dimmer as for [`Composition::AlphaBlend`] (the alpha the dimmer takes away), else
+    /// [`Composition::Additive`]. Returns the frame that last used the same slot
     /// ([`PIPELINE_DEPTH`] frames earlier), once finished, so the caller handles results in
     /// order while the GPU works on newer frames.
     pub fn submit(&mut self, params: &FrameParams, want: Want) -> Result<Option<FrameResult>> {
@@ -369,8 +395,8 @@ impl Renderer {
     }
 
     /// Like [`Renderer::submit`], composed for a display that blends as `composition` says
-    /// (what is drawn behind the glass, and the alpha written); [`Renderer::submit`] is
-    /// [`Composition::Additive`].
+    /// (what is drawn behind the glass, and the alpha written). A scene's segmented dimmer
+    /// is driven only with [`Composition::AlphaBlend`]; the other blends leave it out.
     pub fn submit_composed(
         &mut self,
         params: &FrameParams,
@@ -573,7 +599,12 @@ impl Renderer {
         // Where the eyes go: the renderer's own target, or an attached external image (left in
         // COLOR_ATTACHMENT_OPTIMAL by its render pass), with the real world drawn behind when
         // the display shows no real world of its own.
-        let composition = draw.map_or(Composition::Additive, |d| d.composition);
+        let composition = draw.map_or(self.own_composition(), |d| d.composition);
+        // The dimmer takes the eye passes' images, makes its panel and writes the eyes.
+        let dimmer = self
+            .dimmer
+            .as_ref()
+            .filter(|_| composition == Composition::AlphaBlend);
         let external = draw.filter(|d| d.image != external::OWN_TARGET);
         let (eye_framebuffers, eye_image, eye_pass) = match (external, self.external.as_ref()) {
             (Some(draw), Some(ext)) => (
@@ -611,12 +642,14 @@ impl Renderer {
                 params.look.inducer && !blank,
                 params.look.caustics && !blank,
             );
+            // The shadow's share of the floor's light, for the dimmer to take away.
+            let shadow = dimmer.is_some() && !blank && self.inducer.light_share() > 0.0;
             let stamps = (queries.is_some() || statistics.0.is_some()).then_some(Stamps {
                 pool: queries,
                 first: 3,
                 statistics: statistics.0,
             });
-            if inducer || caustics {
+            if inducer || caustics || shadow {
                 // Once per pose, timed on its own.
                 prepared = self.inducer.prepare(&self.ctx, cmd, &self.scene, stamps);
             } else if let Some(stamps) = stamps {
@@ -633,11 +666,18 @@ impl Renderer {
             if let Some(pool) = queries {
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 1);
             }
+            let (drawn_pass, drawn_framebuffers) = match dimmer {
+                Some(dimmer) => {
+                    dimmer.record_before_drawing(&self.ctx, cmd);
+                    dimmer.drawn_target()
+                }
+                None => (eye_pass, eye_framebuffers),
+            };
             for (index, eye) in params.eyes.iter().enumerate() {
                 self.begin_pass(
                     cmd,
-                    eye_pass,
-                    eye_framebuffers[index],
+                    drawn_pass,
+                    drawn_framebuffers[index],
                     composition.clear_alpha(),
                 );
                 let query = statistics::eye_query(index);
@@ -645,9 +685,10 @@ impl Renderer {
                     if world_behind {
                         self.world.record(&self.ctx, cmd, eye);
                     }
-                    if inducer || caustics {
+                    if inducer || caustics || shadow {
                         // Added before the glass, which covers it where the object is.
-                        self.inducer.record(&self.ctx, cmd, eye, inducer, caustics);
+                        self.inducer
+                            .record(&self.ctx, cmd, eye, [inducer, caustics, shadow]);
                     }
                 });
                 statistics.around(d, cmd, query + 1, || {
@@ -657,13 +698,22 @@ impl Renderer {
                         self.glass
                             .record(&self.ctx, cmd, &self.scene, variant, &push);
                         // What the eye already sees there, taken away (eq. 6), unless the
-                        // display shows the world itself.
-                        if let Some(c) = self.compensation.as_ref().filter(|_| !world_behind) {
+                        // display shows the world itself or the dimmer's resolve does.
+                        let compensate = !world_behind && dimmer.is_none();
+                        if let Some(c) = self.compensation.as_ref().filter(|_| compensate) {
                             c.record(&self.ctx, cmd, eye, self.pose.world_from_model, self.extent);
                         }
                     }
                 });
                 d.cmd_end_render_pass(cmd);
+            }
+            if let Some(dimmer) = dimmer {
+                dimmer.record_panel(&self.ctx, cmd, &params.eyes);
+                for (index, eye) in params.eyes.iter().enumerate() {
+                    self.begin_pass(cmd, eye_pass, eye_framebuffers[index], 0.0);
+                    dimmer.record_resolve(&self.ctx, cmd, eye, index);
+                    d.cmd_end_render_pass(cmd);
+                }
             }
             if let Some(pool) = queries {
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 2);

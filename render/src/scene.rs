@@ -141,6 +141,23 @@ pub struct SceneDesc<'a> {
     /// environment map only where it meets neither. Off: the paper's targets (the background
     /// plane with disparity or defocus, else the environment map).
     pub room: bool,
+    /// The display's segmented dimmer (`[display] model = "dimmer"`), when it has one: the
+    /// eye images then carry the share of the real world's light to take away as their alpha,
+    /// and the light that makes up for what the soft panel takes away too much
+    /// (render/src/dimmer).
+    pub dimmer: Option<DimmerDesc>,
+}
+
+/// A segmented dimmer in front of the display (Magic Leap 2's): a coarse panel whose cells
+/// each take away a share of the real world's light, seen out of focus.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DimmerDesc {
+    /// Cells across and down the eye's view.
+    pub cells: [u32; 2],
+    /// Standard deviation of the panel's optical blur (a Gaussian point spread), degrees.
+    pub blur_deg: f32,
+    /// The largest share of the real world's light a cell takes away (0..1).
+    pub max: f32,
 }
 
 // --- caustics (issue 6; render/src/floor/) ---

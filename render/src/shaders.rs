@@ -114,6 +114,16 @@ pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
 pub const COMPENSATION_VS: &[u8] = spirv!("compensation.vs_main");
 /// Eq. 6 over the glass: the real floor or background the eye sees, to take away.
 pub const COMPENSATION_FS: &[u8] = spirv!("compensation.fs_main");
+/// The segmented dimmer's panel: each cell's want, spread, softened (shaders/dimmer_panel.wgsl).
+pub const DIMMER_WANT_CS: &[u8] = spirv!("dimmer_panel.want");
+/// See [`DIMMER_WANT_CS`].
+pub const DIMMER_SPREAD_CS: &[u8] = spirv!("dimmer_panel.spread");
+/// See [`DIMMER_WANT_CS`].
+pub const DIMMER_SOFTEN_CS: &[u8] = spirv!("dimmer_panel.soften");
+/// The segmented dimmer's eye image: light and alpha (shaders/dimmer_resolve.wgsl).
+pub const DIMMER_RESOLVE_VS: &[u8] = spirv!("dimmer_resolve.vs_main");
+/// See [`DIMMER_RESOLVE_VS`].
+pub const DIMMER_RESOLVE_FS: &[u8] = spirv!("dimmer_resolve.fs_main");
 pub const MASK_VS: &[u8] = spirv!("inducer_mask.vs_main");
 pub const MASK_FS: &[u8] = spirv!("inducer_mask.fs_main");
 pub const FIELD_VS: &[u8] = spirv!("inducer_field.vs_main");
@@ -123,16 +133,22 @@ pub const DISTANCE_FS: &[u8] = spirv!("inducer_field.fs_distance");
 pub const OVERLAY_VS: &[u8] = spirv!("floor_overlay.vs_main");
 /// The floor overlay's fragment shader: the inducer's gain alone, with the caustic gain G
 /// (`CAUSTICS`), and with G filtered by the sampler (`FILTERED_CAUSTICS`).
-pub const OVERLAY_FS: [&[u8]; 3] = [
+pub const OVERLAY_FS: [&[u8]; 6] = [
     spirv!("floor_overlay.fs_main"),
     spirv!("floor_overlay.fs_main.caustics"),
     spirv!("floor_overlay.fs_main.caustics.filtered"),
+    spirv!("floor_overlay.fs_main.shadow"),
+    spirv!("floor_overlay.fs_main.shadow.caustics"),
+    spirv!("floor_overlay.fs_main.shadow.caustics.filtered"),
 ];
 /// The static cost of one invocation of each of [`OVERLAY_FS`]'s entry points.
-pub const OVERLAY_FS_COST: [ShaderCost; 3] = [
+pub const OVERLAY_FS_COST: [ShaderCost; 6] = [
     cost!("floor_overlay.fs_main"),
     cost!("floor_overlay.fs_main.caustics"),
     cost!("floor_overlay.fs_main.caustics.filtered"),
+    cost!("floor_overlay.fs_main.shadow"),
+    cost!("floor_overlay.fs_main.shadow.caustics"),
+    cost!("floor_overlay.fs_main.shadow.caustics.filtered"),
 ];
 pub const CAUSTICS_TRACE_CS: &[u8] = spirv!("caustics_live.cs_trace");
 /// The smoothing's passes: the short kernel along the rows and along the columns, the ring

@@ -61,13 +61,25 @@ impl StereoTarget {
         render_pass: vk::RenderPass,
         extent: vk::Extent2D,
     ) -> Result<StereoTarget> {
+        StereoTarget::with_usage(ctx, name, render_pass, extent, vk::ImageUsageFlags::empty())
+    }
+
+    /// Like [`StereoTarget::new`], both images also usable as `usage` says (`SAMPLED`: read
+    /// by shaders afterwards).
+    pub fn with_usage(
+        ctx: &GpuContext,
+        name: &str,
+        render_pass: vk::RenderPass,
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<StereoTarget> {
         let color = Image::new(
             ctx,
             name,
             COLOR_FORMAT,
             extent,
             2,
-            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC | usage,
         )?;
         let depth = Image::new(
             ctx,
@@ -75,7 +87,7 @@ impl StereoTarget {
             DEPTH_FORMAT,
             extent,
             2,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | usage,
         )?;
         let mut views = Vec::with_capacity(4);
         let mut framebuffers = Vec::with_capacity(2);

@@ -45,3 +45,4 @@ pub mod setup;
 pub mod spread;
 pub mod test_frame;
 pub mod validation;
+pub mod wearer;

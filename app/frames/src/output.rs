@@ -90,9 +90,14 @@ pub fn frame_file_names(frame: u64) -> [String; 4] {
     ]
 }
 
-/// Writes a saved frame's eye images and, when the world was read back, its previews into
-/// `dir`. Returns the file names written.
-pub fn write_frame(dir: &Path, frame: u64, readback: &Readback) -> Result<Vec<String>> {
+/// Writes a saved frame's eye images and, when the world was read back, its previews (what the
+/// wearer sees through `display`) into `dir`. Returns the file names written.
+pub fn write_frame(
+    dir: &Path,
+    frame: u64,
+    readback: &Readback,
+    display: &crate::wearer::WearerView,
+) -> Result<Vec<String>> {
     let names = frame_file_names(frame);
     let (w, h) = (readback.width, readback.height);
     let mut jobs: Vec<(String, Vec<u8>)> = Vec::new();
@@ -101,7 +106,7 @@ pub fn write_frame(dir: &Path, frame: u64, readback: &Readback) -> Result<Vec<St
         if let Some(world) = &readback.world {
             jobs.push((
                 names[eye + 2].clone(),
-                see_through(&readback.eyes[eye], &world[eye]),
+                display.see(&readback.eyes[eye], &world[eye], [w, h]),
             ));
         }
     }

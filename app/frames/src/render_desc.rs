@@ -158,5 +158,6 @@ pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> Sc
         }),
         compensation: scene.compensation,
         room: scene.environment.room,
+        dimmer: scene.dimmer,
     }
 }

@@ -40,6 +40,10 @@ pub(crate) struct SceneFile {
 pub(crate) struct DisplayToml {
     pub compensation: Option<Spanned<String>>,
     pub global_dimmer: Option<Spanned<f32>>,
+    pub model: Option<Spanned<String>>,
+    pub dimmer_cells: Option<Spanned<Vec<f32>>>,
+    pub dimmer_blur_deg: Option<Spanned<f32>>,
+    pub dimmer_max: Option<Spanned<f32>>,
 }
 
 /// `[motion]`: keyframes of the object and the light.

@@ -95,6 +95,8 @@ pub struct Scene {
     /// How much the headset's global dimmer darkens the whole view (`[display] global_dimmer`,
     /// 0 none to 1 the most; Magic Leap 2's `XR_ML_global_dimmer`), when the scene asks for it.
     pub global_dimmer: Option<f32>,
+    /// The display's segmented dimmer (`[display] model = "dimmer"`), when it has one.
+    pub dimmer: Option<vitreous_render::DimmerDesc>,
     /// The shadow inducer's parameters.
     pub inducer: Inducer,
     /// The caustic bake (eq. 6): where it is and, once [`Scene::load_caustics`] ran, its

@@ -29,6 +29,7 @@ use crate::effects::EffectSet;
 use crate::files::{DiskFiles, SceneFiles};
 use vitreous_gaze::{FilterKind, FilterParseError, GazeOverride, PupilSource};
 
+mod display;
 mod object;
 
 /// Loads a scene file and every asset it names, checking ranges and decoding everything.
@@ -429,36 +430,19 @@ impl Loader<'_> {
             },
         };
 
-        let global_dimmer = match &raw.display.global_dimmer {
-            None => None,
-            Some(v) => Some(self.number(
-                "display.global_dimmer",
-                Some(v),
-                0.0,
-                (0.0, 1.0),
-                (false, false),
-            )?),
-        };
+        let display = self.display(
+            &raw.display,
+            [
+                (output.fov.angle_right_rad - output.fov.angle_left_rad).to_degrees(),
+                (output.fov.angle_up_rad - output.fov.angle_down_rad).to_degrees(),
+            ],
+        )?;
         let hash = self
             .hasher
             .finalize()
             .iter()
             .map(|b| format!("{b:02x}"))
             .collect();
-        let compensation = match &raw.display.compensation {
-            None => vitreous_render::Compensation::None,
-            Some(c) => match c.get_ref().as_str() {
-                "none" => vitreous_render::Compensation::None,
-                "background" => vitreous_render::Compensation::Background,
-                other => {
-                    return Err(self.src.invalid(
-                        c.span(),
-                        "display.compensation",
-                        format!("expected \"none\" or \"background\", found {other:?}"),
-                    ));
-                }
-            },
-        };
         let warnings = crate::consistency::warnings(&object, &light, &floor, &background);
         Ok(Scene {
             path: self.src.file.to_path_buf(),
@@ -473,8 +457,9 @@ impl Loader<'_> {
             effects,
             inducer,
             gaze,
-            compensation,
-            global_dimmer,
+            compensation: display.compensation,
+            global_dimmer: display.global_dimmer,
+            dimmer: display.dimmer,
             caustics,
             warnings,
             motion,

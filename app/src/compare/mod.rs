@@ -16,6 +16,7 @@ use serde::Serialize;
 pub use regions::{Eye, Region, regions, regions_of};
 
 use crate::output::{encode_png, ensure_not_input, write_atomic};
+use vitreous_frames::wearer::WearerView;
 
 /// Options of `vitreous compare` (docs/cli.md).
 #[derive(clap::Args, Debug)]
@@ -122,14 +123,14 @@ pub fn additive_limit(seen: &[u8], reference: &[u8]) -> Vec<u8> {
         .collect()
 }
 
-/// What the eye sees with `display` (sRGB RGB8) shown over `seen`: their sum in linear light.
-fn add_light(display: &[u8], seen: &[u8]) -> Vec<u8> {
-    let rgba = |rgb: &[u8]| -> Vec<u8> {
-        rgb.chunks_exact(3)
-            .flat_map(|p| [p[0], p[1], p[2], 255])
-            .collect()
-    };
-    rgb_of(&crate::output::see_through(&rgba(display), &rgba(seen)))
+/// What the eye sees with `display` (sRGB RGBA8, alpha what a dimmer takes away) shown over
+/// `seen` (sRGB RGB8) on the display `view`: sRGB RGB8.
+fn add_light(view: &WearerView, display: &[u8], seen: &[u8], size: (u32, u32)) -> Vec<u8> {
+    let rgba: Vec<u8> = seen
+        .chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    rgb_of(&view.see(display, &rgba, [size.0, size.1]))
 }
 
 /// Most pixels an image may have (as the scene loader's images).
@@ -137,6 +138,13 @@ const MAX_PIXELS: u64 = vitreous_scene::MAX_IMAGE_PIXELS;
 
 /// Reads a PNG as tightly packed sRGB RGB8, naming the file in every error.
 fn read_rgb(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
+    let (w, h, rgba) = read_rgba(path)?;
+    Ok((w, h, rgb_of(&rgba)))
+}
+
+/// Reads a PNG as tightly packed sRGB RGBA8 (opaque where it has no alpha), naming the file in
+/// every error.
+fn read_rgba(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
     let reader =
         image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
@@ -151,7 +159,7 @@ fn read_rgb(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
     }
     let decoded = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
         .with_context(|| format!("{}: not a PNG image", path.display()))?;
-    Ok((w, h, decoded.to_rgb8().into_raw()))
+    Ok((w, h, decoded.to_rgba8().into_raw()))
 }
 
 /// PSNR of 8-bit values, dB; `None` when they are equal.
@@ -234,8 +242,9 @@ pub fn against_reference(
     let ppd = w as f32 / (fov.angle_right_rad - fov.angle_left_rad).to_degrees();
     let labels = regions_of(scene, view, placement, w, h);
     let rows = |image: &[u8]| compare(real, image, (w, h), ppd, Some(&labels)).map(|r| r.1);
+    let view = WearerView::of_scene(scene);
     Ok([
-        rows(&add_light(display, seen))?,
+        rows(&add_light(&view, display, seen, (w, h)))?,
         rows(seen)?,
         rows(&additive_limit(seen, real))?,
     ])
@@ -267,13 +276,15 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         }
         Ok(image)
     };
-    let mut test = same_size(&args.test)?;
-    let seen = args.seen.as_deref().map(same_size).transpose()?;
-    if args.display
-        && let Some(seen) = &seen
-    {
-        test = add_light(&test, seen);
+    let (tw, th, test_rgba) = read_rgba(&args.test)?;
+    if (w, h) != (tw, th) {
+        bail!(
+            "the images differ in size: {} is {w}x{h}, {} is {tw}x{th}",
+            args.reference.display(),
+            args.test.display()
+        );
     }
+    let seen = args.seen.as_deref().map(same_size).transpose()?;
     let scene = match &args.scene {
         Some(path) => {
             let mut scene = vitreous_scene::load_scene(path)?;
@@ -285,6 +296,17 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
             Some(scene)
         }
         None => None,
+    };
+    // The display light over the seen image, as the scene's display composes them (its
+    // dimmers, when it has any; else added).
+    let test = match &seen {
+        Some(seen) if args.display => {
+            let view = scene
+                .as_ref()
+                .map_or_else(WearerView::additive, WearerView::of_scene);
+            add_light(&view, &test_rgba, seen, (w, h))
+        }
+        _ => rgb_of(&test_rgba),
     };
     let ppd = args.ppd.unwrap_or_else(|| match &scene {
         Some(s) => {

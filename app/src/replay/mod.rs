@@ -81,6 +81,8 @@ pub struct ReplayOptions {
 /// Saves chosen frames while the loop runs.
 struct Saver<'a> {
     dir: PathBuf,
+    /// How the scene's display shows the saved frames to the wearer (the previews).
+    display: vitreous_frames::wearer::WearerView,
     /// Decides each frame's look (gaze-dependent defocus).
     planner: LookPlanner,
     /// The scene, when the CPU reference is written beside each saved eye.
@@ -199,7 +201,7 @@ impl FrameSink for Saver<'_> {
         }
         self.progress.inc(1);
         if let Some(readback) = &result.readback {
-            let names = output::write_frame(&self.dir, input.index, readback)?;
+            let names = output::write_frame(&self.dir, input.index, readback, &self.display)?;
             self.saved
                 .extend(names.into_iter().map(|n| format!("frames/{n}")));
             if let Some(physical) = &mut self.physical {
@@ -361,6 +363,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     };
     let mut saver = Saver {
         dir: frames_dir,
+        display: vitreous_frames::wearer::WearerView::of_scene(&scene),
         reference: options.reference.then_some(&scene),
         other,
         save_every: options.save_every,

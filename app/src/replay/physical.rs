@@ -60,7 +60,7 @@ impl Physical {
                 &self.scene,
                 &input.views[eye],
                 &placement,
-                [&rgb_of(&real), &rgb_of(&seen), &rgb_of(&readback.eyes[eye])],
+                [&rgb_of(&real), &rgb_of(&seen), &readback.eyes[eye]],
                 size,
             )?;
             self.figures.push(ReferenceFigures {

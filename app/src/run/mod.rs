@@ -290,6 +290,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
     );
     let runtime = Runtime::new(&OpenXrOptions {
         blend: options.blend,
+        dimmer: scene.dimmer.is_some(),
         validation: options.validate,
         size: options.size,
     })

@@ -29,7 +29,8 @@ struct OverlayPush {
     /// max x).
     rect: [f32; 4],
     /// Weights of k alpha(d) and of the caustic gain G (1 on, 0 off); 1 to draw also over
-    /// the box in the live bounds buffer; 0.
+    /// the box in the live bounds buffer; the share of the floor's light the shadow takes
+    /// away, written as alpha (a segmented dimmer's, 0 without one).
     switches: [f32; 4],
 }
 
@@ -44,7 +45,7 @@ pub(crate) struct OverlayPass {
     layout: Owned<vk::PipelineLayout>,
     /// Pool of the sets.
     _pool: Owned<vk::DescriptorPool>,
-    /// Layout of the set: gain, floor photo, sampler, caustic gain.
+    /// Layout of the set: gain, floor photo, sampler, caustic gain, live bounds, shadow mask.
     _set_layout: Owned<vk::DescriptorSetLayout>,
     /// The set.
     set: vk::DescriptorSet,
@@ -70,13 +71,15 @@ pub(crate) struct OverlayArea {
 impl OverlayPass {
     /// The overlay drawing in `eye_render_pass`, reading the inducer's gain `gain_view`
     /// (R16F, filtered by the sampler), the caustic gain `caustic_view` (R32F, filtered in the
-    /// shader) and the scene's floor photo.
+    /// shader), the shadow mask `mask_view` and the scene's floor photo. With `shadow_alpha`
+    /// (a display with a segmented dimmer) its pipelines add their alpha, the shadow's share,
+    /// to the target's too.
     pub fn new(
         ctx: &GpuContext,
         eye_render_pass: vk::RenderPass,
         scene: &GpuScene,
-        gain_view: vk::ImageView,
-        caustic_view: vk::ImageView,
+        [gain_view, caustic_view, mask_view]: [vk::ImageView; 3],
+        shadow_alpha: bool,
     ) -> Result<OverlayPass> {
         let fragment = vk::ShaderStageFlags::FRAGMENT;
         let set_layout = descriptors::set_layout(
@@ -91,6 +94,7 @@ impl OverlayPass {
                     vk::DescriptorType::STORAGE_BUFFER,
                     vk::ShaderStageFlags::VERTEX,
                 ),
+                (5, vk::DescriptorType::SAMPLED_IMAGE, fragment),
             ],
         )?;
         let mut live_bounds = Buffer::new(
@@ -112,9 +116,11 @@ impl OverlayPass {
         )?;
         // G through the sampler's filter where the device filters R32_SFLOAT, else four loads.
         let filtered = ctx.filters_r32_float();
-        let caustic = usize::from(filtered) + 1;
+        // The shadow's variants (`SHADOW`) follow the three others in OVERLAY_FS.
+        let first = if shadow_alpha { 3 } else { 0 };
+        let caustic = first + usize::from(filtered) + 1;
         let caustic_shader = OVERLAY_FS[caustic];
-        let costs = [OVERLAY_FS_COST[0], OVERLAY_FS_COST[caustic]];
+        let costs = [OVERLAY_FS_COST[first], OVERLAY_FS_COST[caustic]];
         tracing::debug!(
             "floor overlay: G {}",
             if filtered {
@@ -126,7 +132,7 @@ impl OverlayPass {
         // The overlay neither tests nor writes depth: it is drawn before the glass, which then
         // covers it where the object is in front (on a see-through display the real floor
         // behind the glass is seen through the glass's own layer).
-        let pipelines = [OVERLAY_FS[0], caustic_shader]
+        let pipelines = [OVERLAY_FS[first], caustic_shader]
             .into_iter()
             .map(|fragment| {
                 pipeline::create(
@@ -140,7 +146,11 @@ impl OverlayPass {
                         attributes: &[],
                         cull: vk::CullModeFlags::NONE,
                         depth: Depth::Off,
-                        blend: Blend::Add,
+                        blend: if shadow_alpha {
+                            Blend::AddWithAlpha
+                        } else {
+                            Blend::Add
+                        },
                     },
                 )
             })
@@ -149,7 +159,7 @@ impl OverlayPass {
             ctx,
             1,
             &[
-                (vk::DescriptorType::SAMPLED_IMAGE, 3),
+                (vk::DescriptorType::SAMPLED_IMAGE, 4),
                 (vk::DescriptorType::SAMPLER, 1),
                 (vk::DescriptorType::STORAGE_BUFFER, 1),
             ],
@@ -159,6 +169,7 @@ impl OverlayPass {
         descriptors::write_texture(ctx, set, 1, 2, scene.photos[0].view, scene.photo_sampler());
         descriptors::write_image(ctx, set, 3, caustic_view);
         descriptors::write_storage_buffer(ctx, set, 4, live_bounds.buffer);
+        descriptors::write_image(ctx, set, 5, mask_view);
         Ok(OverlayPass {
             pipelines,
             costs,
@@ -192,7 +203,8 @@ impl OverlayPass {
         Ok((b[0] <= b[2] && b[1] <= b[3]).then(|| [b[0], b[1], b[2] + 1, b[3] + 1]))
     }
 
-    /// Records `area` for one eye, adding k alpha(d) and G weighted by `switches`.
+    /// Records `area` for one eye, adding k alpha(d) and G weighted by `switches[0..2]`, and
+    /// the shadow's share `switches[2]` as alpha.
     ///
     /// # Safety
     /// `cmd` must be recording inside a render pass compatible with the one given to
@@ -204,7 +216,7 @@ impl OverlayPass {
         cmd: vk::CommandBuffer,
         eye: &EyeParams,
         world_from_plane: Mat4,
-        switches: [f32; 2],
+        switches: [f32; 3],
         area: OverlayArea,
     ) {
         let d = &ctx.device;
@@ -212,29 +224,21 @@ impl OverlayPass {
         let push = OverlayPush {
             clip_from_plane: (eye.clip_from_world() * world_from_plane).to_cols_array(),
             rect: area.rect,
-            switches: [switches[0], switches[1], live, 0.0],
+            switches: [switches[0], switches[1], live, switches[2]],
         };
         // SAFETY: the caller's contract; the pipeline, layout and set are this pass's and
         // live until the renderer has waited for its frames.
         unsafe {
             // The caustic pipeline only when G is added.
             let pipeline = &self.pipelines[usize::from(switches[1] > 0.0)];
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw());
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout.raw(),
-                0,
-                &[self.set],
-                &[],
-            );
-            d.cmd_push_constants(
-                cmd,
-                self.layout.raw(),
-                PUSH_STAGES,
-                0,
-                bytemuck::bytes_of(&push),
-            );
+            pipeline::Binding {
+                point: vk::PipelineBindPoint::GRAPHICS,
+                pipeline: pipeline.raw(),
+                layout: self.layout.raw(),
+                set: self.set,
+                push_stages: PUSH_STAGES,
+            }
+            .record(d, cmd, bytemuck::bytes_of(&push));
             d.cmd_draw(cmd, 6, 1, 0, 0);
         }
         ctx.work.upload(std::mem::size_of::<OverlayPush>());

@@ -190,8 +190,8 @@ impl InducerPass {
             ctx,
             eye_render_pass,
             scene,
-            targets[GAIN].image.view,
-            caustic.view,
+            [targets[GAIN].image.view, caustic.view, mask_view],
+            desc.dimmer.is_some(),
         )?;
 
         Ok(InducerPass {
@@ -552,6 +552,11 @@ impl InducerPass {
         ctx.work.draw(3);
     }
 
+    /// The light's share of the floor's light (`[light] share`).
+    pub fn light_share(&self) -> f32 {
+        self.caustic_share
+    }
+
     /// The static cost of one fragment of the overlay drawn with the caustics or without.
     pub fn overlay_cost(&self, caustics: bool) -> crate::work::ShaderCost {
         self.overlay.cost(caustics)
@@ -559,7 +564,9 @@ impl InducerPass {
 
     /// Records the floor overlay for one eye, inside that eye's render pass: the inducer's
     /// light if `inducer`, the corrected caustics if `caustics` (as last given to
-    /// [`InducerPass::prepare`]). Draws nothing when no floor texel can receive either.
+    /// [`InducerPass::prepare`]), and with `shadow` the share of the floor's light the shadow
+    /// takes away as alpha (for a segmented dimmer; the pass must have been made for a scene
+    /// with one). Draws nothing when no floor texel can receive any.
     ///
     /// # Safety
     /// `cmd` must be recording inside a render pass compatible with the one given to
@@ -570,15 +577,15 @@ impl InducerPass {
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         eye: &EyeParams,
-        inducer: bool,
-        caustics: bool,
+        [inducer, caustics, shadow]: [bool; 3],
     ) {
         let with_live_bounds = caustics && self.live_rect_on_gpu;
-        let rect = self.overlay_rect(inducer, caustics);
+        let rect = self.overlay_rect(inducer || shadow, caustics);
         if rect.is_some() || with_live_bounds {
             let switches = [
                 f32::from(u8::from(inducer)),
                 if caustics { self.caustic_share } else { 0.0 },
+                if shadow { self.caustic_share } else { 0.0 },
             ];
             let area = OverlayArea {
                 rect: rect.unwrap_or(NO_RECT),

@@ -6,9 +6,14 @@ use std::fmt;
 pub use crate::frame::Blend;
 
 /// Chooses the blend mode: `wanted` when the runtime offers it, else ADDITIVE, ALPHA_BLEND,
-/// OPAQUE in that order. `Err` names what was offered when nothing usable is (or when
-/// `wanted` is not offered: an explicit request is not silently replaced).
-pub fn choose_blend(offered: &[Blend], wanted: Option<Blend>) -> Result<Blend, String> {
+/// OPAQUE in that order, or with `dimmer` (the scene drives a segmented dimmer, which only
+/// ALPHA_BLEND does) ALPHA_BLEND first. `Err` names what was offered when nothing usable is
+/// (or when `wanted` is not offered: an explicit request is not silently replaced).
+pub fn choose_blend(
+    offered: &[Blend],
+    wanted: Option<Blend>,
+    dimmer: bool,
+) -> Result<Blend, String> {
     let list = || {
         if offered.is_empty() {
             "none".to_owned()
@@ -30,7 +35,12 @@ pub fn choose_blend(offered: &[Blend], wanted: Option<Blend>) -> Result<Blend, S
             ))
         };
     }
-    [Blend::Additive, Blend::AlphaBlend, Blend::Opaque]
+    let order = if dimmer {
+        [Blend::AlphaBlend, Blend::Additive, Blend::Opaque]
+    } else {
+        [Blend::Additive, Blend::AlphaBlend, Blend::Opaque]
+    };
+    order
         .into_iter()
         .find(|b| offered.contains(b))
         .ok_or_else(|| {
@@ -263,19 +273,35 @@ mod tests {
     fn blend_prefers_additive_then_alpha_then_opaque() {
         use Blend::*;
         assert_eq!(
-            choose_blend(&[Opaque, AlphaBlend, Additive], None),
+            choose_blend(&[Opaque, AlphaBlend, Additive], None, false),
             Ok(Additive)
         );
-        assert_eq!(choose_blend(&[Opaque, AlphaBlend], None), Ok(AlphaBlend));
-        assert_eq!(choose_blend(&[Opaque], None), Ok(Opaque));
-        assert!(choose_blend(&[], None).unwrap_err().contains("none"));
+        assert_eq!(
+            choose_blend(&[Opaque, AlphaBlend], None, false),
+            Ok(AlphaBlend)
+        );
+        assert_eq!(choose_blend(&[Opaque], None, false), Ok(Opaque));
+        assert!(choose_blend(&[], None, false).unwrap_err().contains("none"));
+    }
+
+    #[test]
+    fn a_dimmer_scene_prefers_alpha_blend_which_drives_the_dimmer() {
+        use Blend::*;
+        let offered = [Additive, AlphaBlend];
+        assert_eq!(choose_blend(&offered, None, true), Ok(AlphaBlend));
+        assert_eq!(choose_blend(&[Additive, Opaque], None, true), Ok(Additive));
+        // An explicit choice still wins.
+        assert_eq!(choose_blend(&offered, Some(Additive), true), Ok(Additive));
     }
 
     #[test]
     fn blend_override_is_honoured_only_when_offered() {
         use Blend::*;
-        assert_eq!(choose_blend(&[Additive, Opaque], Some(Opaque)), Ok(Opaque));
-        let err = choose_blend(&[Opaque], Some(Additive)).unwrap_err();
+        assert_eq!(
+            choose_blend(&[Additive, Opaque], Some(Opaque), false),
+            Ok(Opaque)
+        );
+        let err = choose_blend(&[Opaque], Some(Additive), false).unwrap_err();
         assert!(err.contains("additive") && err.contains("opaque"), "{err}");
     }
 

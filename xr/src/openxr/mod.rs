@@ -58,6 +58,8 @@ pub const CORE_VALIDATION_LAYER: &str = "XR_APILAYER_LUNARG_core_validation";
 pub struct OpenXrOptions {
     /// Blend mode to use instead of the automatic choice (must be offered).
     pub blend: Option<Blend>,
+    /// The scene drives a segmented dimmer: ALPHA_BLEND comes first in the automatic choice.
+    pub dimmer: bool,
     /// Enable the OpenXR core validation layer (XR_APILAYER_LUNARG_core_validation) when it is
     /// installed; it can also be enabled with `XR_ENABLE_API_LAYERS`.
     pub validation: bool,
@@ -213,7 +215,7 @@ impl Runtime {
                 _ => None,
             })
             .collect();
-        let blend = choose::choose_blend(&blend_modes_offered, options.blend)
+        let blend = choose::choose_blend(&blend_modes_offered, options.blend, options.dimmer)
             .map_err(OpenXrError::Unsupported)?;
         let views = instance
             .enumerate_view_configuration_views(system, stereo)

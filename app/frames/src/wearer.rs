@@ -1,0 +1,125 @@
+//! What the wearer sees: the display's light over the real world as the headset passes it. An
+//! additive display passes all of the world and adds its light; a global dimmer
+//! (`[display] global_dimmer`) takes away its share of the world everywhere; a segmented dimmer
+//! (`[display] model = "dimmer"`) takes away, under each of its cells, the mean alpha of the
+//! eye image's pixels there (as a runtime would drive it), seen through the panel's blur
+//! (vitreous_render::dimmer::model).
+
+use vitreous_render::DimmerDesc;
+use vitreous_render::dimmer::model::Panel;
+
+use crate::output::{linear_to_srgb, srgb_to_linear};
+
+/// How the display composes its light with the real world for the eye.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WearerView {
+    /// The segmented dimmer's panel, if the display has one.
+    pub panel: Option<Panel>,
+    /// The share of the world the global dimmer takes away everywhere (0 none).
+    pub global_dimmer: f32,
+}
+
+impl WearerView {
+    /// An additive display without dimming: light added to the whole world.
+    pub fn additive() -> WearerView {
+        WearerView::default()
+    }
+
+    /// The display `dimmer` and `global_dimmer` describe, for a view `fov_deg` wide and high.
+    pub fn new(dimmer: Option<DimmerDesc>, global_dimmer: Option<f32>, fov_deg: [f32; 2]) -> Self {
+        WearerView {
+            panel: dimmer.map(|d| Panel::new(&d, fov_deg)),
+            global_dimmer: global_dimmer.unwrap_or(0.0),
+        }
+    }
+
+    /// The display `scene` describes (`[display]`), for the scene's own field of view.
+    pub fn of_scene(scene: &vitreous_scene::Scene) -> WearerView {
+        let fov = scene.output.fov;
+        WearerView::new(
+            scene.dimmer,
+            scene.global_dimmer,
+            [
+                (fov.angle_right_rad - fov.angle_left_rad).to_degrees(),
+                (fov.angle_up_rad - fov.angle_down_rad).to_degrees(),
+            ],
+        )
+    }
+
+    /// What the eye sees of `eye` (the display's light, sRGB RGBA8, alpha the share the dimmer
+    /// takes away) over `world` (the real world, sRGB RGBA8), both `size` pixels: sRGB RGBA8.
+    pub fn see(&self, eye: &[u8], world: &[u8], size: [u32; 2]) -> Vec<u8> {
+        let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+        let pass = 1.0 - self.global_dimmer;
+        let taken = self.panel.map(|panel| {
+            let alpha: Vec<f32> = eye
+                .chunks_exact(4)
+                .map(|p| f32::from(p[3]) / 255.0)
+                .collect();
+            (panel, panel.soften(&panel.from_alpha(&alpha, size)))
+        });
+        let mut out = Vec::with_capacity(eye.len());
+        for (i, (e, w)) in eye.chunks_exact(4).zip(world.chunks_exact(4)).enumerate() {
+            let (x, y) = (i as u32 % size[0], i as u32 / size[0]);
+            let d = taken
+                .as_ref()
+                .map_or(0.0, |(panel, soft)| panel.at_pixel(soft, x, y, size));
+            let world_share = pass * (1.0 - d);
+            for c in 0..3 {
+                out.push(linear_to_srgb(
+                    lut[e[c] as usize] + world_share * lut[w[c] as usize],
+                ));
+            }
+            out.push(255);
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_additive_display_adds_and_a_global_dimmer_dims_the_world_only() {
+        let eye = [0u8, 0, 0, 0, 255, 255, 255, 0];
+        let world = [128u8, 128, 128, 255, 0, 0, 0, 255];
+        let plain = WearerView::additive().see(&eye, &world, [2, 1]);
+        assert_eq!(plain, crate::output::see_through(&eye, &world));
+        let dimmed = WearerView::new(None, Some(0.5), [40.0, 30.0]).see(&eye, &world, [2, 1]);
+        // Half the world's light (0.216 linear -> 0.108) and all the display's.
+        assert_eq!(dimmed[0], linear_to_srgb(0.5 * srgb_to_linear(128)));
+        assert_eq!(&dimmed[4..7], &[255, 255, 255]);
+    }
+
+    #[test]
+    fn a_dimmed_patch_darkens_the_world_with_a_soft_edge() {
+        let desc = DimmerDesc {
+            cells: [16, 12],
+            blur_deg: 2.5,
+            max: 1.0,
+        };
+        let view = WearerView::new(Some(desc), None, [40.0, 30.0]);
+        let (w, h) = (160u32, 120u32);
+        // Alpha 1 over the middle 4 x 4 cells (pixels 60-99 across, 40-79 down).
+        let mut eye = vec![0u8; (w * h * 4) as usize];
+        for y in 40..80 {
+            for x in 60..100 {
+                eye[((y * w + x) * 4 + 3) as usize] = 255;
+            }
+        }
+        let world = vec![200u8; (w * h * 4) as usize];
+        let seen = view.see(&eye, &world, [w, h]);
+        let at = |x: u32, y: u32| seen[((y * w + x) * 4) as usize];
+        // The blur is one cell (2.5 degrees at 16 cells over 40): the middle keeps 9 % of the
+        // world's light (two standard deviations each way), the edge more, and far away the
+        // world is untouched.
+        assert!(at(80, 60) < 80, "{}", at(80, 60));
+        assert!(
+            at(60, 60) > at(80, 60) && at(60, 60) < 200,
+            "{}",
+            at(60, 60)
+        );
+        assert_eq!(at(5, 5), 200);
+    }
+}

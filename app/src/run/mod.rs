@@ -128,6 +128,14 @@ struct RunSink<'d> {
     object_radius_m: f32,
     /// The blend mode the images are composed for.
     blend: Blend,
+    /// With a segmented dimmer: its panel, where the light is and where the floor lies (a
+    /// point and its normal), so the readback check knows where the shadow falls.
+    dimmer_shadow: Option<(
+        vitreous_render::DimmerDesc,
+        glam::Vec3,
+        glam::Vec3,
+        glam::Vec3,
+    )>,
     /// The readback result.
     readback: Option<ReadbackCheck>,
     /// Where head pose and gaze are recorded, if asked.
@@ -155,6 +163,20 @@ struct RunSink<'d> {
     global_dimmer: Option<f32>,
 }
 
+impl RunSink<'_> {
+    /// With a segmented dimmer, what it must darken: the object's centre and the centre of
+    /// its shadow (where the ray from the light through the centre meets the floor).
+    fn dimmed(&self) -> Option<readback::Dimmed> {
+        let (panel, light, floor, normal) = self.dimmer_shadow?;
+        let to_center = self.object_center_m - light;
+        let t = (floor - light).dot(normal) / to_center.dot(normal);
+        Some(readback::Dimmed {
+            points: vec![self.object_center_m, light + to_center * t],
+            panel,
+        })
+    }
+}
+
 impl FrameSink for RunSink<'_> {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
         self.apply_typed_controls(input);
@@ -162,6 +184,9 @@ impl FrameSink for RunSink<'_> {
         let (center, pose) = (placement.object_position_m, self.motion.pose_of(&placement));
         self.looks.set_object_pose(center, pose.world_from_model);
         self.object_center_m = center;
+        if let Some(shadow) = &mut self.dimmer_shadow {
+            shadow.1 = placement.light_position_m;
+        }
         Some(pose)
     }
 
@@ -231,6 +256,7 @@ impl FrameSink for RunSink<'_> {
                 self.object_center_m,
                 self.object_radius_m,
                 self.blend,
+                self.dimmed().as_ref(),
             ));
         }
         Ok(())
@@ -403,6 +429,14 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         motion: MotionClock::new(&scene),
         object_radius_m: scene.object.radius_m,
         blend: info.blend,
+        dimmer_shadow: scene.dimmer.map(|panel| {
+            (
+                panel,
+                scene.placement_at(0.0).light_position_m,
+                scene.floor.pose.position,
+                scene.floor.normal(),
+            )
+        }),
         readback: None,
         writer,
         recorded: Vec::new(),
@@ -540,10 +574,17 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
                     "black"
                 },
                 c.alpha_nonzero_px,
-                if info.blend.uses_source_alpha() {
-                    " (expected none)"
-                } else {
-                    ""
+                match (
+                    info.blend.uses_source_alpha(),
+                    c.dimmed_points_alpha.is_empty()
+                ) {
+                    (true, true) => " (expected none)".to_owned(),
+                    (true, false) => format!(
+                        " ({} of them away from it, expected none; the dimmer's alpha at the \
+                         object's and its shadow's centres {:?}, expected above 0)",
+                        c.alpha_away_px, c.dimmed_points_alpha
+                    ),
+                    (false, _) => String::new(),
                 }
             ),
             None => bail!("readback check: no frame was read back (the session ended first)"),

@@ -3,7 +3,9 @@
 //! the headset looks), and the pixels away from it are checked against what the blend mode
 //! needs there: black on ADDITIVE and ALPHA_BLEND (nothing added to the world), the scene's
 //! real-world photos on OPAQUE; on ALPHA_BLEND every pixel's alpha must be 0 (premultiplied
-//! colour over alpha 0, so the world shows through).
+//! colour over alpha 0, so the world shows through), unless the scene drives a segmented
+//! dimmer: then the alpha must be above 0 where the object and its shadow are, and 0 (with
+//! nothing drawn) away from both, past the panel's reach around them.
 
 use serde::Serialize;
 use vitreous_xr::FrameInput;
@@ -30,8 +32,13 @@ pub struct ReadbackCheck {
     /// Share of those showing what the blend mode needs there (within [`LIT_THRESHOLD`]):
     /// black (ADDITIVE, ALPHA_BLEND) or the real-world photos (OPAQUE).
     pub away_fraction: f64,
-    /// Pixels (both eyes) whose alpha is not 0 (must be none on ALPHA_BLEND).
+    /// Pixels (both eyes) whose alpha is not 0 (must be none on ALPHA_BLEND without a dimmer).
     pub alpha_nonzero_px: u64,
+    /// Of the pixels away from the object, those whose alpha is not 0 (must be none).
+    pub alpha_away_px: u64,
+    /// With a dimmer: the alpha (0-255) at each point that must be dimmed (the object's
+    /// centre, then the centre of its shadow), left eye then right.
+    pub dimmed_points_alpha: Vec<u8>,
     /// Whether the check passed: the object shows (`object_fraction >=
     /// MIN_OBJECT_FRACTION`), the pixels away from it are as the blend mode needs
     /// (`away_fraction >= MIN_AWAY_FRACTION`), and on ALPHA_BLEND no alpha is above 0.
@@ -48,16 +55,33 @@ pub const AWAY_RADII: f32 = 2.0;
 /// rest: the light the shadow inducer and the caustics add to the floor around the object).
 pub const MIN_AWAY_FRACTION: f64 = 0.8;
 
+/// What a segmented dimmer must darken: world points (the object's centre, its shadow's), and
+/// the panel.
+#[derive(Clone, Debug)]
+pub(super) struct Dimmed {
+    /// The points.
+    pub points: Vec<glam::Vec3>,
+    /// The panel.
+    pub panel: vitreous_render::DimmerDesc,
+}
+
 /// Checks a readback of both eyes (see [`ReadbackCheck`]); `rb.world` (the real world alone)
-/// is what OPAQUE must show away from the object.
+/// is what OPAQUE must show away from the object. `dimmed` is what a segmented dimmer must
+/// darken (the scene has one; it counts only on ALPHA_BLEND): then a pixel is away when it lies
+/// outside the rectangle of [`AWAY_RADII`] object radii and the panel's reach (with a cell)
+/// around every point.
 pub(super) fn check_readback(
     input: &FrameInput,
     rb: &vitreous_render::Readback,
     center_m: glam::Vec3,
     radius_m: f32,
     blend: Blend,
+    dimmed: Option<&Dimmed>,
 ) -> ReadbackCheck {
     let world_behind = blend.needs_world_behind();
+    let dimmed = dimmed.filter(|_| blend.uses_source_alpha());
+    let mut alpha_away = 0u64;
+    let mut dimmed_points_alpha = Vec::new();
     let (w, h) = (rb.width as usize, rb.height as usize);
     let (mut region, mut object, mut sum) = (0u64, 0u64, 0f64);
     let (mut away, mut away_ok, mut alpha_nonzero) = (0u64, 0u64, 0u64);
@@ -65,21 +89,54 @@ pub(super) fn check_readback(
         let view = &input.views[eye];
         let image = &rb.eyes[eye];
         let world = rb.world.as_ref().map(|wv| &wv[eye]);
-        // The object's centre in the eye frame, projected with the eye's (asymmetric) fov;
-        // behind the eye there is no disc and every pixel is away from it.
-        let p = view.pose.orientation.conjugate() * (center_m - view.pose.position);
-        let disc = (p.z < -1e-4).then(|| {
-            let (l, r) = (
-                view.fov.angle_left_rad.tan(),
-                view.fov.angle_right_rad.tan(),
-            );
-            let (d, u) = (view.fov.angle_down_rad.tan(), view.fov.angle_up_rad.tan());
-            let (x, y) = (p.x / -p.z, p.y / -p.z);
-            let px = (x - l) / (r - l) * w as f32;
-            let py = (u - y) / (u - d) * h as f32;
-            let rad = (radius_m / p.length()).min(1.0).asin().tan();
+        let (l, r) = (
+            view.fov.angle_left_rad.tan(),
+            view.fov.angle_right_rad.tan(),
+        );
+        let (d, u) = (view.fov.angle_down_rad.tan(), view.fov.angle_up_rad.tan());
+        // A world point in the eye frame, projected with the eye's (asymmetric) fov: its
+        // pixel coordinates and distance; none behind the eye.
+        let project = |world: glam::Vec3| {
+            let p = view.pose.orientation.conjugate() * (world - view.pose.position);
+            (p.z < -1e-4).then(|| {
+                let (x, y) = (p.x / -p.z, p.y / -p.z);
+                (
+                    (x - l) / (r - l) * w as f32,
+                    (u - y) / (u - d) * h as f32,
+                    p.length(),
+                )
+            })
+        };
+        // The object's disc; behind the eye there is none and every pixel is away from it.
+        let disc = project(center_m).map(|(px, py, dist)| {
+            let rad = (radius_m / dist).min(1.0).asin().tan();
             (px, py, rad / (r - l) * w as f32, rad / (u - d) * h as f32)
         });
+        // The dimmer's points in pixels, and how far from them (across, down) its panel may
+        // darken: the object's radius times AWAY_RADII and the panel's reach with one cell
+        // more.
+        let mut dark = Vec::new();
+        if let Some(dimmed) = dimmed {
+            let fov_deg = [r.atan() - l.atan(), u.atan() - d.atan()].map(f32::to_degrees);
+            let panel = vitreous_render::dimmer::model::Panel::new(&dimmed.panel, fov_deg);
+            // The panel darkens squares of cells: how far, in pixels, across and down.
+            let reach = [0, 1]
+                .map(|a| (panel.reach()[a] + 1) as f32 * [w, h][a] as f32 / panel.cells[a] as f32);
+            for &point in &dimmed.points {
+                let at = project(point);
+                let alpha = at
+                    .filter(|&(x, y, _)| x >= 0.0 && y >= 0.0 && x < w as f32 && y < h as f32)
+                    .map_or(0, |(x, y, _)| {
+                        image[((y as usize) * w + x as usize) * 4 + 3]
+                    });
+                dimmed_points_alpha.push(alpha);
+                if let Some((x, y, dist)) = at {
+                    let rad = (radius_m / dist).min(1.0).asin().tan();
+                    let (rx, ry) = (rad / (r - l) * w as f32, rad / (u - d) * h as f32);
+                    dark.push((x, y, AWAY_RADII * rx + reach[0], AWAY_RADII * ry + reach[1]));
+                }
+            }
+        }
         for row in 0..h {
             for col in 0..w {
                 let i = (row * w + col) * 4;
@@ -97,8 +154,15 @@ pub(super) fn check_readback(
                         .zip(&wv[i..i + 3])
                         .all(|(&a, &b)| a.abs_diff(b) <= LIT_THRESHOLD)
                 };
-                if r2 > AWAY_RADII * AWAY_RADII {
+                let (x, y) = (col as f32 + 0.5, row as f32 + 0.5);
+                let past_dimmer = dark
+                    .iter()
+                    .all(|&(px, py, fx, fy)| (x - px).abs() > fx || (y - py).abs() > fy);
+                if r2 > AWAY_RADII * AWAY_RADII && past_dimmer {
                     away += 1;
+                    if image[i + 3] != 0 {
+                        alpha_away += 1;
+                    }
                     let ok = match (world_behind, world) {
                         (true, Some(wv)) => like_world(wv),
                         (true, None) => false,
@@ -126,7 +190,11 @@ pub(super) fn check_readback(
     let share = |n: u64, of: u64| if of == 0 { 0.0 } else { n as f64 / of as f64 };
     let object_fraction = share(object, region);
     let away_fraction = share(away_ok, away);
-    let alpha_ok = !blend.uses_source_alpha() || alpha_nonzero == 0;
+    let alpha_ok = if dimmed.is_some() {
+        alpha_away == 0 && dimmed_points_alpha.iter().all(|&a| a > 0)
+    } else {
+        !blend.uses_source_alpha() || alpha_nonzero == 0
+    };
     ReadbackCheck {
         frame: input.index,
         blend: blend.to_string(),
@@ -141,6 +209,8 @@ pub(super) fn check_readback(
         away_px: away,
         away_fraction,
         alpha_nonzero_px: alpha_nonzero,
+        alpha_away_px: alpha_away,
+        dimmed_points_alpha,
         passed: region > 0
             && object_fraction >= MIN_OBJECT_FRACTION
             && away > 0
@@ -195,6 +265,7 @@ mod tests {
             CENTER,
             0.1,
             Blend::Additive,
+            None,
         );
         assert!(
             c.passed && c.object_px == c.region_px && c.away_fraction == 1.0,
@@ -208,6 +279,7 @@ mod tests {
             CENTER,
             0.1,
             Blend::Additive,
+            None,
         );
         assert!(!c.passed && c.away_fraction == 0.0, "{c:?}");
         let dark = image([0, 0, 0, 255], [0, 0, 0, 255]);
@@ -217,6 +289,7 @@ mod tests {
             CENTER,
             0.1,
             Blend::Additive,
+            None,
         );
         assert!(!c.passed && c.object_px == 0);
     }
@@ -230,6 +303,7 @@ mod tests {
             CENTER,
             0.1,
             Blend::AlphaBlend,
+            None,
         );
         assert!(c.passed && c.alpha_nonzero_px == 0, "{c:?}");
         // The same colour with opaque alpha would hide the world: fails.
@@ -240,11 +314,64 @@ mod tests {
             CENTER,
             0.1,
             Blend::AlphaBlend,
+            None,
         );
         assert!(
             !c.passed && c.alpha_nonzero_px == u64::from(2 * W * H),
             "{c:?}"
         );
+    }
+
+    fn dimmed_at(points: Vec<glam::Vec3>) -> Dimmed {
+        Dimmed {
+            points,
+            panel: vitreous_render::DimmerDesc {
+                cells: [64, 64],
+                blur_deg: 1.0,
+                max: 0.9,
+            },
+        }
+    }
+
+    #[test]
+    fn a_dimmer_needs_alpha_at_the_object_and_its_shadow_and_none_far_away() {
+        // A 0.03 m object 1 m ahead: a disc of about 1 px radius; the image dims the 4 px
+        // around it, where the shadow's point (1.6 px below) lies too. A panel of 64 x 64 cells
+        // over the 57-degree view with a blur of 1 degree reaches 4 cells (with one more,
+        // 2.5 px): away is beyond about 4.5 px.
+        let dimmed = image([0, 0, 0, 0], [200, 200, 200, 180]);
+        let shadow = glam::Vec3::new(0.0, -0.05, -1.0);
+        let c = check_readback(
+            &frame(),
+            &readback(dimmed.clone(), None),
+            CENTER,
+            0.03,
+            Blend::AlphaBlend,
+            Some(&dimmed_at(vec![CENTER, shadow])),
+        );
+        assert!(c.passed && c.alpha_away_px == 0, "{c:?}");
+        assert_eq!(c.dimmed_points_alpha, vec![180; 4]);
+        // A shadow 10 px below, left undimmed: fails.
+        let c = check_readback(
+            &frame(),
+            &readback(dimmed, None),
+            CENTER,
+            0.03,
+            Blend::AlphaBlend,
+            Some(&dimmed_at(vec![CENTER, glam::Vec3::new(0.0, -0.3, -1.0)])),
+        );
+        assert!(!c.passed, "a shadow left undimmed: {c:?}");
+        // Alpha everywhere: far pixels dimmed too.
+        let everywhere = image([0, 0, 0, 90], [200, 200, 200, 180]);
+        let c = check_readback(
+            &frame(),
+            &readback(everywhere, None),
+            CENTER,
+            0.03,
+            Blend::AlphaBlend,
+            Some(&dimmed_at(vec![CENTER])),
+        );
+        assert!(!c.passed && c.alpha_away_px > 0, "{c:?}");
     }
 
     #[test]
@@ -257,6 +384,7 @@ mod tests {
             CENTER,
             0.1,
             Blend::Opaque,
+            None,
         );
         assert!(c.passed && c.away_fraction == 1.0, "{c:?}");
         let on_black = image([0, 0, 0, 255], [200, 200, 200, 255]);
@@ -266,6 +394,7 @@ mod tests {
             CENTER,
             0.1,
             Blend::Opaque,
+            None,
         );
         assert!(!c.passed && c.away_fraction == 0.0, "{c:?}");
     }
@@ -279,6 +408,7 @@ mod tests {
             glam::Vec3::new(0.0, 0.0, 1.0),
             0.1,
             Blend::Additive,
+            None,
         );
         assert!(!c.passed && c.region_px == 0);
     }

@@ -46,33 +46,52 @@ impl WearerView {
         )
     }
 
+    /// Whether the display takes any of the real world away (a dimmer of either kind).
+    pub fn dims(&self) -> bool {
+        self.panel.is_some() || self.global_dimmer > 0.0
+    }
+
+    /// The share of the real world the eye receives at each pixel of a `size` image whose
+    /// display light is `eye` (sRGB RGBA8, alpha the share the segmented dimmer takes away).
+    pub fn passed(&self, eye: &[u8], size: [u32; 2]) -> Vec<f32> {
+        let pass = 1.0 - self.global_dimmer;
+        let Some(panel) = self.panel else {
+            return vec![pass; eye.len() / 4];
+        };
+        let alpha: Vec<f32> = eye
+            .chunks_exact(4)
+            .map(|p| f32::from(p[3]) / 255.0)
+            .collect();
+        let soft = panel.soften(&panel.from_alpha(&alpha, size));
+        (0..eye.len() / 4)
+            .map(|i| {
+                let (x, y) = (i as u32 % size[0], i as u32 / size[0]);
+                pass * (1.0 - panel.at_pixel(&soft, x, y, size))
+            })
+            .collect()
+    }
+
+    /// The real world `world` (sRGB RGBA8) as the eye receives it through the display whose
+    /// light is `eye`: sRGB RGBA8, opaque.
+    pub fn dimmed_world(&self, eye: &[u8], world: &[u8], size: [u32; 2]) -> Vec<u8> {
+        let passed = self.passed(eye, size);
+        world
+            .chunks_exact(4)
+            .zip(&passed)
+            .flat_map(|(w, &p)| {
+                let c = |c: usize| linear_to_srgb(p * srgb_to_linear(w[c]));
+                [c(0), c(1), c(2), 255]
+            })
+            .collect()
+    }
+
     /// What the eye sees of `eye` (the display's light, sRGB RGBA8, alpha the share the dimmer
     /// takes away) over `world` (the real world, sRGB RGBA8), both `size` pixels: sRGB RGBA8.
     pub fn see(&self, eye: &[u8], world: &[u8], size: [u32; 2]) -> Vec<u8> {
-        let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
-        let pass = 1.0 - self.global_dimmer;
-        let taken = self.panel.map(|panel| {
-            let alpha: Vec<f32> = eye
-                .chunks_exact(4)
-                .map(|p| f32::from(p[3]) / 255.0)
-                .collect();
-            (panel, panel.soften(&panel.from_alpha(&alpha, size)))
-        });
-        let mut out = Vec::with_capacity(eye.len());
-        for (i, (e, w)) in eye.chunks_exact(4).zip(world.chunks_exact(4)).enumerate() {
-            let (x, y) = (i as u32 % size[0], i as u32 / size[0]);
-            let d = taken
-                .as_ref()
-                .map_or(0.0, |(panel, soft)| panel.at_pixel(soft, x, y, size));
-            let world_share = pass * (1.0 - d);
-            for c in 0..3 {
-                out.push(linear_to_srgb(
-                    lut[e[c] as usize] + world_share * lut[w[c] as usize],
-                ));
-            }
-            out.push(255);
+        if !self.dims() {
+            return crate::output::see_through(eye, world);
         }
-        out
+        crate::output::see_through(eye, &self.dimmed_world(eye, world, size))
     }
 }
 

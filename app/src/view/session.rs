@@ -517,10 +517,20 @@ impl FrameSink for ViewSink<'_> {
         };
         let eyes = self.shared.borrow().eyes;
         let preview = self.preview.then_some(&self.see);
+        // Through the scene's dimmers, the world the eye receives (as replay's previews).
+        let display = vitreous_frames::wearer::WearerView::of_scene(&self.loaded.scene);
+        let dimmed = match (&readback.world, self.preview && display.dims()) {
+            (Some(world), true) => Some([0, 1].map(|e| {
+                let size = [readback.width, readback.height];
+                display.dimmed_world(&readback.eyes[e], &world[e], size)
+            })),
+            _ => None,
+        };
+        let world = dimmed.as_ref().or(readback.world.as_ref());
         let overlay = &self.overlay;
         let ready = self.shared.borrow().window_ready;
         let shown = self.presenter.present(ready, |out, w, h| {
-            compose(out, w, h, readback, eyes, preview, readback.world.as_ref());
+            compose(out, w, h, readback, eyes, preview, world);
             overlay.draw(out, w, h, &lines);
         })?;
         self.shared.borrow_mut().presented = shown == Presented::Shown;

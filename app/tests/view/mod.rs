@@ -524,3 +524,49 @@ fn scripted_scene_edits_are_recorded_and_the_replay_ends_where_the_session_did()
         "placing moved the object: {placed} from {rest}"
     );
 }
+
+#[test]
+fn the_preview_of_a_dimmer_scene_shows_the_glass_darker_than_the_world_behind_it() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let shot_of = |name: &str| {
+        let shot = dir.path().join(format!("{name}.png"));
+        view(
+            &xvfb,
+            &scene(name),
+            &[
+                "--frames",
+                "6",
+                "--effects",
+                "none",
+                "--preview",
+                "--screenshot",
+                shot.to_str().unwrap(),
+            ],
+            dir.path(),
+        );
+        Shot::read(&shot)
+    };
+    let (dimmer, additive) = (
+        shot_of("glass-sphere-ml2.toml"),
+        shot_of("glass-sphere-real.toml"),
+    );
+    let (inside, outside) = regions(&glass_discs(&scene("glass-sphere-ml2.toml")));
+    let mean = |img: &Shot, px: &[(u32, u32)]| {
+        px.iter().map(|&(x, y)| img.luma(x, y)).sum::<f32>() / px.len() as f32
+    };
+    // An additive display shows at least the world behind the glass; the dimmer takes the
+    // world away where the glass is darker than it.
+    let (d, a) = (mean(&dimmer, &inside), mean(&additive, &inside));
+    assert!(
+        d < a - 5.0,
+        "the glass at luma {d} with the dimmer, {a} without"
+    );
+    // Away from the glass (the window's top rows: the wall), the world is the same.
+    let top: Vec<(u32, u32)> = outside.into_iter().filter(|&(_, y)| y < 40).collect();
+    let (d, a) = (mean(&dimmer, &top), mean(&additive, &top));
+    assert!(
+        (d - a).abs() < 1.0,
+        "the wall at luma {d} with the dimmer, {a} without"
+    );
+}

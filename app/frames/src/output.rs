@@ -56,29 +56,9 @@ pub fn encode_png(rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
     Ok(out)
 }
 
-/// Linear light (clamped to 0..1) to an sRGB-encoded byte.
-pub fn linear_to_srgb(l: f32) -> u8 {
-    let l = l.clamp(0.0, 1.0);
-    let c = if l <= 0.003_130_8 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (c * 255.0 + 0.5) as u8
-}
-
-/// What the wearer perceives: the display's light added to the real world's, in linear light
-/// (an optical see-through display can only add). Both inputs and the output are sRGB RGBA8.
-pub fn see_through(eye: &[u8], world: &[u8]) -> Vec<u8> {
-    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
-    eye.chunks_exact(4)
-        .zip(world.chunks_exact(4))
-        .flat_map(|(e, w)| {
-            let add = |c: usize| linear_to_srgb(lut[e[c] as usize] + lut[w[c] as usize]);
-            [add(0), add(1), add(2), 255]
-        })
-        .collect()
-}
+/// Linear light to sRGB bytes, and the additive display's see-through (in `wearer`, with the
+/// dimmers).
+pub use crate::wearer::{linear_to_srgb, see_through};
 
 /// The files of one saved frame.
 pub fn frame_file_names(frame: u64) -> [String; 4] {

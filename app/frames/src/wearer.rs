@@ -8,7 +8,31 @@
 use vitreous_render::DimmerDesc;
 use vitreous_render::dimmer::model::Panel;
 
-use crate::output::{linear_to_srgb, srgb_to_linear};
+use vitreous_scene::srgb_to_linear;
+
+/// Linear light (clamped to 0..1) to an sRGB-encoded byte.
+pub fn linear_to_srgb(l: f32) -> u8 {
+    let l = l.clamp(0.0, 1.0);
+    let c = if l <= 0.003_130_8 {
+        l * 12.92
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    };
+    (c * 255.0 + 0.5) as u8
+}
+
+/// What the wearer perceives: the display's light added to the real world's, in linear light
+/// (an optical see-through display can only add). Both inputs and the output are sRGB RGBA8.
+pub fn see_through(eye: &[u8], world: &[u8]) -> Vec<u8> {
+    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+    eye.chunks_exact(4)
+        .zip(world.chunks_exact(4))
+        .flat_map(|(e, w)| {
+            let add = |c: usize| linear_to_srgb(lut[e[c] as usize] + lut[w[c] as usize]);
+            [add(0), add(1), add(2), 255]
+        })
+        .collect()
+}
 
 /// How the display composes its light with the real world for the eye.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -89,9 +113,9 @@ impl WearerView {
     /// takes away) over `world` (the real world, sRGB RGBA8), both `size` pixels: sRGB RGBA8.
     pub fn see(&self, eye: &[u8], world: &[u8], size: [u32; 2]) -> Vec<u8> {
         if !self.dims() {
-            return crate::output::see_through(eye, world);
+            return see_through(eye, world);
         }
-        crate::output::see_through(eye, &self.dimmed_world(eye, world, size))
+        see_through(eye, &self.dimmed_world(eye, world, size))
     }
 }
 
@@ -104,7 +128,7 @@ mod tests {
         let eye = [0u8, 0, 0, 0, 255, 255, 255, 0];
         let world = [128u8, 128, 128, 255, 0, 0, 0, 255];
         let plain = WearerView::additive().see(&eye, &world, [2, 1]);
-        assert_eq!(plain, crate::output::see_through(&eye, &world));
+        assert_eq!(plain, see_through(&eye, &world));
         let dimmed = WearerView::new(None, Some(0.5), [40.0, 30.0]).see(&eye, &world, [2, 1]);
         // Half the world's light (0.216 linear -> 0.108) and all the display's.
         assert_eq!(dimmed[0], linear_to_srgb(0.5 * srgb_to_linear(128)));

@@ -38,12 +38,19 @@ fn soft_at(p: vec2<f32>) -> f32 {
     return mix(top, bottom, f.y);
 }
 
+struct Resolved {
+    @location(0) light: vec4<f32>,
+    // The depth the eye passes drew (the glass's), handed on to the frame's depth image.
+    @builtin(frag_depth) depth: f32,
+};
+
 @fragment
-fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+fn fs_main(@builtin(position) frag: vec4<f32>) -> Resolved {
     let px = vec2<u32>(frag.xy);
     let l = i32(dimmer.position.w);
     let drawn_here = textureLoad(drawn, vec2<i32>(px), l, 0);
-    let glass = textureLoad(drawn_depth, vec2<i32>(px), l, 0) < 1.0;
+    let depth = textureLoad(drawn_depth, vec2<i32>(px), l, 0);
+    let glass = depth < 1.0;
     // What the target takes away from B (all of it under the glass, whose light is all of T).
     let a = select(drawn_here.a, 1.0, glass);
     let d = soft_at(frag.xy);
@@ -52,7 +59,7 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let alpha = panel[u32(l) * cells.x * cells.y + c.y * cells.x + c.x];
     if d == a {
         // Nothing to take away or give back: the light drawn (0 where nothing was).
-        return vec4<f32>(drawn_here.rgb, alpha);
+        return Resolved(vec4<f32>(drawn_here.rgb, alpha), depth);
     }
     // B over the pixel's footprint (four positions), as the eye sees the world through it.
     var b = vec3<f32>(0.0);
@@ -62,5 +69,5 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         let far = dimmer.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
         b += 0.25 * seen_along(dimmer.position.xyz, normalize(far.xyz / far.w - dimmer.position.xyz));
     }
-    return vec4<f32>(max(drawn_here.rgb + b * (d - a), vec3<f32>(0.0)), alpha);
+    return Resolved(vec4<f32>(max(drawn_here.rgb + b * (d - a), vec3<f32>(0.0)), alpha), depth);
 }

@@ -45,6 +45,9 @@ pub enum Depth {
     /// Draws only where something nearer than the fragment was drawn (GREATER), writing
     /// nothing: a full-screen pass at the far plane over what the frame drew.
     Behind,
+    /// Writes every fragment's depth (ALWAYS): a full-screen pass handing on depth drawn
+    /// elsewhere (the segmented dimmer's resolve).
+    Copy,
 }
 
 /// Blending the output's colour with the target's by `op` (both weighted one), the target's
@@ -141,6 +144,10 @@ pub fn create(ctx: &GpuContext, spec: &PipelineSpec) -> Result<Owned<vk::Pipelin
             .depth_test_enable(true)
             .depth_write_enable(true)
             .depth_compare_op(vk::CompareOp::LESS),
+        Depth::Copy => vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(true)
+            .depth_write_enable(true)
+            .depth_compare_op(vk::CompareOp::ALWAYS),
         Depth::Behind => vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(true)
             .depth_write_enable(false)

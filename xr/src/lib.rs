@@ -12,6 +12,7 @@ pub mod frame;
 pub mod import;
 pub mod null;
 pub mod openxr;
+pub mod planes;
 pub mod records;
 pub mod sranipal;
 pub mod synth;

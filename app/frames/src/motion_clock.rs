@@ -160,12 +160,41 @@ impl MotionClock {
                 self.edits.object_offset_m += hit + normal * height - now;
             }
         }
+        Ok(self.applied(edit, &edit, input))
+    }
+
+    /// Places the object over `point` in x and z, its height above the floor kept: a place
+    /// on a detected plane, whose height the world's registration takes (the caller moves the
+    /// world so that the floor lies on the plane). Returns the trace's edit line.
+    pub fn place_over(&mut self, point: Vec3, input: &FrameInput) -> EditRecord {
+        let base = self.keyed_placement(input.time_ns);
+        let now = self.edited(base).object_position_m;
+        self.edits.object_offset_m += Vec3::new(point.x - now.x, 0.0, point.z - now.z);
+        self.applied(
+            SceneEdit::PlaceObject,
+            &"place the object on a detected plane under the gaze",
+            input,
+        )
+    }
+
+    /// The scene's floor: a point on it and its normal, in the scene frame.
+    pub fn floor(&self) -> (Vec3, Vec3) {
+        self.floor
+    }
+
+    /// Counts and logs (as `what`) an edit just applied; its trace line.
+    fn applied(
+        &mut self,
+        edit: SceneEdit,
+        what: &dyn std::fmt::Display,
+        input: &FrameInput,
+    ) -> EditRecord {
         self.edit_count += 1;
         let base = self.keyed_placement(input.time_ns);
         let p = self.edited(base);
         let e = &self.edits;
         tracing::info!(
-            "frame {}: {edit}: object at ({:.4}, {:.4}, {:.4}) m turned {:+.1} deg, light at \
+            "frame {}: {what}: object at ({:.4}, {:.4}, {:.4}) m turned {:+.1} deg, light at \
              ({:.4}, {:.4}, {:.4}) m, world registered {:+.4} {:+.4} {:+.4} m",
             input.index,
             p.object_position_m.x,
@@ -179,7 +208,7 @@ impl MotionClock {
             e.world_offset_m.y,
             e.world_offset_m.z,
         );
-        Ok(self.edits.record(input.time_ns, edit.action()))
+        self.edits.record(input.time_ns, edit.action())
     }
 
     /// Takes the edit state of a recorded edit line (`vitreous replay`), logged like the

@@ -9,10 +9,11 @@ use std::sync::mpsc;
 use glam::Vec3;
 use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::Command;
+use vitreous_xr::planes::nearest_up_hit;
 use vitreous_xr::trace::EditRecord;
 
 use super::RunSink;
-use crate::scene_edit::{Axis, SceneEdit};
+use crate::scene_edit::{Axis, SceneEdit, place_ray, ray_meets_plane};
 
 /// Starts reading commands from standard input; each valid line arrives on the receiver (a
 /// bad one is logged and skipped). The thread ends with the input.
@@ -98,11 +99,59 @@ impl RunSink<'_> {
         }
     }
 
-    /// Applies a live control to this frame and records it in the trace.
+    /// Applies a live control to this frame and records it in the trace. A place goes onto
+    /// the nearest plane the runtime detected that the gaze meets before the floor, if any.
     fn edit(&mut self, edit: SceneEdit, input: &FrameInput) {
+        if edit == SceneEdit::PlaceObject && self.place_on_plane(input) {
+            return;
+        }
         match self.motion.edit(edit, input) {
             Ok(record) => self.record(&record),
             Err(why) => tracing::warn!("{edit}: {why}"),
+        }
+    }
+
+    /// Places the object on the nearest detected plane the place ray meets before the floor:
+    /// the world is registered so that the floor lies on that plane (a nudge through the
+    /// session, recorded when it comes back), and the object goes over the point, resting on
+    /// it as it rested on the floor. Returns false, and does nothing, when no plane is met
+    /// first.
+    fn place_on_plane(&mut self, input: &FrameInput) -> bool {
+        let (origin, dir) = place_ray(input);
+        let Some((_, hit)) = nearest_up_hit(&self.planes, origin, dir) else {
+            return false;
+        };
+        let (floor, normal) = self.motion.floor();
+        if ray_meets_plane(origin, dir, floor, normal)
+            .is_some_and(|f| f.distance(origin) < hit.distance(origin))
+        {
+            return false;
+        }
+        // To a tenth of a millimetre: the registration's step, as recorded.
+        let rise = ((hit - floor).dot(normal) * 1e4).round() / 1e4;
+        if rise.abs() > 1e-4 {
+            let _ = self.registrar.send(Command::Nudge(normal * rise));
+            // The planes stay where they are in the room: in the moved scene frame, lower.
+            for plane in &mut self.planes {
+                plane.pose.position -= normal * rise;
+            }
+        }
+        let record = self.motion.place_over(hit, input);
+        self.record(&record);
+        tracing::info!(
+            "frame {}: placed on a detected plane {:+.4} m above the floor; the floor follows it",
+            input.index,
+            rise
+        );
+        true
+    }
+
+    /// Takes the planes the runtime detected since the last frame (the latest detection's).
+    pub(super) fn take_planes(&mut self) {
+        if let Some(rx) = &self.planes_rx
+            && let Some(latest) = rx.try_iter().last()
+        {
+            self.planes = latest;
         }
     }
 

@@ -153,6 +153,10 @@ struct RunSink<'d> {
     motion: MotionClock,
     /// The keyboard's live controls, when read.
     edits: Option<std::sync::mpsc::Receiver<SceneEdit>>,
+    /// The upward planes the runtime detects (XR_EXT_plane_detection), as they come.
+    planes_rx: Option<std::sync::mpsc::Receiver<Vec<vitreous_xr::planes::DetectedPlane>>>,
+    /// The latest detection's planes, in the scene frame: where a place puts the object.
+    planes: Vec<vitreous_xr::planes::DetectedPlane>,
     /// Where re-registrations go: the session, which moves the scene's placement.
     registrar: std::sync::mpsc::Sender<Command>,
     /// The wearer's filtered fixation depth, which the display's focus plane follows.
@@ -179,6 +183,7 @@ impl RunSink<'_> {
 
 impl FrameSink for RunSink<'_> {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
+        self.take_planes();
         self.apply_typed_controls(input);
         let placement = self.motion.placement(input.time_ns)?;
         let (center, pose) = (placement.object_position_m, self.motion.pose_of(&placement));
@@ -415,6 +420,8 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
     };
     let mut sink = RunSink {
         edits,
+        planes_rx: xr.session().take_planes(),
+        planes: Vec::new(),
         registrar: xr.session().command_sender(),
         looks: LiveConditions::new(
             conditions.iter().copied().zip(planners).collect(),
@@ -538,6 +545,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         frames_with_focus_distance: report.frames_with_focus_distance,
         last_focus_distance_m: report.last_focus_distance_m,
         frames_with_global_dimmer: report.frames_with_global_dimmer,
+        plane_detections: report.plane_detections,
         gaze_image_switches: sink.log.gaze_image_switches(),
         separability: sink.log.separability_summary(),
         pupil: sink.log.pupil_summary(sink.looks.pupil_source()),

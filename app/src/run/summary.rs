@@ -108,6 +108,8 @@ pub struct RunSummary {
     /// Frames submitted with `XrGlobalDimmerFrameEndInfoML` (XR_ML_global_dimmer, the scene's
     /// `[display] global_dimmer`).
     pub frames_with_global_dimmer: u64,
+    /// Plane detections the runtime finished (XR_EXT_plane_detection; 0 without it).
+    pub plane_detections: u64,
     /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
     pub gaze_image_switches: u64,
     /// How far apart the two images are in the tracker's vergence noise, the noise estimated

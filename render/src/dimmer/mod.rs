@@ -125,7 +125,8 @@ impl DimmerPass {
                 bindings: &[],
                 attributes: &[],
                 cull: vk::CullModeFlags::NONE,
-                depth: Depth::Off,
+                // The glass's depth, for an OpenXR depth swapchain.
+                depth: Depth::Copy,
                 blend: Blend::Replace,
             },
         )?;

@@ -12,6 +12,9 @@
 //!   recommended and largest image rectangle are clamped to it).
 //! - `VITREOUS_SIM_ML_FRAME`: `1` to offer Magic Leap 2's frame controls (XR_ML_frame_end_info,
 //!   XR_ML_global_dimmer): what the app chains to `xrEndFrame` is recorded, not passed on.
+//! - `VITREOUS_SIM_PLANES`: `x,y,z,w,d` level rectangles facing up, separated by `;` (centre in
+//!   metres in the frame of the head's level pose when a detection begins, width along x and
+//!   depth along z): offered through XR_EXT_plane_detection (`crate::calls::planes`).
 
 use std::ffi::CStr;
 use std::fmt;
@@ -34,6 +37,10 @@ pub const EYE_MAX_VAR: &str = "VITREOUS_SIM_EYE_MAX";
 /// Whether the layer offers Magic Leap 2's frame controls, XR_ML_frame_end_info and
 /// XR_ML_global_dimmer (`1` or `0`; unset: not).
 pub const ML_FRAME_VAR: &str = "VITREOUS_SIM_ML_FRAME";
+/// Environment variable listing the planes XR_EXT_plane_detection finds.
+pub const PLANES_VAR: &str = "VITREOUS_SIM_PLANES";
+/// The plane detection extension's name.
+pub const PLANE_DETECTION: &CStr = c"XR_EXT_plane_detection";
 /// The sides `VITREOUS_SIM_EYE_MAX` takes, pixels.
 pub const EYE_MAX_RANGE: std::ops::RangeInclusive<u32> = 16..=16384;
 
@@ -124,6 +131,47 @@ pub struct Config {
     /// XR_ML_frame_end_info and XR_ML_global_dimmer are the layer's: taken out of the
     /// instance's extensions and each frame's `XrFrameEndInfo` chain, and recorded.
     pub ml_frame: bool,
+    /// The planes XR_EXT_plane_detection finds (none: the extension is not the layer's).
+    pub planes: Vec<SimPlane>,
+}
+
+/// A level rectangle facing up, as `VITREOUS_SIM_PLANES` gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimPlane {
+    /// Its centre, metres, in the frame of the head's level pose when a detection begins.
+    pub center_m: glam::Vec3,
+    /// Its width (along x) and depth (along z), metres.
+    pub size_m: glam::Vec2,
+}
+
+/// Parses `VITREOUS_SIM_PLANES`.
+pub fn parse_planes(value: &str) -> Result<Vec<SimPlane>, ConfigError> {
+    let bad = || ConfigError {
+        var: PLANES_VAR,
+        value: value.to_owned(),
+        expected: "x,y,z,w,d rectangles (metres; w, d > 0) separated by ;",
+    };
+    value
+        .split(';')
+        .map(str::trim)
+        .filter(|p| !p.is_empty())
+        .map(|p| {
+            let v: Vec<f32> = p
+                .split(',')
+                .map(|n| n.trim().parse::<f32>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| bad())?;
+            match v[..] {
+                [x, y, z, w, d] if v.iter().all(|n| n.is_finite()) && w > 0.0 && d > 0.0 => {
+                    Ok(SimPlane {
+                        center_m: glam::Vec3::new(x, y, z),
+                        size_m: glam::Vec2::new(w, d),
+                    })
+                }
+                _ => Err(bad()),
+            }
+        })
+        .collect()
 }
 
 impl Config {
@@ -143,6 +191,10 @@ impl Config {
             submitted: get(SUBMITTED_VAR).map(PathBuf::from),
             buttons: get(BUTTONS_VAR).map(PathBuf::from),
             eye_max: get(EYE_MAX_VAR).map(|v| parse_eye_max(&v)).transpose()?,
+            planes: get(PLANES_VAR)
+                .map(|v| parse_planes(&v))
+                .transpose()?
+                .unwrap_or_default(),
             ml_frame: match get(ML_FRAME_VAR).as_deref().map(str::trim) {
                 None | Some("0") => false,
                 Some("1") => true,
@@ -264,6 +316,19 @@ mod tests {
         assert_eq!(c.gaze, GazeExtension::ALL.to_vec());
         assert_eq!(c.blend, vec![M::ADDITIVE, M::ALPHA_BLEND]);
         assert_eq!((c.trace, c.submitted), (None, None));
+    }
+
+    #[test]
+    fn planes_are_level_rectangles_and_a_bad_list_names_the_variable() {
+        let c = config(&[(PLANES_VAR, "0,-0.25,-1.5,0.6,0.4; 1,-1,-2,4,4;")]).unwrap();
+        assert_eq!(c.planes.len(), 2);
+        assert_eq!(c.planes[0].center_m, glam::Vec3::new(0.0, -0.25, -1.5));
+        assert_eq!(c.planes[1].size_m, glam::Vec2::new(4.0, 4.0));
+        assert!(config(&[]).unwrap().planes.is_empty());
+        for bad in ["0,0,0,1", "0,0,0,1,0", "a,0,0,1,1", "0,0,nan,1,1"] {
+            let e = config(&[(PLANES_VAR, bad)]).unwrap_err();
+            assert_eq!(e.var, PLANES_VAR, "{bad}");
+        }
     }
 
     #[test]

@@ -182,7 +182,12 @@ unsafe extern "system" fn create_api_layer_instance(
                 (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) })
             })
             .collect();
-        let split = extensions::split(&names, &prepared.config.gaze, prepared.config.ml_frame);
+        let split = extensions::split(
+            &names,
+            &prepared.config.gaze,
+            prepared.config.ml_frame,
+            !prepared.config.planes.is_empty(),
+        );
         // The layer's extensions it does not offer go on to the runtime, which may have them
         // (Monado lists XR_EXT_eye_gaze_interaction) or refuses them.
         let forwarded: Vec<*const c_char> = split.forwarded.iter().map(|n| n.as_ptr()).collect();
@@ -254,6 +259,7 @@ unsafe extern "system" fn create_api_layer_instance(
             buttons,
             button_actions: HashMap::new(),
             attached: false,
+            planes: split.planes,
         };
         registry()
             .instances
@@ -333,6 +339,34 @@ macro_rules! entry {
         // type OpenXR defines for the name it asked for.
         Some(unsafe { std::mem::transmute::<$ty, pfn::VoidFunction>(f) })
     }};
+}
+
+/// The layer's XR_EXT_plane_detection function of that name, if it is one.
+fn plane_function(name: &[u8]) -> Option<Option<pfn::VoidFunction>> {
+    use calls::planes;
+    Some(match name {
+        b"xrCreatePlaneDetectorEXT" => {
+            entry!(planes::create_plane_detector, pfn::CreatePlaneDetectorEXT)
+        }
+        b"xrDestroyPlaneDetectorEXT" => {
+            entry!(planes::destroy_plane_detector, pfn::DestroyPlaneDetectorEXT)
+        }
+        b"xrBeginPlaneDetectionEXT" => {
+            entry!(planes::begin_plane_detection, pfn::BeginPlaneDetectionEXT)
+        }
+        b"xrGetPlaneDetectionStateEXT" => entry!(
+            planes::get_plane_detection_state,
+            pfn::GetPlaneDetectionStateEXT
+        ),
+        b"xrGetPlaneDetectionsEXT" => {
+            entry!(planes::get_plane_detections, pfn::GetPlaneDetectionsEXT)
+        }
+        b"xrGetPlanePolygonBufferEXT" => entry!(
+            planes::get_plane_polygon_buffer,
+            pfn::GetPlanePolygonBufferEXT
+        ),
+        _ => return None,
+    })
 }
 
 /// The layer's own function for `name`, and the extension the app must have enabled for it
@@ -528,6 +562,23 @@ unsafe extern "system" fn get_instance_proc_addr(
                 None => (Vec::new(), Vec::new(), None),
             }
         };
+        // XR_EXT_plane_detection's functions: the layer's when the app enabled the extension
+        // from it; refused when it has planes the app did not enable; else the runtime's.
+        if let Some(f) = plane_function(name_c.to_bytes()) {
+            let (enabled, offered) = {
+                let reg = registry();
+                reg.instances
+                    .get(&sys::Handle::into_raw(instance))
+                    .map_or((false, false), |i| (i.planes, !i.config.planes.is_empty()))
+            };
+            if enabled {
+                *function = f;
+                return sys::Result::SUCCESS;
+            }
+            if offered || next.is_none() {
+                return sys::Result::ERROR_FUNCTION_UNSUPPORTED;
+            }
+        }
         if let Some((needs, f)) = own_function(name_c.to_bytes()) {
             match needs {
                 None => {

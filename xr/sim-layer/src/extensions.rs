@@ -19,19 +19,32 @@ pub struct Split<'a> {
     /// The layer's extensions the app enabled but the configuration does not offer (passed
     /// on: the runtime may have them).
     pub not_offered: Vec<GazeExtension>,
+    /// The app enabled XR_EXT_plane_detection, which the layer answers.
+    pub planes: bool,
 }
 
-/// Splits `enabled` into what the layer handles (those in `offered`, and the ML frame
-/// controls when `ml_frame`) and what goes on. An eye extension of the layer that is not
-/// offered is reported in `not_offered` and also passed on (the runtime may have it).
-pub fn split<'a>(enabled: &[&'a CStr], offered: &[GazeExtension], ml_frame: bool) -> Split<'a> {
+/// Splits `enabled` into what the layer handles (those in `offered`, the ML frame controls
+/// when `ml_frame`, XR_EXT_plane_detection when `planes`) and what goes on. An eye extension of
+/// the layer that is not offered is reported in `not_offered` and also passed on (the runtime
+/// may have it).
+pub fn split<'a>(
+    enabled: &[&'a CStr],
+    offered: &[GazeExtension],
+    ml_frame: bool,
+    planes: bool,
+) -> Split<'a> {
     let mut out = Split {
         forwarded: Vec::with_capacity(enabled.len()),
         owned: Vec::new(),
         not_offered: Vec::new(),
+        planes: false,
     };
     for &name in enabled {
         if ml_frame && ML_FRAME_EXTENSIONS.contains(&name) {
+            continue;
+        }
+        if planes && name == crate::config::PLANE_DETECTION {
+            out.planes = true;
             continue;
         }
         match GazeExtension::from_name(name) {
@@ -66,7 +79,7 @@ mod tests {
             c"XR_FB_eye_tracking_social",
             c"XR_EXT_eye_gaze_interaction",
         ];
-        let s = split(&enabled, &GazeExtension::ALL, false);
+        let s = split(&enabled, &GazeExtension::ALL, false, false);
         assert_eq!(
             s.forwarded,
             vec![c"XR_KHR_vulkan_enable2", c"XR_KHR_composition_layer_depth"]
@@ -82,16 +95,27 @@ mod tests {
             c"XR_KHR_vulkan_enable2",
             c"XR_ML_global_dimmer",
         ];
-        let s = split(&enabled, &[], true);
+        let s = split(&enabled, &[], true, false);
         assert_eq!(s.forwarded, vec![c"XR_KHR_vulkan_enable2"]);
-        let s = split(&enabled, &[], false);
+        let s = split(&enabled, &[], false, false);
         assert_eq!(s.forwarded, enabled.to_vec());
+    }
+
+    #[test]
+    fn plane_detection_stays_with_the_layer_only_when_it_has_planes() {
+        let enabled = [c"XR_EXT_plane_detection", c"XR_KHR_vulkan_enable2"];
+        let s = split(&enabled, &[], false, true);
+        assert_eq!(s.forwarded, vec![c"XR_KHR_vulkan_enable2"]);
+        assert!(s.planes);
+        let s = split(&enabled, &[], false, false);
+        assert_eq!(s.forwarded, enabled.to_vec());
+        assert!(!s.planes);
     }
 
     #[test]
     fn extensions_not_offered_are_passed_on_and_reported() {
         let enabled = [c"XR_ML_eye_tracker", c"XR_EXT_eye_gaze_interaction"];
-        let s = split(&enabled, &[Ext], false);
+        let s = split(&enabled, &[Ext], false, false);
         assert_eq!(s.forwarded, vec![c"XR_ML_eye_tracker"]);
         assert_eq!(s.owned, vec![Ext]);
         assert_eq!(s.not_offered, vec![Ml]);
@@ -99,7 +123,7 @@ mod tests {
 
     #[test]
     fn nothing_enabled_gives_nothing() {
-        let s = split(&[], &GazeExtension::ALL, false);
+        let s = split(&[], &GazeExtension::ALL, false, false);
         assert!(s.forwarded.is_empty() && s.owned.is_empty());
     }
 }

@@ -37,6 +37,8 @@ pub struct InstanceState {
     pub button_actions: HashMap<u64, Vec<usize>>,
     /// Whether action sets were attached to any of its sessions (suggestions are then refused).
     pub attached: bool,
+    /// The app enabled XR_EXT_plane_detection, which the layer answers.
+    pub planes: bool,
 }
 
 impl InstanceState {
@@ -90,6 +92,16 @@ pub struct TrackerState {
     pub kind: GazeExtension,
 }
 
+/// A plane detector the layer made.
+#[derive(Clone, Debug)]
+pub struct DetectorState {
+    /// The session's raw handle.
+    pub session: u64,
+    /// The last detection begun: its base space, the head's level pose in it then, and how
+    /// many of the configured planes it found.
+    pub detection: Option<(sys::Space, Pose, usize)>,
+}
+
 /// All of the layer's state.
 pub struct Registry {
     /// Instances by handle.
@@ -100,6 +112,8 @@ pub struct Registry {
     pub spaces: HashMap<u64, SpaceState>,
     /// Eye trackers by the handle the layer gave them.
     pub trackers: HashMap<u64, TrackerState>,
+    /// Plane detectors by the handle the layer gave them.
+    pub detectors: HashMap<u64, DetectorState>,
     /// The next handle the layer gives out.
     next_handle: u64,
 }
@@ -116,6 +130,7 @@ impl Registry {
             sessions: HashMap::new(),
             spaces: HashMap::new(),
             trackers: HashMap::new(),
+            detectors: HashMap::new(),
             next_handle: FIRST_HANDLE,
         }
     }
@@ -125,6 +140,23 @@ impl Registry {
         let h = self.next_handle;
         self.next_handle = self.next_handle.wrapping_add(1).max(1);
         h
+    }
+
+    /// A new plane detector on `session`: its handle, or `None` when the layer knows no
+    /// such session.
+    pub fn new_detector(&mut self, session: u64) -> Option<u64> {
+        if !self.sessions.contains_key(&session) {
+            return None;
+        }
+        let h = self.new_handle();
+        self.detectors.insert(
+            h,
+            DetectorState {
+                session,
+                detection: None,
+            },
+        );
+        Some(h)
     }
 
     /// A new eye tracker of extension `kind` on `session`: its handle, or `None` when the
@@ -179,6 +211,7 @@ impl Registry {
     pub fn remove_session(&mut self, session: u64) -> Option<SessionState> {
         self.spaces.retain(|_, s| s.session != session);
         self.trackers.retain(|_, t| t.session != session);
+        self.detectors.retain(|_, d| d.session != session);
         self.sessions.remove(&session)
     }
 

@@ -31,6 +31,7 @@ mod error;
 mod gaze;
 pub mod ml_eye_tracker;
 mod ml_tracker;
+mod planes;
 mod session;
 pub mod state;
 mod vulkan;
@@ -116,6 +117,8 @@ pub struct Runtime {
     ml_frame_end: bool,
     /// XR_ML_global_dimmer is enabled: the global dimmer is submitted when asked for.
     ml_dimmer: bool,
+    /// XR_EXT_plane_detection is enabled: the session detects the room's upward planes.
+    planes: bool,
     /// The Vulkan instance made through the runtime, for the device steps.
     vk_instance: Option<vk::Instance>,
 }
@@ -150,6 +153,8 @@ impl Runtime {
         // Magic Leap 2's frame controls: the focus plane and the global dimmer.
         wanted.ml_frame_end_info = available.ml_frame_end_info;
         wanted.ml_global_dimmer = available.ml_global_dimmer;
+        // The room's level surfaces, for placing the object on the table under the gaze.
+        wanted.ext_plane_detection = available.ext_plane_detection;
         // XR_ML_eye_tracker is unknown to the `openxr` crate: enabled by name when listed.
         let ml_name = ml_extension_name();
         let ml_gaze = available.other.contains(&ml_name);
@@ -298,6 +303,7 @@ impl Runtime {
             ml_gaze,
             ml_frame_end: wanted.ml_frame_end_info,
             ml_dimmer: wanted.ml_global_dimmer,
+            planes: wanted.ext_plane_detection,
             vk_instance: None,
         })
     }
@@ -509,6 +515,7 @@ fn enabled_names(set: &xr::ExtensionSet) -> Vec<String> {
             "XR_KHR_android_create_instance",
         ),
         (set.ml_global_dimmer, "XR_ML_global_dimmer"),
+        (set.ext_plane_detection, "XR_EXT_plane_detection"),
     ] {
         if on {
             names.push(name.to_owned());

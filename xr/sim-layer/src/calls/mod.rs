@@ -9,6 +9,7 @@ pub mod controller;
 pub mod fb;
 pub mod instance;
 pub mod ml;
+pub mod planes;
 pub mod session;
 
 use std::ffi::c_void;
@@ -161,6 +162,22 @@ impl SessionContext {
             return None;
         }
         Some((from_posef(&loc.pose), loc.location_flags))
+    }
+
+    /// Where space `a` is in space `b` at `time`, through the runtime; `None` when it cannot
+    /// locate it.
+    pub fn space_in(&self, a: sys::Space, b: sys::Space, time: sys::Time) -> Option<Pose> {
+        let mut loc = sys::SpaceLocation {
+            ty: sys::SpaceLocation::TYPE,
+            next: std::ptr::null_mut(),
+            location_flags: sys::SpaceLocationFlags::EMPTY,
+            pose: sys::Posef::IDENTITY,
+        };
+        // SAFETY: the next layer's function with the app's live spaces and a valid output.
+        let r = unsafe { (self.next.locate_space)(a, b, time, &mut loc) };
+        let needed =
+            sys::SpaceLocationFlags::ORIENTATION_VALID | sys::SpaceLocationFlags::POSITION_VALID;
+        (r.into_raw() >= 0 && loc.location_flags.contains(needed)).then(|| from_posef(&loc.pose))
     }
 
     /// The transform from the head frame into `base` at `time` (`view_in_base`), when the

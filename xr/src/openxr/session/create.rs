@@ -211,8 +211,20 @@ pub(in crate::openxr) unsafe fn start(
     };
     let (commands_tx, commands_rx) = mpsc::channel();
     let (injected_tx, injected_rx) = mpsc::channel();
+    let (planes_tx, planes_rx) = mpsc::channel();
+    let planes = if rt.planes {
+        super::super::planes::PlaneDetector::new(&rt.instance, &session)
+    } else {
+        tracing::info!(
+            "the runtime detects no planes (no XR_EXT_plane_detection): the table is the scene's"
+        );
+        None
+    };
     Ok((
         Session {
+            planes,
+            planes_tx,
+            planes_rx: Some(planes_rx),
             stream,
             waiter,
             swapchain,

@@ -129,6 +129,7 @@ impl Session {
         self.sync_actions(head_m)?;
         self.apply_injected(head_m);
         let world_from_space = self.world_from_space.unwrap_or(placed);
+        self.poll_planes(display, &head_space, &world_from_space);
         let sampled = self
             .gaze
             .sample(&self.session, &self.view_space, display, first_display);

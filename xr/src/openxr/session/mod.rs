@@ -95,6 +95,8 @@ pub struct SessionReport {
     pub last_focus_distance_m: Option<f32>,
     /// Frames submitted with `XrGlobalDimmerFrameEndInfoML` (XR_ML_global_dimmer).
     pub frames_with_global_dimmer: u64,
+    /// Plane detections finished (XR_EXT_plane_detection).
+    pub plane_detections: u64,
 }
 
 impl SessionReport {
@@ -106,6 +108,13 @@ impl SessionReport {
 
 /// A live OpenXR session; the [`crate::Backend`] of `vitreous run`.
 pub struct Session {
+    /// The plane detector, when the runtime has XR_EXT_plane_detection; dropped before the
+    /// session.
+    planes: Option<super::planes::PlaneDetector>,
+    /// Where each finished detection's planes (in the scene frame) go for the app.
+    planes_tx: mpsc::Sender<Vec<crate::planes::DetectedPlane>>,
+    /// The app's end, until taken (see [`Session::take_planes`]).
+    planes_rx: Option<mpsc::Receiver<Vec<crate::planes::DetectedPlane>>>,
     /// Frame submission; dropped before the session.
     stream: xr::FrameStream<xr::Vulkan>,
     /// Frame pacing.
@@ -193,6 +202,40 @@ impl Session {
     /// first call.
     pub fn take_commands(&mut self) -> Option<mpsc::Receiver<Command>> {
         self.commands_rx.take()
+    }
+
+    /// The receiving end of the planes the runtime detects (XR_EXT_plane_detection), each
+    /// finished detection's upward planes in the scene frame; taken once (`None` after).
+    pub fn take_planes(&mut self) -> Option<mpsc::Receiver<Vec<crate::planes::DetectedPlane>>> {
+        self.planes_rx.take()
+    }
+
+    /// Moves plane detection on for the frame shown at `time` (head at `head_space` in app
+    /// space), and hands a finished detection's planes to the app in the scene frame
+    /// (`world_from_space`).
+    pub(super) fn poll_planes(
+        &mut self,
+        time: xr::Time,
+        head_space: &Pose,
+        world_from_space: &Pose,
+    ) {
+        let Some(detector) = &mut self.planes else {
+            return;
+        };
+        if let Some(found) = detector.poll(&self.space, time, *head_space) {
+            self.report.plane_detections += 1;
+            let scene: Vec<_> = found
+                .into_iter()
+                .map(|p| crate::planes::DetectedPlane {
+                    pose: placement::compose(world_from_space, &p.pose),
+                    ..p
+                })
+                .collect();
+            if self.report.plane_detections == 1 {
+                tracing::info!("XR_EXT_plane_detection: {} upward planes", scene.len());
+            }
+            let _ = self.planes_tx.send(scene);
+        }
     }
 
     /// Where the application sends commands to be applied as if a live action gave them, at

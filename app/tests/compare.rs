@@ -234,3 +234,62 @@ fn with_what_is_seen_the_nothing_drawn_and_additive_limit_rows_follow() {
     );
     assert_clean_failure(&out, &["small.png is 8x8", "differ in size"]);
 }
+
+/// The arguments of `compare` of the display's light (`t.png`) over the seen image through
+/// `scene`'s panel, then `extra`.
+fn through(scene: &str, extra: &[&str]) -> Vec<String> {
+    let mut args = vec!["compare", "r.png", "t.png", "--seen", "s.png", "--display"];
+    args.extend_from_slice(&["--scene", scene]);
+    args.extend_from_slice(extra);
+    args.iter().map(|a| a.to_string()).collect()
+}
+
+#[test]
+fn a_dimmer_scenes_display_light_is_seen_through_its_panel_and_the_panels_blur_can_be_varied() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/glass-sphere-ml2.toml");
+    let (w, h) = (64u32, 48u32);
+    let grey = vec![128u8; (w * h * 3) as usize];
+    write_png(&dir.path().join("r.png"), &grey, w, h);
+    write_png(&dir.path().join("s.png"), &grey, w, h);
+    // The display's light: none, and the dimmer taking all of the world away in the middle.
+    let rgba: Vec<u8> = (0..w * h)
+        .flat_map(|i| {
+            let (x, y) = (i % w, i / w);
+            let dark = (24..40).contains(&x) && (16..32).contains(&y);
+            [0, 0, 0, if dark { 255 } else { 0 }]
+        })
+        .collect();
+    std::fs::write(dir.path().join("t.png"), encode_png(&rgba, w, h).unwrap()).unwrap();
+    let scene_arg = scene.to_str().unwrap();
+    let whole = |extra: &[&str]| {
+        let mut args = through(scene_arg, extra);
+        args.push("--json".into());
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        json(&args, dir.path())["regions"][0]["psnr_db"]
+            .as_f64()
+            .unwrap()
+    };
+    // Through the panel the middle goes dark: far from the reference. A sharper panel darkens
+    // less of the view around it than a blurrier one, so the two differ.
+    let scene_blur = whole(&[]);
+    let blurrier = whole(&["--panel-blur-deg", "4"]);
+    assert!(scene_blur < 30.0, "{scene_blur} dB");
+    assert!(
+        (scene_blur - blurrier).abs() > 0.1,
+        "{scene_blur} vs {blurrier} dB"
+    );
+    // The option needs a dimmer scene, and a blur in range.
+    let plain = scene_path();
+    let plain = plain.to_str().unwrap();
+    let refused = |scene: &str, blur: &str| {
+        let args = through(scene, &[&format!("--panel-blur-deg={blur}")]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        vitreous(&args, dir.path())
+    };
+    let out = refused(plain, "2");
+    assert_clean_failure(&out, &["--panel-blur-deg", "segmented dimmer"]);
+    let out = refused(scene_arg, "-1");
+    assert_clean_failure(&out, &["--panel-blur-deg", "0 to 20 degrees"]);
+}

@@ -10,6 +10,7 @@ pub mod atomic_file;
 pub mod crossing;
 pub mod frame;
 pub mod import;
+pub mod light;
 pub mod null;
 pub mod openxr;
 pub mod planes;

@@ -8,9 +8,14 @@ use vitreous_render::ScenePose;
 use vitreous_xr::FrameInput;
 use vitreous_xr::trace::EditRecord;
 
+use vitreous_xr::light::{MIN_TURN_DEG, angle_deg, light_position_along};
+
 use crate::look::LookPlanner;
 use crate::render_desc;
 use crate::scene_edit::{EditState, SceneEdit, place_ray, ray_meets_plane};
+
+/// The action of the edit line that moves the light to the room's estimated light.
+pub const LIGHT_ESTIMATE_ACTION: &str = "light-estimate";
 use vitreous_scene::{CausticsMode, Motion, Placement, Scene, model_placement};
 
 /// Turns frame times into the scene's poses and counts the frames that moved. Owns what it
@@ -182,10 +187,38 @@ impl MotionClock {
         self.floor
     }
 
+    /// Turns the light about the object, at its distance, so that its light travels along
+    /// `direction` (the room's main light as the headset estimates it): an edit like the
+    /// keyboard's light moves, recorded as [`LIGHT_ESTIMATE_ACTION`]. `None`, and nothing done,
+    /// when the light already travels within [`MIN_TURN_DEG`] of it.
+    pub fn follow_light(&mut self, direction: Vec3, input: &FrameInput) -> Option<EditRecord> {
+        let base = self.keyed_placement(input.time_ns);
+        let now = self.edited(base);
+        let (center, light) = (now.object_position_m, now.light_position_m);
+        let turn = angle_deg(center - light, direction);
+        // A NaN turn (a zero direction) is no turn.
+        if turn.is_nan() || turn < MIN_TURN_DEG {
+            return None;
+        }
+        self.edits.light_offset_m += light_position_along(center, light, direction) - light;
+        let what = format!("the light turned {turn:.2} deg about the object to the room's light");
+        Some(self.applied_as(LIGHT_ESTIMATE_ACTION.into(), &what, input))
+    }
+
     /// Counts and logs (as `what`) an edit just applied; its trace line.
     fn applied(
         &mut self,
         edit: SceneEdit,
+        what: &dyn std::fmt::Display,
+        input: &FrameInput,
+    ) -> EditRecord {
+        self.applied_as(edit.action(), what, input)
+    }
+
+    /// Counts and logs (as `what`) an edit just applied; its trace line, named `action`.
+    fn applied_as(
+        &mut self,
+        action: String,
         what: &dyn std::fmt::Display,
         input: &FrameInput,
     ) -> EditRecord {
@@ -208,7 +241,7 @@ impl MotionClock {
             e.world_offset_m.y,
             e.world_offset_m.z,
         );
-        self.edits.record(input.time_ns, edit.action())
+        self.edits.record(input.time_ns, action)
     }
 
     /// Takes the edit state of a recorded edit line (`vitreous replay`), logged like the
@@ -339,6 +372,32 @@ mod tests {
             orientation: Quat::from_rotation_x(-std::f32::consts::FRAC_PI_4),
         };
         f
+    }
+
+    #[test]
+    fn the_light_turns_about_the_object_to_the_estimate_and_only_past_the_threshold() {
+        let mut c = clock(None);
+        let object = Vec3::new(0.3, 0.1, -0.5);
+        let light = Vec3::new(0.0, 1.0, -1.0);
+        let along = (object - light).normalize();
+        // The estimate agrees with the scene's light: nothing moves.
+        assert!(c.follow_light(along, &input(0)).is_none());
+        let nearly = Quat::from_rotation_y(0.2f32.to_radians()) * along;
+        assert!(c.follow_light(nearly, &input(1)).is_none());
+        assert_eq!(c.edit_count, 0);
+        // Turned 30 degrees about the vertical: the light goes round the object, as far away.
+        let turned = Quat::from_rotation_y(30f32.to_radians()) * along;
+        let record = c.follow_light(turned, &input(2)).expect("an edit");
+        assert_eq!(record.action, LIGHT_ESTIMATE_ACTION);
+        assert!(vitreous_xr::trace::valid_action(&record.action));
+        let now = c.placement(2).expect("the light moved");
+        let arm = now.light_position_m - now.object_position_m;
+        assert!((arm.length() - (light - object).length()).abs() < 1e-5);
+        assert!((arm.normalize() + turned).length() < 1e-5, "{arm}");
+        assert_eq!(now.object_position_m, object);
+        assert_eq!(c.edit_count, 1);
+        // The recorded state repeats it.
+        assert_eq!(EditState::of_record(&record), c.edits());
     }
 
     #[test]

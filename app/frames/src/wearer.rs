@@ -34,6 +34,15 @@ pub fn see_through(eye: &[u8], world: &[u8]) -> Vec<u8> {
         .collect()
 }
 
+/// The scene's field of view, degrees across and down.
+pub fn scene_fov_deg(scene: &vitreous_scene::Scene) -> [f32; 2] {
+    let fov = scene.output.fov;
+    [
+        (fov.angle_right_rad - fov.angle_left_rad).to_degrees(),
+        (fov.angle_up_rad - fov.angle_down_rad).to_degrees(),
+    ]
+}
+
 /// How the display composes its light with the real world for the eye.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WearerView {
@@ -59,15 +68,7 @@ impl WearerView {
 
     /// The display `scene` describes (`[display]`), for the scene's own field of view.
     pub fn of_scene(scene: &vitreous_scene::Scene) -> WearerView {
-        let fov = scene.output.fov;
-        WearerView::new(
-            scene.dimmer,
-            scene.global_dimmer,
-            [
-                (fov.angle_right_rad - fov.angle_left_rad).to_degrees(),
-                (fov.angle_up_rad - fov.angle_down_rad).to_degrees(),
-            ],
-        )
+        WearerView::new(scene.dimmer, scene.global_dimmer, scene_fov_deg(scene))
     }
 
     /// Whether the display takes any of the real world away (a dimmer of either kind).

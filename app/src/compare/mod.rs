@@ -47,6 +47,11 @@ pub struct CompareArgs {
     /// see-through display adds it to the real world.
     #[arg(long, requires = "seen")]
     pub display: bool,
+    /// With --display and a scene whose display has a segmented dimmer: the blur the wearer's
+    /// panel really has (standard deviation, degrees), instead of the scene's
+    /// `dimmer_blur_deg` that the image was drawn for. Shows what a mis-measured panel costs.
+    #[arg(long, value_name = "DEG", requires = "display", value_parser = parse_blur)]
+    pub panel_blur_deg: Option<f32>,
     /// Write the ꟻLIP error map here (PNG, the magma colour map: black no error, yellow most).
     #[arg(long, value_name = "FILE")]
     pub map: Option<PathBuf>,
@@ -60,6 +65,13 @@ fn parse_eye(s: &str) -> std::result::Result<Eye, String> {
         "left" => Ok(Eye::Left),
         "right" => Ok(Eye::Right),
         _ => Err(format!("expected left or right, found {s:?}")),
+    }
+}
+
+fn parse_blur(s: &str) -> std::result::Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && (0.0..=20.0).contains(&v) => Ok(v),
+        _ => Err(format!("expected a blur from 0 to 20 degrees, found {s:?}")),
     }
 }
 
@@ -257,6 +269,37 @@ pub fn rgb_of(rgba: &[u8]) -> Vec<u8> {
         .collect()
 }
 
+/// How the wearer of `scene`'s display sees (added light without a scene), with the dimmer's
+/// blur replaced by `panel_blur_deg` when given: an error unless the scene has a dimmer.
+fn wearer_view(
+    scene: Option<&vitreous_scene::Scene>,
+    panel_blur_deg: Option<f32>,
+) -> Result<WearerView> {
+    let Some(scene) = scene else {
+        if panel_blur_deg.is_some() {
+            bail!(
+                "--panel-blur-deg needs --scene with a segmented dimmer ([display] model = \"dimmer\")"
+            );
+        }
+        return Ok(WearerView::additive());
+    };
+    let Some(blur_deg) = panel_blur_deg else {
+        return Ok(WearerView::of_scene(scene));
+    };
+    let Some(dimmer) = scene.dimmer else {
+        bail!(
+            "--panel-blur-deg: {} has no segmented dimmer ([display] model = \"dimmer\")",
+            scene.path.display()
+        );
+    };
+    let dimmer = vitreous_render::DimmerDesc { blur_deg, ..dimmer };
+    Ok(WearerView::new(
+        Some(dimmer),
+        scene.global_dimmer,
+        vitreous_frames::wearer::scene_fov_deg(scene),
+    ))
+}
+
 /// `vitreous compare`.
 pub fn compare_command(args: CompareArgs) -> Result<()> {
     if let Some(map) = &args.map {
@@ -301,9 +344,7 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
     // dimmers, when it has any; else added).
     let test = match &seen {
         Some(seen) if args.display => {
-            let view = scene
-                .as_ref()
-                .map_or_else(WearerView::additive, WearerView::of_scene);
+            let view = wearer_view(scene.as_ref(), args.panel_blur_deg)?;
             add_light(&view, &test_rgba, seen, (w, h))
         }
         _ => rgb_of(&test_rgba),

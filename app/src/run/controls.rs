@@ -156,7 +156,7 @@ impl RunSink<'_> {
     }
 
     /// Writes an edit line into the recording, if any.
-    fn record(&mut self, record: &EditRecord) {
+    pub(super) fn record(&mut self, record: &EditRecord) {
         if let Some(w) = &mut self.writer
             && let Err(e) = w.write_edit(record)
         {

@@ -27,6 +27,7 @@ mod controls;
 mod device;
 mod readback;
 mod recording;
+mod room_light;
 mod summary;
 mod xr_session;
 
@@ -165,6 +166,10 @@ struct RunSink<'d> {
     focus_m: Option<f32>,
     /// The scene's global dimmer level (`[display] global_dimmer`).
     global_dimmer: Option<f32>,
+    /// The room's light as the runtime estimates it (XR_ML_light_estimation), as it comes.
+    light_rx: Option<std::sync::mpsc::Receiver<vitreous_xr::light::LightEstimate>>,
+    /// What the estimates did (`None`: none came).
+    room_light: Option<room_light::RoomLight>,
 }
 
 impl RunSink<'_> {
@@ -184,6 +189,7 @@ impl RunSink<'_> {
 impl FrameSink for RunSink<'_> {
     fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
         self.take_planes();
+        self.follow_room_light(input);
         self.apply_typed_controls(input);
         let placement = self.motion.placement(input.time_ns)?;
         let (center, pose) = (placement.object_position_m, self.motion.pose_of(&placement));
@@ -422,6 +428,8 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         edits,
         planes_rx: xr.session().take_planes(),
         planes: Vec::new(),
+        light_rx: xr.session().take_light_estimates(),
+        room_light: None,
         registrar: xr.session().command_sender(),
         looks: LiveConditions::new(
             conditions.iter().copied().zip(planners).collect(),
@@ -461,14 +469,38 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
     // The loop's error is the one reported; a clean-up failing after it (releasing the images
     // of a lost device) is logged.
     let format = xr.format();
+    let final_light = sink
+        .motion
+        .final_placement()
+        .map_or(scene.placement_at(0.0).light_position_m, |p| {
+            glam::Vec3::from_array(p.light_position_m)
+        });
     let closed = xr.close(|renderer| {
+        let centroids = options.readback_check.then(|| {
+            room_light::floor_centroids(
+                renderer,
+                scene.floor.world_from_plane(),
+                final_light,
+                sink.object_center_m,
+                sink.object_radius_m,
+            )
+        });
         (
             renderer.inducer_computations(),
+            centroids,
             ValidationSummary::of(renderer.context()),
         )
     });
     let report: SessionReport = closed.report;
-    let (inducer_computations, validation) = closed.after;
+    let (inducer_computations, centroids, validation) = closed.after;
+    let floor_centroids = match centroids {
+        Some(Ok(c)) => Some(c),
+        Some(Err(e)) => {
+            tracing::warn!("reading back the floor's fields at the end: {e:#}");
+            None
+        }
+        None => None,
+    };
     let recording_closed = match sink.writer.take() {
         Some(w) => w.finish().map(drop).context("closing the recording"),
         None => Ok(()),
@@ -546,6 +578,9 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         last_focus_distance_m: report.last_focus_distance_m,
         frames_with_global_dimmer: report.frames_with_global_dimmer,
         plane_detections: report.plane_detections,
+        light_estimates: report.light_estimates,
+        room_light: sink.room_light.clone(),
+        floor_centroids,
         gaze_image_switches: sink.log.gaze_image_switches(),
         separability: sink.log.separability_summary(),
         pupil: sink.log.pupil_summary(sink.looks.pupil_source()),

@@ -110,6 +110,13 @@ pub struct RunSummary {
     pub frames_with_global_dimmer: u64,
     /// Plane detections the runtime finished (XR_EXT_plane_detection; 0 without it).
     pub plane_detections: u64,
+    /// Light estimates read from the runtime (XR_ML_light_estimation; 0 without it).
+    pub light_estimates: u64,
+    /// What the room's light estimates did to the scene's light (`null`: none came).
+    pub room_light: Option<super::room_light::RoomLight>,
+    /// With `--readback-check`: where the shadow and the caustic lay on the floor at the end
+    /// (`null` otherwise).
+    pub floor_centroids: Option<super::room_light::FloorCentroids>,
     /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
     pub gaze_image_switches: u64,
     /// How far apart the two images are in the tracker's vergence noise, the noise estimated

@@ -113,7 +113,7 @@ impl XrSession {
     /// Detaches the swapchain images and ends the session, then reads `after` from the
     /// renderer (e.g. the validation layers' messages, with those of the session's end), then
     /// lets the renderer and the runtime go.
-    pub fn close<T>(mut self, after: impl FnOnce(&Renderer) -> T) -> Closed<T> {
+    pub fn close<T>(mut self, after: impl FnOnce(&mut Renderer) -> T) -> Closed<T> {
         let detached = self
             .renderer
             .detach_external()
@@ -127,7 +127,7 @@ impl XrSession {
         Closed {
             detached,
             report,
-            after: after(&self.renderer),
+            after: after(&mut self.renderer),
         }
     }
 }

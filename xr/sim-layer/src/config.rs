@@ -15,6 +15,11 @@
 //! - `VITREOUS_SIM_PLANES`: `x,y,z,w,d` level rectangles facing up, separated by `;` (centre in
 //!   metres in the frame of the head's level pose when a detection begins, width along x and
 //!   depth along z): offered through XR_EXT_plane_detection (`crate::calls::planes`).
+//! - `VITREOUS_SIM_LIGHT`: `x,y,z,r,g,b,a` and optionally `,turn_deg,at_s`: the room's light
+//!   offered through XR_ML_light_estimation (`crate::calls::light`): the way the main light
+//!   travels (in the frame of the head's level pose when the estimation is made), its colour
+//!   (the irradiance it gives a surface facing it), a uniform ambient radiance `a`, and a turn
+//!   of the main light by `turn_deg` about +y `at_s` seconds after the estimation was made.
 
 use std::ffi::CStr;
 use std::fmt;
@@ -41,6 +46,10 @@ pub const ML_FRAME_VAR: &str = "VITREOUS_SIM_ML_FRAME";
 pub const PLANES_VAR: &str = "VITREOUS_SIM_PLANES";
 /// The plane detection extension's name.
 pub const PLANE_DETECTION: &CStr = c"XR_EXT_plane_detection";
+/// Environment variable describing the light XR_ML_light_estimation estimates.
+pub const LIGHT_VAR: &str = "VITREOUS_SIM_LIGHT";
+/// The light estimation extension's name.
+pub const LIGHT_ESTIMATION: &CStr = c"XR_ML_light_estimation";
 /// The sides `VITREOUS_SIM_EYE_MAX` takes, pixels.
 pub const EYE_MAX_RANGE: std::ops::RangeInclusive<u32> = 16..=16384;
 
@@ -133,6 +142,69 @@ pub struct Config {
     pub ml_frame: bool,
     /// The planes XR_EXT_plane_detection finds (none: the extension is not the layer's).
     pub planes: Vec<SimPlane>,
+    /// The light XR_ML_light_estimation estimates (`None`: the extension is not the layer's).
+    pub light: Option<SimLight>,
+}
+
+/// The room's light, as `VITREOUS_SIM_LIGHT` gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimLight {
+    /// The way the main light travels (unit), in the frame of the head's level pose when the
+    /// estimation is made.
+    pub direction: glam::Vec3,
+    /// The main light's colour: the irradiance it gives a surface facing it (linear RGB).
+    pub color: glam::Vec3,
+    /// The ambient light's radiance, the same from every direction.
+    pub ambient: f32,
+    /// A turn of the main light about +y, degrees, and how long after the estimation was made
+    /// it happens, seconds.
+    pub turn: Option<(f32, f64)>,
+}
+
+impl SimLight {
+    /// The way the main light travels `elapsed_s` seconds after the estimation was made.
+    pub fn direction_at(&self, elapsed_s: f64) -> glam::Vec3 {
+        match self.turn {
+            Some((deg, at_s)) if elapsed_s >= at_s => {
+                glam::Quat::from_rotation_y(deg.to_radians()) * self.direction
+            }
+            _ => self.direction,
+        }
+    }
+}
+
+/// Parses `VITREOUS_SIM_LIGHT`.
+pub fn parse_light(value: &str) -> Result<SimLight, ConfigError> {
+    let bad = || ConfigError {
+        var: LIGHT_VAR,
+        value: value.to_owned(),
+        expected: "x,y,z,r,g,b,a[,turn_deg,at_s]: a direction that is not zero, colour and \
+                   ambient at least 0, a turn time at least 0",
+    };
+    let v: Vec<f32> = value
+        .split(',')
+        .map(|n| n.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    if !v.iter().all(|n| n.is_finite()) {
+        return Err(bad());
+    }
+    let (base, turn) = match v[..] {
+        [.., deg, at] if v.len() == 9 && at >= 0.0 => (&v[..7], Some((deg, f64::from(at)))),
+        _ if v.len() == 7 => (&v[..], None),
+        _ => return Err(bad()),
+    };
+    let direction = glam::Vec3::new(base[0], base[1], base[2]);
+    let color = glam::Vec3::new(base[3], base[4], base[5]);
+    if direction.length() < 1e-6 || color.min_element() < 0.0 || base[6] < 0.0 {
+        return Err(bad());
+    }
+    Ok(SimLight {
+        direction: direction.normalize(),
+        color,
+        ambient: base[6],
+        turn,
+    })
 }
 
 /// A level rectangle facing up, as `VITREOUS_SIM_PLANES` gives it.
@@ -195,6 +267,7 @@ impl Config {
                 .map(|v| parse_planes(&v))
                 .transpose()?
                 .unwrap_or_default(),
+            light: get(LIGHT_VAR).map(|v| parse_light(&v)).transpose()?,
             ml_frame: match get(ML_FRAME_VAR).as_deref().map(str::trim) {
                 None | Some("0") => false,
                 Some("1") => true,
@@ -328,6 +401,32 @@ mod tests {
         for bad in ["0,0,0,1", "0,0,0,1,0", "a,0,0,1,1", "0,0,nan,1,1"] {
             let e = config(&[(PLANES_VAR, bad)]).unwrap_err();
             assert_eq!(e.var, PLANES_VAR, "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_light_is_a_direction_colour_and_ambient_with_an_optional_turn() {
+        let c = config(&[(LIGHT_VAR, "0,-2,0, 3,3,3, 0.25")]).unwrap();
+        let light = c.light.unwrap();
+        assert_eq!(light.direction, glam::Vec3::NEG_Y);
+        assert_eq!((light.ambient, light.turn), (0.25, None));
+        let turned = parse_light("0,0,-1,1,1,1,0,30,2.5").unwrap();
+        assert_eq!(turned.turn, Some((30.0, 2.5)));
+        assert_eq!(turned.direction_at(2.4), glam::Vec3::NEG_Z);
+        let after = turned.direction_at(2.5);
+        assert!((after.angle_between(glam::Vec3::NEG_Z).to_degrees() - 30.0).abs() < 1e-3);
+        assert!(config(&[]).unwrap().light.is_none());
+        for bad in [
+            "0,0,0,1,1,1,0",
+            "0,-1,0,1,1",
+            "0,-1,0,-1,1,1,0",
+            "0,-1,0,1,1,1,-0.1",
+            "0,-1,0,1,1,1,0,30",
+            "0,-1,0,1,1,1,0,30,-1",
+            "0,-1,nan,1,1,1,0",
+        ] {
+            let e = config(&[(LIGHT_VAR, bad)]).unwrap_err();
+            assert_eq!(e.var, LIGHT_VAR, "{bad}");
         }
     }
 

@@ -187,6 +187,7 @@ unsafe extern "system" fn create_api_layer_instance(
             &prepared.config.gaze,
             prepared.config.ml_frame,
             !prepared.config.planes.is_empty(),
+            prepared.config.light.is_some(),
         );
         // The layer's extensions it does not offer go on to the runtime, which may have them
         // (Monado lists XR_EXT_eye_gaze_interaction) or refuses them.
@@ -260,6 +261,7 @@ unsafe extern "system" fn create_api_layer_instance(
             button_actions: HashMap::new(),
             attached: false,
             planes: split.planes,
+            light: split.light,
         };
         registry()
             .instances
@@ -364,6 +366,53 @@ fn plane_function(name: &[u8]) -> Option<Option<pfn::VoidFunction>> {
         b"xrGetPlanePolygonBufferEXT" => entry!(
             planes::get_plane_polygon_buffer,
             pfn::GetPlanePolygonBufferEXT
+        ),
+        _ => return None,
+    })
+}
+
+/// The layer's XR_ML_light_estimation function of that name, if it is one.
+fn light_function(name: &[u8]) -> Option<Option<pfn::VoidFunction>> {
+    use calls::light;
+    use vitreous_xr::openxr::ml_light_estimation as ml;
+    Some(match name {
+        b"xrCreateLightEstimationML" => {
+            entry!(light::create_light_estimation, ml::CreateLightEstimationML)
+        }
+        b"xrDestroyLightEstimationML" => {
+            entry!(
+                light::destroy_light_estimation,
+                ml::DestroyLightEstimationML
+            )
+        }
+        b"xrGetLightEstimationStateML" => {
+            entry!(
+                light::get_light_estimation_state,
+                ml::GetLightEstimationStateML
+            )
+        }
+        b"xrCreateLightEstimationEstimateML" => entry!(
+            light::create_light_estimation_estimate,
+            ml::CreateLightEstimationEstimateML
+        ),
+        b"xrDestroyLightEstimationEstimateML" => entry!(
+            light::destroy_light_estimation_estimate,
+            ml::DestroyLightEstimationEstimateML
+        ),
+        b"xrGetLightEstimationTimestampML" => entry!(
+            light::get_light_estimation_timestamp,
+            ml::GetLightEstimationTimestampML
+        ),
+        b"xrGetLightEstimationHDRCubemapML" => {
+            entry!(light::get_hdr_cubemap, ml::GetLightEstimationHdrCubemapML)
+        }
+        b"xrGetLightEstimationMainDirectionalLightML" => entry!(
+            light::get_main_directional_light,
+            ml::GetLightEstimationMainDirectionalLightML
+        ),
+        b"xrGetLightEstimationSphericalHarmonicsML" => entry!(
+            light::get_spherical_harmonics,
+            ml::GetLightEstimationSphericalHarmonicsML
         ),
         _ => return None,
     })
@@ -570,6 +619,22 @@ unsafe extern "system" fn get_instance_proc_addr(
                 reg.instances
                     .get(&sys::Handle::into_raw(instance))
                     .map_or((false, false), |i| (i.planes, !i.config.planes.is_empty()))
+            };
+            if enabled {
+                *function = f;
+                return sys::Result::SUCCESS;
+            }
+            if offered || next.is_none() {
+                return sys::Result::ERROR_FUNCTION_UNSUPPORTED;
+            }
+        }
+        // XR_ML_light_estimation's functions: likewise.
+        if let Some(f) = light_function(name_c.to_bytes()) {
+            let (enabled, offered) = {
+                let reg = registry();
+                reg.instances
+                    .get(&sys::Handle::into_raw(instance))
+                    .map_or((false, false), |i| (i.light, i.config.light.is_some()))
             };
             if enabled {
                 *function = f;

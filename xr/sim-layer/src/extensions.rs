@@ -21,10 +21,13 @@ pub struct Split<'a> {
     pub not_offered: Vec<GazeExtension>,
     /// The app enabled XR_EXT_plane_detection, which the layer answers.
     pub planes: bool,
+    /// The app enabled XR_ML_light_estimation, which the layer answers.
+    pub light: bool,
 }
 
 /// Splits `enabled` into what the layer handles (those in `offered`, the ML frame controls
-/// when `ml_frame`, XR_EXT_plane_detection when `planes`) and what goes on. An eye extension of
+/// when `ml_frame`, XR_EXT_plane_detection when `planes`, XR_ML_light_estimation when `light`)
+/// and what goes on. An eye extension of
 /// the layer that is not offered is reported in `not_offered` and also passed on (the runtime
 /// may have it).
 pub fn split<'a>(
@@ -32,12 +35,14 @@ pub fn split<'a>(
     offered: &[GazeExtension],
     ml_frame: bool,
     planes: bool,
+    light: bool,
 ) -> Split<'a> {
     let mut out = Split {
         forwarded: Vec::with_capacity(enabled.len()),
         owned: Vec::new(),
         not_offered: Vec::new(),
         planes: false,
+        light: false,
     };
     for &name in enabled {
         if ml_frame && ML_FRAME_EXTENSIONS.contains(&name) {
@@ -45,6 +50,10 @@ pub fn split<'a>(
         }
         if planes && name == crate::config::PLANE_DETECTION {
             out.planes = true;
+            continue;
+        }
+        if light && name == crate::config::LIGHT_ESTIMATION {
+            out.light = true;
             continue;
         }
         match GazeExtension::from_name(name) {
@@ -79,7 +88,7 @@ mod tests {
             c"XR_FB_eye_tracking_social",
             c"XR_EXT_eye_gaze_interaction",
         ];
-        let s = split(&enabled, &GazeExtension::ALL, false, false);
+        let s = split(&enabled, &GazeExtension::ALL, false, false, false);
         assert_eq!(
             s.forwarded,
             vec![c"XR_KHR_vulkan_enable2", c"XR_KHR_composition_layer_depth"]
@@ -95,27 +104,38 @@ mod tests {
             c"XR_KHR_vulkan_enable2",
             c"XR_ML_global_dimmer",
         ];
-        let s = split(&enabled, &[], true, false);
+        let s = split(&enabled, &[], true, false, false);
         assert_eq!(s.forwarded, vec![c"XR_KHR_vulkan_enable2"]);
-        let s = split(&enabled, &[], false, false);
+        let s = split(&enabled, &[], false, false, false);
         assert_eq!(s.forwarded, enabled.to_vec());
     }
 
     #[test]
     fn plane_detection_stays_with_the_layer_only_when_it_has_planes() {
         let enabled = [c"XR_EXT_plane_detection", c"XR_KHR_vulkan_enable2"];
-        let s = split(&enabled, &[], false, true);
+        let s = split(&enabled, &[], false, true, false);
         assert_eq!(s.forwarded, vec![c"XR_KHR_vulkan_enable2"]);
         assert!(s.planes);
-        let s = split(&enabled, &[], false, false);
+        let s = split(&enabled, &[], false, false, false);
         assert_eq!(s.forwarded, enabled.to_vec());
         assert!(!s.planes);
     }
 
     #[test]
+    fn light_estimation_stays_with_the_layer_only_when_it_has_a_light() {
+        let enabled = [c"XR_ML_light_estimation", c"XR_KHR_vulkan_enable2"];
+        let s = split(&enabled, &[], false, false, true);
+        assert_eq!(s.forwarded, vec![c"XR_KHR_vulkan_enable2"]);
+        assert!(s.light && !s.planes);
+        let s = split(&enabled, &[], false, false, false);
+        assert_eq!(s.forwarded, enabled.to_vec());
+        assert!(!s.light);
+    }
+
+    #[test]
     fn extensions_not_offered_are_passed_on_and_reported() {
         let enabled = [c"XR_ML_eye_tracker", c"XR_EXT_eye_gaze_interaction"];
-        let s = split(&enabled, &[Ext], false, false);
+        let s = split(&enabled, &[Ext], false, false, false);
         assert_eq!(s.forwarded, vec![c"XR_ML_eye_tracker"]);
         assert_eq!(s.owned, vec![Ext]);
         assert_eq!(s.not_offered, vec![Ml]);
@@ -123,7 +143,7 @@ mod tests {
 
     #[test]
     fn nothing_enabled_gives_nothing() {
-        let s = split(&[], &GazeExtension::ALL, false, false);
+        let s = split(&[], &GazeExtension::ALL, false, false, false);
         assert!(s.forwarded.is_empty() && s.owned.is_empty());
     }
 }

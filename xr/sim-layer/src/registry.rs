@@ -39,6 +39,8 @@ pub struct InstanceState {
     pub attached: bool,
     /// The app enabled XR_EXT_plane_detection, which the layer answers.
     pub planes: bool,
+    /// The app enabled XR_ML_light_estimation, which the layer answers.
+    pub light: bool,
 }
 
 impl InstanceState {
@@ -102,6 +104,33 @@ pub struct DetectorState {
     pub detection: Option<(sys::Space, Pose, usize)>,
 }
 
+/// A light estimation the layer made.
+#[derive(Clone, Copy, Debug)]
+pub struct EstimationState {
+    /// The session's raw handle.
+    pub session: u64,
+    /// The space the estimates' directions are in.
+    pub base_space: sys::Space,
+    /// The head's level pose in that space when the estimation was made: the frame the
+    /// configured light is in.
+    pub anchor: Pose,
+    /// When it was made (its create info's time), nanoseconds.
+    pub made_ns: i64,
+    /// The cube map's face side, texels.
+    pub face_side: u32,
+}
+
+/// One estimate the layer handed out: what it says, fixed when it was made.
+#[derive(Clone, Copy, Debug)]
+pub struct EstimateState {
+    /// The estimation's raw handle.
+    pub estimation: u64,
+    /// The way the main light travels, in the estimation's base space.
+    pub direction: glam::Vec3,
+    /// When it was estimated, nanoseconds.
+    pub time_ns: i64,
+}
+
 /// All of the layer's state.
 pub struct Registry {
     /// Instances by handle.
@@ -114,6 +143,10 @@ pub struct Registry {
     pub trackers: HashMap<u64, TrackerState>,
     /// Plane detectors by the handle the layer gave them.
     pub detectors: HashMap<u64, DetectorState>,
+    /// Light estimations by the handle the layer gave them.
+    pub estimations: HashMap<u64, EstimationState>,
+    /// Light estimates by the handle the layer gave them.
+    pub estimates: HashMap<u64, EstimateState>,
     /// The next handle the layer gives out.
     next_handle: u64,
 }
@@ -131,6 +164,8 @@ impl Registry {
             spaces: HashMap::new(),
             trackers: HashMap::new(),
             detectors: HashMap::new(),
+            estimations: HashMap::new(),
+            estimates: HashMap::new(),
             next_handle: FIRST_HANDLE,
         }
     }
@@ -212,6 +247,10 @@ impl Registry {
         self.spaces.retain(|_, s| s.session != session);
         self.trackers.retain(|_, t| t.session != session);
         self.detectors.retain(|_, d| d.session != session);
+        let estimations = &mut self.estimations;
+        estimations.retain(|_, e| e.session != session);
+        self.estimates
+            .retain(|_, e| estimations.contains_key(&e.estimation));
         self.sessions.remove(&session)
     }
 

@@ -42,7 +42,7 @@ pub(super) struct MlTracker {
 ///
 /// # Safety
 /// `T` must be the function pointer type of the function named `name`.
-unsafe fn load<T: Copy>(instance: &xr::Instance, name: &CStr) -> Result<T> {
+pub(super) unsafe fn load<T: Copy>(instance: &xr::Instance, name: &CStr) -> Result<T> {
     let mut f: Option<xr::sys::pfn::VoidFunction> = None;
     // SAFETY: a live instance and a nul-terminated name; `f` outlives the call.
     let r = unsafe {

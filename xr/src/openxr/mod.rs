@@ -29,7 +29,9 @@ pub mod choose;
 mod convert;
 mod error;
 mod gaze;
+mod light_estimator;
 pub mod ml_eye_tracker;
+pub mod ml_light_estimation;
 mod ml_tracker;
 mod planes;
 mod session;
@@ -119,6 +121,8 @@ pub struct Runtime {
     ml_dimmer: bool,
     /// XR_EXT_plane_detection is enabled: the session detects the room's upward planes.
     planes: bool,
+    /// XR_ML_light_estimation is enabled: the scene's light follows the room's.
+    light: bool,
     /// The Vulkan instance made through the runtime, for the device steps.
     vk_instance: Option<vk::Instance>,
 }
@@ -160,6 +164,12 @@ impl Runtime {
         let ml_gaze = available.other.contains(&ml_name);
         if ml_gaze {
             wanted.other.push(ml_name);
+        }
+        // XR_ML_light_estimation, Magic Leap 2's estimate of the room's light: likewise.
+        let light_name = nul_terminated(ml_light_estimation::EXTENSION_NAME);
+        let light = available.other.contains(&light_name);
+        if light {
+            wanted.other.push(light_name);
         }
         let mut layers = Vec::new();
         if options.validation {
@@ -304,6 +314,7 @@ impl Runtime {
             ml_frame_end: wanted.ml_frame_end_info,
             ml_dimmer: wanted.ml_global_dimmer,
             planes: wanted.ext_plane_detection,
+            light,
             vk_instance: None,
         })
     }
@@ -418,9 +429,14 @@ struct GazeSupport {
 
 /// XR_ML_eye_tracker's name as the `openxr` crate lists unknown extensions (nul-terminated).
 fn ml_extension_name() -> Vec<u8> {
-    let mut name = ml_eye_tracker::EXTENSION_NAME.as_bytes().to_vec();
-    name.push(0);
-    name
+    nul_terminated(ml_eye_tracker::EXTENSION_NAME)
+}
+
+/// An extension's name as `xr::ExtensionSet::other` holds it: nul-terminated bytes.
+fn nul_terminated(name: &str) -> Vec<u8> {
+    let mut bytes = name.as_bytes().to_vec();
+    bytes.push(0);
+    bytes
 }
 
 /// Asks the system which of the enabled eye-tracking extensions it supports.

@@ -9,8 +9,10 @@
 //! ```
 //!
 //! The argument is the number of frames (default 30). Exits with status 1, naming the call,
-//! when a call fails or an answer is not what the layer promises.
+//! when a call fails or an answer is not what the layer promises. When the layer offers
+//! XR_ML_light_estimation (`VITREOUS_SIM_LIGHT`), its calls are probed too ([`light`]).
 
+mod light;
 mod spec;
 
 use std::ffi::c_void;
@@ -77,7 +79,27 @@ fn probe(frames: u32) -> Probe<()> {
     exts.mnd_headless = true;
     exts.fb_eye_tracking_social = true;
     exts.ext_eye_gaze_interaction = true;
-    exts.other = vec![ml::EXTENSION_NAME.as_bytes().to_vec()];
+    // `other` names go to the loader as they are: NUL-terminated.
+    let nul = |name: &str| [name.as_bytes(), &[0]].concat();
+    exts.other = vec![nul(ml::EXTENSION_NAME)];
+    let light_name = vitreous_xr::openxr::ml_light_estimation::EXTENSION_NAME;
+    let offered = entry
+        .enumerate_extensions()
+        .map_err(|e| format!("xrEnumerateInstanceExtensionProperties: {e}"))?;
+    let light_config = match std::env::var("VITREOUS_SIM_LIGHT") {
+        Ok(v) if !v.trim().is_empty() => {
+            Some(vitreous_sim_layer::config::parse_light(&v).map_err(|e| e.to_string())?)
+        }
+        _ => None,
+    };
+    let probe_light = light_config.is_some()
+        && offered
+            .other
+            .iter()
+            .any(|n| n.strip_suffix(&[0]).unwrap_or(n) == light_name.as_bytes());
+    if probe_light {
+        exts.other.push(nul(light_name));
+    }
     let instance = entry
         .create_instance(
             &xr::ApplicationInfo {
@@ -218,6 +240,7 @@ fn probe(frames: u32) -> Probe<()> {
     let mut ended = 0u32;
     let mut buffer = xr::EventDataBuffer::new();
     let mut fixation_seen = 0u32;
+    let mut last_time = None;
     while ended < frames {
         while let Some(event) = instance
             .poll_event(&mut buffer)
@@ -244,6 +267,7 @@ fn probe(frames: u32) -> Probe<()> {
         }
         let state = waiter.wait().map_err(|e| format!("xrWaitFrame: {e}"))?;
         let t = state.predicted_display_time;
+        last_time = Some(t);
         if !located {
             spec::locate(&instance, &gaze, local.as_raw(), t)?;
             located = true;
@@ -370,6 +394,22 @@ fn probe(frames: u32) -> Probe<()> {
         )?;
     }
     println!("fixation valid in {fixation_seen} of {ended} frames");
+    match (light_config, last_time) {
+        (Some(l), Some(t)) if probe_light => light::checks(
+            &instance,
+            session.as_raw(),
+            local.as_raw(),
+            t,
+            l.color,
+            l.ambient,
+        )?,
+        (Some(_), _) => {
+            return Err(
+                "VITREOUS_SIM_LIGHT is set but the layer offers no XR_ML_light_estimation".into(),
+            );
+        }
+        _ => println!("XR_ML_light_estimation not offered (no VITREOUS_SIM_LIGHT): not probed"),
+    }
     session
         .request_exit()
         .map_err(|e| format!("xrRequestExitSession: {e}"))?;

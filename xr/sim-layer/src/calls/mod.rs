@@ -8,6 +8,7 @@ pub mod actions;
 pub mod controller;
 pub mod fb;
 pub mod instance;
+pub mod light;
 pub mod ml;
 pub mod planes;
 pub mod session;

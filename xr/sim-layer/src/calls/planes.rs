@@ -61,7 +61,7 @@ pub unsafe extern "system" fn destroy_plane_detector(handle: sys::PlaneDetectorE
 
 /// The head's level pose in `base` at `time`: its position, turned about `base`'s +y to face
 /// where the head faces.
-fn level_head(ctx: &SessionContext, base: sys::Space, time: sys::Time) -> Option<Pose> {
+pub(crate) fn level_head(ctx: &SessionContext, base: sys::Space, time: sys::Time) -> Option<Pose> {
     let (head, _) = ctx.head_to_base(base, time)?;
     let f = head.orientation * Vec3::NEG_Z;
     let yaw = if f.x.abs() < 1e-6 && f.z.abs() < 1e-6 {

@@ -220,11 +220,24 @@ pub(in crate::openxr) unsafe fn start(
         );
         None
     };
+    let (light_tx, light_rx) = mpsc::channel();
+    let light = if rt.light {
+        super::super::light_estimator::LightEstimator::load(&rt.instance)
+    } else {
+        tracing::info!(
+            "the runtime estimates no light (no XR_ML_light_estimation): the light is the scene \
+             file's"
+        );
+        None
+    };
     Ok((
         Session {
             planes,
             planes_tx,
             planes_rx: Some(planes_rx),
+            light,
+            light_tx,
+            light_rx: Some(light_rx),
             stream,
             waiter,
             swapchain,

@@ -130,6 +130,7 @@ impl Session {
         self.apply_injected(head_m);
         let world_from_space = self.world_from_space.unwrap_or(placed);
         self.poll_planes(display, &head_space, &world_from_space);
+        self.poll_light(display, &world_from_space);
         let sampled = self
             .gaze
             .sample(&self.session, &self.view_space, display, first_display);

@@ -97,6 +97,8 @@ pub struct SessionReport {
     pub frames_with_global_dimmer: u64,
     /// Plane detections finished (XR_EXT_plane_detection).
     pub plane_detections: u64,
+    /// Light estimates read (XR_ML_light_estimation).
+    pub light_estimates: u64,
 }
 
 impl SessionReport {
@@ -115,6 +117,13 @@ pub struct Session {
     planes_tx: mpsc::Sender<Vec<crate::planes::DetectedPlane>>,
     /// The app's end, until taken (see [`Session::take_planes`]).
     planes_rx: Option<mpsc::Receiver<Vec<crate::planes::DetectedPlane>>>,
+    /// The light estimation, when the runtime has XR_ML_light_estimation; dropped before the
+    /// session.
+    light: Option<super::light_estimator::LightEstimator>,
+    /// Where each new light estimate (in the scene frame) goes for the app.
+    light_tx: mpsc::Sender<crate::light::LightEstimate>,
+    /// The app's end, until taken (see [`Session::take_light_estimates`]).
+    light_rx: Option<mpsc::Receiver<crate::light::LightEstimate>>,
     /// Frame submission; dropped before the session.
     stream: xr::FrameStream<xr::Vulkan>,
     /// Frame pacing.
@@ -235,6 +244,35 @@ impl Session {
                 tracing::info!("XR_EXT_plane_detection: {} upward planes", scene.len());
             }
             let _ = self.planes_tx.send(scene);
+        }
+    }
+
+    /// The receiving end of the room's light as the runtime estimates it
+    /// (XR_ML_light_estimation): each new estimate, in the scene frame; taken once (`None`
+    /// after).
+    pub fn take_light_estimates(&mut self) -> Option<mpsc::Receiver<crate::light::LightEstimate>> {
+        self.light_rx.take()
+    }
+
+    /// Moves light estimation on for the frame shown at `time`, and hands a new estimate to
+    /// the app in the scene frame (`world_from_space`).
+    pub(super) fn poll_light(&mut self, time: xr::Time, world_from_space: &Pose) {
+        let Some(estimator) = &mut self.light else {
+            return;
+        };
+        if let Some(estimate) = estimator.poll(&self.session, &self.space, time) {
+            self.report.light_estimates = estimator.estimates;
+            let scene = estimate.rotated(world_from_space.orientation);
+            if estimator.estimates == 1 {
+                tracing::info!(
+                    "XR_ML_light_estimation: the main light travels along ({:.3}, {:.3}, {:.3}) \
+                     in the scene",
+                    scene.direction.x,
+                    scene.direction.y,
+                    scene.direction.z
+                );
+            }
+            let _ = self.light_tx.send(scene);
         }
     }
 

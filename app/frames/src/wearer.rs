@@ -116,7 +116,17 @@ impl WearerView {
         if !self.dims() {
             return see_through(eye, world);
         }
-        see_through(eye, &self.dimmed_world(eye, world, size))
+        // One rounding to 8 bits, of the sum: the dimmed world is not rounded on its own.
+        let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+        let passed = self.passed(eye, size);
+        eye.chunks_exact(4)
+            .zip(world.chunks_exact(4))
+            .zip(&passed)
+            .flat_map(|((e, w), &p)| {
+                let c = |c: usize| linear_to_srgb(lut[e[c] as usize] + p * lut[w[c] as usize]);
+                [c(0), c(1), c(2), 255]
+            })
+            .collect()
     }
 }
 
@@ -134,6 +144,22 @@ mod tests {
         // Half the world's light (0.216 linear -> 0.108) and all the display's.
         assert_eq!(dimmed[0], linear_to_srgb(0.5 * srgb_to_linear(128)));
         assert_eq!(&dimmed[4..7], &[255, 255, 255]);
+    }
+
+    #[test]
+    fn the_eye_sees_the_sum_rounded_once() {
+        // A dark world pixel half passed, plus a little display light: rounding the dimmed
+        // world to 8 bits first would lose the half step the sum keeps.
+        let eye = [1u8, 1, 1, 0];
+        let world = [27u8, 27, 27, 255];
+        let seen = WearerView::new(None, Some(0.5), [40.0, 30.0]).see(&eye, &world, [1, 1]);
+        let want = linear_to_srgb(srgb_to_linear(1) + 0.5 * srgb_to_linear(27));
+        assert_eq!(seen[..3], [want; 3]);
+        let rounded_twice = see_through(
+            &eye,
+            &WearerView::new(None, Some(0.5), [40.0, 30.0]).dimmed_world(&eye, &world, [1, 1]),
+        );
+        assert_ne!(rounded_twice[0], want, "the case must tell the two apart");
     }
 
     #[test]

@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
+use vitreous::reference_cmd::frame_of_image;
 use vitreous::render_desc::eye_params;
 use vitreous::replay::{ReplayOptions, replay};
 use vitreous::scene::load_scene;
@@ -280,11 +281,22 @@ fn compare_reference_measures_every_saved_eye_against_the_physical_reference() {
         ..options("glass-sphere-real.toml", None, dir.path())
     };
     let summary = replay(&opts).expect("replay succeeds with validation on");
-    // Two saved frames (0 and 15), each eye: its image, preview, reference and seen image.
-    assert_eq!(summary.saved.len(), 2 * 2 * 4, "{:?}", summary.saved);
+    // Two saved frames (0 and 15), each eye: its image, preview, reference and seen image;
+    // and the reference.json that says which frame and eye each reference is.
+    assert_eq!(summary.saved.len(), 2 * 2 * 4 + 1, "{:?}", summary.saved);
     for name in ["000015-left-real.png", "000015-right-seen.png"] {
         assert!(dir.path().join("frames").join(name).is_file(), "{name}");
     }
+    // `vitreous compare` finds a reference's frame there (its regions follow that frame's eye,
+    // not the neutral head's).
+    let frames = dir.path().join("frames");
+    let (left, eye) = frame_of_image(&frames.join("000015-left-real.png")).expect("listed");
+    assert_eq!((left.frame, eye), (15, 0));
+    let (right, eye) = frame_of_image(&frames.join("000015-right-real.png")).expect("listed");
+    assert_eq!((right.frame, eye), (15, 1));
+    let ipd =
+        Vec3::from_array(right.eyes[1].position_m) - Vec3::from_array(right.eyes[0].position_m);
+    assert!((ipd.length() - 0.063).abs() < 0.002, "{ipd}");
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
     let figures = json["compare_reference"].as_array().unwrap();

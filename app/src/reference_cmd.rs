@@ -134,7 +134,8 @@ pub struct EyeRecord {
 }
 
 impl EyeRecord {
-    fn of(view: &EyeView) -> EyeRecord {
+    /// The record of `view`.
+    pub fn of(view: &EyeView) -> EyeRecord {
         let f = view.fov;
         EyeRecord {
             position_m: view.pose.position.to_array(),
@@ -231,17 +232,51 @@ pub struct Report {
     pub frames: Vec<FrameReport>,
 }
 
+impl Report {
+    /// The report of `frames` of `scene` (read from `scene_path`) seen along `trace` (or
+    /// `neutral head`), rendered at `size` with `settings`.
+    pub fn new(
+        scene: &Scene,
+        scene_path: &Path,
+        trace: String,
+        size: (u32, u32),
+        settings: &ReferenceSettings,
+        frames: Vec<FrameReport>,
+    ) -> Report {
+        Report {
+            vitreous_version: env!("CARGO_PKG_VERSION").into(),
+            scene: scene_path.display().to_string(),
+            scene_hash: scene.hash.clone(),
+            trace,
+            width_px: size.0,
+            height_px: size.1,
+            samples_per_pixel: settings.samples_per_side * settings.samples_per_side,
+            texel_mm: settings.photons.texel_m * 1000.0,
+            photons_per_texel: settings.photons.photons_per_texel,
+            light_share: scene.light.share,
+            object: if scene.object.is_ball() {
+                "analytic ball".into()
+            } else {
+                "closed mesh".into()
+            },
+            frames,
+        }
+    }
+}
+
 /// The frame and eye of a reference image, from the `reference.json` beside it (`None` when
-/// there is none, or it does not list the image).
+/// there is none, or it does not list the image): `NNNNNN-left.png` as `vitreous reference`
+/// names it, or `NNNNNN-left-real.png` as `replay --compare-reference` does.
 pub fn frame_of_image(image: &Path) -> Option<(FrameReport, usize)> {
     let folder = image.parent()?;
     let name = image.file_name()?.to_str()?;
     let bytes = std::fs::read(folder.join("reference.json")).ok()?;
     let report: Report = serde_json::from_slice(&bytes).ok()?;
     report.frames.into_iter().find_map(|f| {
-        let eye = EYE_NAMES
-            .iter()
-            .position(|e| name == format!("{:06}-{e}.png", f.frame))?;
+        let eye = EYE_NAMES.iter().position(|e| {
+            let stem = format!("{:06}-{e}", f.frame);
+            name == format!("{stem}.png") || name == format!("{stem}-real.png")
+        })?;
         Some((f, eye))
     })
 }
@@ -327,27 +362,18 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
         });
     }
     progress.finish_and_clear();
-    let report = Report {
-        vitreous_version: env!("CARGO_PKG_VERSION").into(),
-        scene: args.scene.display().to_string(),
-        scene_hash: scene.hash.clone(),
-        trace: args
-            .trace
-            .as_ref()
-            .map_or("neutral head".into(), |t| t.display().to_string()),
-        width_px: width,
-        height_px: height,
-        samples_per_pixel: args.samples * args.samples,
-        texel_mm: args.texel_mm,
-        photons_per_texel: args.photons_per_texel,
-        light_share: scene.light.share,
-        object: if scene.object.is_ball() {
-            "analytic ball".into()
-        } else {
-            "closed mesh".into()
-        },
-        frames: reports,
-    };
+    let trace = args
+        .trace
+        .as_ref()
+        .map_or("neutral head".into(), |t| t.display().to_string());
+    let report = Report::new(
+        &scene,
+        &args.scene,
+        trace,
+        (width, height),
+        &settings,
+        reports,
+    );
     let json = serde_json::to_vec_pretty(&report).context("encoding reference.json")?;
     write_atomic(&out.join("reference.json"), &json)?;
     for f in &report.frames {

@@ -386,6 +386,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
                 scene,
                 pending: Vec::new(),
                 figures: Vec::new(),
+                reports: Vec::new(),
+                source: (options.scene.clone(), trace_name.clone()),
             }
         }),
     };
@@ -410,6 +412,10 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     let interrupted = signals && crate::interrupt::requested();
     // The log holds exactly the frames rendered, also when interrupted.
     saver.log.finish()?;
+    if let Some(physical) = &mut saver.physical {
+        let file = physical.write_report(&saver.dir, renderer.size())?;
+        saver.saved.push(file);
+    }
 
     let validation = ValidationSummary::of(renderer.context());
     let status = if interrupted {
@@ -516,7 +522,7 @@ fn remove_earlier_frames(frames_dir: &Path) -> Result<()> {
 /// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`, ... or a
 /// temporary file of an atomic write.
 fn is_replay_file_name(name: &str) -> bool {
-    if name.starts_with(".vitreous-") && name.ends_with(".partial") {
+    if (name.starts_with(".vitreous-") && name.ends_with(".partial")) || name == "reference.json" {
         return true;
     }
     let Some(stem) = name.strip_suffix(".png") else {

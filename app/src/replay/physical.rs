@@ -1,14 +1,18 @@
 //! `replay --compare-reference`: the physical reference of every saved frame, written beside
-//! it, and what the eye sees measured against it.
+//! it, and what the eye sees measured against it; a `reference.json` beside them says which
+//! frame and eye each reference image is, so `vitreous compare` finds their regions.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use vitreous_xr::FrameInput;
 
 use crate::compare::{ReferenceFigures, against_reference, rgb_of};
 use crate::output::{self, write_atomic};
-use crate::reference_cmd::{ReferenceSettings, render_reference, srgb_rgba};
+use crate::reference_cmd::{
+    EyeRecord, FrameReport, ReferenceSettings, Report, render_reference, srgb_rgba,
+};
 use crate::scene::{Placement, Scene};
 
 /// `--compare-reference`: the saved frames' placements until they finish, and the figures.
@@ -19,6 +23,10 @@ pub(super) struct Physical {
     pub(super) pending: Vec<(u64, Placement)>,
     /// Each finished saved frame's figures, per eye.
     pub(super) figures: Vec<ReferenceFigures>,
+    /// Each finished saved frame's record, for `reference.json`.
+    pub(super) reports: Vec<FrameReport>,
+    /// The scene file and the trace's name, for `reference.json`.
+    pub(super) source: (PathBuf, String),
 }
 
 impl Physical {
@@ -36,6 +44,7 @@ impl Physical {
         };
         let (_, placement) = self.pending.swap_remove(k);
         let size = (readback.width, readback.height);
+        let started = Instant::now();
         let frame = render_reference(
             &self.scene,
             &input.views,
@@ -71,6 +80,38 @@ impl Physical {
                 additive_limit,
             });
         }
+        self.reports.push(FrameReport {
+            frame: input.index,
+            time_ns: input.time_ns,
+            eyes: input.views.each_ref().map(EyeRecord::of),
+            object_position_m: placement.object_position_m.to_array(),
+            object_rotation_xyzw: placement.object_rotation.to_array(),
+            light_position_m: placement.light_position_m.to_array(),
+            photons: frame.photons,
+            floor_light_noise: frame.noise,
+            files: files
+                .iter()
+                .map(|f| f.trim_start_matches("frames/").to_owned())
+                .collect(),
+            seconds: started.elapsed().as_secs_f64(),
+        });
         Ok(files)
+    }
+
+    /// Writes `reference.json` into `dir` (the frames' folder), listing every measured frame;
+    /// returns its name as the summary lists files.
+    pub(super) fn write_report(&mut self, dir: &Path, size: (u32, u32)) -> Result<String> {
+        let (scene_path, trace) = self.source.clone();
+        let report = Report::new(
+            &self.scene,
+            &scene_path,
+            trace,
+            size,
+            &ReferenceSettings::default(),
+            std::mem::take(&mut self.reports),
+        );
+        let json = serde_json::to_vec_pretty(&report).context("encoding reference.json")?;
+        write_atomic(&dir.join("reference.json"), &json)?;
+        Ok("frames/reference.json".into())
     }
 }

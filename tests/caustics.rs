@@ -77,30 +77,38 @@ fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], effects: &str) -> Readb
 
 #[test]
 fn eye_image_adds_inducer_and_caustic_gain_times_a_uniform_floor() {
-    adds_inducer_and_caustic_gain(false, 1.0);
+    adds_inducer_and_caustic_gain(false, 1.0, false);
 }
 
 /// `[light] share = 0.4`: the light gives 40 % of the floor's light, so only that share is
 /// focused and G is added times 0.4; the inducer is unchanged.
 #[test]
 fn eye_image_adds_only_the_lights_share_of_the_caustic_gain() {
-    adds_inducer_and_caustic_gain(false, 0.4);
+    adds_inducer_and_caustic_gain(false, 0.4, false);
+}
+
+/// The same share set on a renderer made with the scene's 1.0 (`Renderer::set_light_share`,
+/// as the room's light estimate sets it in `vitreous run`): the same images.
+#[test]
+fn a_share_set_after_the_start_adds_that_share_of_the_caustic_gain() {
+    adds_inducer_and_caustic_gain(false, 0.4, true);
 }
 
 /// As above on the overlay's other path, G filtered from four loads (devices that do not
 /// filter R32_SFLOAT, which Vulkan leaves optional; lavapipe filters it).
 #[test]
 fn eye_image_adds_the_gains_with_g_from_four_loads() {
-    adds_inducer_and_caustic_gain(true, 1.0);
+    adds_inducer_and_caustic_gain(true, 1.0, false);
 }
 
 /// Each pixel of the floor in conditions c, b and inducer against k alpha(d) + share G of the
 /// CPU reference times a uniform grey photo; with `four_loads` the overlay is built as on a
-/// device that does not filter R32_SFLOAT.
-fn adds_inducer_and_caustic_gain(four_loads: bool, share: f32) {
+/// device that does not filter R32_SFLOAT; with `set_later` the scene says 1.0 and the share
+/// is set on the renderer once made.
+fn adds_inducer_and_caustic_gain(four_loads: bool, share: f32, set_later: bool) {
     const GREY: u8 = 120;
     let mut s = shipped_scene("glass-sphere.toml");
-    s.light.share = share;
+    s.light.share = if set_later { 1.0 } else { share };
     s.floor.photo = Image::new(8, 8, PixelData::Srgb8([GREY, GREY, GREY, 255].repeat(64))).unwrap();
     let l_r = srgb_to_linear(GREY);
     // The spot straddles the shadow's edge towards the viewer (shadow, ramp and open floor).
@@ -114,6 +122,9 @@ fn adds_inducer_and_caustic_gain(four_loads: bool, share: f32) {
         ctx.pretend_r32_float_unfiltered();
     }
     let mut r = Renderer::new(ctx, &render_desc::scene_desc(&s, None), w, h).expect("renderer");
+    if set_later {
+        r.set_light_share(share);
+    }
     let eyes = top_down_eyes(&s);
     let none = render(&mut r, eyes, "a");
     // c, then b, then c again: the combined gain is recomputed on every switch change.

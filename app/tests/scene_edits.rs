@@ -45,6 +45,7 @@ fn recorded_edits_offset_the_keyframes_and_move_the_scene_once_each() {
             object_turn: Quat::IDENTITY,
             light_offset_m,
             world_offset_m: Vec3::ZERO,
+            light_share: None,
         };
         if k == 26 {
             w.write_edit(&edit("object+10mmx", Vec3::ZERO)).unwrap();

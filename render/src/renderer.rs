@@ -323,6 +323,13 @@ impl Renderer {
         self.inducer.set_pose(pose);
     }
 
+    /// The light's share of the floor's light from the next frame on (clamped to 0..=1),
+    /// instead of the scene's `[light] share`: what the caustics add (eq. 6) and, with a
+    /// segmented dimmer, how much of the shadow the panel darkens. Nothing is computed again.
+    pub fn set_light_share(&mut self, share: f32) {
+        self.inducer.set_light_share(share);
+    }
+
     /// Computes the caustics on the GPU for every pose from now on instead of using the
     /// scene's bake (docs/caustics.md); `scene` must be the description the renderer was
     /// made with.

@@ -36,6 +36,12 @@ pub trait FrameSink {
         None
     }
 
+    /// The light's share of the floor's light for this frame (called after
+    /// [`FrameSink::pose`]); `None` leaves it as it was (at first the scene's `[light] share`).
+    fn light_share(&mut self) -> Option<f32> {
+        None
+    }
+
     /// How to draw this frame and what to read back of it.
     fn plan(&mut self, input: &FrameInput) -> FramePlan;
 
@@ -122,6 +128,9 @@ fn draw<B: Backend>(
     let started = Instant::now();
     if let Some(pose) = sink.pose(input) {
         renderer.set_pose(pose);
+    }
+    if let Some(share) = sink.light_share() {
+        renderer.set_light_share(share);
     }
     let plan = sink.plan(input);
     let params = render_desc::frame_params(input, plan.look);

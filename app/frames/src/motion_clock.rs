@@ -16,6 +16,9 @@ use crate::scene_edit::{EditState, SceneEdit, place_ray, ray_meets_plane};
 
 /// The action of the edit line that moves the light to the room's estimated light.
 pub const LIGHT_ESTIMATE_ACTION: &str = "light-estimate";
+
+/// Smallest change of the light's share of the floor's light that an estimate makes.
+pub const MIN_SHARE_STEP: f32 = 0.01;
 use vitreous_scene::{CausticsMode, Motion, Placement, Scene, model_placement};
 
 /// Turns frame times into the scene's poses and counts the frames that moved. Owns what it
@@ -53,6 +56,8 @@ pub struct MotionClock {
     edits: EditState,
     /// Edits made or replayed.
     pub edit_count: u64,
+    /// `[light] share`.
+    scene_share: f32,
 }
 
 /// Where the object and the light were at the end, as the summaries report it.
@@ -85,6 +90,7 @@ impl MotionClock {
             stale_reported: false,
             edits: EditState::default(),
             edit_count: 0,
+            scene_share: scene.light.share,
         }
     }
 
@@ -188,21 +194,50 @@ impl MotionClock {
     }
 
     /// Turns the light about the object, at its distance, so that its light travels along
-    /// `direction` (the room's main light as the headset estimates it): an edit like the
-    /// keyboard's light moves, recorded as [`LIGHT_ESTIMATE_ACTION`]. `None`, and nothing done,
-    /// when the light already travels within [`MIN_TURN_DEG`] of it.
-    pub fn follow_light(&mut self, direction: Vec3, input: &FrameInput) -> Option<EditRecord> {
+    /// `direction` (the room's main light as the headset estimates it), and takes `share` as
+    /// its share of the floor's light: an edit like the keyboard's light moves, recorded as
+    /// [`LIGHT_ESTIMATE_ACTION`]. `None`, and nothing done, when the light already travels
+    /// within [`MIN_TURN_DEG`] of it and the share moved by less than [`MIN_SHARE_STEP`].
+    pub fn follow_light(
+        &mut self,
+        direction: Vec3,
+        share: Option<f32>,
+        input: &FrameInput,
+    ) -> Option<EditRecord> {
         let base = self.keyed_placement(input.time_ns);
         let now = self.edited(base);
         let (center, light) = (now.object_position_m, now.light_position_m);
         let turn = angle_deg(center - light, direction);
         // A NaN turn (a zero direction) is no turn.
-        if turn.is_nan() || turn < MIN_TURN_DEG {
+        let turns = turn >= MIN_TURN_DEG;
+        // To a thousandth, as recorded; a share that cannot be known leaves the last one.
+        let share = share
+            .filter(|s| s.is_finite())
+            .map(|s| (s.clamp(0.0, 1.0) * 1000.0).round() / 1000.0);
+        let shares = share.is_some_and(|s| {
+            (s - self.edits.light_share.unwrap_or(self.scene_share)).abs() >= MIN_SHARE_STEP
+        });
+        if !turns && !shares {
             return None;
         }
-        self.edits.light_offset_m += light_position_along(center, light, direction) - light;
-        let what = format!("the light turned {turn:.2} deg about the object to the room's light");
+        if turns {
+            self.edits.light_offset_m += light_position_along(center, light, direction) - light;
+        }
+        if shares {
+            self.edits.light_share = share;
+        }
+        let what = format!(
+            "the light turned {:.2} deg about the object to the room's light, its share of the \
+             floor's light {:.3}",
+            if turns { turn } else { 0.0 },
+            self.light_share()
+        );
         Some(self.applied_as(LIGHT_ESTIMATE_ACTION.into(), &what, input))
+    }
+
+    /// The light's share of the floor's light: the room's light estimate's, else the scene's.
+    pub fn light_share(&self) -> f32 {
+        self.edits.light_share.unwrap_or(self.scene_share)
     }
 
     /// Counts and logs (as `what`) an edit just applied; its trace line.
@@ -360,6 +395,7 @@ mod tests {
             stale_reported: false,
             edits: EditState::default(),
             edit_count: 0,
+            scene_share: 1.0,
         }
     }
 
@@ -380,14 +416,14 @@ mod tests {
         let object = Vec3::new(0.3, 0.1, -0.5);
         let light = Vec3::new(0.0, 1.0, -1.0);
         let along = (object - light).normalize();
-        // The estimate agrees with the scene's light: nothing moves.
-        assert!(c.follow_light(along, &input(0)).is_none());
+        // The estimate agrees with the scene's light and share: nothing moves.
+        assert!(c.follow_light(along, Some(0.995), &input(0)).is_none());
         let nearly = Quat::from_rotation_y(0.2f32.to_radians()) * along;
-        assert!(c.follow_light(nearly, &input(1)).is_none());
+        assert!(c.follow_light(nearly, None, &input(1)).is_none());
         assert_eq!(c.edit_count, 0);
         // Turned 30 degrees about the vertical: the light goes round the object, as far away.
         let turned = Quat::from_rotation_y(30f32.to_radians()) * along;
-        let record = c.follow_light(turned, &input(2)).expect("an edit");
+        let record = c.follow_light(turned, None, &input(2)).expect("an edit");
         assert_eq!(record.action, LIGHT_ESTIMATE_ACTION);
         assert!(vitreous_xr::trace::valid_action(&record.action));
         let now = c.placement(2).expect("the light moved");
@@ -398,6 +434,16 @@ mod tests {
         assert_eq!(c.edit_count, 1);
         // The recorded state repeats it.
         assert_eq!(EditState::of_record(&record), c.edits());
+        assert_eq!((record.light_share, c.light_share()), (None, 1.0));
+        // The same way with another share: only the share changes, recorded to a thousandth.
+        let shared = c
+            .follow_light(turned, Some(0.61234), &input(3))
+            .expect("an edit");
+        assert_eq!((shared.light_share, c.light_share()), (Some(0.612), 0.612));
+        assert_eq!(shared.light_offset_m, record.light_offset_m);
+        assert!(c.follow_light(turned, Some(0.615), &input(4)).is_none());
+        assert!(c.follow_light(turned, Some(f32::NAN), &input(5)).is_none());
+        assert_eq!(c.light_share(), 0.612);
     }
 
     #[test]

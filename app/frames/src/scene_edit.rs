@@ -178,6 +178,9 @@ pub struct EditState {
     pub light_offset_m: Vec3,
     /// The re-registration so far, metres (carried out by the backend; reported).
     pub world_offset_m: Vec3,
+    /// The light's share of the floor's light the room's light estimate set (`None`: the
+    /// scene's).
+    pub light_share: Option<f32>,
 }
 
 impl Default for EditState {
@@ -187,6 +190,7 @@ impl Default for EditState {
             object_turn: Quat::IDENTITY,
             light_offset_m: Vec3::ZERO,
             world_offset_m: Vec3::ZERO,
+            light_share: None,
         }
     }
 }
@@ -209,6 +213,7 @@ impl EditState {
             object_turn: self.object_turn,
             light_offset_m: self.light_offset_m,
             world_offset_m: self.world_offset_m,
+            light_share: self.light_share,
         }
     }
 
@@ -219,6 +224,7 @@ impl EditState {
             object_turn: record.object_turn,
             light_offset_m: record.light_offset_m,
             world_offset_m: record.world_offset_m,
+            light_share: record.light_share,
         }
     }
 }

@@ -147,6 +147,11 @@ impl OtherRefraction {
 }
 
 impl FrameSink for Saver<'_> {
+    fn light_share(&mut self) -> Option<f32> {
+        // A recorded `light-estimate` edit's share, else the scene's.
+        Some(self.motion.light_share())
+    }
+
     fn pose(&mut self, input: &FrameInput) -> Option<ScenePose> {
         // Each edit shows from the first frame at or after its time, as in the session.
         while let Some(edit) = self.edits.front()

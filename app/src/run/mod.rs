@@ -201,6 +201,10 @@ impl FrameSink for RunSink<'_> {
         Some(pose)
     }
 
+    fn light_share(&mut self) -> Option<f32> {
+        Some(self.motion.light_share())
+    }
+
     fn started(&mut self, input: &FrameInput) -> Result<()> {
         if let Some(w) = &mut self.writer {
             w.write(&trace_sample(input))

@@ -1,9 +1,10 @@
 //! The room's light in `vitreous run`: when the runtime estimates it (XR_ML_light_estimation,
 //! Magic Leap 2), the scene's point light turns about the object, at its distance, to shine
 //! the way the room's main light does, so the shadow inducer, the caustics and the dimmed
-//! shadow follow the real light; each move is an edit of the recording (`light-estimate`),
-//! which a replay repeats. The main light's share of the floor's light is reported (not yet
-//! applied: a recording has no field for it).
+//! shadow follow the real light, and the light's share of the floor's light (`[light] share`)
+//! becomes the estimate's: the main light's irradiance on the floor over all the light's. Each
+//! change is an edit of the recording (`light-estimate`, carrying the share), which a replay
+//! repeats.
 //!
 //! With `--readback-check` the run also reads back, at its end, where the shadow and the
 //! caustic lie on the floor ([`FloorCentroids`]), for a check against an independent
@@ -23,14 +24,17 @@ use super::RunSink;
 pub struct RoomLight {
     /// Estimates the app received.
     pub estimates: u64,
-    /// Times the scene's light moved to follow one (the rest were within
-    /// `vitreous_xr::light::MIN_TURN_DEG` of where it shone).
+    /// Times the scene's light moved or its share changed to follow one (the rest were within
+    /// `vitreous_xr::light::MIN_TURN_DEG` of where it shone, and within
+    /// `MIN_SHARE_STEP` of its share).
     pub light_moves: u64,
     /// The way the newest estimate's main light travels, in the scene frame.
     pub direction: Option<[f32; 3]>,
     /// The newest estimate's share of the floor's light: the main light's irradiance on the
     /// floor over all the light's (ambient spherical harmonics included), by luminance.
     pub floor_share: Option<f32>,
+    /// The share the renderer uses after the newest estimate (to a thousandth).
+    pub light_share: Option<f32>,
 }
 
 impl RunSink<'_> {
@@ -48,9 +52,15 @@ impl RunSink<'_> {
         room.direction = Some(estimate.direction.to_array());
         let (_, floor_normal) = self.motion.floor();
         room.floor_share = estimate.share_on(floor_normal);
-        if let Some(record) = self.motion.follow_light(estimate.direction, input) {
+        if let Some(record) = self
+            .motion
+            .follow_light(estimate.direction, room.floor_share, input)
+        {
             room.light_moves += 1;
             self.record(&record);
+        }
+        if let Some(room) = &mut self.room_light {
+            room.light_share = Some(self.motion.light_share());
         }
     }
 }

@@ -552,9 +552,16 @@ impl InducerPass {
         ctx.work.draw(3);
     }
 
-    /// The light's share of the floor's light (`[light] share`).
+    /// The light's share of the floor's light (`[light] share`, or as set).
     pub fn light_share(&self) -> f32 {
         self.caustic_share
+    }
+
+    /// Sets the light's share of the floor's light (clamped to 0..=1; a NaN is ignored).
+    pub fn set_light_share(&mut self, share: f32) {
+        if !share.is_nan() {
+            self.caustic_share = share.clamp(0.0, 1.0);
+        }
     }
 
     /// The static cost of one fragment of the overlay drawn with the caustics or without.

@@ -7,6 +7,9 @@
 //! edit,time_ns,action,object_dx_m,object_dy_m,object_dz_m,object_qx,object_qy,object_qz,object_qw,light_dx_m,light_dy_m,light_dz_m,world_dx_m,world_dy_m,world_dz_m
 //! ```
 //!
+//! and one more, [`EDIT_SHARE_FIELD`] (0 to 1), once the room's light estimate set the light's
+//! share of the floor's light (`light-estimate` edits); without it the share is the scene's.
+//!
 //! The numbers are the edit state *after* the edit (not the step), so a replay sets them
 //! instead of repeating the arithmetic, and a lost line cannot shift every later pose.
 
@@ -38,6 +41,9 @@ pub const EDIT_FIELDS: [&str; 16] = [
     "world_dz_m",
 ];
 
+/// The optional last field of an edit line: the light's share of the floor's light.
+pub const EDIT_SHARE_FIELD: &str = "light_share";
+
 /// Longest action name accepted, bytes.
 pub const MAX_ACTION_BYTES: usize = 40;
 
@@ -61,6 +67,9 @@ pub struct EditRecord {
     /// light) was moved against the tracking, metres. The head poses of the samples already
     /// include it (they are in the re-registered frame), so a replay only reports it.
     pub world_offset_m: Vec3,
+    /// The light's share of the floor's light as the room's light estimate set it (`None`:
+    /// the scene's `[light] share`).
+    pub light_share: Option<f32>,
 }
 
 impl EditRecord {
@@ -73,6 +82,7 @@ impl EditRecord {
             object_turn: Quat::IDENTITY,
             light_offset_m: Vec3::ZERO,
             world_offset_m: Vec3::ZERO,
+            light_share: None,
         }
     }
 }
@@ -123,6 +133,13 @@ pub(super) fn check_edit(
     if !numbers.iter().all(|v| v.is_finite()) || !edit.object_turn.is_finite() {
         return Err(bad("offsets and turn must be finite numbers".into()));
     }
+    if let Some(share) = edit.light_share
+        && !(0.0..=1.0).contains(&share)
+    {
+        return Err(bad(format!(
+            "{EDIT_SHARE_FIELD} {share} is not a share from 0 to 1"
+        )));
+    }
     let norm = edit.object_turn.length();
     if (norm - 1.0).abs() > QUAT_NORM_TOLERANCE {
         return Err(bad(format!(
@@ -137,7 +154,12 @@ pub(super) fn check_edit(
 
 /// Parses an edit line (its first field is [`EDIT_TAG`]) without the order checks.
 pub(super) fn parse_edit(record: &Record<'_>) -> Result<EditRecord, TraceError> {
-    record.expect_len(EDIT_FIELDS.len())?;
+    let light_share = if record.len() == EDIT_FIELDS.len() + 1 {
+        Some(record.f32(EDIT_FIELDS.len(), EDIT_SHARE_FIELD)?)
+    } else {
+        record.expect_len(EDIT_FIELDS.len())?;
+        None
+    };
     let f = &EDIT_FIELDS;
     let vec = |at: usize| record.vec3([at, at + 1, at + 2], [f[at], f[at + 1], f[at + 2]]);
     Ok(EditRecord {
@@ -152,6 +174,7 @@ pub(super) fn parse_edit(record: &Record<'_>) -> Result<EditRecord, TraceError> 
         ),
         light_offset_m: vec(10)?,
         world_offset_m: vec(13)?,
+        light_share,
     })
 }
 
@@ -163,8 +186,9 @@ pub(super) fn format_edit(edit: &EditRecord) -> String {
         edit.light_offset_m,
         edit.world_offset_m,
     );
+    let share = edit.light_share.map_or(String::new(), |s| format!(",{s}"));
     format!(
-        "{EDIT_TAG},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+        "{EDIT_TAG},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}{share}\n",
         edit.time_ns, edit.action, o.x, o.y, o.z, q.x, q.y, q.z, q.w, l.x, l.y, l.z, w.x, w.y, w.z
     )
 }
@@ -184,7 +208,27 @@ mod tests {
             object_turn: Quat::from_rotation_y(10f32.to_radians()),
             light_offset_m: Vec3::new(0.0, 0.1, 0.0),
             world_offset_m: Vec3::new(0.0, 0.0, 0.01),
+            light_share: None,
         }
+    }
+
+    #[test]
+    fn a_light_share_rides_on_its_edit_line_and_must_be_a_share() {
+        let shared = EditRecord {
+            light_share: Some(0.62),
+            ..edit(2500, "light-estimate")
+        };
+        let text = written(&[(0, edit(1000, "object+x")), (1, shared.clone())], 3);
+        let (_, read_edits) = read(&text).unwrap();
+        assert_eq!(read_edits[0].light_share, None);
+        assert_eq!(read_edits[1], shared);
+        for bad in ["1.5", "-0.1", "NaN"] {
+            let e = read(&text.replacen(",0.62\n", &format!(",{bad}\n"), 1)).unwrap_err();
+            assert!(e.to_string().contains(EDIT_SHARE_FIELD), "{bad}: {e}");
+        }
+        // Not 18 fields.
+        let e = read(&text.replacen(",0.62\n", ",0.62,0\n", 1)).unwrap_err();
+        assert!(matches!(e, TraceError::FieldCount { .. }), "{e}");
     }
 
     fn written(edits_at: &[(usize, EditRecord)], samples: usize) -> String {
@@ -245,7 +289,7 @@ mod tests {
         // An action with a space, a short line, a non-unit turn.
         let e = read(&text.replacen("light+y", "light y", 1)).unwrap_err();
         assert!(matches!(e, TraceError::BadEdit { line: 4, .. }), "{e}");
-        let short = text.replacen(",light+y,", ",light+y,1,", 1);
+        let short = text.replacen(",light+y,", ",light+y,1,1,", 1);
         assert!(matches!(
             read(&short).unwrap_err(),
             TraceError::FieldCount { line: 4, .. }

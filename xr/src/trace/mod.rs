@@ -40,7 +40,9 @@ mod write;
 use crate::frame::{GazeSample, Pose};
 
 pub use crate::atomic_file::AtomicFile;
-pub use edit::{EDIT_FIELDS, EDIT_TAG, EditRecord, MAX_ACTION_BYTES, valid_action};
+pub use edit::{
+    EDIT_FIELDS, EDIT_SHARE_FIELD, EDIT_TAG, EditRecord, MAX_ACTION_BYTES, valid_action,
+};
 pub use error::TraceError;
 pub use read::{TraceReader, read_trace, read_trace_with_edits};
 pub use report::{behaviour_name, confidence_name};

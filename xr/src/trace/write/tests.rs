@@ -23,6 +23,7 @@ fn edit(time_ns: i64) -> EditRecord {
         object_turn: Quat::IDENTITY,
         light_offset_m: Vec3::ZERO,
         world_offset_m: Vec3::ZERO,
+        light_share: None,
     }
 }
 

@@ -49,6 +49,10 @@ struct Case {
     effects: &'static [&'static str],
     moving: bool,
     two_surface: bool,
+    /// Frames drawn before the counted ones: enough for the gaze pipeline to decide an image
+    /// where a condition has defocus, and as many as the expectation was recorded after where
+    /// the light circles (the counted frames' poses); the bench's own few elsewhere.
+    warm_up: usize,
 }
 
 /// The study's conditions (with two-surface O5), the floor's, the live scene's moving light,
@@ -60,6 +64,7 @@ const CASES: [Case; 4] = [
         effects: &["O3", "O4", "O5"],
         moving: false,
         two_surface: true,
+        warm_up: 40,
     },
     Case {
         name: "glass-sphere b c",
@@ -67,6 +72,7 @@ const CASES: [Case; 4] = [
         effects: &["b", "c"],
         moving: false,
         two_surface: false,
+        warm_up: vitreous::bench::WARM_UP_FRAMES,
     },
     Case {
         name: "moving-light c moving",
@@ -74,6 +80,7 @@ const CASES: [Case; 4] = [
         effects: &["c"],
         moving: true,
         two_surface: false,
+        warm_up: 40,
     },
     Case {
         name: "glass-sphere-ml2 dimmer",
@@ -81,6 +88,7 @@ const CASES: [Case; 4] = [
         effects: &["caustics"],
         moving: false,
         two_surface: true,
+        warm_up: vitreous::bench::WARM_UP_FRAMES,
     },
 ];
 
@@ -88,8 +96,8 @@ fn expectation_path() -> PathBuf {
     workspace().join("tests/cost-expected.json")
 }
 
-/// The case's bench: small eye images (counts scale with the area, ratios do not), frames
-/// enough for the gaze pipeline to decide an image first, validation on.
+/// The case's bench: small eye images (counts scale with the area, ratios do not), the case's
+/// warm-up frames first, validation on.
 fn run(case: &Case) -> BenchReport {
     bench(&BenchOptions {
         scene: workspace().join("config/scenes").join(case.scene),
@@ -100,7 +108,7 @@ fn run(case: &Case) -> BenchReport {
             .collect(),
         size: (320, 240),
         frames: 4,
-        warm_up: 40,
+        warm_up: case.warm_up,
         reflection: Reflection::Phong,
         validate: true,
         device: None,

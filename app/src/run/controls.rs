@@ -12,7 +12,7 @@ use vitreous_xr::openxr::Command;
 use vitreous_xr::planes::nearest_up_hit;
 use vitreous_xr::trace::EditRecord;
 
-use super::RunSink;
+use super::sink::RunSink;
 use crate::scene_edit::{Axis, SceneEdit, place_ray, ray_meets_plane};
 
 /// Starts reading commands from standard input; each valid line arrives on the receiver (a

@@ -18,7 +18,7 @@
 //!
 //! Parts: `cli.rs` (the command line), `controls.rs` (keyboard edits), `device.rs` (Vulkan
 //! through the runtime), `xr_session.rs` (runtime, renderer and session owned together),
-//! `readback.rs` (the readback check), `recording.rs` (the recorded trace and its replay
+//! `readback.rs` (the readback check), `sink.rs` (what is done with each frame), `recording.rs` (the recorded trace and its replay
 //! check), `summary.rs` (what the run reports); the conditions and live commands are
 //! `vitreous_frames::conditions`. This file sets the session up, runs it and writes the summary.
 
@@ -28,6 +28,7 @@ mod device;
 mod readback;
 mod recording;
 mod room_light;
+mod sink;
 mod summary;
 mod xr_session;
 
@@ -36,15 +37,13 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, Reflection, Renderer};
 use vitreous_xr::openxr::ash::vk;
 use vitreous_xr::openxr::{
-    Blend, Command, DepthOptions, GazeChoice, GazeSource, OpenXrOptions, Runtime, SessionOptions,
+    Blend, DepthOptions, GazeChoice, GazeSource, OpenXrOptions, Runtime, SessionOptions,
     SessionReport, State,
 };
 use vitreous_xr::trace::{TraceVersion, TraceWriter};
-use vitreous_xr::{FrameEndHints, FrameInput};
 
 pub use crate::conditions::{
     CONDITION_CYCLE, GAZE_IMAGE_CYCLE, LiveConditions, STUDY_CONDITIONS, live_conditions,
@@ -63,17 +62,16 @@ use crate::director::Director;
 use crate::effects::EffectSet;
 use crate::focus::FocusFollower;
 use crate::frame_log::FrameLog;
-use crate::frame_loop::{self, FramePlan, FrameSink};
+use crate::frame_loop;
 use crate::look::{GazeSettings, planners_for};
 use crate::motion_clock::MotionClock;
 use crate::output::write_atomic;
 use crate::render_desc;
 use crate::scene::{CausticsMode, load_scene};
-use crate::scene_edit::SceneEdit;
 use crate::spread::Spread;
 use crate::validation::ValidationSummary;
-use readback::check_readback;
-use recording::{replay_check, trace_sample};
+use recording::replay_check;
+use sink::RunSink;
 pub use xr_session::{Closed, XrSession};
 
 /// Options of `vitreous run`.
@@ -113,169 +111,6 @@ pub struct RunOptions {
     /// (a pipe or fifo); in a terminal they are always read (not in a study, whose answers
     /// come from there).
     pub stdin_controls: bool,
-}
-
-/// Records frames and checks a readback.
-struct RunSink<'d> {
-    /// Decides each frame's look (effect condition, gaze-dependent defocus).
-    looks: LiveConditions,
-    /// Live commands from the session.
-    commands: Option<std::sync::mpsc::Receiver<Command>>,
-    /// Frame to read back, if any.
-    readback_frame: Option<u64>,
-    /// The scene's object, for the region check.
-    object_center_m: glam::Vec3,
-    /// The object's radius.
-    object_radius_m: f32,
-    /// The blend mode the images are composed for.
-    blend: Blend,
-    /// With a segmented dimmer: its panel, where the light is and where the floor lies (a
-    /// point and its normal), so the readback check knows where the shadow falls.
-    dimmer_shadow: Option<(
-        vitreous_render::DimmerDesc,
-        glam::Vec3,
-        glam::Vec3,
-        glam::Vec3,
-    )>,
-    /// The readback result.
-    readback: Option<ReadbackCheck>,
-    /// Where head pose and gaze are recorded, if asked.
-    writer: Option<TraceWriter<vitreous_xr::trace::AtomicFile>>,
-    /// Every frame's input, for the replay check.
-    recorded: Vec<FrameInput>,
-    /// The per-frame log (`frames.csv` with `--out`).
-    log: FrameLog,
-    /// What decides each frame's condition and gaze image instead of the live controls (a
-    /// study's trials, `vitreous study run`).
-    director: Option<&'d mut dyn Director>,
-    /// The first error writing the log, reported when the next frame finishes.
-    log_error: Option<anyhow::Error>,
-    /// The scene's motion (`[motion]`), from the session's first frame, with the edits.
-    motion: MotionClock,
-    /// The keyboard's live controls, when read.
-    edits: Option<std::sync::mpsc::Receiver<SceneEdit>>,
-    /// The upward planes the runtime detects (XR_EXT_plane_detection), as they come.
-    planes_rx: Option<std::sync::mpsc::Receiver<Vec<vitreous_xr::planes::DetectedPlane>>>,
-    /// The latest detection's planes, in the scene frame: where a place puts the object.
-    planes: Vec<vitreous_xr::planes::DetectedPlane>,
-    /// Where re-registrations go: the session, which moves the scene's placement.
-    registrar: std::sync::mpsc::Sender<Command>,
-    /// The wearer's filtered fixation depth, which the display's focus plane follows.
-    focus: FocusFollower,
-    /// This frame's filtered fixation depth, metres.
-    focus_m: Option<f32>,
-    /// The scene's global dimmer level (`[display] global_dimmer`).
-    global_dimmer: Option<f32>,
-    /// The room's light as the runtime estimates it (XR_ML_light_estimation), as it comes.
-    light_rx: Option<std::sync::mpsc::Receiver<vitreous_xr::light::LightEstimate>>,
-    /// What the estimates did (`None`: none came).
-    room_light: Option<room_light::RoomLight>,
-}
-
-impl RunSink<'_> {
-    /// With a segmented dimmer, what it must darken: the object's centre and the centre of
-    /// its shadow (where the ray from the light through the centre meets the floor).
-    fn dimmed(&self) -> Option<readback::Dimmed> {
-        let (panel, light, floor, normal) = self.dimmer_shadow?;
-        let to_center = self.object_center_m - light;
-        let t = (floor - light).dot(normal) / to_center.dot(normal);
-        Some(readback::Dimmed {
-            points: vec![self.object_center_m, light + to_center * t],
-            panel,
-        })
-    }
-}
-
-impl FrameSink for RunSink<'_> {
-    fn pose(&mut self, input: &FrameInput) -> Option<vitreous_render::ScenePose> {
-        self.take_planes();
-        self.follow_room_light(input);
-        self.apply_typed_controls(input);
-        let placement = self.motion.placement(input.time_ns)?;
-        let (center, pose) = (placement.object_position_m, self.motion.pose_of(&placement));
-        self.looks.set_object_pose(center, pose.world_from_model);
-        self.object_center_m = center;
-        if let Some(shadow) = &mut self.dimmer_shadow {
-            shadow.1 = placement.light_position_m;
-        }
-        Some(pose)
-    }
-
-    fn light_share(&mut self) -> Option<f32> {
-        Some(self.motion.light_share())
-    }
-
-    fn started(&mut self, input: &FrameInput) -> Result<()> {
-        if let Some(w) = &mut self.writer {
-            w.write(&trace_sample(input))
-                .context("recording the trace")?;
-        }
-        self.recorded.push(input.clone());
-        Ok(())
-    }
-
-    fn plan(&mut self, input: &FrameInput) -> FramePlan {
-        let read = self.readback_frame == Some(input.index);
-        let commands: Vec<Command> = match &self.commands {
-            Some(rx) => rx.try_iter().collect(),
-            None => Vec::new(),
-        };
-        for command in commands {
-            self.record_command(command, input);
-            if let Some(director) = &mut self.director {
-                director.command(command);
-            } else if let Some(change) = self.looks.apply(command) {
-                tracing::info!("frame {}: {change}", input.index);
-            }
-        }
-        let mut look = match &mut self.director {
-            Some(director) => self.looks.plan_directed(*director, input),
-            None => self.looks.plan(input),
-        };
-        look.caustics &= self.motion.caustics_valid();
-        self.focus_m = self.focus.update(input);
-        let condition = self.looks.condition().to_string();
-        if let Err(e) = self
-            .log
-            .record(input, &condition, self.looks.planner().last_defocus())
-        {
-            self.log_error.get_or_insert(e);
-        }
-        FramePlan {
-            look,
-            want: Want {
-                eyes: read,
-                world: read,
-            },
-        }
-    }
-
-    fn frame_end_hints(&mut self, _input: &FrameInput) -> FrameEndHints {
-        FrameEndHints {
-            focus_distance_m: self.focus_m,
-            global_dimmer: self.global_dimmer,
-        }
-    }
-
-    fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()> {
-        if let Some(e) = self.log_error.take() {
-            return Err(e);
-        }
-        if let Some(e) = self.director.as_mut().and_then(|d| d.take_error()) {
-            return Err(e);
-        }
-        if let Some(rb) = &result.readback {
-            self.readback = Some(check_readback(
-                input,
-                rb,
-                self.object_center_m,
-                self.object_radius_m,
-                self.blend,
-                self.dimmed().as_ref(),
-            ));
-        }
-        Ok(())
-    }
 }
 
 /// Runs the scene on the OpenXR runtime. Fails with a clear message when there is no runtime,

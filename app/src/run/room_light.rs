@@ -1,5 +1,5 @@
 //! The room's light in `vitreous run`: when the runtime estimates it (XR_ML_light_estimation,
-//! Magic Leap 2), the scene's point light turns about the object, at its distance, to shine
+//! Magic Leap 2; `RunSink::follow_room_light` in `sink.rs`), the scene's point light turns about the object, at its distance, to shine
 //! the way the room's main light does, so the shadow inducer, the caustics and the dimmed
 //! shadow follow the real light, and the light's share of the floor's light (`[light] share`)
 //! becomes the estimate's: the main light's irradiance on the floor over all the light's. Each
@@ -14,10 +14,6 @@ use anyhow::Result;
 use glam::{DVec2, Vec3};
 use serde::Serialize;
 use vitreous_render::Renderer;
-use vitreous_xr::FrameInput;
-use vitreous_xr::light::LightEstimate;
-
-use super::RunSink;
 
 /// What the room's light estimates did in a session.
 #[derive(Clone, Debug, Default, Serialize)]
@@ -35,34 +31,6 @@ pub struct RoomLight {
     pub floor_share: Option<f32>,
     /// The share the renderer uses after the newest estimate (to a thousandth).
     pub light_share: Option<f32>,
-}
-
-impl RunSink<'_> {
-    /// Takes the newest light estimate since the last frame and turns the scene's light to
-    /// it (recorded) when it points elsewhere.
-    pub(super) fn follow_room_light(&mut self, input: &FrameInput) {
-        let Some(rx) = &self.light_rx else {
-            return;
-        };
-        let Some(estimate): Option<LightEstimate> = rx.try_iter().last() else {
-            return;
-        };
-        let room = self.room_light.get_or_insert_with(RoomLight::default);
-        room.estimates += 1;
-        room.direction = Some(estimate.direction.to_array());
-        let (_, floor_normal) = self.motion.floor();
-        room.floor_share = estimate.share_on(floor_normal);
-        if let Some(record) = self
-            .motion
-            .follow_light(estimate.direction, room.floor_share, input)
-        {
-            room.light_moves += 1;
-            self.record(&record);
-        }
-        if let Some(room) = &mut self.room_light {
-            room.light_share = Some(self.motion.light_share());
-        }
-    }
 }
 
 /// Where the shadow and the caustic lie on the floor, from the renderer's fields.

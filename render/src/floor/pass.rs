@@ -1,6 +1,10 @@
 //! The floor pass: builds the floor-space fields' pipelines once per scene and records their
 //! computation (mask, distance transform, distance, ramp, live caustics) when a frame first needs
 //! them (progress.rs tracks whether it has really run; readback.rs copies the fields back).
+//!
+//! Just over 600 lines, one idea: the pass's state and each step of its life (build, pose,
+//! prepare, record, the switch to live caustics and their read-outs, the light's share) act on
+//! the same private fields; splitting the steps apart would open those fields to the module.
 
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};

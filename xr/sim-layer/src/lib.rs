@@ -21,6 +21,7 @@ pub mod controller;
 pub mod entry;
 pub mod extensions;
 pub mod eye_geometry;
+pub mod functions;
 pub mod guard;
 pub mod next;
 pub mod registry;

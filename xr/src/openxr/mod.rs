@@ -160,7 +160,7 @@ impl Runtime {
         // The room's level surfaces, for placing the object on the table under the gaze.
         wanted.ext_plane_detection = available.ext_plane_detection;
         // XR_ML_eye_tracker is unknown to the `openxr` crate: enabled by name when listed.
-        let ml_name = ml_extension_name();
+        let ml_name = nul_terminated(ml_eye_tracker::EXTENSION_NAME);
         let ml_gaze = available.other.contains(&ml_name);
         if ml_gaze {
             wanted.other.push(ml_name);
@@ -425,11 +425,6 @@ struct GazeSupport {
     fb: bool,
     /// XR_ML_eye_tracker (`supportsEyeTracking`).
     ml: bool,
-}
-
-/// XR_ML_eye_tracker's name as the `openxr` crate lists unknown extensions (nul-terminated).
-fn ml_extension_name() -> Vec<u8> {
-    nul_terminated(ml_eye_tracker::EXTENSION_NAME)
 }
 
 /// An extension's name as `xr::ExtensionSet::other` holds it: nul-terminated bytes.

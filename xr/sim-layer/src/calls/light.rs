@@ -34,13 +34,14 @@ fn estimation(
     Some((ctx, light, e))
 }
 
-/// The estimate of `handle`, with the light it was made from.
-fn estimate(handle: ml::LightEstimationEstimateML) -> Option<(EstimateState, SimLight)> {
+/// The estimate of `handle`, with the light it was made from and its estimation's cube map
+/// face side.
+fn estimate(handle: ml::LightEstimationEstimateML) -> Option<(EstimateState, SimLight, u32)> {
     let reg = registry();
     let e = *reg.estimates.get(&handle.0)?;
-    let session = reg.estimations.get(&e.estimation)?.session;
-    let light = SessionContext::of(&reg, session)?.config.light?;
-    Some((e, light))
+    let estimation = reg.estimations.get(&e.estimation)?;
+    let light = SessionContext::of(&reg, estimation.session)?.config.light?;
+    Some((e, light, estimation.face_side))
 }
 
 /// Whether a structure the app passed has the extension's type `raw`.
@@ -215,7 +216,7 @@ pub unsafe extern "system" fn get_light_estimation_timestamp(
     out: *mut sys::Time,
 ) -> sys::Result {
     guard("xrGetLightEstimationTimestampML", || {
-        let Some((e, _)) = estimate(handle) else {
+        let Some((e, _, _)) = estimate(handle) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the app's output, null or writable.
@@ -236,7 +237,7 @@ pub unsafe extern "system" fn get_main_directional_light(
     out: *mut ml::LightEstimationMainDirectionalLightML,
 ) -> sys::Result {
     guard("xrGetLightEstimationMainDirectionalLightML", || {
-        let Some((e, light)) = estimate(handle) else {
+        let Some((e, light, _)) = estimate(handle) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the app's output, null or writable.
@@ -273,7 +274,7 @@ pub unsafe extern "system" fn get_spherical_harmonics(
     out: *mut ml::LightEstimationSphericalHarmonicsML,
 ) -> sys::Result {
     guard("xrGetLightEstimationSphericalHarmonicsML", || {
-        let Some((_, light)) = estimate(handle) else {
+        let Some((_, light, _)) = estimate(handle) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the app's output, null or writable.
@@ -337,13 +338,9 @@ pub unsafe extern "system" fn get_hdr_cubemap(
     out: *mut ml::LightEstimationHdrCubemapML,
 ) -> sys::Result {
     guard("xrGetLightEstimationHDRCubemapML", || {
-        let Some((e, light)) = estimate(handle) else {
+        let Some((e, light, side)) = estimate(handle) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
-        let side = registry()
-            .estimations
-            .get(&e.estimation)
-            .map_or(64, |s| s.face_side);
         // SAFETY: the app's output, null or writable.
         let Some(out) = (unsafe { out.as_mut() }) else {
             return sys::Result::ERROR_VALIDATION_FAILURE;

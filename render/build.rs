@@ -1,8 +1,9 @@
 //! Compiles every WGSL shader in `../shaders` to SPIR-V with naga, validating it on the way.
 //! Nothing is checked in as SPIR-V and no external shader tool is needed. Pipeline-overridable
 //! constants take their defaults, and the entry points of [`VARIANTS`] are compiled again with
-//! some set, for the pipelines that need (or can skip) the code they guard. Code shared by
-//! several shaders lives in `../shaders/shared` and is appended to each that names it in a
+//! some set, for the pipelines that need (or can skip) the code they guard; every glass fragment
+//! entry point also with `SUPERSAMPLED` set. Code shared by several shaders lives in
+//! `../shaders/shared` and is appended to each that names it in a
 //! `// #include shared/<file>.wgsl` line ([`with_includes`]). Beside each entry point's SPIR-V
 //! it writes the static cost of one invocation (`<name>.cost.rs`, build/shader_cost.rs), which
 //! the renderer's counted work multiplies by the invocations a frame ran.
@@ -86,6 +87,13 @@ const VARIANTS: &[Variant] = &[
             ("FILTERED_CAUSTICS", 1.0),
         ],
         "shadow.caustics.filtered",
+    ),
+    // B over several positions per pixel, as the glass's light (`SUPERSAMPLED`).
+    (
+        "compensation",
+        "fs_main",
+        &[("SUPERSAMPLED", 1.0)],
+        "supersampled",
     ),
     // Every glass model again with the room as its target (`ROOM`).
     ("glass", "fs_paper_", &[("ROOM", 1.0)], "room"),
@@ -172,6 +180,22 @@ fn main() {
                 }
                 outputs.push((constants, format!(".{suffix}"), Some(entry)));
             }
+        }
+        // Every glass entry point again over several positions per pixel (`SUPERSAMPLED`).
+        if name == "glass" {
+            let supersampled: Vec<_> = outputs
+                .iter()
+                .map(|(constants, suffix, only)| {
+                    let mut constants = constants.clone();
+                    constants.insert("SUPERSAMPLED".to_owned(), 1.0);
+                    (
+                        constants,
+                        format!("{suffix}.supersampled"),
+                        Some(only.unwrap_or("fs_")),
+                    )
+                })
+                .collect();
+            outputs.extend(supersampled);
         }
         for (constants, suffix, only) in outputs {
             let (module, info) =

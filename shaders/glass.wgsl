@@ -35,9 +35,14 @@
 // the glass refracts and reflects, exactly, in every variant: a ray leaving the glass takes the
 // photo it meets first (the floor sharp, the background at the frame's blur), the environment
 // map only where it meets neither; one fetch per image. Two-surface refraction then also
-// follows the light the exit reflects back inside to the next meeting with the surface (one
-// partial internal reflection, the faint second image of a real ball): one more exit and one
-// more fetch of the room.
+// follows the light the exit reflects back inside to its next two meetings with the surface
+// (partial internal reflections, the faint further images of a real ball): two more exits and
+// two more fetches of the room.
+//
+// Supersampling (`[output] glass_samples`, beyond the paper): the pixel's light is the mean over
+// an n x n grid of view rays inside it (`supersampled`), so that the glass's image is what the
+// eye averages over the pixel where the glass minifies the room, where its image jumps from the
+// wall to the floor and at a ball's outline.
 
 // #include shared/fresnel.wgsl
 
@@ -64,8 +69,8 @@ struct Globals {
     // rgb: light colour (linear); w: Phong exponent.
     light_colour: vec4<f32>,
     // x: exposure of environment radiance; y: surface opacity (1 - transmittance, 0 without a
-    // surface texture); z: Phong specular strength; w: unused (the refraction model is the
-    // pipeline's entry point).
+    // surface texture); z: Phong specular strength; w: positions along each side of a pixel
+    // (`SUPERSAMPLED`; the refraction model is the pipeline's entry point).
     shading: vec4<f32>,
     // Inverse of world_from_model.
     model_from_world: mat4x4<f32>,
@@ -104,6 +109,12 @@ override CONVEX: bool = false;
 // they meet neither. A pipeline constant (render/build.rs compiles every entry point with it set
 // too), so that the paper's pipelines keep their targets and their cost.
 override ROOM: bool = false;
+
+// The glass's light is the mean over several positions inside each pixel (`[output]
+// glass_samples`, beyond the paper): a pipeline constant (render/build.rs compiles every glass
+// entry point with it set too), so that one position's pipelines, the paper's, keep their code
+// and cost.
+override SUPERSAMPLED: bool = false;
 
 var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -248,6 +259,10 @@ fn beyond(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 }
 
 const MAX_INTERNAL_REFLECTIONS: i32 = 4;
+// Partial internal reflections after the exit followed with the room (`ROOM`): at a ball's rim,
+// where the exit reflects most, the second still shows (ꟻLIP in glass-sphere-real's disc 0.274
+// with one, 0.268 with two, 0.267 with three or six: docs/realism.md).
+const ECHOES: i32 = 2;
 // Radial-map steps per exit at most; a ball needs one.
 const EXIT_STEPS: i32 = 8;
 
@@ -297,13 +312,10 @@ struct Passage {
     transmission: vec3<f32>,
     // 1 when it left the object, 0 when given up inside (environment).
     escaped: f32,
-    // With the room (`ROOM`): the light the exit reflects back inside that leaves at the next
-    // meeting with the surface (one partial internal reflection, which a real ball shows as a
-    // faint second image): where and which way it leaves, world, and its transmittance (0 when
-    // there is none).
-    echo_exit: vec3<f32>,
-    echo_direction: vec3<f32>,
-    echo_transmission: vec3<f32>,
+    // With the room (`ROOM`): the room's light that the exit reflects back inside and that
+    // leaves at the next ECHOES meetings with the surface (the partial internal reflections,
+    // which a real ball shows as faint further images), linear RGB.
+    echoes: vec3<f32>,
 };
 
 // Where the ray p + t d (from inside, d unit; model frame about the radial map's centre)
@@ -383,19 +395,31 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     if ABSORBING {
         out.transmission *= exp2(-g.absorption.rgb * inside);
     }
-    out.echo_transmission = vec3<f32>(0.0);
+    out.echoes = vec3<f32>(0.0);
     if ROOM && out.escaped > 0.0 {
-        let exit = find_exit(p, echo_d);
-        let p2 = p + echo_d * exit.x;
-        let leaving = refract(echo_d, -exit.yzw, ior);
-        if dot(leaving, leaving) > 0.0 {
-            out.echo_transmission = vec3<f32>(
-                arriving * reflectance * (1.0 - fresnel_exact(dot(echo_d, exit.yzw), ior)));
-            if ABSORBING {
-                out.echo_transmission *= exp2(-g.absorption.rgb * (inside + exit.x));
+        // The light the exit reflects back inside, followed to its next ECHOES meetings with
+        // the surface: at each, the share that leaves sees the room, the rest goes on inside.
+        var q = p;
+        var e = echo_d;
+        var carried = arriving * reflectance;
+        var path = inside;
+        for (var k = 0; k < ECHOES; k++) {
+            let exit = find_exit(q, e);
+            q += e * exit.x;
+            path += exit.x;
+            let leaving = refract(e, -exit.yzw, ior);
+            if dot(leaving, leaving) > 0.0 {
+                let reflected = fresnel_exact(dot(e, exit.yzw), ior);
+                var share = vec3<f32>(carried * (1.0 - reflected));
+                if ABSORBING {
+                    share *= exp2(-g.absorption.rgb * path);
+                }
+                let leaves_at = (g.world_from_model * vec4<f32>(q + g.radial.xyz, 1.0)).xyz;
+                let towards = normalize((g.world_from_model * vec4<f32>(leaving, 0.0)).xyz);
+                out.echoes += room(leaves_at, towards) * share;
+                carried *= reflected;
             }
-            out.echo_exit = (g.world_from_model * vec4<f32>(p2 + g.radial.xyz, 1.0)).xyz;
-            out.echo_direction = normalize((g.world_from_model * vec4<f32>(leaving, 0.0)).xyz);
+            e = reflect(e, exit.yzw);
         }
     }
     out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
@@ -477,6 +501,60 @@ fn fs_two_surface_background_phong(in: VertexOut) -> @location(0) vec4<f32> {
 }
 
 fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool) -> vec4<f32> {
+    // eq. 9: C_o = alpha C_s + (1 - alpha) C_b, alpha the surface's opacity.
+    let surface_texel = textureSample(surface, wrap_sampler, in.uv);
+    let alpha = g.shading.y * surface_texel.a;
+    var light: vec3<f32>;
+    if SUPERSAMPLED {
+        light = supersampled(in, two_surface_model, to_background, phong, alpha);
+    } else {
+        light = shade_ray(in, two_surface_model, to_background, phong, alpha);
+    }
+    return vec4<f32>(alpha * surface_texel.rgb + light, 1.0);
+}
+
+// The glass's light over a pixel (`SUPERSAMPLED`): the mean of `shade_ray` over a regular
+// n x n grid of positions inside it (n = `g.shading.w`), each a view ray of its own through the
+// surface found as at the pixel's centre, with the vertex outputs carried there by their screen
+// derivatives. Where a position's ray passes beside a ball (its front surface is the sphere
+// through its vertices), the glass adds nothing there: the pixel's edge is covered in part.
+fn supersampled(
+    in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool, alpha: f32,
+) -> vec3<f32> {
+    let n = max(u32(g.shading.w), 1u);
+    let dx = VertexOut(vec4<f32>(0.0), dpdx(in.world_pos), dpdx(in.world_normal), vec2<f32>(0.0),
+        dpdx(in.curve));
+    let dy = VertexOut(vec4<f32>(0.0), dpdy(in.world_pos), dpdy(in.world_normal), vec2<f32>(0.0),
+        dpdy(in.curve));
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < n * n; i++) {
+        let offset = (vec2<f32>(f32(i % n), f32(i / n)) + 0.5) / f32(n) - 0.5;
+        var at = in;
+        at.world_pos += dx.world_pos * offset.x + dy.world_pos * offset.y;
+        at.world_normal += dx.world_normal * offset.x + dy.world_normal * offset.y;
+        at.curve += dx.curve * offset.x + dy.curve * offset.y;
+        if !misses_ball(at) {
+            sum += shade_ray(at, two_surface_model, to_background, phong, alpha);
+        }
+    }
+    return sum / f32(n * n);
+}
+
+// The eye's ray through `in.world_pos` passes beside the sphere `front_surface` would put it
+// on (a ball's vertices, `in.curve.y` 1).
+fn misses_ball(in: VertexOut) -> bool {
+    let from_centre = eye.position.xyz - g.center_world.xyz;
+    let d = normalize(in.world_pos - eye.position.xyz);
+    let b = dot(from_centre, d);
+    let c = dot(from_centre, from_centre) - in.curve.x * in.curve.x;
+    return in.curve.y > 0.5 && b * b - c < 0.0;
+}
+
+// The glass's light along one view ray, but for the surface's own (eq. 9's
+// `(1 - alpha) C_b`, the refraction and reflection).
+fn shade_ray(
+    in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool, alpha: f32,
+) -> vec3<f32> {
     let front = front_surface(in);
     let world_pos = front.position;
     let incident = normalize(world_pos - eye.position.xyz);
@@ -515,12 +593,8 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         }
         var light = seen * passage.transmission;
         if ROOM {
-            // The real ball's faint second image: light reflected once inside.
-            if passage.echo_transmission.x + passage.echo_transmission.y
-                + passage.echo_transmission.z > 0.0 {
-                light += room(passage.echo_exit, passage.echo_direction)
-                    * passage.echo_transmission;
-            }
+            // The real ball's faint further images: light reflected inside once or more.
+            light += passage.echoes;
         }
         refracted_image = light / max(1.0 - fresnel, 1e-6);
     } else if to_background {
@@ -556,10 +630,5 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         reflected_image = fresnel * beyond(world_pos, reflected);
     }
 
-    // eq. 9: C_o = alpha C_s + (1 - alpha) C_b, alpha the surface's opacity.
-    let surface_texel = textureSample(surface, wrap_sampler, in.uv);
-    let alpha = g.shading.y * surface_texel.a;
-    let colour = alpha * surface_texel.rgb + (1.0 - alpha) * (1.0 - fresnel) * refracted_image
-        + reflected_image;
-    return vec4<f32>(colour, 1.0);
+    return (1.0 - alpha) * (1.0 - fresnel) * refracted_image + reflected_image;
 }

@@ -7,6 +7,7 @@ mod compensation;
 mod cost;
 mod defocus;
 mod dimmer;
+mod glass_samples;
 mod inducer;
 mod live_caustics;
 mod live_caustics_sweep;

@@ -5,11 +5,8 @@
 //! the ball's centre (the room off) does.
 
 use glam::{Vec2, Vec3};
-use vitreous::effects::EffectSet;
 use vitreous_reference::{Window, World, render_eye};
-use vitreous_render::renderer::Want;
-use vitreous_render::{Composition, FrameParams, Reflection, Renderer};
-use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
+use vitreous_tests::{left_eye_light, neutral_eyes, shipped_scene};
 
 const SIZE: (u32, u32) = (320, 240);
 
@@ -17,33 +14,7 @@ const SIZE: (u32, u32) = (320, 240);
 fn gpu_left(scene: &vitreous::scene::Scene) -> Vec<Vec3> {
     let mut scene = scene.clone();
     scene.compensation = vitreous_render::Compensation::None;
-    let desc = vitreous::render_desc::scene_desc(&scene, None);
-    let mut r = Renderer::new(validated_context(), &desc, SIZE.0, SIZE.1).expect("renderer");
-    let left = neutral_eyes(&scene)[0];
-    let params = FrameParams {
-        eyes: [left, left],
-        look: vitreous::look::base_look(
-            &EffectSet::parse("none").unwrap(),
-            Reflection::EnvironmentFresnel,
-        ),
-    };
-    let want = Want {
-        eyes: true,
-        world: false,
-    };
-    let readback = compose_once(&mut r, &params, want, Composition::Additive)
-        .readback
-        .expect("read back");
-    readback.eyes[0]
-        .chunks_exact(4)
-        .map(|p| {
-            Vec3::new(
-                vitreous::output::srgb_to_linear(p[0]),
-                vitreous::output::srgb_to_linear(p[1]),
-                vitreous::output::srgb_to_linear(p[2]),
-            )
-        })
-        .collect()
+    left_eye_light(&scene, SIZE)
 }
 
 #[test]

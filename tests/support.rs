@@ -198,6 +198,7 @@ pub fn scene_desc<'a>(
         caustics: None,
         compensation: vitreous_render::Compensation::None,
         room: false,
+        glass_samples: 1,
         dimmer: None,
     }
 }
@@ -309,4 +310,38 @@ pub fn compose_once(
     let v = renderer.context().validation();
     assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
     done.pop().expect("the frame finished")
+}
+
+/// The left eye's display light (linear RGB, row by row) for `scene` at `size` pixels: both eyes
+/// at the neutral head's left eye, no effects, environment reflection with Fresnel, composed for
+/// an additive display (the scene's `[display] compensation` applies), validation on.
+pub fn left_eye_light(scene: &vitreous::scene::Scene, size: (u32, u32)) -> Vec<Vec3> {
+    use vitreous_render::{Composition, FrameParams, Reflection, Renderer, Want};
+    let desc = vitreous::render_desc::scene_desc(scene, None);
+    let mut r = Renderer::new(validated_context(), &desc, size.0, size.1).expect("renderer");
+    let left = neutral_eyes(scene)[0];
+    let params = FrameParams {
+        eyes: [left, left],
+        look: vitreous::look::base_look(
+            &vitreous::effects::EffectSet::parse("none").unwrap(),
+            Reflection::EnvironmentFresnel,
+        ),
+    };
+    let want = Want {
+        eyes: true,
+        world: false,
+    };
+    let readback = compose_once(&mut r, &params, want, Composition::Additive)
+        .readback
+        .expect("read back");
+    readback.eyes[0]
+        .chunks_exact(4)
+        .map(|p| {
+            Vec3::new(
+                vitreous::output::srgb_to_linear(p[0]),
+                vitreous::output::srgb_to_linear(p[1]),
+                vitreous::output::srgb_to_linear(p[2]),
+            )
+        })
+        .collect()
 }

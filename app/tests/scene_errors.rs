@@ -197,6 +197,20 @@ fn out_of_range_value_is_named() {
     assert!(msg.contains("120"), "{msg}");
     let text = good_text().replace("width_px = 1280", "width_px = 10");
     expect_error(&text, line_of(&text, "width_px"), "output.width_px");
+    for samples in ["0", "9", "2.5"] {
+        let text = good_text().replace(
+            "width_px = 1280",
+            &format!("width_px = 1280\nglass_samples = {samples}"),
+        );
+        let line = line_of(&text, "glass_samples");
+        if samples == "2.5" {
+            // Not a whole number: the TOML type is wrong, named all the same.
+            expect_error(&text, line, "glass_samples");
+        } else {
+            let msg = expect_error(&text, line, "output.glass_samples");
+            assert!(msg.contains("1..=8") && msg.contains(samples), "{msg}");
+        }
+    }
     let text = good_text().replace("diameter_m = 0.08", "diameter_m = 12.0");
     expect_error(&text, line_of(&text, "diameter_m"), "object.diameter_m");
     let text = good_text().replace("diameter_m = 0.08", "diameter_m = -0.1");

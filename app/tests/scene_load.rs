@@ -23,6 +23,7 @@ fn minimal_scene_takes_the_documented_defaults() {
     assert_eq!(scene.viewer.pupil_diameter_m, 0.006);
     assert_eq!(scene.viewer.head_position_m, Vec3::ZERO);
     assert_eq!((scene.output.width_px, scene.output.height_px), (1280, 960));
+    assert_eq!(scene.output.glass_samples, 1);
     let fov = scene.output.fov;
     assert!((fov.angle_right_rad - 20f32.to_radians()).abs() < 1e-6);
     assert!((fov.angle_up_rad - 15f32.to_radians()).abs() < 1e-6);

@@ -190,8 +190,10 @@ fn the_real_glass_scene_refracts_the_room_and_the_papers_scenes_their_hdri() {
     assert!(real.environment.room);
     assert_eq!(real.compensation, vitreous_render::Compensation::Background);
     assert_eq!(real.light.share, 0.5);
+    assert_eq!(real.output.glass_samples, 4);
     let paper = load("glass-sphere.toml");
     assert!(!paper.environment.room);
+    assert_eq!(paper.output.glass_samples, 1);
     // Straight down from the ball, the room's map holds the floor photo, the paper's the HDRI.
     let texel = |s: &Scene| {
         let PixelData::LinearF32(px) = &s.environment.latlong.data else {

@@ -58,6 +58,9 @@ pub struct CompensationPass {
     _seen: SeenPhotos,
     /// The mesh's bounding sphere in model units: centre and radius.
     bounds: (Vec3, f32),
+    /// Positions along each side of a pixel whose mean is B (the glass's own, `[output]
+    /// glass_samples`).
+    samples: u32,
 }
 
 /// The real floor and background as the eye sees them (shaders/shared/seen.wgsl): the planes'
@@ -167,7 +170,10 @@ impl CompensationPass {
                 render_pass,
                 layout: layout.raw(),
                 vertex: (shaders::COMPENSATION_VS, c"vs_main"),
-                fragment: (shaders::COMPENSATION_FS, c"fs_main"),
+                fragment: (
+                    shaders::COMPENSATION_FS[usize::from(desc.glass_samples > 1)],
+                    c"fs_main",
+                ),
                 bindings: &[],
                 attributes: &[],
                 cull: vk::CullModeFlags::NONE,
@@ -195,6 +201,7 @@ impl CompensationPass {
             set,
             _seen: seen,
             bounds: bounding_sphere(desc.mesh.positions),
+            samples: desc.glass_samples.max(1),
         })
     }
 
@@ -218,7 +225,7 @@ impl CompensationPass {
         let d = &ctx.device;
         let push = EyePush {
             world_from_clip: eye.clip_from_world().inverse().to_cols_array(),
-            position: eye.position_m.extend(1.0).to_array(),
+            position: eye.position_m.extend(self.samples as f32).to_array(),
         };
         // SAFETY: the caller's contract (inside a compatible render pass, `self` outliving
         // the execution); the push constants match the layout's range.

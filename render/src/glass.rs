@@ -233,6 +233,14 @@ impl GlassPass {
             (Refraction::TwoSurface, false, true) => 6 - usize::from(clear),
             (Refraction::TwoSurface, false, false) => 2 - usize::from(clear),
         } + if desc.room { shaders::GLASS_MODELS } else { 0 };
+        // Several positions per pixel: the same model's pipelines compiled with `SUPERSAMPLED`.
+        let samples = desc.glass_samples.max(1);
+        let shaded = model
+            + if samples > 1 {
+                2 * shaders::GLASS_MODELS
+            } else {
+                0
+            };
         let pipelines = GlassVariant::ALL
             .iter()
             .map(|variant| {
@@ -242,7 +250,7 @@ impl GlassPass {
                         render_pass,
                         layout: layout.raw(),
                         vertex: (shaders::GLASS_VS, c"vs_main"),
-                        fragment: shaders::GLASS_FS[model][variant.index()],
+                        fragment: shaders::GLASS_FS[shaded][variant.index()],
                         bindings: &bindings,
                         attributes: &attributes,
                         cull: vk::CullModeFlags::BACK,
@@ -275,7 +283,13 @@ impl GlassPass {
             optics: [desc.ior, FRESNEL_BIAS, FRESNEL_SCALE, FRESNEL_POWER],
             light: [0.0; 4],
             light_colour: desc.light.radiance.extend(PHONG_EXPONENT).to_array(),
-            shading: Vec4::new(desc.exposure, surface_opacity, PHONG_STRENGTH, 0.0).to_array(),
+            shading: Vec4::new(
+                desc.exposure,
+                surface_opacity,
+                PHONG_STRENGTH,
+                samples as f32,
+            )
+            .to_array(),
             model_from_world: [0.0; 16],
             radial,
             center_world: [0.0; 4],
@@ -302,7 +316,13 @@ impl GlassPass {
         descriptors::write_image(ctx, set, 8, scene.photos[0].view);
         Ok(GlassPass {
             pipelines,
-            costs: shaders::GLASS_FS_COST[model],
+            // The loop over a pixel's positions counts once in the static cost: each further
+            // position is charged as one more one-position shader (its surface fetch, which the
+            // loop does not repeat, included).
+            costs: std::array::from_fn(|v| {
+                shaders::GLASS_FS_COST[shaded][v]
+                    .with_runs(shaders::GLASS_FS_COST[model][v], samples * samples)
+            }),
             layout,
             _pool: pool,
             _set_layout: set_layout,

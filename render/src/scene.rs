@@ -141,6 +141,9 @@ pub struct SceneDesc<'a> {
     /// environment map only where it meets neither. Off: the paper's targets (the background
     /// plane with disparity or defocus, else the environment map).
     pub room: bool,
+    /// Positions along each side of a pixel whose mean is the glass's light there (`[output]
+    /// glass_samples`): 1, the pixel's centre (the paper); n: an n x n grid.
+    pub glass_samples: u32,
     /// The display's segmented dimmer (`[display] model = "dimmer"`), when it has one: the
     /// eye images then carry the share of the real world's light to take away as their alpha,
     /// and the light that makes up for what the soft panel takes away too much

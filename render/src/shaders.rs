@@ -70,8 +70,9 @@ pub const GLASS_VS: &[u8] = spirv!("glass.vs_main");
 /// two-surface through a ball (3: `BALL`, no radial-map fetch) and through an absorbing ball
 /// (4: both), through a convex faceted object (5: `CONVEX`, the exit from its facet planes)
 /// and through an absorbing one (6: both), the variant as `glass::GlassVariant::index`
-/// numbers it; rows 7 to 13 are the same models with the room as the glass's target (`ROOM`).
-pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 2 * GLASS_MODELS] = [
+/// numbers it; rows 7 to 13 are the same models with the room as the glass's target (`ROOM`),
+/// rows 14 to 27 rows 0 to 13 again over several positions per pixel (`SUPERSAMPLED`).
+pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 4 * GLASS_MODELS] = [
     glass_row!("paper", ""),
     glass_row!("two_surface", ""),
     glass_row!("two_surface", ".absorbing"),
@@ -86,11 +87,26 @@ pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 2 * GLASS_MODELS] = [
     glass_row!("two_surface", ".absorbing.ball.room"),
     glass_row!("two_surface", ".convex.room"),
     glass_row!("two_surface", ".absorbing.convex.room"),
+    glass_row!("paper", ".supersampled"),
+    glass_row!("two_surface", ".supersampled"),
+    glass_row!("two_surface", ".absorbing.supersampled"),
+    glass_row!("two_surface", ".ball.supersampled"),
+    glass_row!("two_surface", ".absorbing.ball.supersampled"),
+    glass_row!("two_surface", ".convex.supersampled"),
+    glass_row!("two_surface", ".absorbing.convex.supersampled"),
+    glass_row!("paper", ".room.supersampled"),
+    glass_row!("two_surface", ".room.supersampled"),
+    glass_row!("two_surface", ".absorbing.room.supersampled"),
+    glass_row!("two_surface", ".ball.room.supersampled"),
+    glass_row!("two_surface", ".absorbing.ball.room.supersampled"),
+    glass_row!("two_surface", ".convex.room.supersampled"),
+    glass_row!("two_surface", ".absorbing.convex.room.supersampled"),
 ];
-/// Glass models without the room; the same again with it (`ROOM`) follow them.
+/// Glass models without the room; the same again with it (`ROOM`) follow them, then all of
+/// those over several positions per pixel (`SUPERSAMPLED`).
 pub const GLASS_MODELS: usize = 7;
 /// The static cost of one invocation of each of [`GLASS_FS`]'s entry points.
-pub const GLASS_FS_COST: [[ShaderCost; 4]; 2 * GLASS_MODELS] = [
+pub const GLASS_FS_COST: [[ShaderCost; 4]; 4 * GLASS_MODELS] = [
     glass_cost_row!("paper", ""),
     glass_cost_row!("two_surface", ""),
     glass_cost_row!("two_surface", ".absorbing"),
@@ -105,6 +121,20 @@ pub const GLASS_FS_COST: [[ShaderCost; 4]; 2 * GLASS_MODELS] = [
     glass_cost_row!("two_surface", ".absorbing.ball.room"),
     glass_cost_row!("two_surface", ".convex.room"),
     glass_cost_row!("two_surface", ".absorbing.convex.room"),
+    glass_cost_row!("paper", ".supersampled"),
+    glass_cost_row!("two_surface", ".supersampled"),
+    glass_cost_row!("two_surface", ".absorbing.supersampled"),
+    glass_cost_row!("two_surface", ".ball.supersampled"),
+    glass_cost_row!("two_surface", ".absorbing.ball.supersampled"),
+    glass_cost_row!("two_surface", ".convex.supersampled"),
+    glass_cost_row!("two_surface", ".absorbing.convex.supersampled"),
+    glass_cost_row!("paper", ".room.supersampled"),
+    glass_cost_row!("two_surface", ".room.supersampled"),
+    glass_cost_row!("two_surface", ".absorbing.room.supersampled"),
+    glass_cost_row!("two_surface", ".ball.room.supersampled"),
+    glass_cost_row!("two_surface", ".absorbing.ball.room.supersampled"),
+    glass_cost_row!("two_surface", ".convex.room.supersampled"),
+    glass_cost_row!("two_surface", ".absorbing.convex.room.supersampled"),
 ];
 pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const BLUR_BLEND_VS: &[u8] = spirv!("blur_blend.vs_main");
@@ -112,8 +142,12 @@ pub const BLUR_BLEND_FS: &[u8] = spirv!("blur_blend.fs_main");
 pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
 /// Eq. 6 over the glass: the full-screen triangle at the far plane (shaders/compensation.wgsl).
 pub const COMPENSATION_VS: &[u8] = spirv!("compensation.vs_main");
-/// Eq. 6 over the glass: the real floor or background the eye sees, to take away.
-pub const COMPENSATION_FS: &[u8] = spirv!("compensation.fs_main");
+/// Eq. 6 over the glass: the real floor or background the eye sees, to take away; at the
+/// pixel's centre, and the mean over several positions in it (`SUPERSAMPLED`).
+pub const COMPENSATION_FS: [&[u8]; 2] = [
+    spirv!("compensation.fs_main"),
+    spirv!("compensation.fs_main.supersampled"),
+];
 /// The segmented dimmer's panel: each cell's want, spread, softened (shaders/dimmer_panel.wgsl).
 pub const DIMMER_WANT_CS: &[u8] = spirv!("dimmer_panel.want");
 /// See [`DIMMER_WANT_CS`].

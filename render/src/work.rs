@@ -122,6 +122,20 @@ pub struct ShaderCost {
     pub instructions: u32,
 }
 
+impl ShaderCost {
+    /// The cost of a shader whose loop runs its body `runs` times where `self` counts it once,
+    /// with `body` an upper bound of one run's cost (a loop over positions per pixel whose body
+    /// is the one-position shader, `body`).
+    pub fn with_runs(self, body: ShaderCost, runs: u32) -> ShaderCost {
+        let more = runs.saturating_sub(1);
+        ShaderCost {
+            fetches: self.fetches + more * body.fetches,
+            texels: self.texels + more * body.texels,
+            instructions: self.instructions + more * body.instructions,
+        }
+    }
+}
+
 /// Shader invocations of one pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Invocations {
@@ -176,4 +190,29 @@ pub struct PassInvocations {
     pub eye_floor: Invocations,
     /// In the eye passes, the glass object.
     pub eye_glass: Invocations,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_loop_run_again_is_charged_its_body_once_more_per_run() {
+        let looped = ShaderCost {
+            fetches: 5,
+            texels: 20,
+            instructions: 300,
+        };
+        let body = ShaderCost {
+            fetches: 4,
+            texels: 16,
+            instructions: 250,
+        };
+        assert_eq!(looped.with_runs(body, 1), looped);
+        assert_eq!(looped.with_runs(body, 0), looped);
+        let sixteen = looped.with_runs(body, 16);
+        assert_eq!(sixteen.fetches, 5 + 15 * 4);
+        assert_eq!(sixteen.texels, 20 + 15 * 16);
+        assert_eq!(sixteen.instructions, 300 + 15 * 250);
+    }
 }

@@ -158,6 +158,7 @@ pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> Sc
         }),
         compensation: scene.compensation,
         room: scene.environment.room,
+        glass_samples: scene.output.glass_samples,
         dimmer: scene.dimmer,
     }
 }

@@ -171,6 +171,7 @@ pub(crate) struct OutputToml {
     pub height_px: Option<Spanned<i64>>,
     pub horizontal_fov_deg: Option<Spanned<f32>>,
     pub vertical_fov_deg: Option<Spanned<f32>>,
+    pub glass_samples: Option<Spanned<i64>>,
 }
 
 /// `[effects]`: the perception-based effects to render.

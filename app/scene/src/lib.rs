@@ -399,6 +399,10 @@ pub struct Output {
     pub height_px: u32,
     /// Field of view of each eye, radians.
     pub fov: Fov,
+    /// Positions along each side of a pixel whose mean is the glass's light there (1..=8):
+    /// 1, the pixel's centre (the paper's rendering); n, an n x n grid, as the eye averages
+    /// the real glass over the pixel.
+    pub glass_samples: u32,
 }
 
 /// Rotation from `[x, y, z]` Euler angles in degrees: about world x first, then world y,

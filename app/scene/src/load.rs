@@ -32,6 +32,9 @@ use vitreous_gaze::{FilterKind, FilterParseError, GazeOverride, PupilSource};
 mod display;
 mod object;
 
+/// The most positions along each side of a pixel `[output] glass_samples` takes (64 per pixel).
+pub const MAX_GLASS_SAMPLES: u32 = 8;
+
 /// Loads a scene file and every asset it names, checking ranges and decoding everything.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
     load_scene_from(path, &DiskFiles)
@@ -331,10 +334,28 @@ impl Loader<'_> {
             (1.0, 170.0),
             CLOSED,
         )?;
+        let glass_samples = match &o.glass_samples {
+            None => 1,
+            Some(v) => match u32::try_from(*v.get_ref()) {
+                Ok(n) if (1..=MAX_GLASS_SAMPLES).contains(&n) => n,
+                _ => {
+                    return Err(self.src.invalid(
+                        v.span(),
+                        "output.glass_samples",
+                        format!(
+                            "expected 1..={MAX_GLASS_SAMPLES} positions along each side of a \
+                             pixel, found {}",
+                            v.get_ref()
+                        ),
+                    ));
+                }
+            },
+        };
         let output = Output {
             width_px,
             height_px,
             fov: Fov::symmetric(h_deg.to_radians(), v_deg.to_radians()),
+            glass_samples,
         };
 
         let effects = match &raw.effects.set {

@@ -20,6 +20,13 @@
 //!   travels (in the frame of the head's level pose when the estimation is made), its colour
 //!   (the irradiance it gives a surface facing it), a uniform ambient radiance `a`, and a turn
 //!   of the main light by `turn_deg` about +y `at_s` seconds after the estimation was made.
+//! - `VITREOUS_SIM_IMAGES`: a folder: every projection image the app releases is read back
+//!   (Vulkan sessions) and each submitted view's alpha written to `alpha.csv` there
+//!   (`crate::images`); with `VITREOUS_SIM_WORLD`, a picture of the real world (any PNG, scaled
+//!   to each view), the last frame as the wearer would see it: `wearer-left.png`,
+//!   `wearer-right.png`, the world dimmed by a segmented dimmer panel of
+//!   `VITREOUS_SIM_PANEL` (`cells_across,cells_down,blur_deg`, default `64,48,1.5`) where the
+//!   alpha asks, and the image's light added.
 
 use std::ffi::CStr;
 use std::fmt;
@@ -50,6 +57,13 @@ pub const PLANE_DETECTION: &CStr = c"XR_EXT_plane_detection";
 pub const LIGHT_VAR: &str = "VITREOUS_SIM_LIGHT";
 /// The light estimation extension's name.
 pub const LIGHT_ESTIMATION: &CStr = c"XR_ML_light_estimation";
+/// Environment variable naming the folder the submitted images' record goes to.
+pub const IMAGES_VAR: &str = "VITREOUS_SIM_IMAGES";
+/// Environment variable naming a picture of the real world, for the wearer's view.
+pub const WORLD_VAR: &str = "VITREOUS_SIM_WORLD";
+/// Environment variable giving the simulated dimmer panel: cells across, down, blur (degrees).
+pub const PANEL_VAR: &str = "VITREOUS_SIM_PANEL";
+
 /// The sides `VITREOUS_SIM_EYE_MAX` takes, pixels.
 pub const EYE_MAX_RANGE: std::ops::RangeInclusive<u32> = 16..=16384;
 
@@ -144,6 +158,61 @@ pub struct Config {
     pub planes: Vec<SimPlane>,
     /// The light XR_ML_light_estimation estimates (`None`: the extension is not the layer's).
     pub light: Option<SimLight>,
+    /// The folder the submitted images' record goes to (`None`: not read back).
+    pub images: Option<PathBuf>,
+    /// A picture of the real world the wearer's view is made over.
+    pub world: Option<PathBuf>,
+    /// The simulated segmented dimmer's panel.
+    pub panel: SimPanel,
+}
+
+/// A segmented dimmer panel, as `VITREOUS_SIM_PANEL` gives it: each cell takes away the mean
+/// alpha of the pixels it covers, seen through a Gaussian blur.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimPanel {
+    /// Cells across and down the view.
+    pub cells: [u32; 2],
+    /// Standard deviation of the blur, degrees.
+    pub blur_deg: f32,
+}
+
+impl Default for SimPanel {
+    /// Magic Leap 2's panel as vitreous's scenes guess it (docs/headsets.md).
+    fn default() -> Self {
+        SimPanel {
+            cells: [64, 48],
+            blur_deg: 1.5,
+        }
+    }
+}
+
+/// Parses `VITREOUS_SIM_PANEL`.
+pub fn parse_panel(value: &str) -> Result<SimPanel, ConfigError> {
+    let bad = || ConfigError {
+        var: PANEL_VAR,
+        value: value.to_owned(),
+        expected: "cells_across,cells_down,blur_deg: two whole numbers 1..=1024 and a blur 0..=20 \
+                   degrees",
+    };
+    let parts: Vec<&str> = value.split(',').map(str::trim).collect();
+    let [across, down, blur] = parts.as_slice() else {
+        return Err(bad());
+    };
+    let cell = |v: &str| {
+        v.parse::<u32>()
+            .ok()
+            .filter(|c| (1..=1024).contains(c))
+            .ok_or_else(bad)
+    };
+    let blur_deg = blur
+        .parse::<f32>()
+        .ok()
+        .filter(|b| (0.0..=20.0).contains(b))
+        .ok_or_else(bad)?;
+    Ok(SimPanel {
+        cells: [cell(across)?, cell(down)?],
+        blur_deg,
+    })
 }
 
 /// The room's light, as `VITREOUS_SIM_LIGHT` gives it.
@@ -268,6 +337,12 @@ impl Config {
                 .transpose()?
                 .unwrap_or_default(),
             light: get(LIGHT_VAR).map(|v| parse_light(&v)).transpose()?,
+            images: get(IMAGES_VAR).map(PathBuf::from),
+            world: get(WORLD_VAR).map(PathBuf::from),
+            panel: get(PANEL_VAR)
+                .map(|v| parse_panel(&v))
+                .transpose()?
+                .unwrap_or_default(),
             ml_frame: match get(ML_FRAME_VAR).as_deref().map(str::trim) {
                 None | Some("0") => false,
                 Some("1") => true,
@@ -401,6 +476,26 @@ mod tests {
         for bad in ["0,0,0,1", "0,0,0,1,0", "a,0,0,1,1", "0,0,nan,1,1"] {
             let e = config(&[(PLANES_VAR, bad)]).unwrap_err();
             assert_eq!(e.var, PLANES_VAR, "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_panel_defaults_to_magic_leap_2s_guess_and_a_bad_one_names_the_variable() {
+        let c = config(&[(IMAGES_VAR, "/tmp/i")]).unwrap();
+        assert_eq!(c.panel, SimPanel::default());
+        assert_eq!(c.images, Some(PathBuf::from("/tmp/i")));
+        let p = config(&[(PANEL_VAR, "32, 24, 0.5")]).unwrap().panel;
+        assert_eq!((p.cells, p.blur_deg), ([32, 24], 0.5));
+        for bad in [
+            "32,24",
+            "0,24,1",
+            "32,24,-1",
+            "32,24,nan",
+            "a,b,c",
+            "32,24,1,2",
+        ] {
+            let e = config(&[(PANEL_VAR, bad)]).unwrap_err();
+            assert_eq!(e.var, PANEL_VAR, "{bad}");
         }
     }
 

@@ -143,6 +143,35 @@ pub fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::V
             entry!(calls::session::begin_session, pfn::BeginSession),
         ),
         b"xrWaitFrame" => (None, entry!(calls::session::wait_frame, pfn::WaitFrame)),
+        b"xrCreateSwapchain" => (
+            None,
+            entry!(calls::swapchain::create_swapchain, pfn::CreateSwapchain),
+        ),
+        b"xrDestroySwapchain" => (
+            None,
+            entry!(calls::swapchain::destroy_swapchain, pfn::DestroySwapchain),
+        ),
+        b"xrEnumerateSwapchainImages" => (
+            None,
+            entry!(
+                calls::swapchain::enumerate_swapchain_images,
+                pfn::EnumerateSwapchainImages
+            ),
+        ),
+        b"xrAcquireSwapchainImage" => (
+            None,
+            entry!(
+                calls::swapchain::acquire_swapchain_image,
+                pfn::AcquireSwapchainImage
+            ),
+        ),
+        b"xrReleaseSwapchainImage" => (
+            None,
+            entry!(
+                calls::swapchain::release_swapchain_image,
+                pfn::ReleaseSwapchainImage
+            ),
+        ),
         b"xrEndFrame" => (None, entry!(calls::session::end_frame, pfn::EndFrame)),
         b"xrCreateReferenceSpace" => (
             None,

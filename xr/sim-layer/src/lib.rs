@@ -5,7 +5,8 @@
 //! `XR_FB_eye_tracking_social` and `XR_ML_eye_tracker`, answered from the eye rays of a
 //! vitreous trace (v1) composed with the runtime's head pose, and lists the ADDITIVE and
 //! ALPHA_BLEND environment blend modes before the runtime's own, composing such frames with
-//! a mode the runtime has and recording what each submitted frame asked for. See
+//! a mode the runtime has and recording what each submitted frame asked for (and, with
+//! `VITREOUS_SIM_IMAGES`, the submitted images themselves: [`images`]). See
 //! `docs/sim-layer.md` for how to enable it and what it approximates.
 //!
 //! The loader finds the layer through its manifest (`xr/sim-layer/manifest/`, written by
@@ -23,6 +24,7 @@ pub mod extensions;
 pub mod eye_geometry;
 pub mod functions;
 pub mod guard;
+pub mod images;
 pub mod next;
 pub mod registry;
 pub mod submitted;

@@ -52,6 +52,16 @@ pub struct NextTable {
     pub enumerate_bound_sources_for_action: pfn::EnumerateBoundSourcesForAction,
     /// `xrSyncActions`.
     pub sync_actions: pfn::SyncActions,
+    /// `xrCreateSwapchain`.
+    pub create_swapchain: pfn::CreateSwapchain,
+    /// `xrDestroySwapchain`.
+    pub destroy_swapchain: pfn::DestroySwapchain,
+    /// `xrEnumerateSwapchainImages`.
+    pub enumerate_swapchain_images: pfn::EnumerateSwapchainImages,
+    /// `xrAcquireSwapchainImage`.
+    pub acquire_swapchain_image: pfn::AcquireSwapchainImage,
+    /// `xrReleaseSwapchainImage`.
+    pub release_swapchain_image: pfn::ReleaseSwapchainImage,
 }
 
 /// Looks up one function through `gipa`.
@@ -156,6 +166,26 @@ impl NextTable {
                 pfn::GetActionStateBoolean
             ),
             sync_actions: load!(gipa, instance, c"xrSyncActions", pfn::SyncActions),
+            create_swapchain: load!(gipa, instance, c"xrCreateSwapchain", pfn::CreateSwapchain),
+            destroy_swapchain: load!(gipa, instance, c"xrDestroySwapchain", pfn::DestroySwapchain),
+            enumerate_swapchain_images: load!(
+                gipa,
+                instance,
+                c"xrEnumerateSwapchainImages",
+                pfn::EnumerateSwapchainImages
+            ),
+            acquire_swapchain_image: load!(
+                gipa,
+                instance,
+                c"xrAcquireSwapchainImage",
+                pfn::AcquireSwapchainImage
+            ),
+            release_swapchain_image: load!(
+                gipa,
+                instance,
+                c"xrReleaseSwapchainImage",
+                pfn::ReleaseSwapchainImage
+            ),
             attach_session_action_sets: load!(
                 gipa,
                 instance,

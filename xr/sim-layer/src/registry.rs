@@ -2,7 +2,7 @@
 //! knows, keyed by the raw handle, behind one mutex. Calls copy what they need out of it and
 //! release the lock before calling down the chain (xrWaitFrame blocks).
 
-use std::collections::{HashMap, HashSet};
+use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::{Arc, LazyLock, Mutex, MutexGuard};
 
 use openxr::sys;
@@ -11,6 +11,7 @@ use vitreous_xr::Pose;
 use crate::bindings::GazePaths;
 use crate::config::{Config, GazeExtension};
 use crate::controller::Buttons;
+use crate::images::{SharedImages, TexelLayout};
 use crate::next::NextTable;
 use crate::submitted::SubmittedLog;
 use crate::timeline::GazeTimeline;
@@ -72,6 +73,27 @@ pub struct SessionState {
     pub runtime_blend: Option<Vec<sys::EnvironmentBlendMode>>,
     /// Whether the app attached its action sets to the session.
     pub attached: bool,
+    /// What the app submits, read back (`VITREOUS_SIM_IMAGES`).
+    pub images: Option<SharedImages>,
+}
+
+/// What the layer keeps per swapchain of a session whose images it reads back.
+#[derive(Clone, Debug)]
+pub struct SwapchainState {
+    /// The session's raw handle.
+    pub session: u64,
+    /// How its texels are laid out (`None`: a format the layer does not read).
+    pub layout: Option<TexelLayout>,
+    /// Width and height, pixels.
+    pub size: (u32, u32),
+    /// Array layers.
+    pub layers: u32,
+    /// Its `VkImage`s, in index order.
+    pub images: Vec<u64>,
+    /// Indices acquired and not yet released, oldest first.
+    pub acquired: VecDeque<u32>,
+    /// The texels of each layer of the image released last.
+    pub released: Option<Arc<Vec<Vec<u8>>>>,
 }
 
 /// What the layer keeps per space it saw created.
@@ -147,6 +169,8 @@ pub struct Registry {
     pub estimations: HashMap<u64, EstimationState>,
     /// Light estimates by the handle the layer gave them.
     pub estimates: HashMap<u64, EstimateState>,
+    /// Swapchains of sessions whose images the layer reads back, by handle.
+    pub swapchains: HashMap<u64, SwapchainState>,
     /// The next handle the layer gives out.
     next_handle: u64,
 }
@@ -166,6 +190,7 @@ impl Registry {
             detectors: HashMap::new(),
             estimations: HashMap::new(),
             estimates: HashMap::new(),
+            swapchains: HashMap::new(),
             next_handle: FIRST_HANDLE,
         }
     }
@@ -247,6 +272,7 @@ impl Registry {
         self.spaces.retain(|_, s| s.session != session);
         self.trackers.retain(|_, t| t.session != session);
         self.detectors.retain(|_, d| d.session != session);
+        self.swapchains.retain(|_, c| c.session != session);
         let estimations = &mut self.estimations;
         estimations.retain(|_, e| e.session != session);
         self.estimates

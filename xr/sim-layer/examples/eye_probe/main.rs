@@ -77,6 +77,9 @@ fn probe(frames: u32) -> Probe<()> {
     let entry = unsafe { xr::Entry::load(&()) }.map_err(|e| format!("loading the loader: {e}"))?;
     let mut exts = xr::ExtensionSet::default();
     exts.mnd_headless = true;
+    // "Now" as an XrTime: Monado's headless session leaves xrWaitFrame's predicted display time
+    // unwritten (below).
+    exts.khr_convert_timespec_time = true;
     exts.fb_eye_tracking_social = true;
     exts.ext_eye_gaze_interaction = true;
     // `other` names go to the loader as they are: NUL-terminated.
@@ -162,7 +165,7 @@ fn probe(frames: u32) -> Probe<()> {
 
     // SAFETY: a headless session needs no graphics binding.
     // Monado refuses xrBeginFrame in a headless session, so the probe only waits for frames.
-    let (session, mut waiter, _stream) = unsafe {
+    let (session, _waiter, _stream) = unsafe {
         instance.create_session::<xr::Headless>(system, &xr::headless::SessionCreateInfo {})
     }
     .map_err(|e| format!("xrCreateSession: {e}"))?;
@@ -265,7 +268,23 @@ fn probe(frames: u32) -> Probe<()> {
             std::thread::sleep(std::time::Duration::from_millis(10));
             continue;
         }
-        let state = waiter.wait().map_err(|e| format!("xrWaitFrame: {e}"))?;
+        // Monado's headless session returns from xrWaitFrame without writing the predicted
+        // display time: the state starts at "now", so the layer (which records the time the
+        // runtime hands back) and the probe see a real time rather than whatever the memory
+        // held.
+        let mut state = sys::FrameState {
+            ty: sys::FrameState::TYPE,
+            next: std::ptr::null_mut(),
+            predicted_display_time: instance
+                .now()
+                .map_err(|e| format!("xrConvertTimespecTimeToTimeKHR: {e}"))?,
+            predicted_display_period: sys::Duration::from_nanos(0),
+            should_render: sys::FALSE,
+        };
+        // SAFETY: the live session, no wait info, a valid output structure.
+        check("xrWaitFrame", unsafe {
+            (instance.fp().wait_frame)(session.as_raw(), std::ptr::null(), &mut state)
+        })?;
         let t = state.predicted_display_time;
         last_time = Some(t);
         if !located {

@@ -12,6 +12,7 @@ pub mod light;
 pub mod ml;
 pub mod planes;
 pub mod session;
+pub mod swapchain;
 
 use std::ffi::c_void;
 use std::sync::Arc;

@@ -5,10 +5,13 @@ use openxr::sys::{self, Handle};
 
 use super::{SessionContext, all_location_flags, chain};
 use crate::blend;
+use crate::config::Config;
 use crate::eye_geometry::{combined_ray, compose, from_posef, ray_pose, relative, to_posef};
 use crate::guard::{guard, report};
+use crate::images::{AlphaLog, Reader, SessionImages, SharedImages, ViewImage, VulkanBinding};
 use crate::registry::{SessionState, SpaceState, registry};
 use crate::submitted::{FrameInfo, LayerInfo};
+use std::sync::{Arc, Mutex};
 use vitreous_xr::Pose;
 
 /// `xrCreateSession`: passed on; the layer then makes its VIEW space in the new session.
@@ -34,7 +37,13 @@ pub unsafe extern "system" fn create_session(
             return r;
         }
         // SAFETY: on success `info` was valid and the new session was written.
-        let (system, created) = unsafe { ((*info).system_id, *session) };
+        let (system, created, chain) = unsafe { ((*info).system_id, *session, (*info).next) };
+        let config = registry()
+            .instances
+            .get(&instance.into_raw())
+            .map(|i| i.config.clone());
+        // SAFETY: the app's valid create info chain.
+        let images = config.and_then(|c| unsafe { session_images(&c, chain) });
         let view_info = sys::ReferenceSpaceCreateInfo {
             ty: sys::ReferenceSpaceCreateInfo::TYPE,
             next: std::ptr::null(),
@@ -62,10 +71,55 @@ pub unsafe extern "system" fn create_session(
                 syncs_ns: (None, None),
                 runtime_blend: None,
                 attached: false,
+                images,
             },
         );
         r
     })
+}
+
+/// The record of what the app submits, when `config` asks for one (`VITREOUS_SIM_IMAGES`):
+/// its `alpha.csv`, and a reader on the Vulkan device of the session's graphics binding (in
+/// `chain`), if it has one.
+///
+/// # Safety
+/// `chain` must be the app's valid `XrSessionCreateInfo` chain of a session just created.
+unsafe fn session_images(config: &Config, chain: *const std::ffi::c_void) -> Option<SharedImages> {
+    let dir = config.images.clone()?;
+    let log = match AlphaLog::create(&dir) {
+        Ok(log) => log,
+        Err(e) => {
+            report(format!(
+                "{}: cannot write {}/alpha.csv: {e}",
+                crate::config::IMAGES_VAR,
+                dir.display()
+            ));
+            return None;
+        }
+    };
+    // SAFETY: the caller's guarantee.
+    let reader = match unsafe { VulkanBinding::find(chain) } {
+        None => {
+            report("the session has no Vulkan graphics binding: its images are not read back");
+            None
+        }
+        // SAFETY: the binding the runtime just accepted for a live session: the app's live
+        // Vulkan instance, physical device and device with that queue.
+        Some(binding) => match unsafe { Reader::new(&binding) } {
+            Ok(reader) => Some(reader),
+            Err(e) => {
+                report(format!("reading back the session's images: {e}"));
+                None
+            }
+        },
+    };
+    Some(Arc::new(Mutex::new(SessionImages {
+        reader,
+        log,
+        dir,
+        last: Vec::new(),
+        last_blend: sys::EnvironmentBlendMode::OPAQUE,
+    })))
 }
 
 /// `xrDestroySession`: the layer's head space is destroyed, then the session.
@@ -84,10 +138,35 @@ pub unsafe extern "system" fn destroy_session(session: sys::Session) -> sys::Res
         if let Some(state) = state {
             // SAFETY: the layer's own space of this live session.
             unsafe { (ctx.next.destroy_space)(state.view_space) };
+            if let Some(images) = state.images {
+                finish_images(&images, &ctx.config);
+            }
         }
         // SAFETY: the next layer's function for its live session.
         unsafe { (ctx.next.destroy_session)(session) }
     })
+}
+
+/// At the end of a session whose images the layer read: the last frame as the wearer saw it
+/// (with `VITREOUS_SIM_WORLD`), and the reader's Vulkan objects freed while the app's device
+/// still lives.
+fn finish_images(images: &Mutex<SessionImages>, config: &Config) {
+    let mut record = images.lock().unwrap_or_else(|e| e.into_inner());
+    // Freed here, while the app's device lives (the app destroys its session first).
+    drop(record.reader.take());
+    if let Some(world) = &config.world {
+        if record.last.is_empty() {
+            report("no submitted view was read back: no wearer's view written");
+        } else if let Err(e) = crate::images::write_wearer_views(
+            &record.dir,
+            world,
+            &record.last,
+            record.last_blend,
+            &config.panel,
+        ) {
+            report(format!("the wearer's view: {e}"));
+        }
+    }
 }
 
 /// `xrBeginSession`: passed on; the layer then learns the runtime's blend modes for the
@@ -237,12 +316,74 @@ pub unsafe extern "system" fn end_frame(
                 report(format!("writing the submitted-frames CSV: {e}"));
             }
         }
+        let record = registry()
+            .sessions
+            .get(&session.into_raw())
+            .and_then(|s| s.images.clone());
+        if let Some(record) = record {
+            // SAFETY: the app's valid frame end info.
+            unsafe { measure_views(app, frame, &record) };
+        }
         let mut forwarded = *app;
         forwarded.environment_blend_mode = runtime_mode;
         forwarded.next = controls.rest;
         // SAFETY: a copy of the app's valid structure, pointing at the app's layers.
         unsafe { (next.end_frame)(session, &forwarded) }
     })
+}
+
+/// Each view of the frame's projection layers, cut from the image its swapchain released
+/// last: its alpha written to `alpha.csv`, and kept as the session's last frame.
+///
+/// # Safety
+/// `app` must be the app's valid `XrFrameEndInfo`.
+unsafe fn measure_views(app: &sys::FrameEndInfo, frame: u64, record: &Mutex<SessionImages>) {
+    let count = if app.layers.is_null() {
+        0
+    } else {
+        app.layer_count as usize
+    };
+    let mut views = Vec::new();
+    for i in 0..count {
+        // SAFETY: the app's non-null array of `layer_count` layer pointers.
+        let p = unsafe { *app.layers.add(i) };
+        // SAFETY: each non-null entry is a valid composition layer header.
+        let Some(header) = (unsafe { p.as_ref() }) else {
+            continue;
+        };
+        if header.ty != sys::StructureType::COMPOSITION_LAYER_PROJECTION {
+            continue;
+        }
+        // SAFETY: a layer of that type is an `XrCompositionLayerProjection`.
+        let projection = unsafe { &*(p as *const sys::CompositionLayerProjection) };
+        for v in 0..projection.view_count as usize {
+            // SAFETY: its array of `view_count` views.
+            let view = unsafe { &*projection.views.add(v) };
+            let sub = view.sub_image;
+            let cut = {
+                let reg = registry();
+                reg.swapchains.get(&sub.swapchain.into_raw()).and_then(|c| {
+                    let layer = c.released.as_ref()?.get(sub.image_array_index as usize)?;
+                    ViewImage::cut(layer, c.size.0, sub.image_rect, c.layout?, view.fov)
+                })
+            };
+            views.extend(cut);
+        }
+    }
+    let mut record = record.lock().unwrap_or_else(|e| e.into_inner());
+    for (v, view) in views.iter().enumerate() {
+        let stats = view.alpha();
+        if let Err(e) = record
+            .log
+            .write(frame, v, view.size, app.environment_blend_mode, &stats)
+        {
+            report(format!("writing alpha.csv: {e}"));
+        }
+    }
+    if !views.is_empty() {
+        record.last = views;
+        record.last_blend = app.environment_blend_mode;
+    }
 }
 
 /// What an `XrFrameEndInfo` chain asks of Magic Leap 2's frame controls.

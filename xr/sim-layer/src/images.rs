@@ -45,31 +45,6 @@ pub struct VulkanBinding {
     pub queue_index: u32,
 }
 
-impl VulkanBinding {
-    /// The binding in a session create info's `next` chain, if there is one.
-    ///
-    /// # Safety
-    /// `chain` must be null or a valid chain of OpenXR structures.
-    pub unsafe fn find(chain: *const std::ffi::c_void) -> Option<VulkanBinding> {
-        // SAFETY: the caller's guarantee; the chain is only read.
-        for p in unsafe { crate::calls::chain(chain as *mut _) } {
-            // SAFETY: every structure of a valid chain starts with its type.
-            if unsafe { (*p).ty } == sys::StructureType::GRAPHICS_BINDING_VULKAN_KHR {
-                // SAFETY: a structure of that type is an `XrGraphicsBindingVulkanKHR`.
-                let b = unsafe { &*(p as *const sys::GraphicsBindingVulkanKHR) };
-                return Some(VulkanBinding {
-                    instance: b.instance as u64,
-                    physical_device: b.physical_device as u64,
-                    device: b.device as u64,
-                    queue_family: b.queue_family_index,
-                    queue_index: b.queue_index,
-                });
-            }
-        }
-        None
-    }
-}
-
 /// A swapchain image's texels as the layer reads them: 4 bytes each, RGBA or BGRA.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TexelLayout {

@@ -98,7 +98,7 @@ unsafe fn session_images(config: &Config, chain: *const std::ffi::c_void) -> Opt
         }
     };
     // SAFETY: the caller's guarantee.
-    let reader = match unsafe { VulkanBinding::find(chain) } {
+    let reader = match unsafe { vulkan_binding(chain) } {
         None => {
             report("the session has no Vulkan graphics binding: its images are not read back");
             None
@@ -145,6 +145,29 @@ pub unsafe extern "system" fn destroy_session(session: sys::Session) -> sys::Res
         // SAFETY: the next layer's function for its live session.
         unsafe { (ctx.next.destroy_session)(session) }
     })
+}
+
+/// The Vulkan graphics binding in a session create info's `next` chain, if there is one.
+///
+/// # Safety
+/// `first` must be null or a valid chain of OpenXR structures.
+unsafe fn vulkan_binding(first: *const std::ffi::c_void) -> Option<VulkanBinding> {
+    // SAFETY: the caller's guarantee; the chain is only read.
+    for p in unsafe { chain(first as *mut _) } {
+        // SAFETY: every structure of a valid chain starts with its type.
+        if unsafe { (*p).ty } == sys::StructureType::GRAPHICS_BINDING_VULKAN_KHR {
+            // SAFETY: a structure of that type is an `XrGraphicsBindingVulkanKHR`.
+            let b = unsafe { &*(p as *const sys::GraphicsBindingVulkanKHR) };
+            return Some(VulkanBinding {
+                instance: b.instance as u64,
+                physical_device: b.physical_device as u64,
+                device: b.device as u64,
+                queue_family: b.queue_family_index,
+                queue_index: b.queue_index,
+            });
+        }
+    }
+    None
 }
 
 /// At the end of a session whose images the layer read: the last frame as the wearer saw it

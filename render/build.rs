@@ -88,12 +88,13 @@ const VARIANTS: &[Variant] = &[
         ],
         "shadow.caustics.filtered",
     ),
-    // B over several positions per pixel, as the glass's light (`SUPERSAMPLED`).
+    // B over the pixel's footprint, where the glass's light is over several positions
+    // (`FOOTPRINT`).
     (
         "compensation",
         "fs_main",
-        &[("SUPERSAMPLED", 1.0)],
-        "supersampled",
+        &[("FOOTPRINT", 1.0)],
+        "footprint",
     ),
     // Every glass model again with the room as its target (`ROOM`).
     ("glass", "fs_paper_", &[("ROOM", 1.0)], "room"),

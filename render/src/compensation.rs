@@ -16,8 +16,10 @@ use crate::error::{RenderError, Result};
 use crate::memory::{Buffer, Image, upload_texture};
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, Depth, PipelineSpec};
+use crate::ripmap;
 use crate::scene::{GpuScene, PlaneDesc, SceneDesc, TexelData};
 use crate::shaders;
+use bytemuck::Zeroable as _;
 
 /// What the display takes away from the glass's light (`[display] compensation`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -48,6 +50,68 @@ struct Planes {
     background_rect: [f32; 4],
 }
 
+/// Where each photo's reductions lie in the ripmap atlas (shaders/compensation.wgsl
+/// `Levels`).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Levels {
+    floor: [[f32; 4]; ripmap::LEVELS],
+    background: [[f32; 4]; ripmap::LEVELS],
+    sizes: [f32; 4],
+}
+
+/// The photos' ripmaps (render/src/ripmap.rs) and where their reductions lie, for B over a
+/// pixel's footprint; freed on drop.
+struct Ripmaps {
+    levels: Buffer,
+    /// `None`: the pipeline reads none.
+    atlas: Option<Image>,
+}
+
+impl Ripmaps {
+    fn new(ctx: &GpuContext, desc: &SceneDesc) -> Result<Ripmaps> {
+        let atlas = ripmap::atlas(&[&desc.floor.photo, &desc.background.photo])?;
+        let (w, h) = (atlas.width as f32, atlas.height as f32);
+        let table = |p: &ripmap::PhotoLevels| {
+            std::array::from_fn(|k| {
+                let ((x, cw), (y, rh)) = (p.columns[k], p.rows[k]);
+                [x as f32 / w, cw as f32 / w, y as f32 / h, rh as f32 / h]
+            })
+        };
+        let [floor, background] = [&atlas.photos[0], &atlas.photos[1]];
+        let levels = Levels {
+            floor: table(floor),
+            background: table(background),
+            sizes: [
+                floor.size.0 as f32,
+                floor.size.1 as f32,
+                background.size.0 as f32,
+                background.size.1 as f32,
+            ],
+        };
+        let levels = Buffer::with_data(
+            ctx,
+            "ripmap levels",
+            bytemuck::bytes_of(&levels),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let atlas = upload_texture(
+            ctx,
+            "ripmaps",
+            vk::Format::R8G8B8A8_SRGB,
+            vk::Extent2D {
+                width: atlas.width,
+                height: atlas.height,
+            },
+            &atlas.texels,
+        )?;
+        Ok(Ripmaps {
+            levels,
+            atlas: Some(atlas),
+        })
+    }
+}
+
 /// The pass, freed on drop.
 pub struct CompensationPass {
     pipeline: Owned<vk::Pipeline>,
@@ -56,11 +120,10 @@ pub struct CompensationPass {
     _set_layout: Owned<vk::DescriptorSetLayout>,
     set: vk::DescriptorSet,
     _seen: SeenPhotos,
+    /// B over a pixel's footprint (with several positions per glass pixel).
+    _ripmaps: Ripmaps,
     /// The mesh's bounding sphere in model units: centre and radius.
     bounds: (Vec3, f32),
-    /// Positions along each side of a pixel whose mean is B (the glass's own, `[output]
-    /// glass_samples`).
-    samples: u32,
 }
 
 /// The real floor and background as the eye sees them (shaders/shared/seen.wgsl): the planes'
@@ -155,6 +218,8 @@ impl CompensationPass {
                 (0, vk::DescriptorType::UNIFORM_BUFFER, fragment),
                 (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
                 (2, vk::DescriptorType::SAMPLER, fragment),
+                (3, vk::DescriptorType::UNIFORM_BUFFER, fragment),
+                (4, vk::DescriptorType::SAMPLED_IMAGE, fragment),
             ],
         )?;
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
@@ -182,17 +247,35 @@ impl CompensationPass {
             },
         )?;
         let seen = SeenPhotos::new(ctx, desc)?;
+        // The footprint's ripmaps only where the pipeline reads them; elsewhere an empty
+        // table and the seen photos stand in for them, unread.
+        let ripmaps = if desc.glass_samples > 1 {
+            Ripmaps::new(ctx, desc)?
+        } else {
+            Ripmaps {
+                levels: Buffer::with_data(
+                    ctx,
+                    "ripmap levels (unread)",
+                    bytemuck::bytes_of(&Levels::zeroed()),
+                    vk::BufferUsageFlags::UNIFORM_BUFFER,
+                )?,
+                atlas: None,
+            }
+        };
         let pool = descriptors::pool(
             ctx,
             1,
             &[
-                (vk::DescriptorType::UNIFORM_BUFFER, 1),
-                (vk::DescriptorType::SAMPLED_IMAGE, 1),
+                (vk::DescriptorType::UNIFORM_BUFFER, 2),
+                (vk::DescriptorType::SAMPLED_IMAGE, 2),
                 (vk::DescriptorType::SAMPLER, 1),
             ],
         )?;
         let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         seen.write(ctx, set, scene);
+        descriptors::write_uniform_buffer(ctx, set, 3, ripmaps.levels.buffer);
+        let atlas = ripmaps.atlas.as_ref().unwrap_or(&seen.photos);
+        descriptors::write_image(ctx, set, 4, atlas.view);
         Ok(CompensationPass {
             pipeline,
             layout,
@@ -200,8 +283,8 @@ impl CompensationPass {
             _set_layout: set_layout,
             set,
             _seen: seen,
+            _ripmaps: ripmaps,
             bounds: bounding_sphere(desc.mesh.positions),
-            samples: desc.glass_samples.max(1),
         })
     }
 
@@ -225,7 +308,7 @@ impl CompensationPass {
         let d = &ctx.device;
         let push = EyePush {
             world_from_clip: eye.clip_from_world().inverse().to_cols_array(),
-            position: eye.position_m.extend(self.samples as f32).to_array(),
+            position: eye.position_m.extend(1.0).to_array(),
         };
         // SAFETY: the caller's contract (inside a compatible render pass, `self` outliving
         // the execution); the push constants match the layout's range.

@@ -42,6 +42,7 @@ pub mod pose;
 pub mod radial_map;
 pub mod reference;
 pub mod renderer;
+pub mod ripmap;
 pub mod scene;
 mod shaders;
 pub mod solid;

@@ -143,10 +143,10 @@ pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
 /// Eq. 6 over the glass: the full-screen triangle at the far plane (shaders/compensation.wgsl).
 pub const COMPENSATION_VS: &[u8] = spirv!("compensation.vs_main");
 /// Eq. 6 over the glass: the real floor or background the eye sees, to take away; at the
-/// pixel's centre, and the mean over several positions in it (`SUPERSAMPLED`).
+/// pixel's centre, and over the pixel's footprint from the photos' ripmaps (`FOOTPRINT`).
 pub const COMPENSATION_FS: [&[u8]; 2] = [
     spirv!("compensation.fs_main"),
-    spirv!("compensation.fs_main.supersampled"),
+    spirv!("compensation.fs_main.footprint"),
 ];
 /// The segmented dimmer's panel: each cell's want, spread, softened (shaders/dimmer_panel.wgsl).
 pub const DIMMER_WANT_CS: &[u8] = spirv!("dimmer_panel.want");
@@ -200,4 +200,19 @@ pub fn words(bytes: &[u8]) -> Vec<u32> {
         .chunks_exact(4)
         .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_compensation_fetches_once_per_pixel_at_the_centre_and_over_the_footprint() {
+        // Eq. 6 over the glass costs one more texture fetch per covered pixel than the frame
+        // without it, also where B is the photo over the pixel's footprint (its ripmaps).
+        let centre: ShaderCost = cost!("compensation.fs_main");
+        let footprint: ShaderCost = cost!("compensation.fs_main.footprint");
+        assert_eq!((centre.fetches, footprint.fetches), (1, 1));
+        assert!(footprint.instructions > centre.instructions);
+    }
 }

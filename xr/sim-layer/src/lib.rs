@@ -26,6 +26,7 @@ pub mod functions;
 pub mod guard;
 pub mod images;
 pub mod next;
+pub mod readback;
 pub mod registry;
 pub mod submitted;
 pub mod timeline;

@@ -1,5 +1,7 @@
 //! Session-level calls: the head space the layer keeps per session, the frame clock, the
 //! submitted-frames record and blend-mode substitution, and the eye-gaze action's space.
+//! Over 600 lines because every call here reads or ends a session's per-frame record (the
+//! submitted images' measurement included), which shares the session's registry entry.
 
 use openxr::sys::{self, Handle};
 

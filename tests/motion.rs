@@ -201,6 +201,25 @@ fn region_limited_fields_match_a_fresh_computation_as_the_object_crosses_the_flo
     assert_silent(&moving);
 }
 
+/// Two frames in a row with the shadow off the floor: the second finds nothing drawn before
+/// nor now, and still writes each of the frame's timestamps once (a second write to a query
+/// not reset is a validation error).
+#[test]
+fn frames_with_the_shadow_off_the_floor_twice_write_each_stamp_once() {
+    let scene = shipped_scene("glass-sphere.toml");
+    let mut renderer = scene_renderer(&scene, 32, 32);
+    let y = scene.object.center_m.y;
+    for x in [5.0, 6.0, 7.0] {
+        let (fields, _) = fields_and_eyes(&scene, &mut renderer, Vec3::new(x, y, 0.0), false);
+        assert!(
+            fields.rect.is_none(),
+            "a shadow at x = {x}: {:?}",
+            fields.rect
+        );
+        assert_silent(&renderer);
+    }
+}
+
 #[test]
 fn fields_are_clear_while_the_light_is_below_the_floor_and_come_back_after() {
     let mut scene = shipped_scene("moving-light.toml");

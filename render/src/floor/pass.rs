@@ -399,7 +399,7 @@ impl InducerPass {
     }
 
     /// Records the mask, the distance transform and the distance and ramp passes, each stage
-    /// followed by its stamp (the first four of `stamps`); returns the texels that may differ
+    /// followed by its stamp (the first three of `stamps`, before the caustics'); returns the texels that may differ
     /// from the cleared values once they ran (the overlay's rectangle).
     ///
     /// Only that rectangle is computed (the shadow and its ramp); the rest of each field
@@ -432,7 +432,7 @@ impl InducerPass {
         };
         // Nothing drawn before nor now: every field already holds its cleared value.
         let Some(area) = union_rect(before, region) else {
-            stamp(0..4);
+            stamp(0..CAUSTIC_PHOTONS_STAMP);
             return None;
         };
         // SAFETY: the caller's contract: `cmd` records outside a render pass and everything

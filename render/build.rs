@@ -32,6 +32,114 @@ fn with_includes(source: &str, shader_dir: &Path) -> String {
     out
 }
 
+/// `module` with every branch whose condition is a constant (a pipeline constant once set, a
+/// literal) replaced by the side taken, and what only the other side used (functions, resource
+/// bindings) removed: a pipeline holds no code its constants rule out, and declares no
+/// descriptor that only such code reads (the glass's set 1, `COMPENSATED`), so its layout need
+/// not have it. Validated again.
+fn without_constant_branches(
+    mut module: naga::Module,
+    info: naga::valid::ModuleInfo,
+) -> Result<(naga::Module, naga::valid::ModuleInfo), String> {
+    let mut pruned = false;
+    let (constants, globals) = (&module.constants, &module.global_expressions);
+    for function in module
+        .functions
+        .iter_mut()
+        .map(|(_, f)| f)
+        .chain(module.entry_points.iter_mut().map(|e| &mut e.function))
+    {
+        let expressions = &function.expressions;
+        let value = |h| constant_bool(constants, globals, expressions, h);
+        pruned |= take_constant_sides(&mut function.body, &value);
+    }
+    if !pruned {
+        return Ok((module, info));
+    }
+    naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
+    let info =
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), info_capabilities())
+            .validate(&module)
+            .map_err(|e| format!("after dropping constant branches: {e:?}"))?;
+    Ok((module, info))
+}
+
+/// Replaces, in `block` and the blocks inside it, each `if` whose condition `value` knows by
+/// the side it takes; whether any was.
+fn take_constant_sides(
+    block: &mut naga::Block,
+    value: &dyn Fn(naga::Handle<naga::Expression>) -> Option<bool>,
+) -> bool {
+    let mut pruned = false;
+    for statement in block.iter_mut() {
+        match statement {
+            naga::Statement::If {
+                condition,
+                accept,
+                reject,
+            } => match value(*condition) {
+                Some(taken) => {
+                    let side = std::mem::take(if taken { accept } else { reject });
+                    *statement = naga::Statement::Block(side);
+                    take_constant_sides_in(statement, value);
+                    pruned = true;
+                }
+                None => {
+                    pruned |= take_constant_sides(accept, value);
+                    pruned |= take_constant_sides(reject, value);
+                }
+            },
+            naga::Statement::Block(inner) => pruned |= take_constant_sides(inner, value),
+            naga::Statement::Switch { cases, .. } => {
+                for case in cases {
+                    pruned |= take_constant_sides(&mut case.body, value);
+                }
+            }
+            naga::Statement::Loop {
+                body, continuing, ..
+            } => {
+                pruned |= take_constant_sides(body, value);
+                pruned |= take_constant_sides(continuing, value);
+            }
+            _ => {}
+        }
+    }
+    pruned
+}
+
+/// [`take_constant_sides`] inside the block `statement` just became.
+fn take_constant_sides_in(
+    statement: &mut naga::Statement,
+    value: &dyn Fn(naga::Handle<naga::Expression>) -> Option<bool>,
+) {
+    if let naga::Statement::Block(inner) = statement {
+        take_constant_sides(inner, value);
+    }
+}
+
+/// The value of a boolean expression of a function when it is a constant: a literal, a module
+/// constant (a set pipeline constant becomes one), or `!` of one.
+fn constant_bool(
+    constants: &naga::Arena<naga::Constant>,
+    globals: &naga::Arena<naga::Expression>,
+    expressions: &naga::Arena<naga::Expression>,
+    h: naga::Handle<naga::Expression>,
+) -> Option<bool> {
+    let global = |h: naga::Handle<naga::Expression>| match globals[h] {
+        naga::Expression::Literal(naga::Literal::Bool(b)) => Some(b),
+        _ => None,
+    };
+    match expressions[h] {
+        naga::Expression::Literal(naga::Literal::Bool(b)) => Some(b),
+        naga::Expression::Constant(c) => global(constants[c].init),
+        naga::Expression::Unary {
+            op: naga::UnaryOperator::LogicalNot,
+            expr,
+        } => constant_bool(constants, globals, expressions, expr).map(|b| !b),
+        _ => None,
+    }
+}
+
 /// Entry points compiled again with pipeline-overridable constants set, written as
 /// `<file>.<entry>.<suffix>.spv`: file stem, entry-point name prefix, constants and their
 /// values, suffix.
@@ -88,14 +196,6 @@ const VARIANTS: &[Variant] = &[
         ],
         "shadow.caustics.filtered",
     ),
-    // B over the pixel's footprint, where the glass's light is over several positions
-    // (`FOOTPRINT`).
-    (
-        "compensation",
-        "fs_main",
-        &[("FOOTPRINT", 1.0)],
-        "footprint",
-    ),
     // Every glass model again with the room as its target (`ROOM`).
     ("glass", "fs_paper_", &[("ROOM", 1.0)], "room"),
     ("glass", "fs_two_surface_", &[("ROOM", 1.0)], "room"),
@@ -131,6 +231,16 @@ const VARIANTS: &[Variant] = &[
     ),
 ];
 
+/// What the shaders may use beyond WGSL's core.
+fn info_capabilities() -> naga::valid::Capabilities {
+    // Half floats packed two to a word (pack2x16float) are core SPIR-V for Vulkan
+    // (GLSL.std.450 PackHalf2x16).
+    naga::valid::Capabilities::PUSH_CONSTANT
+        | naga::valid::Capabilities::SHADER_FLOAT16_IN_FLOAT32
+        // `@early_depth_test(force)` is SPIR-V's EarlyFragmentTests, core in Vulkan.
+        | naga::valid::Capabilities::EARLY_DEPTH_TEST
+}
+
 fn main() {
     let shader_dir = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap()).join("../shaders");
     let out_dir = PathBuf::from(env::var("OUT_DIR").unwrap());
@@ -152,22 +262,15 @@ fn main() {
                 e.emit_to_string_with_path(&source, path.to_str().unwrap())
             )
         });
-        let info = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            // Half floats packed two to a word (pack2x16float) are core SPIR-V for Vulkan
-            // (GLSL.std.450 PackHalf2x16).
-            naga::valid::Capabilities::PUSH_CONSTANT
-                | naga::valid::Capabilities::SHADER_FLOAT16_IN_FLOAT32
-                // `@early_depth_test(force)` is SPIR-V's EarlyFragmentTests, core in Vulkan.
-                | naga::valid::Capabilities::EARLY_DEPTH_TEST,
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| {
-            panic!(
-                "{}",
-                e.emit_to_string_with_path(&source, path.to_str().unwrap())
-            )
-        });
+        let info =
+            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), info_capabilities())
+                .validate(&module)
+                .unwrap_or_else(|e| {
+                    panic!(
+                        "{}",
+                        e.emit_to_string_with_path(&source, path.to_str().unwrap())
+                    )
+                });
         let mut outputs = vec![(
             naga::back::PipelineConstants::default(),
             String::new(),
@@ -197,11 +300,27 @@ fn main() {
                 })
                 .collect();
             outputs.extend(supersampled);
+            // And all of those again taking away what the eye already sees (`COMPENSATED`).
+            let compensated: Vec<_> = outputs
+                .iter()
+                .map(|(constants, suffix, only)| {
+                    let mut constants = constants.clone();
+                    constants.insert("COMPENSATED".to_owned(), 1.0);
+                    (
+                        constants,
+                        format!("{suffix}.compensated"),
+                        Some(only.unwrap_or("fs_")),
+                    )
+                })
+                .collect();
+            outputs.extend(compensated);
         }
         for (constants, suffix, only) in outputs {
             let (module, info) =
                 naga::back::pipeline_constants::process_overrides(&module, &info, None, &constants)
                     .unwrap_or_else(|e| panic!("{}{suffix}: {e}", path.display()));
+            let (module, info) = without_constant_branches(module.into_owned(), info.into_owned())
+                .unwrap_or_else(|e| panic!("{}{suffix}: {e}", path.display()));
             for entry in &module.entry_points {
                 if only.is_some_and(|prefix| !entry.name.starts_with(prefix)) {
                     continue;

@@ -43,8 +43,17 @@
 // an n x n grid of view rays inside it (`supersampled`), so that the glass's image is what the
 // eye averages over the pixel where the glass minifies the room, where its image jumps from the
 // wall to the floor and at a ball's outline.
+//
+// Eq. 6 over the glass (`[display] compensation = "background"`, beyond the paper): the display
+// should add only what the eye does not already see, max(T - B, 0), with T the glass's light
+// and B the real floor or background the eye sees through the (virtual) glass along the
+// pixel's ray (`COMPENSATED`): one more fetch per covered pixel, from both photos packed in one
+// texture (shared/seen.wgsl), or with several positions per pixel from their ripmaps over the
+// pixel's footprint (shared/compensation.wgsl).
 
 // #include shared/fresnel.wgsl
+// #include shared/seen.wgsl
+// #include shared/compensation.wgsl
 
 struct Eye {
     clip_from_world: mat4x4<f32>,
@@ -98,7 +107,7 @@ override ABSORBING: bool = false;
 // constant, so that a ball's pipeline finds its surface without the map's fetch.
 override BALL: bool = false;
 
-// The object is a flat-shaded convex polyhedron (a cut gem) whose facet planes are `planes`
+// The object is a flat-shaded convex polyhedron (a cut gem) whose facet planes are `facet_planes`
 // (render/src/convex.rs `facet_planes`): a pipeline constant, so that its pipeline finds
 // where a ray leaves exactly, without the radial map (whose filtered texels round every
 // facet edge).
@@ -116,6 +125,12 @@ override ROOM: bool = false;
 // and cost.
 override SUPERSAMPLED: bool = false;
 
+// Each pixel's light loses what the eye already sees there (eq. 6 over the glass): a pipeline
+// constant (render/build.rs compiles every glass entry point with it set too), and the code it
+// guards left out of the pipelines without it (with set 1, which only it reads), so that those
+// keep their code, cost and descriptor sets.
+override COMPENSATED: bool = false;
+
 var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(0) @binding(1) var env_map: texture_2d<f32>;
@@ -130,9 +145,17 @@ var<push_constant> eye: Eye;
 @group(0) @binding(6) var radial_map: texture_2d<f32>;
 // The facet planes of a convex object (model frame, about the radial map's centre): xyz the
 // outward unit normal, w the plane's distance from the centre. One unused plane otherwise.
-@group(0) @binding(7) var<storage, read> planes: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> facet_planes: array<vec4<f32>>;
 // The floor photo (sharp), seen through the glass when the room is a refraction target.
 @group(0) @binding(8) var floor_photo: texture_2d<f32>;
+// What the eye already sees (`COMPENSATED`, render/src/compensation.rs): the floor and
+// background planes and both photos packed side by side (shared/seen.wgsl), and with several
+// positions per pixel their ripmaps (shared/compensation.wgsl).
+@group(1) @binding(0) var<uniform> planes: Planes;
+@group(1) @binding(1) var photos: texture_2d<f32>;
+@group(1) @binding(2) var photo_sampler: sampler;
+@group(1) @binding(3) var<uniform> levels: Levels;
+@group(1) @binding(4) var ripmaps: texture_2d<f32>;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -284,13 +307,13 @@ fn sphere_exit(p: vec3<f32>, d: vec3<f32>, r: f32) -> f32 {
     return -b + sqrt(max(b * b - c, 0.0));
 }
 
-// Where the ray p + t d (from inside, d unit) leaves the convex object of `planes`: x the
+// Where the ray p + t d (from inside, d unit) leaves the convex object of `facet_planes`: x the
 // distance t, yzw the outward unit normal (twin of render/src/convex.rs convex_exit).
 fn convex_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     var exit = vec4<f32>(3.0e38, 0.0, 0.0, 0.0);
-    let count = arrayLength(&planes);
+    let count = arrayLength(&facet_planes);
     for (var i = 0u; i < count; i++) {
-        let plane = planes[i];
+        let plane = facet_planes[i];
         let along = dot(plane.xyz, d);
         if along > 1e-7 {
             let t = max((plane.w - dot(plane.xyz, p)) / along, 0.0);
@@ -510,7 +533,25 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
     } else {
         light = shade_ray(in, two_surface_model, to_background, phong, alpha);
     }
-    return vec4<f32>(alpha * surface_texel.rgb + light, 1.0);
+    var out = alpha * surface_texel.rgb + light;
+    if COMPENSATED {
+        out = max(out - seen_behind(in), vec3<f32>(0.0));
+    }
+    return vec4<f32>(out, 1.0);
+}
+
+// B of eq. 6 over the glass: what the eye sees of the real floor or background along the
+// pixel's ray, at its centre, or over the pixel as the glass's light is with several positions
+// per pixel (`SUPERSAMPLED`).
+fn seen_behind(in: VertexOut) -> vec3<f32> {
+    let origin = eye.position.xyz;
+    var seen: vec3<f32>;
+    if SUPERSAMPLED {
+        seen = seen_over_footprint(origin, in.world_pos, dpdx(in.world_pos), dpdy(in.world_pos));
+    } else {
+        seen = seen_along(origin, normalize(in.world_pos - origin));
+    }
+    return seen;
 }
 
 // The glass's light over a pixel (`SUPERSAMPLED`): the mean of `shade_ray` over a regular

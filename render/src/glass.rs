@@ -6,6 +6,7 @@ use ash::vk;
 use glam::Vec4;
 
 use crate::camera::{EyeParams, Look, Reflection};
+use crate::compensation::CompensationSet;
 use crate::context::GpuContext;
 use crate::convex;
 use crate::descriptors;
@@ -58,7 +59,7 @@ impl GlassVariant {
         }
     }
 
-    /// Position in [`GlassVariant::ALL`] and in the second index of `shaders::GLASS_FS`.
+    /// Position in [`GlassVariant::ALL`] and in the last index of `shaders::GLASS_FS`.
     fn index(self) -> usize {
         usize::from(self.background) * 2 + usize::from(self.phong)
     }
@@ -137,12 +138,17 @@ impl Globals {
 /// The glass pipelines and their descriptors, freed on drop.
 pub struct GlassPass {
     /// One pipeline per variant, in [`GlassVariant::index`] order, for the scene's
-    /// refraction model.
+    /// refraction model; with compensation, the same four again taking away what the eye
+    /// already sees.
     pipelines: Vec<Owned<vk::Pipeline>>,
-    /// The static cost of one invocation of each pipeline's fragment shader.
-    costs: [ShaderCost; 4],
-    /// Pipeline layout (set + eye push constants).
+    /// The static cost of one invocation of each pipeline's fragment shader, as
+    /// `pipelines`.
+    costs: Vec<ShaderCost>,
+    /// Pipeline layout (the set, the compensation's set 1 with compensation, eye push
+    /// constants).
     layout: Owned<vk::PipelineLayout>,
+    /// What the compensated pipelines read (`[display] compensation = "background"`).
+    compensation: Option<CompensationSet>,
     /// Pool the set lives in.
     _pool: Owned<vk::DescriptorPool>,
     /// Layout of the single descriptor set.
@@ -160,13 +166,15 @@ pub struct GlassPass {
 }
 
 impl GlassPass {
-    /// Builds the pass for `scene` drawing into `render_pass`.
+    /// Builds the pass for `scene` drawing into `render_pass`; with `compensation`, also the
+    /// pipelines that take away what the eye already sees.
     pub fn new(
         ctx: &GpuContext,
         render_pass: vk::RenderPass,
         scene: &GpuScene,
         desc: &SceneDesc,
         blurred: [vk::ImageView; 2],
+        compensation: Option<CompensationSet>,
     ) -> Result<GlassPass> {
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let fragment = vk::ShaderStageFlags::FRAGMENT;
@@ -188,12 +196,11 @@ impl GlassPass {
                 (8, image, fragment),
             ],
         )?;
-        let layout = pipeline::layout(
-            ctx,
-            Some(set_layout.raw()),
-            stages,
-            size_of::<EyePush>() as u32,
-        )?;
+        let set_layouts: Vec<_> = std::iter::once(set_layout.raw())
+            .chain(compensation.as_ref().map(CompensationSet::set_layout))
+            .collect();
+        let layout =
+            pipeline::layout_of_sets(ctx, &set_layouts, stages, size_of::<EyePush>() as u32)?;
         let f = 4;
         let attributes = [
             vk::VertexInputAttributeDescription {
@@ -241,16 +248,25 @@ impl GlassPass {
             } else {
                 0
             };
-        let pipelines = GlassVariant::ALL
-            .iter()
-            .map(|variant| {
+        let compensated: &[usize] = if compensation.is_some() {
+            &[0, 1]
+        } else {
+            &[0]
+        };
+        let entries = || {
+            compensated
+                .iter()
+                .flat_map(|&c| GlassVariant::ALL.iter().map(move |v| (c, v.index())))
+        };
+        let pipelines = entries()
+            .map(|(c, v)| {
                 pipeline::create(
                     ctx,
                     &PipelineSpec {
                         render_pass,
                         layout: layout.raw(),
                         vertex: (shaders::GLASS_VS, c"vs_main"),
-                        fragment: shaders::GLASS_FS[shaded][variant.index()],
+                        fragment: shaders::GLASS_FS[c][shaded][v],
                         bindings: &bindings,
                         attributes: &attributes,
                         cull: vk::CullModeFlags::BACK,
@@ -319,11 +335,14 @@ impl GlassPass {
             // The loop over a pixel's positions counts once in the static cost: each further
             // position is charged as one more one-position shader (its surface fetch, which the
             // loop does not repeat, included).
-            costs: std::array::from_fn(|v| {
-                shaders::GLASS_FS_COST[shaded][v]
-                    .with_runs(shaders::GLASS_FS_COST[model][v], samples * samples)
-            }),
+            costs: entries()
+                .map(|(c, v)| {
+                    shaders::GLASS_FS_COST[c][shaded][v]
+                        .with_runs(shaders::GLASS_FS_COST[0][model][v], samples * samples)
+                })
+                .collect(),
             layout,
+            compensation,
             _pool: pool,
             _set_layout: set_layout,
             set,
@@ -390,13 +409,21 @@ impl GlassPass {
         }
     }
 
-    /// The static cost of one fragment drawn with the pipeline of `variant`.
-    pub fn cost(&self, variant: GlassVariant) -> ShaderCost {
-        self.costs[variant.index()]
+    /// The position in `pipelines` and `costs` of `variant`, compensated if asked and built.
+    fn entry(&self, variant: GlassVariant, compensated: bool) -> usize {
+        let compensated = compensated && self.compensation.is_some();
+        usize::from(compensated) * GlassVariant::ALL.len() + variant.index()
+    }
+
+    /// The static cost of one fragment drawn with the pipeline of `variant`, taking away what
+    /// the eye already sees if `compensated` (and the pass was built with it).
+    pub fn cost(&self, variant: GlassVariant, compensated: bool) -> ShaderCost {
+        self.costs[self.entry(variant, compensated)]
     }
 
     /// Records the draw of the object for one eye with the pipeline of `variant`, inside that
-    /// eye's render pass.
+    /// eye's render pass; taking away what the eye already sees if `compensated` (and the pass
+    /// was built with it).
     ///
     /// # Safety
     /// `cmd` must be recording inside a render pass compatible with this pass.
@@ -406,9 +433,13 @@ impl GlassPass {
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
         variant: GlassVariant,
+        compensated: bool,
         push: &EyePush,
     ) {
-        let pipeline = self.pipelines[variant.index()].raw();
+        let pipeline = self.pipelines[self.entry(variant, compensated)].raw();
+        let sets: Vec<_> = std::iter::once(self.set)
+            .chain(self.compensation.as_ref().map(CompensationSet::set))
+            .collect();
         let d = &ctx.device;
         // SAFETY: the caller's contract (recording inside a compatible render pass); the
         // pipeline, set and scene buffers are live for as long as the renderer that records
@@ -420,7 +451,7 @@ impl GlassPass {
                 vk::PipelineBindPoint::GRAPHICS,
                 self.layout.raw(),
                 0,
-                &[self.set],
+                &sets,
                 &[],
             );
             d.cmd_push_constants(
@@ -547,13 +578,18 @@ mod tests {
     fn each_variant_draws_with_the_entry_point_named_for_it() {
         for (position, variant) in GlassVariant::ALL.iter().enumerate() {
             assert_eq!(variant.index(), position);
-            for model in 0..shaders::GLASS_FS.len() {
+            for (model, compensated) in
+                (0..shaders::GLASS_FS[0].len()).flat_map(|m| [(m, 0), (m, 1)])
+            {
                 let prefix = if model % shaders::GLASS_MODELS == 0 {
                     "fs_paper_"
                 } else {
                     "fs_two_surface_"
                 };
-                let name = shaders::GLASS_FS[model][position].1.to_str().unwrap();
+                let name = shaders::GLASS_FS[compensated][model][position]
+                    .1
+                    .to_str()
+                    .unwrap();
                 let background = if variant.background {
                     "background"
                 } else {

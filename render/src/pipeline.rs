@@ -30,9 +30,6 @@ pub enum Blend {
     /// Add to the target's colour and alpha (ONE, ONE): light added on top, and a share of
     /// the real world's light to take away (a segmented dimmer's, render/src/dimmer).
     AddWithAlpha,
-    /// Take the colour away from the target's (target minus colour, which the attachment clamps
-    /// at 0) without touching alpha: eq. 6's light the eye already sees.
-    TakeAway,
 }
 
 /// How a pipeline uses the depth attachment.
@@ -42,9 +39,6 @@ pub enum Depth {
     Off,
     /// Draws the nearest surface: tests LESS and writes.
     Nearest,
-    /// Draws only where something nearer than the fragment was drawn (GREATER), writing
-    /// nothing: a full-screen pass at the far plane over what the frame drew.
-    Behind,
     /// Writes every fragment's depth (ALWAYS): a full-screen pass handing on depth drawn
     /// elsewhere (the segmented dimmer's resolve).
     Copy,
@@ -148,17 +142,12 @@ pub fn create(ctx: &GpuContext, spec: &PipelineSpec) -> Result<Owned<vk::Pipelin
             .depth_test_enable(true)
             .depth_write_enable(true)
             .depth_compare_op(vk::CompareOp::ALWAYS),
-        Depth::Behind => vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(true)
-            .depth_write_enable(false)
-            .depth_compare_op(vk::CompareOp::GREATER),
     };
     let blend_attachments = [match spec.blend {
         Blend::Add => onto_colour(vk::BlendOp::ADD),
         Blend::AddWithAlpha => onto_colour(vk::BlendOp::ADD)
             .src_alpha_blend_factor(vk::BlendFactor::ONE)
             .color_write_mask(vk::ColorComponentFlags::RGBA),
-        Blend::TakeAway => onto_colour(vk::BlendOp::REVERSE_SUBTRACT),
         Blend::Replace => vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(false)
             .color_write_mask(vk::ColorComponentFlags::RGBA),
@@ -471,13 +460,23 @@ pub fn layout(
     push_size: u32,
 ) -> Result<Owned<vk::PipelineLayout>> {
     let set_layouts: Vec<_> = set_layout.into_iter().collect();
+    layout_of_sets(ctx, &set_layouts, push_stages, push_size)
+}
+
+/// [`layout`] with several descriptor sets, numbered in order.
+pub fn layout_of_sets(
+    ctx: &GpuContext,
+    set_layouts: &[vk::DescriptorSetLayout],
+    push_stages: vk::ShaderStageFlags,
+    push_size: u32,
+) -> Result<Owned<vk::PipelineLayout>> {
     let ranges = [vk::PushConstantRange {
         stage_flags: push_stages,
         offset: 0,
         size: push_size,
     }];
     let info = vk::PipelineLayoutCreateInfo::default()
-        .set_layouts(&set_layouts)
+        .set_layouts(set_layouts)
         .push_constant_ranges(&ranges);
     // SAFETY: `info` and the set layouts it names are valid for the call.
     let layout =

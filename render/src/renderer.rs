@@ -12,7 +12,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::blur_blend::{self, BlurBlend};
 use crate::camera::FrameParams;
-use crate::compensation::{Compensation, CompensationPass};
+use crate::compensation::{Compensation, CompensationSet};
 use crate::context::GpuContext;
 use crate::dimmer::DimmerPass;
 use crate::error::{RenderError, Result, VkContext};
@@ -155,8 +155,6 @@ pub struct Renderer {
     blur: BlurBlend,
     /// The real-world pass for previews.
     world: WorldPass,
-    /// Eq. 6 over the glass, when the scene asks for it.
-    compensation: Option<CompensationPass>,
     /// The segmented dimmer's panel and eye image, when the display has one.
     dimmer: Option<DimmerPass>,
     /// The shadow inducer's fields and floor overlay.
@@ -190,7 +188,20 @@ impl Renderer {
         let gpu_scene = GpuScene::new(&ctx, scene)?;
         let render_pass = target::create_render_pass(&ctx)?;
         let blur = BlurBlend::new(&ctx, &gpu_scene)?;
-        let glass = GlassPass::new(&ctx, render_pass.raw(), &gpu_scene, scene, blur.views())?;
+        // Eq. 6 over the glass, when the scene asks for it: the glass's own pipelines take away
+        // what the eye already sees.
+        let compensation = match scene.compensation {
+            Compensation::None => None,
+            Compensation::Background => Some(CompensationSet::new(&ctx, &gpu_scene, scene)?),
+        };
+        let glass = GlassPass::new(
+            &ctx,
+            render_pass.raw(),
+            &gpu_scene,
+            scene,
+            blur.views(),
+            compensation,
+        )?;
         let world = WorldPass::new(
             &ctx,
             render_pass.raw(),
@@ -200,15 +211,6 @@ impl Renderer {
                 scene.background.world_from_plane,
             ],
         )?;
-        let compensation = match scene.compensation {
-            Compensation::None => None,
-            Compensation::Background => Some(CompensationPass::new(
-                &ctx,
-                render_pass.raw(),
-                &gpu_scene,
-                scene,
-            )?),
-        };
         let inducer = InducerPass::new(&ctx, render_pass.raw(), &gpu_scene, scene)?;
         let dimmer = match scene.dimmer {
             Some(d) => Some(DimmerPass::new(
@@ -287,7 +289,6 @@ impl Renderer {
             glass,
             blur,
             world,
-            compensation,
             dimmer,
             inducer,
             render_pass,
@@ -453,7 +454,11 @@ impl Renderer {
             let recorded = FrameWork {
                 recorded: self.ctx.work.take(),
                 invocations: None,
-                glass_shader: (!look.blank).then(|| self.glass.cost(GlassVariant::of(look))),
+                glass_shader: (!look.blank).then(|| {
+                    let composition = draw.map_or(self.own_composition(), |d| d.composition);
+                    let compensated = self.compensates(composition);
+                    self.glass.cost(GlassVariant::of(look), compensated)
+                }),
                 overlay_shader: ((look.inducer || look.caustics) && !look.blank)
                     .then(|| self.inducer.overlay_cost(look.caustics)),
             };
@@ -588,6 +593,14 @@ impl Renderer {
         }))
     }
 
+    /// Whether a frame composed as `composition` takes away from the glass what the eye
+    /// already sees (eq. 6 over the glass, where the scene asks for it): not where the display
+    /// shows the world itself, nor where the dimmer's resolve takes it away.
+    fn compensates(&self, composition: Composition) -> bool {
+        let dimmed = self.dimmer.is_some() && composition == Composition::AlphaBlend;
+        !composition.world_behind() && !dimmed
+    }
+
     /// Records one frame into the slot's command buffer; returns the floor fields' work it
     /// recorded.
     ///
@@ -702,14 +715,9 @@ impl Renderer {
                     if !blank {
                         let push = EyePush::new(&params.eyes, index, &params.look);
                         let variant = GlassVariant::of(&params.look);
+                        let compensated = self.compensates(composition);
                         self.glass
-                            .record(&self.ctx, cmd, &self.scene, variant, &push);
-                        // What the eye already sees there, taken away (eq. 6), unless the
-                        // display shows the world itself or the dimmer's resolve does.
-                        let compensate = !world_behind && dimmer.is_none();
-                        if let Some(c) = self.compensation.as_ref().filter(|_| compensate) {
-                            c.record(&self.ctx, cmd, eye, self.pose.world_from_model, self.extent);
-                        }
+                            .record(&self.ctx, cmd, &self.scene, variant, compensated, &push);
                     }
                 });
                 d.cmd_end_render_pass(cmd);

@@ -2,7 +2,7 @@
 //! across and `2^j` down (`i`, `j` below [`LEVELS`]), every reduction packed into one atlas,
 //! so that a shader reads a photo averaged over a pixel's footprint (long and thin where the
 //! eye looks along the floor) with one bilinear fetch: the reduction whose texels are about
-//! the footprint's size along each of the photo's axes (shaders/compensation.wgsl).
+//! the footprint's size along each of the photo's axes (shaders/shared/compensation.wgsl).
 //!
 //! Reduction `(i, j)` of a `W x H` photo is `ceil(W / 2^i) x ceil(H / 2^j)` texels, each the
 //! mean, in linear light, of the photo's texels in its `2^i x 2^j` block (clipped at the

@@ -14,7 +14,7 @@ macro_rules! spirv {
 /// model, `fs_<model>_*` compiled with the pipeline constants that `<suffix>` names
 /// (build.rs `VARIANTS`).
 macro_rules! glass_row {
-    ($model:literal, $suffix:literal) => {
+    ($model:literal, $suffix:expr) => {
         [
             glass_entry!($model, "environment_fresnel", $suffix),
             glass_entry!($model, "environment_phong", $suffix),
@@ -34,7 +34,7 @@ macro_rules! cost {
 
 /// The costs of [`glass_row!`]'s entry points.
 macro_rules! glass_cost_row {
-    ($model:literal, $suffix:literal) => {
+    ($model:literal, $suffix:expr) => {
         [
             cost!(concat!(
                 "glass.fs_",
@@ -49,9 +49,62 @@ macro_rules! glass_cost_row {
     };
 }
 
+/// Every row of a glass table ([`GLASS_FS`] or its costs), `$row` ([`glass_row!`] or
+/// [`glass_cost_row!`]) of each model, with the room, over several positions, and both, the
+/// suffixes ending in `$tail`.
+macro_rules! glass_rows {
+    ($row:ident, $tail:literal) => {
+        [
+            $row!("paper", concat!("", $tail)),
+            $row!("two_surface", concat!("", $tail)),
+            $row!("two_surface", concat!(".absorbing", $tail)),
+            $row!("two_surface", concat!(".ball", $tail)),
+            $row!("two_surface", concat!(".absorbing.ball", $tail)),
+            $row!("two_surface", concat!(".convex", $tail)),
+            $row!("two_surface", concat!(".absorbing.convex", $tail)),
+            $row!("paper", concat!(".room", $tail)),
+            $row!("two_surface", concat!(".room", $tail)),
+            $row!("two_surface", concat!(".absorbing.room", $tail)),
+            $row!("two_surface", concat!(".ball.room", $tail)),
+            $row!("two_surface", concat!(".absorbing.ball.room", $tail)),
+            $row!("two_surface", concat!(".convex.room", $tail)),
+            $row!("two_surface", concat!(".absorbing.convex.room", $tail)),
+            $row!("paper", concat!(".supersampled", $tail)),
+            $row!("two_surface", concat!(".supersampled", $tail)),
+            $row!("two_surface", concat!(".absorbing.supersampled", $tail)),
+            $row!("two_surface", concat!(".ball.supersampled", $tail)),
+            $row!(
+                "two_surface",
+                concat!(".absorbing.ball.supersampled", $tail)
+            ),
+            $row!("two_surface", concat!(".convex.supersampled", $tail)),
+            $row!(
+                "two_surface",
+                concat!(".absorbing.convex.supersampled", $tail)
+            ),
+            $row!("paper", concat!(".room.supersampled", $tail)),
+            $row!("two_surface", concat!(".room.supersampled", $tail)),
+            $row!(
+                "two_surface",
+                concat!(".absorbing.room.supersampled", $tail)
+            ),
+            $row!("two_surface", concat!(".ball.room.supersampled", $tail)),
+            $row!(
+                "two_surface",
+                concat!(".absorbing.ball.room.supersampled", $tail)
+            ),
+            $row!("two_surface", concat!(".convex.room.supersampled", $tail)),
+            $row!(
+                "two_surface",
+                concat!(".absorbing.convex.room.supersampled", $tail)
+            ),
+        ]
+    };
+}
+
 /// One glass fragment entry point: its SPIR-V and its name.
 macro_rules! glass_entry {
-    ($model:literal, $look:literal, $suffix:literal) => {
+    ($model:literal, $look:literal, $suffix:expr) => {
         (
             spirv!(concat!("glass.fs_", $model, "_", $look, $suffix)),
             match std::ffi::CStr::from_bytes_with_nul(
@@ -64,90 +117,35 @@ macro_rules! glass_entry {
     };
 }
 
+/// A glass fragment entry point: its SPIR-V and its name.
+pub type GlassEntry = (&'static [u8], &'static std::ffi::CStr);
+
 pub const GLASS_VS: &[u8] = spirv!("glass.vs_main");
-/// The glass pass's fragment entry points: `[model][variant]`, the model paper (0),
+/// The glass pass's fragment entry points: `[compensated][model][variant]`. The model paper (0),
 /// two-surface (1), two-surface through absorbing glass (2: compiled with `ABSORBING` set),
 /// two-surface through a ball (3: `BALL`, no radial-map fetch) and through an absorbing ball
 /// (4: both), through a convex faceted object (5: `CONVEX`, the exit from its facet planes)
 /// and through an absorbing one (6: both), the variant as `glass::GlassVariant::index`
 /// numbers it; rows 7 to 13 are the same models with the room as the glass's target (`ROOM`),
-/// rows 14 to 27 rows 0 to 13 again over several positions per pixel (`SUPERSAMPLED`).
-pub const GLASS_FS: [[(&[u8], &std::ffi::CStr); 4]; 4 * GLASS_MODELS] = [
-    glass_row!("paper", ""),
-    glass_row!("two_surface", ""),
-    glass_row!("two_surface", ".absorbing"),
-    glass_row!("two_surface", ".ball"),
-    glass_row!("two_surface", ".absorbing.ball"),
-    glass_row!("two_surface", ".convex"),
-    glass_row!("two_surface", ".absorbing.convex"),
-    glass_row!("paper", ".room"),
-    glass_row!("two_surface", ".room"),
-    glass_row!("two_surface", ".absorbing.room"),
-    glass_row!("two_surface", ".ball.room"),
-    glass_row!("two_surface", ".absorbing.ball.room"),
-    glass_row!("two_surface", ".convex.room"),
-    glass_row!("two_surface", ".absorbing.convex.room"),
-    glass_row!("paper", ".supersampled"),
-    glass_row!("two_surface", ".supersampled"),
-    glass_row!("two_surface", ".absorbing.supersampled"),
-    glass_row!("two_surface", ".ball.supersampled"),
-    glass_row!("two_surface", ".absorbing.ball.supersampled"),
-    glass_row!("two_surface", ".convex.supersampled"),
-    glass_row!("two_surface", ".absorbing.convex.supersampled"),
-    glass_row!("paper", ".room.supersampled"),
-    glass_row!("two_surface", ".room.supersampled"),
-    glass_row!("two_surface", ".absorbing.room.supersampled"),
-    glass_row!("two_surface", ".ball.room.supersampled"),
-    glass_row!("two_surface", ".absorbing.ball.room.supersampled"),
-    glass_row!("two_surface", ".convex.room.supersampled"),
-    glass_row!("two_surface", ".absorbing.convex.room.supersampled"),
+/// rows 14 to 27 rows 0 to 13 again over several positions per pixel (`SUPERSAMPLED`). The
+/// first index: as they are (0), or taking away what the eye already sees (1: `COMPENSATED`,
+/// eq. 6 over the glass).
+pub const GLASS_FS: [[[GlassEntry; 4]; 4 * GLASS_MODELS]; 2] = [
+    glass_rows!(glass_row, ""),
+    glass_rows!(glass_row, ".compensated"),
 ];
 /// Glass models without the room; the same again with it (`ROOM`) follow them, then all of
 /// those over several positions per pixel (`SUPERSAMPLED`).
 pub const GLASS_MODELS: usize = 7;
 /// The static cost of one invocation of each of [`GLASS_FS`]'s entry points.
-pub const GLASS_FS_COST: [[ShaderCost; 4]; 4 * GLASS_MODELS] = [
-    glass_cost_row!("paper", ""),
-    glass_cost_row!("two_surface", ""),
-    glass_cost_row!("two_surface", ".absorbing"),
-    glass_cost_row!("two_surface", ".ball"),
-    glass_cost_row!("two_surface", ".absorbing.ball"),
-    glass_cost_row!("two_surface", ".convex"),
-    glass_cost_row!("two_surface", ".absorbing.convex"),
-    glass_cost_row!("paper", ".room"),
-    glass_cost_row!("two_surface", ".room"),
-    glass_cost_row!("two_surface", ".absorbing.room"),
-    glass_cost_row!("two_surface", ".ball.room"),
-    glass_cost_row!("two_surface", ".absorbing.ball.room"),
-    glass_cost_row!("two_surface", ".convex.room"),
-    glass_cost_row!("two_surface", ".absorbing.convex.room"),
-    glass_cost_row!("paper", ".supersampled"),
-    glass_cost_row!("two_surface", ".supersampled"),
-    glass_cost_row!("two_surface", ".absorbing.supersampled"),
-    glass_cost_row!("two_surface", ".ball.supersampled"),
-    glass_cost_row!("two_surface", ".absorbing.ball.supersampled"),
-    glass_cost_row!("two_surface", ".convex.supersampled"),
-    glass_cost_row!("two_surface", ".absorbing.convex.supersampled"),
-    glass_cost_row!("paper", ".room.supersampled"),
-    glass_cost_row!("two_surface", ".room.supersampled"),
-    glass_cost_row!("two_surface", ".absorbing.room.supersampled"),
-    glass_cost_row!("two_surface", ".ball.room.supersampled"),
-    glass_cost_row!("two_surface", ".absorbing.ball.room.supersampled"),
-    glass_cost_row!("two_surface", ".convex.room.supersampled"),
-    glass_cost_row!("two_surface", ".absorbing.convex.room.supersampled"),
+pub const GLASS_FS_COST: [[[ShaderCost; 4]; 4 * GLASS_MODELS]; 2] = [
+    glass_rows!(glass_cost_row, ""),
+    glass_rows!(glass_cost_row, ".compensated"),
 ];
 pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const BLUR_BLEND_VS: &[u8] = spirv!("blur_blend.vs_main");
 pub const BLUR_BLEND_FS: &[u8] = spirv!("blur_blend.fs_main");
 pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
-/// Eq. 6 over the glass: the full-screen triangle at the far plane (shaders/compensation.wgsl).
-pub const COMPENSATION_VS: &[u8] = spirv!("compensation.vs_main");
-/// Eq. 6 over the glass: the real floor or background the eye sees, to take away; at the
-/// pixel's centre, and over the pixel's footprint from the photos' ripmaps (`FOOTPRINT`).
-pub const COMPENSATION_FS: [&[u8]; 2] = [
-    spirv!("compensation.fs_main"),
-    spirv!("compensation.fs_main.footprint"),
-];
 /// The segmented dimmer's panel: each cell's want, spread, softened (shaders/dimmer_panel.wgsl).
 pub const DIMMER_WANT_CS: &[u8] = spirv!("dimmer_panel.want");
 /// See [`DIMMER_WANT_CS`].
@@ -207,12 +205,21 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_compensation_fetches_once_per_pixel_at_the_centre_and_over_the_footprint() {
+    fn the_compensation_costs_the_glass_one_more_fetch_per_pixel() {
         // Eq. 6 over the glass costs one more texture fetch per covered pixel than the frame
-        // without it, also where B is the photo over the pixel's footprint (its ripmaps).
-        let centre: ShaderCost = cost!("compensation.fs_main");
-        let footprint: ShaderCost = cost!("compensation.fs_main.footprint");
-        assert_eq!((centre.fetches, footprint.fetches), (1, 1));
-        assert!(footprint.instructions > centre.instructions);
+        // without it, at the pixel's centre and over its footprint (the photos' ripmaps), in
+        // every model and variant; and the pipelines without it hold none of its code.
+        for (row, (plain, compensated)) in
+            GLASS_FS_COST[0].iter().zip(&GLASS_FS_COST[1]).enumerate()
+        {
+            for (variant, (p, c)) in plain.iter().zip(compensated).enumerate() {
+                assert_eq!(c.fetches, p.fetches + 1, "row {row} variant {variant}");
+                assert_eq!(c.texels, p.texels + 4, "row {row} variant {variant}");
+                assert!(
+                    c.instructions > p.instructions,
+                    "row {row} variant {variant}"
+                );
+            }
+        }
     }
 }

@@ -31,16 +31,21 @@
 //! near the ends of a stretch of tracking (a gap longer than [`BREAK_NS`] ends one), so a
 //! step near the end of a stretch is not folded in either. Samples in saccades are left out;
 //! a window needs [`MIN_WINDOW`] samples. `sigma = 1.4826 * median(|deviation|)` (the median
-//! absolute deviation of a normal distribution) over the newest [`MAX_RESIDUALS`] deviations,
-//! so a spike disturbs only its own deviation. Until [`MIN_RESIDUALS`] deviations are pooled
-//! there is no estimate, and the noise is the prior (1 degree, a head-worn tracker's).
+//! absolute deviation of a normal distribution) over the deviations of the newest
+//! [`MAX_POOLED_S`] seconds of fixation, so a spike disturbs only its own deviation. Until
+//! [`MIN_RESIDUALS`] deviations are pooled there is no estimate, and the noise is the prior
+//! (1 degree, a head-worn tracker's).
 //!
-//! The estimate is then shrunk toward the prior, which counts as [`PRIOR_WEIGHT`] deviations
-//! (10 s of fixations at 30 Hz): `sigma^2 = (300 prior^2 + n s^2) / (300 + n)` with `s` the
-//! estimate from `n` deviations. A short recording, or the first seconds of a session, then
-//! does not stake the decision on a few dozen samples (the importers' test fixtures, for one,
-//! are noiseless: 0 degree from their own data). Each deviation is taken once its window has passed: the online
-//! estimate runs 1.5 s behind the newest sample.
+//! The estimate is then shrunk toward the prior, which counts as [`PRIOR_S`] seconds of
+//! fixation: `sigma^2 = (10 prior^2 + T s^2) / (10 + T)` with `s` the estimate from the
+//! deviations of `T` seconds of fixation (each deviation standing for the time since its
+//! sample's predecessor). Evidence is counted in time, not in samples: within a window the
+//! bias hardly changes, so a tracker that samples four times as often does not know its bias
+//! four times as well (the SRanipal recordings sample at 120 Hz, the Tobii Pro Glasses 3 at
+//! 50 Hz, Neon at 200 Hz). A short recording, or the first seconds of a session, then does not
+//! stake the decision on a few seconds of data (the importers' test fixtures, for one, are
+//! noiseless: 0 degree from their own data). Each deviation is taken once its window has
+//! passed: the online estimate runs 1.5 s behind the newest sample.
 
 use std::collections::VecDeque;
 
@@ -66,11 +71,12 @@ pub const MIN_WINDOW: usize = 7;
 /// Fewest pooled deviations that give an estimate.
 pub const MIN_RESIDUALS: usize = 30;
 
-/// How many deviations the prior noise counts as when the estimate is shrunk toward it.
-pub const PRIOR_WEIGHT: usize = 300;
+/// How many seconds of fixation the prior noise counts as when the estimate is shrunk toward
+/// it.
+pub const PRIOR_S: f32 = 10.0;
 
-/// Most deviations pooled (the newest are kept): about 40 s of fixations at 30 Hz.
-pub const MAX_RESIDUALS: usize = 1200;
+/// Most seconds of fixation whose deviations are pooled (the newest are kept).
+pub const MAX_POOLED_S: f32 = 40.0;
 
 /// Least vergence noise any figure is computed with, degrees: a tracker is never exact, and a
 /// noiseless synthetic trace would otherwise give an infinite separability.
@@ -233,8 +239,11 @@ pub struct VergenceNoise {
     stretch: VecDeque<(i64, f32)>,
     /// Index in `stretch` of the first sample whose deviation is not yet taken.
     next: usize,
-    /// Pooled absolute deviations, degrees, newest last.
-    deviations: VecDeque<f32>,
+    /// Pooled absolute deviations, degrees, and the seconds of fixation each stands for,
+    /// newest last.
+    deviations: VecDeque<(f32, f32)>,
+    /// The seconds of fixation pooled: the sum of `deviations`' seconds.
+    pooled_s: f32,
     /// The estimate from the pooled deviations, degrees.
     sigma_deg: Option<f32>,
 }
@@ -324,17 +333,28 @@ impl VergenceNoise {
             return false;
         }
         let deviation = (v - median(&mut window)).abs();
-        if self.deviations.len() == MAX_RESIDUALS {
-            self.deviations.pop_front();
+        // The time since the sample before it in the stretch (the first: until the next).
+        let neighbour = if i > 0 {
+            self.stretch.get(i - 1)
+        } else {
+            self.stretch.get(i + 1)
+        };
+        let seconds = neighbour.map_or(0.0, |&(n, _)| (t - n).abs() as f32 * 1e-9);
+        self.deviations.push_back((deviation, seconds));
+        self.pooled_s += seconds;
+        while self.pooled_s > MAX_POOLED_S {
+            let Some((_, oldest)) = self.deviations.pop_front() else {
+                break;
+            };
+            self.pooled_s -= oldest;
         }
-        self.deviations.push_back(deviation);
         true
     }
 
     /// Updates the estimate from the pooled deviations.
     fn estimate(&mut self) {
         if self.deviations.len() >= MIN_RESIDUALS {
-            let mut all: Vec<f32> = self.deviations.iter().copied().collect();
+            let mut all: Vec<f32> = self.deviations.iter().map(|d| d.0).collect();
             self.sigma_deg = Some(MAD_TO_SIGMA * median(&mut all));
         }
     }
@@ -347,6 +367,11 @@ impl VergenceNoise {
     /// How many deviations are pooled.
     pub fn pooled(&self) -> usize {
         self.deviations.len()
+    }
+
+    /// How many seconds of fixation the pooled deviations stand for.
+    pub fn pooled_s(&self) -> f32 {
+        self.pooled_s.max(0.0)
     }
 }
 
@@ -424,7 +449,7 @@ impl SeparabilityMonitor {
         let prior = self.prior_noise_deg;
         let (noise_deg, estimated) = match self.noise.sigma_deg() {
             Some(s) => {
-                let (n0, n) = (PRIOR_WEIGHT as f32, self.noise.pooled() as f32);
+                let (n0, n) = (PRIOR_S, self.noise.pooled_s());
                 (((n0 * prior * prior + n * s * s) / (n0 + n)).sqrt(), true)
             }
             None => (prior, false),

@@ -134,3 +134,40 @@ fn no_estimate_from_too_little_or_from_saccades() {
     assert_eq!(est.sigma_deg(), None);
     assert_eq!(est.pooled(), 0);
 }
+
+/// The pooled evidence is the time the fixations lasted, whatever the tracker's rate: 8 s of
+/// fixation at 30 Hz and at 120 Hz pool about 8 s each (less the few samples at each stretch's
+/// ends whose window is too small), so the prior's 10 s weigh about the same against both,
+/// although one has four times the samples; and no more than [`MAX_POOLED_S`] are kept.
+#[test]
+fn pooled_evidence_is_counted_in_seconds_not_samples() {
+    let mut pooled_s = Vec::new();
+    for rate_hz in [30i64, 120] {
+        let mut rng = SplitMix64(7);
+        let mut est = VergenceNoise::new();
+        let step = 1_000_000_000 / rate_hz;
+        // Two stretches of 4 s, a blink between them.
+        let mut t = 0i64;
+        for _ in 0..2 {
+            for _ in 0..4 * rate_hz {
+                est.push(t, Some(1.0 + 0.5 * rng.gaussian() as f32), true);
+                t += step;
+            }
+            est.push(t, None, false);
+            t += 200_000_000;
+        }
+        est.close();
+        let pooled = est.pooled_s();
+        assert!((7.5..=8.0).contains(&pooled), "{rate_hz} Hz: {pooled} s");
+        assert!(est.pooled() as i64 > 7 * rate_hz, "{rate_hz} Hz");
+        pooled_s.push(pooled);
+    }
+    assert!((pooled_s[0] - pooled_s[1]).abs() < 0.5, "{pooled_s:?}");
+    let mut est = VergenceNoise::new();
+    for k in 0..(60 * 30) {
+        est.push(k * 33_333_333, Some(1.0), true);
+    }
+    est.close();
+    assert!(est.pooled_s() <= MAX_POOLED_S, "{}", est.pooled_s());
+    assert!(est.pooled_s() > MAX_POOLED_S - 0.1, "{}", est.pooled_s());
+}

@@ -204,6 +204,42 @@ pub fn words(bytes: &[u8]) -> Vec<u32> {
 mod tests {
     use super::*;
 
+    /// The descriptor sets an entry point's SPIR-V declares (its `DescriptorSet` decorations).
+    fn descriptor_sets(bytes: &[u8]) -> std::collections::BTreeSet<u32> {
+        const OP_DECORATE: u32 = 71;
+        const DESCRIPTOR_SET: u32 = 34;
+        let words = words(bytes);
+        let mut sets = std::collections::BTreeSet::new();
+        let mut at = 5;
+        while at < words.len() {
+            let (count, op) = ((words[at] >> 16) as usize, words[at] & 0xffff);
+            if op == OP_DECORATE && words.get(at + 2) == Some(&DESCRIPTOR_SET) {
+                sets.insert(words[at + 3]);
+            }
+            at += count.max(1);
+        }
+        sets
+    }
+
+    #[test]
+    fn only_the_compensated_glass_pipelines_declare_set_1() {
+        // build.rs drops the branches `COMPENSATED` rules out, and what only they read: the
+        // glass's pipelines without it must not name set 1, which their layout lacks.
+        for (compensated, rows) in GLASS_FS.iter().enumerate() {
+            for (row, entries) in rows.iter().enumerate() {
+                for (variant, (spirv, _)) in entries.iter().enumerate() {
+                    let expected: std::collections::BTreeSet<u32> =
+                        (0..=compensated as u32).collect();
+                    assert_eq!(
+                        descriptor_sets(spirv),
+                        expected,
+                        "compensated {compensated} row {row} variant {variant}"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn the_compensation_costs_the_glass_one_more_fetch_per_pixel() {
         // Eq. 6 over the glass costs one more texture fetch per covered pixel than the frame

@@ -46,6 +46,7 @@ pub mod ripmap;
 pub mod scene;
 mod shaders;
 pub mod solid;
+pub mod srgb;
 pub(crate) mod statistics;
 mod target;
 pub mod two_surface;

@@ -11,6 +11,7 @@
 
 use crate::error::{RenderError, Result};
 use crate::scene::{TexelData, TextureDesc};
+use crate::srgb;
 
 /// Reductions along each axis: by 1, 2, 4, ..., 32.
 pub const LEVELS: usize = 6;
@@ -38,25 +39,6 @@ pub struct Atlas {
     pub texels: Vec<u8>,
     /// Each photo's reductions, in the order given.
     pub photos: Vec<PhotoLevels>,
-}
-
-fn srgb_to_linear(v: u8) -> f64 {
-    let v = f64::from(v) / 255.0;
-    if v <= 0.04045 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-fn linear_to_srgb(v: f64) -> u8 {
-    let v = v.clamp(0.0, 1.0);
-    let s = if v <= 0.003_130_8 {
-        v * 12.92
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5) as u8
 }
 
 /// Packs the ripmaps of `photos` (8-bit sRGB) into one atlas.
@@ -100,7 +82,7 @@ pub fn atlas(photos: &[&TextureDesc]) -> Result<Atlas> {
             for x in 0..w {
                 let t = &bytes[(y * w + x) * 4..(y * w + x) * 4 + 3];
                 for c in 0..3 {
-                    row[c] += srgb_to_linear(t[c]);
+                    row[c] += f64::from(srgb::to_linear(t[c]));
                     sums[(y + 1) * (w + 1) + x + 1][c] = sums[y * (w + 1) + x + 1][c] + row[c];
                 }
             }
@@ -120,7 +102,7 @@ pub fn atlas(photos: &[&TextureDesc]) -> Result<Atlas> {
                         let mean = block(x0, y0, x1, y1);
                         let o = ((ry as usize + ty) * width as usize + cx as usize + tx) * 4;
                         for c in 0..3 {
-                            texels[o + c] = linear_to_srgb(mean[c]);
+                            texels[o + c] = srgb::from_linear(mean[c] as f32);
                         }
                         texels[o + 3] = 255;
                     }

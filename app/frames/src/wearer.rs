@@ -11,15 +11,7 @@ use vitreous_render::dimmer::model::Panel;
 use vitreous_scene::srgb_to_linear;
 
 /// Linear light (clamped to 0..1) to an sRGB-encoded byte.
-pub fn linear_to_srgb(l: f32) -> u8 {
-    let l = l.clamp(0.0, 1.0);
-    let c = if l <= 0.003_130_8 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (c * 255.0 + 0.5) as u8
-}
+pub use vitreous_render::srgb::from_linear as linear_to_srgb;
 
 /// What the wearer perceives: the display's light added to the real world's, in linear light
 /// (an optical see-through display can only add). Both inputs and the output are sRGB RGBA8.

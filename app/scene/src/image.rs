@@ -13,14 +13,7 @@ pub const MAX_IMAGE_SIZE_PX: u32 = 16384;
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 24;
 
 /// sRGB-encoded byte to linear light.
-pub fn srgb_to_linear(v: u8) -> f32 {
-    let c = f32::from(v) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
+pub use vitreous_render::srgb::to_linear as srgb_to_linear;
 
 /// A decoded image, rows top to bottom, RGBA interleaved.
 #[derive(Clone, Debug, PartialEq)]

@@ -177,6 +177,15 @@ pub fn fetches_per_pixel(look: &Look) -> u32 {
     }
 }
 
+/// The fetches per covered pixel that eq. 6 over the glass adds in `scene` as the bench draws
+/// it (additive, or for the scene's segmented dimmer): one where the glass's shader takes the
+/// background away, none where the dimmer's resolve does or the scene keeps the paper's light.
+pub fn compensation_fetches(scene: &crate::scene::Scene) -> u32 {
+    u32::from(
+        scene.compensation == vitreous_render::Compensation::Background && scene.dimmer.is_none(),
+    )
+}
+
 /// Runs the benchmark.
 pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     let mut scene = load_scene(&options.scene)?;
@@ -432,10 +441,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     // two-surface twins).
     let base =
         spreads[(usize::from(options.moving) + 1) * (usize::from(options.two_surface) + 1) - 1];
-    // Eq. 6 over the glass takes what the eye already sees away in the glass's shader: one
-    // fetch more, on the displays the bench draws for (additive, or the dimmer's own).
-    let compensated =
-        scene.compensation == vitreous_render::Compensation::Background && scene.dimmer.is_none();
+    let compensated = compensation_fetches(&scene);
     let results = (0..n)
         .map(|i| {
             let (g, c, wl) = spreads[i];
@@ -448,9 +454,8 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 .two_surface
                 .then(|| variants.iter().position(|v| v.label == paper))
                 .flatten();
-            let fetches = fetches_per_pixel(&looks[i])
-                + u32::from(variant.two_surface)
-                + u32::from(compensated);
+            let fetches =
+                fetches_per_pixel(&looks[i]) + u32::from(variant.two_surface) + compensated;
             VariantResult {
                 effects: variant.label.clone(),
                 fetches_per_pixel: fetches,
@@ -522,4 +527,26 @@ fn with_twins(
         out.push(variant);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_background_taken_away_in_the_glass_is_one_fetch_more() {
+        let scene = |name: &str| {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../config/scenes")
+                .join(name);
+            load_scene(&path).unwrap()
+        };
+        // Compensated, additive: one more; the paper's scene: none; the dimmer's scene takes
+        // the background away in its resolve, not in the glass.
+        assert_eq!(compensation_fetches(&scene("glass-sphere-real.toml")), 1);
+        assert_eq!(compensation_fetches(&scene("glass-sphere.toml")), 0);
+        let ml2 = scene("glass-sphere-ml2.toml");
+        assert_eq!(ml2.compensation, vitreous_render::Compensation::Background);
+        assert_eq!(compensation_fetches(&ml2), 0);
+    }
 }

@@ -53,6 +53,7 @@
 
 // #include shared/fresnel.wgsl
 // #include shared/seen.wgsl
+// #include shared/ripmap.wgsl
 // #include shared/compensation.wgsl
 
 struct Eye {
@@ -150,7 +151,7 @@ var<push_constant> eye: Eye;
 @group(0) @binding(8) var floor_photo: texture_2d<f32>;
 // What the eye already sees (`COMPENSATED`, render/src/compensation.rs): the floor and
 // background planes and both photos packed side by side (shared/seen.wgsl), and with several
-// positions per pixel their ripmaps (shared/compensation.wgsl).
+// positions per pixel their ripmaps (shared/ripmap.wgsl).
 @group(1) @binding(0) var<uniform> planes: Planes;
 @group(1) @binding(1) var photos: texture_2d<f32>;
 @group(1) @binding(2) var photo_sampler: sampler;

@@ -2,13 +2,15 @@
 //! Vulkan device with validation on, against the physical reference's CPU ray tracer, which
 //! averages each pixel over its own grid: the glass's pixels come closer to the real ball's
 //! pixel averages than one position per pixel does, and the real floor or wall taken away
-//! (`[display] compensation = "background"`) is the one over the pixel's footprint.
+//! (`[display] compensation = "background"`) is the one over the pixel's footprint, as is the
+//! world the see-through preview shows.
 
 use glam::{Vec2, Vec3};
 use vitreous::scene::Scene;
+use vitreous_reference::world::PhotoHit;
 use vitreous_reference::{EyeImage, Window, World, render_eye};
 use vitreous_render::{Compensation, EyeParams};
-use vitreous_tests::{left_eye_light, neutral_eyes, shipped_scene};
+use vitreous_tests::{left_eye_light, left_world_view, neutral_eyes, shipped_scene};
 
 const SIZE: (u32, u32) = (320, 240);
 
@@ -151,4 +153,71 @@ fn the_background_taken_away_is_the_real_one_over_the_pixels_footprint() {
         disc.len()
     );
     assert!(footprint < 0.5 * at_centre, "{footprint} vs {at_centre}");
+}
+
+#[test]
+fn the_world_view_with_several_positions_per_pixel_is_the_real_one_over_the_footprint() {
+    let scene = shipped_scene("glass-sphere-real.toml");
+    let camera = neutral_eyes(&scene)[0];
+    let whole = Window {
+        x: 0,
+        y: 0,
+        width: SIZE.0,
+        height: SIZE.1,
+    };
+    let nothing = World::of(&scene, &scene.rest_placement())
+        .unwrap()
+        .without_object();
+    // What the eye sees of the real floor and wall over each pixel (the mean over 5 x 5
+    // positions).
+    let seen = reference(&nothing, &camera, whole, 5);
+    let over_footprint = left_world_view(&with_samples(&scene, 4, Compensation::None), SIZE);
+    let at_centre = left_world_view(&with_samples(&scene, 1, Compensation::None), SIZE);
+    // Each floor pixel's footprint on the photo, in photo texels: how far its neighbours'
+    // rays along the row and down the column meet it (the far floor spans several texels).
+    let rays = camera.pixel_rays(Vec2::new(SIZE.0 as f32, SIZE.1 as f32));
+    let photo = &scene.floor.photo;
+    let photo_texels = Vec2::new(photo.width as f32, photo.height as f32);
+    let hit = |x: u32, y: u32| {
+        let dir = rays.direction(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+        match nothing.photo_hit(camera.position_m, dir) {
+            Some((_, PhotoHit::Floor(uv))) => Some(uv * photo_texels),
+            _ => None,
+        }
+    };
+    let mut wide = Vec::new();
+    for y in 0..SIZE.1 - 1 {
+        for x in 0..SIZE.0 - 1 {
+            let (Some(at), Some(across), Some(down)) = (hit(x, y), hit(x + 1, y), hit(x, y + 1))
+            else {
+                continue;
+            };
+            if (across - at).abs().max((down - at).abs()).max_element() > 4.0 {
+                let i = (y * SIZE.0 + x) as usize;
+                wide.push((i, i));
+            }
+        }
+    }
+    let footprint_error = mean_error(&over_footprint, &seen.rgb, &wide);
+    let centre_error = mean_error(&at_centre, &seen.rgb, &wide);
+    let light = wide
+        .iter()
+        .map(|&(w, _)| seen.rgb[w].element_sum())
+        .sum::<f32>()
+        / wide.len() as f32;
+    eprintln!(
+        "floor pixels spanning over 4 texels: {}, the real floor's light {light:.3}; the world \
+         view's mean difference from it {footprint_error:.4} over the footprint (4 x 4 \
+         positions per glass pixel), {centre_error:.4} at the pixel's centre (one)",
+        wide.len()
+    );
+    assert!(wide.len() > 1000, "{} pixels", wide.len());
+    assert!(
+        footprint_error < 0.5 * centre_error,
+        "{footprint_error} vs {centre_error}"
+    );
+    assert!(
+        footprint_error < 0.1 * light,
+        "{footprint_error} of {light}"
+    );
 }

@@ -316,6 +316,21 @@ pub fn compose_once(
 /// at the neutral head's left eye, no effects, environment reflection with Fresnel, composed for
 /// an additive display (the scene's `[display] compensation` applies), validation on.
 pub fn left_eye_light(scene: &vitreous::scene::Scene, size: (u32, u32)) -> Vec<Vec3> {
+    linear_rgb(&left_eye_frame(scene, size, false).eyes[0])
+}
+
+/// The left eye's world view (the real floor and background as the see-through preview shows
+/// them; linear RGB, row by row) for `scene` at `size` pixels, as [`left_eye_light`] renders.
+pub fn left_world_view(scene: &vitreous::scene::Scene, size: (u32, u32)) -> Vec<Vec3> {
+    let frame = left_eye_frame(scene, size, true);
+    linear_rgb(&frame.world.expect("the world views")[0])
+}
+
+fn left_eye_frame(
+    scene: &vitreous::scene::Scene,
+    size: (u32, u32),
+    world: bool,
+) -> vitreous_render::Readback {
     use vitreous_render::{Composition, FrameParams, Reflection, Renderer, Want};
     let desc = vitreous::render_desc::scene_desc(scene, None);
     let mut r = Renderer::new(validated_context(), &desc, size.0, size.1).expect("renderer");
@@ -327,14 +342,15 @@ pub fn left_eye_light(scene: &vitreous::scene::Scene, size: (u32, u32)) -> Vec<V
             Reflection::EnvironmentFresnel,
         ),
     };
-    let want = Want {
-        eyes: true,
-        world: false,
-    };
-    let readback = compose_once(&mut r, &params, want, Composition::Additive)
+    let want = Want { eyes: true, world };
+    compose_once(&mut r, &params, want, Composition::Additive)
         .readback
-        .expect("read back");
-    readback.eyes[0]
+        .expect("read back")
+}
+
+/// sRGB RGBA8 pixels in linear RGB.
+fn linear_rgb(pixels: &[u8]) -> Vec<Vec3> {
+    pixels
         .chunks_exact(4)
         .map(|p| {
             Vec3::new(

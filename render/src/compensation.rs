@@ -5,15 +5,17 @@
 //! covered pixel. This module holds what that shader reads in its set 1: the planes and both
 //! photos packed side by side, and with several positions per pixel the photos' ripmaps.
 
+use std::sync::Arc;
+
 use ash::vk;
 use glam::{Mat4, Vec4};
 
 use crate::context::GpuContext;
 use crate::descriptors;
 use crate::error::{RenderError, Result};
+use crate::footprint::{Footprint, Levels};
 use crate::memory::{Buffer, Image, upload_texture};
 use crate::owned::Owned;
-use crate::ripmap;
 use crate::scene::{GpuScene, PlaneDesc, SceneDesc, TexelData};
 use bytemuck::Zeroable as _;
 
@@ -38,76 +40,23 @@ struct Planes {
     background_rect: [f32; 4],
 }
 
-/// Where each photo's reductions lie in the ripmap atlas (shaders/shared/compensation.wgsl
-/// `Levels`).
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Levels {
-    floor: [[f32; 4]; ripmap::LEVELS],
-    background: [[f32; 4]; ripmap::LEVELS],
-    sizes: [f32; 4],
-}
-
-/// The photos' ripmaps (render/src/ripmap.rs) and where their reductions lie, for B over a
-/// pixel's footprint; freed on drop.
-struct Ripmaps {
-    levels: Buffer,
-    /// `None`: the pipeline reads none.
-    atlas: Option<Image>,
-}
-
-impl Ripmaps {
-    fn new(ctx: &GpuContext, desc: &SceneDesc) -> Result<Ripmaps> {
-        let atlas = ripmap::atlas(&[&desc.floor.photo, &desc.background.photo])?;
-        let (w, h) = (atlas.width as f32, atlas.height as f32);
-        let table = |p: &ripmap::PhotoLevels| {
-            std::array::from_fn(|k| {
-                let ((x, cw), (y, rh)) = (p.columns[k], p.rows[k]);
-                [x as f32 / w, cw as f32 / w, y as f32 / h, rh as f32 / h]
-            })
-        };
-        let [floor, background] = [&atlas.photos[0], &atlas.photos[1]];
-        let levels = Levels {
-            floor: table(floor),
-            background: table(background),
-            sizes: [
-                floor.size.0 as f32,
-                floor.size.1 as f32,
-                background.size.0 as f32,
-                background.size.1 as f32,
-            ],
-        };
-        let levels = Buffer::with_data(
-            ctx,
-            "ripmap levels",
-            bytemuck::bytes_of(&levels),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        )?;
-        let atlas = upload_texture(
-            ctx,
-            "ripmaps",
-            vk::Format::R8G8B8A8_SRGB,
-            vk::Extent2D {
-                width: atlas.width,
-                height: atlas.height,
-            },
-            &atlas.texels,
-        )?;
-        Ok(Ripmaps {
-            levels,
-            atlas: Some(atlas),
-        })
-    }
-}
-
 /// What the glass's compensated pipelines read (their set 1), freed on drop.
 pub struct CompensationSet {
     _pool: Owned<vk::DescriptorPool>,
     set_layout: Owned<vk::DescriptorSetLayout>,
     set: vk::DescriptorSet,
     _seen: SeenPhotos,
-    /// B over a pixel's footprint (with several positions per glass pixel).
     _ripmaps: Ripmaps,
+}
+
+/// What the set's bindings 3 and 4 hold.
+enum Ripmaps {
+    /// B over a pixel's footprint (several positions per glass pixel): the photos' ripmaps,
+    /// shared with the world view.
+    Read(Arc<Footprint>),
+    /// One position per glass pixel: the pipelines read none; an empty table (and the seen
+    /// photos) stand in.
+    Unread(Box<Buffer>),
 }
 
 /// The real floor and background as the eye sees them (shaders/shared/seen.wgsl): the planes'
@@ -188,9 +137,14 @@ fn pack(floor: &PlaneDesc, background: &PlaneDesc) -> Result<(u32, u32, Vec<u8>,
 }
 
 impl CompensationSet {
-    /// Uploads `desc`'s floor and background (and their ripmaps, with several positions per
-    /// glass pixel) and writes the set.
-    pub fn new(ctx: &GpuContext, scene: &GpuScene, desc: &SceneDesc) -> Result<CompensationSet> {
+    /// Uploads `desc`'s floor and background and writes the set, with `footprint` (the
+    /// photos' ripmaps, which the pipelines read with several positions per glass pixel).
+    pub(crate) fn new(
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        desc: &SceneDesc,
+        footprint: Option<Arc<Footprint>>,
+    ) -> Result<CompensationSet> {
         let fragment = vk::ShaderStageFlags::FRAGMENT;
         let set_layout = descriptors::set_layout(
             ctx,
@@ -203,20 +157,14 @@ impl CompensationSet {
             ],
         )?;
         let seen = SeenPhotos::new(ctx, desc)?;
-        // The footprint's ripmaps only where the pipelines read them; elsewhere an empty
-        // table and the seen photos stand in for them, unread.
-        let ripmaps = if desc.glass_samples > 1 {
-            Ripmaps::new(ctx, desc)?
-        } else {
-            Ripmaps {
-                levels: Buffer::with_data(
-                    ctx,
-                    "ripmap levels (unread)",
-                    bytemuck::bytes_of(&Levels::zeroed()),
-                    vk::BufferUsageFlags::UNIFORM_BUFFER,
-                )?,
-                atlas: None,
-            }
+        let ripmaps = match footprint {
+            Some(f) => Ripmaps::Read(f),
+            None => Ripmaps::Unread(Box::new(Buffer::with_data(
+                ctx,
+                "ripmap levels (unread)",
+                bytemuck::bytes_of(&Levels::zeroed()),
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+            )?)),
         };
         let pool = descriptors::pool(
             ctx,
@@ -229,8 +177,11 @@ impl CompensationSet {
         )?;
         let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         seen.write(ctx, set, scene);
-        descriptors::write_uniform_buffer(ctx, set, 3, ripmaps.levels.buffer);
-        let atlas = ripmaps.atlas.as_ref().unwrap_or(&seen.photos);
+        let (levels, atlas) = match &ripmaps {
+            Ripmaps::Read(f) => (&f.levels, &f.atlas),
+            Ripmaps::Unread(levels) => (&**levels, &seen.photos),
+        };
+        descriptors::write_uniform_buffer(ctx, set, 3, levels.buffer);
         descriptors::write_image(ctx, set, 4, atlas.view);
         Ok(CompensationSet {
             _pool: pool,

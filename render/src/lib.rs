@@ -33,6 +33,7 @@ mod descriptors;
 pub mod dimmer;
 pub mod error;
 pub mod floor;
+mod footprint;
 mod glass;
 mod memory;
 pub mod optics;

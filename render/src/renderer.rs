@@ -5,6 +5,7 @@
 //! queries, submission for each composition and target, collecting what it measured), which
 //! reads best in one place.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use ash::vk;
@@ -17,6 +18,7 @@ use crate::context::GpuContext;
 use crate::dimmer::DimmerPass;
 use crate::error::{RenderError, Result, VkContext};
 use crate::floor::{FIELD_STAMPS, FieldPassesMs, InducerFields, InducerPass, Prepared, Stamps};
+use crate::footprint::Footprint;
 use crate::glass::{EyePush, GlassPass, GlassVariant};
 use crate::memory::Buffer;
 use crate::owned::Owned;
@@ -190,9 +192,20 @@ impl Renderer {
         let blur = BlurBlend::new(&ctx, &gpu_scene)?;
         // Eq. 6 over the glass, when the scene asks for it: the glass's own pipelines take away
         // what the eye already sees.
+        // With several positions per glass pixel, the real world over each pixel's footprint
+        // (the photos' ripmaps), for the world view and eq. 6 over the glass alike.
+        let footprint = match scene.glass_samples {
+            0 | 1 => None,
+            _ => Some(Arc::new(Footprint::new(&ctx, scene)?)),
+        };
         let compensation = match scene.compensation {
             Compensation::None => None,
-            Compensation::Background => Some(CompensationSet::new(&ctx, &gpu_scene, scene)?),
+            Compensation::Background => Some(CompensationSet::new(
+                &ctx,
+                &gpu_scene,
+                scene,
+                footprint.clone(),
+            )?),
         };
         let glass = GlassPass::new(
             &ctx,
@@ -210,6 +223,7 @@ impl Renderer {
                 scene.floor.world_from_plane,
                 scene.background.world_from_plane,
             ],
+            footprint,
         )?;
         let inducer = InducerPass::new(&ctx, render_pass.raw(), &gpu_scene, scene)?;
         let dimmer = match scene.dimmer {

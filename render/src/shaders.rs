@@ -146,6 +146,8 @@ pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const BLUR_BLEND_VS: &[u8] = spirv!("blur_blend.vs_main");
 pub const BLUR_BLEND_FS: &[u8] = spirv!("blur_blend.fs_main");
 pub const WORLD_FS: &[u8] = spirv!("world.fs_main");
+/// The real world over each pixel's footprint, from the photos' ripmaps (shaders/world.wgsl).
+pub const WORLD_FOOTPRINT_FS: &[u8] = spirv!("world.fs_footprint");
 /// The segmented dimmer's panel: each cell's want, spread, softened (shaders/dimmer_panel.wgsl).
 pub const DIMMER_WANT_CS: &[u8] = spirv!("dimmer_panel.want");
 /// See [`DIMMER_WANT_CS`].

@@ -1,5 +1,9 @@
-//! The real world (floor and background photos on their registered planes), drawn only for the
-//! see-through preview, never into an eye image (shaders/world.wgsl).
+//! The real world (floor and background photos on their registered planes), drawn for the
+//! see-through preview and behind the glass on an opaque display (shaders/world.wgsl): each
+//! pixel at its centre, or, when the scene takes several positions per glass pixel, over its
+//! footprint from the photos' ripmaps, the world eq. 6 over the glass takes away.
+
+use std::sync::Arc;
 
 use ash::vk;
 use glam::Mat4;
@@ -8,6 +12,7 @@ use crate::camera::EyeParams;
 use crate::context::GpuContext;
 use crate::descriptors::{self, TextureSets};
 use crate::error::Result;
+use crate::footprint::Footprint;
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, Depth, PipelineSpec};
 use crate::scene::GpuScene;
@@ -31,15 +36,57 @@ pub struct WorldPass {
     sets: TextureSets<2>,
     /// Floor then background plane transforms.
     planes: [Mat4; 2],
+    /// Over each pixel's footprint: the ripmaps' set (set 1).
+    footprint: Option<FootprintSet>,
+}
+
+/// The photos' ripmaps and where their reductions lie, as the world's set 1; freed on drop.
+struct FootprintSet {
+    _pool: Owned<vk::DescriptorPool>,
+    set_layout: Owned<vk::DescriptorSetLayout>,
+    set: vk::DescriptorSet,
+    _footprint: Arc<Footprint>,
+}
+
+impl FootprintSet {
+    fn new(ctx: &GpuContext, footprint: Arc<Footprint>) -> Result<FootprintSet> {
+        let fragment = vk::ShaderStageFlags::FRAGMENT;
+        let set_layout = descriptors::set_layout(
+            ctx,
+            &[
+                (0, vk::DescriptorType::UNIFORM_BUFFER, fragment),
+                (1, vk::DescriptorType::SAMPLED_IMAGE, fragment),
+            ],
+        )?;
+        let pool = descriptors::pool(
+            ctx,
+            1,
+            &[
+                (vk::DescriptorType::UNIFORM_BUFFER, 1),
+                (vk::DescriptorType::SAMPLED_IMAGE, 1),
+            ],
+        )?;
+        let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
+        descriptors::write_uniform_buffer(ctx, set, 0, footprint.levels.buffer);
+        descriptors::write_image(ctx, set, 1, footprint.atlas.view);
+        Ok(FootprintSet {
+            _pool: pool,
+            set_layout,
+            set,
+            _footprint: footprint,
+        })
+    }
 }
 
 impl WorldPass {
-    /// Builds the pass for the scene's two planes.
-    pub fn new(
+    /// Builds the pass for the scene's two planes, sampling each pixel over its footprint
+    /// when given the photos' ripmaps (`footprint`), else at its centre.
+    pub(crate) fn new(
         ctx: &GpuContext,
         render_pass: vk::RenderPass,
         scene: &GpuScene,
         planes: [Mat4; 2],
+        footprint: Option<Arc<Footprint>>,
     ) -> Result<WorldPass> {
         let photos = descriptors::texture_sets(
             ctx,
@@ -47,19 +94,26 @@ impl WorldPass {
             [scene.photos[0].view, scene.photos[1].view],
             scene.photo_sampler(),
         )?;
-        let layout = pipeline::layout(
+        let footprint = footprint.map(|f| FootprintSet::new(ctx, f)).transpose()?;
+        let mut set_layouts = vec![photos.layout.raw()];
+        set_layouts.extend(footprint.as_ref().map(|f| f.set_layout.raw()));
+        let layout = pipeline::layout_of_sets(
             ctx,
-            Some(photos.layout.raw()),
+            &set_layouts,
             vk::ShaderStageFlags::VERTEX,
             size_of::<PlanePush>() as u32,
         )?;
+        let fragment = match footprint {
+            Some(_) => (shaders::WORLD_FOOTPRINT_FS, c"fs_footprint"),
+            None => (shaders::WORLD_FS, c"fs_main"),
+        };
         let pipeline = pipeline::create(
             ctx,
             &PipelineSpec {
                 render_pass,
                 layout: layout.raw(),
                 vertex: (shaders::WORLD_VS, c"vs_main"),
-                fragment: (shaders::WORLD_FS, c"fs_main"),
+                fragment,
                 bindings: &[],
                 attributes: &[],
                 cull: vk::CullModeFlags::NONE,
@@ -72,6 +126,7 @@ impl WorldPass {
             layout,
             sets: photos,
             planes,
+            footprint,
         })
     }
 
@@ -86,7 +141,18 @@ impl WorldPass {
         // waits for its frames before dropping them.
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw());
-            for (set, plane) in self.sets.sets.iter().zip(&self.planes) {
+            if let Some(footprint) = &self.footprint {
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    self.layout.raw(),
+                    1,
+                    &[footprint.set],
+                    &[],
+                );
+            }
+            // The draw's instance names the plane's photo (0 the floor, 1 the background).
+            for (instance, (set, plane)) in self.sets.sets.iter().zip(&self.planes).enumerate() {
                 let push = PlanePush {
                     clip_from_world: eye.clip_from_world().to_cols_array(),
                     world_from_plane: plane.to_cols_array(),
@@ -106,7 +172,7 @@ impl WorldPass {
                     0,
                     bytemuck::bytes_of(&push),
                 );
-                d.cmd_draw(cmd, 6, 1, 0, 0);
+                d.cmd_draw(cmd, 6, 1, 0, instance as u32);
                 ctx.work.upload(std::mem::size_of::<PlanePush>());
                 ctx.work.draw(6);
             }

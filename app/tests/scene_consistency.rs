@@ -1,5 +1,6 @@
 //! Scenes that could not exist as a real room are named (a plane between the light and the
-//! object, an object sunk into the floor), and `[light] share` is read and checked.
+//! object, an object sunk into the floor), at rest and along `[motion]`, and `[light] share` is
+//! read and checked.
 
 use crate::scene_errors::{expect_error, good_text, line_of, load_text};
 
@@ -203,4 +204,67 @@ fn a_dimmer_display_takes_magic_leap_2s_defaults_and_refuses_what_it_cannot_be()
         let msg = expect_error(&text, line_of(&text, at), field);
         assert!(msg.contains(says), "{fields}: {msg}");
     }
+}
+
+/// The base scene with its light in front of the object (no warning at rest) and `motion`
+/// appended.
+fn resting_with_motion(motion: &str) -> String {
+    let rests = with(
+        "position_m = [0.0, 1.0, -1.0]",
+        "position_m = [0.0, 1.0, 1.0]",
+    );
+    assert_eq!(warnings(&rests), Vec::<String>::new());
+    format!("{rests}\n{motion}")
+}
+
+#[test]
+fn an_object_keyframe_sunk_into_the_floor_is_named_with_its_time() {
+    // The model's lowest point rests 18 mm over the floor; down 35 mm over 2 s, it is more
+    // than the 2 mm tolerance into the floor from 1.14 s, first seen at the check 1.2 s in
+    // (four checks between two keyframes), its centre still above the floor.
+    let text = resting_with_motion(
+        "[[motion.object]]\ntime_s = 0.0\nposition_m = [0.0, -0.26, -1.5]\n\
+         [[motion.object]]\ntime_s = 2.0\nposition_m = [0.0, -0.295, -1.5]\n",
+    );
+    let w = warnings(&text);
+    assert_eq!(w.len(), 1, "{w:?}");
+    for part in [
+        "1.20 s into its motion (motion.object)",
+        "mm into the floor",
+        "raise the keyframes",
+    ] {
+        assert!(w[0].contains(part), "{} does not say {part}", w[0]);
+    }
+}
+
+#[test]
+fn a_light_keyframe_path_behind_the_wall_is_named_with_its_time() {
+    // The light (following the object) swings from in front of it to 1 m behind it, past the
+    // wall 0.5 m behind the object.
+    let text = resting_with_motion(
+        "[[motion.light]]\ntime_s = 0.0\nposition_m = [0.0, 1.0, 1.0]\n\
+         [[motion.light]]\ntime_s = 4.0\nposition_m = [0.0, 1.0, -1.0]\n",
+    );
+    let w = warnings(&text);
+    assert_eq!(w.len(), 1, "{w:?}");
+    for part in [
+        "s into its motion (motion.light)",
+        "the background (background.position_m, background.size_m)",
+        "change the keyframes",
+    ] {
+        assert!(w[0].contains(part), "{} does not say {part}", w[0]);
+    }
+}
+
+#[test]
+fn a_motion_a_real_room_allows_and_a_warning_already_given_at_rest_add_nothing() {
+    // The ball rolls 0.2 m along the floor, its light following.
+    let rolls = "[[motion.object]]\ntime_s = 0.0\nposition_m = [0.0, -0.26, -1.5]\n\
+                 [[motion.object]]\ntime_s = 3.0\nposition_m = [0.2, -0.26, -1.5]\n";
+    assert_eq!(warnings(&resting_with_motion(rolls)), Vec::<String>::new());
+    // The base scene's light stands behind the wall at rest and all along the roll: one
+    // warning, the resting one.
+    let w = warnings(&format!("{}\n{rolls}", good_text()));
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains("(light.position_m)"), "{}", w[0]);
 }

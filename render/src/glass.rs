@@ -1,6 +1,10 @@
 //! The glass object pass, baseline method: environment-map reflection and refraction blended
 //! by a Fresnel term (METHOD.md section 6; shaders/glass.wgsl); refraction to the background
 //! plane (eq. 7-8), or through both surfaces of the object (two-surface, with its radial map).
+//!
+//! Just over 600 lines, one idea: the pass and what its pipelines read (the variant table, the
+//! push constants, the globals, the radial map and facet planes it uploads for the exit),
+//! built once per scene and recorded per eye; its tests check that table against the shaders.
 
 use ash::vk;
 use glam::Vec4;

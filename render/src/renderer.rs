@@ -190,14 +190,14 @@ impl Renderer {
         let gpu_scene = GpuScene::new(&ctx, scene)?;
         let render_pass = target::create_render_pass(&ctx)?;
         let blur = BlurBlend::new(&ctx, &gpu_scene)?;
-        // Eq. 6 over the glass, when the scene asks for it: the glass's own pipelines take away
-        // what the eye already sees.
         // With several positions per glass pixel, the real world over each pixel's footprint
         // (the photos' ripmaps), for the world view and eq. 6 over the glass alike.
         let footprint = match scene.glass_samples {
             0 | 1 => None,
             _ => Some(Arc::new(Footprint::new(&ctx, scene)?)),
         };
+        // Eq. 6 over the glass, when the scene asks for it: the glass's own pipelines take away
+        // what the eye already sees.
         let compensation = match scene.compensation {
             Compensation::None => None,
             Compensation::Background => Some(CompensationSet::new(

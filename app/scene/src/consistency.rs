@@ -41,12 +41,16 @@ impl Finding {
     }
 }
 
-/// The warnings for a scene's resting placement.
+/// The warnings for a scene: its resting placement (the object and light as loaded), then the
+/// placements its `motion` goes through ([`motion_warnings`]); `light_in_frame_m` is
+/// `[light] position_m` as written.
 pub fn warnings(
     object: &Object,
     light: &Light,
     floor: &RealPlane,
     background: &RealPlane,
+    motion: &Motion,
+    light_in_frame_m: Vec3,
 ) -> Vec<String> {
     let placed = Placed {
         object,
@@ -54,18 +58,32 @@ pub fn warnings(
         center_m: object.center_m,
         light_m: light.position_m,
     };
-    placed
+    let mut out: Vec<String> = placed
         .findings(floor, background)
         .iter()
         .map(at_rest)
-        .collect()
+        .collect();
+    let rest = Placement {
+        object_position_m: object.center_m,
+        object_rotation: object.rotation,
+        light_position_m: light.position_m,
+    };
+    out.extend(motion_warnings(
+        object,
+        motion,
+        rest,
+        light_in_frame_m,
+        floor,
+        background,
+    ));
+    out
 }
 
 /// The warnings for the placements `motion` goes through (at every keyframe, at
 /// [`BETWEEN_KEYFRAMES`] times between two, at most [`MAX_CHECKED`] in all) that the resting
 /// placement `rest` does not already give, each kind once, at the first time it happens.
 /// `rest_light_in_frame_m` is `[light] position_m` as written.
-pub fn motion_warnings(
+fn motion_warnings(
     object: &Object,
     motion: &Motion,
     rest: Placement,

@@ -22,7 +22,7 @@ use super::file::{LightFrame, PlaneToml, SceneFile};
 use super::mesh::VolumeAttenuation;
 use super::{
     Caustics, CausticsMode, Environment, GazeChoice, Image, Inducer, IorSource, Light, MeshLens,
-    Object, Output, Placement, RealPlane, Scene, SceneError, Viewer, euler_xyz_deg,
+    Object, Output, RealPlane, Scene, SceneError, Viewer, euler_xyz_deg,
 };
 use super::{file, image, mesh};
 use crate::effects::EffectSet;
@@ -464,19 +464,14 @@ impl Loader<'_> {
             .iter()
             .map(|b| format!("{b:02x}"))
             .collect();
-        let mut warnings = crate::consistency::warnings(&object, &light, &floor, &background);
-        warnings.extend(crate::consistency::motion_warnings(
+        let warnings = crate::consistency::warnings(
             &object,
-            &motion,
-            Placement {
-                object_position_m: object.center_m,
-                object_rotation: object.rotation,
-                light_position_m: light.position_m,
-            },
-            light_offset,
+            &light,
             &floor,
             &background,
-        ));
+            &motion,
+            light_offset,
+        );
         Ok(Scene {
             path: self.src.file.to_path_buf(),
             hash,

@@ -51,7 +51,16 @@ fn without_constant_branches(
     {
         let expressions = &function.expressions;
         let value = |h| constant_bool(constants, globals, expressions, h);
-        pruned |= take_constant_sides(&mut function.body, &value);
+        if take_constant_sides(&mut function.body, &value) {
+            pruned = true;
+            // A `let` of a side taken out names an expression no statement evaluates any more:
+            // its name goes with it (compaction keeps named expressions).
+            let mut evaluated = std::collections::HashSet::new();
+            emitted(&function.body, &mut evaluated);
+            function
+                .named_expressions
+                .retain(|h, _| evaluated.contains(h) || expressions[*h].needs_pre_emit());
+        }
     }
     if !pruned {
         return Ok((module, info));
@@ -105,6 +114,39 @@ fn take_constant_sides(
         }
     }
     pruned
+}
+
+/// Every expression that `block` and the blocks inside it evaluate (`Emit`, a call's result).
+fn emitted(
+    block: &naga::Block,
+    into: &mut std::collections::HashSet<naga::Handle<naga::Expression>>,
+) {
+    for statement in block.iter() {
+        match statement {
+            naga::Statement::Emit(range) => into.extend(range.clone()),
+            naga::Statement::Call {
+                result: Some(result),
+                ..
+            } => {
+                into.insert(*result);
+            }
+            naga::Statement::Block(inner) => emitted(inner, into),
+            naga::Statement::If { accept, reject, .. } => {
+                emitted(accept, into);
+                emitted(reject, into);
+            }
+            naga::Statement::Switch { cases, .. } => {
+                cases.iter().for_each(|case| emitted(&case.body, into));
+            }
+            naga::Statement::Loop {
+                body, continuing, ..
+            } => {
+                emitted(body, into);
+                emitted(continuing, into);
+            }
+            _ => {}
+        }
+    }
 }
 
 /// [`take_constant_sides`] inside the block `statement` just became.
@@ -195,6 +237,26 @@ const VARIANTS: &[Variant] = &[
             ("FILTERED_CAUSTICS", 1.0),
         ],
         "shadow.caustics.filtered",
+    ),
+    // The background looks again where the frame proved that every refracted ray reaches
+    // the photo (`COVERED`): the paper's model and two surfaces through a ball.
+    (
+        "glass",
+        "fs_paper_background_",
+        &[("COVERED", 1.0)],
+        "covered",
+    ),
+    (
+        "glass",
+        "fs_two_surface_background_",
+        &[("BALL", 1.0), ("COVERED", 1.0)],
+        "ball.covered",
+    ),
+    (
+        "glass",
+        "fs_two_surface_background_",
+        &[("ABSORBING", 1.0), ("BALL", 1.0), ("COVERED", 1.0)],
+        "absorbing.ball.covered",
     ),
     // Every glass model again with the room as its target (`ROOM`).
     ("glass", "fs_paper_", &[("ROOM", 1.0)], "room"),

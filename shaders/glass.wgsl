@@ -132,6 +132,13 @@ override SUPERSAMPLED: bool = false;
 // keep their code, cost and descriptor sets.
 override COMPENSATED: bool = false;
 
+// Every ray the pixels drawn with this pipeline refract towards the background reaches its
+// photo: the frame proved it on the CPU for the part of the eye's image drawn with it
+// (render/src/coverage.rs), so the environment map that a ray beside the photo would see is
+// left out. A pipeline constant: render/build.rs compiles the background entry points of the
+// models that can be proved (the paper's, and two surfaces through a ball) with it set too.
+override COVERED: bool = false;
+
 var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(0) @binding(1) var env_map: texture_2d<f32>;
@@ -451,6 +458,33 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     return out;
 }
 
+// Two surfaces through a ball where the frame proved the passage (`COVERED`, compiled with
+// `BALL`; render/src/coverage.rs `pass_ball` is its twin): in at the entry, across, and out at
+// the first meeting with the surface, with no reflection inside (the frame keeps
+// `two_surface`'s pipeline wherever one occurs). Where rounding alone reflects a grazing exit,
+// the ray goes on straight; both surfaces pass under 1e-4 of the light there.
+fn ball_passage(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
+    var out: Passage;
+    let inside_world = refract(incident, normal, 1.0 / ior);
+    var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
+    let d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
+    let across = sphere_exit(p, d, length(p));
+    p += d * across;
+    let outward = normalize(p);
+    let leaving = refract(d, -outward, ior);
+    out.transmission = vec3<f32>((1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior))
+        * (1.0 - fresnel_exact(dot(d, outward), ior)));
+    if ABSORBING {
+        out.transmission *= exp2(-g.absorption.rgb * across);
+    }
+    out.escaped = 1.0;
+    out.echoes = vec3<f32>(0.0);
+    out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
+    let away = select(d, leaving, dot(leaving, leaving) > 0.0);
+    out.direction = normalize((g.world_from_model * vec4<f32>(away, 0.0)).xyz);
+    return out;
+}
+
 // The front surface under a fragment: world position and unit normal (not yet facing the
 // eye). Where the vertex normals point away from the object's centre, as a ball's do, the
 // surface between the vertices is taken as the sphere about the centre through them (radius
@@ -618,20 +652,32 @@ fn shade_ray(
             origin = eye.refraction_origin.xyz;
         }
         let from_origin = normalize(world_pos - origin);
-        let passage = two_surface(world_pos, from_origin, n, ior);
+        var passage: Passage;
+        if COVERED {
+            passage = ball_passage(world_pos, from_origin, n, ior);
+        } else {
+            passage = two_surface(world_pos, from_origin, n, ior);
+        }
         fresnel = fresnel_exact(-dot(incident, n), 1.0 / ior);
         // The background where the ray reaches it, else the environment (fetched only there);
         // the room's photos, nearest first, when the scene registers them as the room.
-        var uv = vec3<f32>(0.0);
-        if to_background && passage.escaped > 0.0 && !ROOM {
-            uv = background_uv(passage.exit, passage.direction);
-        }
         var seen: vec3<f32>;
-        if uv.z > 0.0 {
-            seen = textureSampleLevel(
-                background, clamp_sampler, uv.xy, 0.0).rgb;
+        if COVERED {
+            // The frame proved that the ray leaves the ball towards the photo and reaches it
+            // (render/src/coverage.rs; only the background looks are compiled with COVERED).
+            let uv = background_uv(passage.exit, passage.direction);
+            seen = textureSampleLevel(background, clamp_sampler, uv.xy, 0.0).rgb;
         } else {
-            seen = beyond_passage(passage);
+            var uv = vec3<f32>(0.0);
+            if to_background && passage.escaped > 0.0 && !ROOM {
+                uv = background_uv(passage.exit, passage.direction);
+            }
+            if uv.z > 0.0 {
+                seen = textureSampleLevel(
+                    background, clamp_sampler, uv.xy, 0.0).rgb;
+            } else {
+                seen = beyond_passage(passage);
+            }
         }
         var light = seen * passage.transmission;
         if ROOM {
@@ -640,18 +686,35 @@ fn shade_ray(
         }
         refracted_image = light / max(1.0 - fresnel, 1e-6);
     } else if to_background {
-        let from_origin = normalize(world_pos - eye.refraction_origin.xyz);
-        let t = refract_heckbert(from_origin, n, ior);
-        // Total internal reflection (t.w = 0) sees the environment the mirror way.
-        let away = select(reflected, t.xyz, t.w != 0.0);
-        let uv = background_uv(world_pos, away);
-        if ROOM {
-            refracted_image = room(world_pos, away);
-        } else if uv.z * t.w > 0.0 {
+        if COVERED {
+            // The frame proved that this ray reaches the photo (render/src/coverage.rs; only
+            // the background looks are compiled with COVERED): eq. 7-8 give its direction,
+            // V' = V / |V . N| the same for any length of V, with a positive radicand (a ray
+            // from outside the glass is never reflected totally), and it meets the photo's
+            // plane ahead, on the photo.
+            let from_origin = world_pos - eye.refraction_origin.xyz;
+            let v = from_origin / abs(dot(from_origin, n));
+            let w = v + n;
+            let away = inverseSqrt(max(ior * ior * dot(v, v) - dot(w, w), 1e-20)) * w - n;
+            let o = (g.background_from_world * vec4<f32>(world_pos, 1.0)).xyz;
+            let d = (g.background_from_world * vec4<f32>(away, 0.0)).xyz;
+            let hit = o.xy - d.xy * (o.z / d.z);
             refracted_image = textureSampleLevel(
-                background, clamp_sampler, uv.xy, 0.0).rgb;
+                background, clamp_sampler, vec2<f32>(hit.x + 0.5, 0.5 - hit.y), 0.0).rgb;
         } else {
-            refracted_image = environment(away);
+            let from_origin = normalize(world_pos - eye.refraction_origin.xyz);
+            let t = refract_heckbert(from_origin, n, ior);
+            // Total internal reflection (t.w = 0) sees the environment the mirror way.
+            let away = select(reflected, t.xyz, t.w != 0.0);
+            let uv = background_uv(world_pos, away);
+            if ROOM {
+                refracted_image = room(world_pos, away);
+            } else if uv.z * t.w > 0.0 {
+                refracted_image = textureSampleLevel(
+                    background, clamp_sampler, uv.xy, 0.0).rgb;
+            } else {
+                refracted_image = environment(away);
+            }
         }
     } else {
         var t = refract(incident, n, 1.0 / ior);

@@ -5,6 +5,7 @@ mod absorption;
 mod caustics;
 mod compensation;
 mod cost;
+mod coverage;
 mod defocus;
 mod dimmer;
 mod glass_samples;

@@ -4,7 +4,13 @@
 //!
 //! Just over 600 lines, one idea: the pass and what its pipelines read (the variant table, the
 //! push constants, the globals, the radial map and facet planes it uploads for the exit),
-//! built once per scene and recorded per eye; its tests check that table against the shaders.
+//! built once per scene; its tests check that table against the shaders. What a frame draws
+//! with them, and the recording, is `glass/draws.rs`.
+
+mod draws;
+
+use draws::ProofKey;
+pub use draws::{GlassDraws, Pick};
 
 use ash::vk;
 use glam::Vec4;
@@ -13,6 +19,7 @@ use crate::camera::{EyeParams, Look, Reflection};
 use crate::compensation::CompensationSet;
 use crate::context::GpuContext;
 use crate::convex;
+use crate::coverage::{CoveredTiles, PhotoCoverage};
 use crate::descriptors;
 use crate::error::Result;
 use crate::memory::{Buffer, Image, upload_texture};
@@ -148,6 +155,15 @@ pub struct GlassPass {
     /// The static cost of one invocation of each pipeline's fragment shader, as
     /// `pipelines`.
     costs: Vec<ShaderCost>,
+    /// Where the scene's refraction towards the background can be proved to reach its photo:
+    /// the proof, and the background looks' pipelines that leave out the environment's
+    /// lookup (`COVERED`), fresnel then Phong, with compensation the same two again; their
+    /// costs as `covered_pipelines`.
+    coverage: Option<PhotoCoverage>,
+    covered_pipelines: Vec<Owned<vk::Pipeline>>,
+    covered_costs: Vec<ShaderCost>,
+    /// Each eye's last proof and what it was made for.
+    proved: std::cell::Cell<[Option<(ProofKey, CoveredTiles)>; 2]>,
     /// Pipeline layout (the set, the compensation's set 1 with compensation, eye push
     /// constants).
     layout: Owned<vk::PipelineLayout>,
@@ -262,24 +278,41 @@ impl GlassPass {
                 .iter()
                 .flat_map(|&c| GlassVariant::ALL.iter().map(move |v| (c, v.index())))
         };
+        let create = |fragment| {
+            pipeline::create(
+                ctx,
+                &PipelineSpec {
+                    render_pass,
+                    layout: layout.raw(),
+                    vertex: (shaders::GLASS_VS, c"vs_main"),
+                    fragment,
+                    bindings: &bindings,
+                    attributes: &attributes,
+                    cull: vk::CullModeFlags::BACK,
+                    depth: Depth::Nearest,
+                    blend: Blend::ReplaceColor,
+                },
+            )
+        };
         let pipelines = entries()
-            .map(|(c, v)| {
-                pipeline::create(
-                    ctx,
-                    &PipelineSpec {
-                        render_pass,
-                        layout: layout.raw(),
-                        vertex: (shaders::GLASS_VS, c"vs_main"),
-                        fragment: shaders::GLASS_FS[c][shaded][v],
-                        bindings: &bindings,
-                        attributes: &attributes,
-                        cull: vk::CullModeFlags::BACK,
-                        depth: Depth::Nearest,
-                        blend: Blend::ReplaceColor,
-                    },
-                )
-            })
+            .map(|(c, v)| create(shaders::GLASS_FS[c][shaded][v]))
             .collect::<Result<Vec<_>>>()?;
+        // The proof and its pipelines where the model has them compiled.
+        let covered_row = shaders::covered_row(shaded);
+        let coverage = covered_row.and_then(|_| PhotoCoverage::of(desc, ball));
+        let covered = || {
+            compensated.iter().flat_map(|&c| {
+                (0..2).filter_map(move |phong| {
+                    covered_row
+                        .filter(|_| coverage.is_some())
+                        .map(|row| (c, row, phong))
+                })
+            })
+        };
+        let covered_pipelines = covered()
+            .map(|(c, row, phong)| create(shaders::GLASS_FS_COVERED[c][row][phong]))
+            .collect::<Result<Vec<_>>>()?;
+        let unsampled_row = shaders::covered_row(model);
         let pool = descriptors::pool(
             ctx,
             1,
@@ -343,6 +376,17 @@ impl GlassPass {
                 .map(|(c, v)| {
                     shaders::GLASS_FS_COST[c][shaded][v]
                         .with_runs(shaders::GLASS_FS_COST[0][model][v], samples * samples)
+                })
+                .collect(),
+            coverage,
+            proved: std::cell::Cell::new([None; 2]),
+            covered_pipelines,
+            covered_costs: covered()
+                .map(|(c, row, phong)| {
+                    let one = unsampled_row.map_or(ShaderCost::default(), |r| {
+                        shaders::GLASS_FS_COVERED_COST[0][r][phong]
+                    });
+                    shaders::GLASS_FS_COVERED_COST[c][row][phong].with_runs(one, samples * samples)
                 })
                 .collect(),
             layout,
@@ -419,58 +463,25 @@ impl GlassPass {
         usize::from(compensated) * GlassVariant::ALL.len() + variant.index()
     }
 
-    /// The static cost of one fragment drawn with the pipeline of `variant`, taking away what
-    /// the eye already sees if `compensated` (and the pass was built with it).
-    pub fn cost(&self, variant: GlassVariant, compensated: bool) -> ShaderCost {
-        self.costs[self.entry(variant, compensated)]
+    /// The position in `covered_pipelines` and `covered_costs` of `variant`, compensated if
+    /// asked and built; `None` where it has no covered pipeline (a look that does not reach
+    /// the background, or a scene without the proof).
+    fn covered_entry(&self, variant: GlassVariant, compensated: bool) -> Option<usize> {
+        let compensated = compensated && self.compensation.is_some();
+        (variant.background && !self.covered_pipelines.is_empty())
+            .then(|| usize::from(compensated) * 2 + usize::from(variant.phong))
     }
 
-    /// Records the draw of the object for one eye with the pipeline of `variant`, inside that
-    /// eye's render pass; taking away what the eye already sees if `compensated` (and the pass
-    /// was built with it).
-    ///
-    /// # Safety
-    /// `cmd` must be recording inside a render pass compatible with this pass.
-    pub unsafe fn record(
-        &self,
-        ctx: &GpuContext,
-        cmd: vk::CommandBuffer,
-        scene: &GpuScene,
-        variant: GlassVariant,
-        compensated: bool,
-        push: &EyePush,
-    ) {
-        let pipeline = self.pipelines[self.entry(variant, compensated)].raw();
-        let sets: Vec<_> = std::iter::once(self.set)
-            .chain(self.compensation.as_ref().map(CompensationSet::set))
-            .collect();
-        let d = &ctx.device;
-        // SAFETY: the caller's contract (recording inside a compatible render pass); the
-        // pipeline, set and scene buffers are live for as long as the renderer that records
-        // them, which waits for its frames before dropping them.
-        unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout.raw(),
-                0,
-                &sets,
-                &[],
-            );
-            d.cmd_push_constants(
-                cmd,
-                self.layout.raw(),
-                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                0,
-                bytemuck::bytes_of(push),
-            );
-            d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
-            d.cmd_bind_index_buffer(cmd, scene.indices.buffer, 0, vk::IndexType::UINT32);
-            d.cmd_draw_indexed(cmd, scene.index_count, 1, 0, 0, 0);
+    /// The static cost of one fragment drawn with the pipeline `pick` names (with `covered`,
+    /// the one without the environment's lookup where the look has it).
+    pub fn cost(&self, pick: Pick) -> ShaderCost {
+        match self
+            .covered_entry(pick.variant, pick.compensated)
+            .filter(|_| pick.covered)
+        {
+            Some(entry) => self.covered_costs[entry],
+            None => self.costs[self.entry(pick.variant, pick.compensated)],
         }
-        ctx.work.upload(std::mem::size_of::<EyePush>());
-        ctx.work.draw(scene.index_count);
     }
 }
 

@@ -29,6 +29,7 @@ pub mod camera;
 mod compensation;
 pub mod context;
 pub mod convex;
+pub mod coverage;
 mod descriptors;
 pub mod dimmer;
 pub mod error;

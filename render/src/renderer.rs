@@ -19,7 +19,7 @@ use crate::dimmer::DimmerPass;
 use crate::error::{RenderError, Result, VkContext};
 use crate::floor::{FIELD_STAMPS, FieldPassesMs, InducerFields, InducerPass, Prepared, Stamps};
 use crate::footprint::Footprint;
-use crate::glass::{EyePush, GlassPass, GlassVariant};
+use crate::glass::{EyePush, GlassDraws, GlassPass, GlassVariant, Pick};
 use crate::memory::Buffer;
 use crate::owned::Owned;
 use crate::pipeline;
@@ -171,6 +171,10 @@ pub struct Renderer {
     pose: ScenePose,
     /// The pose the glass pass's uniform block holds once submitted work has run.
     glass_pose: ScenePose,
+    /// Whether each frame proves where the glass's refracted rays all reach the background
+    /// photo and draws there without the environment's lookup (`coverage.rs`); on unless
+    /// turned off for a comparison.
+    prove_coverage: bool,
     /// The GPU context; dropped last.
     ctx: GpuContext,
 }
@@ -310,8 +314,16 @@ impl Renderer {
             next_sequence: 0,
             pose: ScenePose::of(scene),
             glass_pose: ScenePose::of(scene),
+            prove_coverage: true,
             ctx,
         })
+    }
+
+    /// Whether frames from now on prove where every refracted ray reaches the background photo
+    /// and draw the glass there without the environment's lookup (on from the start; the
+    /// image is the same either way, which tests and comparisons check by turning it off).
+    pub fn set_coverage_proof(&mut self, on: bool) {
+        self.prove_coverage = on;
     }
 
     /// The GPU context.
@@ -463,16 +475,31 @@ impl Renderer {
             d.begin_command_buffer(slot.cmd, &begin)
                 .vk("vkBeginCommandBuffer")?;
             self.ctx.work.take();
-            let prepared = self.record(slot, params, want, draw);
             let look = &params.look;
+            let composition = draw.map_or(self.own_composition(), |d| d.composition);
+            let glass = (!look.blank).then(|| {
+                let pick = Pick {
+                    variant: GlassVariant::of(look),
+                    compensated: self.compensates(composition),
+                    covered: false,
+                };
+                let pose = self.prove_coverage.then_some(&self.pose);
+                self.glass.plan(pick, pose, &params.eyes, look, self.extent)
+            });
+            let prepared = self.record(slot, params, want, draw, glass.as_ref());
             let recorded = FrameWork {
                 recorded: self.ctx.work.take(),
                 invocations: None,
-                glass_shader: (!look.blank).then(|| {
-                    let composition = draw.map_or(self.own_composition(), |d| d.composition);
-                    let compensated = self.compensates(composition);
-                    self.glass.cost(GlassVariant::of(look), compensated)
-                }),
+                glass_shader: glass.as_ref().map(|g| self.glass.cost(g.pick)),
+                glass_covered_shader: glass
+                    .as_ref()
+                    .filter(|g| g.rects.iter().any(|eye| !eye[1].is_empty()))
+                    .map(|g| {
+                        self.glass.cost(Pick {
+                            covered: true,
+                            ..g.pick
+                        })
+                    }),
                 overlay_shader: ((look.inducer || look.caustics) && !look.blank)
                     .then(|| self.inducer.overlay_cost(look.caustics)),
             };
@@ -627,6 +654,7 @@ impl Renderer {
         params: &FrameParams,
         want: Want,
         draw: Option<external::ExternalDraw>,
+        glass: Option<&GlassDraws>,
     ) -> Prepared {
         let d = &self.ctx.device;
         let cmd = slot.cmd;
@@ -725,15 +753,18 @@ impl Renderer {
                             .record(&self.ctx, cmd, eye, [inducer, caustics, shadow]);
                     }
                 });
-                statistics.around(d, cmd, query + 1, || {
-                    if !blank {
-                        let push = EyePush::new(&params.eyes, index, &params.look);
-                        let variant = GlassVariant::of(&params.look);
-                        let compensated = self.compensates(composition);
-                        self.glass
-                            .record(&self.ctx, cmd, &self.scene, variant, compensated, &push);
-                    }
-                });
+                // The glass with the environment's lookup, then where the proof leaves it out,
+                // each counted on its own.
+                let push = EyePush::new(&params.eyes, index, &params.look);
+                for covered in [false, true] {
+                    statistics.around(d, cmd, query + 1 + u32::from(covered), || {
+                        if let Some(glass) = glass {
+                            let part = (index, covered);
+                            self.glass
+                                .record(&self.ctx, cmd, &self.scene, glass, part, &push);
+                        }
+                    });
+                }
                 d.cmd_end_render_pass(cmd);
             }
             if let Some(dimmer) = dimmer {

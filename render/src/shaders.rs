@@ -102,6 +102,45 @@ macro_rules! glass_rows {
     };
 }
 
+/// The two background entry points of `fs_<model>_*` compiled with `COVERED` and the
+/// constants `<suffix>` names.
+macro_rules! covered_row {
+    ($model:literal, $suffix:expr) => {
+        [
+            glass_entry!($model, "background_fresnel", $suffix),
+            glass_entry!($model, "background_phong", $suffix),
+        ]
+    };
+}
+
+/// The costs of [`covered_row!`]'s entry points.
+macro_rules! covered_cost_row {
+    ($model:literal, $suffix:expr) => {
+        [
+            cost!(concat!("glass.fs_", $model, "_background_fresnel", $suffix)),
+            cost!(concat!("glass.fs_", $model, "_background_phong", $suffix)),
+        ]
+    };
+}
+
+/// The rows of a covered table ([`GLASS_FS_COVERED`] or its costs), the suffixes ending in
+/// `$tail`.
+macro_rules! covered_rows {
+    ($row:ident, $tail:literal) => {
+        [
+            $row!("paper", concat!(".covered", $tail)),
+            $row!("two_surface", concat!(".ball.covered", $tail)),
+            $row!("two_surface", concat!(".absorbing.ball.covered", $tail)),
+            $row!("paper", concat!(".covered.supersampled", $tail)),
+            $row!("two_surface", concat!(".ball.covered.supersampled", $tail)),
+            $row!(
+                "two_surface",
+                concat!(".absorbing.ball.covered.supersampled", $tail)
+            ),
+        ]
+    };
+}
+
 /// One glass fragment entry point: its SPIR-V and its name.
 macro_rules! glass_entry {
     ($model:literal, $look:literal, $suffix:expr) => {
@@ -142,6 +181,33 @@ pub const GLASS_FS_COST: [[[ShaderCost; 4]; 4 * GLASS_MODELS]; 2] = [
     glass_rows!(glass_cost_row, ""),
     glass_rows!(glass_cost_row, ".compensated"),
 ];
+/// The background looks of the models whose refraction towards the background can be proved
+/// to reach its photo (`coverage.rs`), compiled with `COVERED`: `[compensated][row][phong]`,
+/// the rows (`covered_row`) the paper's model, two surfaces through a ball and through an
+/// absorbing ball, then the same over several positions per pixel.
+pub const GLASS_FS_COVERED: [[[GlassEntry; 2]; 6]; 2] = [
+    covered_rows!(covered_row, ""),
+    covered_rows!(covered_row, ".compensated"),
+];
+/// The static cost of one invocation of each of [`GLASS_FS_COVERED`]'s entry points.
+pub const GLASS_FS_COVERED_COST: [[[ShaderCost; 2]; 6]; 2] = [
+    covered_rows!(covered_cost_row, ""),
+    covered_rows!(covered_cost_row, ".compensated"),
+];
+
+/// The row of [`GLASS_FS_COVERED`] of the model in row `model` of [`GLASS_FS`], if it has
+/// one.
+pub const fn covered_row(model: usize) -> Option<usize> {
+    let supersampled = model / (2 * GLASS_MODELS);
+    let row = match model % (2 * GLASS_MODELS) {
+        0 => 0,
+        3 => 1,
+        4 => 2,
+        _ => return None,
+    };
+    Some(3 * supersampled + row)
+}
+
 pub const WORLD_VS: &[u8] = spirv!("world.vs_main");
 pub const BLUR_BLEND_VS: &[u8] = spirv!("blur_blend.vs_main");
 pub const BLUR_BLEND_FS: &[u8] = spirv!("blur_blend.fs_main");

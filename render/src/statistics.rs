@@ -1,5 +1,6 @@
 //! The pipeline-statistics queries behind [`PassInvocations`]: one pool per frame slot, a query
-//! per floor stage, one for the blur's blends and two per eye (before the glass, the glass),
+//! per floor stage, one for the blur's blends and three per eye (before the glass, the glass
+//! with the environment's lookup, the glass without it),
 //! and the frame's invocations read from their results.
 
 use ash::vk;
@@ -18,15 +19,17 @@ const STATISTICS: vk::QueryPipelineStatisticFlags = vk::QueryPipelineStatisticFl
 );
 
 /// Queries per frame: one per floor stage ([`FIELD_STAMPS`], in their order), the blur's
-/// blends ([`BLUR_QUERY`]), then for each eye one before the glass and one for it.
-pub(crate) const STATISTICS_QUERIES: u32 = FIELD_STAMPS + 5;
+/// blends ([`BLUR_QUERY`]), then for each eye one before the glass, one for the glass with
+/// the environment's lookup and one for the glass without it.
+pub(crate) const STATISTICS_QUERIES: u32 = FIELD_STAMPS + 7;
 
 /// The query of the blur's blends (`blur_blend.rs`).
 pub(crate) const BLUR_QUERY: u32 = FIELD_STAMPS;
 
-/// The query of eye `eye`'s part before the glass; the glass's is the next.
+/// The query of eye `eye`'s part before the glass; the glass's with the lookup is the next,
+/// then the glass's without it.
 pub(crate) fn eye_query(eye: usize) -> u32 {
-    BLUR_QUERY + 1 + 2 * eye as u32
+    BLUR_QUERY + 1 + 3 * eye as u32
 }
 
 /// A frame's pipeline-statistics queries, when it counts invocations: each call does
@@ -103,6 +106,7 @@ pub(crate) fn pass_invocations(
         blur: at(BLUR_QUERY),
         eye_floor: eyes(0),
         eye_glass: eyes(1),
+        eye_glass_covered: eyes(2),
     }
 }
 

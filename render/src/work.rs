@@ -31,6 +31,10 @@ pub struct FrameWork {
     pub invocations: Option<PassInvocations>,
     /// The static cost of one fragment of the glass's pipeline, when the glass was drawn.
     pub glass_shader: Option<ShaderCost>,
+    /// The same of the glass's pipeline without the environment's lookup, when part of the
+    /// glass was drawn with it (where the frame proved every refracted ray reaches the
+    /// background photo, `coverage.rs`).
+    pub glass_covered_shader: Option<ShaderCost>,
     /// The static cost of one fragment of the floor overlay's pipeline, when it was drawn.
     pub overlay_shader: Option<ShaderCost>,
 }
@@ -188,8 +192,11 @@ pub struct PassInvocations {
     /// In the eye passes, everything before the glass: the real world behind (for a display
     /// that shows none of its own) and the floor overlay.
     pub eye_floor: Invocations,
-    /// In the eye passes, the glass object.
+    /// In the eye passes, the glass object drawn with the environment's lookup.
     pub eye_glass: Invocations,
+    /// In the eye passes, the glass object drawn without it (where the frame proved every
+    /// refracted ray reaches the background photo).
+    pub eye_glass_covered: Invocations,
 }
 
 #[cfg(test)]

@@ -5,16 +5,18 @@
 
 use std::collections::BTreeMap;
 
-use vitreous_render::{FrameWork, Invocations};
+use vitreous_render::{FrameWork, Invocations, ShaderCost};
 
 /// Named counts, mean per frame, in a stable order. Names: `render_passes`, `draws`,
 /// `vertices`, `dispatches`, `workgroups`, `uploaded_bytes` (recorded, the same on every
 /// device); where the device counts invocations, `<pass>.<stage>_invocations` for each pass
 /// (`mask`, `nearest`, `ramp`, `caustic_photons`, `caustic_smoothing`, `blur`, `eye_floor`,
-/// `eye_glass`) and shader stage (`vertex`, `fragment`, `compute`), and the work of the eye
-/// passes' fragments, their invocations times the static cost of one
-/// (`vitreous_render::work::ShaderCost`): `glass_fetches`, `glass_texels`,
-/// `glass_instructions`, and the same for the floor overlay (`floor_*`).
+/// `eye_glass`, and `eye_glass_covered`: the glass drawn without the environment's lookup where
+/// the frame proved every refracted ray reaches the background photo) and shader stage
+/// (`vertex`, `fragment`, `compute`), and the work of the eye passes' fragments, their
+/// invocations times the static cost of one (`vitreous_render::work::ShaderCost`):
+/// `glass_fetches`, `glass_texels`, `glass_instructions` (both of the glass's pipelines), and
+/// the same for the floor overlay (`floor_*`).
 pub type WorkCounts = BTreeMap<String, f64>;
 
 /// The mean per frame of `frames`' work; empty without frames.
@@ -45,7 +47,7 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
     .map(|(name, value)| (name.to_owned(), value as f64))
     .collect();
     if let Some(p) = &frame.invocations {
-        let passes: [(&str, Invocations); 8] = [
+        let passes: [(&str, Invocations); 9] = [
             ("mask", p.mask),
             ("nearest", p.nearest),
             ("ramp", p.ramp),
@@ -54,6 +56,7 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
             ("blur", p.blur),
             ("eye_floor", p.eye_floor),
             ("eye_glass", p.eye_glass),
+            ("eye_glass_covered", p.eye_glass_covered),
         ];
         for (pass, i) in passes {
             for (stage, value) in [
@@ -65,18 +68,31 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
             }
         }
         let shaded = [
-            ("glass", p.eye_glass.fragment, frame.glass_shader),
-            ("floor", p.eye_floor.fragment, frame.overlay_shader),
+            (
+                "glass",
+                [
+                    (p.eye_glass.fragment, frame.glass_shader),
+                    (p.eye_glass_covered.fragment, frame.glass_covered_shader),
+                ],
+            ),
+            (
+                "floor",
+                [(p.eye_floor.fragment, frame.overlay_shader), (0, None)],
+            ),
         ];
-        for (pass, fragments, cost) in shaded {
-            let cost = cost.unwrap_or_default();
-            for (what, per_fragment) in [
-                ("fetches", cost.fetches),
-                ("texels", cost.texels),
-                ("instructions", cost.instructions),
+        for (pass, parts) in shaded {
+            let total = |of: fn(ShaderCost) -> u32| {
+                parts
+                    .iter()
+                    .map(|&(fragments, cost)| fragments * u64::from(of(cost.unwrap_or_default())))
+                    .sum::<u64>()
+            };
+            for (what, value) in [
+                ("fetches", total(|c| c.fetches)),
+                ("texels", total(|c| c.texels)),
+                ("instructions", total(|c| c.instructions)),
             ] {
-                let total = fragments * u64::from(per_fragment);
-                counts.push((format!("{pass}_{what}"), total as f64));
+                counts.push((format!("{pass}_{what}"), value as f64));
             }
         }
     }
@@ -89,7 +105,7 @@ mod tests {
     use vitreous_render::{PassInvocations, RecordedWork, ShaderCost};
 
     #[test]
-    fn counts_are_means_per_frame_and_fetches_follow_the_glass_fragments() {
+    fn counts_are_means_per_frame_and_fetches_follow_each_glass_pipelines_fragments() {
         let frame = |draws: u64, fragments: u64| FrameWork {
             recorded: RecordedWork {
                 draws,
@@ -100,6 +116,10 @@ mod tests {
                     fragment: fragments,
                     ..Invocations::default()
                 },
+                eye_glass_covered: Invocations {
+                    fragment: 10,
+                    ..Invocations::default()
+                },
                 ..PassInvocations::default()
             }),
             glass_shader: Some(ShaderCost {
@@ -107,14 +127,20 @@ mod tests {
                 texels: 16,
                 instructions: 100,
             }),
+            glass_covered_shader: Some(ShaderCost {
+                fetches: 2,
+                texels: 8,
+                instructions: 50,
+            }),
             overlay_shader: None,
         };
         let counts = mean_counts(&[frame(2, 100), frame(4, 300)]);
         assert_eq!(counts["draws"], 3.0);
         assert_eq!(counts["eye_glass.fragment_invocations"], 200.0);
-        assert_eq!(counts["glass_fetches"], 600.0);
-        assert_eq!(counts["glass_texels"], 3200.0);
-        assert_eq!(counts["glass_instructions"], 20_000.0);
+        // Both pipelines' fragments: 200 with the lookup, 10 without, a frame.
+        assert_eq!(counts["glass_fetches"], 600.0 + 20.0);
+        assert_eq!(counts["glass_texels"], 3200.0 + 80.0);
+        assert_eq!(counts["glass_instructions"], 20_000.0 + 500.0);
         assert_eq!(counts["floor_texels"], 0.0);
         assert_eq!(counts["mask.compute_invocations"], 0.0);
     }
@@ -128,6 +154,7 @@ mod tests {
             },
             invocations: None,
             glass_shader: None,
+            glass_covered_shader: None,
             overlay_shader: None,
         };
         let counts = mean_counts(&[frame]);

@@ -111,7 +111,17 @@ impl BenchReport {
                 ),
                 (
                     "glass frags",
-                    Box::new(count("eye_glass.fragment_invocations")),
+                    Box::new(|v: &VariantResult| {
+                        let frags = |name| v.work.get(name).copied().unwrap_or(0.0);
+                        compact(
+                            frags("eye_glass.fragment_invocations")
+                                + frags("eye_glass_covered.fragment_invocations"),
+                        )
+                    }),
+                ),
+                (
+                    "covered",
+                    Box::new(count("eye_glass_covered.fragment_invocations")),
                 ),
                 ("glass texels", Box::new(count("glass_texels"))),
                 ("glass instr", Box::new(count("glass_instructions"))),

@@ -461,27 +461,31 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
 // Two surfaces through a ball where the frame proved the passage (`COVERED`, compiled with
 // `BALL`; render/src/coverage.rs `pass_ball` is its twin): in at the entry, across, and out at
 // the first meeting with the surface, with no reflection inside (the frame keeps
-// `two_surface`'s pipeline wherever one occurs). Where rounding alone reflects a grazing exit,
-// the ray goes on straight; both surfaces pass under 1e-4 of the light there.
+// `two_surface`'s pipeline wherever one occurs). In the world: the object's transform is a
+// similarity, so the ball is one about its world centre through the entry. Where rounding alone
+// reflects a grazing exit, the ray goes on straight; both surfaces pass under 1e-4 of the light
+// there.
 fn ball_passage(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
     var out: Passage;
-    let inside_world = refract(incident, normal, 1.0 / ior);
-    var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
-    let d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
-    let across = sphere_exit(p, d, length(p));
-    p += d * across;
-    let outward = normalize(p);
-    let leaving = refract(d, -outward, ior);
-    out.transmission = vec3<f32>((1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior))
-        * (1.0 - fresnel_exact(dot(d, outward), ior)));
+    let inside = refract(incident, normal, 1.0 / ior);
+    let from_centre = entry - g.center_world.xyz;
+    let radius = length(from_centre);
+    let across = sphere_exit(from_centre, inside, radius);
+    let exit = from_centre + inside * across;
+    let outward = exit / radius;
+    let leaving = refract(inside, -outward, ior);
+    // A ball meets the ray inside at the exit as steeply as the refracted ray left the entry,
+    // and the reflectance there is the entry's (Stokes): both surfaces pass (1 - F)^2.
+    let passed = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
+    out.transmission = vec3<f32>(passed * passed);
     if ABSORBING {
-        out.transmission *= exp2(-g.absorption.rgb * across);
+        // `g.absorption` is per model unit: the map's radius over the world's.
+        out.transmission *= exp2(-g.absorption.rgb * (across * g.radial.w / radius));
     }
     out.escaped = 1.0;
     out.echoes = vec3<f32>(0.0);
-    out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
-    let away = select(d, leaving, dot(leaving, leaving) > 0.0);
-    out.direction = normalize((g.world_from_model * vec4<f32>(away, 0.0)).xyz);
+    out.exit = exit + g.center_world.xyz;
+    out.direction = select(inside, leaving, dot(leaving, leaving) > 0.0);
     return out;
 }
 

@@ -8,7 +8,7 @@
 use vitreous::effects::EffectSet;
 use vitreous_render::renderer::Want;
 use vitreous_render::{
-    Composition, Defocus, FrameParams, Readback, Reflection, Refraction, Renderer,
+    Attenuation, Composition, Defocus, FrameParams, Readback, Reflection, Refraction, Renderer,
 };
 use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
 
@@ -95,6 +95,13 @@ fn through_both_surfaces_the_rim_keeps_the_lookup_and_the_middle_leaves_it_out()
     let mut scene = shipped_scene("visual-effects.toml");
     scene.object.refraction = Refraction::TwoSurface;
     let [with, without] = compare(&scene, "disparity,defocus");
+    assert!(with > 0 && without > with, "{with} {without}");
+    // Tinted glass: the covered passage absorbs along the same path inside.
+    scene.object.attenuation = Attenuation {
+        color: glam::Vec3::new(0.25, 1.0, 0.6),
+        distance_m: 0.15,
+    };
+    let [with, without] = compare(&scene, "disparity");
     assert!(with > 0 && without > with, "{with} {without}");
 }
 

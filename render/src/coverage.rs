@@ -1,20 +1,21 @@
 //! Where the background photo catches every ray a ball refracts towards it, in one eye's
 //! image: the frame's proof that lets the glass pass leave out the environment map a ray
-//! beside the photo would see (`COVERED` in shaders/glass.wgsl; `glass.rs` `GlassPass::plan`
-//! draws the largest rectangle of proved tiles with that pipeline, the rest with the lookup).
+//! beside the photo would see (`COVERED` in shaders/glass.wgsl; `GlassPass::plan` in
+//! `glass/draws.rs` draws the largest rectangle of proved tiles with that pipeline, the rest
+//! with the lookup).
 //!
 //! The ball's cap that the eye sees is sampled on rings about the axis from the eye to the
 //! centre, out to the silhouette, and each sample's ray is refracted as the shader refracts it
 //! (the paper's model, eq. 7-8, or both surfaces of the ball) and met with the background
 //! plane. A sample fails where it lands off the photo, behind, or closer to the photo's edge
 //! than `SAFETY` times its farthest neighbour's landing is from it, or, through two surfaces,
-//! where the ray would be reflected inside the ball; each failing sample takes out of the proof every tile of the eye's image that
-//! its four grid cells cover (the box of their corners as the eye sees them, grown for the
-//! curvature of a cell). Between samples the landing moves smoothly over the cap (the
-//! refracted direction saturates towards the silhouette rather than turning fast), so a pixel
-//! whose cell has four passing corners lands between them, on the photo. Sampled 8 times finer,
-//! no covered tile shows a ray beside the photo (the tests' property, over moved heads, balls
-//! and photo sizes).
+//! where the ray would be reflected inside the ball; each failing sample takes out of the
+//! proof every tile of the eye's image that its four grid cells cover (the box of their
+//! corners as the eye sees them, grown for the curvature of a cell). Between samples the
+//! landing moves smoothly over the cap (the refracted direction saturates towards the
+//! silhouette rather than turning fast), so a pixel whose cell has four passing corners lands
+//! between them, on the photo. Sampled 8 times finer, no covered tile shows a ray beside the
+//! photo (the tests' property, over moved heads, balls and photo sizes).
 //!
 //! Rays that meet the ball too grazingly to carry 1e-4 of the light are left out
 //! ([`PhotoCoverage::grazing_cos`]): at the silhouette, where the samples end, and, through two
@@ -31,7 +32,8 @@ use crate::radial_map::mesh_center;
 use crate::scene::{Refraction, SceneDesc};
 use crate::two_surface::RADIAL_NORMAL_COS;
 
-/// Rings of samples from the cap's centre to its silhouette, both included.
+/// Steps from the cap's centre to its silhouette: `RINGS + 1` rings of samples, both ends
+/// included.
 const RINGS: usize = 24;
 /// Samples per ring.
 const SPOKES: usize = 48;
@@ -121,9 +123,9 @@ impl PhotoCoverage {
         }
         let axis = to_eye / distance;
         let (across, up) = axis.any_orthonormal_pair();
-        // The cap out to where the eye's ray meets the ball at the grazing cosine: cos(incidence) at
-        // cap angle a is (distance cos a - radius) / |eye - point|, falling as a grows to the
-        // silhouette, acos(radius / distance).
+        // The cap out to where the eye's ray meets the ball at the grazing cosine:
+        // cos(incidence) at cap angle a is (distance cos a - radius) / |eye - point|, falling
+        // as a grows to the silhouette, acos(radius / distance).
         let cos_incidence = |a: f32| {
             let point = radius * Vec3::new(a.sin(), 0.0, a.cos());
             (distance * a.cos() - radius) / (Vec3::Z * distance - point).length()

@@ -27,7 +27,7 @@
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::camera::EyeParams;
-use crate::optics::{refract, refract_heckbert};
+use crate::optics::{plane_photo_point, refract, refract_heckbert};
 use crate::radial_map::mesh_center;
 use crate::scene::{Refraction, SceneDesc};
 use crate::two_surface::RADIAL_NORMAL_COS;
@@ -186,18 +186,16 @@ impl PhotoCoverage {
                 // The sample fails: every pixel whose point lies in one of its four cells
                 // loses the proof. The cells lie within the box of their corners, grown by a
                 // quarter for the image's curvature over a cell and a pixel for rounding.
-                let mut corners = Vec::with_capacity(9);
+                let (mut lo, mut hi) = (Vec2::INFINITY, Vec2::NEG_INFINITY);
                 for r in ring.saturating_sub(1)..=(ring + 1).min(RINGS) {
                     for s in [spoke + SPOKES - 1, spoke, spoke + 1] {
-                        corners.push(seen_at[at(r, s)]);
+                        // A corner behind the eye: where the cells lie, is not known.
+                        let Some(corner) = seen_at[at(r, s)] else {
+                            return CoveredTiles::NONE;
+                        };
+                        (lo, hi) = (lo.min(corner), hi.max(corner));
                     }
                 }
-                let Some(corners) = corners.into_iter().collect::<Option<Vec<Vec2>>>() else {
-                    // Behind the eye: where, is not known.
-                    return CoveredTiles::NONE;
-                };
-                let lo = corners.iter().fold(Vec2::INFINITY, |m, &c| m.min(c));
-                let hi = corners.iter().fold(Vec2::NEG_INFINITY, |m, &c| m.max(c));
                 let grow = (hi - lo) * 0.25 + 1.0;
                 tiles.remove(lo - grow, hi + grow, extent);
             }
@@ -236,7 +234,7 @@ impl PhotoCoverage {
             Refraction::Paper => (point, refract_heckbert(from_origin, facing, self.ior)?),
             Refraction::TwoSurface => self.pass_ball(center, point, from_origin, facing)?,
         };
-        plane_landing(exit, direction, self.background_from_world)
+        plane_photo_point(exit, direction, self.background_from_world)
     }
 
     /// The covered shader's `ball_passage` about `center`: the unit ray `incident` enters at
@@ -349,19 +347,6 @@ fn edge(i: u32, size: u32) -> u32 {
     (u64::from(i) * u64::from(size) / u64::from(TILES)) as u32
 }
 
-/// Where the ray from `origin` along `direction` meets the plane that `plane_from_world` maps
-/// to z = 0, in the photo's coordinates (`optics::plane_uv`'s, also off the photo); `None`
-/// where it runs parallel or away.
-fn plane_landing(origin: Vec3, direction: Vec3, plane_from_world: Mat4) -> Option<Vec2> {
-    let o = plane_from_world.transform_point3(origin);
-    let d = plane_from_world.transform_vector3(direction);
-    let t = -o.z / d.z;
-    (d.z.abs() >= 1e-12 && t > 0.0).then(|| {
-        let hit = o + d * t;
-        Vec2::new(hit.x + 0.5, 0.5 - hit.y)
-    })
-}
-
 /// The uniform scale of a similarity transform; `None` for any other.
 fn uniform_scale(m: Mat4) -> Option<f32> {
     let axes = [
@@ -380,289 +365,4 @@ fn uniform_scale(m: Mat4) -> Option<f32> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use proptest::prelude::*;
-
-    /// The visual-effects scene's glass (render/../config/scenes/visual-effects.toml): a
-    /// 15 cm ball of n = 1.51 0.2 m ahead, a 0.6 m photo 0.4 m ahead.
-    fn scene(model: Refraction, photo_m: f32) -> PhotoCoverage {
-        let world_from_plane = Mat4::from_scale_rotation_translation(
-            Vec3::new(photo_m, photo_m, 1.0),
-            glam::Quat::IDENTITY,
-            Vec3::new(0.0, 0.0, -0.4),
-        );
-        PhotoCoverage {
-            center: Vec3::ZERO,
-            radius: 1.0,
-            ior: 1.51,
-            model,
-            background_from_world: world_from_plane.inverse(),
-        }
-    }
-
-    fn ball_at(position_m: Vec3) -> Mat4 {
-        Mat4::from_scale_rotation_translation(Vec3::splat(0.075), glam::Quat::IDENTITY, position_m)
-    }
-
-    const IPD_M: f32 = 0.063;
-
-    /// Two eyes at `head_m` looking down -z turned by `yaw`, seeing the scene's 40 x 30 degrees.
-    fn eyes(head_m: Vec3, yaw: f32) -> [EyeParams; 2] {
-        let (h, v) = (20f32.to_radians(), 15f32.to_radians());
-        let fov = crate::camera::Fov {
-            left_rad: -h,
-            right_rad: h,
-            up_rad: v,
-            down_rad: -v,
-        };
-        let turn = glam::Quat::from_rotation_y(yaw);
-        [-1.0, 1.0]
-            .map(|side| EyeParams::new(head_m + turn * Vec3::X * side * IPD_M / 2.0, turn, fov))
-    }
-
-    /// Refraction seen from each eye (disparity) or from between them.
-    fn origins(eyes: &[EyeParams; 2], disparity: bool) -> [Vec3; 2] {
-        if disparity {
-            eyes.each_ref().map(|e| e.position_m)
-        } else {
-            [(eyes[0].position_m + eyes[1].position_m) / 2.0; 2]
-        }
-    }
-
-    /// The image size the tests prove for.
-    const EXTENT: (u32, u32) = (320, 240);
-
-    /// Each eye's covered tiles.
-    fn tiles(
-        coverage: &PhotoCoverage,
-        world_from_model: Mat4,
-        eyes: &[EyeParams; 2],
-        origins: [Vec3; 2],
-    ) -> [CoveredTiles; 2] {
-        [0, 1].map(|i| coverage.covered_tiles(world_from_model, &eyes[i], origins[i], EXTENT))
-    }
-
-    /// The tile of each eye's image where a ray through the ball misses the photo, among the
-    /// points of the cap sampled 8 times finer than the proof (but for those the proof leaves
-    /// out: within `grazing_cos` of grazing): for each eye, `(col, row)` of every such tile.
-    fn dense_misses(
-        coverage: &PhotoCoverage,
-        world_from_model: Mat4,
-        eyes: &[EyeParams; 2],
-        origins: [Vec3; 2],
-    ) -> [Vec<(u32, u32)>; 2] {
-        let center = world_from_model.transform_point3(coverage.center);
-        let radius = uniform_scale(world_from_model).unwrap() * coverage.radius;
-        [0, 1].map(|i| {
-            let (eye, origin) = (&eyes[i], origins[i]);
-            let position = eye.position_m;
-            let to_eye = (position - center).normalize();
-            let (across, up) = to_eye.any_orthonormal_pair();
-            let (rings, spokes) = (8 * RINGS, 8 * SPOKES);
-            let mut misses = Vec::new();
-            for ring in 0..=rings {
-                for spoke in 0..spokes {
-                    let a = std::f32::consts::FRAC_PI_2 * ring as f32 / rings as f32;
-                    let b = std::f32::consts::TAU * spoke as f32 / spokes as f32;
-                    let normal = a.cos() * to_eye + a.sin() * (b.cos() * across + b.sin() * up);
-                    let point = center + radius * normal;
-                    let cos_in = (position - point).normalize().dot(normal);
-                    let clip = eye.clip_from_world() * point.extend(1.0);
-                    let ndc = clip.truncate().truncate() / clip.w;
-                    // Two surfaces: a ray that grazes the ball from the refraction origin
-                    // passes as little light as one that grazes it from the eye.
-                    let cos_origin = (point - origin).normalize().dot(normal).abs();
-                    let least = coverage.grazing_cos();
-                    let grazing = cos_in < least
-                        || (coverage.model == Refraction::TwoSurface && cos_origin < least);
-                    if grazing || clip.w <= 0.0 || ndc.abs().max_element() >= 1.0 {
-                        continue;
-                    }
-                    let on_photo = coverage
-                        .landing(center, point, normal, position, origin)
-                        .is_some_and(|uv| uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all());
-                    if !on_photo {
-                        let pixel = (ndc + 1.0) * 0.5 * Vec2::new(EXTENT.0 as f32, EXTENT.1 as f32);
-                        let tile = |x: f32, size: u32| {
-                            (0..TILES)
-                                .rev()
-                                .find(|&t| edge(t, size) as f32 <= x)
-                                .unwrap_or(0)
-                        };
-                        let at = (tile(pixel.x, EXTENT.0), tile(pixel.y, EXTENT.1));
-                        if !misses.contains(&at) {
-                            misses.push(at);
-                        }
-                    }
-                }
-            }
-            misses
-        })
-    }
-
-    /// The first miss (eye, column, row) in a tile the proof covers, if any.
-    fn covered_miss(
-        tiles: &[CoveredTiles; 2],
-        misses: &[Vec<(u32, u32)>; 2],
-    ) -> Option<(usize, u32, u32)> {
-        (0..2).find_map(|eye| {
-            misses[eye]
-                .iter()
-                .find(|&&(col, row)| tiles[eye].contains(col, row))
-                .map(|&(col, row)| (eye, col, row))
-        })
-    }
-
-    #[test]
-    fn the_study_scene_is_covered_from_its_viewing_position_in_the_papers_model() {
-        let coverage = scene(Refraction::Paper, 0.6);
-        let ball = ball_at(Vec3::new(0.0, 0.0, -0.2));
-        for disparity in [false, true] {
-            let eyes = eyes(Vec3::ZERO, 0.0);
-            let origins = origins(&eyes, disparity);
-            assert_eq!(
-                tiles(&coverage, ball, &eyes, origins),
-                [CoveredTiles::ALL; 2]
-            );
-        }
-    }
-
-    #[test]
-    fn two_surfaces_bend_the_rim_beside_the_photo_in_the_corners_only() {
-        let coverage = scene(Refraction::TwoSurface, 0.6);
-        let ball = ball_at(Vec3::new(0.0, 0.0, -0.2));
-        let eyes = eyes(Vec3::ZERO, 0.0);
-        let origins = origins(&eyes, true);
-        let tiles = tiles(&coverage, ball, &eyes, origins);
-        let misses = dense_misses(&coverage, ball, &eyes, origins);
-        assert_eq!(covered_miss(&tiles, &misses), None);
-        for eye in 0..2 {
-            assert!(
-                !misses[eye].is_empty(),
-                "eye {eye}: the rim's rays miss the photo"
-            );
-            // The middle of the image is proved.
-            for (col, row) in [(3, 3), (4, 4), (3, 4), (4, 3)] {
-                assert!(
-                    tiles[eye].contains(col, row),
-                    "eye {eye}: tile {col}, {row}"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn a_photo_whose_edge_shows_through_the_ball_loses_the_tiles_that_see_past_it() {
-        for model in [Refraction::Paper, Refraction::TwoSurface] {
-            // A 5 cm photo: most rays through the ball pass beside it.
-            let coverage = scene(model, 0.05);
-            let ball = ball_at(Vec3::new(0.0, 0.0, -0.2));
-            let eyes = eyes(Vec3::ZERO, 0.0);
-            let origins = origins(&eyes, true);
-            let tiles = tiles(&coverage, ball, &eyes, origins);
-            let misses = dense_misses(&coverage, ball, &eyes, origins);
-            assert!(misses.iter().all(|m| m.len() > 10), "{model:?}");
-            assert_eq!(covered_miss(&tiles, &misses), None, "{model:?}");
-        }
-    }
-
-    #[test]
-    fn no_proof_for_an_eye_inside_the_ball_or_a_stretched_ball() {
-        let coverage = scene(Refraction::Paper, 0.6);
-        let eyes = eyes(Vec3::ZERO, 0.0);
-        let origins = origins(&eyes, true);
-        let inside = ball_at(Vec3::new(0.0, 0.0, -0.05));
-        assert_eq!(
-            tiles(&coverage, inside, &eyes, origins),
-            [CoveredTiles::NONE; 2]
-        );
-        let stretched = Mat4::from_scale_rotation_translation(
-            Vec3::new(0.075, 0.08, 0.075),
-            glam::Quat::IDENTITY,
-            Vec3::new(0.0, 0.0, -0.2),
-        );
-        assert_eq!(
-            tiles(&coverage, stretched, &eyes, origins),
-            [CoveredTiles::NONE; 2]
-        );
-    }
-
-    #[test]
-    fn the_rays_left_out_carry_under_1e4_of_the_light() {
-        let incident = |cos: f32| Vec3::new((1.0 - cos * cos).sqrt(), 0.0, -cos);
-        // The paper's model: the refracted image is weighted by 1 - F, F the empirical term.
-        let paper = scene(Refraction::Paper, 0.6);
-        let cos = paper.grazing_cos();
-        assert!(1.0 - crate::optics::fresnel(incident(cos), Vec3::Z) < 1e-4);
-        assert!(1.0 - crate::optics::fresnel(incident(cos * 10.0), Vec3::Z) > 1e-4);
-        // Two surfaces: a ball's exit meets the surface as the entry did, so the light passed
-        // is (1 - F)^2, F exact.
-        let two = scene(Refraction::TwoSurface, 0.6);
-        let passed =
-            |cos: f32| (1.0 - crate::optics::fresnel_reflectance(cos, 1.0 / two.ior)).powi(2);
-        assert!(
-            passed(two.grazing_cos()) < 1e-4,
-            "{}",
-            passed(two.grazing_cos())
-        );
-        assert!(passed(two.grazing_cos() * 10.0) > 1e-4);
-    }
-
-    #[test]
-    fn the_split_draws_each_pixel_once_and_covered_tiles_only_without_the_lookup() {
-        // Covered but for the four corners and one tile inside.
-        let mut tiles = CoveredTiles::ALL;
-        for (col, row) in [(0, 0), (7, 0), (0, 7), (7, 7), (3, 5)] {
-            tiles.0 &= !(1 << (row * TILES + col));
-        }
-        let extent = (101, 77);
-        let (covered, rest) = tiles.split(extent);
-        let mut owner = vec![0u32; (extent.0 * extent.1) as usize];
-        for (rects, without) in [(vec![covered], true), (rest.clone(), false)] {
-            for [x, y, w, h] in rects {
-                for py in y..y + h {
-                    for px in x..x + w {
-                        owner[(py * extent.0 + px) as usize] += 1;
-                        let col = (0..TILES).rev().find(|&t| edge(t, extent.0) <= px).unwrap();
-                        let row = (0..TILES).rev().find(|&t| edge(t, extent.1) <= py).unwrap();
-                        assert!(!without || tiles.contains(col, row), "{px}, {py}");
-                    }
-                }
-            }
-        }
-        assert!(owner.iter().all(|&n| n == 1));
-        // The largest: rows 1 to 4, all eight columns.
-        assert_eq!(covered, [0, edge(1, 77), 101, edge(5, 77) - edge(1, 77)]);
-        assert_eq!(rest.len(), 2);
-        assert_eq!(CoveredTiles::ALL.split(extent), ([0, 0, 101, 77], vec![]));
-        let (none, all) = CoveredTiles::NONE.split(extent);
-        assert_eq!((none[2] * none[3], all), (0, vec![[0, 0, 101, 77]]));
-    }
-
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(48))]
-        /// Soundness: no ray of a cap sampled 8 times finer than the proof's misses the photo
-        /// in a covered tile; the head, ball and photo vary far enough that tiles are lost.
-        #[test]
-        fn a_covered_tile_has_no_ray_beside_the_photo(
-            head in prop::array::uniform3(-0.15f32..0.15),
-            ball in prop::array::uniform3(-0.1f32..0.1),
-            yaw in -0.5f32..0.5,
-            spin in -3.0f32..3.0,
-            photo_m in 0.1f32..0.8,
-            two_surface in any::<bool>(),
-            disparity in any::<bool>(),
-        ) {
-            let model = if two_surface { Refraction::TwoSurface } else { Refraction::Paper };
-            let coverage = scene(model, photo_m);
-            let world_from_model = ball_at(Vec3::new(ball[0], ball[1], ball[2] - 0.2))
-                * Mat4::from_rotation_z(spin);
-            let eyes = eyes(Vec3::from_array(head), yaw);
-            let origins = origins(&eyes, disparity);
-            let tiles = tiles(&coverage, world_from_model, &eyes, origins);
-            let misses = dense_misses(&coverage, world_from_model, &eyes, origins);
-            prop_assert_eq!(covered_miss(&tiles, &misses), None);
-        }
-    }
-}
+mod tests;

@@ -297,16 +297,15 @@ impl GlassPass {
         let pipelines = entries()
             .map(|(c, v)| create(shaders::GLASS_FS[c][shaded][v]))
             .collect::<Result<Vec<_>>>()?;
-        // The proof and its pipelines where the model has them compiled.
-        let covered_row = shaders::covered_row(shaded);
-        let coverage = covered_row.and_then(|_| PhotoCoverage::of(desc, ball));
+        // The proof and its pipelines where the model has them compiled and the object is a
+        // ball.
+        let coverage = shaders::covered_row(shaded).and_then(|_| PhotoCoverage::of(desc, ball));
+        let covered_row = shaders::covered_row(shaded).filter(|_| coverage.is_some());
         let covered = || {
-            compensated.iter().flat_map(|&c| {
-                (0..2).filter_map(move |phong| {
-                    covered_row
-                        .filter(|_| coverage.is_some())
-                        .map(|row| (c, row, phong))
-                })
+            compensated.iter().flat_map(move |&c| {
+                covered_row
+                    .into_iter()
+                    .flat_map(move |row| (0..2).map(move |phong| (c, row, phong)))
             })
         };
         let covered_pipelines = covered()

@@ -45,20 +45,38 @@ pub fn fresnel(incident: Vec3, normal: Vec3) -> f32 {
 /// as photo texture coordinates (u right, v down from the photo's top edge). `None` when the
 /// ray runs parallel to the plane, points away from it, or hits outside the photo.
 pub fn plane_uv(origin: Vec3, direction: Vec3, plane_from_world: glam::Mat4) -> Option<Vec2> {
+    plane_hit(origin, direction, plane_from_world)
+        .filter(|hit| hit.x.abs() <= 0.5 && hit.y.abs() <= 0.5)
+        .map(photo_coordinates)
+}
+
+/// [`plane_uv`] also where the ray meets the plane off the photo: photo texture coordinates
+/// outside the unit square there. `None` when the ray runs parallel to the plane or points
+/// away from it.
+pub fn plane_photo_point(
+    origin: Vec3,
+    direction: Vec3,
+    plane_from_world: glam::Mat4,
+) -> Option<Vec2> {
+    plane_hit(origin, direction, plane_from_world).map(photo_coordinates)
+}
+
+/// Where the ray meets the plane, in the plane's frame (the photo on `[-0.5, 0.5]^2` at
+/// z = 0), if ahead of it.
+fn plane_hit(origin: Vec3, direction: Vec3, plane_from_world: glam::Mat4) -> Option<Vec3> {
     let o = plane_from_world.transform_point3(origin);
     let d = plane_from_world.transform_vector3(direction);
     if d.z.abs() < 1e-12 {
         return None;
     }
     let t = -o.z / d.z;
-    if t <= 0.0 {
-        return None;
-    }
-    let hit = o + d * t;
-    if hit.x.abs() > 0.5 || hit.y.abs() > 0.5 {
-        return None;
-    }
-    Some(Vec2::new(hit.x + 0.5, 0.5 - hit.y))
+    (t > 0.0).then(|| o + d * t)
+}
+
+/// Photo texture coordinates (u right, v down from the top edge) of a point of the plane's
+/// frame.
+fn photo_coordinates(hit: Vec3) -> Vec2 {
+    Vec2::new(hit.x + 0.5, 0.5 - hit.y)
 }
 
 /// Where a ray first meets a sphere: the distance along the unit `direction`, if it does.

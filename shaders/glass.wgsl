@@ -458,13 +458,13 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     return out;
 }
 
-// Two surfaces through a ball where the frame proved the passage (`COVERED`, compiled with
-// `BALL`; render/src/coverage.rs `pass_ball` is its twin): in at the entry, across, and out at
-// the first meeting with the surface, with no reflection inside (the frame keeps
-// `two_surface`'s pipeline wherever one occurs). In the world: the object's transform is a
-// similarity, so the ball is one about its world centre through the entry. Where rounding alone
-// reflects a grazing exit, the ray goes on straight; both surfaces pass under 1e-4 of the light
-// there.
+// Two surfaces through a ball (`BALL`; render/src/coverage.rs `pass_ball` is its twin): in at
+// the entry, across, and out at the first meeting with the surface. A ray that enters a ball
+// meets the surface inside as steeply as it left the entry, below the critical angle, so none
+// is reflected inside but by rounding at a grazing exit, where the ray goes on straight (both
+// surfaces pass under 1e-4 of the light there). In the world: the object's transform is a
+// similarity, so the ball is one about its world centre through the entry. A room's ball keeps
+// `two_surface`, whose echoes follow the light the exit reflects back inside.
 fn ball_passage(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
     var out: Passage;
     let inside = refract(incident, normal, 1.0 / ior);
@@ -657,7 +657,7 @@ fn shade_ray(
         }
         let from_origin = normalize(world_pos - origin);
         var passage: Passage;
-        if COVERED {
+        if COVERED || (BALL && !ROOM) {
             passage = ball_passage(world_pos, from_origin, n, ior);
         } else {
             passage = two_surface(world_pos, from_origin, n, ior);

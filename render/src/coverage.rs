@@ -1,8 +1,9 @@
 //! Where the background photo catches every ray a ball refracts towards it, in one eye's
 //! image: the frame's proof that lets the glass pass leave out the environment map a ray
 //! beside the photo would see (`COVERED` in shaders/glass.wgsl; `GlassPass::plan` in
-//! `glass/draws.rs` draws the largest rectangle of proved tiles with that pipeline, the rest
-//! with the lookup).
+//! `glass/draws.rs` draws the largest rectangles of proved tiles with that pipeline, the rest
+//! of the glass with the lookup: `coverage/tiles.rs`), and the tiles the ball shows in at all
+//! (`coverage/shown.rs`).
 //!
 //! The ball's cap that the eye sees is sampled on rings about the axis from the eye to the
 //! centre, out to the silhouette, and each sample's ray is refracted as the shader refracts it
@@ -29,8 +30,12 @@ use glam::{Mat4, Vec2, Vec3};
 use crate::camera::EyeParams;
 use crate::optics::{plane_photo_point, refract, refract_heckbert};
 use crate::radial_map::mesh_center;
-use crate::scene::{Refraction, SceneDesc};
+use crate::scene::{MeshRef, Refraction, SceneDesc};
 use crate::two_surface::RADIAL_NORMAL_COS;
+
+mod shown;
+mod tiles;
+pub use tiles::{Split, TILES, Tiles};
 
 /// Steps from the cap's centre to its silhouette: `RINGS + 1` rings of samples, both ends
 /// included.
@@ -49,6 +54,26 @@ const TWO_SURFACE_GRAZING_COS: f32 = 1e-3;
 /// How far inside the photo's edge a passing sample must land, in its farthest neighbour's
 /// landing's distance from it: room for a cell whose landings bulge between its corners.
 const SAFETY: f32 = 1.5;
+
+/// The centre (the bounding box's, as the shader's `g.radial`) and radius of `mesh` (model
+/// units) where it is a ball: every vertex at one distance from the centre with a normal along
+/// it, so that the shader's front surface is that sphere.
+pub fn ball(mesh: &MeshRef) -> Option<(Vec3, f32)> {
+    let center = mesh_center(mesh.positions);
+    let radius = mesh
+        .positions
+        .iter()
+        .map(|&p| (p - center).length())
+        .fold(0.0f32, f32::max);
+    let ball = radius > 0.0
+        && mesh.positions.len() == mesh.normals.len()
+        && mesh.positions.iter().zip(mesh.normals).all(|(&p, &n)| {
+            let out = p - center;
+            (radius - out.length()) <= BALL_TOLERANCE * radius
+                && n.dot(out) > RADIAL_NORMAL_COS * n.length() * out.length()
+        });
+    ball.then_some((center, radius))
+}
 
 /// A scene whose glass is a ball refracting towards the background photo: what the proof
 /// needs of it.
@@ -75,27 +100,33 @@ impl PhotoCoverage {
         if desc.room || (desc.refraction == Refraction::TwoSurface && !ball_pipelines) {
             return None;
         }
-        let m = desc.mesh;
-        let center = mesh_center(m.positions);
-        let radius = m
-            .positions
-            .iter()
-            .map(|&p| (p - center).length())
-            .fold(0.0f32, f32::max);
-        let ball = radius > 0.0
-            && m.positions.len() == m.normals.len()
-            && m.positions.iter().zip(m.normals).all(|(&p, &n)| {
-                let out = p - center;
-                (radius - out.length()) <= BALL_TOLERANCE * radius
-                    && n.dot(out) > RADIAL_NORMAL_COS * n.length() * out.length()
-            });
-        ball.then(|| PhotoCoverage {
+        let (center, radius) = ball(&desc.mesh)?;
+        Some(PhotoCoverage {
             center,
             radius,
             ior: desc.ior,
             model: desc.refraction,
             background_from_world: desc.background.world_from_plane.inverse(),
         })
+    }
+
+    /// The tiles of the image of `eye` (`extent` pixels) that the ball at `world_from_model`
+    /// may show in (`shown.rs`); all of them where the transform is not a similarity.
+    pub fn shown_tiles(
+        &self,
+        world_from_model: Mat4,
+        eye: &EyeParams,
+        extent: (u32, u32),
+    ) -> Tiles {
+        match uniform_scale(world_from_model) {
+            Some(scale) => shown::shown_tiles(
+                world_from_model.transform_point3(self.center),
+                self.radius * scale,
+                eye,
+                extent,
+            ),
+            None => Tiles::ALL,
+        }
     }
 
     /// The tiles of the image of `eye` (`extent` pixels) where every ray the ball at
@@ -108,9 +139,9 @@ impl PhotoCoverage {
         eye: &EyeParams,
         origin_m: Vec3,
         extent: (u32, u32),
-    ) -> CoveredTiles {
+    ) -> Tiles {
         let Some(scale) = uniform_scale(world_from_model) else {
-            return CoveredTiles::NONE;
+            return Tiles::NONE;
         };
         let center = world_from_model.transform_point3(self.center);
         let radius = self.radius * scale;
@@ -119,7 +150,7 @@ impl PhotoCoverage {
         let distance = to_eye.length();
         let outside = distance > radius * (1.0 + 1e-4);
         if !outside || extent.0 == 0 || extent.1 == 0 {
-            return CoveredTiles::NONE;
+            return Tiles::NONE;
         }
         let axis = to_eye / distance;
         let (across, up) = axis.any_orthonormal_pair();
@@ -161,7 +192,7 @@ impl PhotoCoverage {
             }
         }
         let at = |r: usize, s: usize| r * SPOKES + s % SPOKES;
-        let mut tiles = CoveredTiles::ALL;
+        let mut tiles = Tiles::ALL;
         for ring in 0..=RINGS {
             for spoke in 0..SPOKES {
                 let here = at(ring, spoke);
@@ -191,7 +222,7 @@ impl PhotoCoverage {
                     for s in [spoke + SPOKES - 1, spoke, spoke + 1] {
                         // A corner behind the eye: where the cells lie, is not known.
                         let Some(corner) = seen_at[at(r, s)] else {
-                            return CoveredTiles::NONE;
+                            return Tiles::NONE;
                         };
                         (lo, hi) = (lo.min(corner), hi.max(corner));
                     }
@@ -237,10 +268,11 @@ impl PhotoCoverage {
         plane_photo_point(exit, direction, self.background_from_world)
     }
 
-    /// The covered shader's `ball_passage` about `center`: the unit ray `incident` enters at
-    /// `entry` (normal `facing` towards it), crosses the ball and leaves at its first meeting
-    /// with the surface; where and along what, or `None` where it would be reflected inside
-    /// there (the frame then keeps the pipeline that follows it, `two_surface`).
+    /// The shader's `ball_passage` about `center`: the unit ray `incident` enters at `entry`
+    /// (normal `facing` towards it), crosses the ball and leaves at its first meeting with the
+    /// surface; where and along what, or `None` where rounding would reflect it inside there
+    /// (the shader then sends it on straight, which the proof leaves to the pipeline with the
+    /// lookup).
     fn pass_ball(
         &self,
         center: Vec3,
@@ -256,95 +288,6 @@ impl PhotoCoverage {
         let leaving = refract(d, -exit.normalize(), self.ior)?;
         Some((exit + center, leaving))
     }
-}
-
-/// Tiles per side of an eye's image in [`CoveredTiles`].
-pub const TILES: u32 = 8;
-
-/// The tiles of an eye's image ([`TILES`] x [`TILES`], tile `(col, row)` holding pixels
-/// `col * width / TILES` up to the next tile's first, rows alike) whose every pixel's refracted
-/// ray is proved to reach the background photo.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct CoveredTiles(u64);
-
-impl CoveredTiles {
-    /// No tile: the whole image keeps the environment's lookup.
-    pub const NONE: CoveredTiles = CoveredTiles(0);
-    /// Every tile.
-    pub const ALL: CoveredTiles = CoveredTiles(u64::MAX);
-
-    /// Whether tile (`col`, `row`) is covered.
-    pub fn contains(self, col: u32, row: u32) -> bool {
-        self.0 & (1 << (row * TILES + col)) != 0
-    }
-
-    /// Takes out every tile that holds a pixel of the box from `lo` to `hi` (pixels) in an
-    /// image of `extent`.
-    fn remove(&mut self, lo: Vec2, hi: Vec2, extent: (u32, u32)) {
-        let span = |lo: f32, hi: f32, size: u32| {
-            (hi >= 0.0 && lo < size as f32).then(|| {
-                // The tile holding pixel x: the last whose first pixel is not past it.
-                let tile = |x: f32| {
-                    let x = x.clamp(0.0, size as f32 - 1.0) as u32;
-                    (0..TILES).rev().find(|&t| edge(t, size) <= x).unwrap_or(0)
-                };
-                tile(lo)..=tile(hi)
-            })
-        };
-        let cols = span(lo.x, hi.x, extent.0);
-        if let (Some(cols), Some(rows)) = (cols, span(lo.y, hi.y, extent.1)) {
-            for row in rows {
-                for col in cols.clone() {
-                    self.0 &= !(1 << (row * TILES + col));
-                }
-            }
-        }
-    }
-
-    /// The image of `extent` split for drawing: the largest rectangle of covered tiles (none
-    /// without one), drawn without the environment's lookup, and the rest of the image around
-    /// it in at most four rectangles (above, below, left, right), drawn with it; each
-    /// rectangle as pixels: x, y, width, height. At most five draws, whatever the tiles.
-    pub fn split(self, extent: (u32, u32)) -> ([u32; 4], Vec<[u32; 4]>) {
-        // The largest rectangle of tiles, as first and end column, first and end row.
-        let mut best = [0, 0, 0, 0];
-        for r0 in 0..TILES {
-            for c0 in 0..TILES {
-                // Widest run from (c0, r0) in each row going down.
-                let mut width = TILES - c0;
-                for r1 in r0 + 1..=TILES {
-                    let run = (c0..TILES)
-                        .take_while(|&c| self.contains(c, r1 - 1))
-                        .count();
-                    width = width.min(run as u32);
-                    let area = |b: [u32; 4]| (b[1] - b[0]) * (b[3] - b[2]);
-                    if width == 0 {
-                        break;
-                    }
-                    if width * (r1 - r0) > area(best) {
-                        best = [c0, c0 + width, r0, r1];
-                    }
-                }
-            }
-        }
-        let [c0, c1, r0, r1] = best;
-        let (w, h) = extent;
-        let (x0, x1) = (edge(c0, w), edge(c1, w));
-        let (y0, y1) = (edge(r0, h), edge(r1, h));
-        let rest = [
-            [0, 0, w, y0],
-            [0, y1, w, h - y1],
-            [0, y0, x0, y1 - y0],
-            [x1, y0, w - x1, y1 - y0],
-        ];
-        let rest = rest.into_iter().filter(|r| r[2] > 0 && r[3] > 0).collect();
-        ([x0, y0, x1 - x0, y1 - y0], rest)
-    }
-}
-
-/// The first pixel of tile `i` along an image side of `size` pixels.
-fn edge(i: u32, size: u32) -> u32 {
-    (u64::from(i) * u64::from(size) / u64::from(TILES)) as u32
 }
 
 /// The uniform scale of a similarity transform; `None` for any other.

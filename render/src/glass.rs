@@ -5,12 +5,15 @@
 //! Just over 600 lines, one idea: the pass and what its pipelines read (the variant table, the
 //! push constants, the globals, the radial map and facet planes it uploads for the exit),
 //! built once per scene; its tests check that table against the shaders. What a frame draws
-//! with them, and the recording, is `glass/draws.rs`.
+//! with them, and the recording, is `glass/draws.rs`; a ball's triangles in patches, each
+//! drawn where it can show, `glass/patches.rs`.
 
 mod draws;
+mod patches;
 
-use draws::ProofKey;
+use draws::Proof;
 pub use draws::{GlassDraws, Pick};
+use patches::Patches;
 
 use ash::vk;
 use glam::Vec4;
@@ -19,7 +22,7 @@ use crate::camera::{EyeParams, Look, Reflection};
 use crate::compensation::CompensationSet;
 use crate::context::GpuContext;
 use crate::convex;
-use crate::coverage::{CoveredTiles, PhotoCoverage};
+use crate::coverage::{self, PhotoCoverage};
 use crate::descriptors;
 use crate::error::Result;
 use crate::memory::{Buffer, Image, upload_texture};
@@ -163,7 +166,10 @@ pub struct GlassPass {
     covered_pipelines: Vec<Owned<vk::Pipeline>>,
     covered_costs: Vec<ShaderCost>,
     /// Each eye's last proof and what it was made for.
-    proved: std::cell::Cell<[Option<(ProofKey, CoveredTiles)>; 2]>,
+    proved: std::cell::Cell<[Option<Proof>; 2]>,
+    /// Where the object is a ball: its triangles in patches, each drawn only where it can
+    /// show, and the indices in their order.
+    patches: Option<(Patches, Buffer)>,
     /// Pipeline layout (the set, the compensation's set 1 with compensation, eye push
     /// constants).
     layout: Owned<vk::PipelineLayout>,
@@ -311,6 +317,16 @@ impl GlassPass {
         let covered_pipelines = covered()
             .map(|(c, row, phong)| create(shaders::GLASS_FS_COVERED[c][row][phong]))
             .collect::<Result<Vec<_>>>()?;
+        let patches = match coverage::ball(&desc.mesh) {
+            Some((center, _)) => {
+                let patches = Patches::new(desc.mesh.positions, desc.mesh.indices, center);
+                let bytes = bytemuck::cast_slice(&patches.indices);
+                let usage = vk::BufferUsageFlags::INDEX_BUFFER;
+                let buffer = Buffer::with_data(ctx, "glass patches' indices", bytes, usage)?;
+                Some((patches, buffer))
+            }
+            None => None,
+        };
         let unsampled_row = shaders::covered_row(model);
         let pool = descriptors::pool(
             ctx,
@@ -379,6 +395,7 @@ impl GlassPass {
                 .collect(),
             coverage,
             proved: std::cell::Cell::new([None; 2]),
+            patches,
             covered_pipelines,
             covered_costs: covered()
                 .map(|(c, row, phong)| {

@@ -483,8 +483,10 @@ impl Renderer {
                     compensated: self.compensates(composition),
                     covered: false,
                 };
-                let pose = self.prove_coverage.then_some(&self.pose);
-                self.glass.plan(pick, pose, &params.eyes, look, self.extent)
+                let (pose, prove) = (&self.pose, self.prove_coverage);
+                let mesh = (self.extent, self.scene.index_count);
+                self.glass
+                    .plan(pick, (pose, prove), &params.eyes, look, mesh)
             });
             let prepared = self.record(slot, params, want, draw, glass.as_ref());
             let recorded = FrameWork {

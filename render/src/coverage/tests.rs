@@ -59,7 +59,7 @@ fn tiles(
     world_from_model: Mat4,
     eyes: &[EyeParams; 2],
     origins: [Vec3; 2],
-) -> [CoveredTiles; 2] {
+) -> [Tiles; 2] {
     [0, 1].map(|i| coverage.covered_tiles(world_from_model, &eyes[i], origins[i], EXTENT))
 }
 
@@ -104,13 +104,7 @@ fn dense_misses(
                     .is_some_and(|uv| uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all());
                 if !on_photo {
                     let pixel = (ndc + 1.0) * 0.5 * Vec2::new(EXTENT.0 as f32, EXTENT.1 as f32);
-                    let tile = |x: f32, size: u32| {
-                        (0..TILES)
-                            .rev()
-                            .find(|&t| edge(t, size) as f32 <= x)
-                            .unwrap_or(0)
-                    };
-                    let at = (tile(pixel.x, EXTENT.0), tile(pixel.y, EXTENT.1));
+                    let at = tile_at(pixel);
                     if !misses.contains(&at) {
                         misses.push(at);
                     }
@@ -121,11 +115,19 @@ fn dense_misses(
     })
 }
 
+/// The tile of an image of `EXTENT` that holds `pixel`.
+fn tile_at(pixel: Vec2) -> (u32, u32) {
+    let tile = |x: f32, size: u32| {
+        (0..TILES)
+            .rev()
+            .find(|&t| tiles::edge(t, size) as f32 <= x)
+            .unwrap_or(0)
+    };
+    (tile(pixel.x, EXTENT.0), tile(pixel.y, EXTENT.1))
+}
+
 /// The first miss (eye, column, row) in a tile the proof covers, if any.
-fn covered_miss(
-    tiles: &[CoveredTiles; 2],
-    misses: &[Vec<(u32, u32)>; 2],
-) -> Option<(usize, u32, u32)> {
+fn covered_miss(tiles: &[Tiles; 2], misses: &[Vec<(u32, u32)>; 2]) -> Option<(usize, u32, u32)> {
     (0..2).find_map(|eye| {
         misses[eye]
             .iter()
@@ -141,10 +143,7 @@ fn the_study_scene_is_covered_from_its_viewing_position_in_the_papers_model() {
     for disparity in [false, true] {
         let eyes = eyes(Vec3::ZERO, 0.0);
         let origins = origins(&eyes, disparity);
-        assert_eq!(
-            tiles(&coverage, ball, &eyes, origins),
-            [CoveredTiles::ALL; 2]
-        );
+        assert_eq!(tiles(&coverage, ball, &eyes, origins), [Tiles::ALL; 2]);
     }
 }
 
@@ -163,7 +162,7 @@ fn two_surfaces_bend_the_rim_beside_the_photo_in_the_corners_only() {
             "eye {eye}: the rim's rays miss the photo"
         );
         // The middle of the image is proved.
-        for (col, row) in [(3, 3), (4, 4), (3, 4), (4, 3)] {
+        for (col, row) in [(15, 15), (16, 16), (15, 16), (16, 15)] {
             assert!(
                 tiles[eye].contains(col, row),
                 "eye {eye}: tile {col}, {row}"
@@ -193,10 +192,7 @@ fn no_proof_for_an_eye_inside_the_ball_or_a_stretched_ball() {
     let eyes = eyes(Vec3::ZERO, 0.0);
     let origins = origins(&eyes, true);
     let inside = ball_at(Vec3::new(0.0, 0.0, -0.05));
-    assert_eq!(
-        tiles(&coverage, inside, &eyes, origins),
-        [CoveredTiles::NONE; 2]
-    );
+    assert_eq!(tiles(&coverage, inside, &eyes, origins), [Tiles::NONE; 2]);
     let stretched = Mat4::from_scale_rotation_translation(
         Vec3::new(0.075, 0.08, 0.075),
         glam::Quat::IDENTITY,
@@ -204,7 +200,7 @@ fn no_proof_for_an_eye_inside_the_ball_or_a_stretched_ball() {
     );
     assert_eq!(
         tiles(&coverage, stretched, &eyes, origins),
-        [CoveredTiles::NONE; 2]
+        [Tiles::NONE; 2]
     );
 }
 
@@ -228,39 +224,166 @@ fn the_rays_left_out_carry_under_1e4_of_the_light() {
     assert!(passed(two.grazing_cos() * 10.0) > 1e-4);
 }
 
-#[test]
-fn the_split_draws_each_pixel_once_and_covered_tiles_only_without_the_lookup() {
-    // Covered but for the four corners and one tile inside.
-    let mut tiles = CoveredTiles::ALL;
-    for (col, row) in [(0, 0), (7, 0), (0, 7), (7, 7), (3, 5)] {
-        tiles.0 &= !(1 << (row * TILES + col));
-    }
-    let extent = (101, 77);
-    let (covered, rest) = tiles.split(extent);
+/// Every pixel of `shown` tiles drawn once by `split` of `extent`, none twice, and those
+/// drawn without the lookup in `covered` tiles only.
+fn check_split(covered: Tiles, shown: Tiles, split: &Split, extent: (u32, u32)) {
+    let tile_of = |x: u32, y: u32| {
+        let tile = |p: u32, size: u32| (0..TILES).rev().find(|&t| tiles::edge(t, size) <= p);
+        (tile(x, extent.0).unwrap(), tile(y, extent.1).unwrap())
+    };
     let mut owner = vec![0u32; (extent.0 * extent.1) as usize];
-    for (rects, without) in [(vec![covered], true), (rest.clone(), false)] {
-        for [x, y, w, h] in rects {
+    for (rects, without) in [(&split.covered, true), (&split.rest, false)] {
+        for &[x, y, w, h] in rects {
+            assert!(w > 0 && h > 0, "{:?}", [x, y, w, h]);
             for py in y..y + h {
                 for px in x..x + w {
                     owner[(py * extent.0 + px) as usize] += 1;
-                    let col = (0..TILES).rev().find(|&t| edge(t, extent.0) <= px).unwrap();
-                    let row = (0..TILES).rev().find(|&t| edge(t, extent.1) <= py).unwrap();
-                    assert!(!without || tiles.contains(col, row), "{px}, {py}");
+                    let (col, row) = tile_of(px, py);
+                    assert!(!without || covered.contains(col, row), "{px}, {py}");
                 }
             }
         }
     }
-    assert!(owner.iter().all(|&n| n == 1));
-    // The largest: rows 1 to 4, all eight columns.
-    assert_eq!(covered, [0, edge(1, 77), 101, edge(5, 77) - edge(1, 77)]);
-    assert_eq!(rest.len(), 2);
-    assert_eq!(CoveredTiles::ALL.split(extent), ([0, 0, 101, 77], vec![]));
-    let (none, all) = CoveredTiles::NONE.split(extent);
-    assert_eq!((none[2] * none[3], all), (0, vec![[0, 0, 101, 77]]));
+    for py in 0..extent.1 {
+        for px in 0..extent.0 {
+            let (col, row) = tile_of(px, py);
+            let n = owner[(py * extent.0 + px) as usize];
+            assert!(n <= 1, "{px}, {py} drawn {n} times");
+            assert!(n == 1 || !shown.contains(col, row), "{px}, {py} not drawn");
+        }
+    }
+}
+
+#[test]
+fn the_split_draws_each_shown_pixel_once_and_covered_tiles_only_without_the_lookup() {
+    let extent = (401, 317);
+    assert_eq!(
+        Tiles::ALL.split(Tiles::ALL, extent, 40_000),
+        Split {
+            covered: vec![[0, 0, 401, 317]],
+            rest: vec![],
+        }
+    );
+    assert_eq!(
+        Tiles::NONE.split(Tiles::ALL, extent, 40_000),
+        Split {
+            covered: vec![],
+            rest: vec![[0, 0, 401, 317]],
+        }
+    );
+    assert_eq!(Tiles::NONE.split(Tiles::NONE, extent, 0), Split::default());
+    // A ball seen whole through two surfaces: a disc of glass, its rim a ring of tiles whose
+    // rays pass beside the photo.
+    let (mut covered, mut shown) = (Tiles::ALL, Tiles::NONE);
+    for row in 0..TILES {
+        for col in 0..TILES {
+            let r = ((col as f32 - 15.5).powi(2) + (row as f32 - 15.5).powi(2)).sqrt();
+            if r < 14.0 {
+                shown.put_in(col, row);
+            }
+            if (11.0..14.0).contains(&r) {
+                covered.take_out(col, row);
+            }
+        }
+    }
+    // Draws for free: four rectangles inside the ring hold most of its covered tiles.
+    let split = covered.split(shown, extent, 0);
+    check_split(covered, shown, &split, extent);
+    // Four rectangles inside the ring hold 85 % of its covered tiles.
+    let area = |rects: &[[u32; 4]]| rects.iter().map(|r| r[2] * r[3]).sum::<u32>();
+    let inside = (0..TILES * TILES)
+        .filter(|i| covered.and(shown).contains(i % TILES, i / TILES))
+        .count() as f32;
+    let tile_px = (extent.0 * extent.1) as f32 / (TILES * TILES) as f32;
+    let share = area(&split.covered) as f32 / tile_px / inside;
+    assert_eq!(split.covered.len(), 4);
+    assert!(share > 0.8, "{share}");
+    let draws_free = split.covered.len() + split.rest.len();
+    // The ring and what is left around the rectangles, drawn in ten more.
+    assert!(split.rest.len() <= 10, "{:?}", split.rest);
+    // A draw dearer than the image: one draw, with the lookup, taking in the whole disc.
+    let dear = covered.split(shown, extent, u64::from(extent.0 * extent.1));
+    check_split(covered, shown, &dear, extent);
+    assert_eq!((dear.covered.len(), dear.rest.len()), (0, 1), "{dear:?}");
+    // In between, fewer draws, more of them without the lookup than with it.
+    let between = covered.split(shown, extent, u64::from(extent.0 * extent.1) / 40);
+    check_split(covered, shown, &between, extent);
+    let draws = between.covered.len() + between.rest.len();
+    assert!((2..draws_free).contains(&draws), "{between:?}");
+}
+
+/// The tiles of each eye's image where a point of the ball, sampled densely over the whole
+/// sphere, shows (in front of the eye, inside the image).
+fn dense_shown(world_from_model: Mat4, eye: &EyeParams) -> Vec<(u32, u32)> {
+    let center = world_from_model.transform_point3(Vec3::ZERO);
+    let radius = uniform_scale(world_from_model).unwrap();
+    let mut shown = Vec::new();
+    for ring in 0..=400 {
+        for spoke in 0..800 {
+            let a = std::f32::consts::PI * ring as f32 / 400.0;
+            let b = std::f32::consts::TAU * spoke as f32 / 800.0;
+            let normal = Vec3::new(a.sin() * b.cos(), a.cos(), a.sin() * b.sin());
+            let size = Vec2::new(EXTENT.0 as f32, EXTENT.1 as f32);
+            let Some(pixel) = eye.project_to_pixel(center + radius * normal, size) else {
+                continue;
+            };
+            if pixel.cmplt(Vec2::ZERO).any() || pixel.cmpge(size).any() {
+                continue;
+            }
+            let at = tile_at(pixel);
+            if !shown.contains(&at) {
+                shown.push(at);
+            }
+        }
+    }
+    shown
+}
+
+#[test]
+fn a_ball_seen_whole_shows_in_a_disc_of_tiles() {
+    let coverage = scene(Refraction::TwoSurface, 0.6);
+    // A 15 cm ball 0.6 m ahead, slightly right and up: about 14 degrees across, a disc of
+    // about 11 tiles across in the 40 degree wide image.
+    let ball = ball_at(Vec3::new(0.05, 0.03, -0.6));
+    let eye = eyes(Vec3::ZERO, 0.0)[0];
+    let shown = coverage.shown_tiles(ball, &eye, EXTENT);
+    let dense = dense_shown(ball, &eye);
+    for &(col, row) in &dense {
+        assert!(shown.contains(col, row), "{col}, {row}");
+    }
+    // A tile more is shown only along the disc's edge: no bounding box's corners.
+    let (n, m) = (shown.count() as f32, dense.len() as f32);
+    // (164 for 163 here; the box of the four sides alone, 192.)
+    assert!(n < m * 1.1, "{n} tiles shown for {m}");
+    let stretched = Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0)) * ball;
+    assert_eq!(coverage.shown_tiles(stretched, &eye, EXTENT), Tiles::ALL);
 }
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
+    /// Any two sets of tiles are split so that each shown pixel is drawn once, without the
+    /// lookup only in covered tiles, in at most four rectangles without it.
+    #[test]
+    fn any_split_draws_each_shown_pixel_once(
+        covered in prop::collection::vec(any::<bool>(), (TILES * TILES) as usize),
+        shown in prop::collection::vec(any::<bool>(), (TILES * TILES) as usize),
+        width in 32u32..300,
+        height in 32u32..300,
+        draw_px in 0u64..100_000,
+    ) {
+        let set = |bits: &[bool]| {
+            let mut tiles = Tiles::NONE;
+            for (i, _) in bits.iter().enumerate().filter(|(_, on)| **on) {
+                tiles.put_in(i as u32 % TILES, i as u32 / TILES);
+            }
+            tiles
+        };
+        let (covered, shown) = (set(&covered), set(&shown));
+        let split = covered.split(shown, (width, height), draw_px);
+        check_split(covered, shown, &split, (width, height));
+        prop_assert!(split.covered.len() <= 4);
+    }
+
     /// Soundness: no ray of a cap sampled 8 times finer than the proof's misses the photo
     /// in a covered tile; the head, ball and photo vary far enough that tiles are lost.
     #[test]
@@ -282,5 +405,27 @@ proptest! {
         let tiles = tiles(&coverage, world_from_model, &eyes, origins);
         let misses = dense_misses(&coverage, world_from_model, &eyes, origins);
         prop_assert_eq!(covered_miss(&tiles, &misses), None);
+    }
+
+    /// No point of the ball shows in a tile left out of those it shows in, the ball anywhere
+    /// about the eyes, behind them or around them included.
+    #[test]
+    fn a_ball_shows_in_no_tile_left_out(
+        head in prop::array::uniform3(-0.15f32..0.15),
+        ball in prop::array::uniform3(-0.5f32..0.5),
+        size in 0.01f32..0.3,
+        yaw in -3.0f32..3.0,
+    ) {
+        let coverage = scene(Refraction::Paper, 0.6);
+        let world_from_model = Mat4::from_scale_rotation_translation(
+            Vec3::splat(size),
+            glam::Quat::IDENTITY,
+            Vec3::from_array(ball),
+        );
+        let eye = eyes(Vec3::from_array(head), yaw)[1];
+        let shown = coverage.shown_tiles(world_from_model, &eye, EXTENT);
+        for (col, row) in dense_shown(world_from_model, &eye) {
+            prop_assert!(shown.contains(col, row), "{}, {}", col, row);
+        }
     }
 }

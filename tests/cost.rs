@@ -116,6 +116,7 @@ fn run(case: &Case) -> BenchReport {
         moving: case.moving,
         live_caustics: false,
         two_surface: case.two_surface,
+        unproved: false,
     })
     .unwrap_or_else(|e| panic!("{}: {e:#}", case.name))
 }

@@ -90,6 +90,11 @@ enum Command {
         /// alternated with the same variant under the paper's refraction (ratio GPU/paper).
         #[arg(long = "two-surface")]
         two_surface: bool,
+        /// Also time each variant with the frame's proof of coverage off (the whole glass
+        /// drawn with the environment's lookup), alternated with the same variant drawn as
+        /// the proof allows (ratio GPU/unproved).
+        #[arg(long)]
+        unproved: bool,
     },
     /// Replay a scene again and again in one process (a new Vulkan device and renderer each
     /// pass, validation on) and check that resident memory stays flat and validation silent.
@@ -246,6 +251,7 @@ fn run(cli: Cli) -> Result<()> {
             moving,
             live_caustics,
             two_surface,
+            unproved,
         } => {
             let report = bench(&BenchOptions {
                 scene,
@@ -260,6 +266,7 @@ fn run(cli: Cli) -> Result<()> {
                 moving,
                 live_caustics,
                 two_surface,
+                unproved,
             })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);

@@ -66,6 +66,10 @@ pub struct BenchOptions {
     /// Also time each variant with two-surface refraction (a second renderer, alternated
     /// with the same variant under the paper's refraction).
     pub two_surface: bool,
+    /// Also time each variant with the glass's whole image drawn with the environment's
+    /// lookup (the frame's proof of coverage off), alternated with the same variant drawn as
+    /// the proof allows.
+    pub unproved: bool,
 }
 
 /// Degrees the light turns about the vertical axis through the object on each moving frame.
@@ -105,6 +109,9 @@ pub struct VariantResult {
     /// Two-surface variants: median GPU time over the same variant's under the paper's
     /// refraction.
     pub gpu_over_paper: Option<f64>,
+    /// With `--unproved`, each variant drawn as the proof allows: median GPU time over the
+    /// same variant's with the proof off.
+    pub gpu_over_unproved: Option<f64>,
     /// Counted work, mean per timed frame ([`WorkCounts`]).
     pub work: WorkCounts,
 }
@@ -160,6 +167,8 @@ pub struct BenchReport {
     pub moving: bool,
     /// Whether each variant also ran with two-surface refraction (`--two-surface`).
     pub two_surface: bool,
+    /// Whether each variant also ran with the proof of coverage off (`--unproved`).
+    pub unproved: bool,
     /// Whether the device counted shader invocations (pipeline-statistics queries).
     pub invocations_counted: bool,
     /// The baseline first, then each requested set.
@@ -236,6 +245,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             caustics: set.caustics,
             live: false,
             two_surface: false,
+            unproved: false,
             moving: false,
         };
         match (&setup, set.defocus) {
@@ -265,6 +275,11 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     // both surfaces (`<set> two-surface`), right after the same variant under the paper's.
     if options.two_surface {
         variants = with_twins(variants, |_| true, "two-surface", |v| v.two_surface = true);
+    }
+    // With --unproved every variant also runs with the proof of coverage off (`<set>
+    // unproved`), right before the same variant drawn as the proof allows.
+    if options.unproved {
+        variants = with_twins(variants, |_| true, "unproved", |v| v.unproved = true);
     }
 
     // The same views for every variant: a synthetic trace looking at the object.
@@ -387,6 +402,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 };
                 renderer.set_pose(render_desc::scene_pose(&scene, &placement));
             }
+            renderer.set_coverage_proof(!variant.unproved);
             let params = render_desc::frame_params(input, look);
             renderer.submit(&params, Want::default())?;
             let result = renderer.flush()?.pop().expect("one frame in flight");
@@ -437,10 +453,10 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         (Some(a), Some(b)) if b.median_ms > 0.0 => Some(a.median_ms / b.median_ms),
         _ => None,
     };
-    // The baseline standing still under the paper's refraction (after its moving and
-    // two-surface twins).
-    let base =
-        spreads[(usize::from(options.moving) + 1) * (usize::from(options.two_surface) + 1) - 1];
+    // The baseline standing still under the paper's refraction, with the proof (after its
+    // moving, unproved and two-surface twins).
+    let twins = [options.moving, options.unproved, options.two_surface];
+    let base = spreads[twins.iter().map(|&t| usize::from(t) + 1).product::<usize>() - 1];
     let compensated = compensation_fetches(&scene);
     let results = (0..n)
         .map(|i| {
@@ -453,6 +469,14 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
             let paper_twin = variant
                 .two_surface
                 .then(|| variants.iter().position(|v| v.label == paper))
+                .flatten();
+            // A proved variant's unproved twin: the same flags, proof off.
+            let unproved_twin = (options.unproved && !variant.unproved)
+                .then(|| {
+                    variants.iter().position(|v| {
+                        v.unproved && v.label.replace(" unproved", "") == variant.label
+                    })
+                })
                 .flatten();
             let fetches =
                 fetches_per_pixel(&looks[i]) + u32::from(variant.two_surface) + compensated;
@@ -472,6 +496,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 gpu_over_static: twin.and_then(|t| ratio(total_gpu[i], total_gpu[t])),
                 wall_over_static: twin.and_then(|t| ratio(wl, spreads[t].2)),
                 gpu_over_paper: paper_twin.and_then(|t| ratio(g, spreads[t].0)),
+                gpu_over_unproved: unproved_twin.and_then(|t| ratio(g, spreads[t].0)),
             }
         })
         .collect();
@@ -484,6 +509,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         frames: options.frames,
         moving: options.moving,
         two_surface: options.two_surface,
+        unproved: options.unproved,
         invocations_counted,
         variants: results,
     })
@@ -491,7 +517,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
 
 /// One timed variant: an effect set (with its pupil) and where and how it is drawn.
 struct Variant {
-    /// The label printed (`<set> [A_p=..] [live] [two-surface] [moving]`).
+    /// The label printed (`<set> [A_p=..] [live] [two-surface] [unproved] [moving]`).
     label: String,
     /// Its own gaze pipeline over the shared views.
     planner: LookPlanner,
@@ -501,6 +527,8 @@ struct Variant {
     live: bool,
     /// Drawn by the renderer that refracts through both surfaces.
     two_surface: bool,
+    /// Drawn with the proof of coverage off: the whole glass with the environment's lookup.
+    unproved: bool,
     /// The light is turned before each of its frames.
     moving: bool,
 }

@@ -11,7 +11,8 @@ type Column<'a> = (&'a str, Box<dyn Fn(&VariantResult) -> String + 'a>);
 impl BenchReport {
     /// The report as text: the timings, the counted work per frame, then the floor stages of
     /// the variants that recomputed them. The columns of moving variants appear only with
-    /// `--moving`, the two-surface ratio only with `--two-surface`.
+    /// `--moving`, the two-surface ratio only with `--two-surface`, the ratio to the proof off
+    /// only with `--unproved`.
     pub fn table(&self) -> String {
         let mut out = String::new();
         let _ = writeln!(
@@ -85,6 +86,12 @@ impl BenchReport {
         }
         if self.two_surface {
             columns.push(("GPU/paper", Box::new(move |v| ratio(v.gpu_over_paper))));
+        }
+        if self.unproved {
+            columns.push((
+                "GPU/unproved",
+                Box::new(move |v| ratio(v.gpu_over_unproved)),
+            ));
         }
         columns
     }
@@ -193,7 +200,7 @@ fn grid(variants: &[VariantResult], columns: &[Column<'_>]) -> String {
 mod tests {
     use super::*;
 
-    fn report(moving: bool, two_surface: bool) -> BenchReport {
+    fn report(moving: bool, two_surface: bool, unproved: bool) -> BenchReport {
         let spread = Some(Spread {
             median_ms: 12.5,
             p10_ms: 11.0,
@@ -213,6 +220,7 @@ mod tests {
             wall_ratio: Some(1.0),
             gpu_over_static: None,
             gpu_over_paper: None,
+            gpu_over_unproved: None,
             wall_over_static: None,
             work: WorkCounts::from([("draws".to_owned(), 4.0)]),
         };
@@ -225,6 +233,7 @@ mod tests {
             frames: 2,
             moving,
             two_surface,
+            unproved,
             invocations_counted: false,
             variants: vec![
                 variant("none"),
@@ -235,7 +244,7 @@ mod tests {
 
     #[test]
     fn every_row_is_as_wide_as_its_header_whatever_the_label() {
-        let text = report(true, true).table();
+        let text = report(true, true, true).table();
         // Every column is right-aligned to its widest cell or header (the first left-aligned
         // and as wide as the longest label), so a table's lines are all equally long.
         for table in text.split("\n\n") {
@@ -252,15 +261,23 @@ mod tests {
     }
 
     #[test]
-    fn moving_and_two_surface_columns_appear_only_when_asked_for() {
-        let plain = report(false, false).table();
-        for header in ["fields GPU ms", "GPU/still", "wall/still", "GPU/paper"] {
+    fn moving_two_surface_and_unproved_columns_appear_only_when_asked_for() {
+        let plain = report(false, false, false).table();
+        for header in [
+            "fields GPU ms",
+            "GPU/still",
+            "wall/still",
+            "GPU/paper",
+            "GPU/unproved",
+        ] {
             assert!(!plain.contains(header), "{plain}");
         }
-        let moving = report(true, false).table();
+        let moving = report(true, false, false).table();
         assert!(moving.contains("GPU/still") && !moving.contains("GPU/paper"));
-        let two = report(false, true).table();
+        let two = report(false, true, false).table();
         assert!(two.contains("GPU/paper") && !two.contains("GPU/still"));
+        let unproved = report(false, false, true).table();
+        assert!(unproved.contains("GPU/unproved") && !unproved.contains("GPU/paper"));
         assert!(plain.contains("without shader invocations"), "{plain}");
     }
 

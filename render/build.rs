@@ -207,6 +207,7 @@ const VARIANTS: &[Variant] = &[
     ),
     ("glass", "fs_two_surface_", &[("CONVEX", 1.0)], "convex"),
     ("floor_overlay", "fs_main", &[("CAUSTICS", 1.0)], "caustics"),
+    ("caustics_live", "cs_trace", &[("COUNTED", 1.0)], "counted"),
     (
         "floor_overlay",
         "fs_main",

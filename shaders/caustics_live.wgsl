@@ -36,6 +36,14 @@ var<private> floor_normal_world: vec3<f32>;
 // mesh): xyz the outward unit normal, w the distance from the shell's centre. A ray inside
 // such a body leaves it through the nearest plane ahead (`facet_exit`).
 @group(0) @binding(13) var<storage, read> facet_planes: array<vec4<f32>>;
+// Counting the work (`COUNTED`, a pipeline constant: only the pipeline that counts pays for
+// the atomics): the photons that met the object and were traced through it, and the deposits
+// that landed on the map (each path's, and each photon's shadow), one global atomic per photon
+// traced (render/src/floor/live.rs `PhotonWork`).
+override COUNTED: bool = false;
+@group(0) @binding(14) var<storage, read_write> photon_counts: array<atomic<u32>, 2>;
+// This invocation's deposits on the map.
+var<private> splats: u32;
 // A hit's `tri` when it was found on a facet plane: its normal is the facet's, which the
 // shading takes too (the mesh is flat-shaded).
 const FACET: u32 = 0xfffffffeu;
@@ -249,6 +257,7 @@ fn deposit(point_m: vec3<f32>, weight: f32) {
     if cos_theta <= 0.0 {
         return;
     }
+    splats += 1u;
     let g0 = weight * params.light.w * r2 / (params.basis_v.w * cos_theta) * params.misc.y;
     var positive = 0;
     for (var k = 0; k < 4; k++) {
@@ -310,6 +319,7 @@ fn cone_direction(s: f32, t: f32) -> vec3<f32> {
 fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     params = p;
     floor_once();
+    splats = 0u;
     let n = params.grid_dims.w;
     if id.x >= n || id.y >= n {
         return;
@@ -428,6 +438,12 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         if hit.tri == NONE && to_floor > 0.0 {
             deposit(ray.origin + ray.dir * to_floor, ray.weight);
+        }
+    }
+    if COUNTED {
+        atomicAdd(&photon_counts[0], 1u);
+        if splats > 0u {
+            atomicAdd(&photon_counts[1], splats);
         }
     }
 }

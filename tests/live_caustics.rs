@@ -430,3 +430,94 @@ fn reading_the_fields_back_first_computes_the_live_map_too() {
         after_read_back[0].gain.iter().filter(|&&g| g > 0.0).count()
     );
 }
+
+/// One frame of `scene` with live caustics (`live`), counting its work or not, then a second
+/// at the same pose: what each counted, and the live map.
+fn counted_frames(
+    scene: &vitreous::scene::Scene,
+    live: LiveCausticsDesc,
+    count: bool,
+) -> ([Option<vitreous_render::PhotonWork>; 2], Vec<f32>) {
+    let desc = render_desc::scene_desc(scene, None);
+    let mut renderer =
+        Renderer::new(vitreous_tests::validated_context(), &desc, 32, 32).expect("renderer");
+    renderer.enable_live_caustics(&desc, live).expect("live");
+    if count {
+        assert!(renderer.count_invocations().unwrap(), "lavapipe counts");
+    }
+    let params = vitreous_render::FrameParams {
+        eyes: vitreous_tests::neutral_eyes(scene),
+        look: vitreous_render::Look {
+            inducer: true,
+            caustics: true,
+            ..vitreous_render::Look::default()
+        },
+    };
+    let want = vitreous_render::renderer::Want::default();
+    let mut frame = || {
+        renderer.submit(&params, want).expect("submit");
+        renderer.flush().expect("flush").pop().expect("a frame")
+    };
+    // The second frame, at the same pose, computes nothing.
+    let works = [frame().work.photons, frame().work.photons];
+    let v = renderer.context().validation();
+    assert_eq!(v.errors() + v.warnings(), 0, "{:#?}", v.messages());
+    let gain = renderer
+        .live_caustic_gain()
+        .unwrap()
+        .expect("live caustics");
+    (works, gain)
+}
+
+/// What a computation of the live map counts on the device (`PhotonWork`): the photons that
+/// meet the object, against the solid angles of the spheres the tessellated ball lies between
+/// and the torus's hole; their deposits; and the texels the smoothing wrote, against the tiles
+/// it reports. Counting leaves the map as it is.
+#[test]
+fn the_live_maps_counted_photons_meet_the_ball_as_its_solid_angle_says() {
+    let scene = baked_scene("glass-sphere.toml");
+    let live = LiveCausticsDesc {
+        photons_per_side: 96,
+        ..LiveCausticsDesc::default()
+    };
+    let ([counted, still], gain) = counted_frames(&scene, live, true);
+    let (uncounted, plain) = counted_frames(&scene, live, false);
+    assert_eq!(uncounted, [None, None], "nothing counted unless asked");
+    assert!(gain == plain, "counting changes no gain");
+    let counted = counted.expect("the frame counted its photons");
+    assert_eq!(still, Some(vitreous_render::PhotonWork::default()));
+    // The emission cone just holds the ball's bounding sphere, so no photon meets the ball
+    // outside it, and the shipped 96 x 48 ball holds the sphere of 0.9989 of its radius that
+    // touches its flattest triangle's plane: at least 0.9989^2 = 0.9979 of the cone's photons
+    // meet the ball (seen from the light 34 radii away, a sphere's solid angle goes as its
+    // radius squared within 3e-4).
+    let n = u64::from(live.photons_per_side).pow(2);
+    assert!(
+        counted.traced <= n && counted.traced as f64 >= 0.99 * n as f64,
+        "{} of {n} photons traced",
+        counted.traced
+    );
+    // Each traced photon's shadow, the light leaving the ball at its exits, and the reflections
+    // off its front that reach the floor.
+    assert!(
+        counted.splatted > counted.traced && counted.splatted < 8 * counted.traced,
+        "{counted:?}"
+    );
+    // The texels of the tiles the smoothing wrote: 8 x 8 each, those at the map's edges cut.
+    let LiveFrame { tiles, .. } = live_gains(&scene, live, &[None], false).remove(0);
+    let side = (gain.len() as f64).sqrt() as u64;
+    assert!(
+        counted.smoothed_texels <= u64::from(tiles[0]) * 64
+            && counted.smoothed_texels > (u64::from(tiles[0]) * 64).saturating_sub(2 * 8 * side),
+        "{counted:?}, {tiles:?}"
+    );
+    // The torus: the photons through its hole meet nothing and are not counted.
+    let mut torus = load_scene(&workspace().join("config/scenes/torus.toml")).unwrap();
+    torus.caustics.mode = vitreous::scene::CausticsMode::Live;
+    torus.load_caustics().unwrap();
+    let ([counted, _], _) = counted_frames(&torus, live, true);
+    let counted = counted.expect("counted");
+    // (7504 of 9216 here: the light 44 degrees off its axis sees it inside its bounding
+    // sphere's disc, with the hole.)
+    assert!(counted.traced < n * 9 / 10, "{counted:?}");
+}

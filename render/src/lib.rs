@@ -71,4 +71,4 @@ pub use scene::{
     BlurStackDesc, CausticsDesc, DimmerDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc,
     Refraction, RefractionParseError, SceneDesc, TexelData, TextureDesc,
 };
-pub use work::{FrameWork, Invocations, PassInvocations, RecordedWork, ShaderCost};
+pub use work::{FrameWork, Invocations, PassInvocations, PhotonWork, RecordedWork, ShaderCost};

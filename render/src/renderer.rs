@@ -27,7 +27,7 @@ use crate::pose::ScenePose;
 use crate::scene::{GpuScene, SceneDesc};
 use crate::statistics::{self, Statistics};
 use crate::target::{self, StereoTarget};
-use crate::work::FrameWork;
+use crate::work::{FrameWork, PhotonWork};
 use crate::world::WorldPass;
 
 mod composition;
@@ -112,6 +112,9 @@ struct Pending {
     recorded: FrameWork,
     /// Whether it counted its passes' invocations (in the slot's statistics pool).
     counted: bool,
+    /// Whether a live caustic map it computed copied what it counted into the slot's
+    /// `photons`.
+    photons: bool,
 }
 
 /// Per-frame resources, used round-robin; freed on drop.
@@ -128,6 +131,9 @@ struct FrameSlot {
     statistics: Option<Owned<vk::QueryPool>>,
     /// Host-visible copy of both eye layers, then both world layers.
     readback: Buffer,
+    /// Host-visible copy of what a live caustic map's computation counted (`work.rs`
+    /// `PhotonWork`), and its size, once the frames count their work with live caustics on.
+    photons: Option<(Buffer, u64)>,
     /// What the slot's in-flight frame is.
     pending: Option<Pending>,
 }
@@ -294,6 +300,7 @@ impl Renderer {
                 queries,
                 statistics: None,
                 readback,
+                photons: None,
                 pending: None,
             });
         }
@@ -413,6 +420,28 @@ impl Renderer {
         Ok(true)
     }
 
+    /// Makes slot `index`'s copy of what a live caustic map's computation counts, where the
+    /// frames count their work and live caustics are on (dropped where they no longer are).
+    fn prepare_photon_readback(&mut self, index: usize) -> Result<()> {
+        let slot = &mut self.slots[index];
+        let bytes = self
+            .inducer
+            .photon_readback_bytes()
+            .filter(|_| slot.statistics.is_some());
+        if slot.photons.as_ref().map(|(_, n)| *n) != bytes {
+            slot.photons = match bytes {
+                Some(n) => {
+                    let usage = vk::BufferUsageFlags::TRANSFER_DST;
+                    let location = gpu_allocator::MemoryLocation::GpuToCpu;
+                    let name = "live caustics' counts readback";
+                    Some((Buffer::new(&self.ctx, name, n, usage, location)?, n))
+                }
+                None => None,
+            };
+        }
+        Ok(())
+    }
+
     /// How many times the shadow inducer's fields (mask, distance, gain) were computed: once
     /// for the first frame that drew them, then once per frame after the object or light moved.
     pub fn inducer_computations(&self) -> u64 {
@@ -457,6 +486,7 @@ impl Renderer {
         let sequence = self.next_sequence;
         let slot_index = (sequence % PIPELINE_DEPTH as u64) as usize;
         let previous = self.collect(slot_index)?;
+        self.prepare_photon_readback(slot_index)?;
 
         let started = Instant::now();
         let d = &self.ctx.device;
@@ -492,6 +522,7 @@ impl Renderer {
             let recorded = FrameWork {
                 recorded: self.ctx.work.take(),
                 invocations: None,
+                photons: None,
                 glass_shader: glass.as_ref().map(|g| self.glass.cost(g.pick)),
                 glass_covered_shader: glass
                     .as_ref()
@@ -532,6 +563,7 @@ impl Renderer {
             prepared,
             recorded,
             counted: self.slots[slot_index].statistics.is_some(),
+            photons: self.slots[slot_index].photons.is_some(),
         });
         self.next_sequence += 1;
         Ok(previous)
@@ -603,6 +635,16 @@ impl Renderer {
             ),
             _ => None,
         };
+        let photons = match &slot.photons {
+            Some((buffer, _)) if pending.photons => Some(if pending.prepared.computed() {
+                self.inducer
+                    .photon_work(buffer.mapped()?)
+                    .unwrap_or_default()
+            } else {
+                PhotonWork::default()
+            }),
+            _ => None,
+        };
         let bytes = if pending.want.eyes {
             Some(slot.readback.mapped()?)
         } else {
@@ -630,6 +672,7 @@ impl Renderer {
             },
             work: FrameWork {
                 invocations,
+                photons,
                 ..pending.recorded
             },
             readback,
@@ -712,6 +755,7 @@ impl Renderer {
                 pool: queries,
                 first: 3,
                 statistics: statistics.0,
+                photons: slot.photons.as_ref().map(|(b, _)| b.buffer),
             });
             if inducer || caustics || shadow {
                 // Once per pose, timed on its own.

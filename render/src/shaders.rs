@@ -251,6 +251,8 @@ pub const OVERLAY_FS_COST: [ShaderCost; 6] = [
     cost!("floor_overlay.fs_main.shadow.caustics.filtered"),
 ];
 pub const CAUSTICS_TRACE_CS: &[u8] = spirv!("caustics_live.cs_trace");
+/// The same, counting the photons it traces and the deposits they make (`COUNTED`).
+pub const CAUSTICS_TRACE_COUNTED_CS: &[u8] = spirv!("caustics_live.cs_trace.counted");
 /// The smoothing's passes: the short kernel along the rows and along the columns, the ring
 /// buffers' pass for wider boxes, and the short kernel's tiles.
 pub const CAUSTICS_SMOOTH_CS: [&[u8]; 4] = [

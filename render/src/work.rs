@@ -13,6 +13,10 @@
 //!   these are exact for one driver and comparable across frames and builds on it, not across
 //!   drivers; docs/cli.md says which drivers were checked.
 //!
+//! - **counted by the shaders** ([`PhotonWork`]): the live caustic map's photons traced and
+//!   splatted and the texels its smoothing wrote, with integer atomics and the smoothing's tile
+//!   bits, once the frame finished. Exact on every device.
+//!
 //! Recording happens on the thread that calls [`crate::Renderer::submit`]; the tally lives in
 //! the context and is taken at the end of each frame's recording. The queries that count the
 //! invocations are in [`crate::statistics`]; this module holds only the counts, so the context
@@ -37,6 +41,24 @@ pub struct FrameWork {
     pub glass_covered_shader: Option<ShaderCost>,
     /// The static cost of one fragment of the floor overlay's pipeline, when it was drawn.
     pub overlay_shader: Option<ShaderCost>,
+    /// What the live caustic map's computation did, counted on the device: `None` unless the
+    /// frame counted invocations with live caustics on; all 0 on a frame that did not
+    /// compute the map.
+    pub photons: Option<PhotonWork>,
+}
+
+/// One computation of the live caustic map, counted on the device by the trace that counts
+/// (`COUNTED` in shaders/caustics_live.wgsl) and from the smoothing's tile bits. Exact on any
+/// device: integer atomics and bits, not a driver's statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PhotonWork {
+    /// Photons of the emission grid that met the object and were traced through it.
+    pub traced: u64,
+    /// Their deposits on the map: each photon's shadow and each path that lands there.
+    pub splatted: u64,
+    /// Texels of the map the smoothing wrote (its tiles that may hold a gain; every texel
+    /// where it skips none).
+    pub smoothed_texels: u64,
 }
 
 /// Work recorded into one frame's command buffer.

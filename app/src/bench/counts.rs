@@ -16,7 +16,9 @@ use vitreous_render::{FrameWork, Invocations, ShaderCost};
 /// (`vertex`, `fragment`, `compute`), and the work of the eye passes' fragments, their
 /// invocations times the static cost of one (`vitreous_render::work::ShaderCost`):
 /// `glass_fetches`, `glass_texels`, `glass_instructions` (both of the glass's pipelines), and
-/// the same for the floor overlay (`floor_*`).
+/// the same for the floor overlay (`floor_*`); where the frames count their work with live
+/// caustics on, what the live map's computation did (`caustic_photons.traced`,
+/// `caustic_photons.splatted`, `caustic_smoothing.texels`: `vitreous_render::PhotonWork`).
 pub type WorkCounts = BTreeMap<String, f64>;
 
 /// The mean per frame of `frames`' work; empty without frames.
@@ -96,6 +98,15 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
             }
         }
     }
+    if let Some(photons) = frame.photons {
+        for (name, value) in [
+            ("caustic_photons.traced", photons.traced),
+            ("caustic_photons.splatted", photons.splatted),
+            ("caustic_smoothing.texels", photons.smoothed_texels),
+        ] {
+            counts.push((name.to_owned(), value as f64));
+        }
+    }
     counts
 }
 
@@ -133,6 +144,11 @@ mod tests {
                 instructions: 50,
             }),
             overlay_shader: None,
+            photons: (draws == 4).then_some(vitreous_render::PhotonWork {
+                traced: 8,
+                splatted: 20,
+                smoothed_texels: 64,
+            }),
         };
         let counts = mean_counts(&[frame(2, 100), frame(4, 300)]);
         assert_eq!(counts["draws"], 3.0);
@@ -143,6 +159,10 @@ mod tests {
         assert_eq!(counts["glass_instructions"], 20_000.0 + 500.0);
         assert_eq!(counts["floor_texels"], 0.0);
         assert_eq!(counts["mask.compute_invocations"], 0.0);
+        // The live map computed on one frame of two.
+        assert_eq!(counts["caustic_photons.traced"], 4.0);
+        assert_eq!(counts["caustic_photons.splatted"], 10.0);
+        assert_eq!(counts["caustic_smoothing.texels"], 32.0);
     }
 
     #[test]
@@ -156,6 +176,7 @@ mod tests {
             glass_shader: None,
             glass_covered_shader: None,
             overlay_shader: None,
+            photons: None,
         };
         let counts = mean_counts(&[frame]);
         assert_eq!(counts["dispatches"], 5.0);

@@ -37,16 +37,17 @@ impl BenchReport {
             .variants
             .iter()
             .filter(|v| v.prepare_gpu_ms.is_some_and(|p| p.median_ms > 0.5))
-            .filter_map(|v| v.field_passes_gpu_ms.map(|f| (&v.effects, f)))
+            .filter_map(|v| v.field_passes_gpu_ms.map(|f| (v, f)))
             .collect();
         if !stages.is_empty() {
             let _ = writeln!(out, "\nfields GPU ms per stage (medians):");
         }
-        for (effects, f) in stages {
-            let _ = writeln!(
+        for (v, f) in stages {
+            let _ = write!(
                 out,
-                "  {effects}: mask {:.2}, nearest {:.2}, ramp {:.2}, \
+                "  {}: mask {:.2}, nearest {:.2}, ramp {:.2}, \
                  live caustics {:.2} (photons {:.2}, smoothing {:.2})",
+                v.effects,
                 f.mask_ms,
                 f.nearest_ms,
                 f.ramp_ms,
@@ -54,6 +55,18 @@ impl BenchReport {
                 f.caustic_photons_ms,
                 f.caustic_smoothing_ms
             );
+            // What the live map's computations did, counted, mean per frame.
+            let count = |name: &str| v.work.get(name).copied().unwrap_or(0.0);
+            if count("caustic_photons.traced") > 0.0 {
+                let _ = write!(
+                    out,
+                    "; photons traced {}, splatted {}, texels smoothed {}",
+                    compact(count("caustic_photons.traced")),
+                    compact(count("caustic_photons.splatted")),
+                    compact(count("caustic_smoothing.texels"))
+                );
+            }
+            out.push('\n');
         }
         out
     }
@@ -279,6 +292,33 @@ mod tests {
         let unproved = report(false, false, true).table();
         assert!(unproved.contains("GPU/unproved") && !unproved.contains("GPU/paper"));
         assert!(plain.contains("without shader invocations"), "{plain}");
+    }
+
+    #[test]
+    fn a_variant_that_computed_the_live_map_shows_its_counted_photons() {
+        let mut r = report(true, false, false);
+        let stages = super::super::FieldPassesMedians {
+            mask_ms: 0.3,
+            nearest_ms: 1.9,
+            ramp_ms: 0.1,
+            caustic_photons_ms: 6.5,
+            caustic_smoothing_ms: 3.0,
+        };
+        for (v, traced) in r.variants.iter_mut().zip([0.0, 4096.0]) {
+            v.field_passes_gpu_ms = Some(stages);
+            v.work.insert("caustic_photons.traced".into(), traced);
+            v.work
+                .insert("caustic_photons.splatted".into(), 2.5 * traced);
+            v.work.insert("caustic_smoothing.texels".into(), 75_382.6);
+        }
+        let text = r.table();
+        let lines: Vec<&str> = text.lines().filter(|l| l.contains("mask 0.30")).collect();
+        assert_eq!(lines.len(), 2, "{text}");
+        assert!(!lines[0].contains("photons traced"), "{text}");
+        assert!(
+            lines[1].ends_with("; photons traced 4096, splatted 10.2k, texels smoothed 75.4k"),
+            "{text}"
+        );
     }
 
     #[test]

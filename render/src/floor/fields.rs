@@ -311,6 +311,10 @@ pub(crate) struct Stamps {
     /// The frame's pipeline-statistics pool (reset before; its query 0 begun), when the
     /// frame counts invocations.
     pub statistics: Option<vk::QueryPool>,
+    /// Where a live caustic map's computation copies what it counted (host-visible,
+    /// [`super::live::LiveCaustics::photon_readback_bytes`] long), when the frame counts its
+    /// work; the computation then runs the trace that counts.
+    pub photons: Option<vk::Buffer>,
 }
 
 impl Stamps {

@@ -12,8 +12,8 @@ use gpu_allocator::MemoryLocation;
 use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
 use super::live_mesh::LiveMesh;
 use super::smoothing::{
-    FIXED_POINT, SHORT_KERNEL_PX, SmoothPass, SmoothTiles, record_smoothing, row_pitch, shares_fit,
-    smooth_steps,
+    FIXED_POINT, SHORT_KERNEL_PX, SmoothPass, SmoothTiles, TILE_PX, record_smoothing, row_pitch,
+    shares_fit, smooth_steps,
 };
 use crate::context::GpuContext;
 use crate::descriptors;
@@ -23,6 +23,7 @@ use crate::owned::Owned;
 use crate::pipeline;
 use crate::pose::ScenePose;
 use crate::shaders;
+use crate::work::PhotonWork;
 
 /// How caustics are computed live.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -130,8 +131,11 @@ struct Params {
 
 /// The compute passes, their buffers and what they need of the mesh; freed on drop.
 pub(crate) struct LiveCaustics {
-    /// Photon tracing and splatting.
+    /// Photon tracing and splatting; the same counting its work (`COUNTED`).
     trace: Owned<vk::Pipeline>,
+    trace_counted: Owned<vk::Pipeline>,
+    /// What the counting trace counts: photons traced, deposits on the map.
+    counts: Buffer,
     /// The smoothing's passes ([`SmoothPass`]; the first along the rows also clamps, the
     /// last zeroes small gains and bounds).
     smooth: [Owned<vk::Pipeline>; 4],
@@ -214,19 +218,28 @@ impl LiveCaustics {
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuOnly,
         )?;
+        let counts = Buffer::new(
+            ctx,
+            "caustics photon counts",
+            8,
+            storage | vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::GpuOnly,
+        )?;
         let compute = vk::ShaderStageFlags::COMPUTE;
         // The parameters in a storage buffer, not a uniform one: on lavapipe, which can inline
         // uniform values into a shader's loops and compile it again when they change, that
         // took about 1 ms off a moved frame's stage at the defaults and 6 ms with one photon.
-        let bindings: Vec<_> = (0..=13)
+        let bindings: Vec<_> = (0..=14)
             .map(|b| (b, vk::DescriptorType::STORAGE_BUFFER, compute))
             .collect();
         let set_layout = descriptors::set_layout(ctx, &bindings)?;
         // The smoothing step; the trace pass reads none.
         let layout = pipeline::layout(ctx, Some(set_layout.raw()), compute, 4)?;
         let trace = pipeline::compute(ctx, layout.raw(), shaders::CAUSTICS_TRACE_CS, c"cs_trace")?;
+        let counted = shaders::CAUSTICS_TRACE_COUNTED_CS;
+        let trace_counted = pipeline::compute(ctx, layout.raw(), counted, c"cs_trace")?;
         let smooth = SmoothPass::pipelines(ctx, layout.raw())?;
-        let pool = descriptors::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 14)])?;
+        let pool = descriptors::pool(ctx, 1, &[(vk::DescriptorType::STORAGE_BUFFER, 15)])?;
         let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
         let mut buffers = vec![params.buffer];
         buffers.extend(live_mesh.buffers[..3].iter().map(|b| b.buffer));
@@ -238,6 +251,7 @@ impl LiveCaustics {
         let [cell_mass, tile_bits] = tiles.buffers();
         buffers.extend([cell_mass, tile_bits, cell_mass]);
         buffers.push(live_mesh.facets.buffer);
+        buffers.push(counts.buffer);
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|&buffer| {
@@ -263,6 +277,8 @@ impl LiveCaustics {
         unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
         Ok(LiveCaustics {
             trace,
+            trace_counted,
+            counts,
             smooth,
             layout,
             _pool: pool,
@@ -420,6 +436,10 @@ impl LiveCaustics {
             );
             d.cmd_update_buffer(cmd, self.params.buffer, 0, bytemuck::bytes_of(&params));
             d.cmd_fill_buffer(cmd, self.sums.buffer, 0, vk::WHOLE_SIZE, 0);
+            let photons = stamps.and_then(|s| s.photons);
+            if photons.is_some() {
+                d.cmd_fill_buffer(cmd, self.counts.buffer, 0, vk::WHOLE_SIZE, 0);
+            }
             let skipping = params.tiles[3] != 0;
             self.tiles.record_clear(d, cmd, skipping);
             if skipping {
@@ -445,7 +465,12 @@ impl LiveCaustics {
             let bind = vk::PipelineBindPoint::COMPUTE;
             d.cmd_bind_descriptor_sets(cmd, bind, self.layout.raw(), 0, &[self.set], &[]);
             let n = self.desc.photons_per_side;
-            d.cmd_bind_pipeline(cmd, bind, self.trace.raw());
+            let trace = if photons.is_some() {
+                &self.trace_counted
+            } else {
+                &self.trace
+            };
+            d.cmd_bind_pipeline(cmd, bind, trace.raw());
             d.cmd_dispatch(cmd, groups(n), groups(n), 1);
             ctx.work.dispatch(groups(n), groups(n), 1);
             if let Some(stamps) = stamps {
@@ -476,6 +501,21 @@ impl LiveCaustics {
                     vk::AccessFlags::TRANSFER_WRITE,
                 ),
             );
+            if let Some(photons) = photons {
+                let [_, tile_bits] = self.tiles.buffers();
+                let copies = [
+                    (self.counts.buffer, 0, 8),
+                    (tile_bits, 8, self.tiles.bits_bytes()),
+                ];
+                for (src, dst_offset, size) in copies {
+                    let region = vk::BufferCopy {
+                        src_offset: 0,
+                        dst_offset,
+                        size,
+                    };
+                    d.cmd_copy_buffer(cmd, src, photons, &[region]);
+                }
+            }
             let region = crate::memory::color_copy_region(0, self.size[0], self.size[1], 1, 1)
                 .buffer_row_length(row_pitch(self.size[0]));
             d.cmd_copy_buffer_to_image(
@@ -491,7 +531,7 @@ impl LiveCaustics {
                 vertex | vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::HOST,
                 vk::DependencyFlags::empty(),
                 &memory(
-                    vk::AccessFlags::SHADER_WRITE,
+                    vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
                     vk::AccessFlags::HOST_READ | vk::AccessFlags::SHADER_READ,
                 ),
                 &[],
@@ -505,6 +545,29 @@ impl LiveCaustics {
             if let Some(stamps) = stamps {
                 stamps.write(d, cmd, CAUSTIC_PHOTONS_STAMP + 1..FIELD_STAMPS);
             }
+        }
+    }
+
+    /// The bytes a computation that counts its work copies into its frame's buffer
+    /// ([`Stamps::photons`]): the two counts, then the smoothing's tile bits.
+    pub fn photon_readback_bytes(&self) -> u64 {
+        8 + self.tiles.bits_bytes()
+    }
+
+    /// What a computation counted, from the bytes it copied into its frame's buffer.
+    pub fn photon_work(&self, bytes: &[u8]) -> PhotonWork {
+        let word = |at: usize| {
+            u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
+        };
+        let mut texels = 0u64;
+        self.tiles.each_written(&bytes[8..], |x, row| {
+            let along = |t: u32, size: u32| (size - (t * TILE_PX).min(size)).min(TILE_PX);
+            texels += u64::from(along(x, self.size[0]) * along(row, self.size[1]));
+        });
+        PhotonWork {
+            traced: u64::from(word(0)),
+            splatted: u64::from(word(4)),
+            smoothed_texels: texels,
         }
     }
 

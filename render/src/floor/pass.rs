@@ -30,6 +30,7 @@ use crate::pipeline::{self, Blend, Depth, FieldStart, PipelineSpec};
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, InducerDesc, SceneDesc};
 use crate::shaders;
+use crate::work::PhotonWork;
 
 /// The shadow inducer's floor-space fields, the passes that compute them and the overlay; all
 /// GPU objects are freed on drop.
@@ -273,6 +274,18 @@ impl InducerPass {
     /// The live caustic gain map of the last finished computation, if live caustics are on.
     pub fn live_gain(&self) -> Result<Option<Vec<f32>>> {
         self.live.as_ref().map(LiveCaustics::gain).transpose()
+    }
+
+    /// The bytes a live map's computation that counts its work copies into its frame's
+    /// buffer (`None` without live caustics).
+    pub fn photon_readback_bytes(&self) -> Option<u64> {
+        self.live.as_ref().map(LiveCaustics::photon_readback_bytes)
+    }
+
+    /// What a live map's computation counted, from the bytes it copied (`None` without live
+    /// caustics).
+    pub fn photon_work(&self, bytes: &[u8]) -> Option<PhotonWork> {
+        self.live.as_ref().map(|live| live.photon_work(bytes))
     }
 
     /// How many of the live map's smoothing tiles the last finished computation wrote, and

@@ -48,6 +48,13 @@ pub(crate) struct Prepared {
     pub(super) fields_within: Option<TexelRect>,
 }
 
+impl Prepared {
+    /// Whether the fields (and a live caustic map with them) were recorded.
+    pub(crate) fn computed(&self) -> bool {
+        self.fields
+    }
+}
+
 /// Progress of the floor fields' computation: changes only when the renderer reports what
 /// happened to submitted work, never while recording.
 #[derive(Clone, Copy, Debug, Default)]

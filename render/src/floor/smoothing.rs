@@ -213,7 +213,8 @@ impl SmoothTiles {
             ctx,
             "caustics tile bits",
             u64::from(down * words) * 4,
-            usage,
+            // Copied into a counting frame's buffer (`LiveCaustics::photon_work`).
+            usage | vk::BufferUsageFlags::TRANSFER_SRC,
             MemoryLocation::GpuToCpu,
         )?;
         Ok(SmoothTiles {
@@ -253,17 +254,31 @@ impl SmoothTiles {
     /// How many tiles the last computation that finished wrote, and how many the map has
     /// (wait for the frame first).
     pub fn written(&self) -> Result<[u32; 2]> {
-        let [across, down, words] = self.layout;
-        let bits = self.bits.mapped()?;
+        let [across, down, _] = self.layout;
         let mut written = 0;
+        self.each_written(self.bits.mapped()?, |_, _| written += 1);
+        Ok([written, across * down])
+    }
+
+    /// The bits' size, bytes.
+    pub fn bits_bytes(&self) -> u64 {
+        let [_, down, words] = self.layout;
+        u64::from(down * words) * 4
+    }
+
+    /// Calls `f` with the column and row of each tile that `bits` (a copy of the bits'
+    /// buffer) marks written.
+    pub fn each_written(&self, bits: &[u8], mut f: impl FnMut(u32, u32)) {
+        let [across, down, words] = self.layout;
         for row in 0..down {
             for x in 0..across {
                 let at = ((row * words + x / 32) * 4) as usize;
                 let word = u32::from_le_bytes([bits[at], bits[at + 1], bits[at + 2], bits[at + 3]]);
-                written += (word >> (x % 32)) & 1;
+                if (word >> (x % 32)) & 1 != 0 {
+                    f(x, row);
+                }
             }
         }
-        Ok([written, across * down])
     }
 }
 

@@ -432,7 +432,7 @@ impl Renderer {
             slot.photons = match bytes {
                 Some(n) => {
                     let usage = vk::BufferUsageFlags::TRANSFER_DST;
-                    let location = gpu_allocator::MemoryLocation::GpuToCpu;
+                    let location = MemoryLocation::GpuToCpu;
                     let name = "live caustics' counts readback";
                     Some((Buffer::new(&self.ctx, name, n, usage, location)?, n))
                 }

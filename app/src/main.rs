@@ -16,7 +16,6 @@ use vitreous::cli_values::{
 use vitreous::effects::EffectSet;
 use vitreous::error_report::error_text;
 use vitreous::gaze::FilterKind;
-use vitreous::output::ensure_not_input;
 use vitreous::trace_analyze::{analyze_trace_file, plot_trace_file};
 use vitreous::trace_cmd::{self, ImportOptions, SynthOptions};
 
@@ -297,6 +296,7 @@ fn run(cli: Cli) -> Result<()> {
                 read_back_every: 10,
                 validation: !no_validation,
                 recreate,
+                report: json.clone(),
             };
             let report = vitreous::soak::soak(&options, |p| eprintln!("soak: {p}"))?;
             if let Some(path) = &json {
@@ -327,7 +327,6 @@ fn run(cli: Cli) -> Result<()> {
                 out,
                 filters,
             } => {
-                ensure_not_input(&out, "--out", &[&trace, &scene])?;
                 plot_trace_file(&trace, &scene, &filters, &out)?;
                 println!("wrote {}", out.display());
                 Ok(())
@@ -339,7 +338,6 @@ fn run(cli: Cli) -> Result<()> {
                 kappa_deg,
                 eye_state_gaze,
             } => {
-                ensure_not_input(&out, "-o", &[&file])?;
                 let options = ImportOptions {
                     kappa_deg,
                     eye_state_gaze,
@@ -361,7 +359,6 @@ fn run(cli: Cli) -> Result<()> {
                         scene.display()
                     );
                 }
-                ensure_not_input(&out, "-o", &[&scene])?;
                 let options = SynthOptions {
                     duration_s: duration,
                     rate_hz: rate,

@@ -15,8 +15,9 @@ use vitreous_scene::{Placement, Scene, load_scene};
 use vitreous_xr::frame::{Backend, EyeView, Fov};
 use vitreous_xr::null::{NullBackend, NullConfig};
 
+use crate::input_files::InputFiles;
 use crate::motion_clock::MotionClock;
-use crate::output::{EYE_NAMES, encode_png, linear_to_srgb, write_atomic};
+use crate::output::{EYE_NAMES, encode_png, is_frame_file_name, linear_to_srgb, write_atomic};
 use crate::render_desc::eye_params;
 use crate::setup::{check_size, load_trace_with_edits};
 
@@ -305,6 +306,14 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
         PathBuf::from("out").join(format!("{name}-reference"))
     });
     let frames = frames_to_render(&scene, &args)?;
+    let mut inputs = InputFiles::new();
+    inputs.add_scene(&scene, "SCENE");
+    if let Some(trace) = &args.trace {
+        inputs.add(trace, "--trace");
+    }
+    inputs.check_folder("--out", &out, &[], &|p| {
+        p.to_str().is_some_and(is_frame_file_name)
+    })?;
     std::fs::create_dir_all(&out)
         .with_context(|| format!("creating output folder {}", out.display()))?;
     let settings = ReferenceSettings {

@@ -16,6 +16,7 @@ use vitreous_xr::null::{NullBackend, NullConfig};
 
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FramePlan, FrameSink};
+use crate::input_files::InputFiles;
 use crate::look::LookPlanner;
 use crate::look::{GazeSettings, planner_for};
 use crate::motion_clock::MotionClock;
@@ -52,6 +53,9 @@ pub struct SoakOptions {
     /// A new Vulkan device and renderer for every pass (tests teardown) instead of one for the
     /// whole run (a long session).
     pub recreate: bool,
+    /// Where the caller writes the JSON report (`--json`), refused before the first pass when
+    /// it names one of the scene's files.
+    pub report: Option<PathBuf>,
 }
 
 /// One pass: the trace replayed once from its start.
@@ -245,6 +249,11 @@ pub fn resident_kib() -> Result<u64> {
 /// Runs the soak; `progress` is called after every pass.
 pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Result<SoakReport> {
     let mut scene = load_scene(&options.scene)?;
+    if let Some(report) = &options.report {
+        InputFiles::new()
+            .add_scene(&scene, "SCENE")
+            .check_file("--json", report)?;
+    }
     let effects = options.effects.unwrap_or(scene.effects);
     effects.ensure_implemented()?;
     if effects.caustics {

@@ -8,7 +8,8 @@ use anyhow::{Context, Result, bail};
 use vitreous_xr::synth::{SynthParams, synthesize_with_truth};
 use vitreous_xr::trace::{TraceSample, TraceWriter};
 
-use crate::output::{ensure_not_input, write_atomic};
+use crate::input_files::InputFiles;
+use crate::output::write_atomic;
 use crate::scene::{REFRACTED_TARGET, SURFACE_TARGET, load_scene};
 
 pub use crate::scene::synth_params_for;
@@ -48,9 +49,11 @@ pub fn import(from: &str, file: &Path, out: &Path, options: &ImportOptions) -> R
             }
         }
     }
-    let inputs = recording_files(from, file);
-    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
-    ensure_not_input(out, "-o", &inputs)?;
+    let mut inputs = InputFiles::new();
+    for path in recording_files(from, file) {
+        inputs.add(&path, "RECORDING");
+    }
+    inputs.check_file("-o", out)?;
     let (samples, report, rows) = match from {
         "sranipal" => {
             let (samples, report) = vitreous_xr::sranipal::import_sranipal_with_report(file)
@@ -129,6 +132,9 @@ pub struct SynthOptions {
 /// `vitreous trace synth --scene SCENE -o OUT`.
 pub fn synth(scene_path: &Path, options: &SynthOptions, out: &Path) -> Result<String> {
     let scene = load_scene(scene_path)?;
+    InputFiles::new()
+        .add_scene(&scene, "--scene")
+        .check_file("-o", out)?;
     let params = SynthParams {
         duration_s: options.duration_s,
         rate_hz: options.rate_hz,

@@ -293,3 +293,113 @@ fn a_dimmer_scenes_display_light_is_seen_through_its_panel_and_the_panels_blur_c
     let out = refused(scene_arg, "-1");
     assert_clean_failure(&out, &["--panel-blur-deg", "0 to 20 degrees"]);
 }
+
+/// The glass sphere scene copied into `dir` with its assets, in the repository's layout
+/// (`scenes/`, `models/`, ...: the same scene hash), so that a test may aim an output at any of
+/// them without risk to the repository's files. Returns the scene file and its assets.
+pub(crate) fn sphere_copy(dir: &Path) -> (PathBuf, Vec<PathBuf>) {
+    let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config");
+    let mut files = Vec::new();
+    for rel in [
+        "scenes/glass-sphere.toml",
+        "models/sphere.glb",
+        "textures/gravel.png",
+        "textures/brick.png",
+        "env/forest_ll_zip.exr",
+        "bakes/glass-sphere.exr",
+    ] {
+        let to = dir.join(rel);
+        std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+        std::fs::copy(config.join(rel), &to).unwrap();
+        files.push(to);
+    }
+    (files.remove(0), files)
+}
+
+/// The physical reference of `scene` at 16 x 16 pixels in `dir/ref` (`000000-left.png` and
+/// its `reference.json`), quickly.
+fn small_reference(scene: &Path, dir: &Path) -> PathBuf {
+    let out = dir.join("ref");
+    let args = [
+        "reference",
+        scene.to_str().unwrap(),
+        "--size",
+        "16x16",
+        "--samples",
+        "1",
+        "--photons-per-texel",
+        "1",
+        "--eye",
+        "left",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let run = vitreous(&args, dir);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    out
+}
+
+#[test]
+fn a_map_naming_any_file_compare_reads_is_refused_and_the_file_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, assets) = sphere_copy(dir.path());
+    let refs = small_reference(&scene, dir.path());
+    let reference = refs.join("000000-left.png");
+    let test = dir.path().join("test.png");
+    let seen = refs.join("000000-left-seen.png");
+    std::fs::copy(&reference, &test).unwrap();
+    let args = |map: &Path| {
+        [
+            "compare",
+            reference.to_str().unwrap(),
+            test.to_str().unwrap(),
+            "--seen",
+            seen.to_str().unwrap(),
+            "--scene",
+            scene.to_str().unwrap(),
+            "--map",
+            map.to_str().unwrap(),
+        ]
+        .map(String::from)
+    };
+    let run = |map: &Path| {
+        let args = args(map);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        vitreous(&args, dir.path())
+    };
+    let mut inputs = vec![
+        scene.clone(),
+        reference.clone(),
+        test.clone(),
+        seen.clone(),
+        refs.join("reference.json"),
+    ];
+    inputs.extend(assets);
+    for input in &inputs {
+        let before = std::fs::read(input).unwrap();
+        let out = run(input);
+        assert_clean_failure(
+            &out,
+            &["--map", &input.display().to_string(), "is the input file"],
+        );
+        assert_eq!(std::fs::read(input).unwrap(), before, "{}", input.display());
+    }
+    // A hard link to the scene is the scene.
+    let link = dir.path().join("link.toml");
+    std::fs::hard_link(&scene, &link).unwrap();
+    assert_clean_failure(&run(&link), &["--map", "link.toml", "is the input file"]);
+    // Anywhere else the map is written.
+    let map = dir.path().join("map.png");
+    let out = run(&map);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(map.is_file());
+}

@@ -23,6 +23,7 @@ fn one_pass(scene: &str) -> vitreous::soak::SoakReport {
         read_back_every: 3,
         validation: true,
         recreate: false,
+        report: None,
     };
     let mut passes = 0;
     let report = soak(&options, |_| passes += 1).unwrap_or_else(|e| panic!("{e:#}"));

@@ -20,6 +20,7 @@
 //! | [`conditions`] | the effect conditions a live run cycles through, and its live commands |
 //! | [`frame_log`] | `frames.csv`: each frame's defocus decision |
 //! | [`output`] | files a command writes: frame PNGs, previews, whole or not at all |
+//! | [`input_files`] | the files a command reads, which none of its outputs may name |
 //! | [`reference_view`] | a replay's eye images beside the paper's reference |
 //! | [`setup`] | what every command does before its loop: size check, the trace |
 //! | [`validation`] | what the Vulkan validation layers reported |
@@ -34,6 +35,7 @@ pub mod director;
 pub mod focus;
 pub mod frame_log;
 pub mod frame_loop;
+pub mod input_files;
 pub mod interrupt;
 pub mod look;
 pub mod motion_clock;

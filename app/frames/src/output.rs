@@ -3,7 +3,6 @@
 //! Every file is written to a temporary name in its folder and renamed into place, so an
 //! interrupted run never leaves a half-written file under the final name.
 
-use std::fs;
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -22,28 +21,6 @@ pub const EYE_NAMES: [&str; 2] = ["left", "right"];
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     vitreous_xr::atomic_file::write(path, bytes)
         .with_context(|| format!("writing {}", path.display()))
-}
-
-/// Refuses an output path that is one of the command's input files, before anything is
-/// written (an output written over its own input would destroy the recording).
-pub fn ensure_not_input(out: &Path, option: &str, inputs: &[&Path]) -> Result<()> {
-    use std::os::unix::fs::MetadataExt;
-    let Ok(out_meta) = fs::metadata(out) else {
-        return Ok(()); // an output that does not exist yet cannot be an input
-    };
-    for input in inputs {
-        if let Ok(meta) = fs::metadata(input)
-            && meta.dev() == out_meta.dev()
-            && meta.ino() == out_meta.ino()
-        {
-            anyhow::bail!(
-                "{option} {} is the input file {}: choose another output file",
-                out.display(),
-                input.display()
-            );
-        }
-    }
-    Ok(())
 }
 
 /// Encodes RGBA8 pixels as PNG with fast compression (the default level costs ~0.7 s per
@@ -68,6 +45,29 @@ pub fn frame_file_names(frame: u64) -> [String; 4] {
         format!("{frame:06}-left-preview.png"),
         format!("{frame:06}-right-preview.png"),
     ]
+}
+
+/// Whether `name` is a file a replay or `vitreous reference` writes among its frame images:
+/// `NNNNNN-left.png`, `NNNNNN-right-preview.png`, `NNNNNN-left-reference.png`,
+/// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`, ..., `reference.json`, or a temporary file
+/// of an atomic write.
+pub fn is_frame_file_name(name: &str) -> bool {
+    if (name.starts_with(".vitreous-") && name.ends_with(".partial")) || name == "reference.json" {
+        return true;
+    }
+    let Some(stem) = name.strip_suffix(".png") else {
+        return false;
+    };
+    let Some((digits, rest)) = stem.split_once('-') else {
+        return false;
+    };
+    digits.len() >= 6
+        && digits.bytes().all(|b| b.is_ascii_digit())
+        && EYE_NAMES.iter().any(|eye| {
+            ["", "-preview", "-reference", "-real", "-seen"]
+                .iter()
+                .any(|k| rest == format!("{eye}{k}"))
+        })
 }
 
 /// Writes a saved frame's eye images and, when the world was read back, its previews (what the
@@ -116,6 +116,7 @@ pub fn write_frame(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
 
     #[test]
     fn see_through_adds_light_and_black_adds_nothing() {
@@ -126,6 +127,31 @@ mod tests {
         let sum = see_through(&grey, &grey);
         // Two equal linear halves of ~0.216 add to ~0.43, i.e. sRGB ~175: brighter, never darker.
         assert!(sum[0] > 170 && sum[0] < 180, "{sum:?}");
+    }
+
+    #[test]
+    fn only_frame_image_names_are_frame_files() {
+        for name in [
+            "000000-left.png",
+            "000030-right-preview.png",
+            "000060-left-reference.png",
+            "000060-left-real.png",
+            "000060-right-seen.png",
+            "1234567-right.png",
+            "reference.json",
+            ".vitreous-abc123.partial",
+        ] {
+            assert!(is_frame_file_name(name), "{name}");
+        }
+        for name in [
+            "notes.txt",
+            "left.png",
+            "00003-left.png",
+            "000030-middle.png",
+            "x-left.png",
+        ] {
+            assert!(!is_frame_file_name(name), "{name}");
+        }
     }
 
     #[test]
@@ -143,19 +169,5 @@ mod tests {
             0,
             "written files are readable by others as a plain create makes them: {mode:o}"
         );
-    }
-
-    #[test]
-    fn an_output_naming_an_input_is_refused() {
-        let dir = tempfile::tempdir().unwrap();
-        let input = dir.path().join("in.csv");
-        fs::write(&input, "x").unwrap();
-        let e = ensure_not_input(&input, "-o", &[&input]).unwrap_err();
-        assert!(e.to_string().contains("is the input file"), "{e}");
-        // The same file under another name (a relative path through the folder).
-        let other = dir.path().join(".").join("in.csv");
-        assert!(ensure_not_input(&other, "-o", &[&input]).is_err());
-        assert!(ensure_not_input(&dir.path().join("out.csv"), "-o", &[&input]).is_ok());
-        assert_eq!(fs::read(&input).unwrap(), b"x");
     }
 }

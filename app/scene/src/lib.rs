@@ -41,7 +41,7 @@ mod mesh;
 mod motion;
 pub mod room;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
 use vitreous_xr::{Fov, Pose};
@@ -70,6 +70,11 @@ pub struct Scene {
     /// Hex SHA-256 over the scene file's bytes and the bytes of every asset it loads
     /// (labelled by field, so moving the files elsewhere keeps the hash).
     pub hash: String,
+    /// Every asset file the scene names and the loader read (`object.model`,
+    /// `floor.photo`, ...), each with the field that names it, in the order read: with the
+    /// scene file, the files [`Scene::hash`] covers. A glTF model's external buffers are not
+    /// listed; the caustic bake, read later, is [`Caustics::bake`].
+    pub assets: Vec<(String, PathBuf)>,
     /// The virtual transparent object.
     pub object: Object,
     /// The point light.
@@ -143,6 +148,16 @@ pub struct Caustics {
 }
 
 impl Scene {
+    /// The files the scene is read from, each with what names it: the scene file itself
+    /// (`scene`), every asset ([`Scene::assets`]) and the caustic bake when it names one
+    /// (`caustics.bake`).
+    pub fn files(&self) -> Vec<(&str, &Path)> {
+        let mut files = vec![("scene", self.path.as_path())];
+        files.extend(self.assets.iter().map(|(f, p)| (f.as_str(), p.as_path())));
+        files.extend(self.caustics.bake.as_deref().map(|p| ("caustics.bake", p)));
+        files
+    }
+
     /// Where `[object]` and `[light]` put the object and the light.
     pub fn rest_placement(&self) -> Placement {
         Placement {

@@ -73,6 +73,7 @@ pub fn load_scene_from(path: &Path, files: &dyn SceneFiles) -> Result<Scene, Sce
         src: Source { file: path, text },
         dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
         hasher: Sha256::new(),
+        assets: Vec::new(),
     };
     loader.hash_part("scene", &bytes);
     let raw: SceneFile = toml::from_str(text).map_err(|e| loader.src.toml_error(&e))?;
@@ -88,6 +89,8 @@ pub(super) struct Loader<'a> {
     pub(super) src: Source<'a>,
     dir: PathBuf,
     hasher: Sha256,
+    /// Every asset read so far, with the field that names it.
+    assets: Vec<(String, PathBuf)>,
 }
 
 /// Both bounds of a range included.
@@ -133,6 +136,7 @@ impl Loader<'_> {
                 self.src.asset(rel.span(), field, &path, reason)
             })?;
         self.hash_part(field, &bytes);
+        self.assets.push((field.to_owned(), path.clone()));
         Ok((path, bytes))
     }
 
@@ -475,6 +479,7 @@ impl Loader<'_> {
         Ok(Scene {
             path: self.src.file.to_path_buf(),
             hash,
+            assets: std::mem::take(&mut self.assets),
             object,
             light,
             floor,

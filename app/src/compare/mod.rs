@@ -15,7 +15,8 @@ use serde::Serialize;
 
 pub use regions::{Eye, Region, regions, regions_of};
 
-use crate::output::{encode_png, ensure_not_input, write_atomic};
+use crate::input_files::InputFiles;
+use crate::output::{encode_png, write_atomic};
 use vitreous_frames::wearer::WearerView;
 
 /// Options of `vitreous compare` (docs/cli.md).
@@ -302,10 +303,34 @@ fn wearer_view(
 
 /// `vitreous compare`.
 pub fn compare_command(args: CompareArgs) -> Result<()> {
+    let scene = match &args.scene {
+        Some(path) => {
+            let mut scene = vitreous_scene::load_scene(path)?;
+            if scene.caustics.bake.is_some()
+                && let Err(e) = scene.load_caustics()
+            {
+                tracing::warn!("the caustic is left out of the regions: {e}");
+            }
+            Some(scene)
+        }
+        None => None,
+    };
     if let Some(map) = &args.map {
-        let mut inputs = vec![args.reference.as_path(), args.test.as_path()];
-        inputs.extend(args.seen.as_deref());
-        ensure_not_input(map, "--map", &inputs)?;
+        let mut inputs = InputFiles::new();
+        inputs
+            .add(&args.reference, "REFERENCE")
+            .add(&args.test, "TEST");
+        if let Some(seen) = &args.seen {
+            inputs.add(seen, "--seen");
+        }
+        if let Some(scene) = &scene {
+            inputs.add_scene(scene, "--scene");
+        }
+        let beside = args.reference.with_file_name("reference.json");
+        if beside.exists() {
+            inputs.add(&beside, "the reference.json beside REFERENCE");
+        }
+        inputs.check_file("--map", map)?;
     }
     let (w, h, reference) = read_rgb(&args.reference)?;
     let same_size = |path: &Path| -> Result<Vec<u8>> {
@@ -328,18 +353,6 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         );
     }
     let seen = args.seen.as_deref().map(same_size).transpose()?;
-    let scene = match &args.scene {
-        Some(path) => {
-            let mut scene = vitreous_scene::load_scene(path)?;
-            if scene.caustics.bake.is_some()
-                && let Err(e) = scene.load_caustics()
-            {
-                tracing::warn!("the caustic is left out of the regions: {e}");
-            }
-            Some(scene)
-        }
-        None => None,
-    };
     // The display light over the seen image, as the scene's display composes them (its
     // dimmers, when it has any; else added).
     let test = match &seen {

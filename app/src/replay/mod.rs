@@ -19,6 +19,7 @@ use vitreous_xr::trace::{EditRecord, TraceSample};
 use crate::effects::EffectSet;
 use crate::frame_log::FrameLog;
 use crate::frame_loop::{self, FramePlan, FrameSink};
+use crate::input_files::InputFiles;
 pub use crate::look::GazeSettings;
 use crate::look::LookPlanner;
 use crate::motion_clock::MotionClock;
@@ -263,6 +264,12 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         );
     }
     let (samples, edits, trace_name) = load_trace_with_edits(&scene, options.trace.as_deref())?;
+    let mut inputs = InputFiles::new();
+    inputs.add_scene(&scene, "SCENE");
+    if let Some(trace) = &options.trace {
+        inputs.add(trace, "--trace");
+    }
+    inputs.check_folder("--out", &options.out, &["frames"], &replay_writes)?;
     let expected_frames = expected_frames(&samples, options.frame_rate_hz, options.frames);
     if options.frames.is_none() && expected_frames > MAX_FRAMES_WITHOUT_LIMIT {
         bail!(
@@ -515,7 +522,7 @@ fn remove_earlier_frames(frames_dir: &Path) -> Result<()> {
         let entry = entry.with_context(|| format!("listing {}", frames_dir.display()))?;
         let name = entry.file_name();
         let Some(name) = name.to_str() else { continue };
-        if is_replay_file_name(name) {
+        if output::is_frame_file_name(name) {
             fs::remove_file(entry.path())
                 .with_context(|| format!("removing an earlier run's {}", entry.path().display()))?;
         }
@@ -523,26 +530,18 @@ fn remove_earlier_frames(frames_dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// `NNNNNN-left.png`, `NNNNNN-right-preview.png`, `NNNNNN-left-reference.png`,
-/// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`, ... or a
-/// temporary file of an atomic write.
-fn is_replay_file_name(name: &str) -> bool {
-    if (name.starts_with(".vitreous-") && name.ends_with(".partial")) || name == "reference.json" {
-        return true;
+/// Whether a replay writes (or, from an earlier run, removes) `relative` inside its output
+/// folder: `summary.json`, `frames.csv` and the frame images under `frames/`.
+fn replay_writes(relative: &Path) -> bool {
+    let name = relative
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    match relative.parent().and_then(Path::to_str) {
+        Some("") => name == "summary.json" || name == "frames.csv",
+        Some("frames") => output::is_frame_file_name(name),
+        _ => false,
     }
-    let Some(stem) = name.strip_suffix(".png") else {
-        return false;
-    };
-    let Some((digits, rest)) = stem.split_once('-') else {
-        return false;
-    };
-    digits.len() >= 6
-        && digits.bytes().all(|b| b.is_ascii_digit())
-        && ["left", "right"].iter().any(|eye| {
-            ["", "-preview", "-reference", "-real", "-seen"]
-                .iter()
-                .any(|k| rest == format!("{eye}{k}"))
-        })
 }
 
 #[cfg(test)]
@@ -550,26 +549,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn only_replay_output_names_are_treated_as_earlier_frames() {
-        for name in [
-            "000000-left.png",
-            "000030-right-preview.png",
-            "000060-left-reference.png",
-            "000060-left-real.png",
-            "000060-right-seen.png",
-            "1234567-right.png",
-            ".vitreous-abc123.partial",
-        ] {
-            assert!(is_replay_file_name(name), "{name}");
+    fn a_replay_writes_its_summary_log_and_frame_images_only() {
+        for written in ["summary.json", "frames.csv", "frames/000030-left.png"] {
+            assert!(replay_writes(Path::new(written)), "{written}");
         }
-        for name in [
-            "notes.txt",
-            "left.png",
-            "00003-left.png",
-            "000030-middle.png",
-            "x-left.png",
+        for kept in [
+            "trace.csv",
+            "frames/notes.txt",
+            "000030-left.png",
+            "x/summary.json",
         ] {
-            assert!(!is_replay_file_name(name), "{name}");
+            assert!(!replay_writes(Path::new(kept)), "{kept}");
         }
     }
 

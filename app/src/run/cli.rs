@@ -8,7 +8,6 @@ use super::{RunOptions, run};
 use crate::cli_values::{parse_blend, parse_effects, parse_frame_count, parse_gaze, parse_size};
 use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, PupilSource};
-use crate::output::ensure_not_input;
 
 /// Options of `vitreous run` (docs/cli.md).
 #[derive(clap::Args, Debug)]
@@ -69,11 +68,6 @@ pub fn run_command(args: RunArgs) -> Result<()> {
     // Before the runtime starts (which would clamp it to what it offers, silently).
     if let Some((w, h)) = args.size {
         crate::setup::check_size(w, h)?;
-    }
-    if let Some(record) = &args.record {
-        let mut inputs = vec![args.scene.as_path()];
-        inputs.extend(args.gaze_trace.as_deref());
-        ensure_not_input(record, "--record", &inputs)?;
     }
     let s = run(&RunOptions::from(args))?;
     print!("{}", s.report());

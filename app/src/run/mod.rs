@@ -33,7 +33,7 @@ mod summary;
 mod xr_session;
 
 use std::fs;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
@@ -63,6 +63,7 @@ use crate::effects::EffectSet;
 use crate::focus::FocusFollower;
 use crate::frame_log::FrameLog;
 use crate::frame_loop;
+use crate::input_files::InputFiles;
 use crate::look::{GazeSettings, planners_for};
 use crate::motion_clock::MotionClock;
 use crate::output::write_atomic;
@@ -126,9 +127,29 @@ pub fn run_directed(options: &RunOptions, director: &mut dyn Director) -> Result
     run_with(options, Some(director)).map(|_| ())
 }
 
+/// Refuses `--record` and `--out` when they would write over a file the session reads (the
+/// scene, its assets, the gaze trace), before the runtime starts.
+fn check_outputs(options: &RunOptions, scene: &crate::scene::Scene) -> Result<()> {
+    let mut inputs = InputFiles::new();
+    inputs.add_scene(scene, "SCENE");
+    if let Some(trace) = &options.gaze_trace {
+        inputs.add(trace, "--gaze-trace");
+    }
+    if let Some(record) = &options.record {
+        inputs.check_file("--record", record)?;
+    }
+    if let Some(out) = &options.out {
+        inputs.check_folder("--out", out, &[], &|p| {
+            p == Path::new("summary.json") || p == Path::new("frames.csv")
+        })?;
+    }
+    Ok(())
+}
+
 /// [`run`], with a director deciding the looks when given.
 fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result<RunSummary> {
     let mut scene = load_scene(&options.scene)?;
+    check_outputs(options, &scene)?;
     let effects = options.effects.unwrap_or(scene.effects);
     effects.ensure_implemented()?;
     if effects.caustics {

@@ -10,7 +10,8 @@ use super::plan::{MAX_PARTICIPANTS, plan, write_plan};
 use super::protocol::Protocol;
 use super::run::{StudyRunOptions, run_study, timing_log_path};
 use crate::cli_values::{parse_blend, parse_gaze, parse_size};
-use crate::output::{ensure_not_input, write_atomic};
+use crate::input_files::InputFiles;
+use crate::output::write_atomic;
 use crate::run::RunOptions;
 
 /// The study subcommands.
@@ -126,7 +127,9 @@ pub fn run(command: StudyCommand) -> Result<()> {
             if !(1..=MAX_PARTICIPANTS).contains(&participants) {
                 bail!("--participants must be from 1 to {MAX_PARTICIPANTS}, got {participants}");
             }
-            ensure_not_input(&out, "--out", &[protocol.as_path()])?;
+            InputFiles::new()
+                .add(&protocol, "PROTOCOL")
+                .check_file("--out", &out)?;
             let protocol = Protocol::read(&protocol)?;
             let trials = plan(&protocol, participants, seed);
             let mut bytes = Vec::new();
@@ -162,11 +165,15 @@ pub fn run(command: StudyCommand) -> Result<()> {
             gaze,
             gaze_trace,
         } => {
-            let mut inputs = vec![protocol.as_path(), plan.as_path()];
-            inputs.extend(trace.as_deref());
-            inputs.extend(gaze_trace.as_deref());
-            ensure_not_input(&responses, "--responses", &inputs)?;
-            ensure_not_input(&timing_log_path(&responses), "the timing log", &inputs)?;
+            let mut inputs = InputFiles::new();
+            inputs.add(&protocol, "PROTOCOL").add(&plan, "--plan");
+            for (path, option) in [(&trace, "--trace"), (&gaze_trace, "--gaze-trace")] {
+                if let Some(path) = path {
+                    inputs.add(path, option);
+                }
+            }
+            inputs.check_file("--responses", &responses)?;
+            inputs.check_file("the timing log", &timing_log_path(&responses))?;
             if trials == Some(0) {
                 bail!("--trials must be at least 1");
             }
@@ -220,7 +227,9 @@ pub fn run(command: StudyCommand) -> Result<()> {
         } => {
             let analysis = super::report::analyze_file(&responses)?;
             if let Some(path) = &plot {
-                ensure_not_input(path, "--plot", &[responses.as_path()])?;
+                InputFiles::new()
+                    .add(&responses, "RESPONSES")
+                    .check_file("--plot", path)?;
                 let png = super::plot::plot(&analysis)?;
                 write_atomic(path, &png)?;
             }

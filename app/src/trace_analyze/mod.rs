@@ -49,6 +49,7 @@ use crate::gaze::{
     FilterKind, GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances, ObjectInView,
     Separability, SeparabilityMonitor,
 };
+use crate::input_files::InputFiles;
 use crate::scene::{gaze_image_of_target, load_scene};
 
 pub(crate) mod plot;
@@ -521,17 +522,17 @@ pub fn analyze_trace_file(
     scene: &Path,
     filters: &[FilterKind],
 ) -> Result<AnalyzeReport> {
-    let (samples, config) = load_inputs(trace, scene, filters)?;
+    let (samples, config, _) = load_inputs(trace, scene, filters)?;
     Ok(analyze(&samples, Truth::FromRawDepth, &config))
 }
 
 /// The trace's samples and the analysis settings for a scene (its image distances) and
-/// `filters` (empty: every offered filter).
+/// `filters` (empty: every offered filter), with the files read.
 pub(super) fn load_inputs(
     trace: &Path,
     scene: &Path,
     filters: &[FilterKind],
-) -> Result<(Vec<TraceSample>, AnalyzeConfig)> {
+) -> Result<(Vec<TraceSample>, AnalyzeConfig, InputFiles)> {
     let scene = load_scene(scene).context("loading the scene")?;
     // The trace's errors name its file and line.
     let samples = vitreous_xr::read_trace(trace).context("reading the trace")?;
@@ -539,5 +540,7 @@ pub(super) fn load_inputs(
     if !filters.is_empty() {
         config.filters = filters.to_vec();
     }
-    Ok((samples, config))
+    let mut inputs = InputFiles::new();
+    inputs.add(trace, "TRACE").add_scene(&scene, "--scene");
+    Ok((samples, config, inputs))
 }

@@ -30,7 +30,8 @@ pub fn plot_trace_file(
     filters: &[FilterKind],
     out_png: &Path,
 ) -> Result<()> {
-    let (samples, config) = load_inputs(trace, scene, filters)?;
+    let (samples, config, inputs) = load_inputs(trace, scene, filters)?;
+    inputs.check_file("--out", out_png)?;
     plot(&samples, Truth::FromRawDepth, &config, out_png).map(|_| ())
 }
 

@@ -32,7 +32,7 @@ mod window;
 
 use std::cell::RefCell;
 use std::collections::VecDeque;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::time::Instant;
 
@@ -49,6 +49,7 @@ use crate::director::Director;
 use crate::effects::EffectSet;
 use crate::frame_loop::{self, FrameRecord};
 use crate::gaze::{FilterKind, GazeOverride};
+use crate::input_files::InputFiles;
 use crate::output::{encode_png, write_atomic};
 use crate::spread::Spread;
 use crate::validation::ValidationSummary;
@@ -182,15 +183,25 @@ fn view_with(options: &ViewOptions, director: Option<&mut dyn Director>) -> Resu
         Some(path) => Some(Script::load(path)?),
         None => None,
     };
-    let mut inputs = vec![options.scene.as_path()];
-    inputs.extend(options.trace.as_deref());
-    if let Some(shot) = &options.screenshot {
-        crate::output::ensure_not_input(shot, "--screenshot", &inputs)?;
-    }
-    if let Some(record) = &options.record {
-        crate::output::ensure_not_input(record, "--record", &inputs)?;
-    }
     let loaded = Loaded::load(&options.scene, options.effects)?;
+    let mut inputs = InputFiles::new();
+    inputs.add_scene(&loaded.scene, "SCENE");
+    for (path, option) in [(&options.trace, "--trace"), (&options.script, "--script")] {
+        if let Some(path) = path {
+            inputs.add(path, option);
+        }
+    }
+    for (path, option) in [
+        (&options.screenshot, "--screenshot"),
+        (&options.record, "--record"),
+    ] {
+        if let Some(path) = path {
+            inputs.check_file(option, path)?;
+        }
+    }
+    if let Some(out) = &options.out {
+        inputs.check_folder("--out", out, &[], &|p| p == Path::new("summary.json"))?;
+    }
     let (w, h) = options.window;
     if !(64..=8192).contains(&w) || !(64..=8192).contains(&h) {
         bail!("window size {w}x{h} is outside 64..=8192 pixels per side");

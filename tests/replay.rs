@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
-use vitreous::reference_cmd::frame_of_image;
+use vitreous::compare::frame_of_image;
 use vitreous::render_desc::eye_params;
 use vitreous::replay::{ReplayOptions, replay};
 use vitreous::scene::load_scene;
@@ -290,9 +290,13 @@ fn compare_reference_measures_every_saved_eye_against_the_physical_reference() {
     // `vitreous compare` finds a reference's frame there (its regions follow that frame's eye,
     // not the neutral head's).
     let frames = dir.path().join("frames");
-    let (left, eye) = frame_of_image(&frames.join("000015-left-real.png")).expect("listed");
+    let listed = |name: &str| {
+        let listed = frame_of_image(&frames.join(name)).unwrap().expect("listed");
+        (listed.frame, listed.eye)
+    };
+    let (left, eye) = listed("000015-left-real.png");
     assert_eq!((left.frame, eye), (15, 0));
-    let (right, eye) = frame_of_image(&frames.join("000015-right-real.png")).expect("listed");
+    let (right, eye) = listed("000015-right-real.png");
     assert_eq!((right.frame, eye), (15, 1));
     let ipd =
         Vec3::from_array(right.eyes[1].position_m) - Vec3::from_array(right.eyes[0].position_m);

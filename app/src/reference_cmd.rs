@@ -265,23 +265,6 @@ impl Report {
     }
 }
 
-/// The frame and eye of a reference image, from the `reference.json` beside it (`None` when
-/// there is none, or it does not list the image): `NNNNNN-left.png` as `vitreous reference`
-/// names it, or `NNNNNN-left-real.png` as `replay --compare-reference` does.
-pub fn frame_of_image(image: &Path) -> Option<(FrameReport, usize)> {
-    let folder = image.parent()?;
-    let name = image.file_name()?.to_str()?;
-    let bytes = std::fs::read(folder.join("reference.json")).ok()?;
-    let report: Report = serde_json::from_slice(&bytes).ok()?;
-    report.frames.into_iter().find_map(|f| {
-        let eye = EYE_NAMES.iter().position(|e| {
-            let stem = format!("{:06}-{e}", f.frame);
-            name == format!("{stem}.png") || name == format!("{stem}-real.png")
-        })?;
-        Some((f, eye))
-    })
-}
-
 /// Runs `vitreous reference`.
 pub fn reference_command(args: ReferenceArgs) -> Result<()> {
     let scene = load_scene(&args.scene)?;

@@ -403,3 +403,54 @@ fn a_map_naming_any_file_compare_reads_is_refused_and_the_file_kept() {
     );
     assert!(map.is_file());
 }
+
+#[test]
+fn a_reference_json_cut_short_or_written_for_another_scene_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, _) = sphere_copy(dir.path());
+    let refs = small_reference(&scene, dir.path());
+    let reference = refs.join("000000-left.png");
+    let r = reference.to_str().unwrap();
+    let listing = refs.join("reference.json");
+    let with_scene = |scene: &Path| {
+        let scene = scene.to_str().unwrap().to_owned();
+        move |dir: &Path| vitreous(&["compare", r, r, "--scene", &scene, "--json"], dir)
+    };
+    // As written: the regions are the listed frame's.
+    let out = with_scene(&scene)(dir.path());
+    assert!(out.status.success(), "{out:?}");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let from = report["regions_from"].as_str().unwrap();
+    assert!(from.starts_with("frame 0 left eye of"), "{from}");
+    // The same scene with a line more has another hash: the frame is another scene's.
+    let other = scene.with_file_name("other.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&other, format!("{text}\n# moved\n")).unwrap();
+    let out = with_scene(&other)(dir.path());
+    assert_clean_failure(
+        &out,
+        &[
+            &listing.display().to_string(),
+            "as frame 0 of",
+            "not of --scene",
+            "other.toml",
+            "render the reference again",
+        ],
+    );
+    // Cut short.
+    let whole = std::fs::read(&listing).unwrap();
+    std::fs::write(&listing, &whole[..whole.len() / 2]).unwrap();
+    let out = with_scene(&scene)(dir.path());
+    assert_clean_failure(
+        &out,
+        &[
+            &listing.display().to_string(),
+            "not a reference.json",
+            "000000-left.png",
+            "EOF",
+        ],
+    );
+    // Without --scene it is not read: the whole view alone.
+    let report = json(&["compare", r, r, "--json"], dir.path());
+    assert_eq!(report["regions"].as_array().unwrap().len(), 1, "{report}");
+}

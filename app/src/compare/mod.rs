@@ -6,6 +6,7 @@
 //! for the additive limit beside the test's; optionally the ꟻLIP error map as a PNG.
 
 mod flip;
+mod listed;
 mod regions;
 
 use std::path::{Path, PathBuf};
@@ -13,6 +14,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 
+pub use listed::{Listed, REFERENCE_JSON, frame_for_scene, frame_of_image, reference_json_beside};
 pub use regions::{Eye, Region, regions, regions_of};
 
 use crate::input_files::InputFiles;
@@ -326,7 +328,7 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         if let Some(scene) = &scene {
             inputs.add_scene(scene, "--scene");
         }
-        let beside = args.reference.with_file_name("reference.json");
+        let beside = reference_json_beside(&args.reference);
         if beside.exists() {
             inputs.add(&beside, "the reference.json beside REFERENCE");
         }
@@ -369,21 +371,24 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         }
         None => flip::DEFAULT_PIXELS_PER_DEGREE,
     });
-    let from_reference = crate::reference_cmd::frame_of_image(&args.reference);
+    let from_reference = match &scene {
+        Some(s) => frame_for_scene(&args.reference, s)?,
+        None => None,
+    };
     let (labels, regions_from) = match (&scene, &from_reference) {
-        (Some(s), Some((frame, eye))) => (
+        (Some(s), Some(listed)) => (
             Some(regions_of(
                 s,
-                &frame.eyes[*eye].view(),
-                &frame.placement(),
+                &listed.frame.eyes[listed.eye].view(),
+                &listed.frame.placement(),
                 w,
                 h,
             )),
             Some(format!(
                 "frame {} {} eye of {}",
-                frame.frame,
-                crate::output::EYE_NAMES[*eye],
-                args.reference.with_file_name("reference.json").display()
+                listed.frame.frame,
+                crate::output::EYE_NAMES[listed.eye],
+                listed.file.display()
             )),
         ),
         (Some(s), None) => (

@@ -280,9 +280,20 @@ fn a_dimmer_scenes_display_light_is_seen_through_its_panel_and_the_panels_blur_c
         (scene_blur - blurrier).abs() > 0.1,
         "{scene_blur} vs {blurrier} dB"
     );
-    // The option needs a dimmer scene, and a blur in range.
+    // The display image's alpha is the panel's here; through an additive display it is
+    // ignored, and said.
     let plain = scene_path();
     let plain = plain.to_str().unwrap();
+    let alpha_warning = |scene: &str| {
+        let args = through(scene, &[]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = vitreous(&args, dir.path());
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8_lossy(&out.stderr).contains("t.png: alpha ignored")
+    };
+    assert!(!alpha_warning(scene_arg));
+    assert!(alpha_warning(plain));
+    // The option needs a dimmer scene, and a blur in range.
     let refused = |scene: &str, blur: &str| {
         let args = through(scene, &[&format!("--panel-blur-deg={blur}")]);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
@@ -453,4 +464,43 @@ fn a_reference_json_cut_short_or_written_for_another_scene_is_an_error_naming_it
     // Without --scene it is not read: the whole view alone.
     let report = json(&["compare", r, r, "--json"], dir.path());
     assert_eq!(report["regions"].as_array().unwrap().len(), 1, "{report}");
+}
+
+#[test]
+fn alpha_left_out_of_the_comparison_is_said_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (16u32, 8u32);
+    write_png(
+        &dir.path().join("opaque.png"),
+        &vec![90; (w * h * 3) as usize],
+        w,
+        h,
+    );
+    // The same colours, a quarter of the pixels half transparent.
+    let rgba: Vec<u8> = (0..w * h)
+        .flat_map(|i| [90, 90, 90, if i % 4 == 0 { 128 } else { 255 }])
+        .collect();
+    std::fs::write(
+        dir.path().join("clear.png"),
+        encode_png(&rgba, w, h).unwrap(),
+    )
+    .unwrap();
+    let warned = |args: &[&str]| {
+        let out = vitreous(args, dir.path());
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    for (reference, test) in [("clear.png", "opaque.png"), ("opaque.png", "clear.png")] {
+        let stderr = warned(&["compare", reference, test, "--json"]);
+        assert!(
+            stderr.contains("clear.png: alpha ignored: 32 of 128 pixels are not opaque"),
+            "{stderr}"
+        );
+        assert!(stderr.contains("--display"), "{stderr}");
+        assert!(!stderr.contains("opaque.png: alpha"), "{stderr}");
+    }
+    // As what the eye sees: alpha ignored, said; its colours are the opaque image's.
+    let stderr = warned(&["compare", "opaque.png", "opaque.png", "--seen", "clear.png"]);
+    assert!(stderr.contains("clear.png: alpha ignored"), "{stderr}");
+    assert!(!warned(&["compare", "opaque.png", "opaque.png"]).contains("alpha"));
 }

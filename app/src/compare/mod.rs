@@ -6,19 +6,21 @@
 //! for the additive limit beside the test's; optionally the ꟻLIP error map as a PNG.
 
 mod flip;
+mod images;
 mod listed;
 mod regions;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use serde::Serialize;
 
 pub use listed::{Listed, REFERENCE_JSON, frame_for_scene, frame_of_image, reference_json_beside};
 pub use regions::{Eye, Region, regions, regions_of};
 
 use crate::input_files::InputFiles;
-use crate::output::{encode_png, write_atomic};
+use crate::output::{EYE_NAMES, encode_png, write_atomic};
+use images::Png;
 use vitreous_frames::wearer::WearerView;
 
 /// Options of `vitreous compare` (docs/cli.md).
@@ -146,35 +148,6 @@ fn add_light(view: &WearerView, display: &[u8], seen: &[u8], size: (u32, u32)) -
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
     rgb_of(&view.see(display, &rgba, [size.0, size.1]))
-}
-
-/// Most pixels an image may have (as the scene loader's images).
-const MAX_PIXELS: u64 = vitreous_scene::MAX_IMAGE_PIXELS;
-
-/// Reads a PNG as tightly packed sRGB RGB8, naming the file in every error.
-fn read_rgb(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
-    let (w, h, rgba) = read_rgba(path)?;
-    Ok((w, h, rgb_of(&rgba)))
-}
-
-/// Reads a PNG as tightly packed sRGB RGBA8 (opaque where it has no alpha), naming the file in
-/// every error.
-fn read_rgba(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
-    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    let reader =
-        image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
-    let (w, h) = reader
-        .into_dimensions()
-        .with_context(|| format!("{}: not a PNG image", path.display()))?;
-    if w == 0 || h == 0 || u64::from(w) * u64::from(h) > MAX_PIXELS {
-        bail!(
-            "{}: {w}x{h} pixels is outside 1..={MAX_PIXELS} pixels",
-            path.display()
-        );
-    }
-    let decoded = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
-        .with_context(|| format!("{}: not a PNG image", path.display()))?;
-    Ok((w, h, decoded.to_rgba8().into_raw()))
 }
 
 /// PSNR of 8-bit values, dB; `None` when they are equal.
@@ -334,36 +307,34 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         }
         inputs.check_file("--map", map)?;
     }
-    let (w, h, reference) = read_rgb(&args.reference)?;
-    let same_size = |path: &Path| -> Result<Vec<u8>> {
-        let (tw, th, image) = read_rgb(path)?;
-        if (w, h) != (tw, th) {
-            bail!(
-                "the images differ in size: {} is {w}x{h}, {} is {tw}x{th}",
-                args.reference.display(),
-                path.display()
-            );
-        }
-        Ok(image)
-    };
-    let (tw, th, test_rgba) = read_rgba(&args.test)?;
-    if (w, h) != (tw, th) {
-        bail!(
-            "the images differ in size: {} is {w}x{h}, {} is {tw}x{th}",
-            args.reference.display(),
-            args.test.display()
-        );
-    }
-    let seen = args.seen.as_deref().map(same_size).transpose()?;
+    let reference = Png::read(&args.reference)?;
+    let (w, h) = (reference.width, reference.height);
+    let test = Png::read_like(&args.test, &reference)?;
+    let seen = args
+        .seen
+        .as_deref()
+        .map(|path| Png::read_like(path, &reference))
+        .transpose()?;
     // The display light over the seen image, as the scene's display composes them (its
     // dimmers, when it has any; else added).
-    let test = match &seen {
+    let (test_rgb, test_alpha_used) = match &seen {
         Some(seen) if args.display => {
             let view = wearer_view(scene.as_ref(), args.panel_blur_deg)?;
-            add_light(&view, &test_rgba, seen, (w, h))
+            (
+                add_light(&view, &test.rgba, &seen.rgb(), (w, h)),
+                view.panel.is_some(),
+            )
         }
-        _ => rgb_of(&test_rgba),
+        _ => (test.rgb(), false),
     };
+    let ignored = [
+        reference.alpha_ignored(false),
+        test.alpha_ignored(test_alpha_used),
+        seen.as_ref().and_then(|s| s.alpha_ignored(false)),
+    ];
+    for warning in ignored.into_iter().flatten() {
+        tracing::warn!("{warning}");
+    }
     let ppd = args.ppd.unwrap_or_else(|| match &scene {
         Some(s) => {
             let fov = s.output.fov;
@@ -371,42 +342,42 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         }
         None => flip::DEFAULT_PIXELS_PER_DEGREE,
     });
-    let from_reference = match &scene {
-        Some(s) => frame_for_scene(&args.reference, s)?,
-        None => None,
+    let (labels, regions_from) = match &scene {
+        Some(s) => match frame_for_scene(&args.reference, s)? {
+            Some(listed) => (
+                Some(regions_of(
+                    s,
+                    &listed.frame.eyes[listed.eye].view(),
+                    &listed.frame.placement(),
+                    w,
+                    h,
+                )),
+                Some(format!(
+                    "frame {} {} eye of {}",
+                    listed.frame.frame,
+                    EYE_NAMES[listed.eye],
+                    listed.file.display()
+                )),
+            ),
+            None => (
+                Some(regions(s, args.eye, w, h)),
+                Some(format!(
+                    "neutral head, {} eye",
+                    if args.eye == Eye::Left {
+                        "left"
+                    } else {
+                        "right"
+                    }
+                )),
+            ),
+        },
+        None => (None, None),
     };
-    let (labels, regions_from) = match (&scene, &from_reference) {
-        (Some(s), Some(listed)) => (
-            Some(regions_of(
-                s,
-                &listed.frame.eyes[listed.eye].view(),
-                &listed.frame.placement(),
-                w,
-                h,
-            )),
-            Some(format!(
-                "frame {} {} eye of {}",
-                listed.frame.frame,
-                crate::output::EYE_NAMES[listed.eye],
-                listed.file.display()
-            )),
-        ),
-        (Some(s), None) => (
-            Some(regions(s, args.eye, w, h)),
-            Some(format!(
-                "neutral head, {} eye",
-                if args.eye == Eye::Left {
-                    "left"
-                } else {
-                    "right"
-                }
-            )),
-        ),
-        _ => (None, None),
-    };
-    let (error, figures) = compare(&reference, &test, (w, h), ppd, labels.as_deref())?;
+    let reference = reference.rgb();
+    let (error, figures) = compare(&reference, &test_rgb, (w, h), ppd, labels.as_deref())?;
     let rows =
         |image: &[u8]| compare(&reference, image, (w, h), ppd, labels.as_deref()).map(|r| r.1);
+    let seen = seen.map(|s| s.rgb());
     let nothing_drawn = seen.as_deref().map(rows).transpose()?;
     let limit = seen
         .as_deref()

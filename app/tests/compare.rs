@@ -504,3 +504,36 @@ fn alpha_left_out_of_the_comparison_is_said_naming_the_file() {
     assert!(stderr.contains("clear.png: alpha ignored"), "{stderr}");
     assert!(!warned(&["compare", "opaque.png", "opaque.png"]).contains("alpha"));
 }
+
+#[test]
+fn an_eye_without_a_scene_or_against_the_reference_json_is_refused_naming_both() {
+    let dir = tempfile::tempdir().unwrap();
+    write_png(&dir.path().join("a.png"), &[0; 16 * 8 * 3], 16, 8);
+    let out = vitreous(&["compare", "a.png", "a.png", "--eye", "right"], dir.path());
+    assert_clean_failure(
+        &out,
+        &["--eye right", "without --scene", "add --scene SCENE"],
+    );
+    let (scene, _) = sphere_copy(dir.path());
+    let refs = small_reference(&scene, dir.path());
+    let r = refs.join("000000-left.png");
+    let (r, s) = (r.to_str().unwrap(), scene.to_str().unwrap());
+    let out = vitreous(
+        &["compare", r, r, "--scene", s, "--eye", "right"],
+        dir.path(),
+    );
+    assert_clean_failure(
+        &out,
+        &[
+            "--eye right",
+            "reference.json lists",
+            "as the left eye of frame 0",
+        ],
+    );
+    let agreed = json(
+        &["compare", r, r, "--scene", s, "--eye", "left", "--json"],
+        dir.path(),
+    );
+    let from = agreed["regions_from"].as_str().unwrap();
+    assert!(from.starts_with("frame 0 left eye"), "{from}");
+}

@@ -75,8 +75,9 @@ pub fn frame_of_image(image: &Path) -> Result<Option<Listed>> {
 }
 
 /// The frame and eye of `image` for comparing it region by region in `scene`: refused when its
-/// `reference.json` lists it for another scene (the frame's regions would be that scene's).
-pub fn frame_for_scene(image: &Path, scene: &Scene) -> Result<Option<Listed>> {
+/// `reference.json` lists it for another scene (the frame's regions would be that scene's) or
+/// for another eye than `eye`, the eye asked for.
+pub fn frame_for_scene(image: &Path, scene: &Scene, eye: Option<usize>) -> Result<Option<Listed>> {
     let Some(listed) = frame_of_image(image)? else {
         return Ok(None);
     };
@@ -94,6 +95,16 @@ pub fn frame_for_scene(image: &Path, scene: &Scene) -> Result<Option<Listed>> {
             short(&scene.hash),
             listed.scene,
             scene.path.display()
+        );
+    }
+    if let Some(eye) = eye.filter(|&e| e != listed.eye) {
+        bail!(
+            "--eye {}, but {} lists {} as the {} eye of frame {}: leave --eye out",
+            EYE_NAMES[eye],
+            listed.file.display(),
+            image.display(),
+            EYE_NAMES[listed.eye],
+            listed.frame.frame
         );
     }
     Ok(Some(listed))

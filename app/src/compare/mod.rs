@@ -34,9 +34,10 @@ pub struct CompareArgs {
     /// ramp, rest), for an image of `--eye` at the scene's neutral head.
     #[arg(long, value_name = "SCENE")]
     pub scene: Option<PathBuf>,
-    /// The eye the images show, with --scene: left or right.
-    #[arg(long, value_name = "EYE", default_value = "left", value_parser = parse_eye)]
-    pub eye: Eye,
+    /// The eye the images show, with --scene: left or right [default: left, or the eye the
+    /// reference.json beside REFERENCE lists it as].
+    #[arg(long, value_name = "EYE", value_parser = parse_eye)]
+    pub eye: Option<Eye>,
     /// Pixels per degree of visual angle for ꟻLIP (default: the scene's, width over horizontal
     /// field of view, with --scene; else ꟻLIP's default, 67, a 0.7 m viewing distance from a
     /// 24-inch 4K monitor).
@@ -278,6 +279,13 @@ fn wearer_view(
 
 /// `vitreous compare`.
 pub fn compare_command(args: CompareArgs) -> Result<()> {
+    if let (Some(eye), None) = (args.eye, &args.scene) {
+        bail!(
+            "--eye {} chooses the eye whose regions --scene splits the figures into; without \
+             --scene there are none: add --scene SCENE or leave --eye out",
+            EYE_NAMES[eye.index()]
+        );
+    }
     let scene = match &args.scene {
         Some(path) => {
             let mut scene = vitreous_scene::load_scene(path)?;
@@ -343,7 +351,7 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         None => flip::DEFAULT_PIXELS_PER_DEGREE,
     });
     let (labels, regions_from) = match &scene {
-        Some(s) => match frame_for_scene(&args.reference, s)? {
+        Some(s) => match frame_for_scene(&args.reference, s, args.eye.map(Eye::index))? {
             Some(listed) => (
                 Some(regions_of(
                     s,
@@ -359,17 +367,13 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
                     listed.file.display()
                 )),
             ),
-            None => (
-                Some(regions(s, args.eye, w, h)),
-                Some(format!(
-                    "neutral head, {} eye",
-                    if args.eye == Eye::Left {
-                        "left"
-                    } else {
-                        "right"
-                    }
-                )),
-            ),
+            None => {
+                let eye = args.eye.unwrap_or(Eye::Left);
+                (
+                    Some(regions(s, eye, w, h)),
+                    Some(format!("neutral head, {} eye", EYE_NAMES[eye.index()])),
+                )
+            }
         },
         None => (None, None),
     };

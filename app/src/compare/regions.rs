@@ -61,6 +61,16 @@ pub enum Eye {
     Right,
 }
 
+impl Eye {
+    /// 0 for the left eye, 1 for the right (as in `EYE_NAMES` and a frame's views).
+    pub fn index(self) -> usize {
+        match self {
+            Eye::Left => 0,
+            Eye::Right => 1,
+        }
+    }
+}
+
 /// The region of every pixel of a `width` x `height` image of `eye` at the scene's neutral
 /// head (looking down -z from `viewer.head_position_m`), row by row.
 pub fn regions(scene: &Scene, eye: Eye, width: u32, height: u32) -> Vec<Region> {

@@ -500,3 +500,27 @@ fn outputs_that_would_replace_an_input_are_refused_before_anything_is_written() 
     assert_eq!(std::fs::read(&framed).unwrap(), trace_before);
     assert!(!out.join("summary.json").exists());
 }
+
+#[test]
+fn a_reference_of_the_saved_frames_while_saving_none_is_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    for option in ["--compare-reference", "--reference"] {
+        let out = vitreous(
+            &[
+                "replay",
+                &scene("glass-sphere.toml"),
+                option,
+                "--save-every",
+                "0",
+                "--frames",
+                "2",
+                "--out",
+                out_dir.to_str().unwrap(),
+            ],
+            dir.path(),
+        );
+        assert_clean_failure(&out, &[option, "--save-every 0 saves none"]);
+        assert!(!out_dir.exists(), "output folder created with {option}");
+    }
+}

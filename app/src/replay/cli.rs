@@ -140,10 +140,44 @@ pub fn replay_command(a: ReplayArgs) -> Result<()> {
     if let Some(s) = &summary.separability {
         println!("{}", s.line());
     }
-    println!(
-        "wrote {} images and summary.json to {}",
-        summary.saved.len(),
-        out.display()
-    );
+    println!("{}", written_line(&summary.saved, &out));
     Ok(())
+}
+
+/// What a replay wrote into `out`, `saved` the files besides `summary.json`: the images
+/// counted, every other file named (`frames/reference.json`).
+fn written_line(saved: &[String], out: &std::path::Path) -> String {
+    let images = saved.iter().filter(|f| f.ends_with(".png")).count();
+    let mut files: Vec<&str> = saved
+        .iter()
+        .filter(|f| !f.ends_with(".png"))
+        .map(String::as_str)
+        .collect();
+    files.push("summary.json");
+    let last = files.pop().unwrap_or_default();
+    let mut parts = vec![format!(
+        "{images} image{}",
+        if images == 1 { "" } else { "s" }
+    )];
+    parts.extend(files.iter().map(|f| f.to_string()));
+    format!("wrote {} and {last} to {}", parts.join(", "), out.display())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_written_line_counts_images_and_names_other_files() {
+        let out = std::path::Path::new("out/x");
+        let saved = ["frames/000000-left.png", "frames/reference.json"].map(String::from);
+        assert_eq!(
+            written_line(&saved, out),
+            "wrote 1 image, frames/reference.json and summary.json to out/x"
+        );
+        assert_eq!(
+            written_line(&[], out),
+            "wrote 0 images and summary.json to out/x"
+        );
+    }
 }

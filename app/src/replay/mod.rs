@@ -263,6 +263,19 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
             options.frame_rate_hz
         );
     }
+    if options.save_every == 0 {
+        for (asked, option) in [
+            (options.compare_reference, "--compare-reference"),
+            (options.reference, "--reference"),
+        ] {
+            if asked {
+                bail!(
+                    "{option} works on the saved frames, and --save-every 0 saves none: give \
+                     --save-every K (1 or more)"
+                );
+            }
+        }
+    }
     let (samples, edits, trace_name) = load_trace_with_edits(&scene, options.trace.as_deref())?;
     let mut inputs = InputFiles::new();
     inputs.add_scene(&scene, "SCENE");

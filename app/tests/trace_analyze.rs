@@ -400,3 +400,35 @@ fn analyze_prints_each_fallback_note_once_per_run() {
     let log = String::from_utf8_lossy(&out.stderr);
     assert_eq!(log.matches("carries a fixation point").count(), 1, "{log}");
 }
+
+/// A trace of its header alone is refused as replay and reference refuse it, naming the file;
+/// the plot is not written.
+#[test]
+fn analyze_and_plot_refuse_a_trace_without_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("empty.csv");
+    let writer = TraceWriter::new(Vec::new()).unwrap();
+    std::fs::write(&trace, writer.finish().unwrap()).unwrap();
+    let scene = workspace().join("config/scenes/glass-sphere.toml");
+    let (t, s) = (trace.to_str().unwrap(), scene.to_str().unwrap());
+    let plot = dir.path().join("depth.png");
+    for args in [
+        vec!["trace", "analyze", t, "--scene", s],
+        vec![
+            "trace",
+            "plot",
+            t,
+            "--scene",
+            s,
+            "-o",
+            plot.to_str().unwrap(),
+        ],
+        vec!["replay", s, "--trace", t],
+        vec!["reference", s, "--trace", t],
+    ] {
+        let out = crate::cli::vitreous(&args, dir.path());
+        let message = crate::cli::assert_clean_failure(&out, &["empty.csv", "has no samples"]);
+        assert!(out.stdout.is_empty(), "{message}");
+    }
+    assert!(!plot.exists());
+}

@@ -18,6 +18,18 @@ pub fn check_size(width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
+/// Refuses a trace with no samples (its header alone), naming it: there is nothing to
+/// `purpose` (`replay`, `analyse`).
+pub fn ensure_samples(path: &Path, samples: &[TraceSample], purpose: &str) -> Result<()> {
+    if samples.is_empty() {
+        bail!(
+            "trace {} has no samples: nothing to {purpose}",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// Loads the trace or synthesises one for the scene.
 pub fn load_trace(scene: &Scene, trace: Option<&Path>) -> Result<(Vec<TraceSample>, String)> {
     load_trace_with_edits(scene, trace).map(|(samples, _, name)| (samples, name))
@@ -31,9 +43,7 @@ pub fn load_trace_with_edits(
     match trace {
         Some(path) => {
             let (samples, edits) = read_trace_with_edits(path).context("reading the trace")?;
-            if samples.is_empty() {
-                bail!("trace {} has no samples: nothing to replay", path.display());
-            }
+            ensure_samples(path, &samples, "replay")?;
             Ok((samples, edits, path.display().to_string()))
         }
         None => {

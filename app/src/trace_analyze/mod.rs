@@ -51,6 +51,7 @@ use crate::gaze::{
 };
 use crate::input_files::InputFiles;
 use crate::scene::{gaze_image_of_target, load_scene};
+use crate::setup::ensure_samples;
 
 pub(crate) mod plot;
 mod report;
@@ -526,8 +527,8 @@ pub fn analyze_trace_file(
     Ok(analyze(&samples, Truth::FromRawDepth, &config))
 }
 
-/// The trace's samples and the analysis settings for a scene (its image distances) and
-/// `filters` (empty: every offered filter), with the files read.
+/// The trace's samples (refused when it has none) and the analysis settings for a scene (its
+/// image distances) and `filters` (empty: every offered filter), with the files read.
 pub(super) fn load_inputs(
     trace: &Path,
     scene: &Path,
@@ -536,6 +537,7 @@ pub(super) fn load_inputs(
     let scene = load_scene(scene).context("loading the scene")?;
     // The trace's errors name its file and line.
     let samples = vitreous_xr::read_trace(trace).context("reading the trace")?;
+    ensure_samples(trace, &samples, "analyse")?;
     let mut config = AnalyzeConfig::for_scene(&scene);
     if !filters.is_empty() {
         config.filters = filters.to_vec();

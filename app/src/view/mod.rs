@@ -253,9 +253,7 @@ fn view_with(options: &ViewOptions, director: Option<&mut dyn Director>) -> Resu
     if let Some(path) = &options.trace {
         let (samples, edits) = vitreous_xr::trace::read_trace_with_edits(path)
             .with_context(|| format!("reading trace {}", path.display()))?;
-        if samples.is_empty() {
-            bail!("trace {} has no samples: nothing to play", path.display());
-        }
+        crate::setup::ensure_samples(path, &samples, "play")?;
         backend.play(playback::Playback::new(samples));
         played_edits = edits;
     }

@@ -268,3 +268,53 @@ fn a_motion_a_real_room_allows_and_a_warning_already_given_at_rest_add_nothing()
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(w[0].contains("(light.position_m)"), "{}", w[0]);
 }
+
+#[test]
+fn an_object_behind_the_wall_out_of_the_viewers_sight_is_named_with_its_fields() {
+    // Half a metre behind the wall, its light (following it) behind it too: only the wall
+    // between the viewer's head (at the origin) and the object.
+    let behind = with(
+        "position_m = [0.0, -0.26, -1.5]",
+        "position_m = [0.0, -0.26, -2.5]",
+    );
+    let w = warnings(&behind);
+    assert_eq!(w.len(), 1, "{w:?}");
+    for part in [
+        "the background (background.position_m, background.size_m)",
+        "the viewer (viewer.head_position_m)",
+        "the object (object.position_m)",
+        "at [0.00, -0.21, -2.00] m",
+        "could not see a real object there",
+    ] {
+        assert!(w[0].contains(part), "{} does not say {part}", w[0]);
+    }
+    // The viewer's head from the scene: behind the wall as well, the object is in sight.
+    let beside = behind.replace(
+        "ipd_mm = 63.0",
+        "ipd_mm = 63.0\nhead_position_m = [0.0, 0.0, -2.3]",
+    );
+    assert_eq!(warnings(&beside), Vec::<String>::new());
+}
+
+#[test]
+fn an_object_keyframe_behind_the_wall_is_named_with_its_time() {
+    // From its place on the table to 1 m further over 2 s: behind the wall (0.5 m behind
+    // its place) from 1 s on, first seen at the check 1.2 s in.
+    let text = resting_with_motion(
+        "[[motion.object]]\ntime_s = 0.0\nposition_m = [0.0, -0.26, -1.5]\n\
+         [[motion.object]]\ntime_s = 2.0\nposition_m = [0.0, -0.26, -2.5]\n",
+    );
+    let w = warnings(&text);
+    let hidden = w
+        .iter()
+        .find(|w| w.contains("the viewer"))
+        .unwrap_or_else(|| panic!("{w:?}"));
+    for part in [
+        "1.20 s into its motion (motion.object)",
+        "the background (background.position_m, background.size_m)",
+        "the viewer (viewer.head_position_m)",
+        "change the keyframes",
+    ] {
+        assert!(hidden.contains(part), "{hidden} does not say {part}");
+    }
+}

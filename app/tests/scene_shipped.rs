@@ -65,8 +65,8 @@ fn every_shipped_scene_loads() {
             scene.environment.latlong.data,
             PixelData::LinearF32(_)
         ));
-        // A real room could hold it: no wall between the light and the object, nothing sunk
-        // into the floor.
+        // A real room could hold it: no wall between the light or the viewer and the object,
+        // nothing sunk into the floor.
         assert_eq!(scene.warnings, Vec::<String>::new(), "{}", path.display());
     }
 }

@@ -1,8 +1,10 @@
 //! Whether a loaded scene could exist: a real plane standing between the light and the object
 //! (a real wall there would shade the whole table, which neither the shadow nor the caustic
-//! bake knows), and an object sunk into the floor. Each is a warning naming the scene file
-//! and the fields to change, not an error: the paper's own layouts are kept loadable. The
-//! resting placement is checked, and so is every placement its `[motion]` goes through.
+//! bake knows), a real plane standing between the viewer's head and the object (the object
+//! would be out of sight, yet the display draws it over the plane), and an object sunk into
+//! the floor. Each is a warning naming the scene file and the fields to change, not an error:
+//! the paper's own layouts are kept loadable. The resting placement is checked, and so is
+//! every placement its `[motion]` goes through, from the viewer's `head_position_m`.
 
 use glam::{Mat4, Vec3};
 
@@ -26,6 +28,9 @@ enum Finding {
     /// A plane (`"background"` or `"floor"`) stands between the light and the object, its
     /// path crossing it here.
     Between(&'static str, Vec3),
+    /// A plane stands between the viewer's head and the object, the line of sight crossing
+    /// it here.
+    Hidden(&'static str, Vec3),
     /// The object reaches this far into the floor, metres.
     Sunk(f32),
 }
@@ -34,21 +39,23 @@ impl Finding {
     /// Whether `other` is the same kind of finding (for the same plane).
     fn same_kind(&self, other: &Finding) -> bool {
         match (self, other) {
-            (Finding::Between(a, _), Finding::Between(b, _)) => a == b,
+            (Finding::Between(a, _), Finding::Between(b, _))
+            | (Finding::Hidden(a, _), Finding::Hidden(b, _)) => a == b,
             (Finding::Sunk(_), Finding::Sunk(_)) => true,
             _ => false,
         }
     }
 }
 
-/// The warnings for a scene: its resting placement (the object and light as loaded), then the
-/// placements its `motion` goes through ([`motion_warnings`]); `light_in_frame_m` is
-/// `[light] position_m` as written.
+/// The warnings for a scene seen from `viewer_m` (`[viewer] head_position_m`): its resting
+/// placement (the object and light as loaded), then the placements its `motion` goes through
+/// ([`motion_warnings`]); `light_in_frame_m` is `[light] position_m` as written.
 pub fn warnings(
     object: &Object,
     light: &Light,
     floor: &RealPlane,
     background: &RealPlane,
+    viewer_m: Vec3,
     motion: &Motion,
     light_in_frame_m: Vec3,
 ) -> Vec<String> {
@@ -57,6 +64,7 @@ pub fn warnings(
         world_from_model: object.world_from_model,
         center_m: object.center_m,
         light_m: light.position_m,
+        viewer_m,
     };
     let mut out: Vec<String> = placed
         .findings(floor, background)
@@ -73,6 +81,7 @@ pub fn warnings(
         motion,
         rest,
         light_in_frame_m,
+        viewer_m,
         floor,
         background,
     ));
@@ -82,12 +91,14 @@ pub fn warnings(
 /// The warnings for the placements `motion` goes through (at every keyframe, at
 /// [`BETWEEN_KEYFRAMES`] times between two, at most [`MAX_CHECKED`] in all) that the resting
 /// placement `rest` does not already give, each kind once, at the first time it happens.
-/// `rest_light_in_frame_m` is `[light] position_m` as written.
+/// `rest_light_in_frame_m` is `[light] position_m` as written; the viewer stays at
+/// `viewer_m`.
 fn motion_warnings(
     object: &Object,
     motion: &Motion,
     rest: Placement,
     rest_light_in_frame_m: Vec3,
+    viewer_m: Vec3,
     floor: &RealPlane,
     background: &RealPlane,
 ) -> Vec<String> {
@@ -99,6 +110,7 @@ fn motion_warnings(
         world_from_model: object.world_from_model_at(p.object_position_m, p.object_rotation),
         center_m: p.object_position_m,
         light_m: p.light_position_m,
+        viewer_m,
     };
     let mut known = placed_at(rest).findings(floor, background);
     let mut out = Vec::new();
@@ -146,6 +158,8 @@ struct Placed<'a> {
     world_from_model: Mat4,
     center_m: Vec3,
     light_m: Vec3,
+    /// The viewer's head.
+    viewer_m: Vec3,
 }
 
 impl Placed<'_> {
@@ -154,6 +168,9 @@ impl Placed<'_> {
         for (name, plane) in [("background", background), ("floor", floor)] {
             if let Some(at) = crossing(plane, self.light_m, self.center_m) {
                 out.push(Finding::Between(name, at));
+            }
+            if let Some(at) = crossing(plane, self.viewer_m, self.center_m) {
+                out.push(Finding::Hidden(name, at));
             }
         }
         // No vertex reaches further than the bounding sphere: most placements need no look
@@ -193,6 +210,13 @@ fn at_rest(finding: &Finding) -> String {
              shadow inducer nor the caustics know; move the {name} or the light",
             at.x, at.y, at.z
         ),
+        Finding::Hidden(name, at) => format!(
+            "the {name} ({name}.position_m, {name}.size_m) stands between the viewer \
+             (viewer.head_position_m) and the object (object.position_m), at [{:.2}, {:.2}, \
+             {:.2}] m: the viewer could not see a real object there, the {name} hides it, yet \
+             the display draws it over the {name}; move the object or the {name}",
+            at.x, at.y, at.z
+        ),
         Finding::Sunk(depth) => format!(
             "the object reaches {:.0} mm into the floor (object.position_m and \
              object.diameter_m against floor.position_m): a real object would rest on it; \
@@ -215,6 +239,14 @@ fn in_motion(finding: &Finding, time_s: f64, motion: &Motion) -> String {
              {name}.size_m) stands between the light and the object, at [{:.2}, {:.2}, {:.2}] m: \
              a real {name} there would shade the object and the floor around it, which neither \
              the shadow inducer nor the caustics know; change the keyframes or move the {name}",
+            at.x, at.y, at.z
+        ),
+        Finding::Hidden(name, at) => format!(
+            "{time_s:.2} s into its motion ({keys}), the {name} ({name}.position_m, \
+             {name}.size_m) stands between the viewer (viewer.head_position_m) and the object, \
+             at [{:.2}, {:.2}, {:.2}] m: the viewer could not see a real object there, the \
+             {name} hides it, yet the display draws it over the {name}; change the keyframes \
+             or move the {name}",
             at.x, at.y, at.z
         ),
         Finding::Sunk(depth) => format!(

@@ -473,6 +473,7 @@ impl Loader<'_> {
             &light,
             &floor,
             &background,
+            viewer.head_position_m,
             &motion,
             light_offset,
         );

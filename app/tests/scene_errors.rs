@@ -151,7 +151,10 @@ fn unknown_table_is_named() {
 fn wrong_type_is_named() {
     let text = good_text().replace("diameter_m = 0.08", "diameter_m = \"big\"");
     let msg = expect_error(&text, line_of(&text, "diameter_m"), "object.diameter_m");
-    assert!(msg.contains("invalid type"), "{msg}");
+    assert!(
+        msg.contains("expected a number, found string \"big\""),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -207,9 +210,11 @@ fn out_of_range_value_is_named() {
             line_of(&text, "glass_samples"),
             "output.glass_samples",
         );
-        // Not a whole number: the TOML type is wrong, named all the same.
+        // A fraction is refused as a number out of range is, with the range in words.
         assert!(
-            msg.contains("1..=8") || msg.contains("expected i64"),
+            msg.contains(
+                "expected a whole number of positions along each side of a pixel from 1 to 8"
+            ),
             "{msg}"
         );
         assert!(msg.contains(samples), "{msg}");
@@ -483,5 +488,44 @@ fn caustics_mode_and_live_sizes_are_checked() {
     assert_eq!(
         (map.width_px, map.height_px, map.gain.len()),
         (64, 64, 64 * 64)
+    );
+}
+
+/// A value of the wrong type says what the field takes in words (the range of a whole number),
+/// never a Rust type such as `i64` or `i128`.
+#[test]
+fn wrong_types_and_huge_numbers_are_named_in_words() {
+    for (value, says) in [
+        (
+            "1.5",
+            "expected a whole number of pixels from 16 to 8192, found 1.5",
+        ),
+        (
+            "99999999999999999999",
+            "expected a whole number of pixels from 16 to 8192, found 99999999999999999999",
+        ),
+        (
+            "-3",
+            "expected a whole number of pixels from 16 to 8192, found -3",
+        ),
+        ("\"wide\"", "expected a whole number, found string \"wide\""),
+    ] {
+        let text = good_text().replace("width_px = 1280", &format!("width_px = {value}"));
+        let msg = expect_error(&text, line_of(&text, "width_px"), "output.width_px");
+        assert!(msg.contains(says), "{value}: {msg}");
+        assert!(!msg.contains("i64") && !msg.contains("i128"), "{msg}");
+    }
+    let text = good_text().replace("ipd_mm = 63.0", "ipd_mm = 99999999999999999999");
+    let msg = expect_error(&text, line_of(&text, "ipd_mm"), "viewer.ipd_mm");
+    assert!(!msg.contains("i128"), "{msg}");
+    let text = good_text().replace("[output]", "[inducer]\nresolution_px = 0.5\n\n[output]");
+    let msg = expect_error(
+        &text,
+        line_of(&text, "resolution_px"),
+        "inducer.resolution_px",
+    );
+    assert!(
+        msg.contains("a whole number of texels from 16 to 4096"),
+        "{msg}"
     );
 }

@@ -190,7 +190,11 @@ impl Source<'_> {
                 } else {
                     path.join(".")
                 };
-                SceneError::Invalid { at, field, message }
+                SceneError::Invalid {
+                    at,
+                    field,
+                    message: in_words(&message),
+                }
             }
         }
     }
@@ -293,6 +297,33 @@ fn unclosed_bracket(text: &str, offset: usize) -> Option<(usize, char)> {
     stack.contains(&candidate).then_some(candidate)
 }
 
+/// A value of the wrong type in words: serde's `invalid type: string "x", expected f32` as
+/// `expected a number, found string "x"`, the Rust type names (`f32`, `i64`) said as what they
+/// hold and a sequence as TOML's array; any other message as it is.
+fn in_words(message: &str) -> String {
+    const NAMES: [(&str, &str); 4] = [
+        ("f32", "a number"),
+        ("f64", "a number"),
+        ("i64", "a whole number"),
+        ("a sequence", "an array"),
+    ];
+    let Some(rest) = ["invalid type: ", "invalid value: "]
+        .iter()
+        .find_map(|p| message.strip_prefix(p))
+    else {
+        return message.to_owned();
+    };
+    let Some((found, expected)) = rest.rsplit_once(", expected ") else {
+        return message.to_owned();
+    };
+    let expected = NAMES
+        .iter()
+        .find(|(name, _)| *name == expected)
+        .map_or(expected, |(_, words)| words);
+    let found = found.replace(" as i128", "").replace(" as u128", "");
+    format!("expected {expected}, found {found}")
+}
+
 fn table_header(line: &str) -> Option<String> {
     let inner = line.strip_prefix('[')?;
     let end = inner.find(']')?;
@@ -358,6 +389,19 @@ mod tests {
         assert_eq!(unclosed_bracket(text, text.find('x').unwrap()), None);
         let text = "a = \"[\" # {\nb = '''[\n'''\nc = [1, {x = 2}]\nd = = 1\n";
         assert_eq!(unclosed_bracket(text, text.find("= =").unwrap()), None);
+    }
+
+    #[test]
+    fn type_errors_are_said_in_words() {
+        assert_eq!(
+            in_words("invalid type: string \"x\", expected f32"),
+            "expected a number, found string \"x\""
+        );
+        assert_eq!(
+            in_words("invalid type: integer `99999999999999999999` as i128, expected i64"),
+            "expected a whole number, found integer `99999999999999999999`"
+        );
+        assert_eq!(in_words("missing field `model`"), "missing field `model`");
     }
 
     #[test]

@@ -4,8 +4,68 @@
 //! read as `Vec` and their length checked on resolving, because serde's arrays ignore extra
 //! elements.
 
+use std::fmt;
+
 use serde::Deserialize;
 use toml::Spanned;
+
+/// A number where the scene file wants a whole one, kept as written (a fraction, or a whole
+/// number beyond 64 bits, as well as one that fits) so that the field's own check can say
+/// what it expects, in words, rather than the parser's `expected i64`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Whole {
+    /// A whole number.
+    Int(i128),
+    /// A number with a fraction (or an exponent).
+    Fraction(f64),
+}
+
+impl Whole {
+    /// The number as a `u32`, when it is a whole one that fits.
+    pub fn to_u32(self) -> Option<u32> {
+        match self {
+            Whole::Int(n) => u32::try_from(n).ok(),
+            Whole::Fraction(_) => None,
+        }
+    }
+}
+
+impl fmt::Display for Whole {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Whole::Int(n) => write!(f, "{n}"),
+            Whole::Fraction(x) => write!(f, "{x}"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Whole {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Whole, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = Whole;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("a whole number")
+            }
+            fn visit_i64<E>(self, v: i64) -> Result<Whole, E> {
+                Ok(Whole::Int(v.into()))
+            }
+            fn visit_u64<E>(self, v: u64) -> Result<Whole, E> {
+                Ok(Whole::Int(v.into()))
+            }
+            fn visit_i128<E>(self, v: i128) -> Result<Whole, E> {
+                Ok(Whole::Int(v))
+            }
+            fn visit_u128<E>(self, v: u128) -> Result<Whole, E> {
+                Ok(i128::try_from(v).map_or(Whole::Fraction(v as f64), Whole::Int))
+            }
+            fn visit_f64<E>(self, v: f64) -> Result<Whole, E> {
+                Ok(Whole::Fraction(v))
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
+}
 
 /// The whole scene file.
 #[derive(Debug, Deserialize)]
@@ -80,9 +140,9 @@ pub(crate) struct LightKeyToml {
 pub(crate) struct CausticsToml {
     pub bake: Option<Spanned<String>>,
     pub mode: Option<Spanned<String>>,
-    pub resolution_px: Option<Spanned<i64>>,
-    pub photons_per_side: Option<Spanned<i64>>,
-    pub smoothing_px: Option<Spanned<i64>>,
+    pub resolution_px: Option<Spanned<Whole>>,
+    pub photons_per_side: Option<Spanned<Whole>>,
+    pub smoothing_px: Option<Spanned<Whole>>,
     pub min_path_weight: Option<Spanned<f32>>,
 }
 
@@ -167,11 +227,11 @@ pub(crate) struct ViewerToml {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct OutputToml {
-    pub width_px: Option<Spanned<i64>>,
-    pub height_px: Option<Spanned<i64>>,
+    pub width_px: Option<Spanned<Whole>>,
+    pub height_px: Option<Spanned<Whole>>,
     pub horizontal_fov_deg: Option<Spanned<f32>>,
     pub vertical_fov_deg: Option<Spanned<f32>>,
-    pub glass_samples: Option<Spanned<i64>>,
+    pub glass_samples: Option<Spanned<Whole>>,
 }
 
 /// `[effects]`: the perception-based effects to render.
@@ -187,7 +247,7 @@ pub(crate) struct EffectsToml {
 pub(crate) struct InducerToml {
     pub k: Option<Spanned<f32>>,
     pub ramp_width_m: Option<Spanned<f32>>,
-    pub resolution_px: Option<Spanned<i64>>,
+    pub resolution_px: Option<Spanned<Whole>>,
 }
 
 /// Largest scene file read, bytes: a scene is a short TOML text, and a huge file (a model or

@@ -18,7 +18,7 @@ use vitreous_render::floor::{
 use vitreous_xr::{Fov, Pose};
 
 use super::error::Source;
-use super::file::{LightFrame, PlaneToml, SceneFile};
+use super::file::{LightFrame, PlaneToml, SceneFile, Whole};
 use super::mesh::VolumeAttenuation;
 use super::{
     Caustics, CausticsMode, Environment, GazeChoice, Image, Inducer, IorSource, Light, MeshLens,
@@ -311,16 +311,8 @@ impl Loader<'_> {
         };
 
         let o = &raw.output;
-        let pixels = |field: &str, v: Option<&Spanned<i64>>, default: u32| match v {
-            None => Ok(default),
-            Some(v) => match u32::try_from(*v.get_ref()) {
-                Ok(px) if (16..=8192).contains(&px) => Ok(px),
-                _ => Err(self.src.invalid(
-                    v.span(),
-                    field,
-                    format!("expected 16..=8192 pixels, found {}", v.get_ref()),
-                )),
-            },
+        let pixels = |field: &str, v: Option<&Spanned<Whole>>, default: u32| {
+            self.count(field, v, default, 16..=8192, "pixels")
         };
         let width_px = pixels("output.width_px", o.width_px.as_ref(), 1280)?;
         let height_px = pixels("output.height_px", o.height_px.as_ref(), 960)?;
@@ -338,23 +330,13 @@ impl Loader<'_> {
             (1.0, 170.0),
             CLOSED,
         )?;
-        let glass_samples = match &o.glass_samples {
-            None => 1,
-            Some(v) => match u32::try_from(*v.get_ref()) {
-                Ok(n) if (1..=MAX_GLASS_SAMPLES).contains(&n) => n,
-                _ => {
-                    return Err(self.src.invalid(
-                        v.span(),
-                        "output.glass_samples",
-                        format!(
-                            "expected 1..={MAX_GLASS_SAMPLES} positions along each side of a \
-                             pixel, found {}",
-                            v.get_ref()
-                        ),
-                    ));
-                }
-            },
-        };
+        let glass_samples = self.count(
+            "output.glass_samples",
+            o.glass_samples.as_ref(),
+            1,
+            1..=MAX_GLASS_SAMPLES,
+            "positions along each side of a pixel",
+        )?;
         let output = Output {
             width_px,
             height_px,
@@ -402,18 +384,21 @@ impl Loader<'_> {
                 raw.caustics.resolution_px.as_ref(),
                 DEFAULT_LIVE_RESOLUTION_PX,
                 16..=4096,
+                "texels",
             )?,
             photons_per_side: self.count(
                 "caustics.photons_per_side",
                 raw.caustics.photons_per_side.as_ref(),
                 live_default.photons_per_side,
                 1..=MAX_PHOTONS_PER_SIDE,
+                "photons",
             )?,
             smoothing_px: self.count(
                 "caustics.smoothing_px",
                 raw.caustics.smoothing_px.as_ref(),
                 live_default.smoothing_px,
                 0..=MAX_SMOOTHING_PX,
+                "texels",
             )?,
             min_path_weight: self.number(
                 "caustics.min_path_weight",
@@ -501,24 +486,26 @@ impl Loader<'_> {
         })
     }
 
-    /// A whole number within `range`, `default` when absent.
+    /// A whole number of `unit` within `range`, `default` when absent; anything else (a
+    /// fraction, a number out of range) is refused with the range in words.
     fn count(
         &self,
         field: &str,
-        v: Option<&Spanned<i64>>,
+        v: Option<&Spanned<Whole>>,
         default: u32,
         range: std::ops::RangeInclusive<u32>,
+        unit: &str,
     ) -> Result<u32, SceneError> {
         let Some(v) = v else {
             return Ok(default);
         };
-        match u32::try_from(*v.get_ref()) {
-            Ok(n) if range.contains(&n) => Ok(n),
+        match v.get_ref().to_u32() {
+            Some(n) if range.contains(&n) => Ok(n),
             _ => Err(self.src.invalid(
                 v.span(),
                 field,
                 format!(
-                    "expected a whole number within {}..={}, found {}",
+                    "expected a whole number of {unit} from {} to {}, found {}",
                     range.start(),
                     range.end(),
                     v.get_ref()
@@ -529,19 +516,13 @@ impl Loader<'_> {
 
     fn inducer(&self, raw: &file::InducerToml) -> Result<Inducer, SceneError> {
         let default = Inducer::default();
-        let resolution_px = match &raw.resolution_px {
-            None => default.resolution_px,
-            Some(v) => match u32::try_from(*v.get_ref()) {
-                Ok(px) if (16..=4096).contains(&px) => px,
-                _ => {
-                    return Err(self.src.invalid(
-                        v.span(),
-                        "inducer.resolution_px",
-                        format!("expected 16..=4096 texels, found {}", v.get_ref()),
-                    ));
-                }
-            },
-        };
+        let resolution_px = self.count(
+            "inducer.resolution_px",
+            raw.resolution_px.as_ref(),
+            default.resolution_px,
+            16..=4096,
+            "texels",
+        )?;
         Ok(Inducer {
             k: self.number("inducer.k", raw.k.as_ref(), default.k, (0.0, 10.0), CLOSED)?,
             ramp_width_m: self.number(

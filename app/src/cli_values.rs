@@ -1,5 +1,11 @@
 //! Command-line values: each parser takes the text after an option and returns the value or a
-//! message saying what was expected and what was found (clap names the option).
+//! message saying what was expected and what was found (clap names the option). An option
+//! that takes a number accepts a leading hyphen (`allow_negative_numbers`, or
+//! `allow_hyphen_values` for `WxH`), so that `-1` reaches its parser and is refused there
+//! with the option named, not taken for an option of its own.
+
+use std::ops::RangeInclusive;
+use std::str::FromStr;
 
 use vitreous_render::Reflection;
 
@@ -18,17 +24,63 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
-/// A frame count for `--frames`: a whole number of at least 1 (0 would be an empty run).
-pub fn parse_frame_count(s: &str) -> Result<u64, String> {
-    match s.trim().parse::<i128>() {
-        Ok(n) if n >= 1 && n <= i128::from(u64::MAX) => Ok(n as u64),
-        Ok(n) if n < 1 => Err(format!(
-            "expected a number of frames of at least 1, got {n}"
-        )),
+/// A whole number of `unit` (`frames`; empty for a bare number) within `range`: below it, or
+/// not a whole number, is refused saying what was expected; above it, saying it is too large
+/// and what the most is.
+pub fn whole_number(s: &str, range: RangeInclusive<u64>, unit: &str) -> Result<u64, String> {
+    let text = s.trim();
+    let (negative, digits) = match text.strip_prefix('-') {
+        Some(rest) => (true, rest),
+        None => (false, text.strip_prefix('+').unwrap_or(text)),
+    };
+    let of = if unit.is_empty() {
+        String::new()
+    } else {
+        format!(" of {unit}")
+    };
+    let (low, high) = (*range.start(), *range.end());
+    let expected = if high == u64::MAX {
+        format!("a whole number{of}, at least {low}")
+    } else {
+        format!("a whole number{of} from {low} to {high}")
+    };
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(format!("expected {expected}, got '{s}'"));
+    }
+    if negative && digits.bytes().any(|b| b != b'0') {
+        return Err(format!("expected {expected}, got {text}"));
+    }
+    match digits.parse::<u64>() {
+        Ok(n) if range.contains(&n) => Ok(n),
+        Ok(n) if n < low => Err(format!("expected {expected}, got {n}")),
         _ => Err(format!(
-            "expected a whole number of frames (1 or more), got '{s}'"
+            "{} is too large: expected a whole number{of} from {low} to {high}",
+            digits.trim_start_matches('0')
         )),
     }
+}
+
+/// A number (fractions allowed): what it may be is checked where it is used, which names the
+/// option and its range.
+pub fn number<T: FromStr>(s: &str) -> Result<T, String> {
+    s.trim()
+        .parse()
+        .map_err(|_| format!("expected a number, got '{s}'"))
+}
+
+/// A frame count for `--frames`: a whole number of at least 1 (0 would be an empty run).
+pub fn parse_frame_count(s: &str) -> Result<u64, String> {
+    whole_number(s, 1..=u64::MAX, "frames")
+}
+
+/// Which frames are saved, `--save-every K`: every K-th, 0 for none.
+pub fn parse_save_every(s: &str) -> Result<u64, String> {
+    whole_number(s, 0..=u64::MAX, "frames")
+}
+
+/// A random seed: any whole number from 0 to the largest 64-bit one.
+pub fn parse_seed(s: &str) -> Result<u64, String> {
+    whole_number(s, 0..=u64::MAX, "")
 }
 
 /// As [`parse_frame_count`], for counts held in `usize`.
@@ -106,6 +158,37 @@ mod tests {
         assert!(parse_frame_count("0").unwrap_err().contains("at least 1"));
         assert!(parse_frame_count("-1").unwrap_err().contains("at least 1"));
         assert!(parse_frame_count("x").unwrap_err().contains("whole number"));
+        assert!(parse_frame_count("-0").unwrap_err().contains("at least 1"));
+        let large = parse_frame_count("99999999999999999999").unwrap_err();
+        assert!(
+            large.starts_with("99999999999999999999 is too large"),
+            "{large}"
+        );
+        assert!(large.contains(&u64::MAX.to_string()), "{large}");
+        assert_eq!(parse_frame_count(&u64::MAX.to_string()), Ok(u64::MAX));
+    }
+
+    #[test]
+    fn whole_numbers_name_their_range_and_unit() {
+        assert_eq!(whole_number("+7", 1..=10, "trials"), Ok(7));
+        assert_eq!(
+            whole_number("11", 1..=10, "trials"),
+            Err("11 is too large: expected a whole number of trials from 1 to 10".into())
+        );
+        assert_eq!(
+            whole_number("-3", 1..=10, "trials"),
+            Err("expected a whole number of trials from 1 to 10, got -3".into())
+        );
+        assert_eq!(
+            whole_number("2.5", 0..=u64::MAX, ""),
+            Err("expected a whole number, at least 0, got '2.5'".into())
+        );
+        assert_eq!(parse_save_every("0"), Ok(0));
+        assert_eq!(number::<f64>("-1.5"), Ok(-1.5));
+        assert_eq!(
+            number::<f32>("fast"),
+            Err("expected a number, got 'fast'".into())
+        );
     }
 
     #[test]

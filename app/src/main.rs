@@ -10,8 +10,8 @@ use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
 use vitreous::bench::{BenchOptions, bench};
 use vitreous::cli_values::{
-    ReflectionArg, parse_effects, parse_frame_count, parse_frame_count_usize, parse_kappa_deg,
-    parse_pupil_mm, parse_size,
+    ReflectionArg, number, parse_effects, parse_frame_count, parse_frame_count_usize,
+    parse_kappa_deg, parse_pupil_mm, parse_seed, parse_size,
 };
 use vitreous::effects::EffectSet;
 use vitreous::error_report::error_text;
@@ -50,7 +50,8 @@ enum Command {
         #[arg(long, value_name = "LIST", value_parser = parse_effects, default_value = "O4")]
         effects: Vec<EffectSet>,
         /// Eye image size (the Magic Leap One's by default).
-        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "1280x960")]
+        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "1280x960",
+              allow_hyphen_values = true)]
         size: (u32, u32),
         /// Timed frames per variant.
         #[arg(long, value_name = "N", default_value_t = 60, allow_negative_numbers = true,
@@ -102,18 +103,15 @@ enum Command {
         #[arg(default_value = "config/scenes/glass-sphere.toml")]
         scene: PathBuf,
         /// How long to keep replaying, minutes.
-        #[arg(
-            long,
-            value_name = "MIN",
-            default_value_t = 30.0,
-            allow_negative_numbers = true
-        )]
+        #[arg(long, value_name = "MIN", default_value_t = 30.0, allow_negative_numbers = true,
+              value_parser = number::<f64>)]
         minutes: f64,
         /// Effects (default: the scene's); e.g. all.
         #[arg(long, value_name = "LIST", value_parser = parse_effects)]
         effects: Option<EffectSet>,
         /// Eye image size.
-        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "640x480")]
+        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "640x480",
+              allow_hyphen_values = true)]
         size: (u32, u32),
         /// Frames per pass (at most the scene's 12 s synthetic trace at 60 Hz).
         #[arg(long, value_name = "N", default_value_t = 120, allow_negative_numbers = true,
@@ -218,16 +216,19 @@ enum TraceCommand {
         #[arg(short, long)]
         out: PathBuf,
         /// Length, seconds.
-        #[arg(long, default_value_t = 12.0, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 12.0, allow_negative_numbers = true,
+              value_parser = number::<f32>)]
         duration: f32,
         /// Tracker sample rate, hertz.
-        #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 30.0, allow_negative_numbers = true,
+              value_parser = number::<f32>)]
         rate: f32,
         /// Seconds between gaze switches (0 or less: the gaze stays on the surface point).
-        #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 3.0, allow_negative_numbers = true,
+              value_parser = number::<f32>)]
         switch_period: f32,
         /// Random seed (the same seed gives the same trace).
-        #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = parse_seed)]
         seed: u64,
     },
 }

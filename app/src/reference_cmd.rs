@@ -38,28 +38,35 @@ pub struct ReferenceArgs {
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// With --trace: stop after N frames [default: 1].
-    #[arg(long, value_name = "N", value_parser = crate::cli_values::parse_frame_count)]
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          value_parser = crate::cli_values::parse_frame_count)]
     pub frames: Option<u64>,
     /// With --trace: write frames 0, K, 2K, ... (as `vitreous replay --save-every`).
-    #[arg(long, value_name = "K", default_value_t = 30)]
+    #[arg(long, value_name = "K", default_value_t = 30, allow_negative_numbers = true,
+          value_parser = crate::cli_values::parse_save_every)]
     pub save_every: u64,
     /// With --trace: the display's frame rate, hertz (as `vitreous replay --rate`).
-    #[arg(long, value_name = "HZ", default_value_t = 60.0)]
+    #[arg(long, value_name = "HZ", default_value_t = 60.0, allow_negative_numbers = true,
+          value_parser = crate::cli_values::number::<f64>)]
     pub rate: f64,
     /// Eye image size [default: the scene's `[output]`].
-    #[arg(long, value_name = "WxH", value_parser = crate::cli_values::parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = crate::cli_values::parse_size,
+          allow_hyphen_values = true)]
     pub size: Option<(u32, u32)>,
     /// Which eyes: left, right or both.
     #[arg(long, value_name = "EYE", default_value = "both", value_parser = parse_eyes)]
     pub eye: Eyes,
     /// Samples along each side of a pixel (its light is the mean over N x N positions).
-    #[arg(long, value_name = "N", default_value_t = 3, value_parser = parse_samples)]
+    #[arg(long, value_name = "N", default_value_t = 3, allow_negative_numbers = true,
+          value_parser = parse_samples)]
     pub samples: u32,
     /// Side of the floor light's texels, millimetres.
-    #[arg(long, value_name = "MM", default_value_t = 1.0, value_parser = parse_texel_mm)]
+    #[arg(long, value_name = "MM", default_value_t = 1.0, allow_negative_numbers = true,
+          value_parser = parse_texel_mm)]
     pub texel_mm: f32,
     /// Photons traced from the light per texel of floor under the object's cone.
-    #[arg(long, value_name = "N", default_value_t = 64.0, value_parser = parse_photons)]
+    #[arg(long, value_name = "N", default_value_t = 64.0, allow_negative_numbers = true,
+          value_parser = parse_photons)]
     pub photons_per_texel: f32,
     /// No progress bar.
     #[arg(long)]

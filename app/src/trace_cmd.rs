@@ -5,7 +5,7 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use vitreous_xr::synth::{SynthParams, synthesize_with_truth};
+use vitreous_xr::synth::{SynthError, SynthParams, synthesize_with_truth};
 use vitreous_xr::trace::{TraceSample, TraceWriter};
 
 use crate::input_files::InputFiles;
@@ -116,6 +116,16 @@ fn recording_files(from: &str, file: &Path) -> Vec<PathBuf> {
     files
 }
 
+/// The option of `vitreous trace synth` that sets a field of [`SynthParams`], if one does.
+fn synth_option(field: &str) -> Option<&'static str> {
+    match field {
+        "duration_s" => Some("--duration"),
+        "rate_hz" => Some("--rate"),
+        "switch_period_s" => Some("--switch-period"),
+        _ => None,
+    }
+}
+
 /// Options of `vitreous trace synth`.
 #[derive(Clone, Debug)]
 pub struct SynthOptions {
@@ -142,7 +152,18 @@ pub fn synth(scene_path: &Path, options: &SynthOptions, out: &Path) -> Result<St
         seed: options.seed,
         ..synth_params_for(&scene)
     };
-    let trace = synthesize_with_truth(&params).context("synthesising the trace")?;
+    let trace = synthesize_with_truth(&params).map_err(|e| {
+        if let SynthError::BadParam {
+            field,
+            value,
+            expected,
+        } = &e
+            && let Some(option) = synth_option(field)
+        {
+            return anyhow::anyhow!("{option} {value}: expected {expected}");
+        }
+        anyhow::Error::new(e).context("synthesising the trace")
+    })?;
     write_trace_file(&trace.samples, out)?;
     let surface = params.targets[SURFACE_TARGET].point_m.to_array();
     let refracted = params.targets[REFRACTED_TARGET].point_m.to_array();

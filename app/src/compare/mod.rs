@@ -41,7 +41,7 @@ pub struct CompareArgs {
     /// Pixels per degree of visual angle for ꟻLIP (default: the scene's, width over horizontal
     /// field of view, with --scene; else ꟻLIP's default, 67, a 0.7 m viewing distance from a
     /// 24-inch 4K monitor).
-    #[arg(long, value_name = "PPD", value_parser = parse_ppd)]
+    #[arg(long, value_name = "PPD", allow_negative_numbers = true, value_parser = parse_ppd)]
     pub ppd: Option<f32>,
     /// What the eye sees with nothing drawn (PNG, the reference's size): adds two rows, that
     /// image itself and the additive limit, the per-pixel maximum of it and the reference (the
@@ -56,7 +56,8 @@ pub struct CompareArgs {
     /// With --display and a scene whose display has a segmented dimmer: the blur the wearer's
     /// panel really has (standard deviation, degrees), instead of the scene's
     /// `dimmer_blur_deg` that the image was drawn for. Shows what a mis-measured panel costs.
-    #[arg(long, value_name = "DEG", requires = "display", value_parser = parse_blur)]
+    #[arg(long, value_name = "DEG", requires = "display", allow_negative_numbers = true,
+          value_parser = parse_blur)]
     pub panel_blur_deg: Option<f32>,
     /// Write the ꟻLIP error map here (PNG, the magma colour map: black no error, yellow most).
     #[arg(long, value_name = "FILE")]

@@ -6,7 +6,8 @@ use anyhow::{Context, Result};
 
 use super::{GazeSettings, ReplayOptions, replay};
 use crate::cli_values::{
-    ReflectionArg, parse_effects, parse_frame_count, parse_pupil_mm, parse_size,
+    ReflectionArg, number, parse_effects, parse_frame_count, parse_pupil_mm, parse_save_every,
+    parse_size,
 };
 use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, GazeOverride, PupilSource};
@@ -27,15 +28,11 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_frame_count)]
     pub frames: Option<u64>,
     /// Save every K-th frame (0: none).
-    #[arg(
-        long,
-        value_name = "K",
-        default_value_t = 30,
-        allow_negative_numbers = true
-    )]
+    #[arg(long, value_name = "K", default_value_t = 30, allow_negative_numbers = true,
+          value_parser = parse_save_every)]
     pub save_every: u64,
     /// Eye image size overriding the scene's, e.g. 640x480.
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<(u32, u32)>,
     /// Turn on the Vulkan validation layers (with synchronisation validation); any message
     /// fails the run.
@@ -49,12 +46,8 @@ pub struct ReplayArgs {
     #[arg(long)]
     pub device: Option<String>,
     /// Display frame rate of the replay, hertz.
-    #[arg(
-        long,
-        value_name = "HZ",
-        default_value_t = 60.0,
-        allow_negative_numbers = true
-    )]
+    #[arg(long, value_name = "HZ", default_value_t = 60.0, allow_negative_numbers = true,
+          value_parser = number::<f64>)]
     pub rate: f64,
     /// One frame per trace sample, at the sample's time, instead of --rate: how
     /// `vitreous run` rendered the trace it recorded, so the two compare frame by frame.

@@ -41,7 +41,7 @@ pub struct RunArgs {
     pub blend: Option<vitreous_xr::openxr::Blend>,
     /// Eye image size instead of the runtime's recommended one, e.g. 640x480 (16-8192 per
     /// side; the runtime's maximum bounds it).
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<(u32, u32)>,
     /// Effects, overriding the scene's (as for replay).
     #[arg(long, value_name = "LIST", value_parser = parse_effects)]

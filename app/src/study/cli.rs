@@ -9,7 +9,7 @@ use clap::Subcommand;
 use super::plan::{MAX_PARTICIPANTS, plan, write_plan};
 use super::protocol::Protocol;
 use super::run::{StudyRunOptions, run_study, timing_log_path};
-use crate::cli_values::{parse_blend, parse_gaze, parse_size};
+use crate::cli_values::{number, parse_blend, parse_gaze, parse_seed, parse_size, whole_number};
 use crate::input_files::InputFiles;
 use crate::output::write_atomic;
 use crate::run::RunOptions;
@@ -24,10 +24,11 @@ pub enum StudyCommand {
         /// The protocol (config/studies/*.toml).
         protocol: PathBuf,
         /// Number of participants (named p01, p02, ...).
-        #[arg(long, value_name = "N")]
+        #[arg(long, value_name = "N", allow_negative_numbers = true,
+              value_parser = parse_participants)]
         participants: usize,
         /// Seed of the randomisation.
-        #[arg(long, value_name = "S")]
+        #[arg(long, value_name = "S", allow_negative_numbers = true, value_parser = parse_seed)]
         seed: u64,
         /// The plan file to write (CSV).
         #[arg(short, long, value_name = "FILE")]
@@ -58,27 +59,31 @@ pub enum StudyCommand {
         #[arg(long, conflicts_with = "dry_run")]
         view: bool,
         /// Window size of --view.
-        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "960x540")]
+        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "960x540",
+              allow_hyphen_values = true)]
         window: (u32, u32),
         /// The trace a dry run replays, or --view plays.
         #[arg(long, value_name = "FILE")]
         trace: Option<PathBuf>,
         /// Display rate of a dry run, Hz.
-        #[arg(long, value_name = "HZ", default_value_t = 30.0, requires = "dry_run")]
+        #[arg(long, value_name = "HZ", default_value_t = 30.0, requires = "dry_run",
+              allow_negative_numbers = true, value_parser = number::<f64>)]
         rate: f64,
         /// Every protocol duration multiplied by F (rehearsals and tests; logged with each
         /// event's times).
-        #[arg(long, value_name = "F", default_value_t = 1.0)]
+        #[arg(long, value_name = "F", default_value_t = 1.0, allow_negative_numbers = true,
+              value_parser = number::<f64>)]
         time_scale: f64,
         /// Stop after N answers (the next run resumes).
-        #[arg(long, value_name = "N")]
+        #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_trials)]
         trials: Option<usize>,
         /// A simulated participant answers instead, from scale values NAME=VALUE,... (Case V
         /// choices, or ratings of the difference plus unit normal noise).
         #[arg(long, value_name = "SCALE")]
         simulate: Option<String>,
         /// Seed of the simulated participant.
-        #[arg(long, value_name = "S", default_value_t = 1)]
+        #[arg(long, value_name = "S", default_value_t = 1, allow_negative_numbers = true,
+              value_parser = parse_seed)]
         seed: u64,
         /// Do not read answers from the keyboard (controller or --simulate only).
         #[arg(long)]
@@ -87,7 +92,7 @@ pub enum StudyCommand {
         #[arg(long)]
         validate: bool,
         /// Eye image size, e.g. 640x480 (default: the runtime's, or the scene's in a dry run).
-        #[arg(long, value_name = "WxH", value_parser = parse_size)]
+        #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
         size: Option<(u32, u32)>,
         /// Blend mode instead of the automatic choice: additive, alpha-blend, opaque.
         #[arg(long, value_parser = parse_blend)]
@@ -115,6 +120,17 @@ pub enum StudyCommand {
     },
 }
 
+/// `--participants N`: 1 to [`MAX_PARTICIPANTS`].
+fn parse_participants(s: &str) -> std::result::Result<usize, String> {
+    whole_number(s, 1..=MAX_PARTICIPANTS as u64, "participants").map(|n| n as usize)
+}
+
+/// `--trials N`: at least 1.
+fn parse_trials(s: &str) -> std::result::Result<usize, String> {
+    let n = whole_number(s, 1..=u64::MAX, "trials")?;
+    usize::try_from(n).map_err(|_| format!("{n} trials is more than this machine can count"))
+}
+
 /// Runs a study subcommand.
 pub fn run(command: StudyCommand) -> Result<()> {
     match command {
@@ -124,9 +140,6 @@ pub fn run(command: StudyCommand) -> Result<()> {
             seed,
             out,
         } => {
-            if !(1..=MAX_PARTICIPANTS).contains(&participants) {
-                bail!("--participants must be from 1 to {MAX_PARTICIPANTS}, got {participants}");
-            }
             InputFiles::new()
                 .add(&protocol, "PROTOCOL")
                 .check_file("--out", &out)?;
@@ -174,9 +187,6 @@ pub fn run(command: StudyCommand) -> Result<()> {
             }
             inputs.check_file("--responses", &responses)?;
             inputs.check_file("the timing log", &timing_log_path(&responses))?;
-            if trials == Some(0) {
-                bail!("--trials must be at least 1");
-            }
             if let Some((w, h)) = size {
                 crate::setup::check_size(w, h)?;
             }

@@ -178,6 +178,12 @@ pub fn run_study(options: &StudyRunOptions) -> Result<StudyRunSummary> {
             options.time_scale
         );
     }
+    if !(options.frame_rate_hz.is_finite() && (1.0..=1000.0).contains(&options.frame_rate_hz)) {
+        bail!(
+            "--rate must be from 1 to 1000 Hz, got {}",
+            options.frame_rate_hz
+        );
+    }
     let plan = read_plan(&options.plan, &protocol)?;
     let planned: Vec<PlannedTrial> = plan
         .into_iter()
@@ -341,12 +347,6 @@ fn dry_run_block(
         .size
         .unwrap_or((scene.output.width_px, scene.output.height_px));
     crate::setup::check_size(width, height)?;
-    if !(options.frame_rate_hz.is_finite() && (1.0..=1000.0).contains(&options.frame_rate_hz)) {
-        bail!(
-            "--rate must be from 1 to 1000 Hz, got {}",
-            options.frame_rate_hz
-        );
-    }
     let t = protocol.timing.scaled(options.time_scale);
     let needed_s = trials as f64 * (t.first_s + t.blank_s + t.second_s + t.interval_s) + 1.0;
     let samples = match &options.trace {

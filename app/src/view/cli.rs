@@ -16,11 +16,13 @@ pub struct ViewArgs {
     /// Scene file (TOML); saving it, or an asset it names, reloads it.
     pub scene: PathBuf,
     /// Window size, e.g. 960x540.
-    #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "960x540")]
+    #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "960x540",
+          allow_hyphen_values = true)]
     pub window: (u32, u32),
     /// Render the eye images at this fraction of their part of the window (0.25-1) and scale
     /// them up: faster on a CPU device.
-    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    #[arg(long, value_name = "F", default_value_t = 1.0, allow_negative_numbers = true,
+          value_parser = crate::cli_values::number::<f32>)]
     pub render_scale: f32,
     /// End after N frames (default: when the window is closed or Esc is pressed).
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_frame_count)]

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn workspace() -> PathBuf {
+pub(crate) fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
@@ -38,7 +38,7 @@ pub(crate) fn assert_clean_failure(out: &Output, needles: &[&str]) -> String {
     message.to_owned()
 }
 
-fn scene(name: &str) -> String {
+pub(crate) fn scene(name: &str) -> String {
     workspace()
         .join("config/scenes")
         .join(name)
@@ -361,124 +361,6 @@ fn frame_counts_below_one_name_the_option() {
     );
 }
 
-/// Every option that takes a number lets `-1` through to its own check, which names the
-/// option and says what it expects, instead of taking `-1` for an unknown option.
-#[test]
-fn a_negative_number_for_any_numeric_option_names_the_option_and_what_it_expects() {
-    let dir = tempfile::tempdir().unwrap();
-    let s = scene("glass-sphere.toml");
-    let protocol = workspace().join("config/studies/visual-effects.toml");
-    let p = protocol.to_str().unwrap();
-    let plan = dir.path().join("plan.csv");
-    let made = vitreous(
-        &[
-            "study",
-            "plan",
-            p,
-            "--participants",
-            "1",
-            "--seed",
-            "1",
-            "-o",
-            plan.to_str().unwrap(),
-        ],
-        dir.path(),
-    );
-    assert!(made.status.success(), "{made:?}");
-    let plan = plan.to_str().unwrap();
-    let run = [
-        "study",
-        "run",
-        p,
-        "--plan",
-        plan,
-        "--participant",
-        "p01",
-        "--dry-run",
-    ];
-    let compare = ["compare", "a.png", "b.png", "--seen", "a.png", "--display"];
-    let cases: Vec<(Vec<&str>, &str, &str)> = [
-        (vec!["run", &s], &["--size", "--frames"][..]),
-        (
-            vec!["view", &s],
-            &["--window", "--render-scale", "--frames"],
-        ),
-        (
-            vec!["replay", &s],
-            &["--frames", "--save-every", "--size", "--rate", "--pupil-mm"],
-        ),
-        (vec!["bench", &s], &["--size", "--frames", "--pupil-mm"]),
-        (vec!["soak", &s], &["--minutes", "--size", "--frames"]),
-        (compare.to_vec(), &["--ppd", "--panel-blur-deg"]),
-        (
-            vec!["reference", &s, "--trace", "t.csv"],
-            &[
-                "--frames",
-                "--save-every",
-                "--rate",
-                "--size",
-                "--samples",
-                "--texel-mm",
-                "--photons-per-texel",
-            ],
-        ),
-        (
-            vec!["trace", "synth", "--scene", &s, "-o", "t.csv"],
-            &["--duration", "--rate", "--seed"],
-        ),
-        (
-            vec!["study", "plan", p, "-o", "p.csv", "--seed", "1"],
-            &["--participants"],
-        ),
-        (
-            vec!["study", "plan", p, "-o", "p.csv", "--participants", "1"],
-            &["--seed"],
-        ),
-        (
-            run.to_vec(),
-            &[
-                "--rate",
-                "--time-scale",
-                "--trials",
-                "--seed",
-                "--size",
-                "--window",
-            ],
-        ),
-    ]
-    .into_iter()
-    .flat_map(|(args, options)| {
-        options.iter().map(move |&option| {
-            let value = if ["--size", "--window"].contains(&option) {
-                "-1x5"
-            } else {
-                "-1"
-            };
-            (args.clone(), option, value)
-        })
-    })
-    .chain([(
-        vec!["trace", "import", "--from", "neon", "rec", "-o", "t.csv"],
-        "--kappa-deg",
-        "-20",
-    )])
-    .collect();
-    for (mut args, option, value) in cases {
-        args.extend([option, value]);
-        let out = vitreous(&args, dir.path());
-        let message = assert_clean_failure(&out, &[option, value]);
-        assert!(!message.contains("unexpected argument"), "{message}");
-        assert!(
-            ["expected", "must be", "is outside"]
-                .iter()
-                .any(|w| message.contains(w)),
-            "{args:?}: {message}"
-        );
-    }
-    assert!(!dir.path().join("out").exists());
-    assert!(!dir.path().join("t.csv").exists());
-}
-
 #[test]
 fn import_onto_its_own_input_is_refused_and_the_recording_kept() {
     let dir = tempfile::tempdir().unwrap();
@@ -561,79 +443,6 @@ fn a_corrupt_bake_names_its_scene_and_the_command_that_bakes_it_again() {
         ],
     );
     assert!(!dir.path().join("out").exists());
-}
-
-#[test]
-fn outputs_that_would_replace_an_input_are_refused_before_anything_is_written() {
-    let dir = tempfile::tempdir().unwrap();
-    let (scene, _) = crate::compare::sphere_copy(dir.path());
-    let s = scene.to_str().unwrap();
-    let out = dir.path().join("run");
-    std::fs::create_dir_all(out.join("frames")).unwrap();
-    // A trace kept where a replay writes its frame log, and one under a frame image's name.
-    let trace = out.join("frames.csv");
-    let made = vitreous(
-        &[
-            "trace",
-            "synth",
-            "--scene",
-            s,
-            "-o",
-            trace.to_str().unwrap(),
-        ],
-        dir.path(),
-    );
-    assert!(made.status.success(), "{made:?}");
-    let framed = out.join("frames/000000-left.png");
-    std::fs::copy(&trace, &framed).unwrap();
-    let (o, t, f) = (
-        out.to_str().unwrap(),
-        trace.to_str().unwrap(),
-        framed.to_str().unwrap(),
-    );
-    let scene_before = std::fs::read(&scene).unwrap();
-    let trace_before = std::fs::read(&trace).unwrap();
-    let frames = out.join("frames");
-    let cases: [(&[&str], &[&str]); 6] = [
-        (
-            &["replay", s, "--trace", t, "--out", o, "--quiet"],
-            &["--out", "writes frames.csv there", "is the input file"],
-        ),
-        (
-            &["replay", s, "--trace", f, "--out", o, "--quiet"],
-            &["--out", "frames/000000-left.png", "(--trace)"],
-        ),
-        (
-            &[
-                "reference",
-                s,
-                "--trace",
-                f,
-                "--out",
-                frames.to_str().unwrap(),
-            ],
-            &["--out", "writes 000000-left.png there", "(--trace)"],
-        ),
-        (
-            &["trace", "synth", "--scene", s, "-o", s],
-            &["-o", "is the input file", "(--scene)"],
-        ),
-        (
-            &["trace", "plot", t, "--scene", s, "-o", t],
-            &["--out", "is the input file", "(TRACE)"],
-        ),
-        (
-            &["soak", s, "--json", s, "--minutes", "0.01"],
-            &["--json", "is the input file", "(SCENE)"],
-        ),
-    ];
-    for (args, needles) in cases {
-        assert_clean_failure(&vitreous(args, dir.path()), needles);
-    }
-    assert_eq!(std::fs::read(&scene).unwrap(), scene_before);
-    assert_eq!(std::fs::read(&trace).unwrap(), trace_before);
-    assert_eq!(std::fs::read(&framed).unwrap(), trace_before);
-    assert!(!out.join("summary.json").exists());
 }
 
 #[test]

@@ -8,6 +8,8 @@ mod gaze_filter;
 mod gaze_trace;
 mod gaze_vergence;
 mod interrupted;
+mod numeric_options;
+mod outputs;
 mod reference;
 mod scene_asset_errors;
 mod scene_consistency;

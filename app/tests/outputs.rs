@@ -75,3 +75,72 @@ fn outputs_that_would_replace_an_input_are_refused_before_anything_is_written() 
     assert_eq!(std::fs::read(&framed).unwrap(), trace_before);
     assert!(!out.join("summary.json").exists());
 }
+
+/// The live commands check before a runtime or a window is asked for: `run` and `view` here
+/// have neither, so each refusal is the guard's; `study plan` checks before reading.
+#[test]
+fn live_sessions_and_studies_refuse_outputs_over_their_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, assets) = crate::compare::sphere_copy(dir.path());
+    let s = scene.to_str().unwrap();
+    let floor = assets[1].to_str().unwrap();
+    // A folder whose summary.json is the scene (a hard link), and one whose frames.csv is a
+    // trace.
+    let linked = dir.path().join("linked");
+    std::fs::create_dir(&linked).unwrap();
+    std::fs::hard_link(&scene, linked.join("summary.json")).unwrap();
+    let logged = dir.path().join("logged");
+    std::fs::create_dir(&logged).unwrap();
+    let trace = logged.join("frames.csv");
+    std::fs::write(&trace, "a trace").unwrap();
+    let protocol = dir.path().join("study.toml");
+    std::fs::write(&protocol, "a protocol").unwrap();
+    let (l, g, t, p) = (
+        linked.to_str().unwrap(),
+        logged.to_str().unwrap(),
+        trace.to_str().unwrap(),
+        protocol.to_str().unwrap(),
+    );
+    let cases: [(&[&str], &[&str]); 6] = [
+        (
+            &["run", s, "--record", s],
+            &["--record", "is the input file", "(SCENE)"],
+        ),
+        (
+            &["run", s, "--gaze-trace", t, "--out", g],
+            &["--out", "writes frames.csv there", "(--gaze-trace)"],
+        ),
+        (
+            &["view", s, "--screenshot", floor],
+            &["--screenshot", "(floor.photo in"],
+        ),
+        (
+            &["view", s, "--out", l],
+            &["--out", "writes summary.json there", "(SCENE)"],
+        ),
+        (
+            &["view", s, "--trace", t, "--record", t],
+            &["--record", "(--trace)"],
+        ),
+        (
+            &[
+                "study",
+                "plan",
+                p,
+                "--participants",
+                "1",
+                "--seed",
+                "1",
+                "-o",
+                p,
+            ],
+            &["--out", "(PROTOCOL)"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let message = assert_clean_failure(&vitreous(args, dir.path()), needles);
+        assert!(!message.contains("OpenXR"), "{message}");
+    }
+    assert_eq!(std::fs::read(&trace).unwrap(), b"a trace");
+    assert_eq!(std::fs::read(&protocol).unwrap(), b"a protocol");
+}

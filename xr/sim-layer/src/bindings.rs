@@ -1,6 +1,7 @@
 //! Suggested bindings of the eye-gaze interaction profile: the layer takes them (the runtime
 //! has no such device, or does not know the profile once the extension is removed from the
-//! instance) and remembers which actions they bind.
+//! instance) and remembers which actions they bind; and the name of the profile's one input
+//! as `xrGetInputSourceLocalizedName` gives it.
 
 use openxr::sys;
 
@@ -35,6 +36,36 @@ pub const PROFILE: &std::ffi::CStr = c"/interaction_profiles/ext/eye_gaze_intera
 pub const POSE: &std::ffi::CStr = c"/user/eyes_ext/input/gaze_ext/pose";
 /// The profile's top-level user path.
 pub const USER: &std::ffi::CStr = c"/user/eyes_ext";
+
+/// The user path's part of the gaze pose's localized name (`/user/eyes_ext`).
+pub const USER_NAME: &str = "Eyes";
+/// The interaction profile's part of the gaze pose's localized name.
+pub const PROFILE_NAME: &str = "Eye Gaze Interaction";
+/// The input component's part of the gaze pose's localized name (`input/gaze_ext/pose`).
+pub const POSE_NAME: &str = "Gaze Pose";
+
+/// The gaze pose's localized name with the parts `which` asks for, in the order user path,
+/// interaction profile, component, joined by single spaces (as Monado joins its own): with all
+/// three, `Eyes Eye Gaze Interaction Gaze Pose`. `XR_ERROR_VALIDATION_FAILURE` when `which` is
+/// empty or has a bit OpenXR does not define.
+pub fn localized_name(which: sys::InputSourceLocalizedNameFlags) -> Result<String, sys::Result> {
+    use sys::InputSourceLocalizedNameFlags as F;
+    let parts = [
+        (F::USER_PATH, USER_NAME),
+        (F::INTERACTION_PROFILE, PROFILE_NAME),
+        (F::COMPONENT, POSE_NAME),
+    ];
+    let known = parts.iter().fold(F::EMPTY, |all, (bit, _)| all | *bit);
+    if which.is_empty() || !known.contains(which) {
+        return Err(sys::Result::ERROR_VALIDATION_FAILURE);
+    }
+    let named: Vec<&str> = parts
+        .iter()
+        .filter(|(bit, _)| which.contains(*bit))
+        .map(|(_, name)| *name)
+        .collect();
+    Ok(named.join(" "))
+}
 
 /// Decides what to do with a suggestion of `bindings` for `profile`.
 pub fn plan(
@@ -104,6 +135,43 @@ mod tests {
     fn a_suggestion_with_no_binding_is_invalid() {
         assert_eq!(plan(&paths(), paths().profile, &[]), Plan::Empty);
         assert_eq!(plan(&paths(), sys::Path::from_raw(3), &[]), Plan::Forward);
+    }
+
+    #[test]
+    fn each_flag_names_its_part() {
+        use sys::InputSourceLocalizedNameFlags as F;
+        assert_eq!(localized_name(F::USER_PATH), Ok("Eyes".to_string()));
+        assert_eq!(
+            localized_name(F::INTERACTION_PROFILE),
+            Ok("Eye Gaze Interaction".to_string())
+        );
+        assert_eq!(localized_name(F::COMPONENT), Ok("Gaze Pose".to_string()));
+    }
+
+    #[test]
+    fn parts_are_joined_in_order_whatever_the_flags_order() {
+        use sys::InputSourceLocalizedNameFlags as F;
+        assert_eq!(
+            localized_name(F::COMPONENT | F::USER_PATH),
+            Ok("Eyes Gaze Pose".to_string())
+        );
+        assert_eq!(
+            localized_name(F::INTERACTION_PROFILE | F::COMPONENT),
+            Ok("Eye Gaze Interaction Gaze Pose".to_string())
+        );
+        assert_eq!(
+            localized_name(F::USER_PATH | F::INTERACTION_PROFILE | F::COMPONENT),
+            Ok("Eyes Eye Gaze Interaction Gaze Pose".to_string())
+        );
+    }
+
+    #[test]
+    fn no_flag_or_an_undefined_one_is_a_validation_failure() {
+        use sys::InputSourceLocalizedNameFlags as F;
+        let invalid = Err(sys::Result::ERROR_VALIDATION_FAILURE);
+        assert_eq!(localized_name(F::EMPTY), invalid);
+        assert_eq!(localized_name(F::from_raw(1 << 3)), invalid);
+        assert_eq!(localized_name(F::USER_PATH | F::from_raw(1 << 40)), invalid);
     }
 
     #[test]

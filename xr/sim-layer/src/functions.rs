@@ -221,6 +221,15 @@ pub fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::V
                 pfn::EnumerateBoundSourcesForAction
             ),
         ),
+        // Core, so always the layer's; it answers only for the gaze pose while the app has
+        // XR_EXT_eye_gaze_interaction from the layer, and passes every other call on.
+        b"xrGetInputSourceLocalizedName" => (
+            None,
+            entry!(
+                calls::actions::get_input_source_localized_name,
+                pfn::GetInputSourceLocalizedName
+            ),
+        ),
         b"xrGetActionStatePose" => (
             None,
             entry!(

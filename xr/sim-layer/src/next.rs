@@ -50,6 +50,8 @@ pub struct NextTable {
     pub get_current_interaction_profile: pfn::GetCurrentInteractionProfile,
     /// `xrEnumerateBoundSourcesForAction`.
     pub enumerate_bound_sources_for_action: pfn::EnumerateBoundSourcesForAction,
+    /// `xrGetInputSourceLocalizedName`.
+    pub get_input_source_localized_name: pfn::GetInputSourceLocalizedName,
     /// `xrSyncActions`.
     pub sync_actions: pfn::SyncActions,
     /// `xrCreateSwapchain`.
@@ -203,6 +205,12 @@ impl NextTable {
                 instance,
                 c"xrEnumerateBoundSourcesForAction",
                 pfn::EnumerateBoundSourcesForAction
+            ),
+            get_input_source_localized_name: load!(
+                gipa,
+                instance,
+                c"xrGetInputSourceLocalizedName",
+                pfn::GetInputSourceLocalizedName
             ),
         })
     }

@@ -1,11 +1,13 @@
 //! The eye-gaze profile's action calls, answered as the spec orders them for a profile the
 //! runtime below does not know: attaching is passed on and remembered (a suggestion after it
 //! is refused, a gaze action's state before it too), `/user/eyes_ext`'s current interaction
-//! profile is the gaze profile once a gaze binding is attached, and a gaze action's bound
-//! source is the gaze pose. Everything else goes to the runtime.
+//! profile is the gaze profile once a gaze binding is attached, a gaze action's bound source
+//! is the gaze pose, and the gaze pose's localized name is the layer's. Everything else goes
+//! to the runtime.
 
 use openxr::sys::{self, Handle};
 
+use crate::bindings;
 use crate::guard::guard;
 use crate::registry::registry;
 use crate::two_call;
@@ -133,4 +135,85 @@ pub unsafe extern "system" fn enumerate_bound_sources_for_action(
             unsafe { (count_out.as_mut(), two_call::out_slice(capacity, sources)) };
         two_call::answer(&[paths.pose], capacity, count_out, out)
     })
+}
+
+/// `xrGetInputSourceLocalizedName`: the gaze pose's name (XR_EXT_eye_gaze_interaction from the
+/// layer) is the layer's ([`bindings::localized_name`]), in two calls whose count includes the
+/// terminating NUL. A get-info of another type or with no (or an undefined) component flag is
+/// `XR_ERROR_VALIDATION_FAILURE`, a call before the session's action sets were attached
+/// `XR_ERROR_ACTIONSET_NOT_ATTACHED`. Other sources (an invalid path among them) go to the
+/// runtime.
+///
+/// # Safety
+/// As `xrGetInputSourceLocalizedName`.
+pub unsafe extern "system" fn get_input_source_localized_name(
+    session: sys::Session,
+    info: *const sys::InputSourceLocalizedNameGetInfo,
+    capacity: u32,
+    count_out: *mut u32,
+    buffer: *mut std::ffi::c_char,
+) -> sys::Result {
+    guard("xrGetInputSourceLocalizedName", || {
+        let Some((next, paths, attached)) = registry()
+            .session(session.into_raw())
+            .map(|(s, i)| (i.next.clone(), i.gaze_paths, s.attached))
+        else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the app's input structure, null or valid.
+        let get = unsafe { info.as_ref() };
+        let Some(get) = get.filter(|g| paths.is_some_and(|p| p.pose == g.source_path)) else {
+            // SAFETY: the next layer's function with the app's arguments.
+            return unsafe {
+                (next.get_input_source_localized_name)(session, info, capacity, count_out, buffer)
+            };
+        };
+        if get.ty != sys::InputSourceLocalizedNameGetInfo::TYPE {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        }
+        if !attached {
+            return sys::Result::ERROR_ACTIONSET_NOT_ATTACHED;
+        }
+        let name = match bindings::localized_name(get.which_components) {
+            Ok(name) => name,
+            Err(r) => return r,
+        };
+        let text = nul_terminated(&name);
+        // SAFETY: the app's count output, null or writable, and buffer of `capacity` chars,
+        // null or writable.
+        unsafe { two_call::answer_raw(&text, capacity, count_out, buffer) }
+    })
+}
+
+/// `s` as C chars with the terminating NUL, as a two-call string answer counts them.
+fn nul_terminated(s: &str) -> Vec<std::ffi::c_char> {
+    s.bytes()
+        .chain(std::iter::once(0))
+        .map(|b| b as std::ffi::c_char)
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_name_is_counted_with_its_nul() {
+        let text = nul_terminated("Eyes");
+        assert_eq!(text.len(), 5);
+        assert_eq!(text.last(), Some(&0));
+        let mut n = 0;
+        let mut out: [std::ffi::c_char; 4] = [7; 4];
+        // SAFETY: `n` is writable; `out` holds 4 chars.
+        let r = unsafe { two_call::answer_raw(&text, 4, &mut n, out.as_mut_ptr()) };
+        assert_eq!(
+            (r, n, out),
+            (sys::Result::ERROR_SIZE_INSUFFICIENT, 5, [7; 4])
+        );
+        let mut full: [std::ffi::c_char; 5] = [7; 5];
+        // SAFETY: `n` is writable; `full` holds 5 chars.
+        let r = unsafe { two_call::answer_raw(&text, 5, &mut n, full.as_mut_ptr()) };
+        assert_eq!((r, n), (sys::Result::SUCCESS, 5));
+        assert_eq!(full.map(|c| c as u8), *b"Eyes\0");
+    }
 }

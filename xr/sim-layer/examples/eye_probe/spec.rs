@@ -1,7 +1,9 @@
 //! XR_EXT_eye_gaze_interaction as the layer answers it for the runtime, held to the spec's
 //! orders: a suggestion needs a binding and comes before attaching; a gaze action's state,
-//! bound sources and `/user/eyes_ext`'s profile are for attached action sets; a gaze space
-//! is located at valid times only, its position and orientation tracked together or neither.
+//! bound sources, their localized names and `/user/eyes_ext`'s profile are for attached action
+//! sets; a bound source's localized name comes in two calls, each part asked for named as
+//! `docs/sim-layer.md` gives it; a gaze space is located at valid times only, its position and
+//! orientation tracked together or neither.
 
 use openxr as xr;
 use xr::sys;
@@ -89,6 +91,25 @@ pub fn before_frames(instance: &xr::Instance, session: sys::Session) -> Probe<Ga
     // SAFETY: live instance, valid structure and binding.
     let r = unsafe { (fp.suggest_interaction_profile_bindings)(instance.as_raw(), &suggestion) };
     check("xrSuggestInteractionProfileBindings", r)?;
+    let all = sys::InputSourceLocalizedNameFlags::USER_PATH
+        | sys::InputSourceLocalizedNameFlags::INTERACTION_PROFILE
+        | sys::InputSourceLocalizedNameFlags::COMPONENT;
+    let mut count = 0u32;
+    // SAFETY: live session, valid structure; a null buffer with capacity 0 asks for the size.
+    let r = unsafe {
+        (fp.get_input_source_localized_name)(
+            session,
+            &name_info(pose_path, all),
+            0,
+            &mut count,
+            std::ptr::null_mut(),
+        )
+    };
+    expect(
+        "xrGetInputSourceLocalizedName(gaze pose, before attaching)",
+        r,
+        sys::Result::ERROR_ACTIONSET_NOT_ATTACHED,
+    )?;
     let sets = [set.as_raw()];
     let attach = sys::SessionActionSetsAttachInfo {
         ty: sys::SessionActionSetsAttachInfo::TYPE,
@@ -154,6 +175,9 @@ pub fn before_frames(instance: &xr::Instance, session: sys::Session) -> Probe<Ga
         ));
     }
     println!("spec: the gaze action's bound source is the gaze pose");
+    for source in sources {
+        localized_names(instance, session, source)?;
+    }
 
     let space_info = sys::ActionSpaceCreateInfo {
         ty: sys::ActionSpaceCreateInfo::TYPE,
@@ -172,6 +196,138 @@ pub fn before_frames(instance: &xr::Instance, session: sys::Session) -> Probe<Ga
         _action: action,
         _set: set,
     })
+}
+
+/// A localized-name query for `source` with `which`.
+fn name_info(
+    source: sys::Path,
+    which: sys::InputSourceLocalizedNameFlags,
+) -> sys::InputSourceLocalizedNameGetInfo {
+    sys::InputSourceLocalizedNameGetInfo {
+        ty: sys::InputSourceLocalizedNameGetInfo::TYPE,
+        next: std::ptr::null(),
+        source_path: source,
+        which_components: which,
+    }
+}
+
+/// The localized name `info` asks for, in two calls: the size (with the terminating NUL)
+/// first, a buffer one char short refused with the size again, then the text.
+fn two_call_name(
+    instance: &xr::Instance,
+    session: sys::Session,
+    info: &sys::InputSourceLocalizedNameGetInfo,
+) -> Probe<String> {
+    let f = instance.fp().get_input_source_localized_name;
+    let call = format!(
+        "xrGetInputSourceLocalizedName(whichComponents {:#x})",
+        info.which_components.into_raw()
+    );
+    let mut size = 0u32;
+    // SAFETY: live session, valid structure; a null buffer with capacity 0 asks for the size.
+    check(&call, unsafe {
+        f(session, info, 0, &mut size, std::ptr::null_mut())
+    })?;
+    if size < 2 {
+        return Err(format!(
+            "{call}: size {size}, expected a name and its terminating NUL"
+        ));
+    }
+    let mut buffer = vec![1 as std::ffi::c_char; size as usize];
+    let mut short = 0u32;
+    // SAFETY: `buffer` holds more than the `size - 1` chars offered.
+    let r = unsafe { f(session, info, size - 1, &mut short, buffer.as_mut_ptr()) };
+    if r != sys::Result::ERROR_SIZE_INSUFFICIENT || short != size {
+        return Err(format!(
+            "{call} with {} chars for {size}: {r:?} and size {short}, the spec requires \
+             ERROR_SIZE_INSUFFICIENT and {size}",
+            size - 1
+        ));
+    }
+    let mut written = 0u32;
+    // SAFETY: `buffer` holds `size` writable chars.
+    check(&call, unsafe {
+        f(session, info, size, &mut written, buffer.as_mut_ptr())
+    })?;
+    let bytes: Vec<u8> = buffer.iter().map(|&c| c as u8).collect();
+    match bytes.iter().position(|&b| b == 0) {
+        Some(end) if written == size && end + 1 == bytes.len() => {
+            String::from_utf8(bytes[..end].to_vec()).map_err(|e| format!("{call}: {e}"))
+        }
+        _ => Err(format!(
+            "{call}: {written} chars written for size {size}, {bytes:?}: not one name ending \
+             in the buffer's last char"
+        )),
+    }
+}
+
+/// The localized name of a gaze action's bound `source`: each part alone and all together in
+/// two calls as `docs/sim-layer.md` names them; no component flag, an undefined flag and a
+/// get-info of another type refused; invalid paths refused by the runtime.
+fn localized_names(instance: &xr::Instance, session: sys::Session, source: sys::Path) -> Probe<()> {
+    use sys::InputSourceLocalizedNameFlags as F;
+    let expected = [
+        (F::USER_PATH, "Eyes"),
+        (F::INTERACTION_PROFILE, "Eye Gaze Interaction"),
+        (F::COMPONENT, "Gaze Pose"),
+        (
+            F::USER_PATH | F::INTERACTION_PROFILE | F::COMPONENT,
+            "Eyes Eye Gaze Interaction Gaze Pose",
+        ),
+    ];
+    for (which, want) in expected {
+        let name = two_call_name(instance, session, &name_info(source, which))?;
+        if name != want {
+            return Err(format!(
+                "xrGetInputSourceLocalizedName(whichComponents {:#x}): {name:?}, expected \
+                 {want:?}",
+                which.into_raw()
+            ));
+        }
+    }
+    println!(
+        "spec: the bound source's localized name: \"Eyes\", \"Eye Gaze Interaction\", \
+         \"Gaze Pose\", all \"Eyes Eye Gaze Interaction Gaze Pose\" (two calls, one char short \
+         refused)"
+    );
+
+    let f = instance.fp().get_input_source_localized_name;
+    let mut wrong_type = name_info(source, F::USER_PATH);
+    wrong_type.ty = sys::StructureType::ACTION_STATE_GET_INFO;
+    let refused = [
+        (
+            "no component",
+            name_info(source, F::EMPTY),
+            sys::Result::ERROR_VALIDATION_FAILURE,
+        ),
+        (
+            "an undefined component flag",
+            name_info(source, F::USER_PATH | F::from_raw(1 << 3)),
+            sys::Result::ERROR_VALIDATION_FAILURE,
+        ),
+        (
+            "another type",
+            wrong_type,
+            sys::Result::ERROR_VALIDATION_FAILURE,
+        ),
+        (
+            "XR_NULL_PATH",
+            name_info(sys::Path::NULL, F::USER_PATH),
+            sys::Result::ERROR_PATH_INVALID,
+        ),
+        (
+            "path 0x1234",
+            name_info(sys::Path::from_raw(0x1234), F::USER_PATH),
+            sys::Result::ERROR_PATH_INVALID,
+        ),
+    ];
+    for (what, info, want) in refused {
+        let mut size = 0u32;
+        // SAFETY: live session, a structure of the call's layout; capacity 0, null buffer.
+        let r = unsafe { f(session, &info, 0, &mut size, std::ptr::null_mut()) };
+        expect(&format!("xrGetInputSourceLocalizedName({what})"), r, want)?;
+    }
+    Ok(())
 }
 
 /// Locates the gaze space in `base` at time 0 (refused) and at a frame's `time`.

@@ -27,6 +27,9 @@
 //!   `wearer-right.png`, the world dimmed by a segmented dimmer panel of
 //!   `VITREOUS_SIM_PANEL` (`cells_across,cells_down,blur_deg`, default `64,48,1.5`) where the
 //!   alpha asks, and the image's light added.
+//! - `VITREOUS_SIM_FAULTS`: a fault schedule (`crate::faults::schedule`): what a misbehaving
+//!   headset does to the session, and when; `VITREOUS_SIM_FAULT_LOG`: the CSV file the layer
+//!   logs each fault and what the app did about it to (`crate::faults::log`).
 
 use std::ffi::CStr;
 use std::fmt;
@@ -63,6 +66,11 @@ pub const IMAGES_VAR: &str = "VITREOUS_SIM_IMAGES";
 pub const WORLD_VAR: &str = "VITREOUS_SIM_WORLD";
 /// Environment variable giving the simulated dimmer panel: cells across, down, blur (degrees).
 pub const PANEL_VAR: &str = "VITREOUS_SIM_PANEL";
+
+/// Environment variable naming the fault schedule.
+pub const FAULTS_VAR: &str = "VITREOUS_SIM_FAULTS";
+/// Environment variable naming the fault log.
+pub const FAULT_LOG_VAR: &str = "VITREOUS_SIM_FAULT_LOG";
 
 /// The sides `VITREOUS_SIM_EYE_MAX` takes, pixels.
 pub const EYE_MAX_RANGE: std::ops::RangeInclusive<u32> = 16..=16384;
@@ -164,6 +172,10 @@ pub struct Config {
     pub world: Option<PathBuf>,
     /// The simulated segmented dimmer's panel.
     pub panel: SimPanel,
+    /// The fault schedule file.
+    pub faults: Option<PathBuf>,
+    /// The fault log file.
+    pub fault_log: Option<PathBuf>,
 }
 
 /// A segmented dimmer panel, as `VITREOUS_SIM_PANEL` gives it: each cell takes away the mean
@@ -343,6 +355,8 @@ impl Config {
                 .map(|v| parse_panel(&v))
                 .transpose()?
                 .unwrap_or_default(),
+            faults: get(FAULTS_VAR).map(PathBuf::from),
+            fault_log: get(FAULT_LOG_VAR).map(PathBuf::from),
             ml_frame: match get(ML_FRAME_VAR).as_deref().map(str::trim) {
                 None | Some("0") => false,
                 Some("1") => true,

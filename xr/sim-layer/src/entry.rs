@@ -83,8 +83,8 @@ struct Prepared {
     config: Config,
     /// The trace's eye data (when an eye extension is offered).
     timeline: Option<GazeTimeline>,
-    /// The submitted-frames CSV.
-    submitted: Option<SubmittedLog>,
+    /// The submitted-frames CSV (the process's).
+    submitted: Option<Arc<Mutex<SubmittedLog>>>,
     /// The controller button script.
     buttons: Option<ButtonScript>,
 }
@@ -109,7 +109,7 @@ fn prepare() -> Result<Prepared, String> {
     };
     let submitted = match &config.submitted {
         None => None,
-        Some(path) => Some(SubmittedLog::create(path).map_err(|e| {
+        Some(path) => Some(SubmittedLog::shared(path).map_err(|e| {
             format!(
                 "{}: creating {}: {e}",
                 crate::config::SUBMITTED_VAR,
@@ -117,6 +117,7 @@ fn prepare() -> Result<Prepared, String> {
             )
         })?),
     };
+    crate::faults::install(config.faults.as_deref(), config.fault_log.as_deref())?;
     let buttons = match &config.buttons {
         None => None,
         Some(path) => {
@@ -164,6 +165,11 @@ unsafe extern "system" fn create_api_layer_instance(
             return sys::Result::ERROR_INITIALIZATION_FAILED;
         };
 
+        // The runtime away after an instance loss (the fault schedule's outage).
+        if let Some(Some(r)) = crate::faults::with(|f| f.create_instance(std::time::Instant::now()))
+        {
+            return r;
+        }
         let prepared = match prepare() {
             Ok(p) => p,
             Err(message) => {
@@ -255,7 +261,7 @@ unsafe extern "system" fn create_api_layer_instance(
             timeline: prepared.timeline.map(Arc::new),
             gaze_paths,
             gaze_actions: HashSet::new(),
-            submitted: prepared.submitted.map(|s| Arc::new(Mutex::new(s))),
+            submitted: prepared.submitted,
             buttons,
             button_actions: HashMap::new(),
             attached: false,

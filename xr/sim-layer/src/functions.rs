@@ -140,9 +140,31 @@ pub fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::V
         ),
         b"xrBeginSession" => (
             None,
-            entry!(calls::session::begin_session, pfn::BeginSession),
+            entry!(calls::lifecycle::begin_session, pfn::BeginSession),
         ),
-        b"xrWaitFrame" => (None, entry!(calls::session::wait_frame, pfn::WaitFrame)),
+        b"xrEndSession" => (None, entry!(calls::lifecycle::end_session, pfn::EndSession)),
+        b"xrRequestExitSession" => (
+            None,
+            entry!(
+                calls::lifecycle::request_exit_session,
+                pfn::RequestExitSession
+            ),
+        ),
+        b"xrPollEvent" => (None, entry!(calls::lifecycle::poll_event, pfn::PollEvent)),
+        b"xrGetSystem" => (None, entry!(calls::lifecycle::get_system, pfn::GetSystem)),
+        b"xrWaitFrame" => (None, entry!(calls::lifecycle::wait_frame, pfn::WaitFrame)),
+        b"xrBeginFrame" => (None, entry!(calls::lifecycle::begin_frame, pfn::BeginFrame)),
+        b"xrLocateViews" => (
+            None,
+            entry!(calls::tracking::locate_views, pfn::LocateViews),
+        ),
+        b"xrWaitSwapchainImage" => (
+            None,
+            entry!(
+                calls::swapchain::wait_swapchain_image,
+                pfn::WaitSwapchainImage
+            ),
+        ),
         b"xrCreateSwapchain" => (
             None,
             entry!(calls::swapchain::create_swapchain, pfn::CreateSwapchain),

@@ -22,6 +22,7 @@ pub mod controller;
 pub mod entry;
 pub mod extensions;
 pub mod eye_geometry;
+pub mod faults;
 pub mod functions;
 pub mod guard;
 pub mod images;

@@ -64,6 +64,20 @@ pub struct NextTable {
     pub acquire_swapchain_image: pfn::AcquireSwapchainImage,
     /// `xrReleaseSwapchainImage`.
     pub release_swapchain_image: pfn::ReleaseSwapchainImage,
+    /// `xrWaitSwapchainImage`.
+    pub wait_swapchain_image: pfn::WaitSwapchainImage,
+    /// `xrBeginFrame`.
+    pub begin_frame: pfn::BeginFrame,
+    /// `xrEndSession`.
+    pub end_session: pfn::EndSession,
+    /// `xrRequestExitSession`.
+    pub request_exit_session: pfn::RequestExitSession,
+    /// `xrPollEvent`.
+    pub poll_event: pfn::PollEvent,
+    /// `xrGetSystem`.
+    pub get_system: pfn::GetSystem,
+    /// `xrLocateViews`.
+    pub locate_views: pfn::LocateViews,
 }
 
 /// Looks up one function through `gipa`.
@@ -212,6 +226,23 @@ impl NextTable {
                 c"xrGetInputSourceLocalizedName",
                 pfn::GetInputSourceLocalizedName
             ),
+            wait_swapchain_image: load!(
+                gipa,
+                instance,
+                c"xrWaitSwapchainImage",
+                pfn::WaitSwapchainImage
+            ),
+            begin_frame: load!(gipa, instance, c"xrBeginFrame", pfn::BeginFrame),
+            end_session: load!(gipa, instance, c"xrEndSession", pfn::EndSession),
+            request_exit_session: load!(
+                gipa,
+                instance,
+                c"xrRequestExitSession",
+                pfn::RequestExitSession
+            ),
+            poll_event: load!(gipa, instance, c"xrPollEvent", pfn::PollEvent),
+            get_system: load!(gipa, instance, c"xrGetSystem", pfn::GetSystem),
+            locate_views: load!(gipa, instance, c"xrLocateViews", pfn::LocateViews),
         })
     }
 

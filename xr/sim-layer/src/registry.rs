@@ -66,6 +66,8 @@ pub struct SessionState {
     pub latest_display_ns: Option<i64>,
     /// How many frames the app has ended.
     pub frames_ended: u64,
+    /// The process's sessions made before this one.
+    pub serial: u64,
     /// The newest predicted display time at the last two `xrSyncActions` (older, newer).
     pub syncs_ns: (Option<i64>, Option<i64>),
     /// The runtime's blend modes for the session's view configuration (known after
@@ -105,6 +107,8 @@ pub struct SpaceState {
     /// the action is an eye-gaze action is decided when the space is located (its binding
     /// may be suggested after the space is created).
     pub action: Option<(u64, Pose)>,
+    /// For a reference space: its type.
+    pub reference: Option<sys::ReferenceSpaceType>,
 }
 
 /// An eye tracker the layer made.
@@ -173,6 +177,8 @@ pub struct Registry {
     pub swapchains: HashMap<u64, SwapchainState>,
     /// The next handle the layer gives out.
     next_handle: u64,
+    /// Sessions made so far in the process.
+    pub sessions_made: u64,
 }
 
 /// The first handle the layer gives out: unlike the small counters and pointers runtimes use,
@@ -192,6 +198,7 @@ impl Registry {
             estimates: HashMap::new(),
             swapchains: HashMap::new(),
             next_handle: FIRST_HANDLE,
+            sessions_made: 0,
         }
     }
 

@@ -3,11 +3,13 @@
 //! what the app submitted even if the session dies.
 //!
 //! ```text
-//! frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend,focus_distance_m,global_dimmer
-//! 0,1234567890,additive,1,projection,0x0,opaque,1.5,0.25
+//! frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend,focus_distance_m,global_dimmer,session
+//! 0,1234567890,additive,1,projection,0x0,opaque,1.5,0.25,0
 //! ```
 //!
-//! `frame` counts the session's `xrEndFrame` calls from 0; `blend` is the app's
+//! `frame` counts the session's `xrEndFrame` calls from 0 and `session` the process's sessions
+//! from 0 (an app that makes a new session after a loss appends to the same file); `blend` is
+//! the app's
 //! `environmentBlendMode`, `runtime_blend` the one forwarded to the runtime; `layer_types`
 //! and `layer_flags` (hexadecimal `XrCompositionLayerFlags`) hold one entry per layer,
 //! `;`-separated, in submission order. `focus_distance_m` is the `XrFrameEndInfoML` and
@@ -18,14 +20,15 @@
 
 use std::fs::File;
 use std::io::{self, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, LazyLock, Mutex};
 
 use openxr::sys;
 
 use crate::blend;
 
 /// The header line.
-pub const HEADER: &str = "frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend,focus_distance_m,global_dimmer";
+pub const HEADER: &str = "frame,display_time_ns,blend,layers,layer_types,layer_flags,runtime_blend,focus_distance_m,global_dimmer,session";
 
 /// One submitted composition layer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -53,6 +56,8 @@ pub struct FrameInfo {
     pub focus_distance_m: Option<f32>,
     /// The global dimmer chained and enabled (`XrGlobalDimmerFrameEndInfoML`), 0..=1.
     pub global_dimmer: Option<f32>,
+    /// The process's session it belongs to, from 0.
+    pub session: u64,
 }
 
 /// A short name for a composition layer type.
@@ -76,7 +81,7 @@ pub fn line(f: &FrameInfo) -> String {
     let flags: Vec<String> = f.layers.iter().map(|l| format!("{:#x}", l.flags)).collect();
     let optional = |v: Option<f32>| v.map_or(String::new(), |v| v.to_string());
     format!(
-        "{},{},{},{},{},{},{},{},{}\n",
+        "{},{},{},{},{},{},{},{},{},{}\n",
         f.frame,
         f.display_time_ns,
         blend::name(f.blend),
@@ -85,7 +90,8 @@ pub fn line(f: &FrameInfo) -> String {
         flags.join(";"),
         blend::name(f.runtime_blend),
         optional(f.focus_distance_m),
-        optional(f.global_dimmer)
+        optional(f.global_dimmer),
+        f.session
     )
 }
 
@@ -102,6 +108,20 @@ impl SubmittedLog {
         let mut file = File::create(path)?;
         file.write_all(format!("{HEADER}\n").as_bytes())?;
         Ok(SubmittedLog { file })
+    }
+
+    /// The process's log at `path`: created (truncated) by the first instance that names it,
+    /// shared by every later one, so the sessions of a process go to one file.
+    pub fn shared(path: &Path) -> io::Result<Arc<Mutex<SubmittedLog>>> {
+        type Open = Vec<(PathBuf, Arc<Mutex<SubmittedLog>>)>;
+        static OPEN: LazyLock<Mutex<Open>> = LazyLock::new(|| Mutex::new(Vec::new()));
+        let mut open = OPEN.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, log)) = open.iter().find(|(p, _)| p == path) {
+            return Ok(log.clone());
+        }
+        let log = Arc::new(Mutex::new(SubmittedLog::create(path)?));
+        open.push((path.to_path_buf(), log.clone()));
+        Ok(log)
     }
 
     /// Appends a frame's line.
@@ -134,10 +154,11 @@ mod tests {
             ],
             focus_distance_m: None,
             global_dimmer: None,
+            session: 1,
         };
         assert_eq!(
             line(&f),
-            "3,42,alpha_blend,2,projection;quad,0x3;0x0,opaque,,\n"
+            "3,42,alpha_blend,2,projection;quad,0x3;0x0,opaque,,,1\n"
         );
         let empty = FrameInfo {
             layers: vec![],
@@ -145,7 +166,7 @@ mod tests {
             global_dimmer: Some(0.5),
             ..f
         };
-        assert_eq!(line(&empty), "3,42,alpha_blend,0,,,opaque,1.25,0.5\n");
+        assert_eq!(line(&empty), "3,42,alpha_blend,0,,,opaque,1.25,0.5,1\n");
     }
 
     #[test]
@@ -164,13 +185,14 @@ mod tests {
             }],
             focus_distance_m: None,
             global_dimmer: None,
+            session: 0,
         };
         log.write(&f).unwrap();
         // Read while the log is still open: the line is already there.
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(
             text,
-            format!("{HEADER}\n0,1,additive,1,projection,0x2,opaque,,\n")
+            format!("{HEADER}\n0,1,additive,1,projection,0x2,opaque,,,0\n")
         );
     }
 }

@@ -27,6 +27,9 @@ pub unsafe extern "system" fn sync_actions(
         else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
+        if let Some(Some(r)) = crate::faults::with(|f| f.sync_actions(session.into_raw())) {
+            return r;
+        }
         // SAFETY: the next layer's function with the app's arguments.
         let r = unsafe { (next.sync_actions)(session, info) };
         if r.into_raw() >= 0

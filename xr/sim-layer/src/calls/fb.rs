@@ -64,7 +64,7 @@ pub unsafe extern "system" fn destroy_eye_tracker(tracker: sys::EyeTrackerFB) ->
 
 /// `xrGetEyeGazesFB`: per eye, the pose at the eye origin looking along the gaze (-z), in
 /// `baseSpace` at `time`; valid when the trace's ray is valid and the runtime locates the
-/// base space; confidence 1 when valid, else 0.
+/// base space; confidence 1 when valid (0.1 when the sample is reported LOW), else 0.
 ///
 /// # Safety
 /// As `xrGetEyeGazesFB`.
@@ -93,7 +93,11 @@ pub unsafe extern "system" fn get_eye_gazes(
                 (Some((view_in_base, _)), true) => {
                     slot.is_valid = sys::TRUE;
                     slot.gaze_pose = in_base(view_in_base, &ray_pose(ray));
-                    slot.gaze_confidence = 1.0;
+                    // A tracker unsure of the sample (a LOW report) says so here too.
+                    let low = sample
+                        .report
+                        .is_some_and(|r| r.confidence == vitreous_xr::TrackerConfidence::Low);
+                    slot.gaze_confidence = if low { 0.1 } else { 1.0 };
                 }
                 _ => {
                     slot.is_valid = sys::FALSE;

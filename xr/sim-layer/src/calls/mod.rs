@@ -8,21 +8,24 @@ pub mod actions;
 pub mod controller;
 pub mod fb;
 pub mod instance;
+pub mod lifecycle;
 pub mod light;
 pub mod ml;
 pub mod planes;
 pub mod session;
 pub mod swapchain;
+pub mod tracking;
 
 use std::ffi::c_void;
 use std::sync::Arc;
 
 use openxr::sys::{self, Handle};
-use vitreous_xr::{GazeSample, Pose};
+use vitreous_xr::{GazeBehaviour, GazeSample, Pose, TrackerConfidence, TrackerReport};
 
 use crate::behaviour::Behaviour;
 use crate::config::{Config, GazeExtension};
 use crate::eye_geometry::{from_posef, inverse};
+use crate::faults::schedule::Dropout;
 use crate::next::NextTable;
 use crate::registry::Registry;
 use crate::timeline::{GazeTimeline, TimeBase};
@@ -106,6 +109,35 @@ impl SessionContext {
     /// Before the session's first frame there is no clock mapping yet: the trace's first
     /// sample, stamped `time_ns`.
     pub fn gaze_at(&self, time_ns: i64) -> Option<GazeSample> {
+        match crate::faults::with(|f| f.dropout_at(time_ns)).flatten() {
+            None => self.trace_gaze_at(time_ns),
+            Some((kind, from_ns)) => self.dropped_out(time_ns, kind, from_ns),
+        }
+    }
+
+    /// The eye data while the tracker drops out (`kind`, since `from_ns`): the sample at the
+    /// start of the dropout, its time stamp kept (no new sample); a sample with nothing valid;
+    /// or the sample with LOW confidence.
+    fn dropped_out(&self, time_ns: i64, kind: Dropout, from_ns: i64) -> Option<GazeSample> {
+        Some(match kind {
+            Dropout::None => self.trace_gaze_at(from_ns)?,
+            Dropout::Invalid => {
+                self.timeline.as_ref()?;
+                GazeSample::none(time_ns)
+            }
+            Dropout::Low => {
+                let mut s = self.trace_gaze_at(time_ns)?;
+                s.report = Some(TrackerReport {
+                    confidence: TrackerConfidence::Low,
+                    behaviour: s.report.map_or(GazeBehaviour::Unknown, |r| r.behaviour),
+                });
+                s
+            }
+        })
+    }
+
+    /// The trace's eye data at runtime time `time_ns` (see [`SessionContext::gaze_at`]).
+    fn trace_gaze_at(&self, time_ns: i64) -> Option<GazeSample> {
         let timeline = self.timeline.as_ref()?;
         Some(match self.time_base {
             Some(base) => {
@@ -130,6 +162,12 @@ impl SessionContext {
     /// session's first frame: the trace's first sample's, begun at `time_ns`.
     pub fn behaviour_at(&self, time_ns: i64) -> Option<Behaviour> {
         let timeline = self.timeline.as_ref()?;
+        // An eye tracker without samples does not classify the eyes' movement either.
+        if let Some(Some((Dropout::None | Dropout::Invalid, _))) =
+            crate::faults::with(|f| f.dropout_at(time_ns))
+        {
+            return None;
+        }
         Some(match self.time_base {
             Some(base) => {
                 let mut b = timeline.behaviour_at(base.to_trace(time_ns));

@@ -5,10 +5,11 @@
 
 use openxr::sys::{self, Handle};
 
-use super::{SessionContext, all_location_flags, chain};
+use super::{SessionContext, all_location_flags, chain, tracking};
 use crate::blend;
 use crate::config::Config;
 use crate::eye_geometry::{combined_ray, compose, from_posef, ray_pose, relative, to_posef};
+use crate::faults;
 use crate::guard::{guard, report};
 use crate::images::{AlphaLog, Reader, SessionImages, SharedImages, ViewImage, VulkanBinding};
 use crate::registry::{SessionState, SpaceState, registry};
@@ -61,7 +62,10 @@ pub unsafe extern "system" fn create_session(
             unsafe { (next.destroy_session)(created) };
             return sys::Result::ERROR_RUNTIME_FAILURE;
         }
-        registry().sessions.insert(
+        let mut reg = registry();
+        let serial = reg.sessions_made;
+        reg.sessions_made += 1;
+        reg.sessions.insert(
             created.into_raw(),
             SessionState {
                 instance: instance.into_raw(),
@@ -70,12 +74,15 @@ pub unsafe extern "system" fn create_session(
                 first_display_ns: None,
                 latest_display_ns: None,
                 frames_ended: 0,
+                serial,
                 syncs_ns: (None, None),
                 runtime_blend: None,
                 attached: false,
                 images,
             },
         );
+        drop(reg);
+        faults::with(|f| f.session_created(created.into_raw(), instance.into_raw()));
         r
     })
 }
@@ -137,6 +144,7 @@ pub unsafe extern "system" fn destroy_session(session: sys::Session) -> sys::Res
             };
             (ctx, reg.remove_session(session.into_raw()))
         };
+        faults::with(|f| f.session_destroyed(session.into_raw()));
         if let Some(state) = state {
             // SAFETY: the layer's own space of this live session.
             unsafe { (ctx.next.destroy_space)(state.view_space) };
@@ -194,73 +202,6 @@ fn finish_images(images: &Mutex<SessionImages>, config: &Config) {
     }
 }
 
-/// `xrBeginSession`: passed on; the layer then learns the runtime's blend modes for the
-/// session's view configuration.
-///
-/// # Safety
-/// As `xrBeginSession`.
-pub unsafe extern "system" fn begin_session(
-    session: sys::Session,
-    info: *const sys::SessionBeginInfo,
-) -> sys::Result {
-    guard("xrBeginSession", || {
-        let Some((ctx, system)) = ({
-            let reg = registry();
-            SessionContext::of(&reg, session.into_raw())
-                .zip(reg.sessions.get(&session.into_raw()).map(|s| s.system))
-        }) else {
-            return sys::Result::ERROR_HANDLE_INVALID;
-        };
-        // SAFETY: the next layer's function with the app's arguments.
-        let r = unsafe { (ctx.next.begin_session)(session, info) };
-        if r.into_raw() < 0 {
-            return r;
-        }
-        // SAFETY: on success `info` was valid.
-        let view = unsafe { (*info).primary_view_configuration_type };
-        match ctx.next.runtime_blend_modes(ctx.instance, system, view) {
-            Ok(modes) => {
-                if let Some(s) = registry().sessions.get_mut(&session.into_raw()) {
-                    s.runtime_blend = Some(modes);
-                }
-            }
-            Err(e) => report(format!(
-                "the runtime's blend modes could not be listed: {e:?}"
-            )),
-        }
-        r
-    })
-}
-
-/// `xrWaitFrame`: passed on; the first predicted display time starts the trace clock.
-///
-/// # Safety
-/// As `xrWaitFrame`.
-pub unsafe extern "system" fn wait_frame(
-    session: sys::Session,
-    info: *const sys::FrameWaitInfo,
-    state: *mut sys::FrameState,
-) -> sys::Result {
-    guard("xrWaitFrame", || {
-        let Some(ctx) = SessionContext::of(&registry(), session.into_raw()) else {
-            return sys::Result::ERROR_HANDLE_INVALID;
-        };
-        // SAFETY: the next layer's function with the app's arguments (the lock is not held:
-        // this call blocks).
-        let r = unsafe { (ctx.next.wait_frame)(session, info, state) };
-        if r.into_raw() < 0 {
-            return r;
-        }
-        // SAFETY: on success the runtime filled `state`.
-        let display = unsafe { (*state).predicted_display_time.as_nanos() };
-        if let Some(s) = registry().sessions.get_mut(&session.into_raw()) {
-            s.first_display_ns.get_or_insert(display);
-            s.latest_display_ns = Some(display);
-        }
-        r
-    })
-}
-
 /// `xrEndFrame`: the frame is recorded to the submitted-frames CSV, then passed on with a
 /// blend mode the runtime offers in place of one only the layer offered.
 ///
@@ -282,17 +223,39 @@ pub unsafe extern "system" fn end_frame(
                 let frame = s.frames_ended;
                 s.frames_ended += 1;
                 added.map(|(next, added)| {
-                    (next, added, s.runtime_blend.clone(), frame, instance_log)
+                    (
+                        next,
+                        added,
+                        s.runtime_blend.clone(),
+                        (frame, s.serial),
+                        instance_log,
+                    )
                 })
             })
         };
-        let Some((next, (added, ml_frame), runtime_blend, frame, log)) = found else {
+        let Some((next, (added, ml_frame), runtime_blend, (frame, serial), log)) = found else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the app's structure, null or valid.
         let Some(app) = (unsafe { info.as_ref() }) else {
             return sys::Result::ERROR_VALIDATION_FAILURE;
         };
+        let raw = session.into_raw();
+        let layer_count = if app.layers.is_null() {
+            0
+        } else {
+            app.layer_count
+        };
+        if let Some(Some(r)) = faults::with(|f| {
+            f.frame_call("xrEndFrame", raw)
+                .or_else(|| f.refuse("xrEndFrame", raw))
+                .or_else(|| {
+                    f.submitted(raw, layer_count);
+                    None
+                })
+        }) {
+            return r;
+        }
         let controls = if ml_frame {
             // SAFETY: the app's `next` chain: null or valid structures (xrEndFrame's valid
             // usage).
@@ -335,6 +298,7 @@ pub unsafe extern "system" fn end_frame(
                 layers,
                 focus_distance_m: controls.focus_distance_m,
                 global_dimmer: controls.global_dimmer,
+                session: serial,
             };
             let mut log = log.lock().unwrap_or_else(|e| e.into_inner());
             if let Err(e) = log.write(&frame_info) {
@@ -487,13 +451,17 @@ pub unsafe extern "system" fn create_reference_space(
         if r.into_raw() >= 0 {
             // SAFETY: on success the new space was written.
             let created = unsafe { *space };
+            // SAFETY: on success `info` was valid.
+            let reference = unsafe { (*info).reference_space_type };
             registry().spaces.insert(
                 created.into_raw(),
                 SpaceState {
                     session: session.into_raw(),
                     action: None,
+                    reference: Some(reference),
                 },
             );
+            faults::with(|f| f.space_created(session.into_raw(), reference));
         }
         r
     })
@@ -526,6 +494,7 @@ pub unsafe extern "system" fn create_action_space(
             SpaceState {
                 session: session.into_raw(),
                 action: Some((action.into_raw(), from_posef(&offset))),
+                reference: None,
             },
         );
         r
@@ -584,7 +553,7 @@ pub unsafe extern "system" fn locate_space(
     location: *mut sys::SpaceLocation,
 ) -> sys::Result {
     guard("xrLocateSpace", || {
-        let (next, gaze) = {
+        let (next, gaze, head) = {
             let reg = registry();
             let a = reg.gaze_space(space.into_raw());
             let b = reg.gaze_space(base.into_raw());
@@ -592,14 +561,33 @@ pub unsafe extern "system" fn locate_space(
             (
                 reg.next_for_space(space.into_raw()),
                 ctx.map(|c| (c, a.map(|(_, o)| o), b.map(|(_, o)| o))),
+                tracking::head_in_world(&reg, space.into_raw(), base.into_raw()),
             )
         };
         let Some((ctx, a_offset, b_offset)) = gaze else {
             let Some(next) = next else {
                 return sys::Result::ERROR_HANDLE_INVALID;
             };
+            let (refused, loss) = head
+                .and_then(|(session, head_in_world)| {
+                    faults::with(|f| {
+                        let refused = f.refuse("xrLocateSpace", session);
+                        (refused, f.tracking().filter(|_| head_in_world))
+                    })
+                })
+                .unwrap_or((None, None));
+            if let Some(r) = refused {
+                return r;
+            }
             // SAFETY: the next layer's function with the app's arguments.
-            return unsafe { (next.locate_space)(space, base, time, location) };
+            let r = unsafe { (next.locate_space)(space, base, time, location) };
+            if let Some(loss) = loss.filter(|_| r.into_raw() >= 0) {
+                // SAFETY: on success the runtime filled the app's location (null or valid).
+                if let Some(loc) = unsafe { location.as_mut() } {
+                    tracking::lose_location(loc, loss);
+                }
+            }
+            return r;
         };
         // SAFETY: the app's output structure, null or valid.
         let Some(loc) = (unsafe { location.as_mut() }) else {

@@ -9,6 +9,7 @@ use std::sync::Arc;
 use ash::vk::Handle as _;
 use openxr::sys::{self, Handle};
 
+use crate::faults;
 use crate::guard::{guard, report};
 use crate::images::{SharedImages, TexelLayout};
 use crate::next::NextTable;
@@ -37,6 +38,43 @@ fn next_of(swapchain: u64) -> Option<Arc<NextTable>> {
     }
 }
 
+/// What a call on `swapchain` gets instead of going on, when the fault schedule says so (its
+/// session lost, or the call scheduled to fail).
+fn refused(call: &'static str, swapchain: sys::Swapchain) -> Option<sys::Result> {
+    faults::with(|f| {
+        f.swapchain_session(swapchain.into_raw())
+            .and_then(|session| f.refuse(call, session))
+    })
+    .flatten()
+}
+
+/// `xrWaitSwapchainImage`: answered `XR_TIMEOUT_EXPIRED` (without waiting) when the fault
+/// schedule has a timeout due and the app gave a finite timeout, refused when the session is
+/// lost or the call scheduled to fail, else passed on.
+///
+/// # Safety
+/// As `xrWaitSwapchainImage`.
+pub unsafe extern "system" fn wait_swapchain_image(
+    swapchain: sys::Swapchain,
+    info: *const sys::SwapchainImageWaitInfo,
+) -> sys::Result {
+    guard("xrWaitSwapchainImage", || {
+        let Some(next) = next_of(swapchain.into_raw()) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        // SAFETY: the app's structure, null or valid.
+        let Some(wait) = (unsafe { info.as_ref() }) else {
+            return sys::Result::ERROR_VALIDATION_FAILURE;
+        };
+        let infinite = wait.timeout == sys::Duration::INFINITE;
+        if let Some(Some(r)) = faults::with(|f| f.wait_image(swapchain.into_raw(), infinite)) {
+            return r;
+        }
+        // SAFETY: the next layer's function with the app's arguments.
+        unsafe { (next.wait_swapchain_image)(swapchain, info) }
+    })
+}
+
 /// `xrCreateSwapchain`: with transfer-source usage added where the layer reads the images.
 ///
 /// # Safety
@@ -60,11 +98,15 @@ pub unsafe extern "system" fn create_swapchain(
         }
         // SAFETY: a copy of the app's valid create info; the app's output pointer.
         let r = unsafe { (next.create_swapchain)(session, &asked, swapchain) };
-        if r.into_raw() < 0 || images.is_none() {
+        if r.into_raw() < 0 {
             return r;
         }
         // SAFETY: on success the new handle was written.
         let created = unsafe { *swapchain };
+        faults::with(|f| f.swapchain_created(created.into_raw(), session.into_raw()));
+        if images.is_none() {
+            return r;
+        }
         registry().swapchains.insert(
             created.into_raw(),
             SwapchainState {
@@ -147,6 +189,9 @@ pub unsafe extern "system" fn acquire_swapchain_image(
         let Some(next) = next_of(swapchain.into_raw()) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
+        if let Some(r) = refused("xrAcquireSwapchainImage", swapchain) {
+            return r;
+        }
         // SAFETY: the next layer's function with the app's arguments.
         let r = unsafe { (next.acquire_swapchain_image)(swapchain, info, index) };
         if r.into_raw() >= 0
@@ -173,6 +218,9 @@ pub unsafe extern "system" fn release_swapchain_image(
         let Some(next) = next_of(swapchain.into_raw()) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
+        if let Some(r) = refused("xrReleaseSwapchainImage", swapchain) {
+            return r;
+        }
         let found = {
             let mut reg = registry();
             let record = reg

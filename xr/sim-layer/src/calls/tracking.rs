@@ -1,0 +1,155 @@
+//! Lost head tracking ([`crate::faults`]): the frames whose head poses the fault schedule
+//! takes the position (then the orientation too) from, in `xrLocateViews` and in
+//! `xrLocateSpace` of the head (a VIEW reference space) against the world (LOCAL or STAGE).
+//! A pose whose flags say it is not valid holds nothing the app may use: its position is
+//! zeroed, its orientation made the identity, as a runtime leaves them undefined.
+
+use openxr::sys::{self, Handle};
+
+use super::SessionContext;
+use crate::faults::{self, state::TrackingLoss};
+use crate::guard::guard;
+use crate::registry::{Registry, registry};
+
+/// The flags a located pose keeps without its position.
+fn without_position(flags: sys::SpaceLocationFlags) -> sys::SpaceLocationFlags {
+    flags & !(sys::SpaceLocationFlags::POSITION_VALID | sys::SpaceLocationFlags::POSITION_TRACKED)
+}
+
+/// The flags a located pose keeps without position or orientation.
+fn without_orientation(flags: sys::SpaceLocationFlags) -> sys::SpaceLocationFlags {
+    without_position(flags)
+        & !(sys::SpaceLocationFlags::ORIENTATION_VALID
+            | sys::SpaceLocationFlags::ORIENTATION_TRACKED)
+}
+
+/// A pose as it is reported after `loss`: what is not valid is undefined.
+fn lose(pose: &mut sys::Posef, loss: TrackingLoss) {
+    pose.position = sys::Vector3f::default();
+    if loss == TrackingLoss::Orientation {
+        pose.orientation = sys::Posef::IDENTITY.orientation;
+    }
+}
+
+/// Takes from a located space what this frame's head tracking lacks.
+pub fn lose_location(location: &mut sys::SpaceLocation, loss: TrackingLoss) {
+    location.location_flags = match loss {
+        TrackingLoss::Position => without_position(location.location_flags),
+        TrackingLoss::Orientation => without_orientation(location.location_flags),
+    };
+    lose(&mut location.pose, loss);
+}
+
+/// For `xrLocateSpace` of `space` in `base`: the session, and whether one is the head (a
+/// VIEW reference space) and the other the world (LOCAL or STAGE), the pair lost tracking
+/// shows in.
+pub fn head_in_world(reg: &Registry, space: u64, base: u64) -> Option<(u64, bool)> {
+    let a = reg.spaces.get(&space)?;
+    let b = reg.spaces.get(&base);
+    let world = |t: Option<sys::ReferenceSpaceType>| {
+        t == Some(sys::ReferenceSpaceType::LOCAL) || t == Some(sys::ReferenceSpaceType::STAGE)
+    };
+    let view = |t: Option<sys::ReferenceSpaceType>| t == Some(sys::ReferenceSpaceType::VIEW);
+    let (ta, tb) = (a.reference, b.and_then(|b| b.reference));
+    Some((
+        a.session,
+        (view(ta) && world(tb)) || (world(ta) && view(tb)),
+    ))
+}
+
+/// `xrLocateViews`: refused when the session is lost (or the call is scheduled to fail), else
+/// passed on, the views' flags and poses then losing what this frame's head tracking lacks.
+///
+/// # Safety
+/// As `xrLocateViews`.
+pub unsafe extern "system" fn locate_views(
+    session: sys::Session,
+    info: *const sys::ViewLocateInfo,
+    state: *mut sys::ViewState,
+    capacity: u32,
+    count: *mut u32,
+    views: *mut sys::View,
+) -> sys::Result {
+    guard("xrLocateViews", || {
+        let Some(ctx) = SessionContext::of(&registry(), session.into_raw()) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        let Some((refused, loss)) =
+            faults::with(|f| (f.refuse("xrLocateViews", session.into_raw()), f.tracking()))
+        else {
+            // SAFETY: the next layer's function with the app's arguments.
+            return unsafe {
+                (ctx.next.locate_views)(session, info, state, capacity, count, views)
+            };
+        };
+        if let Some(r) = refused {
+            return r;
+        }
+        // SAFETY: the next layer's function with the app's arguments.
+        let r = unsafe { (ctx.next.locate_views)(session, info, state, capacity, count, views) };
+        let Some(loss) = loss else {
+            return r;
+        };
+        if r.into_raw() < 0 || state.is_null() {
+            return r;
+        }
+        // SAFETY: on success the runtime filled the app's view state.
+        let state = unsafe { &mut *state };
+        let flags = sys::SpaceLocationFlags::from_raw(state.view_state_flags.into_raw());
+        let kept = match loss {
+            TrackingLoss::Position => without_position(flags),
+            TrackingLoss::Orientation => without_orientation(flags),
+        };
+        state.view_state_flags = sys::ViewStateFlags::from_raw(kept.into_raw());
+        if capacity > 0 && !views.is_null() && !count.is_null() {
+            // SAFETY: on success `count` says how many of the app's views were written.
+            let written = unsafe { *count }.min(capacity) as usize;
+            for i in 0..written {
+                // SAFETY: the app's array of `capacity` views, `written` of them filled.
+                lose(unsafe { &mut (*views.add(i)).pose }, loss);
+            }
+        }
+        r
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sys::SpaceLocationFlags as F;
+
+    #[test]
+    fn a_lost_position_keeps_the_orientation_and_a_lost_orientation_keeps_nothing() {
+        let all =
+            F::POSITION_VALID | F::POSITION_TRACKED | F::ORIENTATION_VALID | F::ORIENTATION_TRACKED;
+        let mut loc = sys::SpaceLocation {
+            ty: sys::SpaceLocation::TYPE,
+            next: std::ptr::null_mut(),
+            location_flags: all,
+            pose: sys::Posef {
+                orientation: sys::Quaternionf {
+                    x: 0.0,
+                    y: 0.6,
+                    z: 0.0,
+                    w: 0.8,
+                },
+                position: sys::Vector3f {
+                    x: 1.0,
+                    y: 1.6,
+                    z: -2.0,
+                },
+            },
+        };
+        let mut position_lost = loc;
+        lose_location(&mut position_lost, TrackingLoss::Position);
+        assert_eq!(
+            position_lost.location_flags,
+            F::ORIENTATION_VALID | F::ORIENTATION_TRACKED
+        );
+        assert_eq!(position_lost.pose.orientation.y, 0.6);
+        assert_eq!(position_lost.pose.position.y, 0.0);
+        lose_location(&mut loc, TrackingLoss::Orientation);
+        assert_eq!(loc.location_flags, F::EMPTY);
+        assert_eq!(loc.pose.orientation.w, 1.0);
+    }
+}

@@ -252,6 +252,14 @@ pub trait Backend {
     /// default, which does nothing.
     fn abandon_frame(&mut self) {}
 
+    /// What happened to the session since the frame before the last `wait_frame`'s (a headset
+    /// taken off and put back on, frames not rendered, tracking lost, ...), oldest first, taken
+    /// out of the backend; also after `wait_frame` ended the session, for what ended it.
+    /// Backends to which nothing happens keep the default, which has nothing.
+    fn take_events(&mut self) -> Vec<crate::SessionEvent> {
+        Vec::new()
+    }
+
     /// Where the frame handed out by the last `wait_frame` is to be drawn. Backends that
     /// own no display images (the null backend) keep the default, [`FrameTarget::Own`].
     fn frame_target(&self) -> FrameTarget {

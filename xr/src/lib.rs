@@ -15,6 +15,7 @@ pub mod null;
 pub mod openxr;
 pub mod planes;
 pub mod records;
+pub mod session_event;
 pub mod sranipal;
 pub mod synth;
 pub mod trace;
@@ -24,4 +25,5 @@ pub use frame::{
     GazeSample, Pose, TrackerConfidence, TrackerReport,
 };
 pub use null::{NullBackend, NullConfig, NullError};
+pub use session_event::SessionEvent;
 pub use trace::{TraceError, TraceReader, TraceSample, TraceWriter, read_trace};

@@ -29,7 +29,8 @@ use glam::Vec3;
 use thiserror::Error;
 
 use crate::frame::{Backend, Fov, FrameInput};
-use crate::trace::{TraceError, TraceReader, TraceSample};
+use crate::session_event::SessionEvent;
+use crate::trace::{EventRecord, TraceError, TraceReader, TraceSample};
 
 pub use sampling::interpolate;
 
@@ -123,8 +124,25 @@ pub enum NullError {
     FrameOrder(String),
 }
 
-/// Where samples come from: a vector or a streaming reader, behind one interface.
-type SampleSource = Box<dyn Iterator<Item = Result<TraceSample, TraceError>> + Send>;
+/// Where samples come from: a vector or a streaming reader, behind one interface; a reader
+/// also hands over the event lines (version 1.4) it read on the way.
+trait Samples: Iterator<Item = Result<TraceSample, TraceError>> + Send {
+    /// The event lines read since the last call.
+    fn take_events(&mut self) -> Vec<EventRecord> {
+        Vec::new()
+    }
+}
+
+impl Samples for std::vec::IntoIter<Result<TraceSample, TraceError>> {}
+
+impl<R: std::io::Read + Send> Samples for TraceReader<R> {
+    fn take_events(&mut self) -> Vec<EventRecord> {
+        TraceReader::take_events(self)
+    }
+}
+
+/// The samples' source.
+type SampleSource = Box<dyn Samples>;
 
 /// A [`Backend`] that replays a trace. See the module documentation for the timing rules.
 pub struct NullBackend {
@@ -160,16 +178,28 @@ pub struct NullBackend {
     last_time_ns: Option<i64>,
     /// True once the replay has ended (or failed).
     done: bool,
+    /// The recording's session events not yet handed out, oldest first.
+    events: VecDeque<EventRecord>,
+    /// Those that came with the frames handed out since the last [`Backend::take_events`].
+    ready: Vec<SessionEvent>,
 }
 
 impl NullBackend {
     /// Replays samples held in memory. They must be in time order (as a trace file is).
     pub fn new(samples: Vec<TraceSample>, config: NullConfig) -> Result<Self, NullError> {
+        let samples: Vec<Result<TraceSample, TraceError>> = samples.into_iter().map(Ok).collect();
         NullBackend::from_source(
-            Box::new(samples.into_iter().map(Ok)),
+            Box::new(samples.into_iter()),
             "<samples>".to_owned(),
             config,
         )
+    }
+
+    /// Hands `events` (a recording's, in time order) out with the frames they came with: each
+    /// with the first frame displayed at or after its time ([`Backend::take_events`]).
+    pub fn with_events(mut self, events: Vec<EventRecord>) -> Self {
+        self.events.extend(events);
+        self
     }
 
     /// Replays a trace file as it is read.
@@ -222,6 +252,8 @@ impl NullBackend {
             pending: None,
             last_time_ns: None,
             done: false,
+            events: VecDeque::new(),
+            ready: Vec::new(),
         };
         if !this.pull()? {
             return Err(NullError::EmptyTrace {
@@ -317,6 +349,11 @@ impl Backend for NullBackend {
                 self.next_index += 1;
                 self.last_time_ns = Some(time_ns);
                 self.pending = Some(index);
+                self.events.extend(self.source.take_events());
+                while let Some(e) = self.events.front().filter(|e| e.time_ns <= time_ns) {
+                    self.ready.push(e.event);
+                    self.events.pop_front();
+                }
                 Ok(Some(frame))
             }
             Ok(None) => {
@@ -328,6 +365,15 @@ impl Backend for NullBackend {
                 Err(e)
             }
         }
+    }
+
+    fn take_events(&mut self) -> Vec<SessionEvent> {
+        if self.done && self.exhausted {
+            // The trace is over: what came after its last frame too.
+            self.events.extend(self.source.take_events());
+            self.ready.extend(self.events.drain(..).map(|e| e.event));
+        }
+        std::mem::take(&mut self.ready)
     }
 
     fn end_frame(&mut self, frame: &FrameInput) -> Result<(), NullError> {

@@ -326,3 +326,68 @@ fn backend_is_send() {
     fn is_send<T: Send>() {}
     is_send::<NullBackend>();
 }
+
+#[test]
+fn a_recordings_events_come_with_the_frames_they_came_with() {
+    use crate::session_event::{NotRendered, SessionEvent};
+    use crate::trace::{EventRecord, TraceVersion};
+    let mut text = Vec::new();
+    let mut w = TraceWriter::with_version(&mut text, "r", TraceVersion::V1_4).unwrap();
+    let at = |time_ns, event| EventRecord { time_ns, event };
+    let skipped = SessionEvent::NotRendered {
+        reason: NotRendered::Runtime,
+        frames: 3,
+    };
+    w.write(&sample(1_000, Vec3::ZERO, 0.0)).unwrap();
+    w.write_event(&at(5_000, SessionEvent::Ended)).unwrap();
+    w.write_event(&at(5_000, SessionEvent::Resumed)).unwrap();
+    w.write(&sample(5_000, Vec3::ZERO, 0.0)).unwrap();
+    w.write_event(&at(6_000, skipped)).unwrap();
+    w.write(&sample(6_000, Vec3::ZERO, 0.0)).unwrap();
+    w.write_event(&at(
+        7_000,
+        SessionEvent::Lost(crate::session_event::Loss::Session),
+    ))
+    .unwrap();
+    w.finish().unwrap();
+    let reader = TraceReader::new(std::io::Cursor::new(text), "r").unwrap();
+    let mut backend = NullBackend::from_reader(
+        reader,
+        NullConfig {
+            at_samples: true,
+            ..NullConfig::default()
+        },
+    )
+    .unwrap();
+    let mut seen = Vec::new();
+    while let Some(f) = backend.wait_frame().unwrap() {
+        seen.push((f.time_ns, backend.take_events()));
+        backend.end_frame(&f).unwrap();
+    }
+    assert_eq!(
+        seen,
+        vec![
+            (1_000, vec![]),
+            (5_000, vec![SessionEvent::Ended, SessionEvent::Resumed]),
+            (6_000, vec![skipped]),
+        ]
+    );
+    // The one after the last frame comes once the replay is over.
+    assert_eq!(
+        backend.take_events(),
+        vec![SessionEvent::Lost(crate::session_event::Loss::Session)]
+    );
+    // Samples in memory take the events beside them.
+    let mut backend = NullBackend::new(ten_ms_trace(), NullConfig::default())
+        .unwrap()
+        .with_events(vec![at(5_015_000_000, SessionEvent::Recentred)]);
+    let mut with = Vec::new();
+    while let Some(f) = backend.wait_frame().unwrap() {
+        if !backend.take_events().is_empty() {
+            with.push(f.time_ns);
+        }
+        backend.end_frame(&f).unwrap();
+    }
+    // 60 Hz frames: the first at or after 15 ms is at 16.67 ms.
+    assert_eq!(with, vec![5_016_666_667]);
+}

@@ -291,6 +291,24 @@ pub enum TraceError {
         /// What is wrong with it.
         reason: String,
     },
+    /// A session-event line (version 1.4) that cannot be read.
+    #[error("{file}:{line}: event line: {reason}")]
+    BadEvent {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// An event written into a trace whose version has no event lines.
+    #[error("{file}: a version {version} trace holds no session events")]
+    EventsNotInVersion {
+        /// File name.
+        file: String,
+        /// The version being written.
+        version: &'static str,
+    },
     /// An edit written into a trace whose version has no edit lines.
     #[error("{file}: a version {version} trace holds no scene edits")]
     EditsNotInVersion {

@@ -1,6 +1,7 @@
 //! The vitreous trace format, version 1 (and its minor versions: 1.1 adds the per-eye pupil
 //! diameters, 1.2 the scene-edit lines of live controls, 1.3 the tracker's own report of each
-//! sample): head poses and eye-tracker samples as UTF-8 text.
+//! sample, 1.4 the event lines of what happened to a live session between its samples): head
+//! poses and eye-tracker samples as UTF-8 text.
 //!
 //! One sample per line, comma-separated, after a version line and a column header line. The
 //! full description (every column, its unit and axes) is in `docs/trace-format.md`; the short
@@ -30,6 +31,7 @@
 
 mod edit;
 mod error;
+mod event;
 mod read;
 mod report;
 #[cfg(test)]
@@ -44,7 +46,8 @@ pub use edit::{
     EDIT_FIELDS, EDIT_SHARE_FIELD, EDIT_TAG, EditRecord, MAX_ACTION_BYTES, valid_action,
 };
 pub use error::TraceError;
-pub use read::{TraceReader, read_trace, read_trace_with_edits};
+pub use event::{EVENT_FIELDS, EVENT_KINDS, EVENT_TAG, EventRecord};
+pub use read::{Recording, TraceReader, read_recording, read_trace, read_trace_with_edits};
 pub use report::{behaviour_name, confidence_name};
 pub(crate) use validate::check_span;
 pub use validate::clean_ray;
@@ -62,6 +65,9 @@ pub const VERSION_LINE_V1_2: &str = "# vitreous-trace v1.2";
 
 /// The first line of a version-1.3 trace (version 1.2 plus the tracker report columns).
 pub const VERSION_LINE_V1_3: &str = "# vitreous-trace v1.3";
+
+/// The first line of a version-1.4 trace (version 1.3 plus event lines).
+pub const VERSION_LINE_V1_4: &str = "# vitreous-trace v1.4";
 
 /// What the version line starts with, whatever the version.
 const VERSION_PREFIX: &str = "# vitreous-trace ";
@@ -144,6 +150,9 @@ pub enum TraceVersion {
     /// `# vitreous-trace v1.3`: version 1.2 with 37 columns, the last two the tracker's
     /// report of the sample ([`crate::TrackerReport`]).
     V1_3,
+    /// `# vitreous-trace v1.4`: version 1.3 (its columns, edit lines) and event lines
+    /// ([`EventRecord`]): what happened to the live session between its samples.
+    V1_4,
 }
 
 impl TraceVersion {
@@ -152,7 +161,7 @@ impl TraceVersion {
         match self {
             TraceVersion::V1 => &COLUMNS,
             TraceVersion::V1_1 | TraceVersion::V1_2 => &COLUMNS_V1_1,
-            TraceVersion::V1_3 => &COLUMNS_V1_3,
+            TraceVersion::V1_3 | TraceVersion::V1_4 => &COLUMNS_V1_3,
         }
     }
 
@@ -163,17 +172,26 @@ impl TraceVersion {
             TraceVersion::V1_1 => VERSION_LINE_V1_1,
             TraceVersion::V1_2 => VERSION_LINE_V1_2,
             TraceVersion::V1_3 => VERSION_LINE_V1_3,
+            TraceVersion::V1_4 => VERSION_LINE_V1_4,
         }
     }
 
     /// Whether lines of this version may be scene edits.
     pub fn has_edits(self) -> bool {
-        matches!(self, TraceVersion::V1_2 | TraceVersion::V1_3)
+        matches!(
+            self,
+            TraceVersion::V1_2 | TraceVersion::V1_3 | TraceVersion::V1_4
+        )
     }
 
     /// Whether the samples of this version carry the tracker's report.
     pub fn has_reports(self) -> bool {
-        self == TraceVersion::V1_3
+        matches!(self, TraceVersion::V1_3 | TraceVersion::V1_4)
+    }
+
+    /// Whether lines of this version may be session events.
+    pub fn has_events(self) -> bool {
+        self == TraceVersion::V1_4
     }
 }
 

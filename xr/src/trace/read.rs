@@ -7,6 +7,7 @@ use std::path::Path;
 use glam::{Quat, Vec3};
 
 use super::edit::{EDIT_TAG, EditRecord, check_edit, parse_edit};
+use super::event::{EVENT_TAG, EventRecord, check_event, parse_event};
 use super::report::parse_report;
 use super::validate::{Preceding, check_sample};
 use super::{
@@ -86,7 +87,7 @@ fn parse_record(record: &Record<'_>, version: TraceVersion) -> Result<TraceSampl
     };
     let pupil_diameter_m = match version {
         TraceVersion::V1 => [None, None],
-        TraceVersion::V1_1 | TraceVersion::V1_2 | TraceVersion::V1_3 => [
+        TraceVersion::V1_1 | TraceVersion::V1_2 | TraceVersion::V1_3 | TraceVersion::V1_4 => [
             parse_pupil(record, PUPILS)?,
             parse_pupil(record, PUPILS + 1)?,
         ],
@@ -155,6 +156,10 @@ pub struct TraceReader<R: Read> {
     version: TraceVersion,
     /// The edit lines read so far (version 1.2 and later), in file order.
     edits: Vec<EditRecord>,
+    /// The event lines read so far (version 1.4), in file order.
+    events: Vec<EventRecord>,
+    /// Time of the last edit or event line read.
+    previous_line_ns: Option<i64>,
 }
 
 impl TraceReader<BufReader<File>> {
@@ -181,6 +186,8 @@ impl<R: Read> TraceReader<R> {
             done: false,
             version: TraceVersion::V1,
             edits: Vec::new(),
+            events: Vec::new(),
+            previous_line_ns: None,
         };
         this.read_headers()?;
         Ok(this)
@@ -195,6 +202,12 @@ impl<R: Read> TraceReader<R> {
     /// the iterator has ended), taken out of the reader.
     pub fn take_edits(&mut self) -> Vec<EditRecord> {
         std::mem::take(&mut self.edits)
+    }
+
+    /// The session events read so far (the lines among the samples already read; all of them
+    /// once the iterator has ended), taken out of the reader.
+    pub fn take_events(&mut self) -> Vec<EventRecord> {
+        std::mem::take(&mut self.events)
     }
 
     /// The file name used in error messages.
@@ -218,6 +231,7 @@ impl<R: Read> TraceReader<R> {
             Some("v1.1") => self.version = TraceVersion::V1_1,
             Some("v1.2") => self.version = TraceVersion::V1_2,
             Some("v1.3") => self.version = TraceVersion::V1_3,
+            Some("v1.4") => self.version = TraceVersion::V1_4,
             Some(version) => {
                 return Err(TraceError::UnsupportedVersion {
                     file: name,
@@ -263,6 +277,15 @@ impl<R: Read> TraceReader<R> {
             let Some(record) = self.records.next_content_record()? else {
                 return Ok(None);
             };
+            let previous_ns = self.previous.map(|p| p.time_ns());
+            if self.version.has_events() && record.field(0) == EVENT_TAG {
+                let raw = parse_event(&record)?;
+                let latest = previous_ns.into_iter().chain(self.previous_line_ns).max();
+                let event = check_event(record.file(), record.line(), &raw, latest)?;
+                self.previous_line_ns = Some(event.time_ns);
+                self.events.push(event);
+                continue;
+            }
             if !(self.version.has_edits() && record.field(0) == EDIT_TAG) {
                 break record;
             }
@@ -271,9 +294,10 @@ impl<R: Read> TraceReader<R> {
                 record.file(),
                 record.line(),
                 &raw,
-                self.previous.map(|p| p.time_ns()),
-                self.edits.last().map(|e| e.time_ns),
+                previous_ns,
+                self.previous_line_ns,
             )?;
+            self.previous_line_ns = Some(edit.time_ns);
             self.edits.push(edit);
         };
         let raw = parse_record(&record, self.version)?;
@@ -315,7 +339,29 @@ pub fn read_trace_with_edits(
     Ok((samples, reader.take_edits()))
 }
 
-/// Reads a whole trace file into memory (the samples; scene edits are skipped).
+/// A whole trace file: its samples, scene edits and session events.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Recording {
+    /// The samples.
+    pub samples: Vec<TraceSample>,
+    /// The scene edits (none before version 1.2).
+    pub edits: Vec<EditRecord>,
+    /// The session events (none before version 1.4).
+    pub events: Vec<EventRecord>,
+}
+
+/// Reads a whole trace file into memory, with its scene edits and session events.
+pub fn read_recording(path: impl AsRef<Path>) -> Result<Recording, TraceError> {
+    let mut reader = TraceReader::open(path)?;
+    let samples = reader.by_ref().collect::<Result<Vec<_>, _>>()?;
+    Ok(Recording {
+        samples,
+        edits: reader.take_edits(),
+        events: reader.take_events(),
+    })
+}
+
+/// Reads a whole trace file into memory (the samples; scene edits and events are skipped).
 pub fn read_trace(path: impl AsRef<Path>) -> Result<Vec<TraceSample>, TraceError> {
     TraceReader::open(path)?.collect()
 }

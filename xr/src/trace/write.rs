@@ -4,6 +4,7 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use super::edit::{EditRecord, check_edit, format_edit};
+use super::event::{EventRecord, check_event, format_event};
 use super::report::write_report;
 use super::validate::{Preceding, check_sample};
 use super::{AtomicFile, TraceError, TraceSample, TraceVersion};
@@ -30,7 +31,7 @@ pub struct TraceWriter<W: Write> {
     line: usize,
     /// What the ordering checks need of the samples before.
     previous: Option<Preceding>,
-    /// Time of the last edit written.
+    /// Time of the last edit or event written.
     previous_edit_ns: Option<i64>,
     /// The version asked for (1.1; 1.2 when edits may come; 1.3 for reports from the start).
     asked: TraceVersion,
@@ -139,7 +140,7 @@ impl<W: Write> TraceWriter<W> {
         let version = match self.written {
             Some(v) => v,
             None => {
-                let v = if s.gaze.report.is_some() {
+                let v = if s.gaze.report.is_some() && !self.asked.has_reports() {
                     TraceVersion::V1_3
                 } else {
                     self.asked
@@ -218,6 +219,34 @@ impl<W: Write> TraceWriter<W> {
             self.flush_buf("writing edit")?;
         } else {
             self.pending_edits.push_str(&format_edit(&e));
+        }
+        self.previous_edit_ns = Some(e.time_ns);
+        self.line += 1;
+        Ok(())
+    }
+
+    /// Checks and writes one session event (a version-1.4 trace only), then flushes; before
+    /// the first sample it waits for it, as an edit does. Its time must not be before the
+    /// sample, edit or event written before it.
+    pub fn write_event(&mut self, event: &EventRecord) -> Result<(), TraceError> {
+        if !self.asked.has_events() {
+            return Err(TraceError::EventsNotInVersion {
+                file: self.name.clone(),
+                version: self.asked.version_line(),
+            });
+        }
+        let latest = self
+            .previous
+            .map(|p| p.time_ns())
+            .into_iter()
+            .chain(self.previous_edit_ns)
+            .max();
+        let e = check_event(&self.name, self.line, event, latest)?;
+        if self.written.is_some() {
+            self.buf = format_event(&e);
+            self.flush_buf("writing event")?;
+        } else {
+            self.pending_edits.push_str(&format_event(&e));
         }
         self.previous_edit_ns = Some(e.time_ns);
         self.line += 1;

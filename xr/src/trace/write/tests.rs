@@ -166,6 +166,80 @@ fn edits_before_the_first_sample_wait_for_its_version() {
 }
 
 #[test]
+fn events_round_trip_in_version_1_4_among_samples_and_edits() {
+    use crate::session_event::{NotRendered, SessionEvent};
+    let ended = EventRecord {
+        time_ns: 1000,
+        event: SessionEvent::Ended,
+    };
+    let skipped = EventRecord {
+        time_ns: 4000,
+        event: SessionEvent::NotRendered {
+            reason: NotRendered::Runtime,
+            frames: 3,
+        },
+    };
+    let mut w = TraceWriter::with_version(Vec::new(), "v", TraceVersion::V1_4).unwrap();
+    w.write_event(&ended).unwrap();
+    w.write(&sample(1000)).unwrap();
+    w.write_edit(&edit(4000)).unwrap();
+    w.write_event(&skipped).unwrap();
+    w.write(&sample(4000)).unwrap();
+    // Not before the line it follows.
+    assert!(matches!(
+        w.write_event(&EventRecord {
+            time_ns: 3999,
+            ..ended
+        }),
+        Err(TraceError::BadEvent { .. })
+    ));
+    let text = text_of(w);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], VERSION_LINE_V1_4);
+    assert_eq!(lines[1].split(',').count(), 37, "version 1.3's columns");
+    assert_eq!(lines[2], "event,1000,session-ended,,0");
+    assert_eq!(lines[5], "event,4000,not-rendered,runtime,3");
+    let mut r = TraceReader::new(text.as_bytes(), "v").unwrap();
+    let read: Vec<_> = r.by_ref().collect::<Result<_, _>>().unwrap();
+    assert_eq!(read, vec![sample(1000), sample(4000)]);
+    assert_eq!(r.take_events(), vec![ended, skipped]);
+    assert_eq!(r.take_edits(), vec![edit(4000)]);
+    // Earlier versions hold no events.
+    let mut w = TraceWriter::with_version(Vec::new(), "v", TraceVersion::V1_3).unwrap();
+    assert!(matches!(
+        w.write_event(&ended),
+        Err(TraceError::EventsNotInVersion { .. })
+    ));
+}
+
+#[test]
+fn bad_event_lines_name_the_line_and_what_is_wrong() {
+    let head = format!("{VERSION_LINE_V1_4}\n{}\n", COLUMNS_V1_3.join(","));
+    for (line, says) in [
+        (
+            "event,10,crashed,,0",
+            "`crashed` is not one of not-rendered",
+        ),
+        ("event,10,lost,headset,0", "session or instance"),
+        ("event,10,late,,-1", "count"),
+        ("event,x,late,,1", "time_ns"),
+        ("event,10,late,,1,2", "fields"),
+    ] {
+        let text = format!("{head}{line}\n");
+        let mut r = TraceReader::new(text.as_bytes(), "bad.trace").unwrap();
+        let e = r.next().unwrap().unwrap_err().to_string();
+        assert!(e.contains("bad.trace:3") && e.contains(says), "{line}: {e}");
+    }
+    // In version 1.3 an event line is a sample line that does not parse.
+    let text = format!(
+        "{VERSION_LINE_V1_3}\n{}\nevent,10,late,,1\n",
+        COLUMNS_V1_3.join(",")
+    );
+    let mut r = TraceReader::new(text.as_bytes(), "old.trace").unwrap();
+    assert!(r.next().unwrap().is_err());
+}
+
+#[test]
 fn reports_after_a_first_sample_without_one_are_left_out_and_counted() {
     let mut samples: Vec<_> = (1..=3).map(|i| sample(i * 1000)).collect();
     samples[1].gaze.report = report(TrackerConfidence::High, GazeBehaviour::Fixation);

@@ -19,7 +19,7 @@ use crate::input_files::InputFiles;
 use crate::motion_clock::MotionClock;
 use crate::output::{EYE_NAMES, encode_png, is_frame_file_name, linear_to_srgb, write_atomic};
 use crate::render_desc::eye_params;
-use crate::setup::{check_size, load_trace_with_edits};
+use crate::setup::{check_size, load_recording};
 
 /// Most samples per pixel side.
 pub const MAX_SAMPLES_PER_SIDE: u32 = 16;
@@ -496,9 +496,10 @@ fn frames_to_render(scene: &Scene, args: &ReferenceArgs) -> Result<Vec<Frame>> {
             placement: scene.rest_placement(),
         }]);
     };
-    let (samples, edits, name) = load_trace_with_edits(scene, Some(trace.as_path()))?;
+    let (recording, name) = load_recording(scene, Some(trace.as_path()))?;
+    let edits = recording.edits;
     let mut backend = NullBackend::new(
-        samples,
+        recording.samples,
         NullConfig {
             frame_rate_hz: args.rate,
             max_frames: Some(args.frames.unwrap_or(1)),

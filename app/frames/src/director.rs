@@ -5,8 +5,8 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::Command;
+use vitreous_xr::{FrameInput, SessionEvent};
 
 use vitreous_gaze::GazeOverride;
 use vitreous_scene::effects::EffectSet;
@@ -23,6 +23,11 @@ pub trait Director {
     /// A command from the headset's controls (an answer, for a study); the director handles
     /// it instead of the live controls.
     fn command(&mut self, command: Command);
+
+    /// What happened to the session since the frame before (the headset taken off, a menu,
+    /// a loss: [`SessionEvent`]), before the next frame is planned. Directors that do not
+    /// care keep the default, which ignores it.
+    fn session_events(&mut self, _events: &[SessionEvent]) {}
 
     /// The flag set once the session should end.
     fn end_flag(&self) -> Arc<AtomicBool>;

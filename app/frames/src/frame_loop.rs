@@ -10,7 +10,7 @@ use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{Composition, Look, Renderer, ScenePose};
 use vitreous_xr::openxr::Blend;
-use vitreous_xr::{Backend, FrameEndHints, FrameInput, FrameTarget};
+use vitreous_xr::{Backend, FrameEndHints, FrameInput, FrameTarget, SessionEvent};
 
 use crate::render_desc;
 
@@ -54,6 +54,17 @@ pub trait FrameSink {
     /// Handles a finished frame (its input and its results), in frame order.
     fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()>;
 
+    /// What happened to the session since the frame before (`frame`: the frame the backend
+    /// handed out after it, `None` when the session ended), oldest first: called before the
+    /// frame is planned, and once more at the end when the ending brought any.
+    fn session_events(
+        &mut self,
+        _frame: Option<&FrameInput>,
+        _events: &[SessionEvent],
+    ) -> Result<()> {
+        Ok(())
+    }
+
     /// Whether to end the run before the next frame (e.g. on Ctrl-C); frames in flight are
     /// still finished and handed to [`FrameSink::finished`].
     fn stop_requested(&self) -> bool {
@@ -91,8 +102,19 @@ pub fn run<B: Backend>(
     let mut records = Vec::new();
     while !sink.stop_requested() {
         let Some(input) = backend.wait_frame().context("waiting for the next frame")? else {
+            let events = backend.take_events();
+            if !events.is_empty() {
+                sink.session_events(None, &events)?;
+            }
             break;
         };
+        let events = backend.take_events();
+        if !events.is_empty()
+            && let Err(e) = sink.session_events(Some(&input), &events)
+        {
+            backend.abandon_frame();
+            return Err(e);
+        }
         // Between wait_frame and end_frame an error must give the frame back to the backend
         // (release its images, end it unshown) before it is returned.
         let drawn = draw(backend, renderer, sink, &input);

@@ -19,6 +19,7 @@
 //! | [`director`] | who decides each frame's condition and gaze image: the user, or a study |
 //! | [`conditions`] | the effect conditions a live run cycles through, and its live commands |
 //! | [`frame_log`] | `frames.csv`: each frame's defocus decision |
+//! | [`gaze_watch`] | whether the eye tracker gives usable samples: its dropouts |
 //! | [`output`] | files a command writes: frame PNGs, previews, whole or not at all |
 //! | [`input_files`] | the files a command reads, which none of its outputs may name |
 //! | [`reference_view`] | a replay's eye images beside the paper's reference |
@@ -35,6 +36,7 @@ pub mod director;
 pub mod focus;
 pub mod frame_log;
 pub mod frame_loop;
+pub mod gaze_watch;
 pub mod input_files;
 pub mod interrupt;
 pub mod look;

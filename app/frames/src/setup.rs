@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use vitreous_scene::{Scene, synth_params_for};
-use vitreous_xr::trace::{EditRecord, TraceSample, read_trace_with_edits};
+use vitreous_xr::trace::{Recording, TraceSample, read_recording};
 
 /// The largest eye image side accepted, pixels.
 pub const MAX_SIZE_PX: u32 = 8192;
@@ -32,26 +32,28 @@ pub fn ensure_samples(path: &Path, samples: &[TraceSample], purpose: &str) -> Re
 
 /// Loads the trace or synthesises one for the scene.
 pub fn load_trace(scene: &Scene, trace: Option<&Path>) -> Result<(Vec<TraceSample>, String)> {
-    load_trace_with_edits(scene, trace).map(|(samples, _, name)| (samples, name))
+    load_recording(scene, trace).map(|(r, name)| (r.samples, name))
 }
 
-/// Loads the trace, with its scene edits, or synthesises one (without edits) for the scene.
-pub fn load_trace_with_edits(
-    scene: &Scene,
-    trace: Option<&Path>,
-) -> Result<(Vec<TraceSample>, Vec<EditRecord>, String)> {
+/// Loads the trace, with its scene edits and session events, or synthesises one (without
+/// either) for the scene; the name to report it by.
+pub fn load_recording(scene: &Scene, trace: Option<&Path>) -> Result<(Recording, String)> {
     match trace {
         Some(path) => {
-            let (samples, edits) = read_trace_with_edits(path).context("reading the trace")?;
-            ensure_samples(path, &samples, "replay")?;
-            Ok((samples, edits, path.display().to_string()))
+            let recording = read_recording(path).context("reading the trace")?;
+            ensure_samples(path, &recording.samples, "replay")?;
+            Ok((recording, path.display().to_string()))
         }
         None => {
             tracing::info!("no --trace given: replaying a synthetic trace for the scene");
             let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(scene))
                 .context("synthesising a trace for the scene")?
                 .samples;
-            Ok((samples, Vec::new(), "synthetic".into()))
+            let recording = Recording {
+                samples,
+                ..Recording::default()
+            };
+            Ok((recording, "synthetic".into()))
         }
     }
 }

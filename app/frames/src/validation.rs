@@ -4,7 +4,7 @@ use serde::Serialize;
 use vitreous_render::GpuContext;
 
 /// Validation layer results.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct ValidationSummary {
     /// Whether the layers were on.
     pub enabled: bool,
@@ -26,6 +26,15 @@ impl ValidationSummary {
             errors: v.errors(),
             messages: v.messages(),
         }
+    }
+
+    /// The summary of a run whose device was followed by `later`'s (a new session after a
+    /// loss): the counts added, the messages one after the other.
+    pub fn then(&mut self, later: &ValidationSummary) {
+        self.enabled &= later.enabled;
+        self.warnings += later.warnings;
+        self.errors += later.errors;
+        self.messages.extend(later.messages.iter().cloned());
     }
 
     /// An error when the layers reported anything: the counts, the first message, and

@@ -12,9 +12,9 @@ use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{
     ContextOptions, GpuContext, Look, Reflection, Refraction, Renderer, ScenePose,
 };
-use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::trace::{EditRecord, TraceSample};
+use vitreous_xr::trace::{EditRecord, Recording, TraceSample};
+use vitreous_xr::{FrameInput, SessionEvent};
 
 use crate::effects::EffectSet;
 use crate::frame_log::FrameLog;
@@ -27,7 +27,7 @@ use crate::output::{self, write_atomic};
 use crate::reference_view::side_by_side;
 use crate::render_desc;
 use crate::scene::{Scene, load_scene};
-use crate::setup::{check_size, load_trace_with_edits};
+use crate::setup::{check_size, load_recording};
 use crate::spread::Spread;
 use crate::validation::ValidationSummary;
 use physical::Physical;
@@ -106,6 +106,8 @@ struct Saver<'a> {
     edits: std::collections::VecDeque<EditRecord>,
     /// With `--compare-reference`: the physical reference of each saved frame.
     physical: Option<Physical>,
+    /// The recording's session events met so far, by kind (trace v1.4's event lines).
+    session_events: std::collections::BTreeMap<String, u64>,
 }
 
 /// A second renderer with the scene under the refraction model the scene does not use, for
@@ -148,6 +150,27 @@ impl OtherRefraction {
 }
 
 impl FrameSink for Saver<'_> {
+    fn session_events(
+        &mut self,
+        frame: Option<&FrameInput>,
+        events: &[SessionEvent],
+    ) -> Result<()> {
+        for e in events {
+            tracing::info!(
+                "{}: {e} (recorded)",
+                frame.map_or("after the last frame".to_owned(), |f| format!(
+                    "frame {}",
+                    f.index
+                ))
+            );
+            *self
+                .session_events
+                .entry(e.fields().0.to_owned())
+                .or_default() += 1;
+        }
+        Ok(())
+    }
+
     fn light_share(&mut self) -> Option<f32> {
         // A recorded `light-estimate` edit's share, else the scene's.
         Some(self.motion.light_share())
@@ -276,7 +299,12 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
             }
         }
     }
-    let (samples, edits, trace_name) = load_trace_with_edits(&scene, options.trace.as_deref())?;
+    let (recording, trace_name) = load_recording(&scene, options.trace.as_deref())?;
+    let Recording {
+        samples,
+        edits,
+        events,
+    } = recording;
     let mut inputs = InputFiles::new();
     inputs.add_scene(&scene, "SCENE");
     if let Some(trace) = &options.trace {
@@ -303,7 +331,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
             at_samples: options.at_samples,
         },
     )
-    .with_context(|| format!("replaying {trace_name}"))?;
+    .with_context(|| format!("replaying {trace_name}"))?
+    .with_events(events);
 
     let ctx = GpuContext::headless(&ContextOptions {
         validation: options.validate,
@@ -400,6 +429,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         log_error: None,
         motion: MotionClock::new(&scene),
         edits: edits.into(),
+        session_events: Default::default(),
         physical: options.compare_reference.then(|| {
             let mut scene = scene.clone();
             if scene.caustics.bake.is_some()
@@ -474,6 +504,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         moved_frames: saver.motion.moved_frames,
         inducer_computations: renderer.inducer_computations(),
         scene_edits: saver.motion.edit_count,
+        session_events: saver.session_events,
         final_placement: saver.motion.final_placement(),
         compare_reference: saver.physical.map(|p| p.figures),
         per_frame: records,

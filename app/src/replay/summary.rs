@@ -99,6 +99,9 @@ pub struct ReplaySummary {
     pub inducer_computations: u64,
     /// Scene edits of the trace (version 1.2 edit lines) applied.
     pub scene_edits: u64,
+    /// The recording's session events (version 1.4 event lines: frames not rendered, the
+    /// headset taken off, a loss, ...), by kind, as the live session had them.
+    pub session_events: std::collections::BTreeMap<String, u64>,
     /// Where the object and light were in the last frame (`null` when nothing moved).
     pub final_placement: Option<FinalPlacement>,
     /// With `--compare-reference`: each saved frame's eyes measured against the physical

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
-use super::{RunOptions, run};
+use super::{RECONNECT_S_DEFAULT, RECONNECT_S_MAX, RunOptions, run};
 use crate::cli_values::{parse_blend, parse_effects, parse_frame_count, parse_gaze, parse_size};
 use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, PupilSource};
@@ -61,6 +61,20 @@ pub struct RunArgs {
     /// pipe or fifo); in a terminal they are always read.
     #[arg(long)]
     pub stdin_controls: bool,
+    /// After a lost session or a lost runtime (the headset disconnected, the runtime
+    /// restarted), wait up to this many seconds for it to come back and go on in a new
+    /// session; 0 ends the run at the loss.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = parse_reconnect_s, default_value_t = RECONNECT_S_DEFAULT)]
+    pub reconnect_s: f64,
+}
+
+/// Parses `--reconnect-s`: seconds from 0 to [`RECONNECT_S_MAX`].
+fn parse_reconnect_s(s: &str) -> Result<f64, String> {
+    s.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && (0.0..=RECONNECT_S_MAX).contains(v))
+        .ok_or_else(|| format!("expected seconds from 0 to {RECONNECT_S_MAX}, got `{s}`"))
 }
 
 /// Runs the session `args` describe and prints its report.
@@ -91,6 +105,7 @@ impl From<RunArgs> for RunOptions {
             pupil_source: a.pupil_source,
             out: a.out,
             stdin_controls: a.stdin_controls,
+            reconnect_s: Some(a.reconnect_s),
             ..Default::default()
         }
     }

@@ -55,7 +55,9 @@ impl RunSink<'_> {
         for edit in typed {
             match edit {
                 SceneEdit::Register(axis, m) => {
-                    let _ = self.registrar.send(Command::Nudge(axis.unit() * m));
+                    if let Some(registrar) = &self.registrar {
+                        let _ = registrar.send(Command::Nudge(axis.unit() * m));
+                    }
                 }
                 other => self.edit(other, input),
             }
@@ -130,7 +132,9 @@ impl RunSink<'_> {
         // To a tenth of a millimetre: the registration's step, as recorded.
         let rise = ((hit - floor).dot(normal) * 1e4).round() / 1e4;
         if rise.abs() > 1e-4 {
-            let _ = self.registrar.send(Command::Nudge(normal * rise));
+            if let Some(registrar) = &self.registrar {
+                let _ = registrar.send(Command::Nudge(normal * rise));
+            }
             // The planes stay where they are in the room: in the moved scene frame, lower.
             for plane in &mut self.planes {
                 plane.pose.position -= normal * rise;

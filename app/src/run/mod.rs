@@ -25,7 +25,9 @@
 mod cli;
 mod controls;
 mod device;
+mod interruptions;
 mod readback;
+mod reconnect;
 mod recording;
 mod room_light;
 mod sink;
@@ -40,9 +42,10 @@ use anyhow::{Context, Result, bail};
 use vitreous_render::{ContextOptions, Reflection, Renderer};
 use vitreous_xr::openxr::ash::vk;
 use vitreous_xr::openxr::{
-    Blend, DepthOptions, GazeChoice, GazeSource, OpenXrOptions, Runtime, SessionOptions,
+    Blend, Continued, DepthOptions, GazeChoice, OpenXrOptions, Runtime, SessionOptions,
     SessionReport, State,
 };
+use vitreous_xr::session_event::Loss;
 use vitreous_xr::trace::{TraceVersion, TraceWriter};
 
 pub use crate::conditions::{
@@ -52,12 +55,15 @@ pub use crate::conditions::{
 pub(crate) use crate::test_frame::test_frame;
 pub use cli::{RunArgs, run_command};
 pub use device::XrDeviceCreator;
+pub use interruptions::{InterruptionSummary, NotRenderedFrames, Reconnect};
 pub use readback::{
     AWAY_RADII, LIT_THRESHOLD, MIN_AWAY_FRACTION, MIN_OBJECT_FRACTION, ReadbackCheck,
 };
+pub use reconnect::{RECONNECT_S_DEFAULT, RECONNECT_S_MAX};
 pub use recording::ReplayCheck;
 pub use summary::{GazeSamples, RunSummary};
 
+use crate::blur_stack::DefocusSetup;
 use crate::director::Director;
 use crate::effects::EffectSet;
 use crate::focus::FocusFollower;
@@ -112,6 +118,9 @@ pub struct RunOptions {
     /// (a pipe or fifo); in a terminal they are always read (not in a study, whose answers
     /// come from there).
     pub stdin_controls: bool,
+    /// How long to wait for the runtime to come back after a lost session or runtime before
+    /// giving up, seconds (0: end the run at the loss; `None`: [`RECONNECT_S_DEFAULT`]).
+    pub reconnect_s: Option<f64>,
 }
 
 /// Runs the scene on the OpenXR runtime. Fails with a clear message when there is no runtime,
@@ -185,13 +194,13 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             .collect::<Vec<_>>()
             .join(" > ")
     );
-    let runtime = Runtime::new(&OpenXrOptions {
+    let xr_options = OpenXrOptions {
         blend: options.blend,
         dimmer: scene.dimmer.is_some(),
         validation: options.validate,
         size: options.size,
-    })
-    .context("starting OpenXR")?;
+    };
+    let runtime = Runtime::new(&xr_options).context("starting OpenXR")?;
     let info = runtime.info().clone();
     let (width, height) = info.size;
     if let Some((w, h)) = options.size.filter(|&wanted| wanted != info.size) {
@@ -206,60 +215,57 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         info.max_size.0,
         info.max_size.1
     );
-    let (planners, defocus) = planners_for(
-        &scene,
-        &conditions,
-        options.reflection,
-        &GazeSettings {
-            filter: options.filter,
-            pupil_source: options.pupil_source,
-            ..GazeSettings::default()
-        },
-    )?;
+    let gaze_settings = GazeSettings {
+        filter: options.filter,
+        pupil_source: options.pupil_source,
+        ..GazeSettings::default()
+    };
+    let (planners, defocus) =
+        planners_for(&scene, &conditions, options.reflection, &gaze_settings)?;
+    let context_options = ContextOptions {
+        validation: options.validate,
+        device_name: None,
+    };
+    let make_renderer = |ctx, defocus: Option<&DefocusSetup>| {
+        let mut renderer = render_desc::renderer_for(ctx, &scene, defocus, width, height)?;
+        render_desc::enable_live_caustics(&mut renderer, &scene, caustics_loaded)
+            .context("preparing live caustics")?;
+        Ok(renderer)
+    };
+    let end_flag = director.as_ref().map(|d| d.end_flag());
+    let session_options = |continued: Option<Continued>, submitted: u64| SessionOptions {
+        max_frames: options.frames.map(|n| n.saturating_sub(submitted)),
+        gaze_trace: options.gaze_trace.clone(),
+        gaze: options.gaze,
+        scene_origin: None,
+        viewer_position_m: scene.viewer.head_position_m,
+        handle_ctrl_c: true,
+        end: end_flag.clone(),
+        depth: Some(DepthOptions {
+            format: Renderer::DEPTH_FORMAT,
+            near_m: vitreous_render::camera::NEAR_M,
+            far_m: vitreous_render::camera::FAR_M,
+        }),
+        continued,
+    };
     let mut xr = XrSession::start(
         runtime,
-        &ContextOptions {
-            validation: options.validate,
-            device_name: None,
-        },
-        |ctx| {
-            let mut renderer =
-                render_desc::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
-            render_desc::enable_live_caustics(&mut renderer, &scene, caustics_loaded)
-                .context("preparing live caustics")?;
-            Ok(renderer)
-        },
-        &SessionOptions {
-            max_frames: options.frames,
-            gaze_trace: options.gaze_trace.clone(),
-            gaze: options.gaze,
-            scene_origin: None,
-            viewer_position_m: scene.viewer.head_position_m,
-            handle_ctrl_c: true,
-            end: director.as_ref().map(|d| d.end_flag()),
-            depth: Some(DepthOptions {
-                format: Renderer::DEPTH_FORMAT,
-                near_m: vitreous_render::camera::NEAR_M,
-                far_m: vitreous_render::camera::FAR_M,
-            }),
-        },
+        &context_options,
+        |ctx| make_renderer(ctx, defocus.as_ref()),
+        &session_options(None, 0),
     )?;
-    // The blur stacks are on the GPU now.
+    // The blur stacks are on the GPU now (a new session after a loss makes them again).
     drop(defocus);
     let device = {
         let ctx = xr.parts().1.context();
         format!("{} ({})", ctx.device_name, ctx.driver)
     };
 
-    // A tracker that reports its confidence and gaze behaviour records version 1.3 from the
-    // first line, even if its first frame brings no sample.
-    let version = match xr.session().report().gaze_source {
-        Some(GazeSource::MlEyeTracker) => TraceVersion::V1_3,
-        _ => TraceVersion::V1_2,
-    };
+    // Version 1.4 from the first line: every frame may carry the tracker's report, and the
+    // session's events (a headset taken off, frames not rendered) go between the samples.
     let writer = match &options.record {
         Some(path) => Some(
-            TraceWriter::create_version(path, version)
+            TraceWriter::create_version(path, TraceVersion::V1_4)
                 .with_context(|| format!("creating {}", path.display()))?,
         ),
         None => None,
@@ -286,16 +292,16 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
     };
     let mut sink = RunSink {
         edits,
-        planes_rx: xr.session().take_planes(),
+        planes_rx: None,
         planes: Vec::new(),
-        light_rx: xr.session().take_light_estimates(),
+        light_rx: None,
         room_light: None,
-        registrar: xr.session().command_sender(),
+        registrar: None,
         looks: LiveConditions::new(
             conditions.iter().copied().zip(planners).collect(),
             scene.gaze.image,
         ),
-        commands: xr.session().take_commands(),
+        commands: None,
         // Late enough for the pipelines to be warm and the head to have moved.
         readback_frame: options
             .readback_check
@@ -321,57 +327,154 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         focus: FocusFollower::new(&scene, options.filter),
         focus_m: None,
         global_dimmer: scene.global_dimmer,
+        gaze_watch: Default::default(),
+        events: Vec::new(),
+        last_time_ns: None,
     };
+    let reconnect_limit =
+        std::time::Duration::from_secs_f64(options.reconnect_s.unwrap_or(RECONNECT_S_DEFAULT));
     let started = Instant::now();
-    let (session, renderer) = xr.parts();
-    let result = frame_loop::run(session, renderer, &mut sink);
-    let wall_s = started.elapsed().as_secs_f64();
-    // The loop's error is the one reported; a clean-up failing after it (releasing the images
-    // of a lost device) is logged.
+    let mut report: Option<SessionReport> = None;
+    let mut records = Vec::new();
+    let mut reconnects = Vec::new();
+    let mut validation: Option<ValidationSummary> = None;
+    let mut inducer_computations = 0;
+    let mut floor_centroids = None;
     let format = xr.format();
-    let final_light = sink
-        .motion
-        .final_placement()
-        .map_or(scene.placement_at(0.0).light_position_m, |p| {
-            glam::Vec3::from_array(p.light_position_m)
-        });
-    let closed = xr.close(|renderer| {
-        let centroids = options.readback_check.then(|| {
-            room_light::floor_centroids(
-                renderer,
-                scene.floor.world_from_plane(),
-                final_light,
-                sink.object_center_m,
-                sink.object_radius_m,
+    let mut gave_up: Option<anyhow::Error> = None;
+    // One session, or one after another when a session or the runtime is lost: the sink (the
+    // conditions, the gaze filters, the recording, a study's place) goes on across them.
+    loop {
+        sink.attach(xr.session());
+        let (session, renderer) = xr.parts();
+        let result = frame_loop::run(session, renderer, &mut sink);
+        // The loop's error is the one reported; a clean-up failing after it (releasing the
+        // images of a lost device) is logged.
+        let final_light = sink
+            .motion
+            .final_placement()
+            .map_or(scene.placement_at(0.0).light_position_m, |p| {
+                glam::Vec3::from_array(p.light_position_m)
+            });
+        let (continued_from, next_index, first_display_ns) = {
+            let s = xr.session();
+            (s.world_from_space(), s.next_index(), s.first_display_ns())
+        };
+        let closed = xr.close(|renderer| {
+            let centroids = options.readback_check.then(|| {
+                room_light::floor_centroids(
+                    renderer,
+                    scene.floor.world_from_plane(),
+                    final_light,
+                    sink.object_center_m,
+                    sink.object_radius_m,
+                )
+            });
+            (
+                renderer.inducer_computations(),
+                centroids,
+                ValidationSummary::of(renderer.context()),
             )
         });
-        (
-            renderer.inducer_computations(),
-            centroids,
-            ValidationSummary::of(renderer.context()),
-        )
-    });
-    let report: SessionReport = closed.report;
-    let (inducer_computations, centroids, validation) = closed.after;
-    let floor_centroids = match centroids {
-        Some(Ok(c)) => Some(c),
-        Some(Err(e)) => {
-            tracing::warn!("reading back the floor's fields at the end: {e:#}");
-            None
+        let (computations, centroids, checked) = closed.after;
+        inducer_computations += computations;
+        match centroids {
+            Some(Ok(c)) => floor_centroids = Some(c),
+            Some(Err(e)) => tracing::warn!("reading back the floor's fields at the end: {e:#}"),
+            None => {}
         }
-        None => None,
-    };
+        validation = Some(match validation.take() {
+            Some(mut v) => {
+                v.then(&checked);
+                v
+            }
+            None => checked,
+        });
+        let lost = closed.report.interruptions.lost;
+        match &mut report {
+            Some(r) => r.then(&closed.report),
+            None => report = Some(closed.report),
+        }
+        records.extend(first_error(result, closed.detached)?);
+        let Some(loss) = lost.filter(|_| !reconnect_limit.is_zero()) else {
+            break;
+        };
+        let end = end_flag.as_deref();
+        let (runtime, waited) = match reconnect::runtime_again(&xr_options, reconnect_limit, end) {
+            Ok(Some(again)) => again,
+            Ok(None) => break,
+            Err(e) => {
+                tracing::error!("{e:#}");
+                gave_up = Some(e);
+                break;
+            }
+        };
+        let again = runtime.info();
+        if again.blend != info.blend || again.size != info.size {
+            bail!(
+                "the OpenXR runtime came back with another display ({} at {}x{}; the session \
+                 was {} at {width}x{height}): start the run again",
+                again.blend,
+                again.size.0,
+                again.size.1,
+                info.blend
+            );
+        }
+        reconnects.push(Reconnect {
+            lost: match loss {
+                Loss::Session => "session",
+                Loss::Instance => "instance",
+            }
+            .to_owned(),
+            waited_s: waited.as_secs_f64(),
+        });
+        let (_, defocus) = planners_for(&scene, &conditions, options.reflection, &gaze_settings)?;
+        let submitted = report.as_ref().map_or(0, |r| r.frames_submitted);
+        xr = XrSession::start(
+            runtime,
+            &context_options,
+            |ctx| make_renderer(ctx, defocus.as_ref()),
+            &session_options(
+                Some(Continued {
+                    next_index,
+                    first_display_ns,
+                    world_from_space: continued_from,
+                    waited_ms: waited.as_millis() as u64,
+                }),
+                submitted,
+            ),
+        )
+        .context("starting a new OpenXR session after the loss")?;
+    }
+    let wall_s = started.elapsed().as_secs_f64();
+    let report = report.unwrap_or_default();
+    let validation = validation.unwrap_or_default();
     let recording_closed = match sink.writer.take() {
         Some(w) => w.finish().map(drop).context("closing the recording"),
         None => Ok(()),
     };
-    let records = first_error(first_error(result, closed.detached), recording_closed)?;
+    recording_closed?;
     sink.log.finish()?;
 
     let replay_check = match &options.record {
         Some(path) => Some(replay_check(path, &sink.recorded, &scene)?),
         None => None,
     };
+    let interruptions = InterruptionSummary::new(
+        &report,
+        reconnects,
+        &sink.gaze_watch,
+        &sink.events,
+        options.record.is_some(),
+    );
+    if !interruptions.frames_add_up() {
+        tracing::warn!(
+            "the frames do not add up: {} handed out, {} shown, {:?} not rendered",
+            interruptions.frames_waited,
+            interruptions.frames_shown,
+            interruptions.not_rendered
+        );
+    }
     let summary = RunSummary {
         vitreous_version: env!("CARGO_PKG_VERSION").into(),
         scene: options.scene.display().to_string(),
@@ -448,11 +551,15 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         moved_frames: sink.motion.moved_frames,
         inducer_computations,
         final_placement: sink.motion.final_placement(),
+        interruptions,
     };
     if let Some(out) = &options.out {
         fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
         let json = serde_json::to_vec_pretty(&summary).context("encoding summary.json")?;
         write_atomic(&out.join("summary.json"), &json)?;
+    }
+    if let Some(e) = gave_up {
+        return Err(e);
     }
     summary.validation.check(None)?;
     if options.readback_check {

@@ -64,8 +64,9 @@ pub(super) struct RunSink<'d> {
         Option<std::sync::mpsc::Receiver<Vec<vitreous_xr::planes::DetectedPlane>>>,
     /// The latest detection's planes, in the scene frame: where a place puts the object.
     pub(super) planes: Vec<vitreous_xr::planes::DetectedPlane>,
-    /// Where re-registrations go: the session, which moves the scene's placement.
-    pub(super) registrar: std::sync::mpsc::Sender<Command>,
+    /// Where re-registrations go: the session, which moves the scene's placement (the
+    /// current session's, [`RunSink::attach`]).
+    pub(super) registrar: Option<std::sync::mpsc::Sender<Command>>,
     /// The wearer's filtered fixation depth, which the display's focus plane follows.
     pub(super) focus: FocusFollower,
     /// This frame's filtered fixation depth, metres.
@@ -76,9 +77,24 @@ pub(super) struct RunSink<'d> {
     pub(super) light_rx: Option<std::sync::mpsc::Receiver<vitreous_xr::light::LightEstimate>>,
     /// What the estimates did (`None`: none came).
     pub(super) room_light: Option<room_light::RoomLight>,
+    /// The eye tracker's dropouts.
+    pub(super) gaze_watch: vitreous_frames::gaze_watch::GazeWatch,
+    /// Every session event, with the display time of the frame it came with.
+    pub(super) events: Vec<(i64, vitreous_xr::SessionEvent)>,
+    /// Display time of the newest frame, nanoseconds.
+    pub(super) last_time_ns: Option<i64>,
 }
 
 impl RunSink<'_> {
+    /// Takes the channels of a (new) session: its live commands, detected planes, light
+    /// estimates and where re-registrations go.
+    pub(super) fn attach(&mut self, session: &mut vitreous_xr::openxr::Session) {
+        self.commands = session.take_commands();
+        self.planes_rx = session.take_planes();
+        self.light_rx = session.take_light_estimates();
+        self.registrar = Some(session.command_sender());
+    }
+
     /// With a segmented dimmer, what it must darken: the object's centre and the centre of
     /// its shadow (where the ray from the light through the centre meets the floor).
     pub(super) fn dimmed(&self) -> Option<readback::Dimmed> {
@@ -112,6 +128,8 @@ impl FrameSink for RunSink<'_> {
     }
 
     fn started(&mut self, input: &FrameInput) -> Result<()> {
+        self.watch_gaze(input);
+        self.last_time_ns = Some(input.time_ns);
         if let Some(w) = &mut self.writer {
             w.write(&trace_sample(input))
                 .context("recording the trace")?;
@@ -154,6 +172,15 @@ impl FrameSink for RunSink<'_> {
                 world: read,
             },
         }
+    }
+
+    fn session_events(
+        &mut self,
+        frame: Option<&FrameInput>,
+        events: &[vitreous_xr::SessionEvent],
+    ) -> Result<()> {
+        self.note_events(frame, events);
+        Ok(())
     }
 
     fn frame_end_hints(&mut self, _input: &FrameInput) -> FrameEndHints {

@@ -135,6 +135,8 @@ pub struct RunSummary {
     pub inducer_computations: u64,
     /// Where the object and light were in the last frame (`null` when nothing moved).
     pub final_placement: Option<crate::motion_clock::FinalPlacement>,
+    /// What a misbehaving headset did to the run and what the run did about it.
+    pub interruptions: super::InterruptionSummary,
 }
 
 impl RunSummary {
@@ -168,6 +170,9 @@ impl RunSummary {
                  unshown after an error: {}",
                 self.space_changes, self.frames_abandoned
             );
+        }
+        if let Some(line) = self.interruptions.line() {
+            let _ = writeln!(out, "{line}");
         }
         let _ = writeln!(
             out,

@@ -19,6 +19,23 @@ pub(super) fn pose_of(p: &xr::Posef) -> Pose {
     }
 }
 
+/// OpenXR's pose of one of vitreous's.
+pub(super) fn posef_of(p: &Pose) -> xr::Posef {
+    xr::Posef {
+        orientation: xr::Quaternionf {
+            x: p.orientation.x,
+            y: p.orientation.y,
+            z: p.orientation.z,
+            w: p.orientation.w,
+        },
+        position: xr::Vector3f {
+            x: p.position.x,
+            y: p.position.y,
+            z: p.position.z,
+        },
+    }
+}
+
 /// A valid ray from a pose's position along its forward axis (-z).
 pub(super) fn ray_of(pose: &xr::Posef) -> GazeRay {
     let q = Quat::from_xyzw(

@@ -40,6 +40,19 @@ pub enum OpenXrError {
          with Vulkan (offered: {0})"
     )]
     NoVulkan(String),
+    /// The runtime or the headset is not there now and may come back:
+    /// `XR_ERROR_RUNTIME_UNAVAILABLE` from xrCreateInstance, `XR_ERROR_FORM_FACTOR_UNAVAILABLE`
+    /// from xrGetSystem (see [`OpenXrError::is_unavailable`]).
+    #[error(
+        "{call}: {result}: no OpenXR runtime or headset is available now. Connect the headset, \
+         start the runtime (Monado: monado-service) or point XR_RUNTIME_JSON at its manifest"
+    )]
+    Unavailable {
+        /// The call.
+        call: &'static str,
+        /// What it returned.
+        result: xr::sys::Result,
+    },
     /// No head-mounted display is connected.
     #[error("no head-mounted display: {0}")]
     NoHmd(String),
@@ -68,6 +81,14 @@ pub enum OpenXrError {
     /// Frame calls came in the wrong order.
     #[error("frame order: {0}")]
     FrameOrder(String),
+}
+
+impl OpenXrError {
+    /// Whether the runtime or the headset is only away for now: asking again later may work
+    /// (after a lost session or runtime, the app asks again for a while).
+    pub fn is_unavailable(&self) -> bool {
+        matches!(self, OpenXrError::Unavailable { .. })
+    }
 }
 
 /// Why `xrCreateInstance` failed with `error`, given the layers vitreous asked for and the

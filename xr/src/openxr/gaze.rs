@@ -117,6 +117,14 @@ pub struct GazeTally {
 }
 
 impl GazeTally {
+    /// Adds a later session's tally.
+    pub(super) fn add(&mut self, later: &GazeTally) {
+        self.frames += later.frames;
+        self.received += later.received;
+        self.fresh += later.fresh;
+        self.newest_ns = later.newest_ns.max(self.newest_ns);
+    }
+
     /// Counts one frame's sampling.
     pub(super) fn count(&mut self, sampled: &Sampled) {
         self.frames += 1;

@@ -48,7 +48,7 @@ pub use choose::{Blend, ColorFormat, GazeChoice, GazeSource};
 pub(crate) use error::XrContext;
 pub use error::{OpenXrError, Result};
 pub use gaze::GazeTally;
-pub use session::{Session, SessionReport};
+pub use session::{Interruptions, Session, SessionReport, interrupted};
 pub use state::{EndReason, State};
 
 use crate::frame::Pose;
@@ -200,13 +200,25 @@ impl Runtime {
         let instance = entry
             .create_instance(&app, &wanted, &layers, &platform)
             .map_err(|e| {
+                if e == xr::sys::Result::ERROR_RUNTIME_UNAVAILABLE {
+                    return OpenXrError::Unavailable {
+                        call: "xrCreateInstance",
+                        result: e,
+                    };
+                }
                 let from_env = std::env::var("XR_ENABLE_API_LAYERS").ok();
                 error::instance_error(&e.to_string(), &layers, from_env.as_deref())
             })?;
         let props = instance.properties().xr("xrGetInstanceProperties")?;
         let system = instance
             .system(xr::FormFactor::HEAD_MOUNTED_DISPLAY)
-            .map_err(|e| OpenXrError::NoHmd(format!("xrGetSystem: {e}")))?;
+            .map_err(|e| match e {
+                xr::sys::Result::ERROR_FORM_FACTOR_UNAVAILABLE => OpenXrError::Unavailable {
+                    call: "xrGetSystem",
+                    result: e,
+                },
+                _ => OpenXrError::NoHmd(format!("xrGetSystem: {e}")),
+            })?;
         let sys_props = instance
             .system_properties(system)
             .xr("xrGetSystemProperties")?;
@@ -370,6 +382,25 @@ pub struct SessionOptions {
     /// Set by the application when it is done (e.g. a study's last answer is in): the session
     /// then ends the way it does at the frame limit, through STOPPING.
     pub end: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// What a session before this one left to go on from, when the app starts a new one after
+    /// a loss (`None` for the first).
+    pub continued: Option<Continued>,
+}
+
+/// What a new session takes over from the one lost before it, so the app goes on where it was.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Continued {
+    /// The next frame's index.
+    pub next_index: u64,
+    /// The first session's first predicted display time, nanoseconds: a gaze trace's clock
+    /// (`--gaze-trace`) keeps running from it.
+    pub first_display_ns: Option<i64>,
+    /// The scene frame from app space, kept when the new session's space is a STAGE (the
+    /// room's own frame, which outlives sessions); a LOCAL space is placed again.
+    pub world_from_space: Option<Pose>,
+    /// How long the app waited for the runtime to come back, milliseconds (the new session's
+    /// first events say so: [`crate::SessionEvent::Reconnected`]).
+    pub waited_ms: u64,
 }
 
 /// How depth is submitted (XR_KHR_composition_layer_depth).

@@ -263,15 +263,35 @@ pub(in crate::openxr) unsafe fn start(
             running: false,
             exit_requested: false,
             quit: false,
-            world_from_space: None,
-            first_display: None,
-            next_index: 0,
+            world_from_space: options
+                .continued
+                .and_then(|c| c.world_from_space)
+                .filter(|_| space_choice == SpaceChoice::Stage),
+            first_display: options
+                .continued
+                .and_then(|c| c.first_display_ns)
+                .map(xr::Time::from_nanos),
+            next_index: options.continued.map_or(0, |c| c.next_index),
             open: None,
             options: options.clone(),
             report,
             ml_frame_end: rt.ml_frame_end,
             ml_dimmer: rt.ml_dimmer,
             hints: crate::FrameEndHints::default(),
+            pending: {
+                let mut pending = super::interruptions::Pending::default();
+                if let Some(c) = options.continued {
+                    pending.push(crate::SessionEvent::Reconnected {
+                        waited_ms: c.waited_ms,
+                    });
+                }
+                pending
+            },
+            last_waited_ns: None,
+            tracking: Default::default(),
+            paused: None,
+            failed_in_a_row: 0,
+            unfocused: false,
         },
         out,
     ))

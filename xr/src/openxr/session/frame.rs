@@ -4,9 +4,15 @@
 //! From xrBeginFrame to xrEndFrame the session holds an [`OpenFrame`] that records what the
 //! frame has taken from the runtime. Every way out of it ends the frame: [`Backend::end_frame`]
 //! with the layer; an error while the frame is being prepared, [`Backend::abandon_frame`] (the
-//! app's error after the frame was handed out) and a session dropped mid-frame all unwind it
-//! ([`Session::abandon_open_frame`]): acquired images waited for and released, xrEndFrame with
-//! no layers. Errors of that clean-up are logged; the error that caused it is the one returned.
+//! app's error after the frame was handed out), a frame the head's orientation was not tracked
+//! for, and a session dropped mid-frame all unwind it ([`Session::leave_open_frame`]):
+//! acquired images waited for and released, xrEndFrame with no layers.
+//!
+//! What a real headset does on the way ([`super::interruptions`]): a frame the runtime says
+//! not to render is ended with no layers; a call that fails with `XR_ERROR_RUNTIME_FAILURE`
+//! costs its frame and the session goes on; a lost session or runtime ends the session (the
+//! app may start a new one); a runtime that stops the session (the headset taken off) is waited
+//! for, without a time limit, until it makes the session ready again.
 
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -15,30 +21,68 @@ use openxr as xr;
 
 use super::super::convert::pose_of;
 use super::super::state::{self, EndReason};
-use super::super::{DepthOptions, OpenXrError, Result, XrContext};
+use super::super::{OpenXrError, Result, XrContext};
+use super::depth::{chain_depth, depth_info};
 use super::frame_end::FrameEndChain;
+use super::images;
+use super::interruptions::{MAX_FAILED_FRAMES_IN_A_ROW, Pending, Severity, severity};
 use super::placement::{compose, place_scene};
 use super::scope::{Handed, Hold, OpenFrame, Unwind};
+use super::tracking::{Located, Poses};
 use super::{INTERRUPTED, STATE_TIMEOUT, Session};
-use crate::frame::{Backend, EyeView, Fov, FrameInput, FrameTarget, Pose};
+use crate::frame::{Backend, EyeView, Fov, FrameInput, FrameTarget};
+use crate::session_event::{NotRendered, SessionEvent};
+
+/// How often the session says it is still waiting for a runtime that stopped it.
+const PAUSE_LOG_EVERY: Duration = Duration::from_secs(30);
+
+/// What preparing a begun frame came to.
+enum Prepared {
+    /// The frame for the app.
+    Input(Box<FrameInput>),
+    /// Not drawn (the head's orientation not tracked): already ended with no layers.
+    NotDrawn,
+}
 
 impl Session {
-    /// Waits and begins a frame; `None` when the runtime says not to render it (it is then
-    /// ended here with no layers).
+    /// Waits and begins a frame; `None` when it is not to be rendered (it is then ended here
+    /// with no layers, and counted).
     fn begin_frame(&mut self) -> Result<Option<xr::FrameState>> {
         let frame = self.waiter.wait().xr("xrWaitFrame")?;
+        self.report.interruptions.frames_waited += 1;
+        self.note_lateness(&frame);
         self.stream.begin().xr("xrBeginFrame")?;
         if !frame.should_render || self.exit_requested {
             self.stream
                 .end(frame.predicted_display_time, self.blend, &[])
                 .xr("xrEndFrame")?;
-            if !self.exit_requested {
+            if self.exit_requested {
+                self.report.interruptions.not_rendered_exiting += 1;
+            } else {
                 self.report.frames_skipped += 1;
+                self.pending.not_rendered(NotRendered::Runtime);
             }
             return Ok(None);
         }
         self.open = Some(OpenFrame::begun(frame.predicted_display_time));
         Ok(Some(frame))
+    }
+
+    /// Counts the display periods the runtime moved past since the frame waited before (none
+    /// across a stop of the session).
+    fn note_lateness(&mut self, frame: &xr::FrameState) {
+        let display = frame.predicted_display_time.as_nanos();
+        let period = frame.predicted_display_period.as_nanos();
+        if let (Some(before), true) = (self.last_waited_ns, period > 0) {
+            let periods = ((display - before) as f64 / period as f64).round() as i64 - 1;
+            if periods > 0 {
+                self.report.interruptions.late_periods += periods as u64;
+                self.pending.push(SessionEvent::Late {
+                    periods: periods as u64,
+                });
+            }
+        }
+        self.last_waited_ns = Some(display);
     }
 
     /// The open frame, which every step after xrBeginFrame needs.
@@ -56,26 +100,24 @@ impl Session {
             .acquire_image()
             .xr("xrAcquireSwapchainImage")?;
         self.open_frame()?.color = Hold::Acquired;
-        self.swapchain
-            .wait_image(xr::Duration::INFINITE)
-            .xr("xrWaitSwapchainImage")?;
+        self.report.interruptions.image_wait_timeouts +=
+            images::wait(&self.instance, &self.swapchain, "xrWaitSwapchainImage")?;
         self.open_frame()?.color = Hold::Waited;
         let Some((chain, _)) = &mut self.depth else {
             return Ok((image, None));
         };
         let depth = chain.acquire_image().xr("xrAcquireSwapchainImage(depth)")?;
         self.open_frame()?.depth = Hold::Acquired;
-        if let Some((chain, _)) = &mut self.depth {
-            chain
-                .wait_image(xr::Duration::INFINITE)
-                .xr("xrWaitSwapchainImage(depth)")?;
+        if let Some((chain, _)) = &self.depth {
+            self.report.interruptions.image_wait_timeouts +=
+                images::wait(&self.instance, chain, "xrWaitSwapchainImage(depth)")?;
         }
         self.open_frame()?.depth = Hold::Waited;
         Ok((image, Some(depth)))
     }
 
-    /// Locates the head and eyes for a frame displayed at `display`.
-    fn locate(&mut self, display: xr::Time) -> Result<(Pose, Vec<xr::View>, bool)> {
+    /// Locates the head and eyes for a frame displayed at `display`, in app space.
+    fn locate(&mut self, display: xr::Time) -> Result<(Poses, Vec<xr::View>)> {
         let head = self
             .view_space
             .locate(&self.space, display)
@@ -88,21 +130,62 @@ impl Session {
                 &self.space,
             )
             .xr("xrLocateViews")?;
-        let tracked = head.location_flags.contains(
-            xr::SpaceLocationFlags::POSITION_VALID | xr::SpaceLocationFlags::ORIENTATION_VALID,
-        ) && flags
-            .contains(xr::ViewStateFlags::POSITION_VALID | xr::ViewStateFlags::ORIENTATION_VALID);
-        Ok((pose_of(&head.pose), views, tracked))
+        if views.len() < 2 {
+            return Err(OpenXrError::Unsupported(format!(
+                "xrLocateViews gave {} views; expected 2",
+                views.len()
+            )));
+        }
+        let position_valid = head
+            .location_flags
+            .contains(xr::SpaceLocationFlags::POSITION_VALID)
+            && flags.contains(xr::ViewStateFlags::POSITION_VALID);
+        let orientation_valid = head
+            .location_flags
+            .contains(xr::SpaceLocationFlags::ORIENTATION_VALID)
+            && flags.contains(xr::ViewStateFlags::ORIENTATION_VALID);
+        let poses = Poses {
+            head: pose_of(&head.pose),
+            eyes: [pose_of(&views[0].pose), pose_of(&views[1].pose)],
+            position_valid,
+            orientation_valid,
+        };
+        Ok((poses, views))
     }
 
     /// Everything between xrBeginFrame and handing the frame out: images, views, placement,
     /// actions, gaze. Any error leaves the open frame for the caller to unwind.
-    fn prepare_frame(&mut self, display: xr::Time) -> Result<FrameInput> {
+    fn prepare_frame(&mut self, display: xr::Time) -> Result<Prepared> {
         let (image, depth_image) = self.acquire_images()?;
         // Views are located after the wait for the image, as late as this loop allows.
-        let (head_space, views, tracked) = self.locate(display)?;
-        if !tracked {
+        let (poses, mut views) = self.locate(display)?;
+        if !(poses.position_valid && poses.orientation_valid) {
             self.report.frames_untracked += 1;
+        }
+        let mut tracking_events = Vec::new();
+        let located = self.tracking.locate(poses, &mut tracking_events);
+        for e in tracking_events {
+            if let SessionEvent::TrackingLost(loss) = e {
+                self.report.interruptions.tracking_losses[loss as usize] += 1;
+            }
+            self.pending.push(e);
+        }
+        let Located::Draw {
+            head: head_space,
+            eyes,
+            held,
+        } = located
+        else {
+            self.leave_open_frame();
+            self.report.interruptions.not_rendered_tracking += 1;
+            self.pending.not_rendered(NotRendered::Tracking);
+            return Ok(Prepared::NotDrawn);
+        };
+        if held {
+            self.report.interruptions.frames_position_held += 1;
+            for (view, eye) in views.iter_mut().zip(eyes) {
+                view.pose = super::super::convert::posef_of(&eye);
+            }
         }
         let first_display = *self.first_display.get_or_insert(display);
         let placed = match self.world_from_space {
@@ -136,20 +219,20 @@ impl Session {
             .sample(&self.session, &self.view_space, display, first_display);
         self.report.gaze_samples.count(&sampled);
         let gaze = sampled.frame;
-        let eye = |v: &xr::View| EyeView {
-            pose: compose(&world_from_space, &pose_of(&v.pose)),
+        let eye = |i: usize| EyeView {
+            pose: compose(&world_from_space, &eyes[i]),
             fov: Fov {
-                angle_left_rad: v.fov.angle_left,
-                angle_right_rad: v.fov.angle_right,
-                angle_up_rad: v.fov.angle_up,
-                angle_down_rad: v.fov.angle_down,
+                angle_left_rad: views[i].fov.angle_left,
+                angle_right_rad: views[i].fov.angle_right,
+                angle_up_rad: views[i].fov.angle_up,
+                angle_down_rad: views[i].fov.angle_down,
             },
         };
         let input = FrameInput {
             index: self.next_index,
             time_ns: display.as_nanos(),
             head: compose(&world_from_space, &head_space),
-            views: [eye(&views[0]), eye(&views[1])],
+            views: [eye(0), eye(1)],
             gaze,
         };
         self.open_frame()?.handed = Some(Handed {
@@ -159,37 +242,35 @@ impl Session {
             depth_image,
         });
         self.next_index += 1;
-        Ok(input)
+        Ok(Prepared::Input(Box::new(input)))
     }
 
     /// Leaves the open frame, if any, without showing it: acquired images waited for and
     /// released, xrEndFrame with no layers. Failures are logged (the caller is already on an
-    /// error path, or dropping the session); the frame counts as ended either way.
-    pub(super) fn abandon_open_frame(&mut self) {
+    /// error path, or dropping the session); the frame counts as ended either way. Whether
+    /// there was a frame to leave.
+    pub(super) fn leave_open_frame(&mut self) -> bool {
         let Some(open) = self.open.take() else {
-            return;
+            return false;
         };
-        tracing::warn!(
-            "frame at {} ns left without being shown: ending it with no layers",
-            open.display.as_nanos()
-        );
         for step in open.unwind() {
             let done = match step {
-                Unwind::WaitColor => self
-                    .swapchain
-                    .wait_image(xr::Duration::INFINITE)
-                    .xr("xrWaitSwapchainImage"),
-                Unwind::ReleaseColor => {
-                    self.swapchain.release_image().xr("xrReleaseSwapchainImage")
+                Unwind::WaitColor => {
+                    images::wait(&self.instance, &self.swapchain, "xrWaitSwapchainImage").map(drop)
                 }
-                Unwind::WaitDepth => match &mut self.depth {
-                    Some((chain, _)) => chain
-                        .wait_image(xr::Duration::INFINITE)
-                        .xr("xrWaitSwapchainImage(depth)"),
+                Unwind::ReleaseColor => {
+                    images::release(&self.instance, &self.swapchain, "xrReleaseSwapchainImage")
+                }
+                Unwind::WaitDepth => match &self.depth {
+                    Some((chain, _)) => {
+                        images::wait(&self.instance, chain, "xrWaitSwapchainImage(depth)").map(drop)
+                    }
                     None => Ok(()),
                 },
-                Unwind::ReleaseDepth => match &mut self.depth {
-                    Some((chain, _)) => chain.release_image().xr("xrReleaseSwapchainImage(depth)"),
+                Unwind::ReleaseDepth => match &self.depth {
+                    Some((chain, _)) => {
+                        images::release(&self.instance, chain, "xrReleaseSwapchainImage(depth)")
+                    }
                     None => Ok(()),
                 },
                 Unwind::EndWithoutLayers => self
@@ -201,17 +282,60 @@ impl Session {
                 tracing::warn!("while leaving the frame: {e}");
             }
         }
-        self.report.frames_abandoned += 1;
+        true
+    }
+
+    /// Leaves the open frame after an error, counting it abandoned.
+    pub(super) fn abandon_open_frame(&mut self) {
+        if let Some(open) = &self.open {
+            tracing::warn!(
+                "frame at {} ns left without being shown: ending it with no layers",
+                open.display.as_nanos()
+            );
+        }
+        if self.leave_open_frame() {
+            self.report.frames_abandoned += 1;
+        }
+    }
+
+    /// Takes an error of a frame call as its severity says: `Ok` when the session goes on (one
+    /// frame lost to a runtime failure) or ends (lost), the error itself when it is fatal.
+    fn take_failure(&mut self, e: OpenXrError) -> Result<()> {
+        match severity(&e) {
+            Severity::Frame => {
+                if let OpenXrError::Call { call, .. } = &e {
+                    *self
+                        .report
+                        .interruptions
+                        .failed_calls
+                        .entry(call)
+                        .or_default() += 1;
+                }
+                self.failed_in_a_row += 1;
+                if self.failed_in_a_row > MAX_FAILED_FRAMES_IN_A_ROW {
+                    return Err(OpenXrError::Unsupported(format!(
+                        "{MAX_FAILED_FRAMES_IN_A_ROW} frames in a row failed; the last: {e}"
+                    )));
+                }
+                tracing::warn!("{e}: the frame is left and the session goes on");
+                self.pending.not_rendered(NotRendered::Failed);
+                Ok(())
+            }
+            Severity::Lost(loss) => {
+                tracing::warn!("{e}");
+                self.lose(loss);
+                Ok(())
+            }
+            Severity::Fatal => Err(e),
+        }
     }
 
     /// Releases the handed-out frame's images and submits it with its projection layer.
     fn submit_frame(&mut self, handed: &Handed, display: xr::Time) -> Result<()> {
-        self.swapchain
-            .release_image()
-            .xr("xrReleaseSwapchainImage")?;
+        images::release(&self.instance, &self.swapchain, "xrReleaseSwapchainImage")?;
         self.open_frame()?.color = Hold::Free;
-        if let (Some((chain, _)), Some(_)) = (&mut self.depth, handed.depth_image) {
-            chain.release_image().xr("xrReleaseSwapchainImage(depth)")?;
+        if let (Some((chain, _)), Some(_)) = (&self.depth, handed.depth_image) {
+            images::release(&self.instance, chain, "xrReleaseSwapchainImage(depth)")?;
             self.open_frame()?.depth = Hold::Free;
         }
         let (w, h) = self.size;
@@ -309,6 +433,36 @@ impl Session {
         }
         Ok(())
     }
+
+    /// Waits while the session does not run frames: before it is first ready or while it
+    /// walks to its end, for at most [`STATE_TIMEOUT`] in one state; after the runtime stopped
+    /// it (the headset taken off), as long as it takes, saying so every
+    /// [`PAUSE_LOG_EVERY`].
+    fn wait_for_state(&mut self, since_change: Instant) -> Result<()> {
+        match self.paused {
+            Some((since, logged)) if logged.elapsed() >= PAUSE_LOG_EVERY => {
+                tracing::info!(
+                    "waiting for the runtime to make the session ready again (stopped {} s ago: \
+                     is the headset off?)",
+                    since.elapsed().as_secs()
+                );
+                self.paused = Some((since, Instant::now()));
+            }
+            Some(_) => {}
+            None if since_change.elapsed() > STATE_TIMEOUT => {
+                return Err(OpenXrError::Unsupported(format!(
+                    "the session stayed {} for {} s (running: {}); is the runtime's compositor \
+                     working?",
+                    self.state,
+                    STATE_TIMEOUT.as_secs(),
+                    self.running
+                )));
+            }
+            None => {}
+        }
+        std::thread::sleep(Duration::from_millis(5));
+        Ok(())
+    }
 }
 
 impl Backend for Session {
@@ -354,29 +508,42 @@ impl Backend for Session {
                 since_change = Instant::now();
             }
             if !(self.running && state::runs_frames(self.state)) {
-                if since_change.elapsed() > STATE_TIMEOUT {
-                    return Err(OpenXrError::Unsupported(format!(
-                        "the session stayed {} for {} s (running: {}); is the runtime's \
-                         compositor working?",
-                        self.state,
-                        STATE_TIMEOUT.as_secs(),
-                        self.running
-                    )));
-                }
-                std::thread::sleep(Duration::from_millis(5));
+                self.wait_for_state(since_change)?;
                 continue;
             }
-            let Some(frame) = self.begin_frame()? else {
-                continue;
+            let frame = match self.begin_frame() {
+                Ok(Some(frame)) => frame,
+                Ok(None) => continue,
+                Err(e) => match severity(&e) {
+                    // A frame call that fails (waiting, beginning) cannot be left one frame
+                    // later: only a loss is survived here.
+                    Severity::Lost(loss) => {
+                        tracing::warn!("{e}");
+                        self.leave_open_frame();
+                        self.lose(loss);
+                        continue;
+                    }
+                    _ => return Err(e),
+                },
             };
-            return match self.prepare_frame(frame.predicted_display_time) {
-                Ok(input) => Ok(Some(input)),
+            match self.prepare_frame(frame.predicted_display_time) {
+                Ok(Prepared::Input(input)) => {
+                    self.failed_in_a_row = 0;
+                    return Ok(Some(*input));
+                }
+                Ok(Prepared::NotDrawn) => continue,
                 Err(e) => {
                     self.abandon_open_frame();
-                    Err(e)
+                    self.take_failure(e)?;
                 }
-            };
+            }
         }
+    }
+
+    fn take_events(&mut self) -> Vec<SessionEvent> {
+        let events = self.pending.take();
+        Pending::log(&events);
+        events
     }
 
     fn frame_target(&self) -> FrameTarget {
@@ -408,12 +575,15 @@ impl Backend for Session {
                 frame.index, handed.index
             )));
         }
-        let submitted = self.submit_frame(&handed, display);
-        if submitted.is_err() {
-            // Whatever is still held (an image not released, the frame not ended) goes back.
-            self.abandon_open_frame();
+        match self.submit_frame(&handed, display) {
+            Ok(()) => Ok(()),
+            Err(e) => {
+                // Whatever is still held (an image not released, the frame not ended) goes
+                // back; a failure the session survives is counted, not returned.
+                self.abandon_open_frame();
+                self.take_failure(e)
+            }
         }
-        submitted
     }
 
     fn set_frame_end_hints(&mut self, hints: crate::FrameEndHints) {
@@ -430,90 +600,8 @@ impl Drop for Session {
         // A session dropped mid-frame (an error in the app) still ends its frame, so the
         // runtime is not left waiting.
         self.abandon_open_frame();
-        if self.running {
+        if self.running && self.report.interruptions.lost.is_none() {
             let _ = self.session.request_exit();
-        }
-    }
-}
-
-/// The depth info of one eye's layer: image `layer` of `swapchain` over `rect`, depth 0..1
-/// from `near_m` to `far_m` (a standard, not reversed, projection).
-pub(crate) fn depth_info(
-    swapchain: xr::sys::Swapchain,
-    layer: u32,
-    rect: xr::Rect2Di,
-    depth: &DepthOptions,
-) -> xr::sys::CompositionLayerDepthInfoKHR {
-    xr::sys::CompositionLayerDepthInfoKHR {
-        ty: xr::sys::CompositionLayerDepthInfoKHR::TYPE,
-        next: std::ptr::null(),
-        sub_image: xr::sys::SwapchainSubImage {
-            swapchain,
-            image_rect: rect,
-            image_array_index: layer,
-        },
-        min_depth: 0.0,
-        max_depth: 1.0,
-        near_z: depth.near_m,
-        far_z: depth.far_m,
-    }
-}
-
-/// Chains each view's depth info into its `next` (keeping whatever was chained before behind
-/// it).
-///
-/// # Safety
-/// `infos` must outlive every use of `views` (xrEndFrame), and must not move.
-pub(crate) unsafe fn chain_depth(
-    views: &mut [xr::sys::CompositionLayerProjectionView],
-    infos: &mut [xr::sys::CompositionLayerDepthInfoKHR],
-) {
-    for (view, info) in views.iter_mut().zip(infos.iter_mut()) {
-        info.next = view.next;
-        view.next = info as *const xr::sys::CompositionLayerDepthInfoKHR as *const _;
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use ash::vk;
-
-    #[test]
-    fn each_view_chains_its_depth_info() {
-        let rect = xr::Rect2Di {
-            offset: xr::Offset2Di { x: 0, y: 0 },
-            extent: xr::Extent2Di {
-                width: 320,
-                height: 240,
-            },
-        };
-        let options = DepthOptions {
-            format: vk::Format::D32_SFLOAT,
-            near_m: 0.02,
-            far_m: 100.0,
-        };
-        let chain = <xr::sys::Swapchain as xr::sys::Handle>::from_raw(7);
-        let mut infos: Vec<_> = (0..2)
-            .map(|l| depth_info(chain, l, rect, &options))
-            .collect();
-        let view = *xr::CompositionLayerProjectionView::<xr::Vulkan>::new().as_raw();
-        let mut views = [view, view];
-        // SAFETY: `infos` lives, unmoved, until the end of this test, past every use of `views`.
-        unsafe { chain_depth(&mut views, &mut infos) };
-        for (eye, v) in views.iter().enumerate() {
-            // SAFETY: `chain_depth` set `next` to an element of `infos`, still alive here.
-            let info = unsafe { &*(v.next as *const xr::sys::CompositionLayerDepthInfoKHR) };
-            assert_eq!(
-                info.ty,
-                xr::sys::StructureType::COMPOSITION_LAYER_DEPTH_INFO_KHR
-            );
-            assert!(info.next.is_null());
-            assert_eq!(info.sub_image.swapchain, chain);
-            assert_eq!(info.sub_image.image_array_index, eye as u32);
-            assert_eq!(info.sub_image.image_rect.extent.width, 320);
-            assert_eq!((info.min_depth, info.max_depth), (0.0, 1.0));
-            assert_eq!((info.near_z, info.far_z), (0.02, 100.0));
         }
     }
 }

@@ -7,11 +7,15 @@
 //! session.
 
 mod create;
+mod depth;
 mod frame;
 mod frame_end;
+mod images;
+mod interruptions;
 mod placement;
 mod scope;
 mod state_machine;
+mod tracking;
 
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -30,6 +34,7 @@ use super::state::{EndReason, State};
 use crate::frame::Pose;
 
 pub(super) use create::start;
+pub use interruptions::Interruptions;
 use placement::re_register;
 
 /// Set by the Ctrl-C handler; polled by every session.
@@ -44,6 +49,12 @@ fn install_ctrl_c() -> bool {
             .map_err(|e| tracing::warn!("cannot handle Ctrl-C: {e}"))
             .is_ok()
     })
+}
+
+/// Whether Ctrl-C was pressed since a session installed its handler (the app stops waiting
+/// for a runtime to come back then too).
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
 }
 
 /// How long the session waits for the runtime to make it READY or walk it to EXITING.
@@ -99,12 +110,43 @@ pub struct SessionReport {
     pub plane_detections: u64,
     /// Light estimates read (XR_ML_light_estimation).
     pub light_estimates: u64,
+    /// What a misbehaving headset did to the session, and what the session did about it.
+    pub interruptions: Interruptions,
 }
 
 impl SessionReport {
     /// Whether the session reached `state`.
     pub fn reached(&self, state: State) -> bool {
         self.states.contains(&state)
+    }
+
+    /// The report of a run whose session was followed by `later` (a new one after a loss):
+    /// the states one after the other, the counts added, what only one session has (the end,
+    /// the sources, the newest values) the later's.
+    pub fn then(&mut self, later: &SessionReport) {
+        self.states.extend(later.states.iter().copied());
+        self.states.dedup();
+        self.frames_submitted += later.frames_submitted;
+        self.frames_skipped += later.frames_skipped;
+        self.end_reason = later.end_reason;
+        self.gaze_source = later.gaze_source;
+        self.gaze_samples.add(&later.gaze_samples);
+        self.space = later.space;
+        self.blend = later.blend;
+        self.frames_untracked += later.frames_untracked;
+        self.actions_attached &= later.actions_attached;
+        self.action_syncs += later.action_syncs;
+        self.commands += later.commands;
+        self.frames_with_depth += later.frames_with_depth;
+        self.depth_format = later.depth_format;
+        self.frames_abandoned += later.frames_abandoned;
+        self.space_changes += later.space_changes;
+        self.frames_with_focus_distance += later.frames_with_focus_distance;
+        self.last_focus_distance_m = later.last_focus_distance_m.or(self.last_focus_distance_m);
+        self.frames_with_global_dimmer += later.frames_with_global_dimmer;
+        self.plane_detections += later.plane_detections;
+        self.light_estimates += later.light_estimates;
+        self.interruptions.then(&later.interruptions);
     }
 }
 
@@ -193,6 +235,19 @@ pub struct Session {
     ml_dimmer: bool,
     /// What the app asked of the display for the frame in flight.
     hints: crate::FrameEndHints,
+    /// Events for the app since the last frame handed out.
+    pending: interruptions::Pending,
+    /// The predicted display time of the frame waited for last (`None` after a stop).
+    last_waited_ns: Option<i64>,
+    /// The last tracked head pose, and what tracking lacks now.
+    tracking: tracking::HeadTracking,
+    /// Since when the runtime has had the session stopped (the headset taken off), and when
+    /// that was last logged.
+    paused: Option<(std::time::Instant, std::time::Instant)>,
+    /// Frames that failed in a row (a runtime failure each).
+    failed_in_a_row: u32,
+    /// The running session lost the input focus (and has not got it back).
+    unfocused: bool,
 }
 
 impl Session {
@@ -274,6 +329,22 @@ impl Session {
             }
             let _ = self.light_tx.send(scene);
         }
+    }
+
+    /// The scene frame from app space, once placed (a new session after a loss may take it
+    /// over, [`SessionOptions::world_from_space`]).
+    pub fn world_from_space(&self) -> Option<Pose> {
+        self.world_from_space
+    }
+
+    /// The next frame's index.
+    pub fn next_index(&self) -> u64 {
+        self.next_index
+    }
+
+    /// The predicted display time of the session's first frame, nanoseconds.
+    pub fn first_display_ns(&self) -> Option<i64> {
+        self.first_display.map(|t| t.as_nanos())
     }
 
     /// Where the application sends commands to be applied as if a live action gave them, at

@@ -1,12 +1,15 @@
 //! The session state machine: OpenXR events, xrBeginSession/xrEndSession as the runtime
 //! walks the states, ending on request, and the live actions synced while FOCUSED.
 
+use std::time::Instant;
+
 use glam::Vec3;
 use openxr as xr;
 
 use super::super::state::{self, Action, EndReason, State};
 use super::super::{Result, XrContext};
 use super::Session;
+use crate::session_event::{Loss, SessionEvent};
 
 impl Session {
     /// xrSyncActions with every attached set, then the controller commands; only while
@@ -58,51 +61,51 @@ impl Session {
                 xr::Event::SessionStateChanged(e) => {
                     let s = state_of(e.state());
                     // Copy out before `self` is borrowed mutably again.
+                    let before = self.state;
                     self.set_state(s);
+                    self.note_focus(before, s);
                     match state::on_state(s, self.running) {
                         Action::Begin => {
                             self.session
                                 .begin(xr::ViewConfigurationType::PRIMARY_STEREO)
                                 .xr("xrBeginSession")?;
                             self.running = true;
+                            if self.paused.take().is_some() {
+                                self.report.interruptions.resumes += 1;
+                                self.pending.push(SessionEvent::Resumed);
+                            }
                         }
                         Action::End => {
                             self.session.end().xr("xrEndSession")?;
                             self.running = false;
+                            // Not asked for: the runtime stopped the session (the headset
+                            // taken off, the device asleep), which may run again.
                             if !self.exit_requested {
-                                self.end_with(EndReason::RuntimeExit);
+                                let now = Instant::now();
+                                self.paused = Some((now, now));
+                                self.last_waited_ns = None;
+                                self.report.interruptions.pauses += 1;
+                                self.pending.push(SessionEvent::Ended);
                             }
                         }
-                        Action::EndAndQuit => {
-                            let _ = self.session.end();
-                            self.running = false;
-                            self.end_with(EndReason::SessionLost);
-                            self.quit = true;
+                        Action::EndAndQuit | Action::Quit if s == State::LossPending => {
+                            self.lose(Loss::Session);
                         }
-                        Action::Quit => {
-                            if s == State::LossPending {
-                                self.end_with(EndReason::SessionLost);
-                            } else {
-                                self.end_with(EndReason::RuntimeExit);
-                            }
+                        Action::EndAndQuit | Action::Quit => {
+                            self.end_with(EndReason::RuntimeExit);
                             self.quit = true;
                         }
                         Action::Continue => {}
                     }
                 }
                 xr::Event::InstanceLossPending(_) => {
-                    tracing::warn!("the OpenXR runtime is going away (instance loss pending)");
-                    if self.running {
-                        let _ = self.session.end();
-                        self.running = false;
-                    }
-                    self.end_with(EndReason::InstanceLost);
-                    self.quit = true;
+                    self.lose(Loss::Instance);
                 }
                 xr::Event::ReferenceSpaceChangePending(e)
                     if e.reference_space_type() == self.space_type =>
                 {
                     self.report.space_changes += 1;
+                    self.pending.push(SessionEvent::Recentred);
                     self.world_from_space = None;
                     tracing::info!(
                         "the {:?} reference space changes (at {} ns): the scene is placed \
@@ -121,6 +124,35 @@ impl Session {
             }
         }
         Ok(())
+    }
+
+    /// The session or the runtime is lost: the session ends now, without the calls a lost
+    /// session refuses (the app may start a new one).
+    pub(super) fn lose(&mut self, loss: Loss) {
+        if self.report.interruptions.lost.is_none() {
+            self.report.interruptions.lost = Some(loss);
+            self.pending.push(SessionEvent::Lost(loss));
+        }
+        self.running = false;
+        self.end_with(match loss {
+            Loss::Session => EndReason::SessionLost,
+            Loss::Instance => EndReason::InstanceLost,
+        });
+        self.quit = true;
+    }
+
+    /// Notes the running session losing the input focus (FOCUSED to VISIBLE or SYNCHRONIZED,
+    /// not on the way out) and getting it back.
+    fn note_focus(&mut self, before: State, now: State) {
+        let unfocused = matches!(now, State::Visible | State::Synchronized);
+        if before == State::Focused && unfocused && self.running && !self.exit_requested {
+            self.unfocused = true;
+            self.report.interruptions.unfocused += 1;
+            self.pending.push(SessionEvent::Unfocused);
+        } else if now == State::Focused && self.unfocused {
+            self.unfocused = false;
+            self.pending.push(SessionEvent::Focused);
+        }
     }
 
     /// Asks the runtime to end the session (or quits at once if it never ran).

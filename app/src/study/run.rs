@@ -159,6 +159,10 @@ impl Director for StudyStage {
         self.director.command(command);
     }
 
+    fn session_events(&mut self, events: &[vitreous_xr::SessionEvent]) {
+        self.director.session_events(events);
+    }
+
     fn end_flag(&self) -> Arc<AtomicBool> {
         self.end.clone()
     }

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use vitreous_xr::openxr::Command;
+use vitreous_xr::session_event::{SessionEvent, TrackingLoss};
 
 use super::answers::{ControllerAnswers, Keyboard, SimulatedObserver, answer_text, parse_answer};
 use super::plan::PlannedTrial;
@@ -298,7 +299,17 @@ pub struct StudyDirector {
     responses: ResponsesFile,
     /// The timing log.
     log: TimingLog,
+    /// Display time of the frame before, seconds.
+    last_time_s: Option<f64>,
+    /// Why the wearer may have missed part of the stimulus since the frame before (a menu,
+    /// the headset taken off, a lost session), if anything.
+    interruption: Option<String>,
 }
+
+/// The longest the display may show nothing during a trial's stimuli before the trial is shown
+/// again from its start, seconds: a frame or a few late is a glitch, more is a gap the wearer
+/// sees (a headset taken off, frames the runtime did not want, a lost session).
+pub const MAX_STIMULUS_GAP_S: f64 = 0.3;
 
 impl StudyDirector {
     /// A director for `trials` (one participant, one stimulus, unanswered, in order).
@@ -331,7 +342,59 @@ impl StudyDirector {
             typed: Default::default(),
             responses,
             log,
+            last_time_s: None,
+            interruption: None,
         }
+    }
+
+    /// What happened to the session since the frame before: a menu over the display, the
+    /// headset taken off, a lost session or lost head orientation keep the wearer from seeing
+    /// the stimulus, so a trial that was showing its stimuli starts again (at the next frame).
+    pub fn session_events(&mut self, events: &[SessionEvent]) {
+        for event in events {
+            let interrupts = matches!(
+                event,
+                SessionEvent::Unfocused
+                    | SessionEvent::Focused
+                    | SessionEvent::Ended
+                    | SessionEvent::Resumed
+                    | SessionEvent::Lost(_)
+                    | SessionEvent::Reconnected { .. }
+                    | SessionEvent::TrackingLost(TrackingLoss::Orientation)
+            );
+            if interrupts {
+                self.interruption
+                    .get_or_insert_with(|| event.fields().0.to_owned());
+            }
+        }
+    }
+
+    /// Starts the trial under way again from its first stimulus when the wearer may have missed
+    /// part of its stimuli since the frame before: an interruption the session said, or a gap
+    /// of more than [`MAX_STIMULUS_GAP_S`] between frames. Its answer is still asked once.
+    fn restart_if_interrupted(&mut self, frame: u64, time_s: f64) -> Result<()> {
+        let gap_s = self.last_time_s.map_or(0.0, |t| time_s - t);
+        self.last_time_s = Some(time_s);
+        let why = self
+            .interruption
+            .take()
+            .or_else(|| (gap_s > MAX_STIMULUS_GAP_S).then(|| format!("gap {gap_s:.2} s")));
+        let showing = self
+            .current
+            .as_ref()
+            .is_some_and(|c| matches!(c.phase, Some(Phase::First | Phase::Blank | Phase::Second)));
+        let Some(why) = why.filter(|_| showing) else {
+            return Ok(());
+        };
+        let cur = self.current.as_ref().expect("a trial is showing");
+        tracing::warn!(
+            "trial {}: interrupted during its stimuli ({why}): shown again from the start",
+            cur.trial.trial
+        );
+        self.event(frame, time_s, "interrupted", &why)?;
+        let cur = self.current.take().expect("a trial is showing");
+        self.trials.push_front(cur.trial);
+        Ok(())
     }
 
     /// Whether every trial is answered (or the session's answer limit is reached).
@@ -357,6 +420,7 @@ impl StudyDirector {
 
     /// What frame `frame`, displayed at `time_s`, shows; records answers that came in.
     pub fn frame(&mut self, frame: u64, time_s: f64) -> Result<Shown> {
+        self.restart_if_interrupted(frame, time_s)?;
         let commands = std::mem::take(&mut self.commands);
         if let Some(k) = &mut self.sources.keyboard {
             while let Some(line) = k.poll() {
@@ -498,3 +562,6 @@ impl StudyDirector {
         self.log.write_line(&line)
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -103,6 +103,11 @@ pub enum StudyCommand {
         /// Gaze replayed from this trace when the headset has no per-eye eye tracker.
         #[arg(long, value_name = "FILE")]
         gaze_trace: Option<PathBuf>,
+        /// On the headset: a folder where each block's session writes, in a folder named after
+        /// its stimulus, its summary.json, frames.csv and the recording of its head and gaze
+        /// (recorded.trace, as `vitreous run --record`).
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["dry_run", "view"])]
+        out: Option<PathBuf>,
     },
     /// Analyse a responses file (participant,trial,first,second,response[,stimulus]): forced
     /// choices with Thurstone's Case V and Mosteller's chi-square, -3..3 ratings with Nakaya's
@@ -177,6 +182,7 @@ pub fn run(command: StudyCommand) -> Result<()> {
             blend,
             gaze,
             gaze_trace,
+            out,
         } => {
             let mut inputs = InputFiles::new();
             inputs.add(&protocol, "PROTOCOL").add(&plan, "--plan");
@@ -186,6 +192,9 @@ pub fn run(command: StudyCommand) -> Result<()> {
                 }
             }
             inputs.check_file("--responses", &responses)?;
+            if let Some(out) = &out {
+                inputs.check_file("--out", out)?;
+            }
             inputs.check_file("the timing log", &timing_log_path(&responses))?;
             if let Some((w, h)) = size {
                 crate::setup::check_size(w, h)?;
@@ -211,6 +220,7 @@ pub fn run(command: StudyCommand) -> Result<()> {
                 simulate,
                 seed,
                 validate,
+                out,
                 run: RunOptions {
                     gaze,
                     gaze_trace,

@@ -67,6 +67,9 @@ pub struct StudyRunOptions {
     pub keyboard: bool,
     /// Vulkan (and OpenXR core) validation; any message fails the run.
     pub validate: bool,
+    /// On the headset: where each block's session writes its summary.json, frames.csv and
+    /// recording, in a folder named after the block's stimulus.
+    pub out: Option<PathBuf>,
     /// The OpenXR run's own options (blend, gaze source, size, out); scene and frames are set
     /// per block.
     pub run: RunOptions,
@@ -297,6 +300,12 @@ pub fn run_study(options: &StudyRunOptions) -> Result<StudyRunSummary> {
             run.scene = stimulus.scene.clone();
             run.frames = None;
             run.validate = options.validate;
+            run.out = options.out.as_ref().map(|d| d.join(&stimulus.name));
+            run.record = run.out.as_ref().map(|d| d.join("recorded.trace"));
+            if let Some(out) = &run.out {
+                std::fs::create_dir_all(out)
+                    .with_context(|| format!("creating {}", out.display()))?;
+            }
             crate::run::run_directed(&run, &mut stage)?;
             stage
         };

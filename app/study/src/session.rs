@@ -304,7 +304,13 @@ pub struct StudyDirector {
     /// Why the wearer may have missed part of the stimulus since the frame before (a menu,
     /// the headset taken off, a lost session), if anything.
     interruption: Option<String>,
+    /// Trials shown again for gaps between frames alone, and how often.
+    gap_restarts: std::collections::HashMap<u64, u32>,
 }
+
+/// How often one trial is shown again for gaps between frames alone: a display that keeps
+/// stalling for longer than [`MAX_STIMULUS_GAP_S`] would otherwise never let the trial end.
+pub const MAX_GAP_RESTARTS: u32 = 3;
 
 /// The longest the display may show nothing during a trial's stimuli before the trial is shown
 /// again from its start, seconds: a frame or a few late is a glitch, more is a gap the wearer
@@ -344,6 +350,7 @@ impl StudyDirector {
             log,
             last_time_s: None,
             interruption: None,
+            gap_restarts: Default::default(),
         }
     }
 
@@ -375,16 +382,29 @@ impl StudyDirector {
     fn restart_if_interrupted(&mut self, frame: u64, time_s: f64) -> Result<()> {
         let gap_s = self.last_time_s.map_or(0.0, |t| time_s - t);
         self.last_time_s = Some(time_s);
-        let why = self
-            .interruption
-            .take()
-            .or_else(|| (gap_s > MAX_STIMULUS_GAP_S).then(|| format!("gap {gap_s:.2} s")));
-        let showing = self
-            .current
-            .as_ref()
-            .is_some_and(|c| matches!(c.phase, Some(Phase::First | Phase::Blank | Phase::Second)));
-        let Some(why) = why.filter(|_| showing) else {
+        let showing = self.current.as_ref().and_then(|c| {
+            matches!(c.phase, Some(Phase::First | Phase::Blank | Phase::Second))
+                .then_some(c.trial.trial)
+        });
+        let said = self.interruption.take();
+        let Some(trial) = showing else {
             return Ok(());
+        };
+        let why = match said {
+            Some(why) => why,
+            None if gap_s > MAX_STIMULUS_GAP_S => {
+                let n = self.gap_restarts.entry(trial).or_default();
+                if *n >= MAX_GAP_RESTARTS {
+                    tracing::warn!(
+                        "trial {trial}: the display stalled for {gap_s:.2} s again; the trial \
+                         goes on (shown again {MAX_GAP_RESTARTS} times for stalls already)"
+                    );
+                    return Ok(());
+                }
+                *n += 1;
+                format!("gap {gap_s:.2} s")
+            }
+            None => return Ok(()),
         };
         let cur = self.current.as_ref().expect("a trial is showing");
         tracing::warn!(

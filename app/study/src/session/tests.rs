@@ -166,3 +166,20 @@ fn a_gap_in_the_frames_interrupts_and_a_glitch_or_a_rest_does_not() {
         "{rows:?}"
     );
 }
+
+#[test]
+fn a_display_that_keeps_stalling_shows_a_trial_again_three_times_then_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut d = director(dir.path());
+    // Every frame 0.45 s after the one before (0.05 s added to the loop's own step).
+    let frames = run(&mut d, 0.0, |_, t| t + 0.4);
+    assert!(d.done(), "the study ends ({frames} frames)");
+    let rows = log(dir.path());
+    for trial in ["1", "2"] {
+        let again = rows
+            .iter()
+            .filter(|(t, e, _)| t == trial && e == "interrupted")
+            .count();
+        assert_eq!(again, MAX_GAP_RESTARTS as usize, "trial {trial}: {rows:?}");
+    }
+}

@@ -34,6 +34,47 @@ pub fn eye_params(view: &EyeView) -> EyeParams {
     )
 }
 
+/// Draws one frame of each look from the scene's neutral head (the viewer at
+/// `head_position_m`, looking down -z) into the renderer's own images, composed as
+/// `composition` says, and waits for them: a driver that compiles its shaders when they are
+/// first used (lavapipe) does it here, before a live session's first frame, instead of while
+/// the runtime's clock runs (the first frames then came seconds late).
+pub fn warm_up(
+    renderer: &mut vitreous_render::Renderer,
+    scene: &Scene,
+    looks: &[Look],
+    composition: vitreous_render::Composition,
+) -> anyhow::Result<()> {
+    use vitreous_xr::Pose;
+    let head = Pose {
+        position: scene.viewer.head_position_m,
+        orientation: glam::Quat::IDENTITY,
+    };
+    let views = scene.viewer.eye_positions_m(&head).map(|p| EyeView {
+        pose: Pose {
+            position: p,
+            orientation: glam::Quat::IDENTITY,
+        },
+        fov: scene.output.fov,
+    });
+    let input = FrameInput {
+        index: 0,
+        time_ns: 0,
+        head,
+        views,
+        gaze: None,
+    };
+    for look in looks {
+        renderer.submit_composed(
+            &frame_params(&input, *look),
+            vitreous_render::renderer::Want::default(),
+            composition,
+        )?;
+    }
+    renderer.flush()?;
+    Ok(())
+}
+
 /// The renderer's parameters for a frame drawn with `look`.
 pub fn frame_params(input: &FrameInput, look: Look) -> FrameParams {
     FrameParams {

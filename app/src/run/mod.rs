@@ -70,7 +70,7 @@ use crate::focus::FocusFollower;
 use crate::frame_log::FrameLog;
 use crate::frame_loop;
 use crate::input_files::InputFiles;
-use crate::look::{GazeSettings, planners_for};
+use crate::look::{GazeSettings, base_look, planners_for};
 use crate::motion_clock::MotionClock;
 use crate::output::write_atomic;
 use crate::render_desc;
@@ -226,10 +226,32 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         validation: options.validate,
         device_name: None,
     };
+    // Every look the session may draw: each condition's, with its defocus when it has one.
+    let looks: Vec<vitreous_render::Look> = conditions
+        .iter()
+        .flat_map(|c| {
+            let look = base_look(c, options.reflection);
+            let blurred = c.defocus.then_some(vitreous_render::Look {
+                defocus: Some(vitreous_render::camera::Defocus {
+                    refracted_k_g_px: 1.0,
+                    surface_k_g_px: 1.0,
+                }),
+                ..look
+            });
+            std::iter::once(look).chain(blurred)
+        })
+        .collect();
     let make_renderer = |ctx, defocus: Option<&DefocusSetup>| {
         let mut renderer = render_desc::renderer_for(ctx, &scene, defocus, width, height)?;
         render_desc::enable_live_caustics(&mut renderer, &scene, caustics_loaded)
             .context("preparing live caustics")?;
+        render_desc::warm_up(
+            &mut renderer,
+            &scene,
+            &looks,
+            frame_loop::composition_for(info.blend),
+        )
+        .context("drawing the looks once before the session")?;
         Ok(renderer)
     };
     let end_flag = director.as_ref().map(|d| d.end_flag());
@@ -346,6 +368,8 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
     // conditions, the gaze filters, the recording, a study's place) goes on across them.
     loop {
         sink.attach(xr.session());
+        // The session's own count starts after the warm-up's.
+        let warmed = xr.parts().1.inducer_computations();
         let (session, renderer) = xr.parts();
         let result = frame_loop::run(session, renderer, &mut sink);
         // The loop's error is the one reported; a clean-up failing after it (releasing the
@@ -377,7 +401,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             )
         });
         let (computations, centroids, checked) = closed.after;
-        inducer_computations += computations;
+        inducer_computations += computations - warmed;
         match centroids {
             Some(Ok(c)) => floor_centroids = Some(c),
             Some(Err(e)) => tracing::warn!("reading back the floor's fields at the end: {e:#}"),

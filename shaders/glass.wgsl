@@ -176,7 +176,8 @@ struct VertexOut {
     @location(3) curve: vec2<f32>,
     // Positions along each side of a pixel (`SUPERSAMPLED`), `g.shading.w` at every vertex: the
     // end of `supersampled`'s loop, which must not be read from `g` (lavapipe compiles a shader
-    // whose loop ends on a uniform again at each bind and keeps every copy).
+    // whose loop ends on a uniform again at each bind and keeps every copy:
+    // render/build/uniform_loops.rs).
     @location(4) @interpolate(flat) samples: u32,
 };
 

@@ -20,6 +20,7 @@ use crate::look::LookPlanner;
 use crate::look::{GazeSettings, planner_for};
 use crate::motion_clock::MotionClock;
 use crate::render_desc;
+use crate::resident::resident_kib;
 use crate::scene::load_scene;
 use crate::setup::{check_size, load_trace};
 
@@ -229,17 +230,6 @@ pub fn trim_heap_and_measure_kib() -> u64 {
         mallinfo2()
     };
     ((info.uordblks + info.hblkhd) / 1024) as u64
-}
-
-/// Resident memory of this process, kibibytes (Linux `/proc/self/statm`).
-pub fn resident_kib() -> Result<u64> {
-    let statm = std::fs::read_to_string("/proc/self/statm").context("reading /proc/self/statm")?;
-    let pages: u64 = statm
-        .split_whitespace()
-        .nth(1)
-        .and_then(|v| v.parse().ok())
-        .context("parsing /proc/self/statm")?;
-    Ok(pages * 4)
 }
 
 /// Runs the soak; `progress` is called after every pass.

@@ -46,7 +46,8 @@ pub(super) struct RunSink<'d> {
     pub(super) readback: Option<ReadbackCheck>,
     /// Where head pose and gaze are recorded, if asked.
     pub(super) writer: Option<TraceWriter<vitreous_xr::trace::AtomicFile>>,
-    /// Every frame's input, for the replay check.
+    /// Every frame's input while recording, for the replay check (nothing is kept per frame
+    /// otherwise).
     pub(super) recorded: Vec<FrameInput>,
     /// The per-frame log (`frames.csv` with `--out`).
     pub(super) log: FrameLog,
@@ -115,8 +116,8 @@ impl FrameSink for RunSink<'_> {
         if let Some(w) = &mut self.writer {
             w.write(&trace_sample(input))
                 .context("recording the trace")?;
+            self.recorded.push(input.clone());
         }
-        self.recorded.push(input.clone());
         Ok(())
     }
 

@@ -24,7 +24,7 @@
 //! | [`setup`] | what every command does before its loop: size check, the trace |
 //! | [`validation`] | what the Vulkan validation layers reported |
 //! | [`spread`] | the median and spread of a timing |
-//! | [`resident`] | the process's resident memory |
+//! | [`resident`] | the process's resident memory, sampled over a session's frames |
 //! | [`interrupt`] | Ctrl-C and SIGTERM end a headless run after the current frame |
 //! | [`test_frame`] | frame inputs for tests |
 

@@ -67,12 +67,21 @@ use crate::look::{GazeSettings, planners_for};
 use crate::motion_clock::MotionClock;
 use crate::output::write_atomic;
 use crate::render_desc;
+use crate::resident::ResidentSampler;
 use crate::scene::{CausticsMode, load_scene};
 use crate::spread::Spread;
 use crate::validation::ValidationSummary;
 use recording::replay_check;
 use sink::RunSink;
 pub use xr_session::{Closed, XrSession};
+
+/// Frames before the first sample of resident memory (summary.json `resident_memory`): the
+/// first frames compile the driver's shader variants on first use and fill the allocators'
+/// pools.
+pub const RESIDENT_WARM_UP_FRAMES: u64 = 10;
+
+/// Frames between two samples of resident memory after the warm-up.
+pub const RESIDENT_EVERY_FRAMES: u64 = 10;
 
 /// Options of `vitreous run`.
 #[derive(Clone, Debug, Default)]
@@ -300,11 +309,14 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         focus: FocusFollower::new(&scene, options.filter),
         focus_m: None,
         global_dimmer: scene.global_dimmer,
+        resident: ResidentSampler::new(RESIDENT_WARM_UP_FRAMES, RESIDENT_EVERY_FRAMES),
     };
     let started = Instant::now();
     let (session, renderer) = xr.parts();
     let result = frame_loop::run(session, renderer, &mut sink);
     let wall_s = started.elapsed().as_secs_f64();
+    // Before the teardown: the session's memory as its last frame left it.
+    let resident_memory = sink.resident.finish();
     // The loop's error is the one reported; a clean-up failing after it (releasing the images
     // of a lost device) is logged.
     let format = xr.format();
@@ -427,6 +439,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         moved_frames: sink.motion.moved_frames,
         inducer_computations,
         final_placement: sink.motion.final_placement(),
+        resident_memory,
     };
     if let Some(out) = &options.out {
         fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;

@@ -18,6 +18,7 @@ use crate::focus::FocusFollower;
 use crate::frame_log::FrameLog;
 use crate::frame_loop::{FramePlan, FrameSink};
 use crate::motion_clock::MotionClock;
+use crate::resident::ResidentSampler;
 use crate::scene_edit::SceneEdit;
 
 /// Records frames and checks a readback.
@@ -77,6 +78,8 @@ pub(super) struct RunSink<'d> {
     pub(super) light_rx: Option<std::sync::mpsc::Receiver<vitreous_xr::light::LightEstimate>>,
     /// What the estimates did (`None`: none came).
     pub(super) room_light: Option<room_light::RoomLight>,
+    /// Resident memory over the session's frames.
+    pub(super) resident: ResidentSampler,
 }
 
 impl RunSink<'_> {
@@ -165,6 +168,7 @@ impl FrameSink for RunSink<'_> {
     }
 
     fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()> {
+        self.resident.frame(input.index);
         if let Some(e) = self.log_error.take() {
             return Err(e);
         }

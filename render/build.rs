@@ -6,13 +6,17 @@
 //! `../shaders/shared` and is appended to each that names it in a
 //! `// #include shared/<file>.wgsl` line ([`with_includes`]). Beside each entry point's SPIR-V
 //! it writes the static cost of one invocation (`<name>.cost.rs`, build/shader_cost.rs), which
-//! the renderer's counted work multiplies by the invocations a frame ran.
+//! the renderer's counted work multiplies by the invocations a frame ran, and in
+//! `uniform_loops.rs` every entry point's loops that end on uniform values
+//! (build/uniform_loops.rs), which a renderer test holds to the known few.
 
 use std::path::{Path, PathBuf};
 use std::{env, fs};
 
 #[path = "build/shader_cost.rs"]
 mod shader_cost;
+#[path = "build/uniform_loops.rs"]
+mod uniform_loops;
 
 /// `source` with the files its `// #include <path>` lines name (relative to `shader_dir`)
 /// appended in order. WGSL declarations may follow their use, so the shader's own lines keep
@@ -315,6 +319,9 @@ fn main() {
         .filter(|p| p.extension().is_some_and(|x| x == "wgsl"))
         .collect();
     entries.sort();
+    // Every entry point's loops that end on uniform values (build/uniform_loops.rs), for the
+    // renderer's test that holds them to the known few.
+    let mut loops_on_uniforms = Vec::new();
     for path in entries {
         println!("cargo:rerun-if-changed={}", path.display());
         let source = with_includes(&fs::read_to_string(&path).unwrap(), &shader_dir);
@@ -388,6 +395,9 @@ fn main() {
                 if only.is_some_and(|prefix| !entry.name.starts_with(prefix)) {
                     continue;
                 }
+                for found in uniform_loops::uniform_loops(&module, &entry.name, &entry.function) {
+                    loops_on_uniforms.push((format!("{name}.{}{suffix}", entry.name), found));
+                }
                 let options = naga::back::spv::Options {
                     lang_version: (1, 0),
                     flags: naga::back::spv::WriterFlags::empty(),
@@ -414,4 +424,9 @@ fn main() {
             }
         }
     }
+    let table: String = loops_on_uniforms
+        .iter()
+        .map(|(entry, found)| format!("    ({entry:?}, {:?}),\n", found.to_string()))
+        .collect();
+    fs::write(out_dir.join("uniform_loops.rs"), format!("&[\n{table}]\n")).unwrap();
 }

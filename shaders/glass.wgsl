@@ -174,6 +174,11 @@ struct VertexOut {
     // normal points away from the centre (a ball's vertex), else 0. Interpolated: see
     // `front_surface`.
     @location(3) curve: vec2<f32>,
+    // Positions along each side of a pixel (`SUPERSAMPLED`), `g.shading.w` at every vertex: the
+    // end of `supersampled`'s loop, which must not be read from `g` (lavapipe compiles a shader
+    // whose loop ends on a uniform again at each bind and keeps every copy:
+    // render/build/uniform_loops.rs).
+    @location(4) @interpolate(flat) samples: u32,
 };
 
 // Cosine above which a vertex normal counts as pointing away from the object's centre (twin
@@ -197,6 +202,7 @@ fn vs_main(
         radial = 1.0;
     }
     out.curve = vec2<f32>(length(world.xyz - g.center_world.xyz), radial);
+    out.samples = max(u32(g.shading.w), 1u);
     out.clip = eye.clip_from_world * world;
     return out;
 }
@@ -594,18 +600,18 @@ fn seen_behind(in: VertexOut) -> vec3<f32> {
 }
 
 // The glass's light over a pixel (`SUPERSAMPLED`): the mean of `shade_ray` over a regular
-// n x n grid of positions inside it (n = `g.shading.w`), each a view ray of its own through the
+// n x n grid of positions inside it (n = `in.samples`), each a view ray of its own through the
 // surface found as at the pixel's centre, with the vertex outputs carried there by their screen
 // derivatives. Where a position's ray passes beside a ball (its front surface is the sphere
 // through its vertices), the glass adds nothing there: the pixel's edge is covered in part.
 fn supersampled(
     in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool, alpha: f32,
 ) -> vec3<f32> {
-    let n = max(u32(g.shading.w), 1u);
+    let n = in.samples;
     let dx = VertexOut(vec4<f32>(0.0), dpdx(in.world_pos), dpdx(in.world_normal), vec2<f32>(0.0),
-        dpdx(in.curve));
+        dpdx(in.curve), 0u);
     let dy = VertexOut(vec4<f32>(0.0), dpdy(in.world_pos), dpdy(in.world_normal), vec2<f32>(0.0),
-        dpdy(in.curve));
+        dpdy(in.curve), 0u);
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < n * n; i++) {
         let offset = (vec2<f32>(f32(i % n), f32(i / n)) + 0.5) / f32(n) - 0.5;

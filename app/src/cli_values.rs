@@ -89,6 +89,32 @@ pub fn parse_frame_count_usize(s: &str) -> Result<usize, String> {
     usize::try_from(n).map_err(|_| format!("{n} frames is more than this machine can count"))
 }
 
+/// A pass count for `soak --passes`: at least the warm-up passes and the two compared after
+/// them.
+pub fn parse_pass_count(s: &str) -> Result<usize, String> {
+    let least = crate::soak::WARM_UP_PASSES + crate::soak::COMPARED_PASSES;
+    match s.trim().parse::<i128>() {
+        Ok(n) if n >= least as i128 && n <= usize::MAX as i128 => Ok(n as usize),
+        Ok(n) => Err(format!(
+            "expected at least {least} passes ({} of warm-up, then {} compared), got {n}",
+            crate::soak::WARM_UP_PASSES,
+            crate::soak::COMPARED_PASSES
+        )),
+        Err(_) => Err(format!("expected a whole number of passes, got '{s}'")),
+    }
+}
+
+/// A growth limit for `soak --max-growth`, percent: 0 or more.
+pub fn parse_growth_percent(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(percent) if percent >= 0.0 && percent.is_finite() => Ok(percent),
+        Ok(percent) => Err(format!(
+            "expected a growth of 0 percent or more, got {percent}"
+        )),
+        Err(_) => Err(format!("expected a growth in percent, got '{s}'")),
+    }
+}
+
 /// A pupil diameter for `--pupil-mm`, millimetres: 1 to 9 (the range eq. 13-14 accept),
 /// refused here whether or not the run's effects use it.
 pub fn parse_pupil_mm(s: &str) -> Result<f32, String> {

@@ -12,8 +12,8 @@ pub mod error_report;
 pub mod font;
 pub use vitreous_frames::{
     blur_stack, conditions, defocus_model, director, focus, frame_log, frame_loop, input_files,
-    interrupt, look, motion_clock, output, reference_view, render_desc, scene_edit, setup, spread,
-    test_frame, validation, wearer,
+    interrupt, look, motion_clock, output, reference_view, render_desc, resident, scene_edit,
+    setup, spread, test_frame, validation, wearer,
 };
 pub use vitreous_gaze as gaze;
 pub use vitreous_scene::{self as scene, caustics, effects, files};

@@ -11,7 +11,8 @@ use clap::{Parser, Subcommand};
 use vitreous::bench::{BenchOptions, bench};
 use vitreous::cli_values::{
     ReflectionArg, number, parse_effects, parse_frame_count, parse_frame_count_usize,
-    parse_kappa_deg, parse_pupil_mm, parse_seed, parse_size,
+    parse_growth_percent, parse_kappa_deg, parse_pass_count, parse_pupil_mm, parse_seed,
+    parse_size,
 };
 use vitreous::effects::EffectSet;
 use vitreous::error_report::error_text;
@@ -96,19 +97,33 @@ enum Command {
         #[arg(long)]
         unproved: bool,
     },
-    /// Replay a scene again and again in one process (a new Vulkan device and renderer each
-    /// pass, validation on) and check that resident memory stays flat and validation silent.
+    /// Replay a scene again and again in one process (one Vulkan device and renderer for the
+    /// run, validation on) and check that resident memory stays flat and validation silent;
+    /// several scenes one after another, each on its own device.
     Soak {
-        /// Scene file (TOML).
+        /// Scene files (TOML).
         #[arg(default_value = "config/scenes/glass-sphere.toml")]
-        scene: PathBuf,
-        /// How long to keep replaying, minutes.
+        scenes: Vec<PathBuf>,
+        /// How long to keep replaying each scene, minutes.
         #[arg(long, value_name = "MIN", default_value_t = 30.0, allow_negative_numbers = true,
               value_parser = number::<f64>)]
         minutes: f64,
+        /// Replay each scene this many times instead of for --minutes (2 warm-up passes, then
+        /// at least 2 compared).
+        #[arg(long, value_name = "N", conflicts_with = "minutes", allow_negative_numbers = true,
+              value_parser = parse_pass_count)]
+        passes: Option<usize>,
         /// Effects (default: the scene's); e.g. all.
         #[arg(long, value_name = "LIST", value_parser = parse_effects)]
         effects: Option<EffectSet>,
+        /// Every effect each scene's assets allow: all, less the caustics where a scene has
+        /// neither a bake nor live caustics.
+        #[arg(long, conflicts_with = "effects")]
+        all_effects: bool,
+        /// Largest growth of resident memory after warm-up that passes, percent.
+        #[arg(long, value_name = "PERCENT", default_value_t = vitreous::soak::MAX_GROWTH_PERCENT,
+              allow_negative_numbers = true, value_parser = parse_growth_percent)]
+        max_growth: f64,
         /// Eye image size.
         #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "640x480",
               allow_hyphen_values = true)]
@@ -117,7 +132,7 @@ enum Command {
         #[arg(long, value_name = "N", default_value_t = 120, allow_negative_numbers = true,
               value_parser = parse_frame_count)]
         frames: u64,
-        /// Write the report (every pass) as JSON here.
+        /// Write the report (every pass) as JSON here; an array of reports for several scenes.
         #[arg(long, value_name = "FILE")]
         json: Option<PathBuf>,
         /// A new Vulkan device and renderer for every pass instead of one for the whole run.
@@ -276,36 +291,44 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Soak {
-            scene,
+            scenes,
             minutes,
+            passes,
             effects,
+            all_effects,
+            max_growth,
             size,
             frames,
             json,
             recreate,
             no_validation,
         } => {
+            use vitreous::soak::{SoakEffects, SoakLength};
             if !(minutes.is_finite() && minutes > 0.0 && minutes <= 7.0 * 24.0 * 60.0) {
                 bail!("--minutes must be more than 0 and at most a week, got {minutes}");
             }
             let options = vitreous::soak::SoakOptions {
-                scene,
-                effects,
-                duration: std::time::Duration::from_secs_f64(minutes * 60.0),
+                scene: PathBuf::new(),
+                effects: match (effects, all_effects) {
+                    (Some(set), _) => SoakEffects::Set(set),
+                    (None, true) => SoakEffects::Available,
+                    (None, false) => SoakEffects::Scene,
+                },
+                length: match passes {
+                    Some(n) => SoakLength::Passes(n),
+                    None => {
+                        SoakLength::Duration(std::time::Duration::from_secs_f64(minutes * 60.0))
+                    }
+                },
                 size,
                 frames_per_pass: frames,
                 read_back_every: 10,
                 validation: !no_validation,
                 recreate,
                 report: json.clone(),
+                max_growth_percent: max_growth,
             };
-            let report = vitreous::soak::soak(&options, |p| eprintln!("soak: {p}"))?;
-            if let Some(path) = &json {
-                let bytes = serde_json::to_vec_pretty(&report)?;
-                vitreous::output::write_atomic(path, &bytes)?;
-            }
-            println!("{}", report.summary_line());
-            report.verdict()
+            vitreous::soak::soak_scenes(&scenes, &options, json.as_deref())
         }
         Command::Trace { command } => match command {
             TraceCommand::Analyze {

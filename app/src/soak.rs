@@ -4,7 +4,7 @@
 //! memory is process memory, so a leaked buffer or image shows here as growth from pass to
 //! pass; a pass that leaves the device dirty shows as validation messages.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
@@ -21,25 +21,52 @@ use crate::look::LookPlanner;
 use crate::look::{GazeSettings, planner_for};
 use crate::motion_clock::MotionClock;
 use crate::render_desc;
-use crate::scene::load_scene;
+use crate::resident::resident_kib;
+use crate::scene::{CausticsMode, load_scene};
 use crate::setup::{check_size, load_trace};
 
 /// Passes left out of the memory comparison: the first passes grow the allocator's pools and
 /// the driver's shader caches.
 pub const WARM_UP_PASSES: usize = 2;
 
-/// Largest growth of resident memory after warm-up that still counts as flat, percent.
+/// Passes after warm-up that a verdict needs: resident memory after the first is compared
+/// with the later ones.
+pub const COMPARED_PASSES: usize = 2;
+
+/// Largest growth of resident memory after warm-up that still counts as flat by default,
+/// percent.
 pub const MAX_GROWTH_PERCENT: f64 = 1.0;
+
+/// The effects a soak renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SoakEffects {
+    /// The scene's own (`[effects] set`).
+    Scene,
+    /// These.
+    Set(EffectSet),
+    /// Every effect the scene's assets allow: all of them, less the caustics where the scene
+    /// has neither a bake nor live caustics.
+    Available,
+}
+
+/// How long a soak replays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SoakLength {
+    /// Passes until this long has gone by since the start (at least one pass).
+    Duration(Duration),
+    /// This many passes.
+    Passes(usize),
+}
 
 /// Options of a soak run.
 #[derive(Clone, Debug)]
 pub struct SoakOptions {
     /// The scene file.
     pub scene: PathBuf,
-    /// Effects (default: every effect the scene's assets allow).
-    pub effects: Option<EffectSet>,
+    /// Effects.
+    pub effects: SoakEffects,
     /// How long to keep replaying.
-    pub duration: Duration,
+    pub length: SoakLength,
     /// Eye image size, pixels.
     pub size: (u32, u32),
     /// Frames per pass, at most the scene's synthetic trace (721 frames at 60 Hz), replayed
@@ -56,6 +83,8 @@ pub struct SoakOptions {
     /// Where the caller writes the JSON report (`--json`), refused before the first pass when
     /// it names one of the scene's files.
     pub report: Option<PathBuf>,
+    /// Largest growth of resident memory after warm-up that passes, percent.
+    pub max_growth_percent: f64,
 }
 
 /// One pass: the trace replayed once from its start.
@@ -115,6 +144,8 @@ pub struct SoakReport {
     pub rss_max_kib: u64,
     /// Growth of the largest over the warm-up figure, percent.
     pub growth_percent: f64,
+    /// Largest growth that passes, percent.
+    pub max_growth_percent: f64,
     /// Validation messages over all passes.
     pub validation_messages: u32,
     /// The first validation messages' texts.
@@ -124,8 +155,8 @@ pub struct SoakReport {
 impl SoakReport {
     /// Whether memory stayed flat and validation was silent.
     pub fn passed(&self) -> bool {
-        self.passes.len() > WARM_UP_PASSES
-            && self.growth_percent <= MAX_GROWTH_PERCENT
+        self.passes.len() >= WARM_UP_PASSES + COMPARED_PASSES
+            && self.growth_percent <= self.max_growth_percent
             && self.validation_messages == 0
     }
 
@@ -143,7 +174,7 @@ impl SoakReport {
             self.rss_after_warm_up_kib,
             self.rss_max_kib,
             self.growth_percent,
-            MAX_GROWTH_PERCENT,
+            self.max_growth_percent,
             self.validation_messages
         )
     }
@@ -154,11 +185,13 @@ impl SoakReport {
             return Ok(());
         }
         bail!(
-            "soak failed: {} passes (more than {} needed), memory growth {:.2} %, {} validation \
-             messages{}",
+            "soak of {} failed: {} passes ({} needed), memory growth {:+.2} % (limit {} %), {} \
+             validation messages{}",
+            self.scene,
             self.passes.len(),
-            WARM_UP_PASSES,
+            WARM_UP_PASSES + COMPARED_PASSES,
             self.growth_percent,
+            self.max_growth_percent,
             self.validation_messages,
             self.first_messages
                 .first()
@@ -235,17 +268,6 @@ pub fn trim_heap_and_measure_kib() -> u64 {
     ((info.uordblks + info.hblkhd) / 1024) as u64
 }
 
-/// Resident memory of this process, kibibytes (Linux `/proc/self/statm`).
-pub fn resident_kib() -> Result<u64> {
-    let statm = std::fs::read_to_string("/proc/self/statm").context("reading /proc/self/statm")?;
-    let pages: u64 = statm
-        .split_whitespace()
-        .nth(1)
-        .and_then(|v| v.parse().ok())
-        .context("parsing /proc/self/statm")?;
-    Ok(pages * 4)
-}
-
 /// Runs the soak; `progress` is called after every pass.
 pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Result<SoakReport> {
     let mut scene = load_scene(&options.scene)?;
@@ -254,7 +276,14 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
             .add_scene(&scene, "SCENE")
             .check_file("--json", report)?;
     }
-    let effects = options.effects.unwrap_or(scene.effects);
+    let effects = match options.effects {
+        SoakEffects::Scene => scene.effects,
+        SoakEffects::Set(set) => set,
+        SoakEffects::Available => EffectSet {
+            caustics: scene.caustics.mode == CausticsMode::Live || scene.caustics.bake.is_some(),
+            ..EffectSet::ALL
+        },
+    };
     effects.ensure_implemented()?;
     if effects.caustics {
         scene.load_caustics()?;
@@ -262,6 +291,12 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
     check_size(options.size.0, options.size.1)?;
     if options.frames_per_pass == 0 || options.read_back_every == 0 {
         bail!("frames per pass and the readback interval must be at least 1");
+    }
+    if !(options.max_growth_percent >= 0.0 && options.max_growth_percent.is_finite()) {
+        bail!(
+            "the largest growth must be a percentage of 0 or more, got {}",
+            options.max_growth_percent
+        );
     }
     let (samples, _) = load_trace(&scene, None)?;
     let signals = crate::interrupt::watch();
@@ -272,7 +307,11 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
     let mut first_messages = Vec::new();
     let mut current: Option<(Renderer, LookPlanner)> = None;
     let mut messages_before = 0;
-    while passes.is_empty() || started.elapsed() < options.duration {
+    let more = |done: usize| match options.length {
+        SoakLength::Duration(duration) => done == 0 || started.elapsed() < duration,
+        SoakLength::Passes(n) => done < n,
+    };
+    while more(passes.len()) {
         if signals && crate::interrupt::requested() {
             break;
         }
@@ -347,18 +386,7 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
     }
     drop(current);
 
-    let settled: Vec<u64> = passes
-        .iter()
-        .skip(WARM_UP_PASSES)
-        .map(|p| p.rss_kib)
-        .collect();
-    let rss_after_warm_up_kib = settled.first().copied().unwrap_or(0);
-    let rss_max_kib = settled.iter().copied().max().unwrap_or(0);
-    let growth_percent = if rss_after_warm_up_kib > 0 {
-        (rss_max_kib as f64 / rss_after_warm_up_kib as f64 - 1.0) * 100.0
-    } else {
-        0.0
-    };
+    let (rss_after_warm_up_kib, rss_max_kib, growth_percent) = settled_growth(&passes);
     Ok(SoakReport {
         scene: options.scene.display().to_string(),
         effects: effects.to_string(),
@@ -370,6 +398,126 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
         rss_after_warm_up_kib,
         rss_max_kib,
         growth_percent,
+        max_growth_percent: options.max_growth_percent,
         first_messages,
     })
+}
+
+/// Resident memory after the first pass past warm-up, the largest after a later pass (both
+/// kibibytes, 0 without such passes), and the growth of the largest over the first, percent.
+fn settled_growth(passes: &[SoakPass]) -> (u64, u64, f64) {
+    let settled: Vec<u64> = passes
+        .iter()
+        .skip(WARM_UP_PASSES)
+        .map(|p| p.rss_kib)
+        .collect();
+    let first = settled.first().copied().unwrap_or(0);
+    let max = settled.iter().copied().max().unwrap_or(0);
+    let growth_percent = if first > 0 {
+        (max as f64 / first as f64 - 1.0) * 100.0
+    } else {
+        0.0
+    };
+    (first, max, growth_percent)
+}
+
+/// Soaks each of `scenes` in turn with `options` (its scene replaced), each on its own device:
+/// prints every pass on stderr and each scene's summary line on stdout, writes the reports to
+/// `json` (the report of one scene, an array of them for several) and fails naming every scene
+/// that failed. Ctrl-C ends the scene being soaked and skips the rest.
+pub fn soak_scenes(scenes: &[PathBuf], options: &SoakOptions, json: Option<&Path>) -> Result<()> {
+    let mut reports = Vec::new();
+    for scene in scenes {
+        let options = SoakOptions {
+            scene: scene.clone(),
+            ..options.clone()
+        };
+        let report = soak(&options, |p| eprintln!("soak: {p}"))
+            .with_context(|| format!("soaking {}", scene.display()))?;
+        println!("{}", report.summary_line());
+        reports.push(report);
+        if crate::interrupt::requested() {
+            break;
+        }
+    }
+    if let Some(path) = json {
+        let bytes = match reports.as_slice() {
+            [one] => serde_json::to_vec_pretty(one)?,
+            all => serde_json::to_vec_pretty(all)?,
+        };
+        crate::output::write_atomic(path, &bytes)?;
+    }
+    let failed: Vec<String> = reports
+        .iter()
+        .filter_map(|r| r.verdict().err().map(|e| e.to_string()))
+        .collect();
+    match failed.as_slice() {
+        [] => Ok(()),
+        [one] => bail!("{one}"),
+        all => bail!(
+            "{} of {} scenes failed:\n{}",
+            all.len(),
+            reports.len(),
+            all.join("\n")
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A report of passes with these resident sizes, kibibytes, judged against `limit`.
+    fn report(rss_kib: &[u64], limit: f64) -> SoakReport {
+        let passes: Vec<SoakPass> = rss_kib
+            .iter()
+            .enumerate()
+            .map(|(pass, &rss_kib)| SoakPass {
+                pass,
+                frames: 3,
+                rss_kib,
+                heap_in_use_kib: 0,
+                validation_messages: 0,
+                moved_frames: 0,
+            })
+            .collect();
+        let (rss_after_warm_up_kib, rss_max_kib, growth_percent) = settled_growth(&passes);
+        SoakReport {
+            scene: "scene.toml".into(),
+            effects: "all".into(),
+            device: "device".into(),
+            wall_s: 1.0,
+            frames: 3 * passes.len() as u64,
+            passes,
+            rss_after_warm_up_kib,
+            rss_max_kib,
+            growth_percent,
+            max_growth_percent: limit,
+            validation_messages: 0,
+            first_messages: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn growth_counts_from_the_first_pass_after_warm_up_to_the_largest_later() {
+        // The warm-up passes' growth is left out; a later dip does not hide the peak.
+        let leaking = report(&[100, 150, 1000, 1100, 1040], 5.0);
+        assert_eq!(
+            (leaking.rss_after_warm_up_kib, leaking.rss_max_kib),
+            (1000, 1100)
+        );
+        assert!((leaking.growth_percent - 10.0).abs() < 1e-9);
+        let err = leaking.verdict().unwrap_err().to_string();
+        assert!(err.contains("+10.00 % (limit 5 %)"), "{err}");
+        assert!(report(&[100, 150, 1000, 1100, 1040], 10.5).passed());
+        assert!(report(&[100, 150, 1000, 1000, 1000], 0.0).passed());
+    }
+
+    #[test]
+    fn a_soak_that_compares_fewer_than_two_passes_fails() {
+        let short = report(&[100, 150, 1000], 5.0);
+        assert!(!short.passed());
+        let err = short.verdict().unwrap_err().to_string();
+        assert!(err.contains("3 passes (4 needed)"), "{err}");
+    }
 }

@@ -270,6 +270,13 @@ pub fn words(bytes: &[u8]) -> Vec<u32> {
         .collect()
 }
 
+/// Every entry point's loops that end on values read only from uniform buffers and push
+/// constants (build/uniform_loops.rs): the entry point (`<file>.<entry>[.<suffix>]`) and what
+/// ends the loop. lavapipe compiles such a shader again at every bind of its pipeline where it
+/// finds folding the values in worth it, and keeps every copy.
+#[cfg(test)]
+const UNIFORM_LOOPS: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/uniform_loops.rs"));
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -289,6 +296,21 @@ mod tests {
             at += count.max(1);
         }
         sets
+    }
+
+    #[test]
+    fn only_the_inducer_distance_passes_end_loops_on_uniform_values() {
+        // The glass's grid of positions per pixel once ended on the side read from its uniform
+        // buffer: lavapipe (Mesa 22.3) compiled glass-sphere-real's glass again at every bind
+        // and kept every copy (7 MB a frame). A frame's draws bind their pipelines every frame,
+        // so none of them may end a loop so. The distance transform's passes end theirs on the
+        // region in their push constants; they run once per pose, and soaks of the moving
+        // scenes, which run them at every frame that moves, stay flat (`vitreous soak`).
+        let found: std::collections::BTreeSet<&str> =
+            UNIFORM_LOOPS.iter().map(|&(entry, _)| entry).collect();
+        let expected: std::collections::BTreeSet<&str> =
+            ["inducer_distance.cs_columns", "inducer_distance.cs_rows"].into();
+        assert_eq!(found, expected, "{UNIFORM_LOOPS:#?}");
     }
 
     #[test]

@@ -26,6 +26,7 @@
 //! | [`setup`] | what every command does before its loop: size check, the trace |
 //! | [`validation`] | what the Vulkan validation layers reported |
 //! | [`spread`] | the median and spread of a timing |
+//! | [`resident`] | the process's resident memory, sampled over a session's frames |
 //! | [`interrupt`] | Ctrl-C and SIGTERM end a headless run after the current frame |
 //! | [`test_frame`] | frame inputs for tests |
 
@@ -44,6 +45,7 @@ pub mod motion_clock;
 pub mod output;
 pub mod reference_view;
 pub mod render_desc;
+pub mod resident;
 pub mod scene_edit;
 pub mod setup;
 pub mod spread;

@@ -74,12 +74,21 @@ use crate::look::{GazeSettings, base_look, planners_for};
 use crate::motion_clock::MotionClock;
 use crate::output::write_atomic;
 use crate::render_desc;
+use crate::resident::ResidentSampler;
 use crate::scene::{CausticsMode, load_scene};
 use crate::spread::Spread;
 use crate::validation::ValidationSummary;
 use recording::replay_check;
 use sink::RunSink;
 pub use xr_session::{Closed, XrSession};
+
+/// Frames before the first sample of resident memory (summary.json `resident_memory`): the
+/// first frames compile the driver's shader variants on first use and fill the allocators'
+/// pools.
+pub const RESIDENT_WARM_UP_FRAMES: u64 = 10;
+
+/// Frames between two samples of resident memory after the warm-up.
+pub const RESIDENT_EVERY_FRAMES: u64 = 10;
 
 /// Options of `vitreous run`.
 #[derive(Clone, Debug, Default)]
@@ -352,6 +361,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         gaze_watch: Default::default(),
         events: Vec::new(),
         last_time_ns: None,
+        resident: ResidentSampler::new(RESIDENT_WARM_UP_FRAMES, RESIDENT_EVERY_FRAMES),
     };
     let reconnect_limit =
         std::time::Duration::from_secs_f64(options.reconnect_s.unwrap_or(RECONNECT_S_DEFAULT));
@@ -362,6 +372,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
     let mut validation: Option<ValidationSummary> = None;
     let mut inducer_computations = 0;
     let mut floor_centroids = None;
+    let mut resident_memory;
     let format = xr.format();
     let mut gave_up: Option<anyhow::Error> = None;
     // One session, or one after another when a session or the runtime is lost: the sink (the
@@ -372,6 +383,8 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         let warmed = xr.parts().1.inducer_computations();
         let (session, renderer) = xr.parts();
         let result = frame_loop::run(session, renderer, &mut sink);
+        // Before the teardown: the session's memory as its last frame left it.
+        resident_memory = sink.resident.finish();
         // The loop's error is the one reported; a clean-up failing after it (releasing the
         // images of a lost device) is logged.
         let final_light = sink
@@ -576,6 +589,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         inducer_computations,
         final_placement: sink.motion.final_placement(),
         interruptions,
+        resident_memory,
     };
     if let Some(out) = &options.out {
         fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;

@@ -18,6 +18,7 @@ use crate::focus::FocusFollower;
 use crate::frame_log::FrameLog;
 use crate::frame_loop::{FramePlan, FrameSink};
 use crate::motion_clock::MotionClock;
+use crate::resident::ResidentSampler;
 use crate::scene_edit::SceneEdit;
 
 /// Records frames and checks a readback.
@@ -46,7 +47,8 @@ pub(super) struct RunSink<'d> {
     pub(super) readback: Option<ReadbackCheck>,
     /// Where head pose and gaze are recorded, if asked.
     pub(super) writer: Option<TraceWriter<vitreous_xr::trace::AtomicFile>>,
-    /// Every frame's input, for the replay check.
+    /// Every frame's input while recording, for the replay check (nothing is kept per frame
+    /// otherwise).
     pub(super) recorded: Vec<FrameInput>,
     /// The per-frame log (`frames.csv` with `--out`).
     pub(super) log: FrameLog,
@@ -83,6 +85,8 @@ pub(super) struct RunSink<'d> {
     pub(super) events: Vec<(i64, vitreous_xr::SessionEvent)>,
     /// Display time of the newest frame, nanoseconds.
     pub(super) last_time_ns: Option<i64>,
+    /// Resident memory over the session's frames.
+    pub(super) resident: ResidentSampler,
 }
 
 impl RunSink<'_> {
@@ -133,8 +137,8 @@ impl FrameSink for RunSink<'_> {
         if let Some(w) = &mut self.writer {
             w.write(&trace_sample(input))
                 .context("recording the trace")?;
+            self.recorded.push(input.clone());
         }
-        self.recorded.push(input.clone());
         Ok(())
     }
 
@@ -191,6 +195,7 @@ impl FrameSink for RunSink<'_> {
     }
 
     fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()> {
+        self.resident.frame(input.index);
         if let Some(e) = self.log_error.take() {
             return Err(e);
         }

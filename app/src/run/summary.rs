@@ -5,6 +5,7 @@ use serde::Serialize;
 
 use crate::frame_log::PupilSummary;
 use crate::gaze::separability::SeparabilitySummary;
+use crate::resident::ResidentMemory;
 use crate::spread::Spread;
 use crate::validation::ValidationSummary;
 
@@ -137,6 +138,9 @@ pub struct RunSummary {
     pub final_placement: Option<crate::motion_clock::FinalPlacement>,
     /// What a misbehaving headset did to the run and what the run did about it.
     pub interruptions: super::InterruptionSummary,
+    /// The process's resident memory over the frames after a warm-up (`null` when the session
+    /// ended in its warm-up).
+    pub resident_memory: Option<ResidentMemory>,
 }
 
 impl RunSummary {
@@ -222,6 +226,20 @@ impl RunSummary {
                 "gaze-image switches: {}; {}",
                 self.gaze_image_switches,
                 s.line()
+            );
+        }
+        if let Some(m) = &self.resident_memory {
+            let _ = writeln!(
+                out,
+                "resident memory: {} KiB at frame {} (after {} warm-up frames), {} KiB at frame \
+                 {} ({:+.2} %), at most {} KiB",
+                m.first_kib,
+                m.first_frame,
+                m.warm_up_frames,
+                m.last_kib,
+                m.last_frame,
+                m.growth_percent,
+                m.max_kib
             );
         }
         if let Some(r) = &self.replay_check {

@@ -80,6 +80,10 @@ struct DefocusPlan {
     last: Option<DefocusFrame>,
     /// Whether the tracker was found unable to separate the images (warned once).
     warned_inseparable: bool,
+    /// The last image the pipeline decided: held while its decision is unknown again (the
+    /// tracker lost for longer than the blink hold), so the wearer keeps the defocus they saw
+    /// instead of both images turning sharp until the tracker is back.
+    held: Option<GazeImage>,
 }
 
 impl DefocusPlan {
@@ -90,6 +94,7 @@ impl DefocusPlan {
             model,
             last: None,
             warned_inseparable: false,
+            held: None,
         }
     }
 }
@@ -165,11 +170,13 @@ impl LookPlanner {
                 ));
                 let state = d.pipeline.update(input.gaze.as_ref(), input.time_ns);
                 let pupil = d.pupil.update(input.gaze.as_ref());
-                let defocus = d
-                    .model
-                    .defocus_at(state.image, &distances, pupil.diameter_m);
+                let image = match state.image {
+                    GazeImage::Unknown => d.held.unwrap_or(GazeImage::Unknown),
+                    decided => *d.held.insert(decided),
+                };
+                let defocus = d.model.defocus_at(image, &distances, pupil.diameter_m);
                 d.last = Some(DefocusFrame {
-                    image: state.image,
+                    image,
                     distances,
                     defocus,
                     pupil_m: pupil.diameter_m,
@@ -370,6 +377,48 @@ mod tests {
             let d = p.last_defocus().unwrap();
             assert_eq!(d.distances, scene.image_distances());
             assert_eq!((d.pupil_m, d.pupil_measured), (0.006, false));
+        }
+    }
+
+    /// The tracker lost for a second (no valid eye): the pipeline's decision turns unknown
+    /// after its 300 ms hold, but the look keeps the image decided before, and its defocus,
+    /// until the tracker decides again.
+    #[test]
+    fn the_decided_image_is_held_while_the_tracker_is_lost() {
+        let scene = scene();
+        let mut p = planner(&scene, GazeOverride::Auto);
+        let front = Vec3::new(0.0, 0.0, SPHERE_Z_M + SPHERE_RADIUS_M);
+        let frame = |i: i64, valid: bool| {
+            let s = sample(i * 20_000_000, 0.0, front);
+            let mut input = crate::test_frame::test_frame();
+            input.time_ns = s.time_ns;
+            input.gaze = Some(if valid {
+                s.gaze
+            } else {
+                GazeSample::none(s.time_ns)
+            });
+            input
+        };
+        for i in 0..30 {
+            p.plan(&frame(i, true));
+        }
+        let decided = *p.last_defocus().unwrap();
+        assert_eq!(decided.image, GazeImage::Surface);
+        for i in 30..80 {
+            let (look, state) = p.plan(&frame(i, false));
+            assert_eq!(
+                p.last_defocus().unwrap().image,
+                GazeImage::Surface,
+                "frame {i}"
+            );
+            assert_eq!(look.defocus, decided.defocus, "frame {i}");
+            if i > 60 {
+                assert_eq!(
+                    state.unwrap().image,
+                    GazeImage::Unknown,
+                    "the pipeline let go"
+                );
+            }
         }
     }
 

@@ -181,7 +181,18 @@ impl GazePipeline {
     /// `FrameInput::gaze`), `head_time_ns` the frame's time (used for the blink-hold timeout
     /// only when there is no sample).
     pub fn update(&mut self, gaze: Option<&GazeSample>, head_time_ns: i64) -> GazeState {
-        let raw_depth = self.vergence.update(gaze, head_time_ns);
+        // A depth filter averages whatever it is given: a sample the tracker itself reports
+        // with LOW confidence is no measurement for it (the depth is held, as through a blink);
+        // the per-fixation and evidence decisions read the report themselves.
+        let doubted = gaze.is_some_and(|g| {
+            g.report
+                .is_some_and(|r| r.confidence == vitreous_xr::TrackerConfidence::Low)
+        });
+        let measured = match self.decision {
+            Decision::Depth { .. } if doubted => None,
+            _ => gaze,
+        };
+        let raw_depth = self.vergence.update(measured, head_time_ns);
         let (filtered_depth, tracked) = match &mut self.decision {
             Decision::Depth { filter, selector } => {
                 let filtered = filter.feed(&raw_depth);
@@ -216,5 +227,50 @@ impl GazePipeline {
             focus_distance_m: self.config.distances.of(image),
             separability,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use vitreous_xr::{GazeBehaviour, TrackerConfidence, TrackerReport};
+
+    use super::*;
+    use crate::test_samples::looking;
+
+    #[test]
+    fn a_depth_filter_takes_no_sample_the_tracker_doubts() {
+        let mut config = GazeConfig::new(ImageDistances {
+            surface_m: 0.6,
+            refracted_m: 1.5,
+        });
+        config.filter = FilterKind::PAPER;
+        let mut p = GazePipeline::new(config);
+        let ms = 1_000_000;
+        for k in 0..30 {
+            p.update(Some(&looking(k * 33 * ms, 0.6, 0.0)), k * 33 * ms);
+        }
+        // The eyes turn to the refracted image, but the tracker says LOW: no measurement, the
+        // depth held through the 300 ms hold, then none; never the doubted 1.5 m.
+        let doubted = TrackerReport {
+            confidence: TrackerConfidence::Low,
+            behaviour: GazeBehaviour::Fixation,
+        };
+        for k in 30..60 {
+            let mut s = looking(k * 33 * ms, 1.5, 0.0);
+            s.report = Some(doubted);
+            let state = p.update(Some(&s), k * 33 * ms);
+            assert_ne!(state.image, GazeImage::Refracted, "sample {k}");
+            if let Some(d) = state.filtered_depth.depth_m() {
+                assert!((d - 0.6).abs() < 0.01, "sample {k}: {d} m");
+            }
+        }
+        // HIGH again: the same samples decide.
+        let mut last = GazeImage::Unknown;
+        for k in 60..100 {
+            last = p
+                .update(Some(&looking(k * 33 * ms, 1.5, 0.0)), k * 33 * ms)
+                .image;
+        }
+        assert_eq!(last, GazeImage::Refracted);
     }
 }

@@ -448,6 +448,13 @@ impl Renderer {
         self.inducer.computations()
     }
 
+    /// Makes the shadow inducer's fields and a live caustic map due again at the current
+    /// pose, as for a renderer just made: after frames drawn only to warm the pipelines, the
+    /// first real frame computes them as it would have.
+    pub fn recompute_floor(&mut self) {
+        self.inducer.recompute();
+    }
+
     /// Records and submits a frame, composed for the scene's own display: with a segmented
     /// dimmer as for [`Composition::AlphaBlend`] (the alpha the dimmer takes away), else
     /// [`Composition::Additive`]. Returns the frame that last used the same slot

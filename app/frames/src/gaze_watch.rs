@@ -20,6 +20,8 @@ pub struct GazeWatch {
     last_usable_ns: Option<i64>,
     /// Whether the tracker counts as lost now.
     lost: bool,
+    /// Display time of the frame before, nanoseconds.
+    previous_ns: Option<i64>,
     /// Dropouts so far.
     pub dropouts: u64,
     /// The longest, milliseconds (from the last usable sample to the next).
@@ -31,6 +33,16 @@ pub struct GazeWatch {
 impl GazeWatch {
     /// Looks at a frame's gaze; the dropout's start or end, when this frame brings one.
     pub fn observe(&mut self, frame: &FrameInput) -> Option<SessionEvent> {
+        // Time without frames (the headset taken off, frames not rendered) is not the
+        // tracker's: the wait for a usable sample counts frame time only.
+        if let Some(gap) = self
+            .previous_ns
+            .replace(frame.time_ns)
+            .map(|p| frame.time_ns - p)
+            .filter(|g| *g as f64 * 1e-9 > DROPOUT_S)
+        {
+            self.last_usable_ns = self.last_usable_ns.map(|t| t + gap);
+        }
         let fresh = frame
             .gaze
             .filter(|g| self.newest_ns.is_none_or(|n| g.sample_time_ns > n));
@@ -143,6 +155,17 @@ mod tests {
             .filter_map(|t| w.observe(&frame(t, t, true, unsure)))
             .collect();
         assert_eq!(events, [SessionEvent::GazeLost]);
+    }
+
+    #[test]
+    fn time_without_frames_is_not_the_trackers() {
+        let mut w = GazeWatch::default();
+        w.observe(&frame(0, 0, true, None));
+        // The headset off for 3 s; the first frame after it has a stale sample, the next a
+        // fresh one.
+        assert_eq!(w.observe(&frame(3000, 0, true, None)), None);
+        assert_eq!(w.observe(&frame(3050, 3050, true, None)), None);
+        assert_eq!(w.dropouts, 0);
     }
 
     #[test]

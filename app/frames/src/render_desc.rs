@@ -38,7 +38,10 @@ pub fn eye_params(view: &EyeView) -> EyeParams {
 /// `head_position_m`, looking down -z) into the renderer's own images, composed as
 /// `composition` says, and waits for them: a driver that compiles its shaders when they are
 /// first used (lavapipe) does it here, before a live session's first frame, instead of while
-/// the runtime's clock runs (the first frames then came seconds late).
+/// the runtime's clock runs (the first frames then came seconds late). The floor's fields are
+/// then due again, so the session's first frame computes them as a fresh renderer's would;
+/// the warm-up's computations are in [`vitreous_render::Renderer::inducer_computations`]
+/// before the session's.
 pub fn warm_up(
     renderer: &mut vitreous_render::Renderer,
     scene: &Scene,
@@ -72,6 +75,7 @@ pub fn warm_up(
         )?;
     }
     renderer.flush()?;
+    renderer.recompute_floor();
     Ok(())
 }
 

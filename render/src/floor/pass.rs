@@ -306,6 +306,15 @@ impl InducerPass {
         }
     }
 
+    /// Makes the fields (and a live caustic map) due again at the current pose, as for a pass
+    /// just made: the next frame that draws the overlay computes them.
+    pub fn recompute(&mut self) {
+        if self.live.is_some() {
+            (self.caustic_rect, self.live_rect_on_gpu) = (None, true);
+        }
+        self.progress.invalidate();
+    }
+
     /// How many computations of the fields were submitted since the pass was made.
     pub fn computations(&self) -> u64 {
         self.progress.computations

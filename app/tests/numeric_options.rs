@@ -40,7 +40,10 @@ fn a_negative_number_for_any_numeric_option_names_the_option_and_what_it_expects
     ];
     let compare = ["compare", "a.png", "b.png", "--seen", "a.png", "--display"];
     let cases: Vec<(Vec<&str>, &str, &str)> = [
-        (vec!["run", &s], &["--size", "--frames", "--reconnect-s"][..]),
+        (
+            vec!["run", &s],
+            &["--size", "--frames", "--reconnect-s"][..],
+        ),
         (
             vec!["view", &s],
             &["--window", "--render-scale", "--frames"],

@@ -1,6 +1,10 @@
 //! `vitreous replay`: a recorded (or synthesised) trace through the real frame loop on a real
 //! Vulkan device, writing per-eye images, see-through previews, the per-frame defocus log
 //! `frames.csv` and `summary.json`.
+//!
+//! Over 600 lines: the replay's checks of its options and inputs, its sink (saving, the
+//! reference beside the frames, the recording's edits and events) and its summary around the
+//! one loop; the saving, the physical reference and the summary's types are apart already.
 
 use std::fs;
 use std::path::{Path, PathBuf};

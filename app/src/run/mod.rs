@@ -21,6 +21,10 @@
 //! `readback.rs` (the readback check), `sink.rs` (what is done with each frame), `recording.rs` (the recorded trace and its replay
 //! check), `summary.rs` (what the run reports); the conditions and live commands are
 //! `vitreous_frames::conditions`. This file sets the session up, runs it and writes the summary.
+//!
+//! Over 600 lines: the run's set-up, its loop over sessions (a new one after a lost session or
+//! runtime, the sink going on) and its summary share the scene, the runtime's info, the sink and
+//! the merged report; what they need besides is in the parts above.
 
 mod cli;
 mod controls;

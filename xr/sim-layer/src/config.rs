@@ -30,6 +30,9 @@
 //! - `VITREOUS_SIM_FAULTS`: a fault schedule (`crate::faults::schedule`): what a misbehaving
 //!   headset does to the session, and when; `VITREOUS_SIM_FAULT_LOG`: the CSV file the layer
 //!   logs each fault and what the app did about it to (`crate::faults::log`).
+//!
+//! Just over 600 lines: one parser per variable, beside the field it fills, with the error that
+//! names the variable; the tests are most of the rest.
 
 use std::ffi::CStr;
 use std::fmt;

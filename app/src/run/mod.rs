@@ -19,7 +19,9 @@
 //! Parts: `cli.rs` (the command line), `controls.rs` (keyboard edits), `device.rs` (Vulkan
 //! through the runtime), `xr_session.rs` (runtime, renderer and session owned together),
 //! `readback.rs` (the readback check), `sink.rs` (what is done with each frame), `recording.rs` (the recorded trace and its replay
-//! check), `summary.rs` (what the run reports); the conditions and live commands are
+//! check), `summary.rs` (what the run reports), `interruptions.rs` (what a misbehaving headset
+//! did: each session event logged, recorded, counted), `reconnect.rs` (asking the runtime again
+//! after a loss); the conditions and live commands are
 //! `vitreous_frames::conditions`. This file sets the session up, runs it and writes the summary.
 //!
 //! Over 600 lines: the run's set-up, its loop over sessions (a new one after a lost session or

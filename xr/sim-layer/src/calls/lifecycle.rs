@@ -103,11 +103,7 @@ pub unsafe extern "system" fn poll_event(
     buffer: *mut sys::EventDataBuffer,
 ) -> sys::Result {
     guard("xrPollEvent", || {
-        let Some(next) = registry()
-            .instances
-            .get(&instance.into_raw())
-            .map(|i| i.next.clone())
-        else {
+        let Some(next) = super::instance_next(instance) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         if buffer.is_null() {
@@ -206,11 +202,7 @@ pub unsafe extern "system" fn get_system(
     system: *mut sys::SystemId,
 ) -> sys::Result {
     guard("xrGetSystem", || {
-        let Some(next) = registry()
-            .instances
-            .get(&instance.into_raw())
-            .map(|i| i.next.clone())
-        else {
+        let Some(next) = super::instance_next(instance) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         if let Some(Some(r)) = faults::with(|f| f.get_system(Instant::now())) {

@@ -57,6 +57,14 @@ pub fn all_location_flags() -> sys::SpaceLocationFlags {
         | sys::SpaceLocationFlags::POSITION_TRACKED
 }
 
+/// The next layer's functions of an instance the layer knows.
+pub fn instance_next(instance: sys::Instance) -> Option<Arc<NextTable>> {
+    crate::registry::registry()
+        .instances
+        .get(&instance.into_raw())
+        .map(|i| i.next.clone())
+}
+
 /// What a call about a session needs, copied out of the registry.
 #[derive(Clone)]
 pub struct SessionContext {

@@ -27,11 +27,7 @@ pub unsafe extern "system" fn create_session(
     session: *mut sys::Session,
 ) -> sys::Result {
     guard("xrCreateSession", || {
-        let Some(next) = registry()
-            .instances
-            .get(&instance.into_raw())
-            .map(|i| i.next.clone())
-        else {
+        let Some(next) = super::instance_next(instance) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the next layer's function with the app's arguments.

@@ -10,11 +10,13 @@ use super::chain;
 use crate::bindings::{self, Plan};
 use crate::blend;
 use crate::config::GazeExtension;
+use crate::faults;
 use crate::guard::guard;
 use crate::registry::registry;
 use crate::two_call;
 
-/// `xrDestroyInstance`: passed on, then the layer forgets the instance.
+/// `xrDestroyInstance`: passed on, then the layer forgets the instance (and the fault
+/// schedule its sessions and whether it was lost).
 ///
 /// # Safety
 /// As `xrDestroyInstance`.
@@ -27,6 +29,7 @@ pub unsafe extern "system" fn destroy_instance(instance: sys::Instance) -> sys::
         // SAFETY: the next layer's function for its own live instance.
         let r = unsafe { (next.destroy_instance)(instance) };
         registry().remove_instance(raw);
+        faults::with(|f| f.instance_destroyed(raw));
         r
     })
 }

@@ -234,6 +234,22 @@ impl Faults {
         self.swapchains.retain(|_, s| *s != session);
     }
 
+    /// An instance was destroyed: the layer forgets it and its sessions (a runtime may hand the
+    /// same handle to the next instance, which is not lost).
+    pub fn instance_destroyed(&mut self, instance: u64) {
+        self.lost_instances.remove(&instance);
+        self.instance_events.remove(&instance);
+        let gone: Vec<u64> = self
+            .sessions
+            .iter()
+            .filter(|(_, v)| v.instance == instance)
+            .map(|(s, _)| *s)
+            .collect();
+        for session in gone {
+            self.session_destroyed(session);
+        }
+    }
+
     /// The session made a reference space of this type.
     pub fn space_created(&mut self, session: u64, space: sys::ReferenceSpaceType) {
         let world =

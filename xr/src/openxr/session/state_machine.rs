@@ -9,6 +9,7 @@ use openxr as xr;
 use super::super::state::{self, Action, EndReason, State};
 use super::super::{Result, XrContext};
 use super::Session;
+use super::interruptions::{Severity, severity};
 use crate::session_event::{Loss, SessionEvent};
 
 impl Session {
@@ -49,8 +50,30 @@ impl Session {
         }
     }
 
-    /// Handles pending events; applies the state machine.
+    /// Handles pending events; applies the state machine. A session or runtime lost in one of
+    /// its calls (`xrPollEvent`, `xrBeginSession`, `xrEndSession`: a real runtime may say so
+    /// there before any event does) ends the session as its loss event would.
     pub(super) fn poll_events(&mut self) -> Result<()> {
+        let r = self.take_events();
+        self.lost_or(r)
+    }
+
+    /// `r`, or `Ok` with the session lost where its error says the session or runtime is.
+    fn lost_or(&mut self, r: Result<()>) -> Result<()> {
+        match r {
+            Err(e) => match severity(&e) {
+                Severity::Lost(loss) => {
+                    tracing::warn!("{e}");
+                    self.lose(loss);
+                    Ok(())
+                }
+                Severity::Frame | Severity::Fatal => Err(e),
+            },
+            ok => ok,
+        }
+    }
+
+    fn take_events(&mut self) -> Result<()> {
         loop {
             let event = self
                 .instance
@@ -164,7 +187,8 @@ impl Session {
         self.exit_requested = true;
         if self.running {
             tracing::info!("ending the session: {reason}");
-            self.session.request_exit().xr("xrRequestExitSession")?;
+            let r = self.session.request_exit().xr("xrRequestExitSession");
+            self.lost_or(r)?;
         } else {
             self.quit = true;
         }

@@ -168,6 +168,14 @@ fn an_instance_loss_is_announced_once_and_the_runtime_is_away_for_the_outage() {
         Some(sys::Result::ERROR_RUNTIME_UNAVAILABLE)
     );
     assert_eq!(f.create_instance(now + Duration::from_secs(1)), None);
+    // The runtime hands the destroyed instance's handle, and its session's, out again.
+    f.instance_destroyed(INSTANCE);
+    f.session_created(SESSION, INSTANCE);
+    assert_eq!(
+        f.refuse("xrEndFrame", SESSION),
+        None,
+        "a new instance is not lost"
+    );
 }
 
 #[test]

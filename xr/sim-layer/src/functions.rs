@@ -198,18 +198,18 @@ pub fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::V
         b"xrCreateReferenceSpace" => (
             None,
             entry!(
-                calls::session::create_reference_space,
+                calls::spaces::create_reference_space,
                 pfn::CreateReferenceSpace
             ),
         ),
         b"xrCreateActionSpace" => (
             None,
-            entry!(calls::session::create_action_space, pfn::CreateActionSpace),
+            entry!(calls::spaces::create_action_space, pfn::CreateActionSpace),
         ),
-        b"xrLocateSpace" => (None, entry!(calls::session::locate_space, pfn::LocateSpace)),
+        b"xrLocateSpace" => (None, entry!(calls::spaces::locate_space, pfn::LocateSpace)),
         b"xrDestroySpace" => (
             None,
-            entry!(calls::session::destroy_space, pfn::DestroySpace),
+            entry!(calls::spaces::destroy_space, pfn::DestroySpace),
         ),
         b"xrSyncActions" => (
             None,
@@ -255,7 +255,7 @@ pub fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::V
         b"xrGetActionStatePose" => (
             None,
             entry!(
-                calls::session::get_action_state_pose,
+                calls::spaces::get_action_state_pose,
                 pfn::GetActionStatePose
             ),
         ),

@@ -13,6 +13,7 @@ pub mod light;
 pub mod ml;
 pub mod planes;
 pub mod session;
+pub mod spaces;
 pub mod swapchain;
 pub mod tracking;
 

@@ -5,13 +5,13 @@
 //! check and the errors for missing and foreign bakes.
 
 use glam::{Quat, Vec2, Vec3};
-use vitreous::caustics::{Bake, BakeError};
-use vitreous::effects::EffectSet;
-use vitreous::render_desc;
-use vitreous::scene::{CausticsMode, Image, PixelData, Scene};
+use vitreous_frames::render_desc;
 use vitreous_render::camera::EyeParams;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Readback, Reflection, Renderer, ScenePose};
+use vitreous_scene::caustics::{Bake, BakeError};
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{CausticsMode, Image, PixelData, Scene};
 use vitreous_tests::{
     FloorPixel, eyes_looking_down, floor_pixels, floor_uv, render_once, shipped_scene,
 };
@@ -66,7 +66,7 @@ fn render(renderer: &mut Renderer, eyes: [EyeParams; 2], effects: &str) -> Readb
     let effects = EffectSet::parse(effects).unwrap();
     let params = FrameParams {
         eyes,
-        look: vitreous::look::base_look(&effects, Reflection::EnvironmentFresnel),
+        look: vitreous_frames::look::base_look(&effects, Reflection::EnvironmentFresnel),
     };
     let want = Want {
         eyes: true,

@@ -4,13 +4,13 @@
 //! preview's world view draws it), clamped at 0, in linear light; every other pixel is
 //! untouched; with the world drawn behind (an opaque display) nothing is taken away.
 
-use vitreous::effects::EffectSet;
 use vitreous_render::renderer::Want;
 use vitreous_render::{Compensation, Composition, FrameParams, Reflection, Renderer};
+use vitreous_scene::effects::EffectSet;
 use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
 
 fn linear(v: u8) -> f32 {
-    vitreous::output::srgb_to_linear(v)
+    vitreous_frames::output::srgb_to_linear(v)
 }
 
 /// One 8-bit sRGB step at `v`, in linear light.
@@ -24,18 +24,18 @@ fn step(v: u8) -> f32 {
 type GlassWork = Option<(u64, [Option<u32>; 2])>;
 
 fn frame(
-    scene: &vitreous::scene::Scene,
+    scene: &vitreous_scene::Scene,
     compensation: Compensation,
     composition: Composition,
 ) -> (vitreous_render::Readback, GlassWork) {
     let mut scene = scene.clone();
     scene.compensation = compensation;
-    let desc = vitreous::render_desc::scene_desc(&scene, None);
+    let desc = vitreous_frames::render_desc::scene_desc(&scene, None);
     let mut r = Renderer::new(validated_context(), &desc, 320, 240).expect("renderer");
     let counted = r.count_invocations().unwrap();
     let params = FrameParams {
         eyes: neutral_eyes(&scene),
-        look: vitreous::look::base_look(
+        look: vitreous_frames::look::base_look(
             &EffectSet::parse("disparity").unwrap(),
             Reflection::EnvironmentFresnel,
         ),

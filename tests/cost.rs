@@ -15,8 +15,8 @@ use std::path::PathBuf;
 
 use serde_json::{Value, json};
 use vitreous::bench::{BenchOptions, BenchReport, bench};
-use vitreous::effects::EffectSet;
 use vitreous_render::Reflection;
+use vitreous_scene::effects::EffectSet;
 
 use vitreous_tests::workspace;
 

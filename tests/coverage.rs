@@ -5,17 +5,17 @@
 //! all reach its photo in the paper's model, through both surfaces of the ball, whose rim bends
 //! them past it in the image's corners, and before a photo too small for the ball.
 
-use vitreous::effects::EffectSet;
 use vitreous_render::renderer::Want;
 use vitreous_render::{
     Attenuation, Composition, Defocus, FrameParams, Readback, Reflection, Refraction, Renderer,
 };
+use vitreous_scene::effects::EffectSet;
 use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
 
 /// One frame of `scene` with `effects`, with or without the proof: its eye images and the glass
 /// fragments drawn with the environment's lookup and without it.
-fn frame(scene: &vitreous::scene::Scene, effects: &str, proof: bool) -> (Readback, [u64; 2]) {
-    let desc = vitreous::render_desc::scene_desc(scene, None);
+fn frame(scene: &vitreous_scene::Scene, effects: &str, proof: bool) -> (Readback, [u64; 2]) {
+    let desc = vitreous_frames::render_desc::scene_desc(scene, None);
     let mut r = Renderer::new(validated_context(), &desc, 320, 240).expect("renderer");
     assert!(
         r.count_invocations().unwrap(),
@@ -23,7 +23,7 @@ fn frame(scene: &vitreous::scene::Scene, effects: &str, proof: bool) -> (Readbac
     );
     r.set_coverage_proof(proof);
     let effects = EffectSet::parse(effects).unwrap();
-    let mut look = vitreous::look::base_look(&effects, Reflection::EnvironmentFresnel);
+    let mut look = vitreous_frames::look::base_look(&effects, Reflection::EnvironmentFresnel);
     // The frame's gaze would set the blur; a refracted image 4 px out of focus stands for it.
     look.defocus = effects.defocus.then_some(Defocus {
         refracted_k_g_px: 4.0,
@@ -59,7 +59,7 @@ fn largest_difference(a: &Readback, b: &Readback) -> u8 {
 /// The frame with the proof against the frame without it: the same image (within one 8-bit
 /// step: the covered shader leaves out a normalisation and a branch, not the light), and the
 /// glass fragments drawn each way.
-fn compare(scene: &vitreous::scene::Scene, effects: &str) -> [u64; 2] {
+fn compare(scene: &vitreous_scene::Scene, effects: &str) -> [u64; 2] {
     let (proved, split) = frame(scene, effects, true);
     let (plain, all_with_lookup) = frame(scene, effects, false);
     assert_eq!(

@@ -6,17 +6,17 @@
 use std::path::Path;
 
 use glam::Vec2;
-use vitreous::blur_stack::DefocusSetup;
-use vitreous::frame_loop::{self, FramePlan, FrameSink};
-use vitreous::gaze::blur::blur_reference;
-use vitreous::gaze::{GazeConfig, GazeImage};
-use vitreous::look::LookPlanner;
-use vitreous::render_desc;
-use vitreous::scene::{Image, PixelData, Scene, gaze_image_of_target, load_scene};
 use vitreous::trace_cmd::synth_params_for;
+use vitreous_frames::blur_stack::DefocusSetup;
+use vitreous_frames::frame_loop::{self, FramePlan, FrameSink};
+use vitreous_frames::look::LookPlanner;
+use vitreous_frames::render_desc;
+use vitreous_gaze::blur::blur_reference;
+use vitreous_gaze::{GazeConfig, GazeImage};
 use vitreous_render::reference::{RefractionSample, refraction_sample};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{Defocus, Look, Reflection, Renderer};
+use vitreous_scene::{Image, PixelData, Scene, gaze_image_of_target, load_scene};
 use vitreous_tests::render_once;
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
@@ -124,7 +124,7 @@ fn refracted_blur_matches_the_literal_convolution() {
             .map(|(a, b)| (a - b).abs())
             .sum::<f32>()
             / grey.len() as f32;
-        let sphere = vitreous::reference_view::sphere_of(&scene);
+        let sphere = vitreous_frames::reference_view::sphere_of(&scene);
         let size = Vec2::new(W as f32, H as f32);
         let camera = render_desc::eye_params(&input.views[0]);
         let (mut err, mut n) = (0.0f64, 0usize);
@@ -239,8 +239,8 @@ fn sharpness_by_gaze(scene: &Scene) -> Vec<(GazeImage, f64)> {
         .map(|p| gaze_image_of_target(p.target))
         .collect();
     assert!(images.contains(&GazeImage::Surface) && images.contains(&GazeImage::Refracted));
-    let effects = vitreous::effects::EffectSet::parse("O5").unwrap();
-    let mut look = vitreous::look::base_look(&effects, Reflection::EnvironmentFresnel);
+    let effects = vitreous_scene::effects::EffectSet::parse("O5").unwrap();
+    let mut look = vitreous_frames::look::base_look(&effects, Reflection::EnvironmentFresnel);
     look.reflection = Reflection::EnvironmentFresnel;
     // The scene's filter (eq. 15, whose 20-sample mean the frames above wait for).
     let config = GazeConfig {

@@ -6,10 +6,10 @@
 //! far from the object nothing is dimmed or drawn.
 
 use glam::{Vec2, Vec3};
-use vitreous::effects::EffectSet;
-use vitreous::wearer::WearerView;
+use vitreous_frames::wearer::WearerView;
 use vitreous_render::renderer::Want;
 use vitreous_render::{Composition, FrameParams, Reflection, Renderer};
+use vitreous_scene::effects::EffectSet;
 use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -24,13 +24,13 @@ struct Left {
 }
 
 /// The left eye's frame of `scene` composed as `composition`.
-fn left(scene: &vitreous::scene::Scene, composition: Composition) -> Left {
-    let desc = vitreous::render_desc::scene_desc(scene, None);
+fn left(scene: &vitreous_scene::Scene, composition: Composition) -> Left {
+    let desc = vitreous_frames::render_desc::scene_desc(scene, None);
     let mut r = Renderer::new(validated_context(), &desc, SIZE.0, SIZE.1).expect("renderer");
     let left = neutral_eyes(scene)[0];
     let params = FrameParams {
         eyes: [left, left],
-        look: vitreous::look::base_look(&EffectSet::NONE, Reflection::EnvironmentFresnel),
+        look: vitreous_frames::look::base_look(&EffectSet::NONE, Reflection::EnvironmentFresnel),
     };
     let want = Want {
         eyes: true,
@@ -47,7 +47,9 @@ fn left(scene: &vitreous::scene::Scene, composition: Composition) -> Left {
     let seen = view.see(&readback.eyes[0], world, [SIZE.0, SIZE.1]);
     let linear = |rgba: &[u8]| -> Vec<Vec3> {
         rgba.chunks_exact(4)
-            .map(|p| Vec3::from_array([0, 1, 2].map(|c| vitreous::output::srgb_to_linear(p[c]))))
+            .map(|p| {
+                Vec3::from_array([0, 1, 2].map(|c| vitreous_frames::output::srgb_to_linear(p[c])))
+            })
             .collect()
     };
     Left {
@@ -60,7 +62,7 @@ fn left(scene: &vitreous::scene::Scene, composition: Composition) -> Left {
 
 /// Whether the left eye's pixel `(x, y)` sees the floor in the object's shadow (`Some(true)`),
 /// the lit floor (`Some(false)`), or something else: the ball itself or no floor.
-fn shadowed(scene: &vitreous::scene::Scene, x: u32, y: u32) -> Option<bool> {
+fn shadowed(scene: &vitreous_scene::Scene, x: u32, y: u32) -> Option<bool> {
     let eye = neutral_eyes(scene)[0];
     let (c, r) = (scene.object.center_m, scene.object.radius_m);
     let dir = eye.pixel_ray(

@@ -5,10 +5,10 @@
 use std::time::Instant;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
-use vitreous::render_desc;
-use vitreous::scene::load_scene;
+use vitreous_frames::render_desc;
 use vitreous_render::floor::LiveCausticsDesc;
 use vitreous_render::{Renderer, ScenePose};
+use vitreous_scene::load_scene;
 use vitreous_tests::{shipped_scene, workspace};
 
 use crate::live_maps::{
@@ -27,7 +27,7 @@ fn live_sphere_caustics_match_the_bake_and_focus_on_the_light_axis() {
 fn the_moving_light_scenes_settings_match_the_bake_too() {
     let moving = shipped_scene("moving-light.toml");
     let c = &moving.caustics;
-    assert_eq!(c.mode, vitreous::scene::CausticsMode::Live);
+    assert_eq!(c.mode, vitreous_scene::CausticsMode::Live);
     let live = LiveCausticsDesc {
         photons_per_side: c.photons_per_side,
         smoothing_px: c.smoothing_px,
@@ -360,7 +360,7 @@ fn live_torus_caustics_match_a_bake_of_it() {
     // resolution (a quarter of the shipped bakes' rays).
     let path = workspace().join("config/scenes/torus.toml");
     let mut scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-    scene.caustics.mode = vitreous::scene::CausticsMode::Live;
+    scene.caustics.mode = vitreous_scene::CausticsMode::Live;
     scene.load_caustics().unwrap_or_else(|e| panic!("{e}"));
     let side = scene.caustics.resolution_px;
     let started = Instant::now();
@@ -434,7 +434,7 @@ fn reading_the_fields_back_first_computes_the_live_map_too() {
 /// One frame of `scene` with live caustics (`live`), counting its work or not, then a second
 /// at the same pose: what each counted, and the live map.
 fn counted_frames(
-    scene: &vitreous::scene::Scene,
+    scene: &vitreous_scene::Scene,
     live: LiveCausticsDesc,
     count: bool,
 ) -> ([Option<vitreous_render::PhotonWork>; 2], Vec<f32>) {
@@ -513,7 +513,7 @@ fn the_live_maps_counted_photons_meet_the_ball_as_its_solid_angle_says() {
     );
     // The torus: the photons through its hole meet nothing and are not counted.
     let mut torus = load_scene(&workspace().join("config/scenes/torus.toml")).unwrap();
-    torus.caustics.mode = vitreous::scene::CausticsMode::Live;
+    torus.caustics.mode = vitreous_scene::CausticsMode::Live;
     torus.load_caustics().unwrap();
     let ([counted, _], _) = counted_frames(&torus, live, true);
     let counted = counted.expect("counted");

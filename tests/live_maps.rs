@@ -6,12 +6,12 @@
 use std::time::Instant;
 
 use glam::{Quat, Vec2, Vec3};
-use vitreous::render_desc;
-use vitreous::scene::Scene;
+use vitreous_frames::render_desc;
 use vitreous_render::camera::{EyeParams, Fov};
 use vitreous_render::floor::LiveCausticsDesc;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Renderer, ScenePose};
+use vitreous_scene::Scene;
 use vitreous_tests::shipped_scene;
 
 /// The shipped scene `name` with its bake loaded.
@@ -29,7 +29,7 @@ pub(crate) fn live_scene(name: &str, side: Option<u32>) -> (Scene, Vec<f32>) {
     let baked = baked_scene(name);
     let bake = baked.caustics.gain.as_ref().expect("the bake is loaded");
     let mut live = baked.clone();
-    live.caustics.mode = vitreous::scene::CausticsMode::Live;
+    live.caustics.mode = vitreous_scene::CausticsMode::Live;
     if let Some(side) = side {
         live.caustics.resolution_px = side;
     }

@@ -112,7 +112,7 @@ pub(crate) fn fine_sphere() -> SphereMesh {
 pub(crate) fn shipped_sphere() -> SphereMesh {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../config/scenes/visual-effects.toml");
-    let scene = vitreous::scene::load_scene(&path).expect("the visual-effects scene");
+    let scene = vitreous_scene::load_scene(&path).expect("the visual-effects scene");
     let m = scene.object.mesh;
     ((m.positions, m.normals, m.uvs, m.indices), 0.5)
 }
@@ -497,7 +497,7 @@ fn the_shipped_sphere_places_the_marker_within_the_bar_in_both_models() {
 fn shipped_diamond() -> (MeshData, Mat4) {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/diamond.toml");
-    let scene = vitreous::scene::load_scene(&path).expect("the diamond scene");
+    let scene = vitreous_scene::load_scene(&path).expect("the diamond scene");
     let m = scene.object.mesh;
     let (lo, hi) = m
         .positions

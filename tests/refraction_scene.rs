@@ -351,7 +351,7 @@ fn markers_land_within_two_pixels_at_the_scene_resolution_for_a_turned_and_moved
 fn the_scene_geometry_is_the_tests_geometry() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../config/scenes/visual-effects.toml");
-    let scene = vitreous::scene::load_scene(&path).expect("the visual-effects scene");
+    let scene = vitreous_scene::load_scene(&path).expect("the visual-effects scene");
     assert!(scene.object.center_m.abs_diff_eq(CENTER, 1e-6));
     assert!((scene.object.radius_m - RADIUS).abs() < 1e-6);
     assert!((scene.object.ior - IOR).abs() < 1e-6);

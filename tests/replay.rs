@@ -5,9 +5,9 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use vitreous::compare::frame_of_image;
-use vitreous::render_desc::eye_params;
 use vitreous::replay::{ReplayOptions, replay};
-use vitreous::scene::load_scene;
+use vitreous_frames::render_desc::eye_params;
+use vitreous_scene::load_scene;
 use vitreous_tests::{lit_centroid, workspace};
 use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
@@ -178,8 +178,8 @@ fn visual_effects_scene_replays_its_shipped_synthetic_trace() {
 /// counts the switches, and with `[gaze] pupil = "measured"` A_p follows the trace's pupils.
 #[test]
 fn frames_csv_follows_the_synthetic_traces_alternating_fixation() {
-    use vitreous::frame_log::{FRAME_LOG_HEADER, FRAME_LOG_NAME};
-    use vitreous::scene::gaze_image_of_target;
+    use vitreous_frames::frame_log::{FRAME_LOG_HEADER, FRAME_LOG_NAME};
+    use vitreous_scene::gaze_image_of_target;
 
     let dir = tempfile::tempdir().unwrap();
     // The shipped scene with a measured pupil, its assets named from the workspace.
@@ -203,7 +203,7 @@ fn frames_csv_follows_the_synthetic_traces_alternating_fixation() {
     opts.frame_rate_hz = 10.0;
     opts.save_every = 0;
     opts.size = Some((64, 48));
-    opts.effects = Some(vitreous::effects::EffectSet::parse("defocus").unwrap());
+    opts.effects = Some(vitreous_scene::effects::EffectSet::parse("defocus").unwrap());
     let summary = replay(&opts).expect("replay succeeds with validation on");
     assert_eq!(summary.frames, 121, "12 s at 10 Hz");
 

@@ -11,7 +11,7 @@ use vitreous_tests::{left_eye_light, neutral_eyes, shipped_scene};
 const SIZE: (u32, u32) = (320, 240);
 
 /// The left eye's display light (linear RGB) with nothing taken away.
-fn gpu_left(scene: &vitreous::scene::Scene) -> Vec<Vec3> {
+fn gpu_left(scene: &vitreous_scene::Scene) -> Vec<Vec3> {
     let mut scene = scene.clone();
     scene.compensation = vitreous_render::Compensation::None;
     left_eye_light(&scene, SIZE)

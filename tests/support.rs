@@ -71,18 +71,18 @@ pub fn workspace() -> std::path::PathBuf {
 
 /// The shipped scene `config/scenes/<name>`, loaded as `vitreous run` loads it (without its
 /// bake).
-pub fn shipped_scene(name: &str) -> vitreous::scene::Scene {
+pub fn shipped_scene(name: &str) -> vitreous_scene::Scene {
     let path = workspace().join("config/scenes").join(name);
-    vitreous::scene::load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
+    vitreous_scene::load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A renderer of `scene` with eye images of `width` x `height`, validation on.
 pub fn scene_renderer(
-    scene: &vitreous::scene::Scene,
+    scene: &vitreous_scene::Scene,
     width: u32,
     height: u32,
 ) -> vitreous_render::Renderer {
-    let desc = vitreous::render_desc::scene_desc(scene, None);
+    let desc = vitreous_frames::render_desc::scene_desc(scene, None);
     vitreous_render::Renderer::new(validated_context(), &desc, width, height).expect("renderer")
 }
 
@@ -119,12 +119,12 @@ pub fn validated_context() -> vitreous_render::GpuContext {
 }
 
 /// The scene's two eyes at its neutral head (the viewer at `head_position_m`, looking down -z).
-pub fn neutral_eyes(scene: &vitreous::scene::Scene) -> [vitreous_render::EyeParams; 2] {
+pub fn neutral_eyes(scene: &vitreous_scene::Scene) -> [vitreous_render::EyeParams; 2] {
     let head = vitreous_xr::Pose {
         position: scene.viewer.head_position_m,
         orientation: glam::Quat::IDENTITY,
     };
-    let fov = vitreous::render_desc::render_fov(scene.output.fov);
+    let fov = vitreous_frames::render_desc::render_fov(scene.output.fov);
     scene
         .viewer
         .eye_positions_m(&head)
@@ -209,7 +209,7 @@ pub fn place(center_m: Vec3, radius_m: f32) -> Mat4 {
 }
 
 /// The photo coordinate of a world point on the scene's floor (u right, v down).
-pub fn floor_uv(scene: &vitreous::scene::Scene, world: Vec3) -> Vec2 {
+pub fn floor_uv(scene: &vitreous_scene::Scene, world: Vec3) -> Vec2 {
     let local = scene
         .floor
         .world_from_plane()
@@ -237,7 +237,7 @@ pub struct FloorPixel {
 /// without any floor overlay from the same eyes, leaves black (elsewhere the glass covers
 /// the floor).
 pub fn floor_pixels(
-    scene: &vitreous::scene::Scene,
+    scene: &vitreous_scene::Scene,
     eyes: &[vitreous_render::EyeParams; 2],
     bare: &vitreous_render::Readback,
 ) -> Vec<FloorPixel> {
@@ -315,30 +315,30 @@ pub fn compose_once(
 /// The left eye's display light (linear RGB, row by row) for `scene` at `size` pixels: both eyes
 /// at the neutral head's left eye, no effects, environment reflection with Fresnel, composed for
 /// an additive display (the scene's `[display] compensation` applies), validation on.
-pub fn left_eye_light(scene: &vitreous::scene::Scene, size: (u32, u32)) -> Vec<Vec3> {
+pub fn left_eye_light(scene: &vitreous_scene::Scene, size: (u32, u32)) -> Vec<Vec3> {
     linear_rgb(&left_eye_frame(scene, size, false).eyes[0])
 }
 
 /// The left eye's world view (the real floor and background as the see-through preview shows
 /// them; linear RGB, row by row) for `scene` at `size` pixels, as [`left_eye_light`] renders.
-pub fn left_world_view(scene: &vitreous::scene::Scene, size: (u32, u32)) -> Vec<Vec3> {
+pub fn left_world_view(scene: &vitreous_scene::Scene, size: (u32, u32)) -> Vec<Vec3> {
     let frame = left_eye_frame(scene, size, true);
     linear_rgb(&frame.world.expect("the world views")[0])
 }
 
 fn left_eye_frame(
-    scene: &vitreous::scene::Scene,
+    scene: &vitreous_scene::Scene,
     size: (u32, u32),
     world: bool,
 ) -> vitreous_render::Readback {
     use vitreous_render::{Composition, FrameParams, Reflection, Renderer, Want};
-    let desc = vitreous::render_desc::scene_desc(scene, None);
+    let desc = vitreous_frames::render_desc::scene_desc(scene, None);
     let mut r = Renderer::new(validated_context(), &desc, size.0, size.1).expect("renderer");
     let left = neutral_eyes(scene)[0];
     let params = FrameParams {
         eyes: [left, left],
-        look: vitreous::look::base_look(
-            &vitreous::effects::EffectSet::parse("none").unwrap(),
+        look: vitreous_frames::look::base_look(
+            &vitreous_scene::effects::EffectSet::parse("none").unwrap(),
             Reflection::EnvironmentFresnel,
         ),
     };
@@ -354,9 +354,9 @@ fn linear_rgb(pixels: &[u8]) -> Vec<Vec3> {
         .chunks_exact(4)
         .map(|p| {
             Vec3::new(
-                vitreous::output::srgb_to_linear(p[0]),
-                vitreous::output::srgb_to_linear(p[1]),
-                vitreous::output::srgb_to_linear(p[2]),
+                vitreous_frames::output::srgb_to_linear(p[0]),
+                vitreous_frames::output::srgb_to_linear(p[1]),
+                vitreous_frames::output::srgb_to_linear(p[2]),
             )
         })
         .collect()

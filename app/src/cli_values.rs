@@ -9,7 +9,7 @@ use std::str::FromStr;
 
 use vitreous_render::Reflection;
 
-use crate::effects::EffectSet;
+use vitreous_scene::effects::EffectSet;
 
 /// `WIDTHxHEIGHT` (`1280x960`) in whole pixels.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -122,7 +122,7 @@ pub fn parse_pupil_mm(s: &str) -> Result<f32, String> {
         .trim()
         .parse::<f32>()
         .map_err(|_| format!("expected a pupil diameter in millimetres, got '{s}'"))?;
-    crate::gaze::blur::check_pupil_diameter_m(mm / 1000.0)
+    vitreous_gaze::blur::check_pupil_diameter_m(mm / 1000.0)
         .map(|_| mm)
         .map_err(|e| e.to_string())
 }

@@ -14,11 +14,11 @@ use vitreous::cli_values::{
     parse_growth_percent, parse_kappa_deg, parse_pass_count, parse_pupil_mm, parse_seed,
     parse_size,
 };
-use vitreous::effects::EffectSet;
 use vitreous::error_report::error_text;
-use vitreous::gaze::FilterKind;
 use vitreous::trace_analyze::{analyze_trace_file, plot_trace_file};
 use vitreous::trace_cmd::{self, ImportOptions, SynthOptions};
+use vitreous_gaze::FilterKind;
+use vitreous_scene::effects::EffectSet;
 
 /// Perception-based virtual glass for optical see-through headsets.
 #[derive(Parser, Debug)]

@@ -15,11 +15,13 @@ use vitreous_scene::{Placement, Scene, load_scene};
 use vitreous_xr::frame::{Backend, EyeView, Fov};
 use vitreous_xr::null::{NullBackend, NullConfig};
 
-use crate::input_files::InputFiles;
-use crate::motion_clock::MotionClock;
-use crate::output::{EYE_NAMES, encode_png, is_frame_file_name, linear_to_srgb, write_atomic};
-use crate::render_desc::eye_params;
-use crate::setup::{check_size, load_recording};
+use vitreous_frames::input_files::InputFiles;
+use vitreous_frames::motion_clock::MotionClock;
+use vitreous_frames::output::{
+    EYE_NAMES, encode_png, is_frame_file_name, linear_to_srgb, write_atomic,
+};
+use vitreous_frames::render_desc::eye_params;
+use vitreous_frames::setup::{check_size, load_recording};
 
 /// Most samples per pixel side.
 pub const MAX_SAMPLES_PER_SIDE: u32 = 16;

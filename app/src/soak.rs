@@ -14,16 +14,16 @@ use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer, ScenePos
 use vitreous_xr::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 
-use crate::effects::EffectSet;
-use crate::frame_loop::{self, FramePlan, FrameSink};
-use crate::input_files::InputFiles;
-use crate::look::LookPlanner;
-use crate::look::{GazeSettings, planner_for};
-use crate::motion_clock::MotionClock;
-use crate::render_desc;
-use crate::resident::resident_kib;
-use crate::scene::{CausticsMode, load_scene};
-use crate::setup::{check_size, load_trace};
+use vitreous_frames::frame_loop::{self, FramePlan, FrameSink};
+use vitreous_frames::input_files::InputFiles;
+use vitreous_frames::look::LookPlanner;
+use vitreous_frames::look::{GazeSettings, planner_for};
+use vitreous_frames::motion_clock::MotionClock;
+use vitreous_frames::render_desc;
+use vitreous_frames::resident::resident_kib;
+use vitreous_frames::setup::{check_size, load_trace};
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{CausticsMode, load_scene};
 
 /// Passes left out of the memory comparison: the first passes grow the allocator's pools and
 /// the driver's shader caches.
@@ -229,7 +229,7 @@ impl FrameSink for Discard {
     }
 
     fn stop_requested(&self) -> bool {
-        crate::interrupt::requested()
+        vitreous_frames::interrupt::requested()
     }
 }
 
@@ -299,7 +299,7 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
         );
     }
     let (samples, _) = load_trace(&scene, None)?;
-    let signals = crate::interrupt::watch();
+    let signals = vitreous_frames::interrupt::watch();
 
     let started = Instant::now();
     let mut passes = Vec::new();
@@ -312,7 +312,7 @@ pub fn soak(options: &SoakOptions, mut progress: impl FnMut(&SoakPass)) -> Resul
         SoakLength::Passes(n) => done < n,
     };
     while more(passes.len()) {
-        if signals && crate::interrupt::requested() {
+        if signals && vitreous_frames::interrupt::requested() {
             break;
         }
         if options.recreate {
@@ -436,7 +436,7 @@ pub fn soak_scenes(scenes: &[PathBuf], options: &SoakOptions, json: Option<&Path
             .with_context(|| format!("soaking {}", scene.display()))?;
         println!("{}", report.summary_line());
         reports.push(report);
-        if crate::interrupt::requested() {
+        if vitreous_frames::interrupt::requested() {
             break;
         }
     }
@@ -445,7 +445,7 @@ pub fn soak_scenes(scenes: &[PathBuf], options: &SoakOptions, json: Option<&Path
             [one] => serde_json::to_vec_pretty(one)?,
             all => serde_json::to_vec_pretty(all)?,
         };
-        crate::output::write_atomic(path, &bytes)?;
+        vitreous_frames::output::write_atomic(path, &bytes)?;
     }
     let failed: Vec<String> = reports
         .iter()

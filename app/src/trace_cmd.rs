@@ -8,11 +8,11 @@ use anyhow::{Context, Result, bail};
 use vitreous_xr::synth::{SynthError, SynthParams, synthesize_with_truth};
 use vitreous_xr::trace::{TraceSample, TraceWriter};
 
-use crate::input_files::InputFiles;
-use crate::output::write_atomic;
-use crate::scene::{REFRACTED_TARGET, SURFACE_TARGET, load_scene};
+use vitreous_frames::input_files::InputFiles;
+use vitreous_frames::output::write_atomic;
+use vitreous_scene::{REFRACTED_TARGET, SURFACE_TARGET, load_scene};
 
-pub use crate::scene::synth_params_for;
+pub use vitreous_scene::synth_params_for;
 
 /// Writes `samples` as a trace file at `out` (atomically).
 pub fn write_trace_file(samples: &[TraceSample], out: &Path) -> Result<()> {

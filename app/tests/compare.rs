@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use vitreous::compare::{Eye, Region, regions};
-use vitreous::output::encode_png;
-use vitreous::scene::load_scene;
+use vitreous_frames::output::encode_png;
+use vitreous_scene::load_scene;
 
 use crate::cli::{assert_clean_failure, vitreous};
 

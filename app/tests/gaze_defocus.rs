@@ -1,7 +1,7 @@
 //! Defocus maths (eq. 10-14) through the public API.
 
 use proptest::prelude::*;
-use vitreous::gaze::blur::{
+use vitreous_gaze::blur::{
     DefocusError, blur_circle_diameter_m, blur_reference, check_pupil_diameter_m, gaussian_kernel,
     gaussian_variance_px2, kernel_radius_px, kernel_width_px, px_per_m,
 };

@@ -1,7 +1,7 @@
 //! eq. 15 through the whole pipeline: tracker samples, not frames, are averaged.
 
 use proptest::prelude::*;
-use vitreous::gaze::{
+use vitreous_gaze::{
     FilterKind, FixationDepth, GazeConfig, GazePipeline, ImageDistances, SampleFilter,
 };
 use vitreous_xr::GazeSample;
@@ -12,7 +12,7 @@ fn eq15(depths: &[f64], n: usize) -> f64 {
 }
 
 fn looking_at(time_ns: i64, depth_m: f32) -> GazeSample {
-    vitreous::test_frame::sample_looking_at(time_ns, depth_m)
+    vitreous_frames::test_frame::sample_looking_at(time_ns, depth_m)
 }
 
 proptest! {

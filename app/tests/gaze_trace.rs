@@ -2,8 +2,8 @@
 //! truth), blinks, the real SRanipal recordings, and the plot.
 
 use glam::Vec3;
-use vitreous::gaze::{FilterKind, GazeConfig, GazeImage, GazeOverride, ImageDistances};
 use vitreous::trace_analyze::{AnalyzeConfig, FILTER_COLOURS, Truth, analyze, plot, replay};
+use vitreous_gaze::{FilterKind, GazeConfig, GazeImage, GazeOverride, ImageDistances};
 use vitreous_xr::synth::{FixationTarget, SynthParams, SynthTrace, synthesize_with_truth};
 
 /// The synthetic trace the alternative is tuned on: 30 Hz, 0.5 degree noise, blinks every
@@ -18,8 +18,8 @@ fn alternating(seed: u64) -> (SynthTrace, ImageDistances) {
     let trace = synthesize_with_truth(&p).unwrap();
     let d = ImageDistances::from_points(
         p.head_position,
-        p.targets[vitreous::scene::SURFACE_TARGET].point_m,
-        p.targets[vitreous::scene::REFRACTED_TARGET].point_m,
+        p.targets[vitreous_scene::SURFACE_TARGET].point_m,
+        p.targets[vitreous_scene::REFRACTED_TARGET].point_m,
     );
     (trace, d)
 }

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use proptest::prelude::*;
-use vitreous::gaze::vergence::{
+use vitreous_gaze::vergence::{
     DEFAULT_HOLD_NS, DivergentRays, FixationDepth, RayCrossing, VergenceConfig, VergenceEstimator,
     closest_approach,
 };

@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec2};
-use vitreous::render_desc::render_fov;
-use vitreous::scene::load_scene;
+use vitreous_frames::render_desc::render_fov;
 use vitreous_render::camera::EyeParams;
+use vitreous_scene::load_scene;
 
 use crate::cli::{assert_clean_failure, vitreous};
 use crate::compare::json;
@@ -20,9 +20,9 @@ fn pixel(path: &Path, x: u32, y: u32) -> glam::Vec3 {
     let image = image::open(path).unwrap().to_rgb8();
     let p = image.get_pixel(x, y);
     glam::Vec3::new(
-        vitreous::output::srgb_to_linear(p[0]),
-        vitreous::output::srgb_to_linear(p[1]),
-        vitreous::output::srgb_to_linear(p[2]),
+        vitreous_frames::output::srgb_to_linear(p[0]),
+        vitreous_frames::output::srgb_to_linear(p[1]),
+        vitreous_frames::output::srgb_to_linear(p[2]),
     )
 }
 
@@ -133,7 +133,7 @@ fn the_reference_shows_the_ball_and_half_its_lights_shadow_and_nothing_else() {
     let rgba = vec![0u8; 320 * 240 * 4];
     std::fs::write(
         &black,
-        vitreous::output::encode_png(&rgba, 320, 240).unwrap(),
+        vitreous_frames::output::encode_png(&rgba, 320, 240).unwrap(),
     )
     .unwrap();
     let cmp = json(

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use vitreous::scene::SceneError;
+use vitreous_scene::SceneError;
 
 use super::scene_errors::{
     data, expect_error, good_env, good_model, good_text, line_of, load_text, repo, scene_text,

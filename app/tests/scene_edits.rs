@@ -6,9 +6,9 @@
 use std::path::Path;
 
 use glam::{Quat, Vec3};
-use vitreous::effects::EffectSet;
 use vitreous::replay::{ReplayOptions, replay};
-use vitreous::scene::load_scene;
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::load_scene;
 use vitreous_xr::trace::{EditRecord, TraceSample, TraceWriter};
 use vitreous_xr::{GazeSample, Pose};
 

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use vitreous::scene::{SceneError, load_scene};
+use vitreous_scene::{SceneError, load_scene};
 
 pub(crate) fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -77,7 +77,7 @@ pub(crate) fn load_text(
 ) -> (
     tempfile::TempDir,
     PathBuf,
-    Result<vitreous::scene::Scene, SceneError>,
+    Result<vitreous_scene::Scene, SceneError>,
 ) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.toml");
@@ -333,7 +333,7 @@ fn transmittance_needs_a_texture_and_a_range() {
 
 #[test]
 fn gaze_pupil_source_is_read_and_a_bad_one_named() {
-    use vitreous::gaze::PupilSource;
+    use vitreous_gaze::PupilSource;
     let (_dir, _path, result) = load_text(&good_text());
     assert_eq!(result.unwrap().gaze.pupil, PupilSource::Paper);
     let text = format!("{}\n[gaze]\npupil = \"measured\"\n", good_text());

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
-use vitreous::effects::EffectSet;
-use vitreous::scene::{IorSource, load_scene};
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{IorSource, load_scene};
 
 fn data(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -202,9 +202,9 @@ fn rolling_diamond_moves_and_turns_on_the_table() {
     );
     // Its caustics are computed live; a caustic bake is refused: it holds one pose.
     let mut scene = scene;
-    assert_eq!(scene.caustics.mode, vitreous::scene::CausticsMode::Live);
+    assert_eq!(scene.caustics.mode, vitreous_scene::CausticsMode::Live);
     scene.load_caustics().expect("live caustics read no file");
-    scene.caustics.mode = vitreous::scene::CausticsMode::Baked;
+    scene.caustics.mode = vitreous_scene::CausticsMode::Baked;
     let err = scene.load_caustics().unwrap_err();
     assert!(err.to_string().contains("[motion]"), "{err}");
 }

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use vitreous::effects::EffectSet;
-use vitreous::scene::{IorSource, PixelData, Scene, load_scene};
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{IorSource, PixelData, Scene, load_scene};
 use vitreous_xr::Pose;
 
 fn scenes_dir() -> PathBuf {
@@ -178,7 +178,7 @@ fn visual_effects_keeps_the_papers_distances() {
     assert_eq!(scene.light.position_m, Vec3::new(1.0, 1.0, 1.0));
     assert_eq!(scene.viewer.pupil_diameter_m, 0.006);
     // The study's gaze image followed eq. 15, not the default filter.
-    assert_eq!(scene.gaze.filter, vitreous::gaze::FilterKind::PAPER);
+    assert_eq!(scene.gaze.filter, vitreous_gaze::FilterKind::PAPER);
     // Documented: at 0.2 m the 150 mm sphere overfills the 40 x 30 degree view.
     assert!(!sphere_in_view(&scene, object.center_m, object.radius_m));
     assert!(sphere_in_view(&scene, object.center_m, 0.01));

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use vitreous::effects::EffectSet;
 use vitreous::soak::{SoakEffects, SoakLength, SoakOptions, soak};
+use vitreous_scene::effects::EffectSet;
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")

@@ -7,8 +7,8 @@ use std::process::Command;
 
 use glam::Vec3;
 use serde_json::Value;
-use vitreous::gaze::{FilterKind, ImageDistances};
 use vitreous::trace_analyze::{AnalyzeConfig, Truth, analyze};
+use vitreous_gaze::{FilterKind, ImageDistances};
 use vitreous_xr::synth::{FixationTarget, SynthParams, synthesize_with_truth};
 use vitreous_xr::trace::TraceWriter;
 use vitreous_xr::{GazeRay, GazeSample, Pose, TraceSample};
@@ -343,9 +343,8 @@ fn default_decision_holds_on_real_recordings_in_the_shipped_scenes() {
     let (neon, _) = vitreous_xr::import::neon::import_neon(data.join("neon")).unwrap();
     recordings.push(("neon".to_owned(), neon));
     for scene_name in ["visual-effects.toml", "glass-sphere.toml"] {
-        let scene =
-            vitreous::scene::load_scene(&workspace().join("config/scenes").join(scene_name))
-                .unwrap();
+        let scene = vitreous_scene::load_scene(&workspace().join("config/scenes").join(scene_name))
+            .unwrap();
         let (mut switches, mut minutes) = (0, 0.0);
         for (name, samples) in &recordings {
             let mut config = AnalyzeConfig::for_scene(&scene);

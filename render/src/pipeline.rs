@@ -424,31 +424,71 @@ pub unsafe fn begin_render_pass(
     extent: vk::Extent2D,
     clear: &[vk::ClearValue],
 ) {
-    let area = vk::Rect2D {
+    let all = vk::Rect2D {
         offset: vk::Offset2D { x: 0, y: 0 },
         extent,
     };
-    let begin = vk::RenderPassBeginInfo::default()
-        .render_pass(render_pass)
-        .framebuffer(framebuffer)
-        .render_area(area)
-        .clear_values(clear);
-    let viewport = vk::Viewport {
-        x: 0.0,
-        y: 0.0,
-        width: extent.width as f32,
-        height: extent.height as f32,
-        min_depth: 0.0,
-        max_depth: 1.0,
+    let pass = PassBegin {
+        render_pass,
+        framebuffer,
+        extent,
+        area: all,
+        scissor: all,
     };
-    let device = &ctx.device;
-    ctx.work.render_pass();
-    // SAFETY: the caller's contract: `cmd` records outside a render pass, the handles are
-    // live; the pipelines bound inside set viewport and scissor dynamically.
-    unsafe {
-        device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
-        device.cmd_set_viewport(cmd, 0, &[viewport]);
-        device.cmd_set_scissor(cmd, 0, &[area]);
+    // SAFETY: the caller's contract.
+    unsafe { pass.record(ctx, cmd, clear) }
+}
+
+/// A render pass begun over part of its framebuffer: `area` is the render area (what it may
+/// clear or store), the viewport covers all of `extent` (so that fragment coordinates are
+/// texel coordinates) and draws are limited to `scissor`, which must lie in `area`.
+pub struct PassBegin {
+    /// The render pass.
+    pub render_pass: vk::RenderPass,
+    /// A framebuffer compatible with it.
+    pub framebuffer: vk::Framebuffer,
+    /// The framebuffer's size.
+    pub extent: vk::Extent2D,
+    /// The render area.
+    pub area: vk::Rect2D,
+    /// The dynamic scissor.
+    pub scissor: vk::Rect2D,
+}
+
+impl PassBegin {
+    /// Begins the render pass, clearing to `clear`, and sets the viewport and scissor.
+    ///
+    /// # Safety
+    /// `cmd` must be recording outside any render pass; the render pass and framebuffer must
+    /// be live, compatible, and outlive the command buffer's execution.
+    pub unsafe fn record(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        clear: &[vk::ClearValue],
+    ) {
+        let begin = vk::RenderPassBeginInfo::default()
+            .render_pass(self.render_pass)
+            .framebuffer(self.framebuffer)
+            .render_area(self.area)
+            .clear_values(clear);
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: self.extent.width as f32,
+            height: self.extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        let device = &ctx.device;
+        ctx.work.render_pass();
+        // SAFETY: the caller's contract: `cmd` records outside a render pass, the handles are
+        // live; the pipelines bound inside set viewport and scissor dynamically.
+        unsafe {
+            device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+            device.cmd_set_viewport(cmd, 0, &[viewport]);
+            device.cmd_set_scissor(cmd, 0, &[self.scissor]);
+        }
     }
 }
 

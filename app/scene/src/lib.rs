@@ -177,7 +177,7 @@ impl Scene {
     /// for this scene (its stored hash equals [`Scene::hash`]). Errors name the file: no bake
     /// named, missing, corrupt, or made for another scene; a moving scene is refused. In live
     /// mode no file is read: the gain map is zeros of `[caustics] resolution_px`, which the
-    /// renderer fills for each pose (`vitreous::render_desc::enable_live_caustics`).
+    /// renderer fills for each pose (`vitreous_frames::render_desc::enable_live_caustics`).
     pub fn load_caustics(&mut self) -> Result<(), crate::caustics::BakeError> {
         if self.caustics.mode == CausticsMode::Live {
             // The map's size; the renderer fills it for every pose.

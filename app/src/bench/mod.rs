@@ -18,15 +18,15 @@ use vitreous_render::{
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::{Backend, FrameInput};
 
-use crate::blur_stack::DefocusSetup;
-use crate::effects::EffectSet;
-use crate::gaze::GazeConfig;
-use crate::gaze::blur::check_pupil_diameter_m;
-use crate::look::{DefocusModel, LookPlanner};
-use crate::render_desc;
-use crate::scene::{CausticsMode, load_scene, synth_params_for};
-use crate::setup::check_size;
-use crate::spread::Spread;
+use vitreous_frames::blur_stack::DefocusSetup;
+use vitreous_frames::look::{DefocusModel, LookPlanner};
+use vitreous_frames::render_desc;
+use vitreous_frames::setup::check_size;
+use vitreous_frames::spread::Spread;
+use vitreous_gaze::GazeConfig;
+use vitreous_gaze::blur::check_pupil_diameter_m;
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{CausticsMode, load_scene, synth_params_for};
 
 pub use counts::{WorkCounts, mean_counts};
 
@@ -189,7 +189,7 @@ pub fn fetches_per_pixel(look: &Look) -> u32 {
 /// The fetches per covered pixel that eq. 6 over the glass adds in `scene` as the bench draws
 /// it (additive, or for the scene's segmented dimmer): one where the glass's shader takes the
 /// background away, none where the dimmer's resolve does or the scene keeps the paper's light.
-pub fn compensation_fetches(scene: &crate::scene::Scene) -> u32 {
+pub fn compensation_fetches(scene: &vitreous_scene::Scene) -> u32 {
     u32::from(
         scene.compensation == vitreous_render::Compensation::Background && scene.dimmer.is_none(),
     )
@@ -238,7 +238,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     // gaze pipeline over the same views.
     let mut variants = Vec::new();
     for set in &sets {
-        let base = crate::look::base_look(set, options.reflection);
+        let base = vitreous_frames::look::base_look(set, options.reflection);
         let variant = |label: String, planner: LookPlanner| Variant {
             label,
             planner,
@@ -254,7 +254,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                     // Each variant times its own fixed A_p, whatever the scene's source.
                     let model = DefocusModel {
                         pupil_m,
-                        pupil_source: crate::gaze::PupilSource::Paper,
+                        pupil_source: vitreous_gaze::PupilSource::Paper,
                         ..setup.model.clone()
                     };
                     variants.push(variant(
@@ -396,7 +396,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
                 let turn = glam::Quat::from_rotation_y(
                     (turns as f32 * MOVING_LIGHT_STEP_DEG).to_radians(),
                 );
-                let placement = crate::scene::Placement {
+                let placement = vitreous_scene::Placement {
                     light_position_m: center + turn * (rest.light_position_m - center),
                     ..rest
                 };
@@ -427,7 +427,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
         .chain(live_renderer.as_ref())
         .chain(two_renderer.as_ref())
     {
-        crate::frame_loop::ensure_validation_clean(r)?;
+        vitreous_frames::frame_loop::ensure_validation_clean(r)?;
     }
     let spreads: Vec<_> = (0..n)
         .map(|i| {

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 
 use super::{BenchReport, VariantResult, WorkCounts};
-use crate::spread::Spread;
+use vitreous_frames::spread::Spread;
 
 /// A column: its header, and its cell for a variant.
 type Column<'a> = (&'a str, Box<dyn Fn(&VariantResult) -> String + 'a>);

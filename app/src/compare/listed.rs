@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, bail};
 use vitreous_scene::Scene;
 
-use crate::output::EYE_NAMES;
 use crate::reference_cmd::{FrameReport, Report};
+use vitreous_frames::output::EYE_NAMES;
 
 /// The file beside a reference image that lists its frames.
 pub const REFERENCE_JSON: &str = "reference.json";

@@ -18,9 +18,9 @@ use serde::Serialize;
 pub use listed::{Listed, REFERENCE_JSON, frame_for_scene, frame_of_image, reference_json_beside};
 pub use regions::{Eye, Region, regions, regions_of};
 
-use crate::input_files::InputFiles;
-use crate::output::{EYE_NAMES, encode_png, write_atomic};
 use images::Png;
+use vitreous_frames::input_files::InputFiles;
+use vitreous_frames::output::{EYE_NAMES, encode_png, write_atomic};
 use vitreous_frames::wearer::WearerView;
 
 /// Options of `vitreous compare` (docs/cli.md).

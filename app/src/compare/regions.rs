@@ -10,7 +10,7 @@ use vitreous_render::floor::{FAR_M, exact_edge_distances};
 use vitreous_scene::{Placement, Scene};
 use vitreous_xr::frame::EyeView;
 
-use crate::render_desc::eye_params;
+use vitreous_frames::render_desc::eye_params;
 
 /// A region of the eye image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]

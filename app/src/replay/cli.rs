@@ -9,9 +9,9 @@ use crate::cli_values::{
     ReflectionArg, number, parse_effects, parse_frame_count, parse_pupil_mm, parse_save_every,
     parse_size,
 };
-use crate::effects::EffectSet;
-use crate::gaze::{FilterKind, GazeOverride, PupilSource};
-use crate::setup::check_size;
+use vitreous_frames::setup::check_size;
+use vitreous_gaze::{FilterKind, GazeOverride, PupilSource};
+use vitreous_scene::effects::EffectSet;
 
 /// Options of `vitreous replay` (docs/cli.md).
 #[derive(clap::Args, Debug)]

@@ -20,23 +20,23 @@ use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{EditRecord, Recording, TraceSample};
 use vitreous_xr::{FrameInput, SessionEvent};
 
-use crate::effects::EffectSet;
-use crate::frame_log::FrameLog;
-use crate::frame_loop::{self, FramePlan, FrameSink};
-use crate::input_files::InputFiles;
-pub use crate::look::GazeSettings;
-use crate::look::LookPlanner;
-use crate::motion_clock::MotionClock;
-use crate::output::{self, write_atomic};
-use crate::reference_view::side_by_side;
-use crate::render_desc;
-use crate::scene::{Scene, load_scene};
-use crate::setup::{check_size, load_recording};
-use crate::spread::Spread;
-use crate::validation::ValidationSummary;
 use physical::Physical;
 use summary::UnfinishedSummary;
 pub use summary::{ReplaySummary, RunStatus};
+use vitreous_frames::frame_log::FrameLog;
+use vitreous_frames::frame_loop::{self, FramePlan, FrameSink};
+use vitreous_frames::input_files::InputFiles;
+use vitreous_frames::look::GazeSettings;
+use vitreous_frames::look::LookPlanner;
+use vitreous_frames::motion_clock::MotionClock;
+use vitreous_frames::output::{self, write_atomic};
+use vitreous_frames::reference_view::side_by_side;
+use vitreous_frames::render_desc;
+use vitreous_frames::setup::{check_size, load_recording};
+use vitreous_frames::spread::Spread;
+use vitreous_frames::validation::ValidationSummary;
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{Scene, load_scene};
 
 mod cli;
 mod physical;
@@ -225,7 +225,7 @@ impl FrameSink for Saver<'_> {
     }
 
     fn stop_requested(&self) -> bool {
-        crate::interrupt::requested()
+        vitreous_frames::interrupt::requested()
     }
 
     fn finished(&mut self, input: &FrameInput, result: &FrameResult) -> Result<()> {
@@ -345,7 +345,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     .context("setting up the Vulkan device")?;
     let (device, driver) = (ctx.device_name.clone(), ctx.driver.clone());
     let (planner, defocus) =
-        crate::look::planner_for(&scene, &effects, options.reflection, &options.gaze)?;
+        vitreous_frames::look::planner_for(&scene, &effects, options.reflection, &options.gaze)?;
     let mut renderer = Renderer::new(
         ctx,
         &render_desc::scene_desc(&scene, defocus.as_ref()),
@@ -405,7 +405,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     write_atomic(&summary_path, &running)?;
     remove_earlier_frames(&frames_dir)?;
     let log = FrameLog::create(&options.out)?;
-    let signals = crate::interrupt::watch();
+    let signals = vitreous_frames::interrupt::watch();
     let progress = if options.progress {
         let bar = ProgressBar::new(expected_frames);
         bar.set_style(
@@ -468,7 +468,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     if let Some(other) = &saver.other {
         frame_loop::ensure_validation_clean(&other.renderer)?;
     }
-    let interrupted = signals && crate::interrupt::requested();
+    let interrupted = signals && vitreous_frames::interrupt::requested();
     // The log holds exactly the frames rendered, also when interrupted.
     saver.log.finish()?;
     if let Some(physical) = &mut saver.physical {

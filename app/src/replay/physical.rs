@@ -9,11 +9,11 @@ use anyhow::{Context, Result};
 use vitreous_xr::FrameInput;
 
 use crate::compare::{ReferenceFigures, against_reference, rgb_of};
-use crate::output::{self, write_atomic};
 use crate::reference_cmd::{
     EyeRecord, FrameReport, ReferenceSettings, Report, render_reference, srgb_rgba,
 };
-use crate::scene::{Placement, Scene};
+use vitreous_frames::output::{self, write_atomic};
+use vitreous_scene::{Placement, Scene};
 
 /// `--compare-reference`: the saved frames' placements until they finish, and the figures.
 pub(super) struct Physical {

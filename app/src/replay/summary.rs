@@ -3,12 +3,12 @@
 
 use serde::Serialize;
 
-use crate::frame_log::PupilSummary;
-use crate::frame_loop::FrameRecord;
-use crate::gaze::separability::SeparabilitySummary;
-use crate::motion_clock::FinalPlacement;
-use crate::spread::Spread;
-use crate::validation::ValidationSummary;
+use vitreous_frames::frame_log::PupilSummary;
+use vitreous_frames::frame_loop::FrameRecord;
+use vitreous_frames::motion_clock::FinalPlacement;
+use vitreous_frames::spread::Spread;
+use vitreous_frames::validation::ValidationSummary;
+use vitreous_gaze::separability::SeparabilitySummary;
 
 /// How a replay ended, as `summary.json` says it. Anything but `complete` means the output
 /// folder holds only part of the run.

@@ -6,8 +6,8 @@ use anyhow::Result;
 
 use super::{RECONNECT_S_DEFAULT, RECONNECT_S_MAX, RunOptions, run};
 use crate::cli_values::{parse_blend, parse_effects, parse_frame_count, parse_gaze, parse_size};
-use crate::effects::EffectSet;
-use crate::gaze::{FilterKind, PupilSource};
+use vitreous_gaze::{FilterKind, PupilSource};
+use vitreous_scene::effects::EffectSet;
 
 /// Options of `vitreous run` (docs/cli.md).
 #[derive(clap::Args, Debug)]
@@ -81,7 +81,7 @@ fn parse_reconnect_s(s: &str) -> Result<f64, String> {
 pub fn run_command(args: RunArgs) -> Result<()> {
     // Before the runtime starts (which would clamp it to what it offers, silently).
     if let Some((w, h)) = args.size {
-        crate::setup::check_size(w, h)?;
+        vitreous_frames::setup::check_size(w, h)?;
     }
     let s = run(&RunOptions::from(args))?;
     print!("{}", s.report());

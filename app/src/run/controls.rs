@@ -13,7 +13,7 @@ use vitreous_xr::planes::nearest_up_hit;
 use vitreous_xr::trace::EditRecord;
 
 use super::sink::RunSink;
-use crate::scene_edit::{Axis, SceneEdit, place_ray, ray_meets_plane};
+use vitreous_frames::scene_edit::{Axis, SceneEdit, place_ray, ray_meets_plane};
 
 /// Starts reading commands from standard input; each valid line arrives on the receiver (a
 /// bad one is logged and skipped). The thread ends with the input.

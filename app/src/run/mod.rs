@@ -6,7 +6,7 @@
 //! reverse: the renderer lets go of the swapchain images, the session goes, then the device,
 //! then the OpenXR instance; [`XrSession`] owns the four and keeps that order itself.
 //!
-//! The loop is the shared one ([`crate::frame_loop`]) plus one hook: each frame is drawn where
+//! The loop is the shared one ([`vitreous_frames::frame_loop`]) plus one hook: each frame is drawn where
 //! [`Backend::frame_target`](vitreous_xr::Backend::frame_target) says (the renderer's own
 //! images or swapchain image `i`, and depth swapchain image `j` when depth is submitted).
 //!
@@ -54,11 +54,6 @@ use vitreous_xr::openxr::{
 use vitreous_xr::session_event::Loss;
 use vitreous_xr::trace::{TraceVersion, TraceWriter};
 
-pub use crate::conditions::{
-    CONDITION_CYCLE, GAZE_IMAGE_CYCLE, LiveConditions, STUDY_CONDITIONS, live_conditions,
-};
-#[cfg(test)]
-pub(crate) use crate::test_frame::test_frame;
 pub use cli::{RunArgs, run_command};
 pub use device::XrDeviceCreator;
 pub use interruptions::{InterruptionSummary, NotRenderedFrames, Reconnect};
@@ -68,24 +63,27 @@ pub use readback::{
 pub use reconnect::{RECONNECT_S_DEFAULT, RECONNECT_S_MAX};
 pub use recording::ReplayCheck;
 pub use summary::{GazeSamples, RunSummary};
+#[cfg(test)]
+pub(crate) use vitreous_frames::test_frame::test_frame;
 
-use crate::blur_stack::DefocusSetup;
-use crate::director::Director;
-use crate::effects::EffectSet;
-use crate::focus::FocusFollower;
-use crate::frame_log::FrameLog;
-use crate::frame_loop;
-use crate::input_files::InputFiles;
-use crate::look::{GazeSettings, base_look, planners_for};
-use crate::motion_clock::MotionClock;
-use crate::output::write_atomic;
-use crate::render_desc;
-use crate::resident::ResidentSampler;
-use crate::scene::{CausticsMode, load_scene};
-use crate::spread::Spread;
-use crate::validation::ValidationSummary;
 use recording::replay_check;
 use sink::RunSink;
+use vitreous_frames::blur_stack::DefocusSetup;
+use vitreous_frames::conditions::{LiveConditions, live_conditions};
+use vitreous_frames::director::Director;
+use vitreous_frames::focus::FocusFollower;
+use vitreous_frames::frame_log::FrameLog;
+use vitreous_frames::frame_loop;
+use vitreous_frames::input_files::InputFiles;
+use vitreous_frames::look::{GazeSettings, base_look, planners_for};
+use vitreous_frames::motion_clock::MotionClock;
+use vitreous_frames::output::write_atomic;
+use vitreous_frames::render_desc;
+use vitreous_frames::resident::ResidentSampler;
+use vitreous_frames::spread::Spread;
+use vitreous_frames::validation::ValidationSummary;
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{CausticsMode, load_scene};
 pub use xr_session::{Closed, XrSession};
 
 /// Frames before the first sample of resident memory (summary.json `resident_memory`): the
@@ -124,9 +122,9 @@ pub struct RunOptions {
     /// How the reflected image is drawn.
     pub reflection: Reflection,
     /// Fixation-depth filter overriding the scene's `[gaze] filter`.
-    pub filter: Option<crate::gaze::FilterKind>,
+    pub filter: Option<vitreous_gaze::FilterKind>,
     /// Where A_p comes from, overriding the scene's `[gaze] pupil`.
-    pub pupil_source: Option<crate::gaze::PupilSource>,
+    pub pupil_source: Option<vitreous_gaze::PupilSource>,
     /// Where summary.json goes (None: not written).
     pub out: Option<PathBuf>,
     /// Read the keyboard's live controls from standard input even when it is not a terminal
@@ -153,7 +151,7 @@ pub fn run_directed(options: &RunOptions, director: &mut dyn Director) -> Result
 
 /// Refuses `--record` and `--out` when they would write over a file the session reads (the
 /// scene, its assets, the gaze trace), before the runtime starts.
-fn check_outputs(options: &RunOptions, scene: &crate::scene::Scene) -> Result<()> {
+fn check_outputs(options: &RunOptions, scene: &vitreous_scene::Scene) -> Result<()> {
     let mut inputs = InputFiles::new();
     inputs.add_scene(scene, "SCENE");
     if let Some(trace) = &options.gaze_trace {

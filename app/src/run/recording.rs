@@ -9,7 +9,7 @@ use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{TraceSample, read_trace};
 use vitreous_xr::{Backend, FrameInput, GazeSample, Pose};
 
-use crate::scene::Scene;
+use vitreous_scene::Scene;
 
 /// How well a replay of the recording reproduces the session's views.
 #[derive(Clone, Debug, Serialize)]

@@ -12,14 +12,14 @@ use vitreous_xr::{FrameEndHints, FrameInput};
 use super::readback::{self, ReadbackCheck, check_readback};
 use super::recording::trace_sample;
 use super::room_light;
-use crate::conditions::LiveConditions;
-use crate::director::Director;
-use crate::focus::FocusFollower;
-use crate::frame_log::FrameLog;
-use crate::frame_loop::{FramePlan, FrameSink};
-use crate::motion_clock::MotionClock;
-use crate::resident::ResidentSampler;
-use crate::scene_edit::SceneEdit;
+use vitreous_frames::conditions::LiveConditions;
+use vitreous_frames::director::Director;
+use vitreous_frames::focus::FocusFollower;
+use vitreous_frames::frame_log::FrameLog;
+use vitreous_frames::frame_loop::{FramePlan, FrameSink};
+use vitreous_frames::motion_clock::MotionClock;
+use vitreous_frames::resident::ResidentSampler;
+use vitreous_frames::scene_edit::SceneEdit;
 
 /// Records frames and checks a readback.
 pub(super) struct RunSink<'d> {

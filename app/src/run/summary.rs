@@ -3,11 +3,11 @@
 
 use serde::Serialize;
 
-use crate::frame_log::PupilSummary;
-use crate::gaze::separability::SeparabilitySummary;
-use crate::resident::ResidentMemory;
-use crate::spread::Spread;
-use crate::validation::ValidationSummary;
+use vitreous_frames::frame_log::PupilSummary;
+use vitreous_frames::resident::ResidentMemory;
+use vitreous_frames::spread::Spread;
+use vitreous_frames::validation::ValidationSummary;
+use vitreous_gaze::separability::SeparabilitySummary;
 
 use super::{ReadbackCheck, ReplayCheck};
 
@@ -135,7 +135,7 @@ pub struct RunSummary {
     /// frame that draws them).
     pub inducer_computations: u64,
     /// Where the object and light were in the last frame (`null` when nothing moved).
-    pub final_placement: Option<crate::motion_clock::FinalPlacement>,
+    pub final_placement: Option<vitreous_frames::motion_clock::FinalPlacement>,
     /// What a misbehaving headset did to the run and what the run did about it.
     pub interruptions: super::InterruptionSummary,
     /// The process's resident memory over the frames after a warm-up (`null` when the session

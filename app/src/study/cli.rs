@@ -6,13 +6,13 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 
-use super::plan::{MAX_PARTICIPANTS, plan, write_plan};
-use super::protocol::Protocol;
 use super::run::{StudyRunOptions, run_study, timing_log_path};
 use crate::cli_values::{number, parse_blend, parse_gaze, parse_seed, parse_size, whole_number};
-use crate::input_files::InputFiles;
-use crate::output::write_atomic;
 use crate::run::RunOptions;
+use vitreous_frames::input_files::InputFiles;
+use vitreous_frames::output::write_atomic;
+use vitreous_study::plan::{MAX_PARTICIPANTS, plan, write_plan};
+use vitreous_study::protocol::Protocol;
 
 /// The study subcommands.
 #[derive(Subcommand, Debug)]
@@ -197,7 +197,7 @@ pub fn run(command: StudyCommand) -> Result<()> {
             }
             inputs.check_file("the timing log", &timing_log_path(&responses))?;
             if let Some((w, h)) = size {
-                crate::setup::check_size(w, h)?;
+                vitreous_frames::setup::check_size(w, h)?;
             }
             if trace.is_some() && !(dry_run || view) {
                 bail!(
@@ -245,7 +245,7 @@ pub fn run(command: StudyCommand) -> Result<()> {
             json,
             plot,
         } => {
-            let analysis = super::report::analyze_file(&responses)?;
+            let analysis = vitreous_study::report::analyze_file(&responses)?;
             if let Some(path) = &plot {
                 InputFiles::new()
                     .add(&responses, "RESPONSES")

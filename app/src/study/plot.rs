@@ -7,7 +7,7 @@ use std::fmt;
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 
-use super::report::{Analysis, StudyReport};
+use vitreous_study::report::{Analysis, StudyReport};
 
 /// Width of the figure, pixels.
 const WIDTH_PX: u32 = 1200;
@@ -36,7 +36,7 @@ pub struct Mark {
 /// The figure as PNG bytes.
 pub fn plot(report: &StudyReport) -> Result<Vec<u8>> {
     let (rgba, w, h, _) = draw(report)?;
-    crate::output::encode_png(&rgba, w, h)
+    vitreous_frames::output::encode_png(&rgba, w, h)
 }
 
 /// The figure as RGBA pixels (width, height) and where each condition was marked.
@@ -165,7 +165,7 @@ pub fn draw(report: &StudyReport) -> Result<(Vec<u8>, u32, u32, Vec<Mark>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::thurstone::case_v;
+    use vitreous_study::thurstone::case_v;
 
     #[test]
     fn each_condition_is_marked_in_scale_order_at_its_place() {

@@ -17,19 +17,22 @@ use vitreous_render::{ContextOptions, GpuContext, Reflection};
 use vitreous_xr::openxr::Command;
 use vitreous_xr::{FrameInput, NullBackend, NullConfig};
 
-use super::answers::{Keyboard, SimulatedObserver};
-use super::plan::{PlannedTrial, read_plan};
-use super::protocol::{Protocol, Show};
-use super::session::{AnswerSources, ResponsesFile, StudyDirector, TimingLog, remaining_trials};
-use crate::director::Director;
-use crate::effects::EffectSet;
-use crate::frame_loop::{self, FramePlan, FrameSink};
-use crate::gaze::GazeOverride;
-use crate::look::{GazeSettings, planners_for};
-use crate::motion_clock::MotionClock;
-use crate::render_desc;
-use crate::run::{LiveConditions, RunOptions};
-use crate::scene::{Scene, load_scene};
+use crate::run::RunOptions;
+use vitreous_frames::conditions::LiveConditions;
+use vitreous_frames::director::Director;
+use vitreous_frames::frame_loop::{self, FramePlan, FrameSink};
+use vitreous_frames::look::{GazeSettings, planners_for};
+use vitreous_frames::motion_clock::MotionClock;
+use vitreous_frames::render_desc;
+use vitreous_gaze::GazeOverride;
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{Scene, load_scene};
+use vitreous_study::answers::{Keyboard, SimulatedObserver};
+use vitreous_study::plan::{PlannedTrial, read_plan};
+use vitreous_study::protocol::{Protocol, Show};
+use vitreous_study::session::{
+    AnswerSources, ResponsesFile, StudyDirector, TimingLog, remaining_trials,
+};
 
 /// The shortest and longest time scale `--time-scale` accepts.
 pub const TIME_SCALE_RANGE: (f64, f64) = (0.001, 10.0);
@@ -359,16 +362,16 @@ fn dry_run_block(
     let (width, height) = options
         .size
         .unwrap_or((scene.output.width_px, scene.output.height_px));
-    crate::setup::check_size(width, height)?;
+    vitreous_frames::setup::check_size(width, height)?;
     let t = protocol.timing.scaled(options.time_scale);
     let needed_s = trials as f64 * (t.first_s + t.blank_s + t.second_s + t.interval_s) + 1.0;
     let samples = match &options.trace {
         Some(path) => {
-            let (samples, _) = crate::setup::load_trace(&scene, Some(path))?;
+            let (samples, _) = vitreous_frames::setup::load_trace(&scene, Some(path))?;
             samples
         }
         None => {
-            let mut params = crate::scene::synth_params_for(&scene);
+            let mut params = vitreous_scene::synth_params_for(&scene);
             params.duration_s = needed_s.min(4.0 * 3600.0) as f32;
             vitreous_xr::synth::synthesize_with_truth(&params)
                 .context("synthesising a trace for the dry run")?
@@ -405,7 +408,7 @@ fn dry_run_block(
         stage.sets.iter().copied().zip(planners).collect(),
         GazeOverride::Auto,
     );
-    crate::interrupt::watch();
+    vitreous_frames::interrupt::watch();
     let mut sink = DryRunSink {
         stage: &mut stage,
         looks,
@@ -416,7 +419,7 @@ fn dry_run_block(
         return Err(e);
     }
     frame_loop::ensure_validation_clean(&renderer)?;
-    if !stage.director.done() && !crate::interrupt::requested() {
+    if !stage.director.done() && !vitreous_frames::interrupt::requested() {
         tracing::warn!(
             "the dry run's trace ended before the block's last trial; run again to resume"
         );
@@ -458,6 +461,6 @@ impl FrameSink for DryRunSink<'_> {
     }
 
     fn stop_requested(&self) -> bool {
-        self.stage.ending() || crate::interrupt::requested()
+        self.stage.ending() || vitreous_frames::interrupt::requested()
     }
 }

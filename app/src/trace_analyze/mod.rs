@@ -41,17 +41,19 @@ use serde::Serialize;
 use vitreous_xr::TraceSample;
 use vitreous_xr::synth::GazePhase;
 
-use crate::gaze::evidence::DEFAULT_PRIOR_NOISE_DEG;
-pub use crate::gaze::fixation::DROPOUT_NS;
-use crate::gaze::fixation::{DEFAULT_VELOCITY_DEG_S, Step, VelocityClassifier, combined_direction};
-use crate::gaze::vergence::{Measurement, VergenceConfig, VergenceEstimator};
-use crate::gaze::{
+use vitreous_frames::input_files::InputFiles;
+use vitreous_frames::setup::ensure_samples;
+use vitreous_gaze::evidence::DEFAULT_PRIOR_NOISE_DEG;
+pub use vitreous_gaze::fixation::DROPOUT_NS;
+use vitreous_gaze::fixation::{
+    DEFAULT_VELOCITY_DEG_S, Step, VelocityClassifier, combined_direction,
+};
+use vitreous_gaze::vergence::{Measurement, VergenceConfig, VergenceEstimator};
+use vitreous_gaze::{
     FilterKind, GazeConfig, GazeImage, GazePipeline, GazeState, ImageDistances, ObjectInView,
     Separability, SeparabilityMonitor,
 };
-use crate::input_files::InputFiles;
-use crate::scene::{gaze_image_of_target, load_scene};
-use crate::setup::ensure_samples;
+use vitreous_scene::{gaze_image_of_target, load_scene};
 
 pub(crate) mod plot;
 mod report;
@@ -106,7 +108,7 @@ impl AnalyzeConfig {
 
     /// [`AnalyzeConfig::new`] with a scene's image distances (from its viewer's position) and
     /// its object, whose projection the `evidence` decision checks the gaze against.
-    pub fn for_scene(scene: &crate::scene::Scene) -> Self {
+    pub fn for_scene(scene: &vitreous_scene::Scene) -> Self {
         let geometry = scene.viewing_geometry();
         AnalyzeConfig {
             object: Some((geometry.center_m, geometry.radius_m)),
@@ -282,7 +284,7 @@ pub fn raw_depths(samples: &[TraceSample], vergence: VergenceConfig) -> Vec<(i64
 }
 
 /// The truth timeline of ground-truth phases of a trace whose targets are laid out as
-/// [`crate::scene::synth_params_for`] does (surface, then refracted).
+/// [`vitreous_scene::synth_params_for`] does (surface, then refracted).
 pub fn timeline_from_phases(phases: &[GazePhase]) -> TruthTimeline {
     let image = |p: &GazePhase| gaze_image_of_target(p.target);
     let mut changes = Vec::new();
@@ -493,7 +495,7 @@ pub fn analyze(samples: &[TraceSample], truth: Truth<'_>, config: &AnalyzeConfig
             score(&frames, &timeline, &gaps, f)
         })
         .collect();
-    let selector = crate::gaze::ImageSelector::new(config.distances, config.band);
+    let selector = vitreous_gaze::ImageSelector::new(config.distances, config.band);
     let duration_s = match (samples.first(), samples.last()) {
         (Some(a), Some(b)) => (b.time_ns - a.time_ns) as f64 * 1e-9,
         _ => 0.0,
@@ -515,7 +517,7 @@ pub fn analyze(samples: &[TraceSample], truth: Truth<'_>, config: &AnalyzeConfig
 }
 
 /// `vitreous trace analyze TRACE --scene SCENE`: the image distances come from the scene
-/// ([`Scene::image_distances`](crate::scene::Scene::image_distances)); gaze changes are
+/// ([`Scene::image_distances`](vitreous_scene::Scene::image_distances)); gaze changes are
 /// derived from the raw depth (a trace file carries no ground truth). `filters` empty means
 /// every offered filter ([`FilterKind::all_default`]).
 pub fn analyze_trace_file(

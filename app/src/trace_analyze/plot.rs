@@ -20,8 +20,8 @@ use super::{
     AnalyzeConfig, RawSample, ReplayedFrame, Truth, load_inputs, raw_samples, replay,
     timeline_from_phases, timeline_from_raw_depth,
 };
-use crate::gaze::fixation::{DEFAULT_MIN_FIXATION_MS, DEFAULT_VELOCITY_DEG_S, fixation_spans};
-use crate::gaze::{FilterKind, GazeImage};
+use vitreous_gaze::fixation::{DEFAULT_MIN_FIXATION_MS, DEFAULT_VELOCITY_DEG_S, fixation_spans};
+use vitreous_gaze::{FilterKind, GazeImage};
 
 /// `vitreous trace plot TRACE --scene SCENE -o OUT`: see [`plot`].
 pub fn plot_trace_file(
@@ -418,8 +418,8 @@ pub fn plot(
         .chunks_exact(3)
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
-    let png = crate::output::encode_png(&rgba, w, h)?;
-    crate::output::write_atomic(out_png, &png)?;
+    let png = vitreous_frames::output::encode_png(&rgba, w, h)?;
+    vitreous_frames::output::write_atomic(out_png, &png)?;
     Ok(layout)
 }
 

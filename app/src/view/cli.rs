@@ -7,8 +7,8 @@ use vitreous_render::Reflection;
 
 use super::{EyesShown, ViewOptions, view};
 use crate::cli_values::{parse_effects, parse_frame_count, parse_size};
-use crate::effects::EffectSet;
-use crate::gaze::FilterKind;
+use vitreous_gaze::FilterKind;
+use vitreous_scene::effects::EffectSet;
 
 /// Options of `vitreous view` (docs/view.md).
 #[derive(clap::Args, Debug)]
@@ -73,7 +73,7 @@ pub struct ViewArgs {
 
 /// Runs `vitreous view` and prints its summary line.
 pub fn run(args: ViewArgs) -> Result<()> {
-    let _signals = crate::interrupt::watch();
+    let _signals = vitreous_frames::interrupt::watch();
     let summary = view(&ViewOptions {
         scene: args.scene,
         window: args.window,

@@ -5,9 +5,9 @@ use anyhow::Result;
 use vitreous_render::{Look, Reflection};
 use vitreous_xr::FrameInput;
 
-use crate::effects::EffectSet;
-use crate::gaze::{FilterKind, GazeConfig, GazeOverride, GazeState};
-use crate::look::{DefocusModel, LookPlanner};
+use vitreous_frames::look::{DefocusModel, LookPlanner};
+use vitreous_gaze::{FilterKind, GazeConfig, GazeOverride, GazeState};
+use vitreous_scene::effects::EffectSet;
 
 /// The conditions keys 1-7 choose: none (O2, a), O3, O4, O5, b, c, and the inducer alone
 /// (disparity, defocus and caustics alone are O4, O3 and b).
@@ -95,7 +95,10 @@ impl ViewConditions {
                         }
                         _ => None,
                     };
-                    LookPlanner::new(crate::look::base_look(&set, self.reflection), defocus)
+                    LookPlanner::new(
+                        vitreous_frames::look::base_look(&set, self.reflection),
+                        defocus,
+                    )
                 })
             })
             .collect();

@@ -19,8 +19,8 @@ use super::input::{Action, EyesShown, InputEvent, action_for_key, movement};
 use super::playback::Playback;
 use super::script::{Script, Step};
 use super::window::DesktopWindow;
-use crate::scene::ViewingGeometry;
-use crate::scene_edit::SceneEdit;
+use vitreous_frames::scene_edit::SceneEdit;
+use vitreous_scene::ViewingGeometry;
 
 /// Radians of head turn per window width dragged.
 const DRAG_RAD_PER_WIDTH: f32 = std::f32::consts::PI;
@@ -143,7 +143,7 @@ impl DesktopBackend {
         shared: Rc<RefCell<Shared>>,
         script: Option<Script>,
         max_frames: Option<u64>,
-        scene: &crate::scene::Scene,
+        scene: &vitreous_scene::Scene,
     ) -> DesktopBackend {
         let fov = scene.output.fov;
         DesktopBackend {
@@ -177,7 +177,7 @@ impl DesktopBackend {
     }
 
     /// Takes a reloaded scene's viewing geometry and eye spacing (the head stays where it is).
-    pub fn set_scene(&mut self, scene: &crate::scene::Scene) {
+    pub fn set_scene(&mut self, scene: &vitreous_scene::Scene) {
         self.geometry = scene.viewing_geometry();
         self.ipd_m = scene.viewer.ipd_m;
         self.home_m = scene.viewer.head_position_m;

@@ -8,9 +8,9 @@ use vitreous_render::ScenePose;
 use vitreous_xr::FrameInput;
 use vitreous_xr::trace::{AtomicFile, EditRecord, TraceWriter};
 
-use crate::motion_clock::MotionClock;
-use crate::scene::Scene;
-use crate::scene_edit::{EditState, SceneEdit};
+use vitreous_frames::motion_clock::MotionClock;
+use vitreous_frames::scene_edit::{EditState, SceneEdit};
+use vitreous_scene::Scene;
 
 /// The scene's motion with the edits made in the window and those of a trace played.
 pub struct ViewEdits {

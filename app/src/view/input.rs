@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-use crate::scene_edit::{Axis, MOVE_STEPS_M, SceneEdit, TURN_STEPS_DEG};
+use vitreous_frames::scene_edit::{Axis, MOVE_STEPS_M, SceneEdit, TURN_STEPS_DEG};
 
 /// One input event, from the window or from a script.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,6 +1,6 @@
 //! `vitreous view`: the see-through display simulated in a desktop window.
 //!
-//! The same frame loop as `run` and `replay` ([`crate::frame_loop`]) drives the real renderer
+//! The same frame loop as `run` and `replay` ([`vitreous_frames::frame_loop`]) drives the real renderer
 //! through a third backend, [`desktop::DesktopBackend`], whose head pose comes from the mouse
 //! and keys and whose gaze is synthesised from the cursor. Each finished frame's eye images
 //! are read back and put in the window (left, right or both; the display's light or the
@@ -45,17 +45,17 @@ pub use desktop::{FixationTarget, fixation_point};
 pub use input::{Action, EyesShown, InputEvent, KEYS};
 pub use script::{Script, ScriptError, Step};
 
-use crate::director::Director;
-use crate::effects::EffectSet;
-use crate::frame_loop::{self, FrameRecord};
-use crate::gaze::{FilterKind, GazeOverride};
-use crate::input_files::InputFiles;
-use crate::output::{encode_png, write_atomic};
-use crate::spread::Spread;
-use crate::validation::ValidationSummary;
 use desktop::{DesktopBackend, Shared};
 use reload::Loaded;
 use session::{Request, ViewSink};
+use vitreous_frames::director::Director;
+use vitreous_frames::frame_loop::{self, FrameRecord};
+use vitreous_frames::input_files::InputFiles;
+use vitreous_frames::output::{encode_png, write_atomic};
+use vitreous_frames::spread::Spread;
+use vitreous_frames::validation::ValidationSummary;
+use vitreous_gaze::{FilterKind, GazeOverride};
+use vitreous_scene::effects::EffectSet;
 
 /// Options of `vitreous view`.
 #[derive(Clone, Debug)]
@@ -142,7 +142,7 @@ pub struct ViewSummary {
     /// Frames whose object or light pose differed from the previous frame's.
     pub moved_frames: u64,
     /// Where the object and light were in the last frame (`null` when nothing moved).
-    pub final_placement: Option<crate::motion_clock::FinalPlacement>,
+    pub final_placement: Option<vitreous_frames::motion_clock::FinalPlacement>,
 }
 
 impl ViewSummary {
@@ -253,7 +253,7 @@ fn view_with(options: &ViewOptions, director: Option<&mut dyn Director>) -> Resu
     if let Some(path) = &options.trace {
         let (samples, edits) = vitreous_xr::trace::read_trace_with_edits(path)
             .with_context(|| format!("reading trace {}", path.display()))?;
-        crate::setup::ensure_samples(path, &samples, "play")?;
+        vitreous_frames::setup::ensure_samples(path, &samples, "play")?;
         backend.play(playback::Playback::new(samples));
         played_edits = edits;
     }

@@ -7,7 +7,7 @@ use vitreous_render::Readback;
 
 use super::input::EyesShown;
 use crate::font::FONT_TTF;
-use crate::output::{linear_to_srgb, srgb_to_linear};
+use vitreous_frames::output::{linear_to_srgb, srgb_to_linear};
 
 /// Height of the overlay's text, pixels.
 const TEXT_PX: f32 = 14.0;
@@ -230,7 +230,7 @@ mod tests {
     fn the_preview_adds_light_as_replay_does() {
         let tables = SeeThrough::new();
         for (e, w) in [(0u8, 0u8), (128, 64), (10, 250), (255, 255)] {
-            let replay = crate::output::see_through(&[e, e, e, 255], &[w, w, w, 255]);
+            let replay = vitreous_frames::output::see_through(&[e, e, e, 255], &[w, w, w, 255]);
             assert!(
                 i16::from(tables.add(e, w)).abs_diff(i16::from(replay[0])) <= 1,
                 "{e} + {w}"

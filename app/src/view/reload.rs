@@ -9,10 +9,10 @@ use std::time::{Duration, Instant, SystemTime};
 use anyhow::{Context, Result, bail};
 use vitreous_render::{ContextOptions, GpuContext, Renderer};
 
-use crate::blur_stack::DefocusSetup;
-use crate::effects::EffectSet;
-use crate::render_desc;
-use crate::scene::{CausticsMode, DiskFiles, Scene, SceneFiles, load_scene_from};
+use vitreous_frames::blur_stack::DefocusSetup;
+use vitreous_frames::render_desc;
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{CausticsMode, DiskFiles, Scene, SceneFiles, load_scene_from};
 
 /// A scene loaded with what its renderer needs.
 pub struct Loaded {
@@ -116,7 +116,7 @@ fn stamp(path: &Path) -> Stamp {
 }
 
 /// Loads a scene and lists the files it read (the scene file, its assets, its caustic bake).
-pub fn load_watched(path: &Path) -> (Result<Scene, crate::scene::SceneError>, Vec<PathBuf>) {
+pub fn load_watched(path: &Path) -> (Result<Scene, vitreous_scene::SceneError>, Vec<PathBuf>) {
     let recorder = Recorder::default();
     let scene = load_scene_from(path, &recorder);
     let mut files = recorder.read.into_inner();

@@ -24,13 +24,13 @@ use super::input::{Action, KEYS};
 use super::picture::{Overlay, SeeThrough, compose};
 use super::reload::{Loaded, Watcher};
 use super::swapchain::{Presented, Presenter};
-use crate::director::Director;
-use crate::frame_loop::{FramePlan, FrameSink};
-use crate::gaze::{FilterKind, FixationDepth, GazeOverride};
-use crate::motion_clock::MotionClock;
-use crate::scene::Scene;
-use crate::scene_edit::SceneEdit;
-use crate::validation::ValidationSummary;
+use vitreous_frames::director::Director;
+use vitreous_frames::frame_loop::{FramePlan, FrameSink};
+use vitreous_frames::motion_clock::MotionClock;
+use vitreous_frames::scene_edit::SceneEdit;
+use vitreous_frames::validation::ValidationSummary;
+use vitreous_gaze::{FilterKind, FixationDepth, GazeOverride};
+use vitreous_scene::Scene;
 
 mod overlay;
 
@@ -539,7 +539,7 @@ impl FrameSink for ViewSink<'_> {
 
     fn stop_requested(&self) -> bool {
         self.request.is_some()
-            || crate::interrupt::requested()
+            || vitreous_frames::interrupt::requested()
             || self.director.as_ref().is_some_and(|d| d.ending())
     }
 }

@@ -518,7 +518,7 @@ fn scripted_scene_edits_are_recorded_and_the_replay_ends_where_the_session_did()
     let p = summary(&played_dir);
     assert_eq!(p["final_placement"], s["final_placement"], "{p:#}\n{s:#}");
     let placed = &s["final_placement"]["object_position_m"];
-    let rest = vitreous::scene::load_scene(&scene).unwrap().object.center_m;
+    let rest = vitreous_scene::load_scene(&scene).unwrap().object.center_m;
     assert!(
         (placed[2].as_f64().unwrap() - f64::from(rest.z)).abs() > 0.01,
         "placing moved the object: {placed} from {rest}"

@@ -72,7 +72,7 @@ impl Shot {
 /// Where the scene's glass (its bounding sphere) lies in each half of the window, as the
 /// viewer projects it from the starting pose: centre and radius in window pixels.
 pub fn glass_discs(scene_path: &Path) -> [(f32, f32, f32); 2] {
-    let scene = vitreous::scene::load_scene(scene_path).expect("scene loads");
+    let scene = vitreous_scene::load_scene(scene_path).expect("scene loads");
     let g = scene.viewing_geometry();
     let fov = scene.output.fov;
     let tan_v = ((fov.angle_up_rad - fov.angle_down_rad) / 2.0).tan();

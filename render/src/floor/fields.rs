@@ -8,7 +8,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::memory::Image;
 use crate::owned::Owned;
-use crate::pipeline::{self, FieldStart};
+use crate::pipeline::{self, FieldStart, PassBegin};
 
 /// Indices into the pass's field targets.
 pub(crate) const MASK: usize = 0;
@@ -126,28 +126,16 @@ impl FieldTarget {
             FieldStart::Clear => 1,
             FieldStart::KeepClear => 2,
         };
-        let begin = vk::RenderPassBeginInfo::default()
-            .render_pass(self.render_passes[index].raw())
-            .framebuffer(self.framebuffer.raw())
-            .render_area(rect(area))
-            .clear_values(&clear);
-        let viewport = vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: self.extent.width as f32,
-            height: self.extent.height as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
+        let pass = PassBegin {
+            render_pass: self.render_passes[index].raw(),
+            framebuffer: self.framebuffer.raw(),
+            extent: self.extent,
+            area: rect(area),
+            scissor: rect(scissor),
         };
-        let device = &ctx.device;
-        ctx.work.render_pass();
         // SAFETY: the caller's contract; the render pass and framebuffer are this target's
-        // and compatible; the pipelines bound inside set viewport and scissor dynamically.
-        unsafe {
-            device.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
-            device.cmd_set_viewport(cmd, 0, &[viewport]);
-            device.cmd_set_scissor(cmd, 0, &[rect(scissor)]);
-        }
+        // and compatible.
+        unsafe { pass.record(ctx, cmd, &clear) }
     }
 }
 

@@ -9,7 +9,7 @@ use vitreous::caustics::{Bake, BakeError};
 use vitreous::effects::EffectSet;
 use vitreous::render_desc;
 use vitreous::scene::{CausticsMode, Image, PixelData, Scene};
-use vitreous_render::camera::EyeParams;
+use vitreous_optics::camera::EyeParams;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Readback, Reflection, Renderer, ScenePose};
 use vitreous_tests::{

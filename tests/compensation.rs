@@ -5,8 +5,9 @@
 //! untouched; with the world drawn behind (an opaque display) nothing is taken away.
 
 use vitreous::effects::EffectSet;
+use vitreous_optics::display::Compensation;
 use vitreous_render::renderer::Want;
-use vitreous_render::{Compensation, Composition, FrameParams, Reflection, Renderer};
+use vitreous_render::{Composition, FrameParams, Reflection, Renderer};
 use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
 
 fn linear(v: u8) -> f32 {

@@ -12,7 +12,7 @@ use glam::{Quat, Vec2, Vec3};
 use vitreous::output::see_through;
 use vitreous::render_desc;
 use vitreous::scene::{Image, PixelData, Scene};
-use vitreous_render::camera::EyeParams;
+use vitreous_optics::camera::EyeParams;
 use vitreous_render::floor::{self, InducerFields};
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Readback, Renderer};

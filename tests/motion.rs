@@ -9,7 +9,7 @@ use vitreous::effects::EffectSet;
 use vitreous::render_desc;
 use vitreous::replay::{ReplayOptions, replay};
 use vitreous::scene::{Placement, Scene, load_scene};
-use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_optics::camera::{EyeParams, Fov};
 use vitreous_render::floor::InducerFields;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Renderer};

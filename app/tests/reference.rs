@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use glam::{Quat, Vec2};
 use vitreous::render_desc::render_fov;
 use vitreous::scene::load_scene;
-use vitreous_render::camera::EyeParams;
+use vitreous_optics::camera::EyeParams;
 
 use crate::cli::{assert_clean_failure, vitreous};
 use crate::compare::json;

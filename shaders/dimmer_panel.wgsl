@@ -81,7 +81,7 @@ fn spread(@builtin(global_invocation_id) id: vec3<u32>) {
     panel[layer() * n + id.x] = most;
 }
 
-// The error function (Abramowitz and Stegun 7.1.26), as render/src/dimmer/model.rs `erf`.
+// The error function (Abramowitz and Stegun 7.1.26), as optics/src/display/dimmer.rs `erf`.
 fn erf(x: f32) -> f32 {
     let t = 1.0 / (1.0 + 0.3275911 * abs(x));
     let poly = t * (0.2548296 + t * (-0.28449674 + t * (1.4214137 + t * (-1.4531521 + t * 1.0614054))));
@@ -108,7 +108,7 @@ fn soften(@builtin(global_invocation_id) id: vec3<u32>) {
     let lo = max(at - reach, vec2<i32>(0));
     let hi = min(at + reach, vec2<i32>(cells()) - 1);
     let n = cells().x * cells().y;
-    // Each column's weight once (the reach is at most 31 cells: render/src/dimmer/model.rs).
+    // Each column's weight once (the reach is at most 31 cells: optics/src/display/dimmer.rs).
     var wx: array<f32, 64>;
     for (var x = lo.x; x <= hi.x; x++) {
         wx[x - lo.x] = cell_weight(x, uv.x, sigma.x);

@@ -21,7 +21,7 @@
 // the back, total internal reflection followed for up to MAX_INTERNAL_REFLECTIONS bounces
 // (then the environment), with exact Fresnel at both interfaces and Beer-Lambert absorption
 // over the path inside (glTF KHR_materials_volume). The exit is found against the
-// object's radial map (render/src/radial_map.rs `radial_map`): the distance from the object's
+// object's radial map (optics/src/radial_map.rs `radial_map`): the distance from the object's
 // centre to its surface and the normal there, per direction. Starting from the sphere through
 // the entry point, secant steps on the ray's height above the surface: one fetch for a ball, a
 // few for a faceted stone.
@@ -104,12 +104,12 @@ struct Globals {
 override ABSORBING: bool = false;
 
 // The object is a ball about the radial map's centre (its map is the sphere of radius
-// `g.radial.w` with radial normals, render/src/radial_map.rs `RadialMap::ball`): a pipeline
+// `g.radial.w` with radial normals, optics/src/radial_map.rs `RadialMap::ball`): a pipeline
 // constant, so that a ball's pipeline finds its surface without the map's fetch.
 override BALL: bool = false;
 
 // The object is a flat-shaded convex polyhedron (a cut gem) whose facet planes are `facet_planes`
-// (render/src/convex.rs `facet_planes`): a pipeline constant, so that its pipeline finds
+// (optics/src/convex.rs `facet_planes`): a pipeline constant, so that its pipeline finds
 // where a ray leaves exactly, without the radial map (whose filtered texels round every
 // facet edge).
 override CONVEX: bool = false;
@@ -182,7 +182,7 @@ struct VertexOut {
 };
 
 // Cosine above which a vertex normal counts as pointing away from the object's centre (twin
-// of render/src/two_surface.rs RADIAL_NORMAL_COS).
+// of optics/src/two_surface.rs RADIAL_NORMAL_COS).
 const RADIAL_NORMAL_COS: f32 = 0.9999;
 
 @vertex
@@ -222,7 +222,7 @@ fn environment(d: vec3<f32>) -> vec3<f32> {
     return textureSampleLevel(env_map, wrap_sampler, latlong_uv(d), 0.0).rgb * g.shading.x;
 }
 
-// eq. 7-8, Heckbert's form (twin of render/src/optics.rs refract_heckbert): incident I unit
+// eq. 7-8, Heckbert's form (twin of optics/src/optics.rs refract_heckbert): incident I unit
 // from the eye, normal N unit facing the eye, n relative index. xyz: T (not normalised);
 // w: 1, or 0 for total internal reflection (non-positive radicand).
 fn refract_heckbert(incident: vec3<f32>, normal: vec3<f32>, n: f32) -> vec4<f32> {
@@ -254,7 +254,7 @@ fn plane_hit(plane_from_world: mat4x4<f32>, origin: vec3<f32>, dir: vec3<f32>) -
 }
 
 // Where the ray origin + t * dir (t > 0) meets the background plane: xy photo coordinates,
-// z: 1 on the photo, 0 on a miss (twin of render/src/optics.rs plane_uv).
+// z: 1 on the photo, 0 on a miss (twin of optics/src/optics.rs plane_uv).
 fn background_uv(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     let hit = plane_hit(g.background_from_world, origin, dir);
     return vec3<f32>(hit.xy, hit.w);
@@ -322,7 +322,7 @@ fn sphere_exit(p: vec3<f32>, d: vec3<f32>, r: f32) -> f32 {
 }
 
 // Where the ray p + t d (from inside, d unit) leaves the convex object of `facet_planes`: x the
-// distance t, yzw the outward unit normal (twin of render/src/convex.rs convex_exit).
+// distance t, yzw the outward unit normal (twin of optics/src/convex.rs convex_exit).
 fn convex_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     var exit = vec4<f32>(3.0e38, 0.0, 0.0, 0.0);
     let count = arrayLength(&facet_planes);
@@ -396,7 +396,7 @@ fn find_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(t, s.yzw);
 }
 
-// Two-surface refraction (twin of render/src/two_surface.rs pass_through): the unit ray
+// Two-surface refraction (twin of optics/src/two_surface.rs pass_through): the unit ray
 // `incident` meets the front surface at `entry` (world) with unit normal `normal` facing it.
 fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
     var out: Passage;

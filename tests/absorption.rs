@@ -5,13 +5,12 @@
 //! glass.
 
 use glam::{Mat4, Quat, Vec2, Vec3};
-use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_optics::absorption::Attenuation;
+use vitreous_optics::camera::{EyeParams, Fov};
+use vitreous_optics::refraction::Refraction;
 use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sample};
 use vitreous_render::renderer::Want;
-use vitreous_render::{
-    Attenuation, FrameParams, LightDesc, Look, PlaneDesc, Reflection, Refraction, Renderer,
-    SceneDesc,
-};
+use vitreous_render::{FrameParams, LightDesc, Look, PlaneDesc, Reflection, Renderer, SceneDesc};
 use vitreous_tests::{
     flat_environment, grey_photo, linear, mesh_ref, render_once, scene_desc, srgb, uv_sphere,
 };

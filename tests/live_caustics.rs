@@ -6,9 +6,9 @@ use std::time::Instant;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 use vitreous_frames::render_desc;
-use vitreous_render::floor::LiveCausticsDesc;
-use vitreous_render::{Renderer, ScenePose};
 use vitreous_scene::load_scene;
+use vitreous_optics::live_caustics::LiveCausticsDesc;
+use vitreous_render::{Renderer, ScenePose};
 use vitreous_tests::{shipped_scene, workspace};
 
 use crate::live_maps::{
@@ -395,11 +395,11 @@ fn the_shipped_sphere_and_diamond_are_convex_the_torus_is_not() {
         let scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
         let mesh = &scene.object.mesh;
         assert_eq!(
-            vitreous_render::convex::is_convex(&mesh.positions, &mesh.indices),
+            vitreous_optics::convex::is_convex(&mesh.positions, &mesh.indices),
             convex,
             "{name}"
         );
-        let planes = vitreous_render::convex::facet_planes(
+        let planes = vitreous_optics::convex::facet_planes(
             &mesh.positions,
             &mesh.normals,
             &mesh.indices,
@@ -407,7 +407,7 @@ fn the_shipped_sphere_and_diamond_are_convex_the_torus_is_not() {
         );
         assert_eq!(planes.is_some(), faceted, "{name}");
         assert!(
-            vitreous_render::convex::is_closed(&mesh.positions, &mesh.indices),
+            vitreous_optics::convex::is_closed(&mesh.positions, &mesh.indices),
             "{name}"
         );
     }

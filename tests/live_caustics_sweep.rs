@@ -1,7 +1,7 @@
 //! The sweep of live-map settings behind docs/caustics.md's tables, with the helpers of
 //! tests/live_maps.rs.
 
-use vitreous_render::floor::LiveCausticsDesc;
+use vitreous_optics::live_caustics::LiveCausticsDesc;
 
 use crate::live_maps::{
     LiveFrame, axis_texel, baked_at, baked_scene, live_gains, live_scene, peak, relative_rms,

@@ -6,12 +6,11 @@
 //! CPU references each render is held to), which would otherwise be split across files.
 
 use glam::{Mat4, Quat, Vec2, Vec3};
-use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_optics::camera::{EyeParams, Fov};
+use vitreous_optics::refraction::Refraction;
 use vitreous_render::reference::{SphereScene, marker_centroid};
 use vitreous_render::renderer::Want;
-use vitreous_render::{
-    FrameParams, LightDesc, Look, PlaneDesc, Reflection, Refraction, Renderer, SceneDesc,
-};
+use vitreous_render::{FrameParams, LightDesc, Look, PlaneDesc, Reflection, Renderer, SceneDesc};
 use vitreous_tests::{MeshData, linear, mesh_ref, render_once, scene_desc, srgb, uv_sphere};
 
 const W: u32 = 640;
@@ -312,7 +311,7 @@ fn reference_dot(eye: &EyeParams, size: Vec2) -> Vec2 {
         for x in 0..W {
             let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
             let dir = eye.pixel_ray(p, size);
-            let Some(t) = vitreous_render::optics::ray_sphere(eye.position_m, dir, CENTER, RADIUS)
+            let Some(t) = vitreous_optics::optics::ray_sphere(eye.position_m, dir, CENTER, RADIUS)
             else {
                 continue;
             };
@@ -338,7 +337,7 @@ pub(crate) fn reference_scene(refraction: Refraction) -> SphereScene {
         radius_m: RADIUS,
         ior: IOR,
         refraction,
-        attenuation: vitreous_render::Attenuation::NONE,
+        attenuation: vitreous_optics::absorption::Attenuation::NONE,
         background_from_world: background_plane().inverse(),
     }
 }
@@ -516,7 +515,7 @@ fn shipped_diamond() -> (MeshData, Mat4) {
 
 #[test]
 fn two_surface_light_through_the_diamond_lands_where_the_mesh_tracer_says() {
-    use vitreous_render::two_surface::{MAX_INTERNAL_REFLECTIONS, MeshBody, pass_through};
+    use vitreous_optics::two_surface::{MAX_INTERNAL_REFLECTIONS, MeshBody, pass_through};
     const DIAMOND_IOR: f32 = 2.42;
     let ((positions, normals, uvs, indices), world_from_model) = shipped_diamond();
     // The render scales by RADIUS and turns half a turn about y about the centre: give it the
@@ -532,8 +531,8 @@ fn two_surface_light_through_the_diamond_lands_where_the_mesh_tracer_says() {
     let body = MeshBody::new(&world, &world_normals, &indices).expect("a closed diamond");
     // The round brilliant's 57 facets and 16 girdle segments: the renderer leaves it through
     // these planes (glass.wgsl `convex_exit`), not through its radial map.
-    let center = vitreous_render::radial_map::mesh_center(&positions);
-    let planes = vitreous_render::convex::facet_planes(&positions, &normals, &indices, center)
+    let center = vitreous_optics::radial_map::mesh_center(&positions);
+    let planes = vitreous_optics::convex::facet_planes(&positions, &normals, &indices, center)
         .expect("the diamond is flat-shaded and convex");
     assert_eq!(planes.len(), 57 + 16);
     let local: Vec<Vec3> = world.iter().map(|&p| p - CENTER).collect();
@@ -574,7 +573,7 @@ fn two_surface_light_through_the_diamond_lands_where_the_mesh_tracer_says() {
                     continue;
                 }
                 let Some(uv) =
-                    vitreous_render::optics::plane_uv(pass.exit_m, pass.direction, plane)
+                    vitreous_optics::optics::plane_uv(pass.exit_m, pass.direction, plane)
                 else {
                     continue;
                 };

@@ -6,8 +6,8 @@
 //! turns over, move fastest with the surface normal.
 
 use glam::{DVec2, Quat, Vec2, Vec3};
-use vitreous_render::Refraction;
-use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_optics::camera::{EyeParams, Fov};
+use vitreous_optics::refraction::Refraction;
 use vitreous_render::reference::{RefractionSample, refraction_sample};
 
 use crate::refraction::{

@@ -2,7 +2,7 @@
 //! CPU projection says, in both eyes, and validation stays silent.
 
 use glam::{Quat, Vec2, Vec3};
-use vitreous_render::camera::{EyeParams, Fov};
+use vitreous_optics::camera::{EyeParams, Fov};
 use vitreous_render::renderer::Want;
 use vitreous_render::{
     CausticsDesc, FrameParams, Look, PlaneDesc, RenderError, Renderer, SceneDesc, TextureDesc,

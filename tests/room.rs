@@ -13,7 +13,7 @@ const SIZE: (u32, u32) = (320, 240);
 /// The left eye's display light (linear RGB) with nothing taken away.
 fn gpu_left(scene: &vitreous_scene::Scene) -> Vec<Vec3> {
     let mut scene = scene.clone();
-    scene.compensation = vitreous_render::Compensation::None;
+    scene.compensation = vitreous_optics::display::Compensation::None;
     left_eye_light(&scene, SIZE)
 }
 

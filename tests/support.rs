@@ -98,15 +98,16 @@ pub fn assert_silent(renderer: &vitreous_render::Renderer) {
 }
 
 /// Two eyes 63 mm apart around `above`, looking straight down (0.8 x 0.6 rad field of view).
-pub fn eyes_looking_down(above: Vec3) -> [vitreous_render::EyeParams; 2] {
-    let fov = vitreous_render::camera::Fov {
+pub fn eyes_looking_down(above: Vec3) -> [vitreous_optics::camera::EyeParams; 2] {
+    let fov = vitreous_optics::camera::Fov {
         left_rad: -0.4,
         right_rad: 0.4,
         up_rad: 0.3,
         down_rad: -0.3,
     };
     let down = glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2);
-    [-0.0315f32, 0.0315].map(|x| vitreous_render::EyeParams::new(above + Vec3::X * x, down, fov))
+    [-0.0315f32, 0.0315]
+        .map(|x| vitreous_optics::camera::EyeParams::new(above + Vec3::X * x, down, fov))
 }
 
 /// The machine's Vulkan device with validation on (every test checks its messages).
@@ -119,7 +120,7 @@ pub fn validated_context() -> vitreous_render::GpuContext {
 }
 
 /// The scene's two eyes at its neutral head (the viewer at `head_position_m`, looking down -z).
-pub fn neutral_eyes(scene: &vitreous_scene::Scene) -> [vitreous_render::EyeParams; 2] {
+pub fn neutral_eyes(scene: &vitreous_scene::Scene) -> [vitreous_optics::camera::EyeParams; 2] {
     let head = vitreous_xr::Pose {
         position: scene.viewer.head_position_m,
         orientation: glam::Quat::IDENTITY,
@@ -128,7 +129,7 @@ pub fn neutral_eyes(scene: &vitreous_scene::Scene) -> [vitreous_render::EyeParam
     scene
         .viewer
         .eye_positions_m(&head)
-        .map(|p| vitreous_render::EyeParams::new(p, glam::Quat::IDENTITY, fov))
+        .map(|p| vitreous_optics::camera::EyeParams::new(p, glam::Quat::IDENTITY, fov))
 }
 
 /// Positions, normals, uvs and indices of a mesh, as [`uv_sphere`] makes them.
@@ -179,8 +180,8 @@ pub fn scene_desc<'a>(
         mesh,
         world_from_model,
         ior: 1.5,
-        refraction: vitreous_render::Refraction::Paper,
-        attenuation: vitreous_render::Attenuation::NONE,
+        refraction: vitreous_optics::refraction::Refraction::Paper,
+        attenuation: vitreous_optics::absorption::Attenuation::NONE,
         environment,
         floor,
         background,
@@ -196,7 +197,7 @@ pub fn scene_desc<'a>(
         surface_stack: None,
         inducer: vitreous_render::InducerDesc::PAPER,
         caustics: None,
-        compensation: vitreous_render::Compensation::None,
+        compensation: vitreous_optics::display::Compensation::None,
         room: false,
         glass_samples: 1,
         dimmer: None,
@@ -238,7 +239,7 @@ pub struct FloorPixel {
 /// the floor).
 pub fn floor_pixels(
     scene: &vitreous_scene::Scene,
-    eyes: &[vitreous_render::EyeParams; 2],
+    eyes: &[vitreous_optics::camera::EyeParams; 2],
     bare: &vitreous_render::Readback,
 ) -> Vec<FloorPixel> {
     let (w, h) = (bare.width, bare.height);
@@ -267,7 +268,7 @@ pub fn floor_pixels(
 /// Where the centre of pixel (x, y) of an image of `size` pixels sees the horizontal floor
 /// plane at height `floor_y`.
 pub fn pixel_on_floor(
-    eye: &vitreous_render::EyeParams,
+    eye: &vitreous_optics::camera::EyeParams,
     size: (u32, u32),
     x: u32,
     y: u32,

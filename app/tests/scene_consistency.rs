@@ -104,7 +104,7 @@ fn display_compensation_is_read_and_an_unknown_one_names_the_field() {
     let (_dir, _path, scene) = load_text(&good_text());
     assert_eq!(
         scene.unwrap().compensation,
-        vitreous_render::Compensation::None
+        vitreous_optics::display::Compensation::None
     );
     let text = format!(
         "{}\n[display]\ncompensation = \"background\"\n",
@@ -113,7 +113,7 @@ fn display_compensation_is_read_and_an_unknown_one_names_the_field() {
     let (_dir, _path, scene) = load_text(&text);
     assert_eq!(
         scene.unwrap().compensation,
-        vitreous_render::Compensation::Background
+        vitreous_optics::display::Compensation::Background
     );
     let text = format!("{}\n[display]\ncompensation = \"half\"\n", good_text());
     let msg = expect_error(

@@ -102,7 +102,10 @@ fn refraction_defaults_to_the_paper_and_reads_two_surface() {
     let path = dir.path().join("s.toml");
     std::fs::write(&path, &text).unwrap();
     let scene = load_scene(&path).unwrap();
-    assert_eq!(scene.object.refraction, vitreous_render::Refraction::Paper);
+    assert_eq!(
+        scene.object.refraction,
+        vitreous_optics::refraction::Refraction::Paper
+    );
     let two = text.replace(
         "diameter_m = 0.5",
         "diameter_m = 0.5\nrefraction = \"two-surface\"",
@@ -111,7 +114,7 @@ fn refraction_defaults_to_the_paper_and_reads_two_surface() {
     let scene = load_scene(&path).unwrap();
     assert_eq!(
         scene.object.refraction,
-        vitreous_render::Refraction::TwoSurface
+        vitreous_optics::refraction::Refraction::TwoSurface
     );
 }
 
@@ -258,7 +261,7 @@ pub(crate) fn tetrahedron_with_volume(dir: &Path, volume: &str) -> PathBuf {
 
 #[test]
 fn gltf_volume_attenuation_scales_with_the_object_and_the_scene_overrides_it() {
-    use vitreous_render::Attenuation;
+    use vitreous_optics::absorption::Attenuation;
 
     let dir = tempfile::tempdir().unwrap();
     let model = tetrahedron_with_volume(

@@ -188,7 +188,10 @@ fn visual_effects_keeps_the_papers_distances() {
 fn the_real_glass_scene_refracts_the_room_and_the_papers_scenes_their_hdri() {
     let real = load("glass-sphere-real.toml");
     assert!(real.environment.room);
-    assert_eq!(real.compensation, vitreous_render::Compensation::Background);
+    assert_eq!(
+        real.compensation,
+        vitreous_optics::display::Compensation::Background
+    );
     assert_eq!(real.light.share, 0.5);
     assert_eq!(real.output.glass_samples, 4);
     let paper = load("glass-sphere.toml");

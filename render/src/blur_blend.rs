@@ -12,11 +12,11 @@ use std::cell::Cell;
 
 use ash::vk;
 
-use crate::camera::Look;
 use crate::context::GpuContext;
 use crate::descriptors::{self, TextureSets};
 use crate::error::Result;
 use crate::floor::FieldTarget;
+use crate::look::Look;
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, Depth, FieldStart, PipelineSpec};
 use crate::scene::GpuScene;

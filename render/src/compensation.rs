@@ -19,16 +19,6 @@ use crate::owned::Owned;
 use crate::scene::{GpuScene, PlaneDesc, SceneDesc, TexelData};
 use bytemuck::Zeroable as _;
 
-/// What the display takes away from the glass's light (`[display] compensation`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Compensation {
-    /// Nothing: the glass's whole light is added (the paper's conditions).
-    #[default]
-    None,
-    /// The real floor or background the eye sees through the glass (eq. 6 over the glass).
-    Background,
-}
-
 /// The planes and where each photo lies in the packed texture (shaders/shared/seen.wgsl
 /// `Planes`).
 #[repr(C)]

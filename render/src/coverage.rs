@@ -26,12 +26,13 @@
 //! of the light from the photo where the ray points.
 
 use glam::{Mat4, Vec2, Vec3};
+use vitreous_optics::camera::EyeParams;
+use vitreous_optics::optics::{plane_photo_point, refract, refract_heckbert};
+use vitreous_optics::radial_map::mesh_center;
+use vitreous_optics::refraction::Refraction;
+use vitreous_optics::two_surface::RADIAL_NORMAL_COS;
 
-use crate::camera::EyeParams;
-use crate::optics::{plane_photo_point, refract, refract_heckbert};
-use crate::radial_map::mesh_center;
-use crate::scene::{MeshRef, Refraction, SceneDesc};
-use crate::two_surface::RADIAL_NORMAL_COS;
+use crate::scene::{MeshRef, SceneDesc};
 
 mod shown;
 mod tiles;

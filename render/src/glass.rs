@@ -17,21 +17,23 @@ use patches::Patches;
 
 use ash::vk;
 use glam::Vec4;
+use vitreous_optics::camera::EyeParams;
+use vitreous_optics::convex;
+use vitreous_optics::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
+use vitreous_optics::radial_map::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, mesh_center, radial_map};
+use vitreous_optics::refraction::Refraction;
 
-use crate::camera::{EyeParams, Look, Reflection};
 use crate::compensation::CompensationSet;
 use crate::context::GpuContext;
-use crate::convex;
 use crate::coverage::{self, PhotoCoverage};
 use crate::descriptors;
 use crate::error::Result;
+use crate::look::{Look, Reflection};
 use crate::memory::{Buffer, Image, upload_texture};
-use crate::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, Depth, PipelineSpec};
 use crate::pose::ScenePose;
-use crate::radial_map::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, mesh_center, radial_map};
-use crate::scene::{GpuScene, Refraction, SceneDesc, VERTEX_STRIDE};
+use crate::scene::{GpuScene, SceneDesc, VERTEX_STRIDE};
 use crate::shaders;
 use crate::work::ShaderCost;
 
@@ -603,7 +605,7 @@ fn upload_facet_planes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::Defocus;
+    use crate::look::Defocus;
 
     #[test]
     fn each_variant_draws_with_the_entry_point_named_for_it() {

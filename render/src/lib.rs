@@ -22,13 +22,12 @@
 //! the device, is dropped after all of them.
 //!
 //! Knows nothing about OpenXR: device creation is an injected step ([`context::DeviceCreator`]).
+//! The optics it draws and tests against on the CPU (refraction, the tracers, the radial map,
+//! the eye's camera, the dimmer's panel) are `vitreous-optics`'.
 
-pub mod absorption;
 mod blur_blend;
-pub mod camera;
 mod compensation;
 pub mod context;
-pub mod convex;
 pub mod coverage;
 mod descriptors;
 pub mod dimmer;
@@ -36,39 +35,33 @@ pub mod error;
 pub mod floor;
 mod footprint;
 mod glass;
+pub mod look;
 mod memory;
-pub mod optics;
 mod owned;
 mod pipeline;
 pub mod pose;
-pub mod radial_map;
 pub mod reference;
 pub mod renderer;
 pub mod ripmap;
 pub mod scene;
 mod shaders;
-pub mod solid;
-pub mod srgb;
 pub(crate) mod statistics;
 mod target;
-pub mod two_surface;
 mod validation;
 pub mod work;
 mod world;
 
-pub use absorption::Attenuation;
-pub use camera::{Defocus, EyeParams, FrameParams, Look, Reflection};
-pub use compensation::Compensation;
 pub use context::{ContextOptions, DeviceCreator, GpuContext, PlainVulkan};
 pub use error::{RenderError, Result};
 /// The floor passes under their earlier name.
 pub use floor as inducer;
 pub use floor::InducerFields;
+pub use look::{Defocus, FrameParams, Look, Reflection};
 pub use memory::{color_copy_region, layout_barrier, subresource_range};
 pub use pose::ScenePose;
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
-    BlurStackDesc, CausticsDesc, DimmerDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc,
-    Refraction, RefractionParseError, SceneDesc, TexelData, TextureDesc,
+    BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData,
+    TextureDesc,
 };
 pub use work::{FrameWork, Invocations, PassInvocations, PhotonWork, RecordedWork, ShaderCost};

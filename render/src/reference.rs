@@ -1,15 +1,14 @@
 //! CPU reference of the refraction layer for an analytic sphere: what each pixel of an eye
 //! image samples from the registered background photo, under the paper's model (eq. 7-8) or
-//! two-surface refraction (`two_surface.rs`, with the absorption of a tinted glass). Tests compare the GPU against it;
-//! `vitreous replay --reference` writes it beside the GPU image.
+//! two-surface refraction (`vitreous_optics::two_surface`, with the absorption of a tinted glass).
+//! Tests compare the GPU against it; `vitreous replay --reference` writes it beside the GPU image.
 
 use glam::{Mat4, Vec2, Vec3};
-
-use crate::absorption::Attenuation;
-use crate::camera::EyeParams;
-use crate::optics::{fresnel, plane_uv, ray_sphere, refract_heckbert};
-use crate::scene::Refraction;
-use crate::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, pass_through};
+use vitreous_optics::absorption::Attenuation;
+use vitreous_optics::camera::EyeParams;
+use vitreous_optics::optics::{fresnel, plane_uv, ray_sphere, refract_heckbert};
+use vitreous_optics::refraction::Refraction;
+use vitreous_optics::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, pass_through};
 
 /// An analytic glass sphere in front of a registered background plane.
 #[derive(Clone, Copy, Debug)]
@@ -48,41 +47,6 @@ pub enum RefractionSample {
         /// glass).
         absorption: Vec3,
     },
-}
-
-impl EyeParams {
-    /// Unit direction of the view ray through a pixel position (x right, y down, pixel centres
-    /// at half-integers) of an image of `size` pixels.
-    pub fn pixel_ray(&self, pixel: Vec2, size: Vec2) -> Vec3 {
-        self.pixel_rays(size).direction(pixel)
-    }
-
-    /// The view rays of an image of `size` pixels, for many pixels at the cost of one matrix
-    /// inverse.
-    pub fn pixel_rays(&self, size: Vec2) -> PixelRays {
-        PixelRays {
-            world_from_clip: self.clip_from_world().inverse(),
-            size,
-        }
-    }
-}
-
-/// The view rays of one eye image ([`EyeParams::pixel_rays`]).
-#[derive(Clone, Copy, Debug)]
-pub struct PixelRays {
-    world_from_clip: Mat4,
-    size: Vec2,
-}
-
-impl PixelRays {
-    /// Unit direction of the view ray through a pixel position (x right, y down, pixel centres
-    /// at half-integers).
-    pub fn direction(&self, pixel: Vec2) -> Vec3 {
-        let ndc = pixel / self.size * 2.0 - Vec2::ONE;
-        let near = self.world_from_clip.project_point3(ndc.extend(0.0));
-        let far = self.world_from_clip.project_point3(ndc.extend(1.0));
-        (far - near).normalize()
-    }
 }
 
 /// Traces one pixel of one eye: eye ray -> sphere -> first refraction (eq. 7-8), or both
@@ -163,30 +127,8 @@ pub fn marker_centroid(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::Fov;
     use glam::Quat;
-
-    #[test]
-    fn pixel_ray_through_the_centre_looks_forward() {
-        let fov = Fov {
-            left_rad: -0.5,
-            right_rad: 0.5,
-            up_rad: 0.4,
-            down_rad: -0.4,
-        };
-        let eye = EyeParams::new(Vec3::ZERO, Quat::IDENTITY, fov);
-        let d = eye.pixel_ray(Vec2::new(50.0, 40.0), Vec2::new(100.0, 80.0));
-        assert!(d.abs_diff_eq(Vec3::NEG_Z, 1e-5), "{d}");
-        // A pixel ray projects back onto its pixel.
-        let p = Vec2::new(13.5, 71.5);
-        let back = eye
-            .project_to_pixel(
-                eye.pixel_ray(p, Vec2::new(100.0, 80.0)),
-                Vec2::new(100.0, 80.0),
-            )
-            .unwrap();
-        assert!(back.abs_diff_eq(p, 1e-3), "{back}");
-    }
+    use vitreous_optics::camera::Fov;
 
     #[test]
     fn the_centre_ray_refracts_straight_to_the_plane_centre() {

@@ -7,19 +7,20 @@
 
 use std::sync::Arc;
 use std::time::Instant;
+use vitreous_optics::display::Compensation;
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use crate::blur_blend::BlurBlend;
-use crate::camera::FrameParams;
-use crate::compensation::{Compensation, CompensationSet};
+use crate::compensation::CompensationSet;
 use crate::context::GpuContext;
 use crate::dimmer::DimmerPass;
 use crate::error::{RenderError, Result, VkContext};
 use crate::floor::{FIELD_STAMPS, FieldPassesMs, InducerFields, InducerPass, Prepared};
 use crate::footprint::Footprint;
 use crate::glass::{GlassPass, GlassVariant, Pick};
+use crate::look::FrameParams;
 use crate::memory::Buffer;
 use crate::owned::Owned;
 use crate::pose::ScenePose;
@@ -370,7 +371,7 @@ impl Renderer {
     pub fn enable_live_caustics(
         &mut self,
         scene: &SceneDesc,
-        live: crate::floor::LiveCausticsDesc,
+        live: vitreous_optics::live_caustics::LiveCausticsDesc,
     ) -> Result<()> {
         self.inducer.enable_live(&self.ctx, scene, live)
     }

@@ -9,9 +9,10 @@
 //! photo's edge), stored as 8-bit sRGB. A photo's reductions lie in columns by `i` and rows
 //! by `j`; the second photo's to the right of the first's.
 
+use vitreous_optics::srgb;
+
 use crate::error::{RenderError, Result};
 use crate::scene::{TexelData, TextureDesc};
-use crate::srgb;
 
 /// Reductions along each axis: by 1, 2, 4, ..., 32.
 pub const LEVELS: usize = 6;

@@ -2,8 +2,11 @@
 
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
+use vitreous_optics::absorption::Attenuation;
+use vitreous_optics::display::Compensation;
+use vitreous_optics::display::dimmer::DimmerDesc;
+use vitreous_optics::refraction::Refraction;
 
-use crate::absorption::Attenuation;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result, VkContext};
 use crate::memory::{Buffer, Image, upload_texture, upload_volume};
@@ -51,45 +54,6 @@ pub struct PlaneDesc<'a> {
     pub photo: TextureDesc<'a>,
 }
 
-/// How the glass pass refracts the view ray (`[object] refraction` in a scene file).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Refraction {
-    /// The paper's model (eq. 7-8): one refraction at the front surface, then straight on to
-    /// the background. The reference for the paper's studies.
-    #[default]
-    Paper,
-    /// In at the front and out at the back surface, with total internal reflection followed
-    /// for a bounded number of bounces (docs/equations.md, *Beyond the paper*).
-    TwoSurface,
-}
-
-impl Refraction {
-    /// The name a scene file uses.
-    pub fn name(self) -> &'static str {
-        match self {
-            Refraction::Paper => "paper",
-            Refraction::TwoSurface => "two-surface",
-        }
-    }
-}
-
-/// A refraction model name that is neither `paper` nor `two-surface`.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("expected \"paper\" or \"two-surface\", found \"{0}\"")]
-pub struct RefractionParseError(pub String);
-
-impl std::str::FromStr for Refraction {
-    type Err = RefractionParseError;
-
-    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
-        match s {
-            "paper" => Ok(Refraction::Paper),
-            "two-surface" => Ok(Refraction::TwoSurface),
-            _ => Err(RefractionParseError(s.to_owned())),
-        }
-    }
-}
-
 /// Everything static the renderer draws.
 #[derive(Clone, Copy, Debug)]
 pub struct SceneDesc<'a> {
@@ -135,7 +99,7 @@ pub struct SceneDesc<'a> {
     pub caustics: Option<CausticsDesc<'a>>,
     // --- end caustics ---
     /// What the display takes away from the glass's light (eq. 6 over the glass).
-    pub compensation: crate::Compensation,
+    pub compensation: Compensation,
     /// The floor and background photos are the room the glass refracts and reflects
     /// (`[environment] room`): every ray leaving the glass takes the photo it meets first, the
     /// environment map only where it meets neither. Off: the paper's targets (the background
@@ -149,18 +113,6 @@ pub struct SceneDesc<'a> {
     /// and the light that makes up for what the soft panel takes away too much
     /// (render/src/dimmer).
     pub dimmer: Option<DimmerDesc>,
-}
-
-/// A segmented dimmer in front of the display (Magic Leap 2's): a coarse panel whose cells
-/// each take away a share of the real world's light, seen out of focus.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DimmerDesc {
-    /// Cells across and down the eye's view.
-    pub cells: [u32; 2],
-    /// Standard deviation of the panel's optical blur (a Gaussian point spread), degrees.
-    pub blur_deg: f32,
-    /// The largest share of the real world's light a cell takes away (0..1).
-    pub max: f32,
 }
 
 // --- caustics (issue 6; render/src/floor/) ---

@@ -4,11 +4,11 @@
 //! footprint from the photos' ripmaps, the world eq. 6 over the glass takes away.
 
 use std::sync::Arc;
+use vitreous_optics::camera::EyeParams;
 
 use ash::vk;
 use glam::Mat4;
 
-use crate::camera::EyeParams;
 use crate::context::GpuContext;
 use crate::descriptors::{self, TextureSets};
 use crate::error::Result;

@@ -1,7 +1,7 @@
 // Shared by the shaders that name it in a `// #include shared/fresnel.wgsl` line (render/build.rs
 // appends it to their source).
 
-// Exact Fresnel reflectance for unpolarised light (twin of render/src/optics.rs
+// Exact Fresnel reflectance for unpolarised light (twin of optics/src/optics.rs
 // fresnel_reflectance): cos_i on the incident side, eta = n_incident / n_transmitted.
 fn fresnel_exact(cos_incident: f32, eta: f32) -> f32 {
     let cos_i = clamp(cos_incident, 0.0, 1.0);

@@ -5,7 +5,7 @@
 //! glass's absorption along each ray's path inside.
 
 use glam::{Vec2, Vec3};
-use vitreous_render::Refraction;
+use vitreous_optics::refraction::Refraction;
 use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sample};
 use vitreous_xr::FrameInput;
 

@@ -1,7 +1,7 @@
 //! From what a backend hands out to what the renderer takes: per-eye cameras and the scene's
 //! GPU description.
 
-use vitreous_render::camera::{EyeParams, Fov as RenderFov};
+use vitreous_optics::camera::{EyeParams, Fov as RenderFov};
 use vitreous_render::{
     CausticsDesc, FrameParams, InducerDesc, LightDesc, Look, MeshRef, PlaneDesc, SceneDesc,
     ScenePose, TexelData, TextureDesc,
@@ -108,7 +108,7 @@ pub fn enable_live_caustics(
     if !caustics || scene.caustics.mode != CausticsMode::Live {
         return Ok(());
     }
-    let live = vitreous_render::floor::LiveCausticsDesc {
+    let live = vitreous_optics::live_caustics::LiveCausticsDesc {
         photons_per_side: scene.caustics.photons_per_side,
         smoothing_px: scene.caustics.smoothing_px,
         min_path_weight: scene.caustics.min_path_weight,

@@ -3,15 +3,14 @@
 //! (`[display] global_dimmer`) takes away its share of the world everywhere; a segmented dimmer
 //! (`[display] model = "dimmer"`) takes away, under each of its cells, the mean alpha of the
 //! eye image's pixels there (as a runtime would drive it), seen through the panel's blur
-//! (vitreous_render::dimmer::model).
+//! (vitreous_optics::display::dimmer).
 
-use vitreous_render::DimmerDesc;
-use vitreous_render::dimmer::model::Panel;
+use vitreous_optics::display::dimmer::{DimmerDesc, Panel};
 
 use vitreous_scene::srgb_to_linear;
 
 /// Linear light (clamped to 0..1) to an sRGB-encoded byte.
-pub use vitreous_render::srgb::from_linear as linear_to_srgb;
+pub use vitreous_optics::srgb::from_linear as linear_to_srgb;
 
 /// What the wearer perceives: the display's light added to the real world's, in linear light
 /// (an optical see-through display can only add). Both inputs and the output are sRGB RGBA8.

@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use vitreous_render::camera::EyeParams;
+use vitreous_optics::camera::EyeParams;
 
 use crate::world::World;
 

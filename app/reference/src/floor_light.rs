@@ -22,8 +22,8 @@ use std::f32::consts::TAU;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use vitreous_render::optics::{fresnel_reflectance, reflect, refract};
-use vitreous_render::two_surface::Body;
+use vitreous_optics::optics::{fresnel_reflectance, reflect, refract};
+use vitreous_optics::two_surface::Body;
 
 use crate::light_map::FloorLight;
 use crate::world::{EPS_M, Glass, MAX_INTERFACES, MIN_WEIGHT, PhotoHit, World};

@@ -25,6 +25,9 @@
 //! shadow on the wall and its occlusion of the room's ambient light, dispersion and
 //! polarisation.
 //!
+//! The optics it traces with (Snell, Fresnel, the ball and closed-mesh bodies, absorption, the
+//! eye's camera) are `vitreous-optics`': no device is involved.
+//!
 //! | module | what it is |
 //! |---|---|
 //! | [`world`] | the real world: photos on their planes, the environment, the glass object |

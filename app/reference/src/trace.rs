@@ -2,8 +2,8 @@
 //! every interface splits the light by Fresnel into a reflected and a transmitted branch.
 
 use glam::{Vec2, Vec3};
-use vitreous_render::optics::{fresnel_reflectance, reflect, refract};
-use vitreous_render::two_surface::Body;
+use vitreous_optics::optics::{fresnel_reflectance, reflect, refract};
+use vitreous_optics::two_surface::Body;
 
 use crate::world::{EPS_M, Glass, MAX_INTERFACES, MIN_WEIGHT, PhotoHit, World};
 
@@ -142,7 +142,7 @@ mod tests {
     use super::*;
     use crate::world::{Picture, Surface};
     use glam::Mat4;
-    use vitreous_render::Attenuation;
+    use vitreous_optics::absorption::Attenuation;
 
     fn grey_world(glass: Option<Glass>) -> World {
         World {

@@ -5,9 +5,9 @@ use std::f32::consts::{PI, TAU};
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3};
-use vitreous_render::Attenuation;
-use vitreous_render::solid::SolidError;
-use vitreous_render::two_surface::{Ball, Body, MeshBody};
+use vitreous_optics::absorption::Attenuation;
+use vitreous_optics::solid::SolidError;
+use vitreous_optics::two_surface::{Ball, Body, MeshBody};
 use vitreous_scene::{Image, PixelData, Placement, RealPlane, Scene, srgb_to_linear};
 
 use crate::light_map::FloorLight;

@@ -11,10 +11,10 @@
 use std::path::Path;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
+use vitreous_optics::absorption::Attenuation;
+use vitreous_optics::camera::{EyeParams, Fov};
+use vitreous_optics::solid::flat_cube;
 use vitreous_reference::{Glass, Picture, Surface, World};
-use vitreous_render::Attenuation;
-use vitreous_render::camera::{EyeParams, Fov};
-use vitreous_render::solid::flat_cube;
 
 const SIZE: (u32, u32) = (1280, 960);
 const IOR: f32 = 1.51;

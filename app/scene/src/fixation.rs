@@ -10,8 +10,8 @@
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
-use vitreous_render::Refraction;
-use vitreous_render::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, MeshBody, pass_through};
+use vitreous_optics::refraction::Refraction;
+use vitreous_optics::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, MeshBody, pass_through};
 use vitreous_xr::synth::{FixationTarget, SynthParams};
 
 use super::{Object, Scene};
@@ -356,7 +356,7 @@ mod tests {
         // 0.125 m from it, 0.075 m in front of the viewer (on the ball's surface plane).
         let g = ball_geometry(-1.2);
         let p = g.points_from(Vec3::ZERO);
-        let (image_m, _) = vitreous_render::two_surface::ball_image(1.0, 0.075, 1.51);
+        let (image_m, _) = vitreous_optics::two_surface::ball_image(1.0, 0.075, 1.51);
         let expected = Vec3::new(0.0, 0.0, -0.2 + image_m);
         assert!(
             p.refracted_m.distance(expected) < 1e-3,
@@ -400,7 +400,7 @@ mod tests {
         // A flat-shaded glass cube 10 cm thick, face on, 0.5 m ahead; the background 1.5 m
         // ahead. Paraxially a plate of thickness T shows a point behind it T (1 - 1/n) nearer:
         // a virtual image 1.5 - 0.1 (1 - 1/1.5) = 1.4667 m away.
-        let (positions, normals, indices) = vitreous_render::solid::flat_cube(0.05);
+        let (positions, normals, indices) = vitreous_optics::solid::flat_cube(0.05);
         let lens = MeshLens {
             body: MeshBody::new(&positions, &normals, &indices).expect("a closed cube"),
         };

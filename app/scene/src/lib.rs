@@ -96,12 +96,12 @@ pub struct Scene {
     /// What the display takes away from the glass's light (`[display] compensation`): nothing
     /// (the paper's), or the real floor or background the eye already sees (eq. 6 over the
     /// glass).
-    pub compensation: vitreous_render::Compensation,
+    pub compensation: vitreous_optics::display::Compensation,
     /// How much the headset's global dimmer darkens the whole view (`[display] global_dimmer`,
     /// 0 none to 1 the most; Magic Leap 2's `XR_ML_global_dimmer`), when the scene asks for it.
     pub global_dimmer: Option<f32>,
     /// The display's segmented dimmer (`[display] model = "dimmer"`), when it has one.
-    pub dimmer: Option<vitreous_render::DimmerDesc>,
+    pub dimmer: Option<vitreous_optics::display::dimmer::DimmerDesc>,
     /// The shadow inducer's parameters.
     pub inducer: Inducer,
     /// The caustic bake (eq. 6): where it is and, once [`Scene::load_caustics`] ran, its
@@ -278,11 +278,12 @@ pub struct Object {
     pub ior_source: IorSource,
     /// How the view ray is refracted through the object (`refraction`; the paper's model by
     /// default).
-    pub refraction: vitreous_render::Refraction,
+    pub refraction: vitreous_optics::refraction::Refraction,
     /// Absorption inside the object, world metres: the model's `KHR_materials_volume`
     /// (its distance scaled with the object), each part overridden by `attenuation_distance_m`
-    /// and `attenuation_color`; clear glass ([`vitreous_render::Attenuation::NONE`]) without.
-    pub attenuation: vitreous_render::Attenuation,
+    /// and `attenuation_color`; clear glass
+    /// ([`vitreous_optics::absorption::Attenuation::NONE`]) without.
+    pub attenuation: vitreous_optics::absorption::Attenuation,
     /// Surface texture (sRGB), mapped with the mesh's `TEXCOORD_0`, if any.
     pub surface_texture: Option<Image>,
     /// Fraction of light the surface texture lets through, 0..1 (1 = no visible surface
@@ -316,7 +317,7 @@ impl Object {
         m.positions.iter().zip(&m.normals).all(|(&p, &n)| {
             (p.distance(c) - radius).abs() <= 1e-4 * radius
                 && n.normalize_or_zero().dot(p - c)
-                    > vitreous_render::two_surface::RADIAL_NORMAL_COS * p.distance(c)
+                    > vitreous_optics::two_surface::RADIAL_NORMAL_COS * p.distance(c)
         })
     }
 }

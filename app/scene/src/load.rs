@@ -11,9 +11,10 @@ use std::path::{Component, Path, PathBuf};
 use glam::{Mat4, Quat, Vec2, Vec3};
 use sha2::{Digest, Sha256};
 use toml::Spanned;
-use vitreous_render::Attenuation;
-use vitreous_render::floor::{
-    DEFAULT_LIVE_RESOLUTION_PX, LiveCausticsDesc, MAX_PHOTONS_PER_SIDE, MAX_SMOOTHING_PX,
+use vitreous_optics::absorption::Attenuation;
+use vitreous_optics::live_caustics::{
+    DEFAULT_RESOLUTION_PX as DEFAULT_LIVE_RESOLUTION_PX, LiveCausticsDesc, MAX_PHOTONS_PER_SIDE,
+    MAX_SMOOTHING_PX,
 };
 use vitreous_xr::{Fov, Pose};
 

@@ -10,11 +10,10 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
+use vitreous_optics::refraction::Refraction;
 use vitreous_render::floor::FieldPassesMs;
 use vitreous_render::renderer::Want;
-use vitreous_render::{
-    ContextOptions, FrameWork, GpuContext, Look, Reflection, Refraction, Renderer,
-};
+use vitreous_render::{ContextOptions, FrameWork, GpuContext, Look, Reflection, Renderer};
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::{Backend, FrameInput};
 
@@ -191,7 +190,8 @@ pub fn fetches_per_pixel(look: &Look) -> u32 {
 /// background away, none where the dimmer's resolve does or the scene keeps the paper's light.
 pub fn compensation_fetches(scene: &vitreous_scene::Scene) -> u32 {
     u32::from(
-        scene.compensation == vitreous_render::Compensation::Background && scene.dimmer.is_none(),
+        scene.compensation == vitreous_optics::display::Compensation::Background
+            && scene.dimmer.is_none(),
     )
 }
 
@@ -574,7 +574,10 @@ mod tests {
         assert_eq!(compensation_fetches(&scene("glass-sphere-real.toml")), 1);
         assert_eq!(compensation_fetches(&scene("glass-sphere.toml")), 0);
         let ml2 = scene("glass-sphere-ml2.toml");
-        assert_eq!(ml2.compensation, vitreous_render::Compensation::Background);
+        assert_eq!(
+            ml2.compensation,
+            vitreous_optics::display::Compensation::Background
+        );
         assert_eq!(compensation_fetches(&ml2), 0);
     }
 }

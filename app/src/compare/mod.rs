@@ -270,7 +270,7 @@ fn wearer_view(
             scene.path.display()
         );
     };
-    let dimmer = vitreous_render::DimmerDesc { blur_deg, ..dimmer };
+    let dimmer = vitreous_optics::display::dimmer::DimmerDesc { blur_deg, ..dimmer };
     Ok(WearerView::new(
         Some(dimmer),
         scene.global_dimmer,

@@ -12,10 +12,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
+use vitreous_optics::refraction::Refraction;
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{
-    ContextOptions, GpuContext, Look, Reflection, Refraction, Renderer, ScenePose,
-};
+use vitreous_render::{ContextOptions, GpuContext, Look, Reflection, Renderer, ScenePose};
 use vitreous_xr::null::{NullBackend, NullConfig};
 use vitreous_xr::trace::{EditRecord, Recording, TraceSample};
 use vitreous_xr::{FrameInput, SessionEvent};

@@ -245,7 +245,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         .flat_map(|c| {
             let look = base_look(c, options.reflection);
             let blurred = c.defocus.then_some(vitreous_render::Look {
-                defocus: Some(vitreous_render::camera::Defocus {
+                defocus: Some(vitreous_render::Defocus {
                     refracted_k_g_px: 1.0,
                     surface_k_g_px: 1.0,
                 }),
@@ -278,8 +278,8 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         end: end_flag.clone(),
         depth: Some(DepthOptions {
             format: Renderer::DEPTH_FORMAT,
-            near_m: vitreous_render::camera::NEAR_M,
-            far_m: vitreous_render::camera::FAR_M,
+            near_m: vitreous_optics::camera::NEAR_M,
+            far_m: vitreous_optics::camera::FAR_M,
         }),
         continued,
     };

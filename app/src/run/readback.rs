@@ -62,7 +62,7 @@ pub(super) struct Dimmed {
     /// The points.
     pub points: Vec<glam::Vec3>,
     /// The panel.
-    pub panel: vitreous_render::DimmerDesc,
+    pub panel: vitreous_optics::display::dimmer::DimmerDesc,
 }
 
 /// Checks a readback of both eyes (see [`ReadbackCheck`]); `rb.world` (the real world alone)
@@ -118,7 +118,7 @@ pub(super) fn check_readback(
         let mut dark = Vec::new();
         if let Some(dimmed) = dimmed {
             let fov_deg = [r.atan() - l.atan(), u.atan() - d.atan()].map(f32::to_degrees);
-            let panel = vitreous_render::dimmer::model::Panel::new(&dimmed.panel, fov_deg);
+            let panel = vitreous_optics::display::dimmer::Panel::new(&dimmed.panel, fov_deg);
             // The panel darkens squares of cells: how far, in pixels, across and down.
             let reach = [0, 1]
                 .map(|a| (panel.reach()[a] + 1) as f32 * [w, h][a] as f32 / panel.cells[a] as f32);
@@ -325,7 +325,7 @@ mod tests {
     fn dimmed_at(points: Vec<glam::Vec3>) -> Dimmed {
         Dimmed {
             points,
-            panel: vitreous_render::DimmerDesc {
+            panel: vitreous_optics::display::dimmer::DimmerDesc {
                 cells: [64, 64],
                 blur_deg: 1.0,
                 max: 0.9,

@@ -38,7 +38,7 @@ pub(super) struct RunSink<'d> {
     /// With a segmented dimmer: its panel, where the light is and where the floor lies (a
     /// point and its normal), so the readback check knows where the shadow falls.
     pub(super) dimmer_shadow: Option<(
-        vitreous_render::DimmerDesc,
+        vitreous_optics::display::dimmer::DimmerDesc,
         glam::Vec3,
         glam::Vec3,
         glam::Vec3,

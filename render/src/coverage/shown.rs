@@ -2,9 +2,9 @@
 //! reaches. The glass pass draws no other tile, so the test errs only towards showing.
 
 use glam::Vec3;
+use vitreous_optics::camera::EyeParams;
 
 use super::tiles::{TILES, Tiles, edge};
-use crate::camera::EyeParams;
 
 /// The tiles of the image of `eye` (`extent` pixels) that the ball about `center` (world) of
 /// `radius` may show in. A tile is left out where its frustum (its pixels' box, grown by a

@@ -31,7 +31,7 @@ const IPD_M: f32 = 0.063;
 /// Two eyes at `head_m` looking down -z turned by `yaw`, seeing the scene's 40 x 30 degrees.
 fn eyes(head_m: Vec3, yaw: f32) -> [EyeParams; 2] {
     let (h, v) = (20f32.to_radians(), 15f32.to_radians());
-    let fov = crate::camera::Fov {
+    let fov = vitreous_optics::camera::Fov {
         left_rad: -h,
         right_rad: h,
         up_rad: v,
@@ -210,12 +210,13 @@ fn the_rays_left_out_carry_under_1e4_of_the_light() {
     // The paper's model: the refracted image is weighted by 1 - F, F the empirical term.
     let paper = scene(Refraction::Paper, 0.6);
     let cos = paper.grazing_cos();
-    assert!(1.0 - crate::optics::fresnel(incident(cos), Vec3::Z) < 1e-4);
-    assert!(1.0 - crate::optics::fresnel(incident(cos * 10.0), Vec3::Z) > 1e-4);
+    assert!(1.0 - vitreous_optics::optics::fresnel(incident(cos), Vec3::Z) < 1e-4);
+    assert!(1.0 - vitreous_optics::optics::fresnel(incident(cos * 10.0), Vec3::Z) > 1e-4);
     // Two surfaces: a ball's exit meets the surface as the entry did, so the light passed
     // is (1 - F)^2, F exact.
     let two = scene(Refraction::TwoSurface, 0.6);
-    let passed = |cos: f32| (1.0 - crate::optics::fresnel_reflectance(cos, 1.0 / two.ior)).powi(2);
+    let passed =
+        |cos: f32| (1.0 - vitreous_optics::optics::fresnel_reflectance(cos, 1.0 / two.ior)).powi(2);
     assert!(
         passed(two.grazing_cos()) < 1e-4,
         "{}",

@@ -8,6 +8,7 @@
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
+use vitreous_optics::live_caustics::{LiveCausticsDesc, MAX_PHOTONS_PER_SIDE, MAX_SMOOTHING_PX};
 
 use super::fields::{CAUSTIC_PHOTONS_STAMP, FIELD_STAMPS, Stamps};
 use super::live_mesh::LiveMesh;
@@ -25,81 +26,26 @@ use crate::pose::ScenePose;
 use crate::shaders;
 use crate::work::PhotonWork;
 
-/// How caustics are computed live.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LiveCausticsDesc {
-    /// Photons along each side of the emission grid (its square is the photon count).
-    pub photons_per_side: u32,
-    /// Most reflections and refractions on one light path (the bake's default: 12).
-    pub max_interactions: u32,
-    /// Light paths carrying less than this share of their photon's light end (greater than
-    /// 0, less than 1; the bake follows them to 1e-4).
-    pub min_path_weight: f32,
-    /// Radius of the box the map is smoothed with, texels of the map (0: not smoothed): each
-    /// texel becomes the mean of the 2 r + 1 texels around it, three times along the rows,
-    /// then three times along the columns, a kernel close to a Gaussian of standard deviation
-    /// sqrt(r (r + 1)) texels, 6r + 1 texels wide.
-    pub smoothing_px: u32,
-    /// Whether a smoothing of radius 0 to 2 skips the tiles whose gains are certain to be
-    /// stored as 0 (docs/caustics.md, *Smoothing*); the map is the same either way.
-    pub skip_tiles: bool,
-}
-
-impl Default for LiveCausticsDesc {
-    /// 128 x 128 photons, 12 interactions, paths ending below [`MIN_WEIGHT`], a smoothing box
-    /// of radius 2 texels (on the default
-    /// [`DEFAULT_RESOLUTION_PX`] map, the glass sphere's map within 0.6 % of its bake and the
-    /// diamond's within 3.3 %, both bakes averaged to that resolution and smoothed alike;
-    /// docs/caustics.md).
-    fn default() -> LiveCausticsDesc {
-        LiveCausticsDesc {
-            photons_per_side: 128,
-            max_interactions: 12,
-            min_path_weight: MIN_WEIGHT,
-            smoothing_px: 2,
-            skip_tiles: true,
-        }
+/// An error naming the settings unless each is within its range.
+pub(super) fn check(desc: &LiveCausticsDesc) -> Result<()> {
+    let weight = desc.min_path_weight;
+    if !(1..=MAX_PHOTONS_PER_SIDE).contains(&desc.photons_per_side)
+        || desc.max_interactions == 0
+        || desc.smoothing_px > MAX_SMOOTHING_PX
+        || weight.is_nan()
+        || weight <= 0.0
+        || weight >= 1.0
+    {
+        return Err(RenderError::InvalidInput(format!(
+            "live caustics need 1..={MAX_PHOTONS_PER_SIDE} photons per side, at least \
+             one interaction, a smoothing of 0..={MAX_SMOOTHING_PX} texels and a least \
+             path weight above 0 and below 1, got {}, {}, {} and {weight}",
+            desc.photons_per_side, desc.max_interactions, desc.smoothing_px
+        )));
     }
+    Ok(())
 }
 
-impl LiveCausticsDesc {
-    /// An error naming the settings unless each is within its range.
-    pub(super) fn check(&self) -> Result<()> {
-        let weight = self.min_path_weight;
-        if !(1..=MAX_PHOTONS_PER_SIDE).contains(&self.photons_per_side)
-            || self.max_interactions == 0
-            || self.smoothing_px > MAX_SMOOTHING_PX
-            || weight.is_nan()
-            || weight <= 0.0
-            || weight >= 1.0
-        {
-            return Err(RenderError::InvalidInput(format!(
-                "live caustics need 1..={MAX_PHOTONS_PER_SIDE} photons per side, at least \
-                 one interaction, a smoothing of 0..={MAX_SMOOTHING_PX} texels and a least \
-                 path weight above 0 and below 1, got {}, {}, {} and {weight}",
-                self.photons_per_side, self.max_interactions, self.smoothing_px
-            )));
-        }
-        Ok(())
-    }
-}
-
-/// Default side of the live gain map, texels: 1 mm texels on the shipped 1 m floors, half the
-/// bakes' 1980. Smoothed with the default box (standard deviation sqrt(6) texels, 2.5 mm
-/// there) it keeps as much detail as the bakes' resolution smoothed with a box of radius 5
-/// (2.8 mm), at a quarter of the texels each computation clears, smooths and copies.
-pub const DEFAULT_RESOLUTION_PX: u32 = 990;
-
-/// Largest photon grid side accepted.
-pub const MAX_PHOTONS_PER_SIDE: u32 = 4096;
-/// Largest smoothing box radius accepted, texels.
-pub const MAX_SMOOTHING_PX: u32 = 64;
-/// Paths below this weight end by default. The bake follows them to 1e-4; the live maps of the sphere,
-/// the diamond and the torus are as close to their bakes with 1e-2 (0.52 %, 3.23 % and 3.38 %
-/// against 0.51 %, 3.23 % and 3.40 %), and the sphere's stage after a move costs about 10 ms
-/// less on lavapipe (a ball's second internal reflection, 0.16 % of the light, is one more
-/// walk through the glass for every photon).
-pub(super) const MIN_WEIGHT: f32 = 1e-2;
 /// Gains below this are stored as 0 (the bake's `MIN_GAIN`).
 const MIN_GAIN: f32 = 0.001;
 
@@ -176,7 +122,7 @@ pub(crate) struct LiveCaustics {
 impl LiveCaustics {
     /// Prepares the passes for `live_mesh` over a floor mapped by `world_from_plane`, writing
     /// a `size` gain map and the box of its non-zero texels into `bounds` (16 bytes, a storage
-    /// buffer that outlives the passes); `desc` must pass [`LiveCausticsDesc::check`].
+    /// buffer that outlives the passes); `desc` must pass [`check`].
     pub fn new(
         ctx: &GpuContext,
         live_mesh: LiveMesh,
@@ -186,7 +132,7 @@ impl LiveCaustics {
         desc: LiveCausticsDesc,
         bounds: vk::Buffer,
     ) -> Result<LiveCaustics> {
-        debug_assert!(desc.check().is_ok(), "{desc:?}");
+        debug_assert!(check(&desc).is_ok(), "{desc:?}");
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let texels = u64::from(row_pitch(size[0])) * u64::from(size[1]);
         let sums = Buffer::new(

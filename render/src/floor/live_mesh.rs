@@ -19,8 +19,9 @@ pub(super) struct LiveMesh {
     /// Per triangle its vertex normals, the grid's cells, their triangles, and per triangle
     /// its corner and edges: the trace's bindings 1, 2, 3 and 8.
     pub buffers: [Buffer; 4],
-    /// The facet planes of a convex flat-faceted mesh ([`crate::convex::facet_planes`]; one
-    /// unused entry for any other mesh): binding 13.
+    /// The facet planes of a convex flat-faceted mesh
+    /// ([`vitreous_optics::convex::facet_planes`]; one unused entry for any other mesh):
+    /// binding 13.
     pub facets: Buffer,
     /// The grid's placement, model units.
     pub grid_origin: Vec3,
@@ -35,7 +36,7 @@ pub(super) struct LiveMesh {
     /// Smallest distance from it to a triangle's plane, model units: no surface point lies
     /// nearer the centre.
     pub inner_radius: f32,
-    /// Whether the mesh bounds one convex body ([`crate::convex::is_convex`]): a photon
+    /// Whether the mesh bounds one convex body ([`vitreous_optics::convex::is_convex`]): a photon
     /// leaving it outward then meets no more of it.
     pub convex: bool,
     /// Whether, besides, the shell's inner ball lies inside that body
@@ -49,7 +50,7 @@ pub(super) struct LiveMesh {
 
 impl LiveMesh {
     /// The buffers and shape of `mesh` (model units, outward normals, closed), which bounds
-    /// one convex body when `convex` ([`crate::convex::is_convex`]).
+    /// one convex body when `convex` ([`vitreous_optics::convex::is_convex`]).
     pub fn new(ctx: &GpuContext, mesh: &MeshRef, convex: bool) -> Result<LiveMesh> {
         let grid = Grid::new(mesh.positions, mesh.indices);
         let lo = mesh
@@ -74,7 +75,7 @@ impl LiveMesh {
         // them), where walking the grid through the body's empty middle loads per lane.
         let planes = convex
             .then(|| {
-                crate::convex::facet_planes(
+                vitreous_optics::convex::facet_planes(
                     mesh.positions,
                     mesh.normals,
                     mesh.indices,

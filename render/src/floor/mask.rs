@@ -2,10 +2,10 @@
 //! light onto the floor plane and rasterised straight into floor space, once per pose.
 //!
 //! A convex object's shadow is the convex hull of its projected vertices. For such a mesh the
-//! CPU finds that polygon for each pose ([`crate::convex::hull_2d`]) and the pass draws it as
-//! a fan of triangles, written into the command buffer with the draw: the glass sphere's
-//! shadow becomes about a hundred triangles instead of the 4512 facing the light, which the
-//! rasteriser of a CPU device (lavapipe) would set up one by one after every move. The
+//! CPU finds that polygon for each pose ([`vitreous_optics::convex::hull_2d`]) and the pass
+//! draws it as a fan of triangles, written into the command buffer with the draw: the glass
+//! sphere's shadow becomes about a hundred triangles instead of the 4512 facing the light, which
+//! the rasteriser of a CPU device (lavapipe) would set up one by one after every move. The
 //! texels covered are the same: the hull's edges are the mesh's silhouette. Other meshes, and
 //! poses where part of the mesh is at or above the light's height (its shadow is then
 //! unbounded and the rasteriser clips it), draw the mesh.
@@ -49,7 +49,7 @@ pub(super) struct MaskPass {
     layout: Owned<vk::PipelineLayout>,
     /// The hull's triangles, rewritten by each computation that draws them.
     hull_buffer: Buffer,
-    /// Whether the mesh bounds one convex body ([`crate::convex::is_convex`]).
+    /// Whether the mesh bounds one convex body ([`vitreous_optics::convex::is_convex`]).
     convex: bool,
     /// Indices of the mesh's triangles.
     index_count: u32,
@@ -62,7 +62,8 @@ pub(super) struct MaskPass {
 
 impl MaskPass {
     /// The pipelines in `render_pass` (the mask's) for `mesh`, with `convex` as
-    /// [`crate::convex::is_convex`] says of it and `closed` as [`crate::convex::is_closed`].
+    /// [`vitreous_optics::convex::is_convex`] says of it and `closed` as
+    /// [`vitreous_optics::convex::is_closed`].
     pub fn new(
         ctx: &GpuContext,
         render_pass: vk::RenderPass,
@@ -235,7 +236,7 @@ pub(super) fn hull_triangles(clip_from_model: Mat4, positions: &[Vec3]) -> Optio
         }
         projected.push(Vec2::new(clip.x, clip.y) / clip.w);
     }
-    let corners = crate::convex::hull_2d(&projected);
+    let corners = vitreous_optics::convex::hull_2d(&projected);
     let triangles = corners.len().saturating_sub(2);
     if (triangles * 3 * size_of::<HullVertex>()) as u64 > HULL_BYTES {
         return None;
@@ -368,7 +369,7 @@ mod tests {
             check_same_cover(&ball, &ball_indices, resting, light);
         }
         // A cube on one corner, turned: its hull's corners are six of its eight.
-        let (cube, _, cube_indices) = crate::solid::flat_cube(0.03);
+        let (cube, _, cube_indices) = vitreous_optics::solid::flat_cube(0.03);
         let tilted = Mat4::from_rotation_translation(
             Quat::from_rotation_x(0.6) * Quat::from_rotation_z(0.7),
             Vec3::new(0.05, -0.24, -1.45),

@@ -84,10 +84,6 @@ pub use crate::scene::{
 pub use fields::{FIELD_STAMPS, FieldPassesMs, InducerFields};
 pub(crate) use fields::{FieldTarget, Stamps};
 pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
-pub use live::{
-    DEFAULT_RESOLUTION_PX as DEFAULT_LIVE_RESOLUTION_PX, LiveCausticsDesc, MAX_PHOTONS_PER_SIDE,
-    MAX_SMOOTHING_PX,
-};
 pub(crate) use pass::InducerPass;
 pub(crate) use progress::Prepared;
 pub use reference::{

@@ -7,8 +7,8 @@
 use ash::vk;
 use glam::Mat4;
 use gpu_allocator::MemoryLocation;
+use vitreous_optics::camera::EyeParams;
 
-use crate::camera::EyeParams;
 use crate::context::GpuContext;
 use crate::descriptors;
 use crate::error::Result;

@@ -8,6 +8,8 @@
 
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
+use vitreous_optics::camera::EyeParams;
+use vitreous_optics::live_caustics::LiveCausticsDesc;
 
 use super::distance_transform::{self, DIST, DistanceTransform, Ramp};
 use super::fields::{
@@ -15,12 +17,11 @@ use super::fields::{
     MASK, Stamps, TexelRect,
 };
 use super::geometry::{Floor, caustic_rect, shadow_of, texel_rect, texels_plane_rect, union_rect};
-use super::live::{LiveCaustics, LiveCausticsDesc};
+use super::live::LiveCaustics;
 use super::live_mesh::LiveMesh;
 use super::mask::MaskPass;
 use super::overlay::{NO_RECT, OverlayArea, OverlayPass};
 use super::progress::{Prepared, Progress, Written};
-use crate::camera::EyeParams;
 use crate::context::GpuContext;
 use crate::descriptors;
 use crate::error::Result;
@@ -129,7 +130,7 @@ impl InducerPass {
 
         let fragment = vk::ShaderStageFlags::FRAGMENT;
         let (positions, indices) = (desc.mesh.positions, desc.mesh.indices);
-        let (closed, convex) = crate::convex::closed_and_convex(positions, indices);
+        let (closed, convex) = vitreous_optics::convex::closed_and_convex(positions, indices);
         let mut mask = MaskPass::new(ctx, targets[MASK].render_pass(), &desc.mesh, convex, closed)?;
         mask.set_pose(mask_clip_from_model, positions);
 
@@ -255,7 +256,7 @@ impl InducerPass {
         live: LiveCausticsDesc,
     ) -> Result<()> {
         let extent = self.caustic_extent;
-        live.check()?;
+        super::live::check(&live)?;
         let mesh = LiveMesh::new(ctx, &desc.mesh, self.mask.convex())?;
         self.live = Some(LiveCaustics::new(
             ctx,

@@ -323,7 +323,7 @@ pub(super) fn shares_fit(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::floor::live::MAX_SMOOTHING_PX;
+    use vitreous_optics::live_caustics::MAX_SMOOTHING_PX;
 
     #[test]
     fn smoothing_runs_along_rows_then_columns_or_once_without_a_box() {
@@ -358,7 +358,7 @@ mod tests {
 
     #[test]
     fn the_shares_fit_unless_the_light_is_nearly_level_with_the_floor() {
-        use crate::floor::live::MIN_WEIGHT;
+        use vitreous_optics::live_caustics::MIN_WEIGHT;
         // The shipped 1 m floor facing up, 990 x 990 texels, and an 80 mm ball 1.4 m from a
         // light 1 m above it: a cone of about 2.5e-3 sr.
         let floor = Mat4::from_rotation_translation(

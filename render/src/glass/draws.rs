@@ -4,12 +4,13 @@
 //! recording.
 
 use ash::vk;
+use vitreous_optics::camera::EyeParams;
 
 use super::{EyePush, GlassPass, GlassVariant};
-use crate::camera::{EyeParams, Look};
 use crate::compensation::CompensationSet;
 use crate::context::GpuContext;
 use crate::coverage::Tiles;
+use crate::look::Look;
 use crate::pose::ScenePose;
 use crate::scene::GpuScene;
 

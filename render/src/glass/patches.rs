@@ -8,10 +8,9 @@
 //! their order changes no pixel: the patches' triangles are stored one patch after another.
 
 use std::ops::Range;
+use vitreous_optics::camera::EyeParams;
 
 use glam::{Mat4, Vec2, Vec3};
-
-use crate::camera::EyeParams;
 
 /// Patches around the ball's vertical model axis, and from pole to pole.
 const LONGITUDES: usize = 16;

@@ -17,8 +17,8 @@
 use ash::vk;
 
 use super::{Composition, FrameResult, Renderer, Want};
-use crate::camera::FrameParams;
 use crate::error::{RenderError, Result, VkContext};
+use crate::look::FrameParams;
 use crate::memory::{layout_barrier, subresource_range};
 use crate::owned::Owned;
 use crate::{pipeline, target};

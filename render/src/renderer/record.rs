@@ -4,7 +4,7 @@ use ash::vk;
 
 use super::{Composition, FrameSlot, QUERIES, Renderer, Want, copy, external};
 use crate::blur_blend;
-use crate::camera::FrameParams;
+use crate::look::FrameParams;
 use crate::floor::{FIELD_STAMPS, Prepared, Stamps};
 use crate::glass::{EyePush, GlassDraws};
 use crate::owned::Owned;

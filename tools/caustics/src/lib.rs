@@ -19,11 +19,14 @@
 //!
 //! Accumulation is in 64-bit fixed point with atomic adds, which commute, so a bake is
 //! bit-identical for a given input whatever the thread count or scheduling.
+//!
+//! The closed-mesh tracer (`vitreous_optics::solid` and its BVH) and the interface optics
+//! (Snell, mirror reflection, the exact Fresnel reflectance) are `vitreous-optics`', shared with
+//! the two-surface refraction reference.
 
 pub mod bake;
 pub mod bake_file;
 pub mod emission;
-pub mod optics;
 mod splat;
 mod trace;
 
@@ -31,10 +34,7 @@ use std::path::PathBuf;
 
 use glam::{Mat4, Vec3};
 use thiserror::Error;
-
-/// The mesh tracer the baker shares with the two-surface refraction reference.
-pub use vitreous_render::solid;
-pub use vitreous_render::solid::bvh;
+use vitreous_optics::solid::SolidError;
 
 pub use bake::{BakeOutput, BakeParams, Comparison, FluxLedger, bake, compare, gain};
 pub use bake_file::{
@@ -95,7 +95,7 @@ impl CausticScene {
 pub enum InputError {
     /// The mesh is not a closed solid (the caustics trace light through its volume).
     #[error(transparent)]
-    Mesh(#[from] solid::SolidError),
+    Mesh(#[from] SolidError),
     /// The light is inside the glass.
     #[error(
         "the light at {light_m} m (world) is inside the object; a caustic bake needs the light \

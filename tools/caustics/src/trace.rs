@@ -2,10 +2,10 @@
 //! Fresnel splitting: one grid ray becomes a small tree of weighted paths.
 
 use glam::{Mat4, Vec2, Vec3};
+use vitreous_optics::optics::{fresnel_reflectance, reflect, refract};
+use vitreous_optics::solid::Solid;
+use vitreous_optics::solid::bvh::{Bvh, Hit};
 
-use crate::bvh::Bvh;
-use crate::optics::{fresnel_reflectance, reflect, refract};
-use crate::solid::Solid;
 use crate::{CausticScene, InputError};
 
 /// How a path ended.
@@ -311,13 +311,7 @@ impl Tracer {
     }
 
     /// Splits `ray` at the surface point `hit` into its reflected and refracted parts.
-    fn interact(
-        &self,
-        ray: &Ray,
-        hit: crate::bvh::Hit,
-        leaves: &mut Vec<Leaf>,
-        stack: &mut Vec<Ray>,
-    ) {
+    fn interact(&self, ray: &Ray, hit: Hit, leaves: &mut Vec<Leaf>, stack: &mut Vec<Ray>) {
         let leaf = |end| Leaf {
             sig: ray.sig,
             weight: ray.weight,

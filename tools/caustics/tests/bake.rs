@@ -4,10 +4,11 @@
 use std::f32::consts::PI;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
-use vitreous_caustics::optics::{fresnel_reflectance, refract};
 use vitreous_caustics::{
-    BakeOutput, BakeParams, CausticScene, InputError, bake, compare, solid::SolidError, write_bake,
+    BakeOutput, BakeParams, CausticScene, InputError, bake, compare, write_bake,
 };
+use vitreous_optics::optics::{fresnel_reflectance, refract};
+use vitreous_optics::solid::SolidError;
 
 /// A UV sphere of radius `radius_m` at `center_m`: smooth radial normals, seam duplicated,
 /// one triangle per pole quad.
@@ -290,7 +291,7 @@ fn every_unit_of_flux_is_accounted_for() {
 
 /// A flat-shaded cube, `size_m` across, centred at `center_m`.
 fn cube(center_m: Vec3, size_m: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
-    let (p, n, idx) = vitreous_render::solid::flat_cube(0.5 * size_m);
+    let (p, n, idx) = vitreous_optics::solid::flat_cube(0.5 * size_m);
     (p.into_iter().map(|v| v + center_m).collect(), n, idx)
 }
 

@@ -1,8 +1,8 @@
 //! `[display]`: what the display does with the light vitreous draws, checked field by field.
 
 use toml::Spanned;
-use vitreous_render::dimmer::model::MAX_SIGMA_CELLS;
-use vitreous_render::{Compensation, DimmerDesc};
+use vitreous_optics::display::Compensation;
+use vitreous_optics::display::dimmer::{DimmerDesc, MAX_SIGMA_CELLS};
 
 use super::{CLOSED, Loader};
 use crate::SceneError;

@@ -1,5 +1,7 @@
 //! The `[object]` table: the model, its placement, refraction and absorption.
 
+use vitreous_optics::refraction::{Refraction, RefractionParseError};
+
 use super::*;
 
 impl Loader<'_> {
@@ -100,15 +102,11 @@ impl Loader<'_> {
         let attenuation = self.attenuation(raw, model.volume, scale)?;
 
         let refraction = match &raw.refraction {
-            None => vitreous_render::Refraction::default(),
-            Some(r) => {
-                r.get_ref()
-                    .parse()
-                    .map_err(|e: vitreous_render::RefractionParseError| {
-                        self.src
-                            .invalid(r.span(), "object.refraction", e.to_string())
-                    })?
-            }
+            None => Refraction::default(),
+            Some(r) => r.get_ref().parse().map_err(|e: RefractionParseError| {
+                self.src
+                    .invalid(r.span(), "object.refraction", e.to_string())
+            })?,
         };
 
         let surface_texture = match &raw.surface_texture {

@@ -2,8 +2,8 @@
 //! image meets a rectangle is drawn there, once.
 
 use super::*;
-use crate::camera::Fov;
 use proptest::prelude::*;
+use vitreous_optics::camera::Fov;
 
 /// A ball of radius 1 about `center` as latitude rings and longitude segments, wound either
 /// way (the patches do not rely on the winding).

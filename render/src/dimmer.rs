@@ -7,16 +7,15 @@
 //! pass, three compute dispatches per eye make the panel (shaders/dimmer_panel.wgsl: what each
 //! cell wants, spread by the blur's reach, and the share the eye loses through the blurred
 //! panel); then inside the frame's own eye pass one full-screen triangle writes the light and
-//! the alpha (shaders/dimmer_resolve.wgsl). The model it assumes is [`model`]'s, which the
-//! see-through preview also applies.
-
-pub mod model;
+//! the alpha (shaders/dimmer_resolve.wgsl). The model it assumes is
+//! [`vitreous_optics::display::dimmer`]'s, which the see-through preview also applies.
 
 use ash::vk;
 use glam::{Vec3, Vec4Swizzles};
 use gpu_allocator::MemoryLocation;
+use vitreous_optics::camera::EyeParams;
+use vitreous_optics::display::dimmer::{DimmerDesc, FINE, Panel};
 
-use crate::camera::EyeParams;
 use crate::compensation::SeenPhotos;
 use crate::context::GpuContext;
 use crate::descriptors;
@@ -24,11 +23,9 @@ use crate::error::Result;
 use crate::memory::{Buffer, layout_barrier, memory_barrier, subresource_range};
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, Depth, PipelineSpec};
-use crate::scene::{DimmerDesc, GpuScene, SceneDesc};
+use crate::scene::{GpuScene, SceneDesc};
 use crate::shaders;
 use crate::target::{self, StereoTarget};
-
-use model::{FINE, Panel};
 
 /// Push constants: one eye (shaders/dimmer_panel.wgsl `Dimmer`).
 #[repr(C)]

@@ -1,7 +1,7 @@
-//! The segmented dimmer as the eye meets it, on the CPU: the panel's cells, each taking away a
-//! share of the real world's light, seen through the panel's optical blur. The GPU pass
-//! (shaders/dimmer_panel.wgsl `soften`) evaluates the same sums; the see-through preview
-//! (vitreous-frames) and the tests use these.
+//! A segmented dimmer ([`DimmerDesc`], `[display] model = "dimmer"`) as the eye meets it, on
+//! the CPU: the panel's cells, each taking away a share of the real world's light, seen through
+//! the panel's optical blur. The renderer's GPU pass (shaders/dimmer_panel.wgsl `soften`)
+//! evaluates the same sums; the see-through preview (vitreous-frames) and the tests use these.
 //!
 //! The panel is `cells[0] x cells[1]` cells spread evenly over the eye image. A cell holding
 //! `p` takes away the share `p` of the light behind it; the panel sits out of focus, so the eye
@@ -12,7 +12,17 @@
 //! `D` is evaluated on a grid [`FINE`] times finer than the cells and interpolated bilinearly
 //! between its points.
 
-use crate::scene::DimmerDesc;
+/// A segmented dimmer in front of the display (Magic Leap 2's): a coarse panel whose cells
+/// each take away a share of the real world's light, seen out of focus.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DimmerDesc {
+    /// Cells across and down the eye's view.
+    pub cells: [u32; 2],
+    /// Standard deviation of the panel's optical blur (a Gaussian point spread), degrees.
+    pub blur_deg: f32,
+    /// The largest share of the real world's light a cell takes away (0..1).
+    pub max: f32,
+}
 
 /// Points of the attenuation grid per cell side.
 pub const FINE: u32 = 4;

@@ -1,4 +1,6 @@
-//! Per-eye view and projection for Vulkan's clip space, and the CPU projection tests use.
+//! An eye's camera: its view and its projection into Vulkan's clip space from the four angles
+//! of an OpenXR field of view, and where a world point lands on its image (the CPU projection
+//! the tracers and the tests use).
 
 use glam::{Mat4, Quat, Vec2, Vec3, Vec4Swizzles};
 
@@ -72,58 +74,39 @@ impl EyeParams {
         let ndc = clip.xy() / clip.w;
         Some((ndc + Vec2::ONE) * 0.5 * size)
     }
+
+    /// Unit direction of the view ray through a pixel position (x right, y down, pixel centres
+    /// at half-integers) of an image of `size` pixels.
+    pub fn pixel_ray(&self, pixel: Vec2, size: Vec2) -> Vec3 {
+        self.pixel_rays(size).direction(pixel)
+    }
+
+    /// The view rays of an image of `size` pixels, for many pixels at the cost of one matrix
+    /// inverse.
+    pub fn pixel_rays(&self, size: Vec2) -> PixelRays {
+        PixelRays {
+            world_from_clip: self.clip_from_world().inverse(),
+            size,
+        }
+    }
 }
 
-/// How the reflected image is drawn.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Reflection {
-    /// The environment map in the mirror direction, weighted by the Fresnel term.
-    #[default]
-    EnvironmentFresnel,
-    /// A Phong highlight of the scene's point light (the paper's choice).
-    Phong,
+/// The view rays of one eye image ([`EyeParams::pixel_rays`]).
+#[derive(Clone, Copy, Debug)]
+pub struct PixelRays {
+    world_from_clip: Mat4,
+    size: Vec2,
 }
 
-/// Gaze-dependent defocus of one frame (eq. 9-14): the kernel width K_g of eq. 13 for each
-/// image, in pixels of its own photo or texture (0: sharp).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Defocus {
-    /// K_g of the refracted image (the background photo), pixels.
-    pub refracted_k_g_px: f32,
-    /// K_g of the surface image (the surface texture), pixels.
-    pub surface_k_g_px: f32,
-}
-
-/// Which layers of the method are drawn, per frame (so one process can alternate them).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Look {
-    /// Refract each eye's own view ray to the registered background plane (eq. 7-8), giving
-    /// the refracted image its own disparity. Off, the baseline refracts into the environment
-    /// map, unless `defocus` is on: then the background plane is refracted from the point
-    /// between the eyes, the same for both eyes (no refracted-image disparity).
-    pub disparity: bool,
-    /// Gaze-dependent defocus; `None`: both images sharp.
-    pub defocus: Option<Defocus>,
-    /// How the reflected image is drawn.
-    pub reflection: Reflection,
-    /// Add the shadow inducer's floor overlay (eq. 1-5, render/src/inducer.rs).
-    pub inducer: bool,
-    /// Add the corrected caustics G L_r (eq. 6) to the floor overlay; needs the scene's
-    /// caustic gain map ([`crate::SceneDesc::caustics`]), draws nothing without one.
-    pub caustics: bool,
-    /// Draw nothing of the method: the display adds no light (a study's blank between two
-    /// stimuli, or a condition where a real object is shown instead). The real-world photos
-    /// are still drawn behind where the composition needs them.
-    pub blank: bool,
-}
-
-/// Everything the renderer needs to draw one stereo frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FrameParams {
-    /// Left and right eye, in that order.
-    pub eyes: [EyeParams; 2],
-    /// Which layers are drawn and how.
-    pub look: Look,
+impl PixelRays {
+    /// Unit direction of the view ray through a pixel position (x right, y down, pixel centres
+    /// at half-integers).
+    pub fn direction(&self, pixel: Vec2) -> Vec3 {
+        let ndc = pixel / self.size * 2.0 - Vec2::ONE;
+        let near = self.world_from_clip.project_point3(ndc.extend(0.0));
+        let far = self.world_from_clip.project_point3(ndc.extend(1.0));
+        (far - near).normalize()
+    }
 }
 
 #[cfg(test)]
@@ -181,5 +164,27 @@ mod tests {
         assert!(xl > 50.0 && xr < 50.0);
         let expected = 0.03 / 0.5 / 0.5_f32.tan() * 50.0;
         assert!((xl - 50.0 - expected).abs() < 1e-3);
+    }
+
+    #[test]
+    fn pixel_ray_through_the_centre_looks_forward() {
+        let fov = Fov {
+            left_rad: -0.5,
+            right_rad: 0.5,
+            up_rad: 0.4,
+            down_rad: -0.4,
+        };
+        let eye = EyeParams::new(Vec3::ZERO, Quat::IDENTITY, fov);
+        let d = eye.pixel_ray(Vec2::new(50.0, 40.0), Vec2::new(100.0, 80.0));
+        assert!(d.abs_diff_eq(Vec3::NEG_Z, 1e-5), "{d}");
+        // A pixel ray projects back onto its pixel.
+        let p = Vec2::new(13.5, 71.5);
+        let back = eye
+            .project_to_pixel(
+                eye.pixel_ray(p, Vec2::new(100.0, 80.0)),
+                Vec2::new(100.0, 80.0),
+            )
+            .unwrap();
+        assert!(back.abs_diff_eq(p, 1e-3), "{back}");
     }
 }

@@ -21,6 +21,10 @@
 //! a failed constructor gives back what it made by returning early; the context, which owns
 //! the device, is dropped after all of them.
 //!
+//! Besides the eye images, [`present`] puts finished pictures in a window's swapchain
+//! (`vitreous view`, on a context of its own), given a surface the caller made: this crate
+//! knows no windowing library.
+//!
 //! Knows nothing about OpenXR: device creation is an injected step ([`context::DeviceCreator`]).
 
 pub mod absorption;
@@ -41,6 +45,7 @@ pub mod optics;
 mod owned;
 mod pipeline;
 pub mod pose;
+pub mod present;
 pub mod radial_map;
 pub mod reference;
 pub mod renderer;
@@ -66,6 +71,7 @@ pub use floor as inducer;
 pub use floor::InducerFields;
 pub use memory::{color_copy_region, layout_barrier, subresource_range};
 pub use pose::ScenePose;
+pub use present::{PresentWindow, Presented, Presenter};
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
     BlurStackDesc, CausticsDesc, DimmerDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc,

@@ -5,13 +5,13 @@
 //! check and the errors for missing and foreign bakes.
 
 use glam::{Quat, Vec2, Vec3};
-use vitreous_scene::caustics::{Bake, BakeError};
-use vitreous_scene::effects::EffectSet;
 use vitreous_frames::render_desc;
-use vitreous_scene::{CausticsMode, Image, PixelData, Scene};
 use vitreous_optics::camera::EyeParams;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Readback, Reflection, Renderer, ScenePose};
+use vitreous_scene::caustics::{Bake, BakeError};
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{CausticsMode, Image, PixelData, Scene};
 use vitreous_tests::{
     FloorPixel, eyes_looking_down, floor_pixels, floor_uv, render_once, shipped_scene,
 };

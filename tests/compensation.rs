@@ -4,10 +4,10 @@
 //! preview's world view draws it), clamped at 0, in linear light; every other pixel is
 //! untouched; with the world drawn behind (an opaque display) nothing is taken away.
 
-use vitreous_scene::effects::EffectSet;
 use vitreous_optics::display::Compensation;
 use vitreous_render::renderer::Want;
 use vitreous_render::{Composition, FrameParams, Reflection, Renderer};
+use vitreous_scene::effects::EffectSet;
 use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
 
 fn linear(v: u8) -> f32 {

@@ -5,11 +5,11 @@
 //! all reach its photo in the paper's model, through both surfaces of the ball, whose rim bends
 //! them past it in the image's corners, and before a photo too small for the ball.
 
-use vitreous_scene::effects::EffectSet;
 use vitreous_optics::absorption::Attenuation;
 use vitreous_optics::refraction::Refraction;
 use vitreous_render::renderer::Want;
 use vitreous_render::{Composition, Defocus, FrameParams, Readback, Reflection, Renderer};
+use vitreous_scene::effects::EffectSet;
 use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
 
 /// One frame of `scene` with `effects`, with or without the proof: its eye images and the glass

@@ -6,11 +6,11 @@
 //! world the see-through preview shows.
 
 use glam::{Vec2, Vec3};
-use vitreous_scene::Scene;
 use vitreous_optics::camera::EyeParams;
 use vitreous_optics::display::Compensation;
 use vitreous_reference::world::PhotoHit;
 use vitreous_reference::{EyeImage, Window, World, render_eye};
+use vitreous_scene::Scene;
 use vitreous_tests::{left_eye_light, left_world_view, neutral_eyes, shipped_scene};
 
 const SIZE: (u32, u32) = (320, 240);

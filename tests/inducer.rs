@@ -11,11 +11,11 @@
 use glam::{Quat, Vec2, Vec3};
 use vitreous_frames::output::see_through;
 use vitreous_frames::render_desc;
-use vitreous_scene::{Image, PixelData, Scene};
 use vitreous_optics::camera::EyeParams;
 use vitreous_render::floor::{self, InducerFields};
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Readback, Renderer};
+use vitreous_scene::{Image, PixelData, Scene};
 use vitreous_tests::{
     FloorPixel, assert_silent, eyes_looking_down, floor_pixels, render_once, scene_renderer,
     shipped_scene,

@@ -6,9 +6,9 @@ use std::time::Instant;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 use vitreous_frames::render_desc;
-use vitreous_scene::load_scene;
 use vitreous_optics::live_caustics::LiveCausticsDesc;
 use vitreous_render::{Renderer, ScenePose};
+use vitreous_scene::load_scene;
 use vitreous_tests::{shipped_scene, workspace};
 
 use crate::live_maps::{

@@ -7,11 +7,11 @@ use std::time::Instant;
 
 use glam::{Quat, Vec2, Vec3};
 use vitreous_frames::render_desc;
-use vitreous_scene::Scene;
 use vitreous_optics::camera::{EyeParams, Fov};
 use vitreous_optics::live_caustics::LiveCausticsDesc;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Renderer, ScenePose};
+use vitreous_scene::Scene;
 use vitreous_tests::shipped_scene;
 
 /// The shipped scene `name` with its bake loaded.

@@ -5,14 +5,14 @@
 //! frames that did not.
 
 use glam::{DVec2, Quat, Vec2, Vec3};
-use vitreous_scene::effects::EffectSet;
-use vitreous_frames::render_desc;
 use vitreous::replay::{ReplayOptions, replay};
-use vitreous_scene::{Placement, Scene, load_scene};
+use vitreous_frames::render_desc;
 use vitreous_optics::camera::{EyeParams, Fov};
 use vitreous_render::floor::InducerFields;
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, Look, Renderer};
+use vitreous_scene::effects::EffectSet;
+use vitreous_scene::{Placement, Scene, load_scene};
 use vitreous_tests::{
     assert_silent, floor_uv, lit_centroid, render_once, scene_renderer, shipped_scene, workspace,
 };

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec2};
 use vitreous_frames::render_desc::render_fov;
-use vitreous_scene::load_scene;
 use vitreous_optics::camera::EyeParams;
+use vitreous_scene::load_scene;
 
 use crate::cli::{assert_clean_failure, vitreous};
 use crate::compare::json;

@@ -57,6 +57,11 @@ pub enum RenderError {
     /// A device creation step injected by the caller (e.g. an OpenXR runtime) failed.
     #[error("device creation failed: {0}")]
     Creation(String),
+    /// A window cannot be presented to as [`crate::present::Presenter`] needs (no
+    /// presentation from the graphics queue, no usable format or image usage, no host-visible
+    /// memory for its pictures).
+    #[error("presenting to a window: {0}")]
+    Presentation(String),
     /// A failure forced by [`crate::GpuContext::fail_allocation_after`], to test unwinding.
     #[error("injected failure while allocating memory for {0}")]
     Injected(String),

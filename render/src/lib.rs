@@ -21,6 +21,10 @@
 //! a failed constructor gives back what it made by returning early; the context, which owns
 //! the device, is dropped after all of them.
 //!
+//! Besides the eye images, [`present`] puts finished pictures in a window's swapchain
+//! (`vitreous view`, on a context of its own), given a surface the caller made: this crate
+//! knows no windowing library.
+//!
 //! Knows nothing about OpenXR: device creation is an injected step ([`context::DeviceCreator`]).
 //! The optics it draws and tests against on the CPU (refraction, the tracers, the radial map,
 //! the eye's camera, the dimmer's panel) are `vitreous-optics`'.
@@ -40,6 +44,7 @@ mod memory;
 mod owned;
 mod pipeline;
 pub mod pose;
+pub mod present;
 pub mod reference;
 pub mod renderer;
 pub mod ripmap;
@@ -59,6 +64,7 @@ pub use floor::InducerFields;
 pub use look::{Defocus, FrameParams, Look, Reflection};
 pub use memory::{color_copy_region, layout_barrier, subresource_range};
 pub use pose::ScenePose;
+pub use present::{PresentWindow, Presented, Presenter};
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};
 pub use scene::{
     BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData,

@@ -1,13 +1,15 @@
-//! Live actions' side in the app: the effect conditions `vitreous run` cycles through and the
-//! mapping of the backend's generic cycle buttons to the effect condition and the forced gaze
-//! image ([`GAZE_IMAGE_CYCLE`], [`CONDITION_CYCLE`]).
+//! The effect conditions a live session switches between, each with a warm look planner, and
+//! the forced gaze image ([`LiveConditions`]: `vitreous run`'s controller cycle, a study's
+//! trials, and under `vitreous view`'s keys); the conditions `vitreous run` cycles through
+//! ([`live_conditions`]) and the mapping of the backend's generic cycle buttons to the effect
+//! condition and the forced gaze image ([`GAZE_IMAGE_CYCLE`], [`CONDITION_CYCLE`]).
 
 use vitreous_xr::FrameInput;
 use vitreous_xr::openxr::{Command, Cycle};
 
 use crate::director::Director;
 use crate::look::LookPlanner;
-use vitreous_gaze::GazeOverride;
+use vitreous_gaze::{GazeOverride, GazeState};
 use vitreous_scene::effects::EffectSet;
 
 /// The paper's study conditions, in the order the live action cycles through them (after the
@@ -32,52 +34,112 @@ pub fn live_conditions(start: EffectSet, caustics_loaded: bool) -> Vec<EffectSet
     out
 }
 
-/// The looks the live actions switch between: a look planner per effect condition (all fed
-/// every frame, so switching keeps the gaze filters warm) and the forced gaze image.
+/// The effect conditions a live session switches between, each with its look planner (all fed
+/// every frame, so a switch finds its gaze filter warm), and the forced gaze image: what
+/// `vitreous run`'s controller cycles, a study's trials (through [`Director`]) and `vitreous
+/// view`'s keys choose among.
 pub struct LiveConditions {
-    /// Each condition and its planner.
-    conditions: Vec<(EffectSet, LookPlanner)>,
+    /// Each condition and its planner; `None` where the session cannot show the condition (kept
+    /// so that the others keep the index the session knows them by).
+    conditions: Vec<Option<(EffectSet, LookPlanner)>>,
     /// Index of the condition shown.
     current: usize,
     /// The forced gaze image.
     gaze: GazeOverride,
+    /// The newest gaze state of the condition shown.
+    state: Option<GazeState>,
 }
 
 impl LiveConditions {
     /// Starts at the first condition with gaze image `gaze`, applied to every planner.
     pub fn new(conditions: Vec<(EffectSet, LookPlanner)>, gaze: GazeOverride) -> LiveConditions {
         assert!(!conditions.is_empty(), "at least one condition");
+        LiveConditions::with_gaps(conditions.into_iter().map(Some).collect(), 0, gaze)
+    }
+
+    /// Conditions of which some cannot be shown (`None`), starting at index `current`, with
+    /// gaze image `gaze` applied to every planner.
+    pub fn with_gaps(
+        conditions: Vec<Option<(EffectSet, LookPlanner)>>,
+        current: usize,
+        gaze: GazeOverride,
+    ) -> LiveConditions {
         let mut looks = LiveConditions {
             conditions,
-            current: 0,
+            current,
             gaze,
+            state: None,
         };
         looks.set_gaze(gaze);
         looks
     }
 
+    /// New planners for every condition that can be shown (their gaze history starts over),
+    /// with the forced gaze image applied.
+    pub fn replan(&mut self, mut planner: impl FnMut(EffectSet) -> LookPlanner) {
+        for (set, p) in self.conditions.iter_mut().flatten() {
+            *p = planner(*set);
+        }
+        self.set_gaze(self.gaze);
+    }
+
     /// The condition shown.
     pub fn condition(&self) -> EffectSet {
-        self.conditions[self.current].0
+        self.shown().0
+    }
+
+    /// The condition shown and its planner.
+    fn shown(&self) -> &(EffectSet, LookPlanner) {
+        self.conditions[self.current]
+            .as_ref()
+            .expect("the current condition can be shown")
+    }
+
+    /// Index of the condition shown.
+    pub fn current(&self) -> usize {
+        self.current
+    }
+
+    /// How many conditions there are, those that cannot be shown included.
+    pub fn len(&self) -> usize {
+        self.conditions.len()
+    }
+
+    /// Whether there are no conditions at all.
+    pub fn is_empty(&self) -> bool {
+        self.conditions.is_empty()
+    }
+
+    /// Condition `index`, when it exists and can be shown.
+    pub fn get(&self, index: usize) -> Option<EffectSet> {
+        self.conditions.get(index)?.as_ref().map(|(set, _)| *set)
     }
 
     /// Moves the object the image distances are measured to (its centre and model-to-world
     /// transform), for every condition.
     pub fn set_object_pose(&mut self, center_m: glam::Vec3, world_from_model: glam::Mat4) {
-        for (_, planner) in &mut self.conditions {
+        for (_, planner) in self.conditions.iter_mut().flatten() {
             planner.set_object_pose(center_m, world_from_model);
         }
     }
 
     /// The planner of the condition shown (its newest defocus decision, its pupil source).
     pub fn planner(&self) -> &LookPlanner {
-        &self.conditions[self.current].1
+        &self.shown().1
+    }
+
+    /// The newest gaze state of the condition shown (None without defocus).
+    pub fn gaze_state(&self) -> Option<GazeState> {
+        self.state
     }
 
     /// Where A_p comes from and the tracker samples with a measurement, of the conditions with
     /// defocus (all share the scene's pupil source; the counts of the first one).
     pub fn pupil_source(&self) -> Option<(vitreous_gaze::PupilSource, u64)> {
-        self.conditions.iter().find_map(|(_, p)| p.pupil_source())
+        self.conditions
+            .iter()
+            .flatten()
+            .find_map(|(_, p)| p.pupil_source())
     }
 
     /// The forced gaze image.
@@ -87,16 +149,49 @@ impl LiveConditions {
 
     /// Shows condition `index` (of those given to [`LiveConditions::new`]).
     pub fn select(&mut self, index: usize) {
-        assert!(index < self.conditions.len(), "condition {index} exists");
+        assert!(self.get(index).is_some(), "condition {index} exists");
         self.current = index;
+    }
+
+    /// Shows the condition with effects `set`; false when there is none that can be shown.
+    pub fn show_set(&mut self, set: EffectSet) -> bool {
+        match (0..self.len()).find(|&i| self.get(i) == Some(set)) {
+            Some(i) => {
+                self.current = i;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Shows the next condition that can be shown (after the last, the first; the one shown
+    /// when it is the only one) and returns it; None when none can be shown.
+    pub fn step(&mut self) -> Option<EffectSet> {
+        let n = self.len();
+        let next = (1..=n)
+            .map(|step| (self.current + step) % n)
+            .find(|&i| self.get(i).is_some())?;
+        self.current = next;
+        self.get(next)
     }
 
     /// Forces the gaze image of every condition.
     pub fn set_gaze(&mut self, gaze: GazeOverride) {
         self.gaze = gaze;
-        for (_, planner) in &mut self.conditions {
+        for (_, planner) in self.conditions.iter_mut().flatten() {
             planner.set_gaze_override(gaze);
         }
+    }
+
+    /// Forces the next gaze image (auto, surface, refracted, auto) and returns it.
+    pub fn cycle_gaze(&mut self) -> GazeOverride {
+        let next = match self.gaze {
+            GazeOverride::Auto => GazeOverride::Surface,
+            GazeOverride::Surface => GazeOverride::Refracted,
+            GazeOverride::Refracted => GazeOverride::Auto,
+        };
+        self.set_gaze(next);
+        next
     }
 
     /// Applies a live command; says what changed (None for commands handled elsewhere: the
@@ -105,7 +200,7 @@ impl LiveConditions {
     pub fn apply(&mut self, command: Command) -> Option<String> {
         match command {
             Command::Cycle(CONDITION_CYCLE) => {
-                self.current = (self.current + 1) % self.conditions.len();
+                self.step();
                 Some(format!(
                     "effect condition now {} ({} of {})",
                     self.condition(),
@@ -114,12 +209,7 @@ impl LiveConditions {
                 ))
             }
             Command::Cycle(GAZE_IMAGE_CYCLE) => {
-                let next = match self.gaze {
-                    GazeOverride::Auto => GazeOverride::Surface,
-                    GazeOverride::Surface => GazeOverride::Refracted,
-                    GazeOverride::Refracted => GazeOverride::Auto,
-                };
-                self.set_gaze(next);
+                let next = self.cycle_gaze();
                 Some(format!(
                     "gaze image now {next}{}",
                     if self.condition().defocus {
@@ -159,16 +249,23 @@ impl LiveConditions {
         look
     }
 
-    /// This frame's look: every planner sees the frame, the current one's look is used.
+    /// This frame's look: every planner sees the frame, the current one's look is used (a
+    /// default look when it cannot be shown).
     pub fn plan(&mut self, input: &FrameInput) -> vitreous_render::Look {
-        let mut look = None;
-        for (i, (_, planner)) in self.conditions.iter_mut().enumerate() {
-            let l = planner.plan(input).0;
+        let mut look = vitreous_render::Look::default();
+        for (i, (_, planner)) in self
+            .conditions
+            .iter_mut()
+            .enumerate()
+            .filter_map(|(i, c)| Some((i, c.as_mut()?)))
+        {
+            let (l, state) = planner.plan(input);
             if i == self.current {
-                look = Some(l);
+                look = l;
+                self.state = state;
             }
         }
-        look.expect("current condition exists")
+        look
     }
 }
 
@@ -233,5 +330,34 @@ mod tests {
         // Re-registration is the session's: nothing changes here.
         assert!(looks.apply(Command::Rotate(0.1)).is_none());
         assert_eq!(looks.condition(), sets[0]);
+    }
+
+    #[test]
+    fn conditions_that_cannot_be_shown_keep_their_index_and_are_stepped_over() {
+        let sets = [
+            EffectSet::NONE,
+            EffectSet::parse("disparity").unwrap(),
+            EffectSet::parse("O5").unwrap(),
+        ];
+        let planner = |e: &EffectSet| {
+            LookPlanner::new(crate::look::base_look(e, Reflection::default()), None)
+        };
+        let mut looks = LiveConditions::with_gaps(
+            vec![
+                Some((sets[0], planner(&sets[0]))),
+                None,
+                Some((sets[2], planner(&sets[2]))),
+            ],
+            2,
+            GazeOverride::Auto,
+        );
+        assert_eq!(looks.condition(), sets[2]);
+        assert_eq!(looks.get(1), None);
+        assert!(!looks.show_set(sets[1]));
+        assert_eq!(looks.step(), Some(sets[0]), "wraps round");
+        assert_eq!(looks.step(), Some(sets[2]), "skips the gap");
+        assert_eq!(looks.current(), 2);
+        assert!(looks.show_set(sets[0]));
+        assert!(!looks.plan(&frame()).disparity);
     }
 }

@@ -1,7 +1,8 @@
 //! `vitreous run`: the frame loop on a live OpenXR runtime (a headset, or Monado in CI).
 //!
 //! Set-up order is dictated by XR_KHR_vulkan_enable2: the OpenXR runtime first, then the
-//! renderer's Vulkan instance and device created *through* it ([`XrDeviceCreator`]), then the
+//! renderer's Vulkan instance and device created *through* it
+//! ([`XrDeviceCreator`](vitreous_xr::openxr::XrDeviceCreator)), then the
 //! session on that device, whose swapchain images the renderer draws into. Teardown is the
 //! reverse: the renderer lets go of the swapchain images, the session goes, then the device,
 //! then the OpenXR instance; [`XrSession`] owns the four and keeps that order itself.
@@ -16,10 +17,10 @@
 //! by [`LiveConditions`]: the next effect condition among those this build implements, and the
 //! forced gaze image (surface, refracted, auto).
 //!
-//! Parts: `cli.rs` (the command line), `controls.rs` (keyboard edits), `device.rs` (Vulkan
-//! through the runtime), `xr_session.rs` (runtime, renderer and session owned together),
-//! `readback.rs` (the readback check), `sink.rs` (what is done with each frame), `recording.rs` (the recorded trace and its replay
-//! check), `summary.rs` (what the run reports), `interruptions.rs` (what a misbehaving headset
+//! Parts: `cli.rs` (the command line), `controls.rs` (keyboard edits), `xr_session.rs`
+//! (runtime, renderer and session owned together, the device made through the runtime by
+//! `vitreous_xr`'s `XrDeviceCreator`), `readback.rs` (the readback check), `sink.rs` (what is
+//! done with each frame), `recording.rs` (the recorded trace and its replay check), `summary.rs` (what the run reports), `interruptions.rs` (what a misbehaving headset
 //! did: each session event logged, recorded, counted), `reconnect.rs` (asking the runtime again
 //! after a loss); the conditions and live commands are
 //! `vitreous_frames::conditions`. This file sets the session up, runs it and writes the summary.
@@ -30,7 +31,6 @@
 
 mod cli;
 mod controls;
-mod device;
 mod interruptions;
 mod readback;
 mod reconnect;
@@ -55,7 +55,6 @@ use vitreous_xr::session_event::Loss;
 use vitreous_xr::trace::{TraceVersion, TraceWriter};
 
 pub use cli::{RunArgs, run_command};
-pub use device::XrDeviceCreator;
 pub use interruptions::{InterruptionSummary, NotRenderedFrames, Reconnect};
 pub use readback::{
     AWAY_RADII, LIT_THRESHOLD, MIN_AWAY_FRACTION, MIN_OBJECT_FRACTION, ReadbackCheck,

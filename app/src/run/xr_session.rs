@@ -6,9 +6,9 @@
 use anyhow::{Context, Result, bail};
 use vitreous_render::{ContextOptions, GpuContext, Renderer};
 use vitreous_xr::openxr::ash::vk;
-use vitreous_xr::openxr::{Runtime, Session, SessionOptions, SessionReport, VulkanHandles};
-
-use super::XrDeviceCreator;
+use vitreous_xr::openxr::{
+    Runtime, Session, SessionOptions, SessionReport, VulkanHandles, XrDeviceCreator,
+};
 
 /// A live OpenXR session with the renderer attached to its swapchain images.
 pub struct XrSession {

@@ -1,12 +1,15 @@
-//! The effect conditions the viewer switches between, and their look planners (every planner
-//! sees every frame, so a switch finds its gaze filter warm).
+//! The viewer's side of the effect conditions: which condition each of keys 1-7 shows, and the
+//! gaze filters and reflections it cycles, on top of the conditions and warm planners every
+//! live session switches between ([`LiveConditions`]).
+
+use std::ops::{Deref, DerefMut};
 
 use anyhow::Result;
-use vitreous_render::{Look, Reflection};
-use vitreous_xr::FrameInput;
+use vitreous_render::Reflection;
 
+use vitreous_frames::conditions::LiveConditions;
 use vitreous_frames::look::{DefocusModel, LookPlanner};
-use vitreous_gaze::{FilterKind, GazeConfig, GazeOverride, GazeState};
+use vitreous_gaze::{FilterKind, GazeConfig, GazeOverride};
 use vitreous_scene::effects::EffectSet;
 
 /// The conditions keys 1-7 choose: none (O2, a), O3, O4, O5, b, c, and the inducer alone
@@ -16,24 +19,18 @@ pub const CONDITION_KEYS: [&str; 7] = ["none", "O3", "O4", "O5", "b", "c", "indu
 /// The gaze filters G steps through.
 pub const FILTERS: [&str; 5] = ["evidence", "fixation", "mean20", "median20", "one-euro"];
 
-/// The viewer's conditions and planners.
+/// The viewer's conditions: those of the keys, by index of [`CONDITION_KEYS`] (the ones this
+/// build or scene cannot show held as gaps), and the settings their planners are made with.
+/// Derefs to the [`LiveConditions`] they are.
 pub struct ViewConditions {
-    /// Each condition (None where this build or scene cannot show it), by key.
-    conditions: Vec<Option<EffectSet>>,
-    /// The planner of each available condition.
-    planners: Vec<Option<LookPlanner>>,
-    /// Index of the condition shown.
-    current: usize,
+    /// The conditions and their planners.
+    looks: LiveConditions,
     /// The scene's numbers for eq. 13-14, when any condition has defocus.
     model: Option<DefocusModel>,
     /// How the reflected image is drawn.
     reflection: Reflection,
     /// The gaze filter.
     filter: FilterKind,
-    /// The forced gaze image.
-    gaze: GazeOverride,
-    /// The newest gaze state of the condition shown.
-    state: Option<GazeState>,
 }
 
 impl ViewConditions {
@@ -62,104 +59,57 @@ impl ViewConditions {
         let conditions = sets
             .into_iter()
             .map(|s| {
-                (s.ensure_implemented().is_ok() && (!s.caustics || caustics_loaded)).then_some(s)
+                (s.ensure_implemented().is_ok() && (!s.caustics || caustics_loaded)).then(|| {
+                    let planner = planner(s, model.as_ref(), reflection, filter, gaze);
+                    (s, planner)
+                })
             })
             .collect();
-        let mut looks = ViewConditions {
-            conditions,
-            planners: Vec::new(),
-            current,
+        ViewConditions {
+            looks: LiveConditions::with_gaps(conditions, current, gaze),
             model,
             reflection,
             filter,
-            gaze,
-            state: None,
-        };
-        looks.rebuild();
-        looks
+        }
     }
 
     /// New planners for the current settings (gaze history starts over).
     fn rebuild(&mut self) {
-        self.planners = self
-            .conditions
-            .iter()
-            .map(|c| {
-                c.map(|set| {
-                    let defocus = match (set.defocus, &self.model) {
-                        (true, Some(model)) => {
-                            let mut config = GazeConfig::new(model.distances);
-                            config.filter = self.filter;
-                            config.override_image = self.gaze;
-                            Some((config, model.clone()))
-                        }
-                        _ => None,
-                    };
-                    LookPlanner::new(
-                        vitreous_frames::look::base_look(&set, self.reflection),
-                        defocus,
-                    )
-                })
-            })
-            .collect();
-    }
-
-    /// The condition shown.
-    pub fn condition(&self) -> EffectSet {
-        self.conditions[self.current].expect("the current condition is available")
-    }
-
-    /// The planner of the condition shown.
-    pub fn planner(&self) -> &LookPlanner {
-        self.planners[self.current]
-            .as_ref()
-            .expect("the current condition has a planner")
-    }
-
-    /// Moves the object the image distances are measured to (its centre and model-to-world
-    /// transform), for every condition.
-    pub fn set_object_pose(&mut self, center_m: glam::Vec3, world_from_model: glam::Mat4) {
-        for planner in self.planners.iter_mut().flatten() {
-            planner.set_object_pose(center_m, world_from_model);
-        }
+        let (model, reflection, filter) = (self.model.as_ref(), self.reflection, self.filter);
+        let gaze = self.looks.gaze();
+        self.looks
+            .replan(|set| planner(set, model, reflection, filter, gaze));
     }
 
     /// The gaze filter, reflection and forced gaze image, for the overlay.
     pub fn settings(&self) -> (FilterKind, Reflection, GazeOverride) {
-        (self.filter, self.reflection, self.gaze)
-    }
-
-    /// The newest gaze state of the condition shown (None without defocus).
-    pub fn gaze_state(&self) -> Option<GazeState> {
-        self.state
+        (self.filter, self.reflection, self.looks.gaze())
     }
 
     /// Shows condition `index` of [`CONDITION_KEYS`]; says what happened.
     pub fn choose(&mut self, index: usize) -> String {
-        match self.conditions.get(index) {
-            Some(Some(set)) => {
-                self.current = index;
+        if index >= self.looks.len() {
+            return "no such condition".into();
+        }
+        match self.looks.get(index) {
+            Some(set) => {
+                self.looks.select(index);
                 format!("effects now {set}")
             }
-            Some(None) => format!(
+            None => format!(
                 "condition {} is not available here (not implemented, or no caustic bake for \
                  the scene)",
                 CONDITION_KEYS[index]
             ),
-            None => "no such condition".into(),
         }
     }
 
     /// The next available condition.
     pub fn next(&mut self) -> String {
-        let n = self.conditions.len();
-        for step in 1..=n {
-            let i = (self.current + step) % n;
-            if self.conditions[i].is_some() {
-                return self.choose(i);
-            }
+        match self.looks.step() {
+            Some(set) => format!("effects now {set}"),
+            None => self.choose(self.looks.current()),
         }
-        self.choose(self.current)
     }
 
     /// Switches the reflected image between Phong and environment + Fresnel.
@@ -181,55 +131,44 @@ impl ViewConditions {
         Ok(format!("gaze filter now {}", self.filter))
     }
 
-    /// Shows the condition with effects `set`; false when the viewer has no such condition
-    /// available.
-    pub fn show_set(&mut self, set: EffectSet) -> bool {
-        match self.conditions.iter().position(|c| *c == Some(set)) {
-            Some(i) => {
-                self.current = i;
-                true
-            }
-            None => false,
-        }
-    }
-
-    /// Forces the gaze image (auto: the gaze pipeline decides).
-    pub fn set_gaze(&mut self, gaze: GazeOverride) {
-        if gaze != self.gaze {
-            self.gaze = gaze;
-            for p in self.planners.iter_mut().flatten() {
-                p.set_gaze_override(gaze);
-            }
-        }
-    }
-
     /// The next forced gaze image (auto, surface, refracted).
     pub fn next_gaze(&mut self) -> String {
-        self.gaze = match self.gaze {
-            GazeOverride::Auto => GazeOverride::Surface,
-            GazeOverride::Surface => GazeOverride::Refracted,
-            GazeOverride::Refracted => GazeOverride::Auto,
-        };
-        for p in self.planners.iter_mut().flatten() {
-            p.set_gaze_override(self.gaze);
-        }
-        format!("gaze image forced: {}", self.gaze)
+        format!("gaze image forced: {}", self.looks.cycle_gaze())
     }
+}
 
-    /// This frame's look: every planner sees the frame, the current one's look is used.
-    pub fn plan(&mut self, input: &FrameInput) -> Look {
-        let mut look = Look::default();
-        for (i, planner) in self.planners.iter_mut().enumerate() {
-            if let Some(p) = planner {
-                let (l, state) = p.plan(input);
-                if i == self.current {
-                    look = l;
-                    self.state = state;
-                }
-            }
-        }
-        look
+impl Deref for ViewConditions {
+    type Target = LiveConditions;
+
+    fn deref(&self) -> &LiveConditions {
+        &self.looks
     }
+}
+
+impl DerefMut for ViewConditions {
+    fn deref_mut(&mut self) -> &mut LiveConditions {
+        &mut self.looks
+    }
+}
+
+/// The planner of condition `set` with the viewer's settings.
+fn planner(
+    set: EffectSet,
+    model: Option<&DefocusModel>,
+    reflection: Reflection,
+    filter: FilterKind,
+    gaze: GazeOverride,
+) -> LookPlanner {
+    let defocus = match (set.defocus, model) {
+        (true, Some(model)) => {
+            let mut config = GazeConfig::new(model.distances);
+            config.filter = filter;
+            config.override_image = gaze;
+            Some((config, model.clone()))
+        }
+        _ => None,
+    };
+    LookPlanner::new(vitreous_frames::look::base_look(&set, reflection), defocus)
 }
 
 #[cfg(test)]

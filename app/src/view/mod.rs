@@ -4,17 +4,18 @@
 //! through a third backend, [`desktop::DesktopBackend`], whose head pose comes from the mouse
 //! and keys and whose gaze is synthesised from the cursor. Each finished frame's eye images
 //! are read back and put in the window (left, right or both; the display's light or the
-//! see-through preview) by [`swapchain::Presenter`], on a Vulkan device of its own.
+//! see-through preview) by the renderer's [`vitreous_render::Presenter`], on a Vulkan device of
+//! its own.
 //!
 //! What needs a new renderer (a new eye image size after a resize or a change of the eyes
 //! shown, a reloaded scene) ends the frame loop with the frames in flight finished, makes the
 //! renderer, and runs the loop again with the same backend and sink.
 //!
-//! Parts: `desktop.rs` (the backend), `window.rs` (winit), `swapchain.rs` (surface, swapchain,
-//! presentation), `staging.rs` (its staging buffers and their copy to the screen), `input.rs`
-//! (events and keys), `script.rs` (`--script`), `conditions.rs` (effect conditions),
-//! `picture.rs` (the window's picture and overlay), `reload.rs` (hot reload), `playback.rs`
-//! (`--trace`), `session.rs` (the sink and what the overlay shows), `cli.rs` (the options).
+//! Parts: `desktop.rs` (the backend), `window.rs` (winit), `surface.rs` (the window's Vulkan
+//! surface and its presenter), `input.rs` (events and keys), `script.rs` (`--script`),
+//! `conditions.rs` (the keys' effect conditions), `picture.rs` (the window's picture and
+//! overlay), `reload.rs` (hot reload), `playback.rs` (`--trace`), `session.rs` (the sink and
+//! what the overlay shows), `cli.rs` (the options).
 
 mod cli;
 mod conditions;
@@ -26,8 +27,7 @@ mod playback;
 mod reload;
 mod script;
 mod session;
-mod staging;
-mod swapchain;
+mod surface;
 mod window;
 
 use std::cell::RefCell;
@@ -215,7 +215,7 @@ fn view_with(options: &ViewOptions, director: Option<&mut dyn Director>) -> Resu
     let title = format!("vitreous view: {}", options.scene.display());
     let desktop = window::DesktopWindow::open(&title, w, h)?;
     let win = desktop.window();
-    let extensions = swapchain::surface_extensions(&win)?;
+    let extensions = surface::surface_extensions(&win)?;
     let context_options = ContextOptions {
         validation: options.validate,
         device_name: options.device.clone(),
@@ -227,7 +227,7 @@ fn view_with(options: &ViewOptions, director: Option<&mut dyn Director>) -> Resu
         &[ash::khr::swapchain::NAME],
     )
     .context("setting up the Vulkan device for the window")?;
-    let presenter = swapchain::Presenter::new(present_ctx, win)?;
+    let presenter = surface::presenter(present_ctx, win)?;
 
     let shared = Rc::new(RefCell::new(Shared {
         actions: VecDeque::new(),

@@ -3,8 +3,8 @@
 //!
 //! Just over 600 lines: it is the viewer's one `FrameSink`, and each of its parts (actions,
 //! reload requests, renderer hand-over, overlay lines, presentation) reads and writes the same
-//! session state; the state machines it drives live in `conditions.rs`, `reload.rs` and
-//! `swapchain.rs`.
+//! session state; the state machines it drives live in `conditions.rs`, `reload.rs` and the
+//! renderer's `present` module.
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_render::{ContextOptions, Renderer};
+use vitreous_render::{ContextOptions, Presented, Renderer};
 use vitreous_xr::trace::{AtomicFile, TraceSample, TraceWriter};
 use vitreous_xr::{FrameInput, GazeSample};
 
@@ -23,7 +23,7 @@ use super::edits::ViewEdits;
 use super::input::{Action, KEYS};
 use super::picture::{Overlay, SeeThrough, compose};
 use super::reload::{Loaded, Watcher};
-use super::swapchain::{Presented, Presenter};
+use super::surface::WindowPresenter;
 use vitreous_frames::director::Director;
 use vitreous_frames::frame_loop::{FramePlan, FrameSink};
 use vitreous_frames::motion_clock::MotionClock;
@@ -57,7 +57,7 @@ pub struct ViewSink<'d> {
     /// The scene's files.
     watcher: Watcher,
     /// The window's swapchain.
-    presenter: Presenter,
+    presenter: WindowPresenter,
     /// Shared with the backend.
     shared: Rc<RefCell<Shared>>,
     /// Show the see-through preview instead of the display's light.
@@ -105,7 +105,7 @@ impl<'d> ViewSink<'d> {
     pub fn new(
         options: &ViewOptions,
         loaded: Loaded,
-        presenter: Presenter,
+        presenter: WindowPresenter,
         shared: Rc<RefCell<Shared>>,
         filter: Option<FilterKind>,
         gaze: GazeOverride,

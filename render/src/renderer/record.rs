@@ -4,9 +4,9 @@ use ash::vk;
 
 use super::{Composition, FrameSlot, QUERIES, Renderer, Want, copy, external};
 use crate::blur_blend;
-use crate::look::FrameParams;
 use crate::floor::{FIELD_STAMPS, Prepared, Stamps};
 use crate::glass::{EyePush, GlassDraws};
+use crate::look::FrameParams;
 use crate::owned::Owned;
 use crate::pipeline;
 use crate::statistics::{self, Statistics};

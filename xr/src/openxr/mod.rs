@@ -5,7 +5,7 @@
 //! 1. [`Runtime::new`]: OpenXR instance (HMD form factor; XR_KHR_vulkan_enable2 required,
 //!    eye-gaze and depth-layer extensions when offered), system, stereo view configuration,
 //!    blend-mode choice. Its `create_vulkan_*` methods (`vulkan.rs`) are what the renderer's
-//!    device creator calls (the app adapts them to `vitreous_render::DeviceCreator`).
+//!    device creator calls ([`XrDeviceCreator`], a `vitreous_render::DeviceCreator`).
 //! 2. [`Runtime::start`]: session on the renderer's device, reference space (STAGE when offered,
 //!    else LOCAL), one 2-layer array swapchain (and a 2-layer depth swapchain when depth is
 //!    submitted with XR_KHR_composition_layer_depth), gaze source, the controller action set
@@ -27,6 +27,7 @@
 pub mod actions;
 pub mod choose;
 mod convert;
+mod device_creator;
 mod error;
 mod gaze;
 mod light_estimator;
@@ -45,6 +46,7 @@ pub use actions::{Command, Cycle};
 /// The `ash` crate these APIs use, for callers without their own dependency on it.
 pub use ash;
 pub use choose::{Blend, ColorFormat, GazeChoice, GazeSource};
+pub use device_creator::XrDeviceCreator;
 pub(crate) use error::XrContext;
 pub use error::{OpenXrError, Result};
 pub use gaze::GazeTally;

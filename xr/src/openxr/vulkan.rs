@@ -1,6 +1,6 @@
 //! Vulkan through the runtime (XR_KHR_vulkan_enable2): the runtime creates the renderer's
 //! instance and device and names the physical device its headset is driven by; these are the
-//! calls the app's `vitreous_render::DeviceCreator` makes.
+//! calls [`super::XrDeviceCreator`], the renderer's device creator, makes.
 
 use ash::vk;
 use ash::vk::Handle;

@@ -1,14 +1,16 @@
 //! A host-visible buffer a picture is written into, and its copy into the window's image.
 
-use anyhow::{Context, Result};
 use ash::vk;
-use vitreous_render::{GpuContext, layout_barrier, subresource_range};
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result, VkContext};
+use crate::memory::{color_copy_region, layout_barrier, subresource_range};
 
 /// A staging buffer, mapped for as long as it lives. Freed with [`Staging::free`] (it holds
 /// no device, so it cannot free itself on drop).
-pub struct Staging {
+pub(super) struct Staging {
     /// The buffer (null until first sized).
-    pub buffer: vk::Buffer,
+    pub(super) buffer: vk::Buffer,
     /// Its memory.
     memory: vk::DeviceMemory,
     /// The mapped pointer to `memory`.
@@ -19,7 +21,7 @@ pub struct Staging {
 
 impl Staging {
     /// No buffer yet.
-    pub const EMPTY: Staging = Staging {
+    pub(super) const EMPTY: Staging = Staging {
         buffer: vk::Buffer::null(),
         memory: vk::DeviceMemory::null(),
         mapped: std::ptr::null_mut(),
@@ -27,7 +29,7 @@ impl Staging {
     };
 
     /// Makes the buffer hold at least `bytes`. No submitted work may use it.
-    pub fn ensure(&mut self, ctx: &GpuContext, bytes: u64) -> Result<()> {
+    pub(super) fn ensure(&mut self, ctx: &GpuContext, bytes: u64) -> Result<()> {
         if self.capacity >= bytes {
             return Ok(());
         }
@@ -38,7 +40,7 @@ impl Staging {
             .usage(vk::BufferUsageFlags::TRANSFER_SRC)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: a valid create info; stored at once, so `free` releases it on a later error.
-        self.buffer = unsafe { d.create_buffer(&info, None) }.context("vkCreateBuffer")?;
+        self.buffer = unsafe { d.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
         // SAFETY: the buffer is live.
         let needs = unsafe { d.get_buffer_memory_requirements(self.buffer) };
         // SAFETY: the physical device belongs to the context's instance.
@@ -54,20 +56,22 @@ impl Staging {
                         .property_flags
                         .contains(wanted)
             })
-            .context("no host-visible coherent memory for the window's staging buffer")?;
+            .ok_or_else(|| {
+                RenderError::Presentation(
+                    "no host-visible coherent memory for the window's staging buffer".into(),
+                )
+            })?;
         let alloc = vk::MemoryAllocateInfo::default()
             .allocation_size(needs.size)
             .memory_type_index(type_index);
         // SAFETY: a valid allocate info; stored at once; bound to the buffer and mapped whole.
         unsafe {
-            self.memory = d
-                .allocate_memory(&alloc, None)
-                .context("vkAllocateMemory")?;
+            self.memory = d.allocate_memory(&alloc, None).vk("vkAllocateMemory")?;
             d.bind_buffer_memory(self.buffer, self.memory, 0)
-                .context("vkBindBufferMemory")?;
+                .vk("vkBindBufferMemory")?;
             self.mapped = d
                 .map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty())
-                .context("vkMapMemory")?
+                .vk("vkMapMemory")?
                 .cast();
         }
         self.capacity = bytes;
@@ -79,7 +83,7 @@ impl Staging {
     /// # Safety
     /// `bytes` must not exceed what [`Staging::ensure`] was last given, and no submitted work
     /// may read the buffer while the slice lives.
-    pub unsafe fn bytes_mut(&mut self, bytes: usize) -> &mut [u8] {
+    pub(super) unsafe fn bytes_mut(&mut self, bytes: usize) -> &mut [u8] {
         debug_assert!(bytes as u64 <= self.capacity);
         // SAFETY: the caller's contract: `mapped` points at `capacity` >= `bytes` bytes of
         // host-coherent memory that nothing else uses meanwhile.
@@ -87,7 +91,7 @@ impl Staging {
     }
 
     /// Frees the buffer and its memory, if any; no submitted work may use them.
-    pub fn free(&mut self, d: &ash::Device) {
+    pub(super) fn free(&mut self, d: &ash::Device) {
         // SAFETY: the contract above; null handles are ignored by the destroy calls.
         unsafe {
             if self.memory != vk::DeviceMemory::null() {
@@ -105,7 +109,7 @@ impl Staging {
 /// # Safety
 /// `cmd` must be recording outside a render pass; buffer and image must hold `extent` and
 /// outlive the command buffer's execution.
-pub unsafe fn record_copy(
+pub(super) unsafe fn record_copy(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
     staging: vk::Buffer,
@@ -123,7 +127,7 @@ pub unsafe fn record_copy(
         (vk::ImageLayout::UNDEFINED, vk::AccessFlags::empty()),
         transfer_dst,
     );
-    let region = vitreous_render::color_copy_region(0, extent.width, extent.height, 1, 1);
+    let region = color_copy_region(0, extent.width, extent.height, 1, 1);
     let to_present = layout_barrier(
         image,
         range,

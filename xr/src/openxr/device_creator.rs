@@ -1,10 +1,12 @@
 //! The renderer's Vulkan instance and device, created through the OpenXR runtime as
-//! XR_KHR_vulkan_enable2 requires.
+//! XR_KHR_vulkan_enable2 requires: the runtime's `create_vulkan_*` calls (`vulkan.rs`) as the
+//! renderer's [`DeviceCreator`].
 
+use ash::vk;
 use vitreous_render::context::API_VERSION;
 use vitreous_render::{ContextOptions, DeviceCreator, RenderError};
-use vitreous_xr::openxr::Runtime;
-use vitreous_xr::openxr::ash::{self, vk};
+
+use super::Runtime;
 
 /// Creates the renderer's Vulkan instance and device through the OpenXR runtime.
 pub struct XrDeviceCreator<'a> {

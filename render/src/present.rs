@@ -1,4 +1,9 @@
-//! The window's Vulkan surface and swapchain, and putting a finished picture on screen.
+//! A window's Vulkan swapchain, and putting a finished picture on screen (`vitreous view`).
+//!
+//! The window and its surface are the caller's: a [`Presenter`] takes a `vk::SurfaceKHR`
+//! already made on its context's instance and a [`PresentWindow`] standing for the window
+//! (its size, and what the windowing system is told around each presentation), so this crate
+//! knows no windowing library.
 //!
 //! # Synchronisation
 //! [`FRAMES_IN_FLIGHT`] presentation slots are used round-robin. Each slot owns a fence (its
@@ -18,15 +23,27 @@
 //! before the next picture after the device is idle; a window of zero size (minimised)
 //! presents nothing until it has a size again.
 
-use std::sync::Arc;
+mod staging;
 
-use anyhow::{Context, Result, bail};
 use ash::vk;
-use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
-use vitreous_render::GpuContext;
-use winit::window::Window;
 
-use super::staging::{Staging, record_copy};
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result, VkContext};
+use staging::{Staging, record_copy};
+
+/// The window a [`Presenter`] puts pictures in, as far as presenting needs it. Whoever
+/// implements it keeps the native window alive for as long as the value lives.
+pub trait PresentWindow {
+    /// Size of the window's drawable area now, pixels.
+    fn size(&self) -> (u32, u32);
+
+    /// A picture is about to be presented (winit: `pre_present_notify`, which on Wayland
+    /// asks for a frame callback for it).
+    fn presenting(&self);
+
+    /// A picture was handed to presentation: ask for the next (winit: `request_redraw`).
+    fn presented(&self);
+}
 
 /// Presentation slots in flight at once.
 pub const FRAMES_IN_FLIGHT: usize = 2;
@@ -72,7 +89,7 @@ struct Chain {
 ///
 /// Fields are freed in [`Drop`] in the reverse order of creation; the context (holding the
 /// device and instance) and then the window drop after that.
-pub struct Presenter {
+pub struct Presenter<W: PresentWindow> {
     /// Presentation slots.
     slots: Vec<Slot>,
     /// The slot the next picture uses.
@@ -98,28 +115,18 @@ pub struct Presenter {
     /// The Vulkan device the window's images live on; dropped after everything above.
     ctx: GpuContext,
     /// The window; dropped after its surface.
-    window: Arc<Window>,
+    window: W,
 }
 
-impl Presenter {
-    /// The surface and presentation slots for `window` on `ctx`, which must have been made
-    /// with [`surface_extensions`] and `VK_KHR_swapchain`.
-    pub fn new(ctx: GpuContext, window: Arc<Window>) -> Result<Presenter> {
-        let display = window.display_handle().context("the window's display")?;
-        let handle = window.window_handle().context("the window's handle")?;
-        // SAFETY: the instance was created with the extensions `ash_window` asks for this
-        // display (surface_extensions); the handles are the live window's, which the presenter
-        // keeps alive (field `window`) until the surface is destroyed in Drop.
-        let surface = unsafe {
-            ash_window::create_surface(
-                &ctx.entry,
-                &ctx.instance,
-                display.as_raw(),
-                handle.as_raw(),
-                None,
-            )
-        }
-        .context("creating the window's Vulkan surface")?;
+impl<W: PresentWindow> Presenter<W> {
+    /// The presentation slots for `surface` on `ctx`, whose device must have been made with
+    /// `VK_KHR_swapchain`.
+    ///
+    /// # Safety
+    /// `surface` must be a live surface made on `ctx.instance` for the native window `window`
+    /// stands for, which `window` keeps alive as long as it lives; nothing else may destroy
+    /// it: the presenter owns it from this call on (and destroys it, also when this fails).
+    pub unsafe fn new(ctx: GpuContext, surface: vk::SurfaceKHR, window: W) -> Result<Self> {
         let surface_fn = ash::khr::surface::Instance::new(&ctx.entry, &ctx.instance);
         let swapchain_fn = ash::khr::swapchain::Device::new(&ctx.instance, &ctx.device);
         // From here on the guard owns what is made; Drop frees whatever exists.
@@ -150,41 +157,41 @@ impl Presenter {
             self.surface_fn
                 .get_physical_device_surface_support(pd, family, self.surface)
         }
-        .context("vkGetPhysicalDeviceSurfaceSupportKHR")?;
+        .vk("vkGetPhysicalDeviceSurfaceSupportKHR")?;
         if !supported {
-            bail!(
+            return Err(RenderError::Presentation(format!(
                 "the Vulkan device {} cannot present to this window from its graphics queue",
                 self.ctx.device_name
-            );
+            )));
         }
         // SAFETY: as above.
         let formats = unsafe {
             self.surface_fn
                 .get_physical_device_surface_formats(pd, self.surface)
         }
-        .context("vkGetPhysicalDeviceSurfaceFormatsKHR")?;
-        self.format = pick_format(&formats).with_context(|| {
-            format!("the window offers no 8-bit RGBA or BGRA UNORM format: {formats:?}")
+        .vk("vkGetPhysicalDeviceSurfaceFormatsKHR")?;
+        self.format = pick_format(&formats).ok_or_else(|| {
+            RenderError::Presentation(format!(
+                "the window offers no 8-bit RGBA or BGRA UNORM format: {formats:?}"
+            ))
         })?;
         let d = &self.ctx.device;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         // SAFETY: a valid create info for the device's queue family; freed in Drop.
-        self.pool =
-            unsafe { d.create_command_pool(&pool_info, None) }.context("vkCreateCommandPool")?;
+        self.pool = unsafe { d.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(self.pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(FRAMES_IN_FLIGHT as u32);
         // SAFETY: the pool is live and used only here.
-        let cmds =
-            unsafe { d.allocate_command_buffers(&alloc) }.context("vkAllocateCommandBuffers")?;
+        let cmds = unsafe { d.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?;
         for cmd in cmds {
             let signalled = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
             // SAFETY: a valid create info; the fence goes into a slot (freed in Drop) at once,
             // so it does not leak on a later error.
-            let fence = unsafe { d.create_fence(&signalled, None) }.context("vkCreateFence")?;
+            let fence = unsafe { d.create_fence(&signalled, None) }.vk("vkCreateFence")?;
             self.slots.push(Slot {
                 fence,
                 acquired: vk::Semaphore::null(),
@@ -195,7 +202,7 @@ impl Presenter {
             // SAFETY: a valid create info; stored in the slot (freed in Drop) at once.
             slot.acquired =
                 unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
-                    .context("vkCreateSemaphore")?;
+                    .vk("vkCreateSemaphore")?;
         }
         Ok(())
     }
@@ -207,8 +214,7 @@ impl Presenter {
 
     /// Size of the window's drawable area now, pixels.
     pub fn window_size(&self) -> (u32, u32) {
-        let s = self.window.inner_size();
-        (s.width, s.height)
+        self.window.size()
     }
 
     /// The last picture put on screen (RGBA8, rows from the top), with its width and height.
@@ -221,10 +227,10 @@ impl Presenter {
         self.not_shown
     }
 
-    /// Puts a picture on screen if the window asked for one (`asked`: its `RedrawRequested`
-    /// came since the last picture, see [`super::window::DesktopWindow::redraw_due`]). `draw`
-    /// fills an RGBA8 buffer of the given width and height (the swapchain's size, rows from
-    /// the top); it is not called when nothing is presented.
+    /// Puts a picture on screen if the window asked for one (`asked`: the windowing system
+    /// asked for a picture since the last one, winit's `RedrawRequested`). `draw` fills an
+    /// RGBA8 buffer of the given width and height (the swapchain's size, rows from the top);
+    /// it is not called when nothing is presented.
     pub fn present(
         &mut self,
         asked: bool,
@@ -260,14 +266,14 @@ impl Presenter {
         let chain = self
             .chain
             .as_ref()
-            .context("a swapchain after recreation")?;
+            .ok_or_else(|| RenderError::Presentation("no swapchain after recreation".into()))?;
         let extent = chain.extent;
         let slot_index = self.next_slot;
         let d = &self.ctx.device;
         let slot = &self.slots[slot_index];
         // SAFETY: the fence is live; waiting has no other precondition.
         unsafe { d.wait_for_fences(&[slot.fence], true, u64::MAX) }
-            .context("waiting for a presentation slot")?;
+            .vk("vkWaitForFences (a presentation slot)")?;
         // SAFETY: swapchain and semaphore are live; the slot's semaphore is unsignalled (its
         // last acquire was waited on by the slot's last submission, finished per its fence).
         let acquired = unsafe {
@@ -287,7 +293,7 @@ impl Presenter {
                 self.stale = true;
                 return Ok(Presented::Recreated);
             }
-            Err(e) => return Err(e).context("vkAcquireNextImageKHR"),
+            Err(e) => return Err(e).vk("vkAcquireNextImageKHR"),
         };
         let bytes = u64::from(extent.width) * u64::from(extent.height) * 4;
         self.slots[slot_index].staging.ensure(&self.ctx, bytes)?;
@@ -295,7 +301,10 @@ impl Presenter {
         draw(&mut picture, extent.width, extent.height);
         let d = &self.ctx.device;
         let slot = &mut self.slots[slot_index];
-        let chain = self.chain.as_ref().context("a swapchain")?;
+        let chain = self
+            .chain
+            .as_ref()
+            .ok_or_else(|| RenderError::Presentation("no swapchain".into()))?;
         let bgra = matches!(self.format.format, vk::Format::B8G8R8A8_UNORM);
         // SAFETY: the buffer was sized for `bytes` above, and no submitted work uses it (the
         // slot's fence signalled above).
@@ -318,16 +327,15 @@ impl Presenter {
         // the staging buffer and image outlive the submission (recreation and Drop wait for
         // the device to be idle first).
         unsafe {
-            d.reset_fences(&[slot.fence]).context("vkResetFences")?;
+            d.reset_fences(&[slot.fence]).vk("vkResetFences")?;
             d.reset_command_buffer(slot.cmd, vk::CommandBufferResetFlags::empty())
-                .context("vkResetCommandBuffer")?;
+                .vk("vkResetCommandBuffer")?;
             let begin = vk::CommandBufferBeginInfo::default()
                 .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             d.begin_command_buffer(slot.cmd, &begin)
-                .context("vkBeginCommandBuffer")?;
+                .vk("vkBeginCommandBuffer")?;
             record_copy(d, slot.cmd, slot.staging.buffer, image, extent);
-            d.end_command_buffer(slot.cmd)
-                .context("vkEndCommandBuffer")?;
+            d.end_command_buffer(slot.cmd).vk("vkEndCommandBuffer")?;
             let waits = [slot.acquired];
             let stages = [vk::PipelineStageFlags::TRANSFER];
             let cmds = [slot.cmd];
@@ -338,7 +346,7 @@ impl Presenter {
                 .command_buffers(&cmds)
                 .signal_semaphores(&signals);
             d.queue_submit(self.ctx.queue, &[submit], slot.fence)
-                .context("vkQueueSubmit (presentation copy)")?;
+                .vk("vkQueueSubmit (presentation copy)")?;
         }
         self.next_slot = (self.next_slot + 1) % FRAMES_IN_FLIGHT;
         let swapchains = [chain.swapchain];
@@ -349,16 +357,16 @@ impl Presenter {
             .swapchains(&swapchains)
             .image_indices(&indices);
         // The windowing system is told a picture follows (Wayland: a frame callback for it),
-        // and asked for the next one, which `RedrawRequested` brings once this one is taken.
-        self.window.pre_present_notify();
+        // and asked for the next one, which it asks for in turn once this one is taken.
+        self.window.presenting();
         // SAFETY: the image was acquired from this swapchain and the submission above signals
         // the semaphore presentation waits for.
         let result = unsafe { self.swapchain_fn.queue_present(self.ctx.queue, &info) };
-        self.window.request_redraw();
+        self.window.presented();
         match result {
             Ok(suboptimal) => self.stale |= suboptimal,
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => self.stale = true,
-            Err(e) => return Err(e).context("vkQueuePresentKHR"),
+            Err(e) => return Err(e).vk("vkQueuePresentKHR"),
         }
         self.last = Some((picture, extent.width, extent.height));
         Ok(Presented::Shown)
@@ -372,7 +380,7 @@ impl Presenter {
             self.surface_fn
                 .get_physical_device_surface_capabilities(pd, surface)
         }
-        .context("vkGetPhysicalDeviceSurfaceCapabilitiesKHR")?;
+        .vk("vkGetPhysicalDeviceSurfaceCapabilitiesKHR")?;
         let (w, h) = self.window_size();
         let extent = if caps.current_extent.width == u32::MAX {
             vk::Extent2D {
@@ -389,7 +397,9 @@ impl Presenter {
             .supported_usage_flags
             .contains(vk::ImageUsageFlags::TRANSFER_DST)
         {
-            bail!("the window's swapchain images cannot be copied to (no TRANSFER_DST usage)");
+            return Err(RenderError::Presentation(
+                "the window's swapchain images cannot be copied to (no TRANSFER_DST usage)".into(),
+            ));
         }
         let mut count = caps.min_image_count + 1;
         if caps.max_image_count > 0 {
@@ -397,7 +407,7 @@ impl Presenter {
         }
         // SAFETY: waiting for idle has no precondition; afterwards no copy uses the old
         // swapchain's images or semaphores, which are freed below.
-        unsafe { self.ctx.device.device_wait_idle() }.context("vkDeviceWaitIdle")?;
+        unsafe { self.ctx.device.device_wait_idle() }.vk("vkDeviceWaitIdle")?;
         let old = self.chain.take();
         let info = vk::SwapchainCreateInfoKHR::default()
             .surface(surface)
@@ -422,7 +432,7 @@ impl Presenter {
         if let Some(old) = old {
             self.destroy_chain(old);
         }
-        let swapchain = created.context("vkCreateSwapchainKHR")?;
+        let swapchain = created.vk("vkCreateSwapchainKHR")?;
         let mut chain = Chain {
             swapchain,
             images: Vec::new(),
@@ -435,7 +445,7 @@ impl Presenter {
             Ok(images) => images,
             Err(e) => {
                 self.destroy_chain(chain);
-                return Err(e).context("vkGetSwapchainImagesKHR");
+                return Err(e).vk("vkGetSwapchainImagesKHR");
             }
         };
         for _ in 0..chain.images.len() {
@@ -448,7 +458,7 @@ impl Presenter {
                 Ok(s) => chain.finished.push(s),
                 Err(e) => {
                     self.destroy_chain(chain);
-                    return Err(e).context("vkCreateSemaphore");
+                    return Err(e).vk("vkCreateSemaphore");
                 }
             }
         }
@@ -475,7 +485,7 @@ impl Presenter {
     }
 }
 
-impl Drop for Presenter {
+impl<W: PresentWindow> Drop for Presenter<W> {
     fn drop(&mut self) {
         let d = &self.ctx.device;
         // SAFETY: after the device is idle no submitted work uses any object freed here; each
@@ -507,18 +517,6 @@ fn pick_format(formats: &[vk::SurfaceFormatKHR]) -> Option<vk::SurfaceFormatKHR>
                 .copied()
                 .find(|s| s.format == f && s.color_space == vk::ColorSpaceKHR::SRGB_NONLINEAR)
         })
-}
-
-/// The instance extensions a surface on this window's display needs.
-pub fn surface_extensions(window: &Window) -> Result<Vec<&'static std::ffi::CStr>> {
-    let display = window.display_handle().context("the window's display")?;
-    let names = ash_window::enumerate_required_extensions(display.as_raw())
-        .context("no Vulkan surface extension for this display (X11 or Wayland expected)")?;
-    Ok(names
-        .iter()
-        // SAFETY: `ash_window` returns pointers to static NUL-terminated extension names.
-        .map(|&p| unsafe { std::ffi::CStr::from_ptr(p) })
-        .collect())
 }
 
 #[cfg(test)]

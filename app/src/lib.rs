@@ -1,9 +1,10 @@
 //! vitreous: perception-based virtual glass for optical see-through head-mounted displays.
 //!
 //! The library behind the `vitreous` command: scene files, the frame loop shared by every XR
-//! backend, trace replay and trace tools. Rendering lives in `vitreous-render`, XR backends and
-//! the trace format in `vitreous-xr`, the gaze pipeline (vergence, the gaze-image decisions,
-//! defocus maths) in `vitreous-gaze`, re-exported here as [`gaze`].
+//! backend, trace replay and trace tools. Rendering lives in `vitreous-render`, XR backends in
+//! `vitreous-xr`, the trace format and frame data in `vitreous-trace`, the gaze pipeline
+//! (vergence, the gaze-image decisions, defocus maths) in `vitreous-gaze`, re-exported here as
+//! [`gaze`].
 
 pub mod bench;
 pub mod cli_values;

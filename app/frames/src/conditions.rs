@@ -2,8 +2,7 @@
 //! mapping of the backend's generic cycle buttons to the effect condition and the forced gaze
 //! image ([`GAZE_IMAGE_CYCLE`], [`CONDITION_CYCLE`]).
 
-use vitreous_xr::FrameInput;
-use vitreous_xr::openxr::{Command, Cycle};
+use vitreous_trace::{Command, Cycle, FrameInput};
 
 use crate::director::Director;
 use crate::look::LookPlanner;

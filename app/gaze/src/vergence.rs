@@ -32,8 +32,8 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use vitreous_xr::GazeSample;
-pub use vitreous_xr::crossing::{RayCrossing, closest_approach};
+use vitreous_trace::GazeSample;
+pub use vitreous_trace::crossing::{RayCrossing, closest_approach};
 
 /// Default cap on the reported depth (far fixations and near-parallel rays), metres.
 pub const DEFAULT_MAX_DEPTH_M: f32 = 10.0;
@@ -281,7 +281,7 @@ fn log_once(which: Fallback) -> bool {
 mod tests {
     use super::*;
     use glam::Vec3;
-    use vitreous_xr::GazeRay;
+    use vitreous_trace::GazeRay;
 
     fn ray(origin: Vec3, target: Vec3) -> GazeRay {
         GazeRay {

@@ -16,9 +16,9 @@ use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{
     ContextOptions, GpuContext, Look, Reflection, Refraction, Renderer, ScenePose,
 };
+use vitreous_trace::format::{EditRecord, Recording, TraceSample};
+use vitreous_trace::{FrameInput, SessionEvent};
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::trace::{EditRecord, Recording, TraceSample};
-use vitreous_xr::{FrameInput, SessionEvent};
 
 use crate::effects::EffectSet;
 use crate::frame_log::FrameLog;

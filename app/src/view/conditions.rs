@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 use vitreous_render::{Look, Reflection};
-use vitreous_xr::FrameInput;
+use vitreous_trace::FrameInput;
 
 use crate::effects::EffectSet;
 use crate::gaze::{FilterKind, GazeConfig, GazeOverride, GazeState};

@@ -13,7 +13,8 @@ use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use glam::{EulerRot, Quat, Vec3};
-use vitreous_xr::{Backend, EyeView, Fov, FrameInput, GazeRay, GazeSample, Pose};
+use vitreous_trace::{EyeView, Fov, FrameInput, GazeRay, GazeSample, Pose};
+use vitreous_xr::Backend;
 
 use super::input::{Action, EyesShown, InputEvent, action_for_key, movement};
 use super::playback::Playback;

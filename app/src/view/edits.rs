@@ -5,8 +5,8 @@
 use anyhow::Context;
 use glam::Vec3;
 use vitreous_render::ScenePose;
-use vitreous_xr::FrameInput;
-use vitreous_xr::trace::{AtomicFile, EditRecord, TraceWriter};
+use vitreous_trace::FrameInput;
+use vitreous_trace::format::{AtomicFile, EditRecord, TraceWriter};
 
 use crate::motion_clock::MotionClock;
 use crate::scene::Scene;

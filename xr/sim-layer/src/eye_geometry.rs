@@ -4,8 +4,8 @@
 
 use glam::{Mat3, Quat, Vec3};
 use openxr::sys;
-use vitreous_xr::crossing::{RayCrossing, closest_approach};
-use vitreous_xr::{GazeRay, GazeSample, Pose};
+use vitreous_trace::crossing::{RayCrossing, closest_approach};
+use vitreous_trace::{GazeRay, GazeSample, Pose};
 
 /// The pose at `origin` whose -z axis points along `direction` and whose +y axis is as close
 /// to the frame's +y (head up) as it can be, so a gaze pose has no roll of its own.

@@ -12,13 +12,13 @@
 use std::path::Path;
 
 use openxr as xr;
+use vitreous_trace::format::{TraceSample, read_trace};
+use vitreous_trace::{GazeRay, GazeSample};
 
 use super::choose::GazeSource;
 use super::convert::ray_of;
 use super::ml_tracker::MlTracker;
 use super::{OpenXrError, Result, XrContext};
-use crate::frame::{GazeRay, GazeSample};
-use crate::trace::{TraceSample, read_trace};
 
 /// A gaze source, ready to sample.
 pub(super) enum Gaze {
@@ -340,8 +340,8 @@ impl TraceGaze {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::Pose;
     use glam::Vec3;
+    use vitreous_trace::Pose;
 
     fn sample(time_ns: i64, gaze_ns: i64, x: f32) -> TraceSample {
         let ray = GazeRay {

@@ -20,13 +20,13 @@
 //! session's newest frame.
 
 use openxr::sys::{self, Handle};
+use vitreous_trace::{GazeBehaviour, GazeRay, GazeSample, Pose, TrackerConfidence};
 use vitreous_xr::openxr::ml_eye_tracker::{
     ConfidenceML, EyeML, EyeTrackerCreateInfoML, EyeTrackerGazeBehaviorML,
     EyeTrackerGeometricDataML, EyeTrackerGetInfoML, EyeTrackerML, EyeTrackerPoseML,
     EyeTrackerPosesGetInfoML, EyeTrackerPosesML, EyeTrackerPupilDataML, EyeTrackerStaticDataML,
     GazeBehaviorTypeML, pose_flags, structure_type,
 };
-use vitreous_xr::{GazeBehaviour, GazeRay, GazeSample, Pose, TrackerConfidence};
 
 use super::{SessionContext, in_base};
 use crate::config::GazeExtension;
@@ -449,7 +449,7 @@ mod tests {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
-            report: Some(vitreous_xr::TrackerReport {
+            report: Some(vitreous_trace::TrackerReport {
                 confidence: TrackerConfidence::Medium,
                 behaviour: GazeBehaviour::Pursuit,
             }),

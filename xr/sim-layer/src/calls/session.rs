@@ -15,7 +15,7 @@ use crate::images::{AlphaLog, Reader, SessionImages, SharedImages, ViewImage, Vu
 use crate::registry::{SessionState, SpaceState, registry};
 use crate::submitted::{FrameInfo, LayerInfo};
 use std::sync::{Arc, Mutex};
-use vitreous_xr::Pose;
+use vitreous_trace::Pose;
 
 /// `xrCreateSession`: passed on; the layer then makes its VIEW space in the new session.
 ///

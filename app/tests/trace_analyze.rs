@@ -33,15 +33,7 @@ fn sample(t_ms: i64, depth_m: Option<f32>) -> TraceSample {
     TraceSample {
         time_ns: t_ms * MS,
         head: Pose::IDENTITY,
-        gaze: GazeSample {
-            sample_time_ns: t_ms * MS,
-            left: eye(-0.0315),
-            right: eye(0.0315),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        },
+        gaze: GazeSample::binocular(t_ms * MS, eye(-0.0315), eye(0.0315)),
     }
 }
 

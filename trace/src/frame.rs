@@ -149,19 +149,26 @@ pub struct TrackerReport {
 }
 
 impl GazeSample {
-    /// A sample at `sample_time_ns` that holds no gaze: both eyes' rays invalid, no combined
-    /// ray, fixation or pupil measurement (a tracker's dropout; a frame without a tracker,
-    /// as recorded in a trace).
-    pub const fn none(sample_time_ns: i64) -> GazeSample {
+    /// A sample at `sample_time_ns` of the two eyes' rays alone: no combined ray, fixation,
+    /// pupil measurement or tracker report (what a tracker that gives only per-eye rays
+    /// reports).
+    pub const fn binocular(sample_time_ns: i64, left: GazeRay, right: GazeRay) -> GazeSample {
         GazeSample {
             sample_time_ns,
-            left: GazeRay::INVALID,
-            right: GazeRay::INVALID,
+            left,
+            right,
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
             report: None,
         }
+    }
+
+    /// A sample at `sample_time_ns` that holds no gaze: both eyes' rays invalid, no combined
+    /// ray, fixation or pupil measurement (a tracker's dropout; a frame without a tracker,
+    /// as recorded in a trace).
+    pub const fn none(sample_time_ns: i64) -> GazeSample {
+        GazeSample::binocular(sample_time_ns, GazeRay::INVALID, GazeRay::INVALID)
     }
 }
 

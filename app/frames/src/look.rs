@@ -343,15 +343,7 @@ mod tests {
                 position: head,
                 orientation: Quat::IDENTITY,
             },
-            gaze: GazeSample {
-                sample_time_ns: time_ns,
-                left: eye(-IPD_M / 2.0),
-                right: eye(IPD_M / 2.0),
-                combined: None,
-                fixation: None,
-                pupil_diameter_m: [None, None],
-                report: None,
-            },
+            gaze: GazeSample::binocular(time_ns, eye(-IPD_M / 2.0), eye(IPD_M / 2.0)),
         }
     }
 

@@ -345,15 +345,7 @@ mod tests {
             direction: down,
             valid: true,
         };
-        let gaze = GazeSample {
-            sample_time_ns: 0,
-            left: ray(-0.03),
-            right: ray(0.03),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        };
+        let gaze = GazeSample::binocular(0, ray(-0.03), ray(0.03));
         let (o, d) = place_ray(&frame(head, Some(gaze)));
         let hit = ray_meets_plane(o, d, floor.0, floor.1).unwrap();
         assert!(hit.abs_diff_eq(Vec3::new(-1.0, 0.0, 0.0), 1e-5), "{hit}");

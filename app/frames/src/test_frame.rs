@@ -33,15 +33,7 @@ pub fn sample_looking_at(time_ns: i64, depth_m: f32) -> vitreous_trace::GazeSamp
             valid: true,
         }
     };
-    GazeSample {
-        sample_time_ns: time_ns,
-        left: eye(-0.0315),
-        right: eye(0.0315),
-        combined: None,
-        fixation: None,
-        pupil_diameter_m: [None, None],
-        report: None,
-    }
+    GazeSample::binocular(time_ns, eye(-0.0315), eye(0.0315))
 }
 
 /// Frame `index` at 60 Hz (identity head) whose gaze sample, taken at the frame's time, has

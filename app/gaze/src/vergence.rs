@@ -292,15 +292,7 @@ mod tests {
     }
 
     fn sample(t_ns: i64, left: GazeRay, right: GazeRay) -> GazeSample {
-        GazeSample {
-            sample_time_ns: t_ns,
-            left,
-            right,
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        }
+        GazeSample::binocular(t_ns, left, right)
     }
 
     #[test]

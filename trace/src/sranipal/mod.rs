@@ -268,15 +268,7 @@ impl Importer {
                 position: head_position,
                 orientation: (anchor.unyaw * pose.orientation).normalize(),
             },
-            gaze: GazeSample {
-                sample_time_ns: time_ns,
-                left,
-                right,
-                combined: None,
-                fixation: None,
-                pupil_diameter_m: [None, None],
-                report: None,
-            },
+            gaze: GazeSample::binocular(time_ns, left, right),
         });
         Ok(())
     }

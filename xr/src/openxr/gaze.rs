@@ -192,15 +192,11 @@ impl FbTracker {
                 GazeRay::INVALID
             }
         };
-        Some(GazeSample {
-            sample_time_ns: gazes.time.as_nanos(),
-            left: eye(&gazes.gaze[0]),
-            right: eye(&gazes.gaze[1]),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        })
+        Some(GazeSample::binocular(
+            gazes.time.as_nanos(),
+            eye(&gazes.gaze[0]),
+            eye(&gazes.gaze[1]),
+        ))
     }
 }
 
@@ -352,15 +348,7 @@ mod tests {
         TraceSample {
             time_ns,
             head: Pose::IDENTITY,
-            gaze: GazeSample {
-                sample_time_ns: gaze_ns,
-                left: ray,
-                right: ray,
-                combined: None,
-                fixation: None,
-                pupil_diameter_m: [None, None],
-                report: None,
-            },
+            gaze: GazeSample::binocular(gaze_ns, ray, ray),
         }
     }
 

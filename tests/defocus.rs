@@ -18,9 +18,9 @@ use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{Defocus, Look, Reflection, Renderer};
 use vitreous_scene::{Image, PixelData, Scene, gaze_image_of_target, load_scene};
 use vitreous_tests::render_once;
-use vitreous_xr::FrameInput;
+use vitreous_trace::FrameInput;
+use vitreous_trace::synth::synthesize_with_truth;
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::synth::synthesize_with_truth;
 
 const W: u32 = 320;
 const H: u32 = 240;

@@ -300,7 +300,7 @@ fn glass_sphere_preview_shows_a_shadow_on_the_real_floor() {
     let fov = render_desc::render_fov(s.output.fov);
     let eyes = s
         .viewer
-        .eye_positions_m(&vitreous_xr::Pose {
+        .eye_positions_m(&vitreous_trace::Pose {
             position: head,
             orientation: Quat::IDENTITY,
         })

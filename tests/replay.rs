@@ -9,9 +9,9 @@ use vitreous::replay::{ReplayOptions, replay};
 use vitreous_frames::render_desc::eye_params;
 use vitreous_scene::load_scene;
 use vitreous_tests::{lit_centroid, workspace};
+use vitreous_trace::format::read_trace;
 use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::trace::read_trace;
 
 fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOptions {
     ReplayOptions {
@@ -76,7 +76,7 @@ fn check_geometry(scene_name: &str, trace: Option<&str>, check: Check) {
     let samples = match &opts.trace {
         Some(t) => read_trace(t).unwrap(),
         None => {
-            vitreous_xr::synth::synthesize_with_truth(&vitreous::trace_cmd::synth_params_for(
+            vitreous_trace::synth::synthesize_with_truth(&vitreous::trace_cmd::synth_params_for(
                 &scene,
             ))
             .unwrap()
@@ -215,11 +215,11 @@ fn frames_csv_follows_the_synthetic_traces_alternating_fixation() {
     let images: Vec<&str> = rows.iter().map(|r| r[4]).collect();
     // The trace's truth: the synthesiser's phases for the scene (12 s, as shipped).
     let scene = load_scene(&workspace().join("config/scenes/visual-effects.toml")).unwrap();
-    let params = vitreous_xr::synth::SynthParams {
+    let params = vitreous_trace::synth::SynthParams {
         duration_s: 12.0,
         ..vitreous::trace_cmd::synth_params_for(&scene)
     };
-    let truth = vitreous_xr::synth::synthesize_with_truth(&params).unwrap();
+    let truth = vitreous_trace::synth::synthesize_with_truth(&params).unwrap();
     assert!(truth.phases.len() >= 4);
     for phase in &truth.phases {
         // 2.5 s into each phase the eq. 15 mean has settled on the new depth.

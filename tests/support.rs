@@ -121,7 +121,7 @@ pub fn validated_context() -> vitreous_render::GpuContext {
 
 /// The scene's two eyes at its neutral head (the viewer at `head_position_m`, looking down -z).
 pub fn neutral_eyes(scene: &vitreous_scene::Scene) -> [vitreous_optics::camera::EyeParams; 2] {
-    let head = vitreous_xr::Pose {
+    let head = vitreous_trace::Pose {
         position: scene.viewer.head_position_m,
         orientation: glam::Quat::IDENTITY,
     };

@@ -140,8 +140,8 @@ pub fn parse_kappa_deg(s: &str) -> Result<f64, String> {
 }
 
 /// An OpenXR environment blend mode by its command-line name.
-pub fn parse_blend(s: &str) -> Result<vitreous_xr::openxr::Blend, String> {
-    vitreous_xr::openxr::Blend::parse(s)
+pub fn parse_blend(s: &str) -> Result<vitreous_trace::Blend, String> {
+    vitreous_trace::Blend::parse(s)
         .ok_or_else(|| format!("expected additive, alpha-blend or opaque, got '{s}'"))
 }
 

@@ -4,7 +4,8 @@
 //! `study`, `compare`, `reference`), each wiring the libraries that do the work: the frame loop
 //! in `vitreous-frames`, scenes in `vitreous-scene`, the gaze pipeline in `vitreous-gaze`,
 //! studies in `vitreous-study`, the physical reference in `vitreous-reference`, rendering in
-//! `vitreous-render` and the XR backends in `vitreous-xr`. A library here so that the tests
+//! `vitreous-render`, the XR backends in `vitreous-xr`, traces and frame data in
+//! `vitreous-trace`. A library here so that the tests
 //! reach the commands' own parts.
 
 pub mod bench;

@@ -12,7 +12,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use vitreous_reference::{EyeImage, FloorLight, PhotonParams, Window, World, render_eye};
 use vitreous_scene::{Placement, Scene, load_scene};
-use vitreous_xr::frame::{Backend, EyeView, Fov};
+use vitreous_trace::{EyeView, Fov};
+use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
 
 use vitreous_frames::input_files::InputFiles;
@@ -163,7 +164,7 @@ impl EyeRecord {
     pub fn view(&self) -> EyeView {
         let [l, r, u, d] = self.fov_rad;
         EyeView {
-            pose: vitreous_xr::Pose {
+            pose: vitreous_trace::Pose {
                 position: Vec3::from_array(self.position_m),
                 orientation: Quat::from_array(self.orientation_xyzw).normalize(),
             },
@@ -480,12 +481,12 @@ struct Frame {
 /// frames at the rate that are saved, placed as the replay places them.
 fn frames_to_render(scene: &Scene, args: &ReferenceArgs) -> Result<Vec<Frame>> {
     let Some(trace) = &args.trace else {
-        let head = vitreous_xr::Pose {
+        let head = vitreous_trace::Pose {
             position: scene.viewer.head_position_m,
             orientation: Quat::IDENTITY,
         };
         let views = scene.viewer.eye_positions_m(&head).map(|p: Vec3| EyeView {
-            pose: vitreous_xr::Pose {
+            pose: vitreous_trace::Pose {
                 position: p,
                 orientation: Quat::IDENTITY,
             },

@@ -11,7 +11,7 @@ use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, GpuContext, Reflection, Renderer, ScenePose};
-use vitreous_xr::FrameInput;
+use vitreous_trace::FrameInput;
 use vitreous_xr::null::{NullBackend, NullConfig};
 
 use vitreous_frames::frame_loop::{self, FramePlan, FrameSink};

@@ -5,8 +5,8 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use vitreous_xr::synth::{SynthError, SynthParams, synthesize_with_truth};
-use vitreous_xr::trace::{TraceSample, TraceWriter};
+use vitreous_trace::format::{TraceSample, TraceWriter};
+use vitreous_trace::synth::{SynthError, SynthParams, synthesize_with_truth};
 
 use vitreous_frames::input_files::InputFiles;
 use vitreous_frames::output::write_atomic;
@@ -56,19 +56,19 @@ pub fn import(from: &str, file: &Path, out: &Path, options: &ImportOptions) -> R
     inputs.check_file("-o", out)?;
     let (samples, report, rows) = match from {
         "sranipal" => {
-            let (samples, report) = vitreous_xr::sranipal::import_sranipal_with_report(file)
+            let (samples, report) = vitreous_trace::sranipal::import_sranipal_with_report(file)
                 .context("importing the recording")?;
             let rows = report.rows;
             (samples, report.to_string(), rows)
         }
         "tobii-g3" => {
-            let (samples, report) = vitreous_xr::import::tobii_g3::import_tobii_g3(file)
+            let (samples, report) = vitreous_trace::import::tobii_g3::import_tobii_g3(file)
                 .context("importing the Tobii Pro Glasses 3 recording")?;
             let rows = report.records;
             (samples, report.to_string(), rows)
         }
         "neon" => {
-            use vitreous_xr::import::neon::{GazeSource, NeonOptions, import_neon_with};
+            use vitreous_trace::import::neon::{GazeSource, NeonOptions, import_neon_with};
             let neon = NeonOptions {
                 gaze: if options.eye_state_gaze {
                     GazeSource::EyeState
@@ -192,7 +192,7 @@ mod tests {
 
     fn neon_data(name: &str) -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../xr/tests/data")
+            .join("../trace/tests/data")
             .join(name)
     }
 
@@ -213,7 +213,7 @@ mod tests {
             report.contains("turned 5.0 degrees toward the nose") && report.contains("unreliable"),
             "{report}"
         );
-        assert_eq!(vitreous_xr::read_trace(&out).unwrap().len(), 200);
+        assert_eq!(vitreous_trace::read_trace(&out).unwrap().len(), 200);
         let options = ImportOptions {
             kappa_deg: Some(3.5),
             eye_state_gaze: true,

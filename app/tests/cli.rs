@@ -98,7 +98,7 @@ fn missing_trace_is_named_and_nothing_is_written() {
 #[test]
 fn trace_with_nan_time_names_the_line() {
     let dir = tempfile::tempdir().unwrap();
-    let header = vitreous_xr::trace::COLUMNS.join(",");
+    let header = vitreous_trace::format::COLUMNS.join(",");
     let good = "0,0,0,0,0,0,0,1,0,0,,,,,,,0,,,,,,,,,,,,,,,,";
     let nan = "NaN,0,0,0,0,0,0,1,0,0,,,,,,,0,,,,,,,,,,,,,,,,";
     let trace = write(
@@ -126,7 +126,7 @@ fn trace_with_nan_time_names_the_line() {
 #[test]
 fn truncated_trace_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let header = vitreous_xr::trace::COLUMNS.join(",");
+    let header = vitreous_trace::format::COLUMNS.join(",");
     let trace = write(
         dir.path(),
         "short.csv",
@@ -263,7 +263,7 @@ fn unknown_and_unimplemented_effects_are_refused() {
 #[test]
 fn import_of_header_only_recording_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let recording = workspace().join("xr/tests/data/sranipal/TESTVA03_2D_Spread9.csv");
+    let recording = workspace().join("trace/tests/data/sranipal/TESTVA03_2D_Spread9.csv");
     let target = dir.path().join("t.csv");
     let out = vitreous(
         &[
@@ -295,7 +295,7 @@ fn import_from_unknown_format_is_refused() {
 #[test]
 fn imported_real_trace_replays_from_a_fresh_import() {
     let dir = tempfile::tempdir().unwrap();
-    let recording = workspace().join("xr/tests/data/sranipal/TESTNA10_360VR_Fist3.csv");
+    let recording = workspace().join("trace/tests/data/sranipal/TESTNA10_360VR_Fist3.csv");
     let target = dir.path().join("t.csv");
     let out = vitreous(
         &[

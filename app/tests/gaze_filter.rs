@@ -4,7 +4,7 @@ use proptest::prelude::*;
 use vitreous_gaze::{
     FilterKind, FixationDepth, GazeConfig, GazePipeline, ImageDistances, SampleFilter,
 };
-use vitreous_xr::GazeSample;
+use vitreous_trace::GazeSample;
 
 /// eq. 15 as printed: the mean of the 20 depths ending at index `n` (n >= 19).
 fn eq15(depths: &[f64], n: usize) -> f64 {

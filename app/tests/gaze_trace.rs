@@ -4,7 +4,7 @@
 use glam::Vec3;
 use vitreous::trace_analyze::{AnalyzeConfig, FILTER_COLOURS, Truth, analyze, plot, replay};
 use vitreous_gaze::{FilterKind, GazeConfig, GazeImage, GazeOverride, ImageDistances};
-use vitreous_xr::synth::{FixationTarget, SynthParams, SynthTrace, synthesize_with_truth};
+use vitreous_trace::synth::{FixationTarget, SynthParams, SynthTrace, synthesize_with_truth};
 
 /// The synthetic trace the alternative is tuned on: 30 Hz, 0.5 degree noise, blinks every
 /// 4 s, gaze switching every 3 s between 0.6 m (the surface, target 0) and 1.5 m (the
@@ -134,7 +134,7 @@ fn override_forces_the_image_and_its_focus_distance() {
 
 fn sranipal(name: &str) -> String {
     format!(
-        "{}/../xr/tests/data/sranipal/{name}",
+        "{}/../trace/tests/data/sranipal/{name}",
         env!("CARGO_MANIFEST_DIR")
     )
 }
@@ -151,7 +151,7 @@ fn real_sranipal_traces_replay_without_panics() {
         "TESTNA10_360VR_Fist3.csv",
         "TESTVA03_2D_Spread9.csv",
     ] {
-        let samples = vitreous_xr::sranipal::import_sranipal(sranipal(name)).unwrap();
+        let samples = vitreous_trace::sranipal::import_sranipal(sranipal(name)).unwrap();
         let report = analyze(&samples, Truth::FromRawDepth, &AnalyzeConfig::new(d));
         assert_eq!(report.samples, samples.len());
         let text = report.to_string();
@@ -197,7 +197,7 @@ fn plot_lines_stay_inside_the_chart_and_far_samples_are_drawn() {
         refracted_m: 1.5,
     };
     let samples =
-        vitreous_xr::sranipal::import_sranipal(sranipal("TESTNA01_2D_Fist3.csv")).unwrap();
+        vitreous_trace::sranipal::import_sranipal(sranipal("TESTNA01_2D_Fist3.csv")).unwrap();
     let out = dir.path().join("real.png");
     let config = AnalyzeConfig::new(d);
     let layout = plot(&samples, Truth::FromRawDepth, &config, &out).unwrap();
@@ -241,7 +241,7 @@ fn plot_holds_or_marks_every_finite_sample() {
         refracted_m: 2.03,
     };
     let samples =
-        vitreous_xr::sranipal::import_sranipal(sranipal("TESTNA05_360VR_Spread7.csv")).unwrap();
+        vitreous_trace::sranipal::import_sranipal(sranipal("TESTNA05_360VR_Spread7.csv")).unwrap();
     let out = dir.path().join("sphere.png");
     let layout = plot(&samples, Truth::FromRawDepth, &AnalyzeConfig::new(d), &out).unwrap();
     let rgb = image::open(&out).unwrap().to_rgb8();

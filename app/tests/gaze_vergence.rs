@@ -6,7 +6,7 @@ use vitreous_gaze::vergence::{
     DEFAULT_HOLD_NS, DivergentRays, FixationDepth, RayCrossing, VergenceConfig, VergenceEstimator,
     closest_approach,
 };
-use vitreous_xr::{GazeRay, GazeSample};
+use vitreous_trace::{GazeRay, GazeSample};
 
 fn ray(origin: Vec3, target: Vec3) -> GazeRay {
     GazeRay {
@@ -246,10 +246,10 @@ fn bisector_depth_is_close_to_the_euclidean_distance_on_real_recordings() {
         "TESTNA10_360VR_Fist3.csv",
     ] {
         let path = format!(
-            "{}/../xr/tests/data/sranipal/{name}",
+            "{}/../trace/tests/data/sranipal/{name}",
             env!("CARGO_MANIFEST_DIR")
         );
-        for s in vitreous_xr::sranipal::import_sranipal(path).unwrap() {
+        for s in vitreous_trace::sranipal::import_sranipal(path).unwrap() {
             let g = s.gaze;
             if !(g.left.valid && g.right.valid) {
                 continue;

@@ -75,7 +75,7 @@ fn the_reference_shows_the_ball_and_half_its_lights_shadow_and_nothing_else() {
     let floor_y = scene.floor.pose.position.y;
     let towards = (centre - light).normalize();
     let umbra = light + towards * ((floor_y - light.y) / towards.y);
-    let head = vitreous_xr::Pose {
+    let head = vitreous_trace::Pose {
         position: scene.viewer.head_position_m,
         orientation: Quat::IDENTITY,
     };

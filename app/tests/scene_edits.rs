@@ -9,8 +9,8 @@ use glam::{Quat, Vec3};
 use vitreous::replay::{ReplayOptions, replay};
 use vitreous_scene::effects::EffectSet;
 use vitreous_scene::load_scene;
-use vitreous_xr::trace::{EditRecord, TraceSample, TraceWriter};
-use vitreous_xr::{GazeSample, Pose};
+use vitreous_trace::format::{EditRecord, TraceSample, TraceWriter};
+use vitreous_trace::{GazeSample, Pose};
 
 /// Frame spacing of the recording, nanoseconds (4 Hz).
 const STEP_NS: i64 = 250_000_000;

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use vitreous_scene::effects::EffectSet;
 use vitreous_scene::{IorSource, PixelData, Scene, load_scene};
-use vitreous_xr::Pose;
+use vitreous_trace::Pose;
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes")

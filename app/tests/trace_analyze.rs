@@ -9,9 +9,9 @@ use glam::Vec3;
 use serde_json::Value;
 use vitreous::trace_analyze::{AnalyzeConfig, Truth, analyze};
 use vitreous_gaze::{FilterKind, ImageDistances};
-use vitreous_xr::synth::{FixationTarget, SynthParams, synthesize_with_truth};
-use vitreous_xr::trace::TraceWriter;
-use vitreous_xr::{GazeRay, GazeSample, Pose, TraceSample};
+use vitreous_trace::format::TraceWriter;
+use vitreous_trace::synth::{FixationTarget, SynthParams, synthesize_with_truth};
+use vitreous_trace::{GazeRay, GazeSample, Pose, TraceSample};
 
 const MS: i64 = 1_000_000;
 
@@ -33,15 +33,7 @@ fn sample(t_ms: i64, depth_m: Option<f32>) -> TraceSample {
     TraceSample {
         time_ns: t_ms * MS,
         head: Pose::IDENTITY,
-        gaze: GazeSample {
-            sample_time_ns: t_ms * MS,
-            left: eye(-0.0315),
-            right: eye(0.0315),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        },
+        gaze: GazeSample::binocular(t_ms * MS, eye(-0.0315), eye(0.0315)),
     }
 }
 
@@ -255,7 +247,7 @@ fn default_filter_meets_the_synthetic_bar_over_ten_seeds_and_three_layouts() {
 }
 
 fn sranipal(name: &str) -> PathBuf {
-    workspace().join("xr/tests/data/sranipal").join(name)
+    workspace().join("trace/tests/data/sranipal").join(name)
 }
 
 /// The real-recording bar on the shipped SRanipal recordings, for each layout's distances: the
@@ -269,7 +261,7 @@ fn default_filter_meets_the_real_recording_bar_on_sranipal() {
         "TESTNA05_360VR_Spread7.csv",
         "TESTNA10_360VR_Fist3.csv",
     ] {
-        let samples = vitreous_xr::sranipal::import_sranipal(sranipal(name)).unwrap();
+        let samples = vitreous_trace::sranipal::import_sranipal(sranipal(name)).unwrap();
         for distances in [
             D,
             ImageDistances {
@@ -299,8 +291,9 @@ fn default_filter_meets_the_real_recording_bar_on_sranipal() {
 /// fixation depth (one gaze point: the eye rays are parallel), so it never switches.
 #[test]
 fn default_filter_meets_the_real_recording_bar_on_the_import_fixtures() {
-    let data = workspace().join("xr/tests/data");
-    let (tobii, _) = vitreous_xr::import::tobii_g3::import_tobii_g3(data.join("tobii_g3")).unwrap();
+    let data = workspace().join("trace/tests/data");
+    let (tobii, _) =
+        vitreous_trace::import::tobii_g3::import_tobii_g3(data.join("tobii_g3")).unwrap();
     // The images of config/scenes/visual-effects.toml, which the fixture's depths straddle.
     let mut config = AnalyzeConfig::new(ImageDistances {
         surface_m: 0.125,
@@ -314,7 +307,7 @@ fn default_filter_meets_the_real_recording_bar_on_the_import_fixtures() {
     assert_eq!(default.episodes_under_settle(), 0, "{report}");
     assert_eq!(default.switches_after_gap, 0, "{report}");
 
-    let (neon, _) = vitreous_xr::import::neon::import_neon(data.join("neon")).unwrap();
+    let (neon, _) = vitreous_trace::import::neon::import_neon(data.join("neon")).unwrap();
     let report = analyze(&neon, Truth::FromRawDepth, &config);
     assert_eq!(report.filters[0].switches, 0, "{report}");
 }
@@ -328,19 +321,20 @@ fn default_filter_meets_the_real_recording_bar_on_the_import_fixtures() {
 /// and no switch within 150 ms after a gap.
 #[test]
 fn default_decision_holds_on_real_recordings_in_the_shipped_scenes() {
-    let data = workspace().join("xr/tests/data");
+    let data = workspace().join("trace/tests/data");
     let mut recordings = Vec::new();
     for name in [
         "TESTNA01_2D_Fist3.csv",
         "TESTNA05_360VR_Spread7.csv",
         "TESTNA10_360VR_Fist3.csv",
     ] {
-        let samples = vitreous_xr::sranipal::import_sranipal(sranipal(name)).unwrap();
+        let samples = vitreous_trace::sranipal::import_sranipal(sranipal(name)).unwrap();
         recordings.push((name.to_owned(), samples));
     }
-    let (tobii, _) = vitreous_xr::import::tobii_g3::import_tobii_g3(data.join("tobii_g3")).unwrap();
+    let (tobii, _) =
+        vitreous_trace::import::tobii_g3::import_tobii_g3(data.join("tobii_g3")).unwrap();
     recordings.push(("tobii_g3".to_owned(), tobii));
-    let (neon, _) = vitreous_xr::import::neon::import_neon(data.join("neon")).unwrap();
+    let (neon, _) = vitreous_trace::import::neon::import_neon(data.join("neon")).unwrap();
     recordings.push(("neon".to_owned(), neon));
     for scene_name in ["visual-effects.toml", "glass-sphere.toml"] {
         let scene = vitreous_scene::load_scene(&workspace().join("config/scenes").join(scene_name))

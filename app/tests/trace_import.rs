@@ -1,14 +1,14 @@
 //! `vitreous trace import --from tobii-g3 | neon` on the synthetic recordings in
-//! xr/tests/data: the trace written and read back, and clean failures on broken recordings.
+//! trace/tests/data: the trace written and read back, and clean failures on broken recordings.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use vitreous_xr::read_trace;
+use vitreous_trace::read_trace;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../xr/tests/data")
+        .join("../trace/tests/data")
         .join(name)
 }
 

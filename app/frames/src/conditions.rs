@@ -4,8 +4,7 @@
 //! ([`live_conditions`]) and the mapping of the backend's generic cycle buttons to the effect
 //! condition and the forced gaze image ([`GAZE_IMAGE_CYCLE`], [`CONDITION_CYCLE`]).
 
-use vitreous_xr::FrameInput;
-use vitreous_xr::openxr::{Command, Cycle};
+use vitreous_trace::{Command, Cycle, FrameInput};
 
 use crate::director::Director;
 use crate::look::LookPlanner;

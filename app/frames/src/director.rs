@@ -5,8 +5,7 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use vitreous_xr::openxr::Command;
-use vitreous_xr::{FrameInput, SessionEvent};
+use vitreous_trace::{Command, FrameInput, SessionEvent};
 
 use vitreous_gaze::GazeOverride;
 use vitreous_scene::effects::EffectSet;

@@ -6,7 +6,7 @@
 
 use vitreous_gaze::{FilterKind, GazeConfig, GazePipeline};
 use vitreous_scene::Scene;
-use vitreous_xr::FrameInput;
+use vitreous_trace::FrameInput;
 
 /// Follows the wearer's filtered fixation depth frame by frame.
 #[derive(Debug)]

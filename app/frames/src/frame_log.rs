@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use tempfile::NamedTempFile;
-use vitreous_xr::FrameInput;
+use vitreous_trace::FrameInput;
 
 use crate::look::DefocusFrame;
 use vitreous_gaze::separability::SeparabilitySummary;

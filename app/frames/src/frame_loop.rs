@@ -9,8 +9,8 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{Composition, Look, Renderer, ScenePose};
-use vitreous_xr::openxr::Blend;
-use vitreous_xr::{Backend, FrameEndHints, FrameInput, FrameTarget, SessionEvent};
+use vitreous_trace::{Blend, FrameInput, SessionEvent};
+use vitreous_xr::{Backend, FrameEndHints, FrameTarget};
 
 use crate::render_desc;
 

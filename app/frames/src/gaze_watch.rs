@@ -5,7 +5,7 @@
 //! with how long it lasted. A blink or closed eyes that the tracker reports as such are the
 //! wearer's, not a dropout.
 
-use vitreous_xr::{FrameInput, GazeBehaviour, SessionEvent, TrackerConfidence};
+use vitreous_trace::{FrameInput, GazeBehaviour, SessionEvent, TrackerConfidence};
 
 /// How long the tracker may give no usable sample before it counts as lost, seconds: longer
 /// than a blink (100-400 ms).
@@ -88,7 +88,7 @@ impl GazeWatch {
 
 #[cfg(test)]
 mod tests {
-    use vitreous_xr::{GazeRay, GazeSample, TrackerReport};
+    use vitreous_trace::{GazeRay, GazeSample, TrackerReport};
 
     use super::*;
     use crate::test_frame::test_frame;

@@ -1,7 +1,7 @@
 //! vitreous-frames: one frame from an XR backend's input to the renderer's look, shared by
 //! every command (`run` on a headset, `replay`, `view`, `bench`, `soak`, `study run`).
 //!
-//! A frame goes: the backend's [`FrameInput`](vitreous_xr::FrameInput) (head, eyes, gaze) ->
+//! A frame goes: the backend's [`FrameInput`](vitreous_trace::FrameInput) (head, eyes, gaze) ->
 //! the motion clock's poses of the scene (with the live edits) -> the look planner's decision
 //! (effect set, gaze image, defocus of both images) -> the renderer's per-eye descriptions ->
 //! the renderer's frame -> the frame log and the command's sink.

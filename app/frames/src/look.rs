@@ -14,7 +14,7 @@
 use anyhow::Result;
 use glam::Vec3;
 use vitreous_render::{Defocus, Look, Reflection};
-use vitreous_xr::FrameInput;
+use vitreous_trace::FrameInput;
 
 use crate::blur_stack::DefocusSetup;
 pub use crate::defocus_model::DefocusModel;
@@ -290,9 +290,10 @@ pub fn planners_for(
 mod tests {
     use glam::{Quat, Vec3};
     use vitreous_render::Reflection;
+    use vitreous_trace::format::TraceSample;
+    use vitreous_trace::{GazeRay, GazeSample, Pose};
+    use vitreous_xr::Backend;
     use vitreous_xr::null::{NullBackend, NullConfig};
-    use vitreous_xr::trace::TraceSample;
-    use vitreous_xr::{Backend, GazeRay, GazeSample, Pose};
 
     use super::*;
 
@@ -342,15 +343,7 @@ mod tests {
                 position: head,
                 orientation: Quat::IDENTITY,
             },
-            gaze: GazeSample {
-                sample_time_ns: time_ns,
-                left: eye(-IPD_M / 2.0),
-                right: eye(IPD_M / 2.0),
-                combined: None,
-                fixation: None,
-                pupil_diameter_m: [None, None],
-                report: None,
-            },
+            gaze: GazeSample::binocular(time_ns, eye(-IPD_M / 2.0), eye(IPD_M / 2.0)),
         }
     }
 

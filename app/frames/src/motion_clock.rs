@@ -5,10 +5,10 @@
 use glam::{Quat, Vec3};
 use serde::Serialize;
 use vitreous_render::ScenePose;
-use vitreous_xr::FrameInput;
-use vitreous_xr::trace::EditRecord;
+use vitreous_trace::FrameInput;
+use vitreous_trace::format::EditRecord;
 
-use vitreous_xr::light::{MIN_TURN_DEG, angle_deg, light_position_along};
+use vitreous_trace::light::{MIN_TURN_DEG, angle_deg, light_position_along};
 
 use crate::look::LookPlanner;
 use crate::render_desc;
@@ -403,7 +403,7 @@ mod tests {
         let mut f = crate::test_frame::test_frame();
         f.time_ns = time_ns;
         // Head 1 m above the floor at z = 0, looking 45 degrees down ahead.
-        f.head = vitreous_xr::Pose {
+        f.head = vitreous_trace::Pose {
             position: Vec3::new(0.0, 1.0, 0.0),
             orientation: Quat::from_rotation_x(-std::f32::consts::FRAC_PI_4),
         };
@@ -425,7 +425,7 @@ mod tests {
         let turned = Quat::from_rotation_y(30f32.to_radians()) * along;
         let record = c.follow_light(turned, None, &input(2)).expect("an edit");
         assert_eq!(record.action, LIGHT_ESTIMATE_ACTION);
-        assert!(vitreous_xr::trace::valid_action(&record.action));
+        assert!(vitreous_trace::format::valid_action(&record.action));
         let now = c.placement(2).expect("the light moved");
         let arm = now.light_position_m - now.object_position_m;
         assert!((arm.length() - (light - object).length()).abs() < 1e-5);

@@ -16,10 +16,10 @@ pub use vitreous_scene::srgb_to_linear;
 pub const EYE_NAMES: [&str; 2] = ["left", "right"];
 
 /// Writes `bytes` to `path` through a temporary file in the same folder, renamed into place
-/// once complete and synced ([`vitreous_xr::atomic_file::write`]): an interrupted write leaves
+/// once complete and synced ([`vitreous_trace::atomic_file::write`]): an interrupted write leaves
 /// either the old file or none, never a half-written one.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    vitreous_xr::atomic_file::write(path, bytes)
+    vitreous_trace::atomic_file::write(path, bytes)
         .with_context(|| format!("writing {}", path.display()))
 }
 

@@ -7,7 +7,7 @@
 use glam::{Vec2, Vec3};
 use vitreous_optics::refraction::Refraction;
 use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sample};
-use vitreous_xr::FrameInput;
+use vitreous_trace::FrameInput;
 
 use crate::output::{linear_to_srgb, srgb_to_linear};
 use crate::render_desc::eye_params;

@@ -6,7 +6,7 @@ use vitreous_render::{
     CausticsDesc, FrameParams, InducerDesc, LightDesc, Look, MeshRef, PlaneDesc, SceneDesc,
     ScenePose, TexelData, TextureDesc,
 };
-use vitreous_xr::{EyeView, Fov, FrameInput};
+use vitreous_trace::{EyeView, Fov, FrameInput};
 
 use crate::blur_stack::DefocusSetup;
 use vitreous_scene::{CausticsMode, Image, PixelData, Placement, Scene};
@@ -48,7 +48,7 @@ pub fn warm_up(
     looks: &[Look],
     composition: vitreous_render::Composition,
 ) -> anyhow::Result<()> {
-    use vitreous_xr::Pose;
+    use vitreous_trace::Pose;
     let head = Pose {
         position: scene.viewer.head_position_m,
         orientation: glam::Quat::IDENTITY,

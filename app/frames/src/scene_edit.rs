@@ -17,8 +17,8 @@
 use std::fmt;
 
 use glam::{Quat, Vec3};
-use vitreous_xr::FrameInput;
-use vitreous_xr::trace::EditRecord;
+use vitreous_trace::FrameInput;
+use vitreous_trace::format::EditRecord;
 
 /// The fine and coarse move steps of the keys and buttons, metres (1 mm, 1 cm).
 pub const MOVE_STEPS_M: [f32; 2] = [0.001, 0.01];
@@ -267,7 +267,7 @@ pub fn ray_meets_plane(origin: Vec3, dir: Vec3, point: Vec3, normal: Vec3) -> Op
 #[cfg(test)]
 mod tests {
     use super::*;
-    use vitreous_xr::{EyeView, Fov, GazeRay, GazeSample, Pose};
+    use vitreous_trace::{EyeView, Fov, GazeRay, GazeSample, Pose};
 
     fn frame(head: Pose, gaze: Option<GazeSample>) -> FrameInput {
         let view = EyeView {
@@ -320,7 +320,10 @@ mod tests {
             SceneEdit::PlaceObject,
             SceneEdit::Register(Axis::Y, 0.01),
         ] {
-            assert!(vitreous_xr::trace::valid_action(&edit.action()), "{edit}");
+            assert!(
+                vitreous_trace::format::valid_action(&edit.action()),
+                "{edit}"
+            );
         }
     }
 
@@ -342,15 +345,7 @@ mod tests {
             direction: down,
             valid: true,
         };
-        let gaze = GazeSample {
-            sample_time_ns: 0,
-            left: ray(-0.03),
-            right: ray(0.03),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        };
+        let gaze = GazeSample::binocular(0, ray(-0.03), ray(0.03));
         let (o, d) = place_ray(&frame(head, Some(gaze)));
         let hit = ray_meets_plane(o, d, floor.0, floor.1).unwrap();
         assert!(hit.abs_diff_eq(Vec3::new(-1.0, 0.0, 0.0), 1e-5), "{hit}");

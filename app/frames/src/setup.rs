@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use vitreous_scene::{Scene, synth_params_for};
-use vitreous_xr::trace::{Recording, TraceSample, read_recording};
+use vitreous_trace::format::{Recording, TraceSample, read_recording};
 
 /// The largest eye image side accepted, pixels.
 pub const MAX_SIZE_PX: u32 = 8192;
@@ -46,7 +46,7 @@ pub fn load_recording(scene: &Scene, trace: Option<&Path>) -> Result<(Recording,
         }
         None => {
             tracing::info!("no --trace given: replaying a synthetic trace for the scene");
-            let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(scene))
+            let samples = vitreous_trace::synth::synthesize_with_truth(&synth_params_for(scene))
                 .context("synthesising a trace for the scene")?
                 .samples;
             let recording = Recording {

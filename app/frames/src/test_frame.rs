@@ -1,11 +1,11 @@
 //! A frame input for the crate's tests (the run's parts, the frame log, the look planner, the
 //! motion clock).
 
-use vitreous_xr::FrameInput;
+use vitreous_trace::FrameInput;
 
 /// A frame at time 5 ns with identity poses and no gaze.
 pub fn test_frame() -> FrameInput {
-    use vitreous_xr::{EyeView, Fov, Pose};
+    use vitreous_trace::{EyeView, Fov, Pose};
     let view = EyeView {
         pose: Pose::IDENTITY,
         fov: Fov::symmetric(1.0, 1.0),
@@ -21,9 +21,9 @@ pub fn test_frame() -> FrameInput {
 
 /// A tracker sample taken at `time_ns` with both eyes (63 mm apart, identity head) fixating
 /// the point `depth_m` straight ahead.
-pub fn sample_looking_at(time_ns: i64, depth_m: f32) -> vitreous_xr::GazeSample {
+pub fn sample_looking_at(time_ns: i64, depth_m: f32) -> vitreous_trace::GazeSample {
     use glam::Vec3;
-    use vitreous_xr::{GazeRay, GazeSample};
+    use vitreous_trace::{GazeRay, GazeSample};
     let target = Vec3::new(0.0, 0.0, -depth_m);
     let eye = |x: f32| {
         let origin = Vec3::new(x, 0.0, 0.0);
@@ -33,15 +33,7 @@ pub fn sample_looking_at(time_ns: i64, depth_m: f32) -> vitreous_xr::GazeSample 
             valid: true,
         }
     };
-    GazeSample {
-        sample_time_ns: time_ns,
-        left: eye(-0.0315),
-        right: eye(0.0315),
-        combined: None,
-        fixation: None,
-        pupil_diameter_m: [None, None],
-        report: None,
-    }
+    GazeSample::binocular(time_ns, eye(-0.0315), eye(0.0315))
 }
 
 /// Frame `index` at 60 Hz (identity head) whose gaze sample, taken at the frame's time, has

@@ -38,7 +38,7 @@ pub use pupil::{PupilEstimate, PupilFilter, PupilSource, PupilSourceParseError};
 pub use separability::{Separability, SeparabilityMonitor};
 pub use vergence::{FixationDepth, VergenceConfig, VergenceEstimator};
 
-use vitreous_xr::GazeSample;
+use vitreous_trace::GazeSample;
 
 /// Everything the gaze pipeline needs to know.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -186,7 +186,7 @@ impl GazePipeline {
         // the per-fixation and evidence decisions read the report themselves.
         let doubted = gaze.is_some_and(|g| {
             g.report
-                .is_some_and(|r| r.confidence == vitreous_xr::TrackerConfidence::Low)
+                .is_some_and(|r| r.confidence == vitreous_trace::TrackerConfidence::Low)
         });
         let measured = match self.decision {
             Decision::Depth { .. } if doubted => None,
@@ -232,7 +232,7 @@ impl GazePipeline {
 
 #[cfg(test)]
 mod tests {
-    use vitreous_xr::{GazeBehaviour, TrackerConfidence, TrackerReport};
+    use vitreous_trace::{GazeBehaviour, TrackerConfidence, TrackerReport};
 
     use super::*;
     use crate::test_samples::looking;

@@ -17,7 +17,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use thiserror::Error;
-use vitreous_xr::GazeSample;
+use vitreous_trace::GazeSample;
 
 use super::blur::check_pupil_diameter_m;
 

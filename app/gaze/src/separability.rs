@@ -49,7 +49,7 @@
 
 use std::collections::VecDeque;
 
-use vitreous_xr::{GazeBehaviour, GazeSample};
+use vitreous_trace::{GazeBehaviour, GazeSample};
 
 use super::fixation::{Step, VelocityClassifier, combined_direction};
 use super::image::ImageDistances;

@@ -1,7 +1,7 @@
 //! Tracker samples the decisions' tests are made of.
 
 use glam::Vec3;
-use vitreous_xr::{GazeRay, GazeSample};
+use vitreous_trace::{GazeRay, GazeSample};
 
 /// A sample at `t_ns` whose eyes (63 mm apart) look at a point `depth_m` ahead, `offset_deg` to
 /// the right.

@@ -32,8 +32,8 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use vitreous_xr::GazeSample;
-pub use vitreous_xr::crossing::{RayCrossing, closest_approach};
+use vitreous_trace::GazeSample;
+pub use vitreous_trace::crossing::{RayCrossing, closest_approach};
 
 /// Default cap on the reported depth (far fixations and near-parallel rays), metres.
 pub const DEFAULT_MAX_DEPTH_M: f32 = 10.0;
@@ -281,7 +281,7 @@ fn log_once(which: Fallback) -> bool {
 mod tests {
     use super::*;
     use glam::Vec3;
-    use vitreous_xr::GazeRay;
+    use vitreous_trace::GazeRay;
 
     fn ray(origin: Vec3, target: Vec3) -> GazeRay {
         GazeRay {
@@ -292,15 +292,7 @@ mod tests {
     }
 
     fn sample(t_ns: i64, left: GazeRay, right: GazeRay) -> GazeSample {
-        GazeSample {
-            sample_time_ns: t_ns,
-            left,
-            right,
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        }
+        GazeSample::binocular(t_ns, left, right)
     }
 
     #[test]

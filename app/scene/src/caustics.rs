@@ -189,7 +189,7 @@ pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError
         .non_parallel()
         .to_buffered(&mut bytes)
         .map_err(|e| write_err(e.to_string()))?;
-    vitreous_xr::atomic_file::write(path, bytes.get_ref()).map_err(|e| write_err(e.to_string()))
+    vitreous_trace::atomic_file::write(path, bytes.get_ref()).map_err(|e| write_err(e.to_string()))
 }
 
 /// ` (named by <scene>)` when the scene is known.

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use glam::{Mat4, Vec3};
 use vitreous_optics::refraction::Refraction;
 use vitreous_optics::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, MeshBody, pass_through};
-use vitreous_xr::synth::{FixationTarget, SynthParams};
+use vitreous_trace::synth::{FixationTarget, SynthParams};
 
 use super::{Object, Scene};
 use vitreous_gaze::{GazeImage, ImageDistances};

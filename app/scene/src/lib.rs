@@ -44,7 +44,7 @@ pub mod room;
 use std::path::{Path, PathBuf};
 
 use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
-use vitreous_xr::{Fov, Pose};
+use vitreous_trace::{Fov, Pose};
 
 use crate::effects::EffectSet;
 use vitreous_gaze::{FilterKind, GazeOverride, PupilSource};

@@ -16,7 +16,7 @@ use vitreous_optics::live_caustics::{
     DEFAULT_RESOLUTION_PX as DEFAULT_LIVE_RESOLUTION_PX, LiveCausticsDesc, MAX_PHOTONS_PER_SIDE,
     MAX_SMOOTHING_PX,
 };
-use vitreous_xr::{Fov, Pose};
+use vitreous_trace::{Fov, Pose};
 
 use super::error::Source;
 use super::file::{LightFrame, PlaneToml, SceneFile, Whole};

@@ -80,7 +80,7 @@ pub fn with_room(map: &Image, center: Vec3, floor: &RealPlane, background: &Real
 mod tests {
     use super::*;
     use glam::Quat;
-    use vitreous_xr::Pose;
+    use vitreous_trace::Pose;
 
     fn plane(level: u8, position: Vec3, orientation: Quat) -> RealPlane {
         RealPlane {

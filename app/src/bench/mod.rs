@@ -14,8 +14,9 @@ use vitreous_optics::refraction::Refraction;
 use vitreous_render::floor::FieldPassesMs;
 use vitreous_render::renderer::Want;
 use vitreous_render::{ContextOptions, FrameWork, GpuContext, Look, Reflection, Renderer};
+use vitreous_trace::FrameInput;
+use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::{Backend, FrameInput};
 
 use vitreous_frames::blur_stack::DefocusSetup;
 use vitreous_frames::look::{DefocusModel, LookPlanner};
@@ -283,7 +284,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     }
 
     // The same views for every variant: a synthetic trace looking at the object.
-    let samples = vitreous_xr::synth::synthesize_with_truth(&synth_params_for(&scene))
+    let samples = vitreous_trace::synth::synthesize_with_truth(&synth_params_for(&scene))
         .context("synthesising the benchmark's views")?
         .samples;
     let total = options.warm_up + options.frames;

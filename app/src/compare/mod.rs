@@ -222,7 +222,7 @@ pub struct ReferenceFigures {
 /// with the object and light at `placement`, at the scene's pixels per degree.
 pub fn against_reference(
     scene: &vitreous_scene::Scene,
-    view: &vitreous_xr::frame::EyeView,
+    view: &vitreous_trace::EyeView,
     placement: &vitreous_scene::Placement,
     images: [&[u8]; 3],
     (w, h): (u32, u32),

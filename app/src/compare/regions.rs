@@ -8,7 +8,7 @@ use glam::{Quat, Vec2, Vec3};
 use serde::Serialize;
 use vitreous_render::floor::{FAR_M, exact_edge_distances};
 use vitreous_scene::{Placement, Scene};
-use vitreous_xr::frame::EyeView;
+use vitreous_trace::EyeView;
 
 use vitreous_frames::render_desc::eye_params;
 
@@ -74,14 +74,14 @@ impl Eye {
 /// The region of every pixel of a `width` x `height` image of `eye` at the scene's neutral
 /// head (looking down -z from `viewer.head_position_m`), row by row.
 pub fn regions(scene: &Scene, eye: Eye, width: u32, height: u32) -> Vec<Region> {
-    let head = vitreous_xr::Pose {
+    let head = vitreous_trace::Pose {
         position: scene.viewer.head_position_m,
         orientation: Quat::IDENTITY,
     };
     let [left, right] = scene.viewer.eye_positions_m(&head);
     let position = if eye == Eye::Left { left } else { right };
     let view = EyeView {
-        pose: vitreous_xr::Pose {
+        pose: vitreous_trace::Pose {
             position,
             orientation: Quat::IDENTITY,
         },

@@ -15,9 +15,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use vitreous_optics::refraction::Refraction;
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, GpuContext, Look, Reflection, Renderer, ScenePose};
+use vitreous_trace::format::{EditRecord, Recording, TraceSample};
+use vitreous_trace::{FrameInput, SessionEvent};
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::trace::{EditRecord, Recording, TraceSample};
-use vitreous_xr::{FrameInput, SessionEvent};
 
 use physical::Physical;
 use summary::UnfinishedSummary;

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use vitreous_xr::FrameInput;
+use vitreous_trace::FrameInput;
 
 use crate::compare::{ReferenceFigures, against_reference, rgb_of};
 use crate::reference_cmd::{

@@ -38,7 +38,7 @@ pub struct RunArgs {
     pub readback_check: bool,
     /// Blend mode instead of the automatic choice: additive, alpha-blend, opaque.
     #[arg(long, value_parser = parse_blend)]
-    pub blend: Option<vitreous_xr::openxr::Blend>,
+    pub blend: Option<vitreous_trace::Blend>,
     /// Eye image size instead of the runtime's recommended one, e.g. 640x480 (16-8192 per
     /// side; the runtime's maximum bounds it).
     #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]

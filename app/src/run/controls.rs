@@ -7,10 +7,9 @@ use std::io::BufRead;
 use std::sync::mpsc;
 
 use glam::Vec3;
-use vitreous_xr::FrameInput;
-use vitreous_xr::openxr::Command;
-use vitreous_xr::planes::nearest_up_hit;
-use vitreous_xr::trace::EditRecord;
+use vitreous_trace::format::EditRecord;
+use vitreous_trace::planes::nearest_up_hit;
+use vitreous_trace::{Command, FrameInput};
 
 use super::sink::RunSink;
 use vitreous_frames::scene_edit::{Axis, SceneEdit, place_ray, ray_meets_plane};

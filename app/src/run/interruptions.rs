@@ -7,10 +7,10 @@
 use std::collections::BTreeMap;
 
 use serde::Serialize;
+use vitreous_trace::format::EventRecord;
+use vitreous_trace::session_event::{Loss, TrackingLoss};
+use vitreous_trace::{FrameInput, SessionEvent};
 use vitreous_xr::openxr::Interruptions;
-use vitreous_xr::session_event::{Loss, TrackingLoss};
-use vitreous_xr::trace::EventRecord;
-use vitreous_xr::{FrameInput, SessionEvent};
 
 use super::sink::RunSink;
 use vitreous_frames::gaze_watch::GazeWatch;
@@ -219,8 +219,8 @@ impl InterruptionSummary {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use vitreous_trace::session_event::NotRendered;
     use vitreous_xr::openxr::SessionReport;
-    use vitreous_xr::session_event::NotRendered;
 
     #[test]
     fn every_frame_handed_out_is_shown_or_counted_once() {

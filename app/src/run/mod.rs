@@ -11,8 +11,9 @@
 //! [`Backend::frame_target`](vitreous_xr::Backend::frame_target) says (the renderer's own
 //! images or swapchain image `i`, and depth swapchain image `j` when depth is submitted).
 //!
-//! Live actions (controller buttons, see `vitreous_xr::openxr::actions`) re-register the scene
-//! in the session itself; the commands that change the look reach the sink through
+//! Live actions (controller buttons, see `vitreous_trace::command` and
+//! `vitreous_xr::openxr::actions`) re-register the scene in the session itself; the commands
+//! that change the look reach the sink through
 //! [`Session::take_commands`](vitreous_xr::openxr::Session::take_commands) and are applied
 //! by [`LiveConditions`]: the next effect condition among those this build implements, and the
 //! forced gaze image (surface, refracted, auto).
@@ -46,13 +47,14 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use vitreous_render::{ContextOptions, Reflection, Renderer};
+use vitreous_trace::Blend;
+use vitreous_trace::format::{TraceVersion, TraceWriter};
+use vitreous_trace::session_event::Loss;
 use vitreous_xr::openxr::ash::vk;
 use vitreous_xr::openxr::{
-    Blend, Continued, DepthOptions, GazeChoice, OpenXrOptions, Runtime, SessionOptions,
-    SessionReport, State,
+    Continued, DepthOptions, GazeChoice, OpenXrOptions, Runtime, SessionOptions, SessionReport,
+    State,
 };
-use vitreous_xr::session_event::Loss;
-use vitreous_xr::trace::{TraceVersion, TraceWriter};
 
 pub use cli::{RunArgs, run_command};
 pub use interruptions::{InterruptionSummary, NotRenderedFrames, Reconnect};

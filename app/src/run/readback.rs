@@ -8,8 +8,7 @@
 //! nothing drawn) away from both, past the panel's reach around them.
 
 use serde::Serialize;
-use vitreous_xr::FrameInput;
-use vitreous_xr::openxr::Blend;
+use vitreous_trace::{Blend, FrameInput};
 
 /// What the readback of a submitted swapchain image showed.
 #[derive(Clone, Debug, Serialize)]

@@ -5,9 +5,10 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
+use vitreous_trace::format::{TraceSample, read_trace};
+use vitreous_trace::{FrameInput, GazeSample, Pose};
+use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
-use vitreous_xr::trace::{TraceSample, read_trace};
-use vitreous_xr::{Backend, FrameInput, GazeSample, Pose};
 
 use vitreous_scene::Scene;
 

@@ -21,7 +21,7 @@ pub struct RoomLight {
     /// Estimates the app received.
     pub estimates: u64,
     /// Times the scene's light moved or its share changed to follow one (the rest were within
-    /// `vitreous_xr::light::MIN_TURN_DEG` of where it shone, and within
+    /// `vitreous_trace::light::MIN_TURN_DEG` of where it shone, and within
     /// `MIN_SHARE_STEP` of its share).
     pub light_moves: u64,
     /// The way the newest estimate's main light travels, in the scene frame.

@@ -4,10 +4,10 @@
 
 use anyhow::{Context, Result};
 use vitreous_render::renderer::{FrameResult, Want};
-use vitreous_xr::light::LightEstimate;
-use vitreous_xr::openxr::{Blend, Command};
-use vitreous_xr::trace::TraceWriter;
-use vitreous_xr::{FrameEndHints, FrameInput};
+use vitreous_trace::format::TraceWriter;
+use vitreous_trace::light::LightEstimate;
+use vitreous_trace::{Blend, Command, FrameInput};
+use vitreous_xr::FrameEndHints;
 
 use super::readback::{self, ReadbackCheck, check_readback};
 use super::recording::trace_sample;
@@ -46,7 +46,7 @@ pub(super) struct RunSink<'d> {
     /// The readback result.
     pub(super) readback: Option<ReadbackCheck>,
     /// Where head pose and gaze are recorded, if asked.
-    pub(super) writer: Option<TraceWriter<vitreous_xr::trace::AtomicFile>>,
+    pub(super) writer: Option<TraceWriter<vitreous_trace::format::AtomicFile>>,
     /// Every frame's input while recording, for the replay check (nothing is kept per frame
     /// otherwise).
     pub(super) recorded: Vec<FrameInput>,
@@ -63,9 +63,9 @@ pub(super) struct RunSink<'d> {
     pub(super) edits: Option<std::sync::mpsc::Receiver<SceneEdit>>,
     /// The upward planes the runtime detects (XR_EXT_plane_detection), as they come.
     pub(super) planes_rx:
-        Option<std::sync::mpsc::Receiver<Vec<vitreous_xr::planes::DetectedPlane>>>,
+        Option<std::sync::mpsc::Receiver<Vec<vitreous_trace::planes::DetectedPlane>>>,
     /// The latest detection's planes, in the scene frame: where a place puts the object.
-    pub(super) planes: Vec<vitreous_xr::planes::DetectedPlane>,
+    pub(super) planes: Vec<vitreous_trace::planes::DetectedPlane>,
     /// Where re-registrations go: the session, which moves the scene's placement (the
     /// current session's, [`RunSink::attach`]).
     pub(super) registrar: Option<std::sync::mpsc::Sender<Command>>,
@@ -76,13 +76,13 @@ pub(super) struct RunSink<'d> {
     /// The scene's global dimmer level (`[display] global_dimmer`).
     pub(super) global_dimmer: Option<f32>,
     /// The room's light as the runtime estimates it (XR_ML_light_estimation), as it comes.
-    pub(super) light_rx: Option<std::sync::mpsc::Receiver<vitreous_xr::light::LightEstimate>>,
+    pub(super) light_rx: Option<std::sync::mpsc::Receiver<vitreous_trace::light::LightEstimate>>,
     /// What the estimates did (`None`: none came).
     pub(super) room_light: Option<room_light::RoomLight>,
     /// The eye tracker's dropouts.
     pub(super) gaze_watch: vitreous_frames::gaze_watch::GazeWatch,
     /// Every session event, with the display time of the frame it came with.
-    pub(super) events: Vec<(i64, vitreous_xr::SessionEvent)>,
+    pub(super) events: Vec<(i64, vitreous_trace::SessionEvent)>,
     /// Display time of the newest frame, nanoseconds.
     pub(super) last_time_ns: Option<i64>,
     /// Resident memory over the session's frames.
@@ -181,7 +181,7 @@ impl FrameSink for RunSink<'_> {
     fn session_events(
         &mut self,
         frame: Option<&FrameInput>,
-        events: &[vitreous_xr::SessionEvent],
+        events: &[vitreous_trace::SessionEvent],
     ) -> Result<()> {
         self.note_events(frame, events);
         Ok(())

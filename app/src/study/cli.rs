@@ -96,7 +96,7 @@ pub enum StudyCommand {
         size: Option<(u32, u32)>,
         /// Blend mode instead of the automatic choice: additive, alpha-blend, opaque.
         #[arg(long, value_parser = parse_blend)]
-        blend: Option<vitreous_xr::openxr::Blend>,
+        blend: Option<vitreous_trace::Blend>,
         /// Gaze source (as for `vitreous run`).
         #[arg(long, value_name = "SOURCE", value_parser = parse_gaze, default_value = "auto")]
         gaze: vitreous_xr::openxr::GazeChoice,

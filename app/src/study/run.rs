@@ -14,8 +14,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, Result, bail};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, GpuContext, Reflection};
-use vitreous_xr::openxr::Command;
-use vitreous_xr::{FrameInput, NullBackend, NullConfig};
+use vitreous_trace::{Command, FrameInput};
+use vitreous_xr::{NullBackend, NullConfig};
 
 use crate::run::RunOptions;
 use vitreous_frames::conditions::LiveConditions;
@@ -165,7 +165,7 @@ impl Director for StudyStage {
         self.director.command(command);
     }
 
-    fn session_events(&mut self, events: &[vitreous_xr::SessionEvent]) {
+    fn session_events(&mut self, events: &[vitreous_trace::SessionEvent]) {
         self.director.session_events(events);
     }
 
@@ -373,7 +373,7 @@ fn dry_run_block(
         None => {
             let mut params = vitreous_scene::synth_params_for(&scene);
             params.duration_s = needed_s.min(4.0 * 3600.0) as f32;
-            vitreous_xr::synth::synthesize_with_truth(&params)
+            vitreous_trace::synth::synthesize_with_truth(&params)
                 .context("synthesising a trace for the dry run")?
                 .samples
         }

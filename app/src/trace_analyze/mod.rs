@@ -38,8 +38,8 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use glam::Vec3;
 use serde::Serialize;
-use vitreous_xr::TraceSample;
-use vitreous_xr::synth::GazePhase;
+use vitreous_trace::TraceSample;
+use vitreous_trace::synth::GazePhase;
 
 use vitreous_frames::input_files::InputFiles;
 use vitreous_frames::setup::ensure_samples;
@@ -538,7 +538,7 @@ pub(super) fn load_inputs(
 ) -> Result<(Vec<TraceSample>, AnalyzeConfig, InputFiles)> {
     let scene = load_scene(scene).context("loading the scene")?;
     // The trace's errors name its file and line.
-    let samples = vitreous_xr::read_trace(trace).context("reading the trace")?;
+    let samples = vitreous_trace::read_trace(trace).context("reading the trace")?;
     ensure_samples(trace, &samples, "analyse")?;
     let mut config = AnalyzeConfig::for_scene(&scene);
     if !filters.is_empty() {

@@ -14,7 +14,7 @@ use std::path::Path;
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use vitreous_xr::TraceSample;
+use vitreous_trace::TraceSample;
 
 use super::{
     AnalyzeConfig, RawSample, ReplayedFrame, Truth, load_inputs, raw_samples, replay,

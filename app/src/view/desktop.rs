@@ -13,7 +13,8 @@ use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use glam::{EulerRot, Quat, Vec3};
-use vitreous_xr::{Backend, EyeView, Fov, FrameInput, GazeRay, GazeSample, Pose};
+use vitreous_trace::{EyeView, Fov, FrameInput, GazeRay, GazeSample, Pose};
+use vitreous_xr::Backend;
 
 use super::input::{Action, EyesShown, InputEvent, action_for_key, movement};
 use super::playback::Playback;
@@ -496,15 +497,7 @@ impl Backend for DesktopBackend {
                 valid: true,
             }
         };
-        let gaze = GazeSample {
-            sample_time_ns: time_ns,
-            left: ray(eye_local[0]),
-            right: ray(eye_local[1]),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        };
+        let gaze = GazeSample::binocular(time_ns, ray(eye_local[0]), ray(eye_local[1]));
         Ok(Some(self.frame(head, Some(gaze), time_ns)))
     }
 

@@ -5,8 +5,8 @@
 use anyhow::Context;
 use glam::Vec3;
 use vitreous_render::ScenePose;
-use vitreous_xr::FrameInput;
-use vitreous_xr::trace::{AtomicFile, EditRecord, TraceWriter};
+use vitreous_trace::FrameInput;
+use vitreous_trace::format::{AtomicFile, EditRecord, TraceWriter};
 
 use vitreous_frames::motion_clock::MotionClock;
 use vitreous_frames::scene_edit::{EditState, SceneEdit};

@@ -251,7 +251,7 @@ fn view_with(options: &ViewOptions, director: Option<&mut dyn Director>) -> Resu
     );
     let mut played_edits = Vec::new();
     if let Some(path) = &options.trace {
-        let (samples, edits) = vitreous_xr::trace::read_trace_with_edits(path)
+        let (samples, edits) = vitreous_trace::format::read_trace_with_edits(path)
             .with_context(|| format!("reading trace {}", path.display()))?;
         vitreous_frames::setup::ensure_samples(path, &samples, "play")?;
         backend.play(playback::Playback::new(samples));

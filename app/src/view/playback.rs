@@ -1,8 +1,7 @@
 //! `--trace FILE`: a recorded trace played in the window, with pause, single step and seek.
 
-use vitreous_xr::GazeSample;
-use vitreous_xr::Pose;
-use vitreous_xr::trace::TraceSample;
+use vitreous_trace::format::TraceSample;
+use vitreous_trace::{GazeSample, Pose};
 
 /// Nanoseconds per second.
 const NS_PER_S: i64 = 1_000_000_000;

@@ -13,8 +13,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{ContextOptions, Presented, Renderer};
-use vitreous_xr::trace::{AtomicFile, TraceSample, TraceWriter};
-use vitreous_xr::{FrameInput, GazeSample};
+use vitreous_trace::format::{AtomicFile, TraceSample, TraceWriter};
+use vitreous_trace::{FrameInput, GazeSample};
 
 use super::ViewOptions;
 use super::conditions::ViewConditions;
@@ -217,7 +217,7 @@ impl<'d> ViewSink<'d> {
     }
 
     /// Shows the scene edits of the trace played (see [`ViewEdits::play`]).
-    pub fn play_edits(&mut self, edits: Vec<vitreous_xr::trace::EditRecord>) {
+    pub fn play_edits(&mut self, edits: Vec<vitreous_trace::format::EditRecord>) {
         self.edits.play(edits);
     }
 

@@ -5,8 +5,8 @@
 use std::io::BufRead;
 use std::sync::mpsc::{Receiver, TryRecvError};
 
-use vitreous_xr::openxr::{Command, Cycle};
-use vitreous_xr::synth::SplitMix64;
+use vitreous_trace::synth::SplitMix64;
+use vitreous_trace::{Command, Cycle};
 
 use super::distributions::normal_cdf;
 use super::responses::{Answer, Choice, RATING_LIMIT, ResponseKind};

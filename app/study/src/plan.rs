@@ -16,7 +16,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use thiserror::Error;
-use vitreous_xr::synth::SplitMix64;
+use vitreous_trace::synth::SplitMix64;
 
 use super::protocol::{Orders, Protocol};
 

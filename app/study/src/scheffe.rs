@@ -273,7 +273,7 @@ mod tests {
     #[test]
     fn sums_of_squares_add_up_and_the_error_is_the_residual() {
         let (t, n) = (4, 5);
-        let mut rng = vitreous_xr::synth::SplitMix64(7);
+        let mut rng = vitreous_trace::synth::SplitMix64(7);
         let ratings: Vec<Vec<Vec<f64>>> = (0..n)
             .map(|_| {
                 (0..t)
@@ -328,7 +328,7 @@ mod tests {
     fn scale_values_are_recovered_from_simulated_ratings() {
         let truth = [-0.6, -0.2, 0.0, 0.3, 0.5];
         let (t, n) = (5, 60);
-        let mut rng = vitreous_xr::synth::SplitMix64(99);
+        let mut rng = vitreous_trace::synth::SplitMix64(99);
         let ratings: Vec<Vec<Vec<f64>>> = (0..n)
             .map(|_| {
                 (0..t)

@@ -8,8 +8,8 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use vitreous_xr::openxr::Command;
-use vitreous_xr::session_event::{SessionEvent, TrackingLoss};
+use vitreous_trace::Command;
+use vitreous_trace::session_event::{SessionEvent, TrackingLoss};
 
 use super::answers::{ControllerAnswers, Keyboard, SimulatedObserver, answer_text, parse_answer};
 use super::plan::PlannedTrial;

@@ -251,7 +251,7 @@ mod tests {
     #[test]
     fn scale_values_are_recovered_from_simulated_choices() {
         let truth = [0.0, 0.4, 0.7, 1.2, 1.3];
-        let mut rng = vitreous_xr::synth::SplitMix64(14);
+        let mut rng = vitreous_trace::synth::SplitMix64(14);
         let mut counts = vec![vec![0u64; 5]; 5];
         for i in 0..5 {
             for j in i + 1..5 {

@@ -285,7 +285,7 @@ fn a_recorded_session_replays_and_the_preview_shows_the_world() {
         dark * 100 < img.pixels.len() / 4,
         "{dark} px black in the preview"
     );
-    let samples = vitreous_xr::trace::read_trace(&trace).expect("the recording is a trace");
+    let samples = vitreous_trace::format::read_trace(&trace).expect("the recording is a trace");
     assert_eq!(samples.len(), 8);
     let out = Command::new(env!("CARGO_BIN_EXE_vitreous"))
         .arg("replay")
@@ -393,12 +393,12 @@ fn a_played_trace_pauses_and_steps_and_the_recording_shows_it() {
         ],
         dir.path(),
     );
-    let samples = vitreous_xr::trace::read_trace(&recorded).unwrap();
+    let samples = vitreous_trace::format::read_trace(&recorded).unwrap();
     // Frames 0 and 1 play, 2-4 stand still (not recorded again), 5 is one step on, 6-7 stand.
     let times: Vec<i64> = samples.iter().map(|s| s.time_ns).collect();
     assert_eq!(times.len(), 3, "{times:?}");
     assert_eq!(times[2] - times[1], 1_000_000_000 / 60, "{times:?}");
-    let played = vitreous_xr::trace::read_trace(&trace).unwrap();
+    let played = vitreous_trace::format::read_trace(&trace).unwrap();
     assert_eq!(
         samples[0].head, played[0].head,
         "the trace's first head pose"
@@ -451,7 +451,7 @@ fn scripted_scene_edits_are_recorded_and_the_replay_ends_where_the_session_did()
         "the stale bake is reported once: {stderr}"
     );
     let (samples, edits) =
-        vitreous_xr::trace::read_trace_with_edits(&trace).expect("the recording reads");
+        vitreous_trace::format::read_trace_with_edits(&trace).expect("the recording reads");
     let actions: Vec<&str> = edits.iter().map(|e| e.action.as_str()).collect();
     assert_eq!(
         actions,

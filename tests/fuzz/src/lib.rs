@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use vitreous_scene::{Scene, SceneError, SceneFiles};
-use vitreous_xr::trace::{TraceReader, TraceSample, TraceVersion, TraceWriter};
+use vitreous_trace::format::{TraceReader, TraceSample, TraceVersion, TraceWriter};
 
 /// Names of the targets, as in `fuzz_targets/` and `corpus/`.
 pub const TARGETS: [&str; 8] = [
@@ -92,13 +92,13 @@ pub fn study(data: &[u8]) {
 /// SRanipal CSV text: import it; the samples of a successful import must make a valid trace
 /// that reads back unchanged, and the report must format.
 pub fn sranipal(data: &[u8]) {
-    check_import(vitreous_xr::sranipal::parse_sranipal(data, "fuzz.csv"));
+    check_import(vitreous_trace::sranipal::parse_sranipal(data, "fuzz.csv"));
 }
 
 /// Tobii Pro Glasses 3 gaze data (gzip-compressed or plain JSON lines): import it; like
 /// [`sranipal`], a successful import must make a valid trace that reads back unchanged.
 pub fn tobii_g3(data: &[u8]) {
-    check_import(vitreous_xr::import::tobii_g3::parse_tobii_g3(
+    check_import(vitreous_trace::import::tobii_g3::parse_tobii_g3(
         data, "fuzz.gz", None,
     ));
 }
@@ -155,7 +155,7 @@ pub fn unpack_neon(mut data: &[u8]) -> Vec<(&'static str, &[u8])> {
 
 /// A Pupil Labs Neon native recording, packed ([`pack_neon`]): its files are written to a
 /// folder of their own (emptied first) and imported with
-/// [`vitreous_xr::import::neon::import_neon`]; like [`sranipal`], a successful import must make a
+/// [`vitreous_trace::import::neon::import_neon`]; like [`sranipal`], a successful import must make a
 /// valid trace that reads back unchanged.
 pub fn neon(data: &[u8]) {
     thread_local! {
@@ -173,7 +173,7 @@ pub fn neon(data: &[u8]) {
         for (name, bytes) in unpack_neon(data) {
             fs::write(dir.join(name), bytes).expect("writing a recording file");
         }
-        check_import(vitreous_xr::import::neon::import_neon(dir));
+        check_import(vitreous_trace::import::neon::import_neon(dir));
     });
 }
 

@@ -180,7 +180,7 @@ fn neon_survives_its_corpus() {
     check("neon");
 }
 
-/// The seeds are whole recordings (the committed fixture of `xr/tests/data/neon`, packed): each
+/// The seeds are whole recordings (the committed fixture of `trace/tests/data/neon`, packed): each
 /// one imports, so the fuzzer starts past the folder's checks.
 #[test]
 fn every_neon_seed_imports() {
@@ -189,7 +189,7 @@ fn every_neon_seed_imports() {
         for (name, bytes) in vitreous_fuzz::unpack_neon(data) {
             fs::write(dir.path().join(name), bytes).expect("writing a recording file");
         }
-        let imported = vitreous_xr::import::neon::import_neon(dir.path());
+        let imported = vitreous_trace::import::neon::import_neon(dir.path());
         imported.map(drop).map_err(|e| e.to_string())
     });
 }

@@ -110,9 +110,9 @@ fn main() -> Result<()> {
             }
             if let Some(dir) = dump_raw {
                 let raw = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-                vitreous_xr::atomic_file::write(dir.join("test.f32"), &raw(&t.gain))
+                vitreous_trace::atomic_file::write(dir.join("test.f32"), &raw(&t.gain))
                     .with_context(|| format!("writing {}", dir.join("test.f32").display()))?;
-                vitreous_xr::atomic_file::write(dir.join("reference.f32"), &raw(&r.gain))
+                vitreous_trace::atomic_file::write(dir.join("reference.f32"), &raw(&r.gain))
                     .with_context(|| format!("writing {}", dir.join("reference.f32").display()))?;
             }
             if t.scene_hash != r.scene_hash {

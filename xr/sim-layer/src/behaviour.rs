@@ -23,7 +23,7 @@
 //! behaviour (the time the eyes were lost, for eyes closed too); its duration, the time since.
 
 use glam::Vec3;
-use vitreous_xr::{GazeBehaviour, GazeSample};
+use vitreous_trace::{GazeBehaviour, GazeSample};
 
 /// Above this angular velocity of the gaze, degrees per second, a sample is a saccade.
 pub const SACCADE_DEG_S: f64 = 30.0;
@@ -159,7 +159,7 @@ fn common_directions(a: &GazeSample, b: &GazeSample) -> Option<(Vec3, Vec3)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use vitreous_xr::{GazeRay, TrackerConfidence, TrackerReport};
+    use vitreous_trace::{GazeRay, TrackerConfidence, TrackerReport};
 
     /// Both eyes looking `yaw_deg` to the right of straight ahead at `time_ms`; no gaze when
     /// `yaw_deg` is `None`.

@@ -101,7 +101,7 @@ fn prepare() -> Result<Prepared, String> {
             ));
         };
         let samples =
-            vitreous_xr::read_trace(path).map_err(|e| format!("reading {TRACE_VAR}: {e}"))?;
+            vitreous_trace::read_trace(path).map_err(|e| format!("reading {TRACE_VAR}: {e}"))?;
         Some(
             GazeTimeline::new(&samples)
                 .ok_or_else(|| format!("{TRACE_VAR}: {} has no samples", path.display()))?,

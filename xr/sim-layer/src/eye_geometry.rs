@@ -4,8 +4,8 @@
 
 use glam::{Mat3, Quat, Vec3};
 use openxr::sys;
-use vitreous_xr::crossing::{RayCrossing, closest_approach};
-use vitreous_xr::{GazeRay, GazeSample, Pose};
+use vitreous_trace::crossing::{RayCrossing, closest_approach};
+use vitreous_trace::{GazeRay, GazeSample, Pose};
 
 /// The pose at `origin` whose -z axis points along `direction` and whose +y axis is as close
 /// to the frame's +y (head up) as it can be, so a gaze pose has no roll of its own.
@@ -201,15 +201,7 @@ mod tests {
     fn combined_ray_is_the_mean_of_the_valid_eyes() {
         let l = ray(Vec3::new(-0.03, 0.0, 0.0), Vec3::new(0.1, 0.0, -1.0));
         let r = ray(Vec3::new(0.03, 0.0, 0.0), Vec3::new(-0.1, 0.0, -1.0));
-        let mut s = GazeSample {
-            sample_time_ns: 0,
-            left: l,
-            right: r,
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        };
+        let mut s = GazeSample::binocular(0, l, r);
         let c = combined_ray(&s);
         assert!(c.valid && close(c.origin, Vec3::ZERO) && close(c.direction, Vec3::NEG_Z));
         s.right = GazeRay::INVALID;
@@ -228,15 +220,7 @@ mod tests {
         let target = Vec3::new(0.1, 0.0, -0.4);
         let l = Vec3::new(-0.032, 0.0, 0.0);
         let r = Vec3::new(0.032, 0.0, 0.0);
-        let mut s = GazeSample {
-            sample_time_ns: 0,
-            left: ray(l, target - l),
-            right: ray(r, target - r),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        };
+        let mut s = GazeSample::binocular(0, ray(l, target - l), ray(r, target - r));
         assert!(close(fixation_point(&s).unwrap(), target));
         s.fixation = Some(Vec3::new(0.0, 0.0, -2.0));
         assert_eq!(fixation_point(&s), Some(Vec3::new(0.0, 0.0, -2.0)));

@@ -423,7 +423,7 @@ pub fn write_wearer_views(
             .write_to(&mut io::Cursor::new(&mut png), image::ImageFormat::Png)
             .map_err(|e| format!("encoding {name}: {e}"))?;
         let path = dir.join(&name);
-        vitreous_xr::atomic_file::write(&path, &png)
+        vitreous_trace::atomic_file::write(&path, &png)
             .map_err(|e| format!("writing {}: {e}", path.display()))?;
         written.push(path);
     }

@@ -6,7 +6,7 @@ use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::{Arc, LazyLock, Mutex, MutexGuard};
 
 use openxr::sys;
-use vitreous_xr::Pose;
+use vitreous_trace::Pose;
 
 use crate::bindings::GazePaths;
 use crate::config::{Config, GazeExtension};

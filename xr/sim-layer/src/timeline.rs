@@ -10,8 +10,8 @@
 //! ([`crate::behaviour`]), so a blink is answered exactly while the eye rays are invalid.
 
 use glam::Vec3;
-use vitreous_xr::trace::TraceSample;
-use vitreous_xr::{GazeRay, GazeSample};
+use vitreous_trace::format::TraceSample;
+use vitreous_trace::{GazeRay, GazeSample};
 
 use crate::behaviour::{Behaviour, Episode, classify};
 
@@ -181,7 +181,7 @@ fn lerp_ray(a: &GazeRay, b: &GazeRay, w: f32) -> GazeRay {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use vitreous_xr::Pose;
+    use vitreous_trace::Pose;
 
     fn ray(x: f32, dir: Vec3) -> GazeRay {
         GazeRay {
@@ -299,7 +299,7 @@ mod tests {
 
     #[test]
     fn behaviour_and_report_come_from_the_nearer_sample() {
-        use vitreous_xr::{GazeBehaviour, TrackerConfidence, TrackerReport};
+        use vitreous_trace::{GazeBehaviour, TrackerConfidence, TrackerReport};
         // Steady gaze, then the eyes lost from 200 ns to 400 ns.
         let mut lines = vec![
             line(0, 0, ray(-0.03, Vec3::NEG_Z), None),

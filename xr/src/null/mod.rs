@@ -27,10 +27,11 @@ use std::io::BufRead;
 
 use glam::Vec3;
 use thiserror::Error;
+use vitreous_trace::format::{EventRecord, TraceError, TraceReader, TraceSample};
+use vitreous_trace::session_event::SessionEvent;
+use vitreous_trace::{Fov, FrameInput};
 
-use crate::frame::{Backend, Fov, FrameInput};
-use crate::session_event::SessionEvent;
-use crate::trace::{EventRecord, TraceError, TraceReader, TraceSample};
+use crate::Backend;
 
 pub use sampling::interpolate;
 
@@ -84,8 +85,8 @@ pub enum NullError {
         expected: &'static str,
     },
     /// Samples handed in directly span more time than a trace may
-    /// ([`crate::trace::MAX_SAMPLE_GAP_NS`] after the previous sample,
-    /// [`crate::trace::MAX_TRACE_SPAN_NS`] after the first).
+    /// ([`vitreous_trace::format::MAX_SAMPLE_GAP_NS`] after the previous sample,
+    /// [`vitreous_trace::format::MAX_TRACE_SPAN_NS`] after the first).
     #[error(
         "{source_name}: sample {index}: time_ns {time_ns} is too far after {what} {reference_ns} (at most {limit_s} s)"
     )]

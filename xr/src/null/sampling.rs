@@ -3,10 +3,10 @@
 //! and the running eye positions.
 
 use glam::Vec3;
+use vitreous_trace::format::{MAX_SAMPLE_GAP_NS, MAX_TRACE_SPAN_NS};
+use vitreous_trace::{EyeView, FrameInput, GazeSample, Pose};
 
 use super::{NullBackend, NullError};
-use crate::frame::{EyeView, FrameInput, GazeSample, Pose};
-use crate::trace::{MAX_SAMPLE_GAP_NS, MAX_TRACE_SPAN_NS};
 
 impl NullBackend {
     /// Reads one sample into the buffer, checking its order; `false` at the end of the source.

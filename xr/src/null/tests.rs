@@ -2,11 +2,11 @@
 //! streaming, and the errors.
 
 use glam::Quat;
+use vitreous_trace::format::{MAX_SAMPLE_GAP_NS, MAX_TRACE_SPAN_NS, TraceWriter};
+use vitreous_trace::synth::{SynthParams, synthesize};
+use vitreous_trace::{GazeRay, GazeSample, Pose};
 
 use super::*;
-use crate::frame::{GazeRay, GazeSample, Pose};
-use crate::synth::{SynthParams, synthesize};
-use crate::trace::{MAX_SAMPLE_GAP_NS, MAX_TRACE_SPAN_NS, TraceWriter};
 
 fn sample(time_ns: i64, position: Vec3, yaw_rad: f32) -> TraceSample {
     TraceSample {
@@ -238,8 +238,8 @@ fn empty_or_broken_traces_are_errors_not_panics() {
     assert!(matches!(e, NullError::EmptyTrace { .. }), "{e}");
     let header_only = format!(
         "{}\n{}\n",
-        crate::trace::VERSION_LINE,
-        crate::trace::COLUMNS.join(",")
+        vitreous_trace::format::VERSION_LINE,
+        vitreous_trace::format::COLUMNS.join(",")
     );
     let reader = TraceReader::new(std::io::Cursor::new(header_only), "empty.trace").unwrap();
     let e = NullBackend::from_reader(reader, NullConfig::default())
@@ -329,8 +329,8 @@ fn backend_is_send() {
 
 #[test]
 fn a_recordings_events_come_with_the_frames_they_came_with() {
-    use crate::session_event::{NotRendered, SessionEvent};
-    use crate::trace::{EventRecord, TraceVersion};
+    use vitreous_trace::format::{EventRecord, TraceVersion};
+    use vitreous_trace::session_event::{NotRendered, SessionEvent};
     let mut text = Vec::new();
     let mut w = TraceWriter::with_version(&mut text, "r", TraceVersion::V1_4).unwrap();
     let at = |time_ns, event| EventRecord { time_ns, event };
@@ -346,7 +346,7 @@ fn a_recordings_events_come_with_the_frames_they_came_with() {
     w.write(&sample(6_000, Vec3::ZERO, 0.0)).unwrap();
     w.write_event(&at(
         7_000,
-        SessionEvent::Lost(crate::session_event::Loss::Session),
+        SessionEvent::Lost(vitreous_trace::session_event::Loss::Session),
     ))
     .unwrap();
     w.finish().unwrap();
@@ -375,7 +375,9 @@ fn a_recordings_events_come_with_the_frames_they_came_with() {
     // The one after the last frame comes once the replay is over.
     assert_eq!(
         backend.take_events(),
-        vec![SessionEvent::Lost(crate::session_event::Loss::Session)]
+        vec![SessionEvent::Lost(
+            vitreous_trace::session_event::Loss::Session
+        )]
     );
     // Samples in memory take the events beside them.
     let mut backend = NullBackend::new(ten_ms_trace(), NullConfig::default())

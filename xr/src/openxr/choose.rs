@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-pub use crate::frame::Blend;
+use vitreous_trace::Blend;
 
 /// Chooses the blend mode: `wanted` when the runtime offers it, else ADDITIVE, ALPHA_BLEND,
 /// OPAQUE in that order, or with `dimmer` (the scene drives a segmented dimmer, which only

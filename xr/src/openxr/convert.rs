@@ -3,7 +3,7 @@
 use glam::{Quat, Vec3};
 use openxr as xr;
 
-use crate::frame::{GazeRay, Pose};
+use vitreous_trace::{GazeRay, Pose};
 
 /// A pose from OpenXR's (orientation normalised).
 pub(super) fn pose_of(p: &xr::Posef) -> Pose {

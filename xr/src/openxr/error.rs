@@ -77,7 +77,7 @@ pub enum OpenXrError {
     },
     /// The gaze trace could not be read.
     #[error(transparent)]
-    Trace(#[from] crate::trace::TraceError),
+    Trace(#[from] vitreous_trace::format::TraceError),
     /// Frame calls came in the wrong order.
     #[error("frame order: {0}")]
     FrameOrder(String),

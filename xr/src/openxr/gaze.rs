@@ -12,13 +12,13 @@
 use std::path::Path;
 
 use openxr as xr;
+use vitreous_trace::format::{TraceSample, read_trace};
+use vitreous_trace::{GazeRay, GazeSample};
 
 use super::choose::GazeSource;
 use super::convert::ray_of;
 use super::ml_tracker::MlTracker;
 use super::{OpenXrError, Result, XrContext};
-use crate::frame::{GazeRay, GazeSample};
-use crate::trace::{TraceSample, read_trace};
 
 /// A gaze source, ready to sample.
 pub(super) enum Gaze {
@@ -192,15 +192,11 @@ impl FbTracker {
                 GazeRay::INVALID
             }
         };
-        Some(GazeSample {
-            sample_time_ns: gazes.time.as_nanos(),
-            left: eye(&gazes.gaze[0]),
-            right: eye(&gazes.gaze[1]),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        })
+        Some(GazeSample::binocular(
+            gazes.time.as_nanos(),
+            eye(&gazes.gaze[0]),
+            eye(&gazes.gaze[1]),
+        ))
     }
 }
 
@@ -340,8 +336,8 @@ impl TraceGaze {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::Pose;
     use glam::Vec3;
+    use vitreous_trace::Pose;
 
     fn sample(time_ns: i64, gaze_ns: i64, x: f32) -> TraceSample {
         let ray = GazeRay {
@@ -352,15 +348,7 @@ mod tests {
         TraceSample {
             time_ns,
             head: Pose::IDENTITY,
-            gaze: GazeSample {
-                sample_time_ns: gaze_ns,
-                left: ray,
-                right: ray,
-                combined: None,
-                fixation: None,
-                pupil_diameter_m: [None, None],
-                report: None,
-            },
+            gaze: GazeSample::binocular(gaze_ns, ray, ray),
         }
     }
 

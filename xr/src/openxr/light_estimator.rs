@@ -9,10 +9,10 @@
 use glam::Vec3;
 use openxr as xr;
 use openxr::sys;
+use vitreous_trace::light::LightEstimate;
 
 use super::ml_light_estimation as ml;
 use super::ml_tracker::load;
-use crate::light::LightEstimate;
 
 /// Frames between two questions whether the estimate updated (Magic Leap's own samples ask
 /// every 2 s; the runtime updates it about that often).

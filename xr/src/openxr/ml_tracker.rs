@@ -14,12 +14,12 @@ use std::ffi::CStr;
 
 use glam::Vec3;
 use openxr as xr;
+use vitreous_trace::format::PUPIL_RANGE_M;
+use vitreous_trace::{GazeBehaviour, GazeRay, GazeSample, TrackerConfidence, TrackerReport};
 
 use super::convert::ray_of;
 use super::ml_eye_tracker as ml;
 use super::{OpenXrError, Result, XrContext};
-use crate::frame::{GazeBehaviour, GazeRay, GazeSample, TrackerConfidence, TrackerReport};
-use crate::trace::PUPIL_RANGE_M;
 
 /// An XR_ML_eye_tracker tracker and the functions it is used with (loaded through
 /// xrGetInstanceProcAddr: the `openxr` crate does not carry the extension).

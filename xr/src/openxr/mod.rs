@@ -41,19 +41,17 @@ mod vulkan;
 
 use ash::vk;
 use openxr as xr;
+use vitreous_trace::{Blend, Pose};
 
-pub use actions::{Command, Cycle};
 /// The `ash` crate these APIs use, for callers without their own dependency on it.
 pub use ash;
-pub use choose::{Blend, ColorFormat, GazeChoice, GazeSource};
+pub use choose::{ColorFormat, GazeChoice, GazeSource};
 pub use device_creator::XrDeviceCreator;
 pub(crate) use error::XrContext;
 pub use error::{OpenXrError, Result};
 pub use gaze::GazeTally;
 pub use session::{Interruptions, Session, SessionReport, interrupted};
 pub use state::{EndReason, State};
-
-use crate::frame::Pose;
 
 /// The OpenXR core validation layer's name.
 pub const CORE_VALIDATION_LAYER: &str = "XR_APILAYER_LUNARG_core_validation";
@@ -401,7 +399,7 @@ pub struct Continued {
     /// room's own frame, which outlives sessions); a LOCAL space is placed again.
     pub world_from_space: Option<Pose>,
     /// How long the app waited for the runtime to come back, milliseconds (the new session's
-    /// first events say so: [`crate::SessionEvent::Reconnected`]).
+    /// first events say so: [`vitreous_trace::SessionEvent::Reconnected`]).
     pub waited_ms: u64,
 }
 

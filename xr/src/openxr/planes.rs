@@ -9,8 +9,8 @@
 use openxr as xr;
 use openxr::sys::{self, Handle};
 
-use crate::frame::Pose;
-use crate::planes::DetectedPlane;
+use vitreous_trace::Pose;
+use vitreous_trace::planes::DetectedPlane;
 
 /// Frames between a finished detection and the next one begun.
 pub const REDETECT_FRAMES: u64 = 90;

@@ -53,7 +53,7 @@
 //! vergence hold (300 ms) the image is unknown until the evidence decides again.
 
 use glam::Vec3;
-use vitreous_xr::{GazeSample, TrackerConfidence};
+use vitreous_trace::{GazeSample, TrackerConfidence};
 
 use super::fixation::{DEFAULT_VELOCITY_DEG_S, Step};
 use super::image::{GazeImage, ImageDistances};
@@ -289,7 +289,7 @@ impl EvidenceFilter {
         let pending = self.pending.take();
         self.withheld = if g
             .report
-            .is_some_and(|r| r.behaviour == vitreous_xr::GazeBehaviour::Saccade)
+            .is_some_and(|r| r.behaviour == vitreous_trace::GazeBehaviour::Saccade)
         {
             Withheld::Saccade
         } else if g

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::test_samples::looking;
-use vitreous_xr::{GazeBehaviour, GazeRay, TrackerReport};
+use vitreous_trace::{GazeBehaviour, GazeRay, TrackerReport};
 
 const D: ImageDistances = ImageDistances {
     surface_m: 0.6,
@@ -87,7 +87,7 @@ fn a_spike_shorter_than_the_threshold_does_not_switch() {
 }
 
 /// [`looking`] with normal noise of `sigma_deg` on each eye's direction, per axis.
-fn noisy(rng: &mut vitreous_xr::synth::SplitMix64, g: GazeSample, sigma_deg: f32) -> GazeSample {
+fn noisy(rng: &mut vitreous_trace::synth::SplitMix64, g: GazeSample, sigma_deg: f32) -> GazeSample {
     let mut turn = |r: GazeRay| {
         let yaw = sigma_deg.to_radians() * rng.gaussian() as f32;
         let pitch = sigma_deg.to_radians() * rng.gaussian() as f32;
@@ -111,7 +111,7 @@ fn no_decision_while_the_images_are_inside_the_noise() {
         refracted_m: 2.03,
     };
     let trace = |sigma_deg: f32| {
-        let mut rng = vitreous_xr::synth::SplitMix64(7);
+        let mut rng = vitreous_trace::synth::SplitMix64(7);
         let mut s = fixating(0, 600, 33, 1.48);
         s.extend(fixating(20_000, 300, 33, 2.03));
         s.into_iter()

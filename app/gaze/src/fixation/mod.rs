@@ -60,7 +60,7 @@
 use std::collections::VecDeque;
 
 use glam::Vec3;
-use vitreous_xr::GazeSample;
+use vitreous_trace::GazeSample;
 
 use super::image::{GazeImage, ImageDistances, ImageSelector};
 use super::vergence::{FixationDepth, Measurement, newer_sample};

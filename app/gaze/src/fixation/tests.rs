@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::test_samples::looking;
-use vitreous_xr::GazeRay;
+use vitreous_trace::GazeRay;
 
 const D: ImageDistances = ImageDistances {
     surface_m: 0.6,

@@ -1,8 +1,8 @@
 //! Tests of `separability`.
 
 use glam::Vec3;
-use vitreous_xr::GazeRay;
-use vitreous_xr::synth::SplitMix64;
+use vitreous_trace::GazeRay;
+use vitreous_trace::synth::SplitMix64;
 
 use super::*;
 

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use vitreous_xr::session_event::{Loss, SessionEvent, TrackingLoss};
+use vitreous_trace::session_event::{Loss, SessionEvent, TrackingLoss};
 
 use super::super::answers::SimulatedObserver;
 use super::super::protocol::Protocol;

@@ -96,7 +96,7 @@ pub unsafe extern "system" fn get_eye_gazes(
                     // A tracker unsure of the sample (a LOW report) says so here too.
                     let low = sample
                         .report
-                        .is_some_and(|r| r.confidence == vitreous_xr::TrackerConfidence::Low);
+                        .is_some_and(|r| r.confidence == vitreous_trace::TrackerConfidence::Low);
                     slot.gaze_confidence = if low { 0.1 } else { 1.0 };
                 }
                 _ => {

@@ -386,7 +386,7 @@ mod tests {
         let e = EstimationState {
             session: 1,
             base_space: sys::Space::NULL,
-            anchor: vitreous_xr::Pose::IDENTITY,
+            anchor: vitreous_trace::Pose::IDENTITY,
             made_ns: 1_000,
             face_side: 64,
         };

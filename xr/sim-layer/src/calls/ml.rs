@@ -20,13 +20,13 @@
 //! session's newest frame.
 
 use openxr::sys::{self, Handle};
+use vitreous_trace::{GazeBehaviour, GazeRay, GazeSample, Pose, TrackerConfidence};
 use vitreous_xr::openxr::ml_eye_tracker::{
     ConfidenceML, EyeML, EyeTrackerCreateInfoML, EyeTrackerGazeBehaviorML,
     EyeTrackerGeometricDataML, EyeTrackerGetInfoML, EyeTrackerML, EyeTrackerPoseML,
     EyeTrackerPosesGetInfoML, EyeTrackerPosesML, EyeTrackerPupilDataML, EyeTrackerStaticDataML,
     GazeBehaviorTypeML, pose_flags, structure_type,
 };
-use vitreous_xr::{GazeBehaviour, GazeRay, GazeSample, Pose, TrackerConfidence};
 
 use super::{SessionContext, in_base};
 use crate::config::GazeExtension;
@@ -403,15 +403,7 @@ mod tests {
         let target = Vec3::new(0.05, -0.02, -0.6);
         let l = Vec3::new(-0.032, 0.0, 0.0);
         let r = Vec3::new(0.032, 0.0, 0.0);
-        let s = GazeSample {
-            sample_time_ns: 0,
-            left: ray(l, target),
-            right: ray(r, target),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        };
+        let s = GazeSample::binocular(0, ray(l, target), ray(r, target));
         let [gaze, left, right, fixation] = head_frame_poses(&s);
         let (p, c) = fixation;
         let p = p.unwrap();
@@ -425,15 +417,11 @@ mod tests {
 
     #[test]
     fn one_eye_lost_lowers_confidence_and_drops_the_vergence() {
-        let s = GazeSample {
-            sample_time_ns: 0,
-            left: ray(Vec3::new(-0.032, 0.0, 0.0), Vec3::new(0.0, 0.0, -1.0)),
-            right: GazeRay::INVALID,
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        };
+        let s = GazeSample::binocular(
+            0,
+            ray(Vec3::new(-0.032, 0.0, 0.0), Vec3::new(0.0, 0.0, -1.0)),
+            GazeRay::INVALID,
+        );
         let [gaze, _, right, fixation] = head_frame_poses(&s);
         assert_eq!(gaze.1, ConfidenceML::MEDIUM);
         assert!(right.0.is_none() && fixation.0.is_none());
@@ -449,7 +437,7 @@ mod tests {
             combined: None,
             fixation: None,
             pupil_diameter_m: [None, None],
-            report: Some(vitreous_xr::TrackerReport {
+            report: Some(vitreous_trace::TrackerReport {
                 confidence: TrackerConfidence::Medium,
                 behaviour: GazeBehaviour::Pursuit,
             }),

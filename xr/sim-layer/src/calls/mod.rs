@@ -21,7 +21,7 @@ use std::ffi::c_void;
 use std::sync::Arc;
 
 use openxr::sys::{self, Handle};
-use vitreous_xr::{GazeBehaviour, GazeSample, Pose, TrackerConfidence, TrackerReport};
+use vitreous_trace::{GazeBehaviour, GazeSample, Pose, TrackerConfidence, TrackerReport};
 
 use crate::behaviour::Behaviour;
 use crate::config::{Config, GazeExtension};

@@ -7,7 +7,7 @@
 
 use glam::{Quat, Vec3};
 use openxr::sys::{self, Handle};
-use vitreous_xr::Pose;
+use vitreous_trace::Pose;
 
 use super::SessionContext;
 use crate::eye_geometry::{compose, to_posef};

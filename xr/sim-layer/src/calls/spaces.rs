@@ -9,7 +9,7 @@ use crate::eye_geometry::{combined_ray, compose, from_posef, ray_pose, relative,
 use crate::faults;
 use crate::guard::guard;
 use crate::registry::{SpaceState, registry};
-use vitreous_xr::Pose;
+use vitreous_trace::Pose;
 
 /// `xrCreateReferenceSpace`: passed on; the layer notes the space's session.
 ///

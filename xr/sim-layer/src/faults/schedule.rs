@@ -23,7 +23,7 @@
 
 use std::fmt;
 
-use vitreous_xr::synth::SplitMix64;
+use vitreous_trace::synth::SplitMix64;
 
 /// When a fault starts.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -6,9 +6,10 @@ use std::sync::mpsc;
 use ash::vk;
 use ash::vk::Handle;
 use openxr as xr;
+use vitreous_trace::Blend;
 
 use super::super::actions::Controls;
-use super::super::choose::{self, Blend, GazeChoice, GazeOffer, GazeSource, SpaceChoice};
+use super::super::choose::{self, GazeChoice, GazeOffer, GazeSource, SpaceChoice};
 use super::super::gaze::{ExtGaze, FbTracker, Gaze, TraceGaze};
 use super::super::ml_tracker::MlTracker;
 use super::super::state::State;
@@ -281,7 +282,7 @@ pub(in crate::openxr) unsafe fn start(
             pending: {
                 let mut pending = super::interruptions::Pending::default();
                 if let Some(c) = options.continued {
-                    pending.push(crate::SessionEvent::Reconnected {
+                    pending.push(vitreous_trace::SessionEvent::Reconnected {
                         waited_ms: c.waited_ms,
                     });
                 }

@@ -23,6 +23,8 @@ use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use openxr as xr;
+use vitreous_trace::session_event::{NotRendered, SessionEvent};
+use vitreous_trace::{EyeView, Fov, FrameInput};
 
 use super::super::convert::pose_of;
 use super::super::state::{self, EndReason};
@@ -35,8 +37,7 @@ use super::placement::{compose, place_scene};
 use super::scope::{Handed, Hold, OpenFrame, Unwind};
 use super::tracking::{Located, Poses};
 use super::{INTERRUPTED, STATE_TIMEOUT, Session};
-use crate::frame::{Backend, EyeView, Fov, FrameInput, FrameTarget};
-use crate::session_event::{NotRendered, SessionEvent};
+use crate::{Backend, FrameTarget};
 
 /// How often the session says it is still waiting for a runtime that stopped it.
 const PAUSE_LOG_EVERY: Duration = Duration::from_secs(30);

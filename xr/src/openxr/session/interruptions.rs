@@ -6,9 +6,9 @@
 use std::collections::BTreeMap;
 
 use openxr as xr;
+use vitreous_trace::session_event::{Loss, NotRendered, SessionEvent};
 
 use super::super::OpenXrError;
-use crate::session_event::{Loss, NotRendered, SessionEvent};
 
 /// How many frames in a row may fail with a runtime failure before the session gives up: a
 /// runtime that fails every call is not coming back by itself.

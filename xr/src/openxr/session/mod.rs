@@ -24,14 +24,14 @@ use std::time::Duration;
 
 use glam::Vec3;
 use openxr as xr;
+use vitreous_trace::{Blend, Command, Pose};
 
 use super::DepthOptions;
 use super::SessionOptions;
-use super::actions::{Command, Controls};
-use super::choose::{Blend, GazeSource, SpaceChoice};
+use super::actions::Controls;
+use super::choose::{GazeSource, SpaceChoice};
 use super::gaze::{Gaze, GazeTally};
 use super::state::{EndReason, State};
-use crate::frame::Pose;
 
 pub(super) use create::start;
 pub use interruptions::Interruptions;
@@ -156,16 +156,16 @@ pub struct Session {
     /// session.
     planes: Option<super::planes::PlaneDetector>,
     /// Where each finished detection's planes (in the scene frame) go for the app.
-    planes_tx: mpsc::Sender<Vec<crate::planes::DetectedPlane>>,
+    planes_tx: mpsc::Sender<Vec<vitreous_trace::planes::DetectedPlane>>,
     /// The app's end, until taken (see [`Session::take_planes`]).
-    planes_rx: Option<mpsc::Receiver<Vec<crate::planes::DetectedPlane>>>,
+    planes_rx: Option<mpsc::Receiver<Vec<vitreous_trace::planes::DetectedPlane>>>,
     /// The light estimation, when the runtime has XR_ML_light_estimation; dropped before the
     /// session.
     light: Option<super::light_estimator::LightEstimator>,
     /// Where each new light estimate (in the scene frame) goes for the app.
-    light_tx: mpsc::Sender<crate::light::LightEstimate>,
+    light_tx: mpsc::Sender<vitreous_trace::light::LightEstimate>,
     /// The app's end, until taken (see [`Session::take_light_estimates`]).
-    light_rx: Option<mpsc::Receiver<crate::light::LightEstimate>>,
+    light_rx: Option<mpsc::Receiver<vitreous_trace::light::LightEstimate>>,
     /// Frame submission; dropped before the session.
     stream: xr::FrameStream<xr::Vulkan>,
     /// Frame pacing.
@@ -270,7 +270,9 @@ impl Session {
 
     /// The receiving end of the planes the runtime detects (XR_EXT_plane_detection), each
     /// finished detection's upward planes in the scene frame; taken once (`None` after).
-    pub fn take_planes(&mut self) -> Option<mpsc::Receiver<Vec<crate::planes::DetectedPlane>>> {
+    pub fn take_planes(
+        &mut self,
+    ) -> Option<mpsc::Receiver<Vec<vitreous_trace::planes::DetectedPlane>>> {
         self.planes_rx.take()
     }
 
@@ -290,7 +292,7 @@ impl Session {
             self.report.plane_detections += 1;
             let scene: Vec<_> = found
                 .into_iter()
-                .map(|p| crate::planes::DetectedPlane {
+                .map(|p| vitreous_trace::planes::DetectedPlane {
                     pose: placement::compose(world_from_space, &p.pose),
                     ..p
                 })
@@ -305,7 +307,9 @@ impl Session {
     /// The receiving end of the room's light as the runtime estimates it
     /// (XR_ML_light_estimation): each new estimate, in the scene frame; taken once (`None`
     /// after).
-    pub fn take_light_estimates(&mut self) -> Option<mpsc::Receiver<crate::light::LightEstimate>> {
+    pub fn take_light_estimates(
+        &mut self,
+    ) -> Option<mpsc::Receiver<vitreous_trace::light::LightEstimate>> {
         self.light_rx.take()
     }
 

@@ -2,9 +2,7 @@
 //! re-registration commands, and the pose algebra both need.
 
 use glam::{Quat, Vec3};
-
-use super::super::actions::Command;
-use crate::frame::Pose;
+use vitreous_trace::{Command, Pose};
 
 /// The scene frame from app space after a re-registration command: the scene moves by `d`
 /// (Nudge), or turns by `a` about the vertical axis through the head at `head_m` (Rotate),
@@ -121,7 +119,7 @@ mod tests {
         assert!((yaw(f) - yaw(f0) + a).abs() < 1e-5, "{f} {f0}");
         // Other commands leave the placement alone.
         assert_eq!(
-            re_register(&w, Command::Cycle(crate::openxr::Cycle::Secondary), head_m),
+            re_register(&w, Command::Cycle(vitreous_trace::Cycle::Secondary), head_m),
             w
         );
     }

@@ -5,12 +5,12 @@ use std::time::Instant;
 
 use glam::Vec3;
 use openxr as xr;
+use vitreous_trace::session_event::{Loss, SessionEvent};
 
 use super::super::state::{self, Action, EndReason, State};
 use super::super::{Result, XrContext};
 use super::Session;
 use super::interruptions::{Severity, severity};
-use crate::session_event::{Loss, SessionEvent};
 
 impl Session {
     /// xrSyncActions with every attached set, then the controller commands; only while

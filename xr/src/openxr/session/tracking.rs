@@ -5,8 +5,8 @@
 //! orientation leaves nothing to draw a world-locked object with, and the frame is not drawn
 //! (on an optical see-through display, glass in the wrong place is worse than none).
 
-use crate::frame::Pose;
-use crate::session_event::{SessionEvent, TrackingLoss};
+use vitreous_trace::Pose;
+use vitreous_trace::session_event::{SessionEvent, TrackingLoss};
 
 use super::placement::{compose, inverse};
 

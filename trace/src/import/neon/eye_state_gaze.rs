@@ -7,9 +7,9 @@ use glam::DVec3;
 use super::kappa::{Eye, visual_axis};
 use super::raw::{Scalar, Stream};
 use super::{Counts, Inputs, Timeline, eye_ray, neon_to_openxr, pupil_m, sample_time};
+use crate::format::TraceSample;
 use crate::frame::{GazeRay, GazeSample};
 use crate::import::RecordingError;
-use crate::trace::TraceSample;
 
 /// The eye-state fields read when the gaze comes from the eye states:
 /// [`super::EYE_FIELDS`], then the optical axes (unit vectors, scene camera frame), in this

@@ -1,5 +1,5 @@
 //! Imports of synthetic Tobii Pro Glasses 3 recordings made from known geometry, of the
-//! committed fixture in xr/tests/data/tobii_g3, and of malformed files.
+//! committed fixture in trace/tests/data/tobii_g3, and of malformed files.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -109,9 +109,9 @@ fn data_dir() -> PathBuf {
 }
 
 /// Rewrites the committed fixture from [`fixture_text`]:
-/// `cargo test -p vitreous-xr --lib write_tobii_fixture -- --ignored`.
+/// `cargo test -p vitreous-trace --lib write_tobii_fixture -- --ignored`.
 #[test]
-#[ignore = "rewrites xr/tests/data/tobii_g3"]
+#[ignore = "rewrites trace/tests/data/tobii_g3"]
 fn write_tobii_fixture() {
     let (gaze, imu) = fixture_text();
     std::fs::create_dir_all(data_dir()).unwrap();

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::trace::TraceSample;
+use crate::format::TraceSample;
 
 /// Moves the head-frame origin of `samples` to the middle of the eyes: the per-axis median,
 /// over the samples with both eyes valid, of the midpoint of the two eye origins. Ray

@@ -1,5 +1,6 @@
 //! Imports of synthetic Neon recordings written from known geometry, of the committed
-//! fixtures in xr/tests/data/neon and xr/tests/data/neon-eye-state, and of malformed folders.
+//! fixtures in trace/tests/data/neon and trace/tests/data/neon-eye-state, and of malformed
+//! folders.
 
 use std::path::{Path, PathBuf};
 
@@ -133,9 +134,9 @@ fn data_dir() -> PathBuf {
 }
 
 /// Rewrites the committed fixture from [`write_recording`]:
-/// `cargo test -p vitreous-xr --lib write_neon_fixture -- --ignored`.
+/// `cargo test -p vitreous-trace --lib write_neon_fixture -- --ignored`.
 #[test]
-#[ignore = "rewrites xr/tests/data/neon"]
+#[ignore = "rewrites trace/tests/data/neon"]
 fn write_neon_fixture() {
     std::fs::create_dir_all(data_dir()).unwrap();
     write_recording(&data_dir());

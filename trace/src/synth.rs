@@ -21,8 +21,8 @@ mod pupil;
 use glam::{Mat3, Quat, Vec3};
 use thiserror::Error;
 
+use crate::format::TraceSample;
 use crate::frame::{GazeRay, GazeSample, Pose};
-use crate::trace::TraceSample;
 
 /// Amplitude of the head's positional sway along each world axis, metres.
 const SWAY_POSITION_M: f32 = 0.003;

@@ -3,8 +3,8 @@
 
 use glam::{Quat, Vec3};
 
+use crate::format::clean_ray;
 use crate::frame::{GazeRay, Pose};
-use crate::trace::clean_ray;
 
 /// Converts an SRanipal gaze ray (origin in millimetres, +x to the wearer's left, +z forward)
 /// into the OpenXR head frame (metres, +x right, -z forward). Non-finite values or a zero

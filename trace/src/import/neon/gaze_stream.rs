@@ -8,9 +8,9 @@ use super::raw::Stream;
 use super::{
     Counts, EYE_STATE_MAX_GAP_NS, Inputs, Timeline, eye_ray, neon_to_openxr, pupil_m, sample_time,
 };
+use crate::format::{TraceSample, clean_ray};
 use crate::frame::{GazeRay, GazeSample};
 use crate::import::RecordingError;
-use crate::trace::{TraceSample, clean_ray};
 
 impl Inputs {
     /// The samples of the gaze stream: the visual gaze direction from each eyeball centre.

@@ -4,7 +4,7 @@ use std::io;
 
 use thiserror::Error;
 
-use crate::trace::TraceError;
+use crate::format::TraceError;
 
 /// Everything that can go wrong importing a Tobii Pro Glasses 3 or Neon recording. Messages
 /// name the file and, where there is one, the line (JSON lines, 1-based) or the record

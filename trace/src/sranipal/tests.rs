@@ -1,4 +1,4 @@
-//! Imports of the recordings in xr/tests/data/sranipal and of small hand-made files.
+//! Imports of the recordings in trace/tests/data/sranipal and of small hand-made files.
 
 use std::path::PathBuf;
 
@@ -314,12 +314,12 @@ fn repeated_times_are_dropped_and_counted() {
 #[test]
 fn imported_trace_survives_the_trace_format() {
     let samples = import_sranipal(data("TESTNA01_2D_Fist3.csv")).unwrap();
-    let mut w = crate::trace::TraceWriter::new(Vec::new()).unwrap();
+    let mut w = crate::format::TraceWriter::new(Vec::new()).unwrap();
     for s in &samples {
         w.write(s).unwrap();
     }
     let text = w.finish().unwrap();
-    let back: Vec<TraceSample> = crate::trace::TraceReader::new(&text[..], "t")
+    let back: Vec<TraceSample> = crate::format::TraceReader::new(&text[..], "t")
         .unwrap()
         .collect::<Result<_, _>>()
         .unwrap();

@@ -54,9 +54,9 @@ fn eye_state_data_dir() -> PathBuf {
 }
 
 /// Rewrites the committed fixture from [`write_eye_state_recording`]:
-/// `cargo test -p vitreous-xr --lib write_neon_eye_state_fixture -- --ignored`.
+/// `cargo test -p vitreous-trace --lib write_neon_eye_state_fixture -- --ignored`.
 #[test]
-#[ignore = "rewrites xr/tests/data/neon-eye-state"]
+#[ignore = "rewrites trace/tests/data/neon-eye-state"]
 fn write_neon_eye_state_fixture() {
     let dir = eye_state_data_dir();
     if dir.exists() {

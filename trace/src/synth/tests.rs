@@ -168,12 +168,12 @@ fn times_strictly_increase_and_trace_round_trips() {
     });
     assert_eq!(samples.len(), 901);
     assert!(samples.windows(2).all(|w| w[0].time_ns < w[1].time_ns));
-    let mut w = crate::trace::TraceWriter::new(Vec::new()).unwrap();
+    let mut w = crate::format::TraceWriter::new(Vec::new()).unwrap();
     for s in &samples {
         w.write(s).unwrap();
     }
     let text = w.finish().unwrap();
-    let back: Vec<TraceSample> = crate::trace::TraceReader::new(&text[..], "synth")
+    let back: Vec<TraceSample> = crate::format::TraceReader::new(&text[..], "synth")
         .unwrap()
         .collect::<Result<_, _>>()
         .unwrap();

@@ -20,14 +20,14 @@ pub use report::{HeadSource, RecordingReport};
 /// The samples written as a trace and read back (what an import's round-trip tests compare).
 #[cfg(test)]
 fn written_and_read(samples: &[crate::TraceSample]) -> Vec<crate::TraceSample> {
-    let mut writer = crate::trace::TraceWriter::new(Vec::new()).expect("writing to memory");
+    let mut writer = crate::format::TraceWriter::new(Vec::new()).expect("writing to memory");
     for s in samples {
         writer
             .write(s)
             .expect("an imported sample is a valid trace sample");
     }
     let bytes = writer.finish().expect("flushing to memory");
-    crate::trace::TraceReader::new(&bytes[..], "t.trace")
+    crate::format::TraceReader::new(&bytes[..], "t.trace")
         .expect("a written trace has a header")
         .collect::<Result<_, _>>()
         .expect("a written trace reads back")

@@ -41,8 +41,8 @@ use serde::de::DeserializeOwned;
 use super::eye_centre::centre_on_eyes;
 use super::orientation::{OrientationTrack, level_from_gravity, unyaw};
 use super::{HeadSource, RecordingError, RecordingReport};
+use crate::format::{PUPIL_RANGE_M, TraceSample, check_span, clean_ray};
 use crate::frame::{GazeRay, GazeSample, Pose};
-use crate::trace::{PUPIL_RANGE_M, TraceSample, check_span, clean_ray};
 use json_lines::{for_each_line, open_text, text_reader};
 
 /// The recording format, as reports name it.

@@ -1,9 +1,9 @@
 //! What happens to a live session between two frames handed to the app: what real headsets do
 //! (the wearer takes the headset off, a system menu takes the focus, the session or the runtime
 //! is lost, tracking is lost, the runtime says not to render, frames come late). A backend
-//! hands them out after each frame ([`crate::Backend::take_events`]); the app counts them,
-//! logs them and records them as a trace's event lines (version 1.4), and the null backend
-//! hands a recording's events out again with the frames they came with.
+//! hands them out after each frame (`vitreous-xr`'s `Backend::take_events`); the app counts
+//! them, logs them and records them as a trace's event lines (version 1.4), and the null
+//! backend hands a recording's events out again with the frames they came with.
 
 use std::fmt;
 

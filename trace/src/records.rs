@@ -1,5 +1,5 @@
 //! Delimited text records: the one CSV reading layer under the trace reader
-//! ([`crate::trace`], `,`-separated) and the SRanipal importer ([`crate::sranipal`],
+//! ([`crate::format`], `,`-separated) and the SRanipal importer ([`crate::sranipal`],
 //! `;`-separated).
 //!
 //! Both formats are plain delimiter-separated text without quoting, so the parser runs with
@@ -20,7 +20,7 @@ use std::io::{self, Read};
 
 use glam::Vec3;
 
-use crate::trace::TraceError;
+use crate::format::TraceError;
 
 /// At most this many characters of file content are quoted in an error message.
 pub const QUOTED_CHARS: usize = 60;

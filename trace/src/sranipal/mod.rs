@@ -27,8 +27,8 @@
 //!   motion relative to the first row, are kept.
 //! - **Time**: nanoseconds since the first row; the gaze sample time is the row time. Rows
 //!   whose time is not after the previous kept row are dropped and counted in the report.
-//!   The trace limits apply: a gap over [`crate::trace::MAX_SAMPLE_GAP_NS`] after the
-//!   previous row, or a span over [`crate::trace::MAX_TRACE_SPAN_NS`], fails the import.
+//!   The trace limits apply: a gap over [`crate::format::MAX_SAMPLE_GAP_NS`] after the
+//!   previous row, or a span over [`crate::format::MAX_TRACE_SPAN_NS`], fails the import.
 
 mod convert;
 mod report;
@@ -45,9 +45,9 @@ pub use convert::{heading_rad, sranipal_ray_to_openxr, unity_pose_to_openxr};
 pub use report::ImportReport;
 use report::median_sorted;
 
+use crate::format::{TraceError, TraceSample, check_span};
 use crate::frame::{GazeRay, GazeSample, Pose};
 use crate::records::{Record, RecordReader};
-use crate::trace::{TraceError, TraceSample, check_span};
 
 /// SRanipal validity bits needed for a usable gaze ray: gaze origin (bit 0) and gaze
 /// direction (bit 1).
@@ -268,15 +268,7 @@ impl Importer {
                 position: head_position,
                 orientation: (anchor.unyaw * pose.orientation).normalize(),
             },
-            gaze: GazeSample {
-                sample_time_ns: time_ns,
-                left,
-                right,
-                combined: None,
-                fixation: None,
-                pupil_diameter_m: [None, None],
-                report: None,
-            },
+            gaze: GazeSample::binocular(time_ns, left, right),
         });
         Ok(())
     }

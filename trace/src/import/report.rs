@@ -4,7 +4,7 @@ use std::fmt;
 
 use glam::Vec3;
 
-use crate::trace::TraceSample;
+use crate::format::TraceSample;
 
 /// Where the head orientation of an imported trace comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -20,15 +20,11 @@ pub(super) fn sample(time_ns: i64) -> TraceSample {
             position: Vec3::new(0.1, 1.6, -0.2),
             orientation: Quat::from_rotation_y(0.3),
         },
-        gaze: GazeSample {
-            sample_time_ns: time_ns - 5,
-            left: ray(Vec3::new(-0.032, 0.0, 0.01), Vec3::new(0.1, 0.0, -1.0)),
-            right: ray(Vec3::new(0.032, 0.0, 0.01), Vec3::new(-0.1, 0.0, -1.0)),
-            combined: None,
-            fixation: None,
-            pupil_diameter_m: [None, None],
-            report: None,
-        },
+        gaze: GazeSample::binocular(
+            time_ns - 5,
+            ray(Vec3::new(-0.032, 0.0, 0.01), Vec3::new(0.1, 0.0, -1.0)),
+            ray(Vec3::new(0.032, 0.0, 0.01), Vec3::new(-0.1, 0.0, -1.0)),
+        ),
     }
 }
 

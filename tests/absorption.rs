@@ -105,15 +105,6 @@ fn render(refraction: Refraction, attenuation: Attenuation) -> [Vec<u8>; 2] {
     readback.eyes
 }
 
-fn to_linear(byte: u8) -> f32 {
-    let c = f32::from(byte) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// Largest relative error of the linear light decoded from an sRGB byte `code` (above the
 /// linear segment) that was rounded to the nearest byte: half a code over
 /// d ln(linear) / d code = 2.4 / (code + 0.055 * 255).
@@ -151,8 +142,16 @@ fn darkening(
             let i = ((y * W + x) * 4) as usize;
             let [c, t] = [&clear[i..i + 3], &tinted[i..i + 3]];
             assert!(c[0] > 150, "pixel {p} of the clear ball is dark: {c:?}");
-            sum_clear += Vec3::new(to_linear(c[0]), to_linear(c[1]), to_linear(c[2]));
-            sum_tinted += Vec3::new(to_linear(t[0]), to_linear(t[1]), to_linear(t[2]));
+            sum_clear += Vec3::new(
+                vitreous_optics::srgb::to_linear(c[0]),
+                vitreous_optics::srgb::to_linear(c[1]),
+                vitreous_optics::srgb::to_linear(c[2]),
+            );
+            sum_tinted += Vec3::new(
+                vitreous_optics::srgb::to_linear(t[0]),
+                vitreous_optics::srgb::to_linear(t[1]),
+                vitreous_optics::srgb::to_linear(t[2]),
+            );
             darkest[0] = darkest[0].min(*c.iter().min().unwrap());
             darkest[1] = darkest[1].min(*t.iter().min().unwrap());
         }

@@ -16,15 +16,6 @@ use vitreous_tests::{
     FloorPixel, eyes_looking_down, floor_pixels, floor_uv, render_once, shipped_scene,
 };
 
-fn srgb_to_linear(v: u8) -> f32 {
-    let c = f32::from(v) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// Where the straight ray from the light through the object's centre meets the floor: the
 /// middle of the shadow.
 fn shadow_centre(scene: &Scene) -> Vec3 {
@@ -110,7 +101,7 @@ fn adds_inducer_and_caustic_gain(four_loads: bool, share: f32, set_later: bool) 
     let mut s = shipped_scene("glass-sphere.toml");
     s.light.share = if set_later { 1.0 } else { share };
     s.floor.photo = Image::new(8, 8, PixelData::Srgb8([GREY, GREY, GREY, 255].repeat(64))).unwrap();
-    let l_r = srgb_to_linear(GREY);
+    let l_r = vitreous_optics::srgb::to_linear(GREY);
     // The spot straddles the shadow's edge towards the viewer (shadow, ramp and open floor).
     let centre = floor_uv(&s, shadow_centre(&s) + Vec3::new(0.02, 0.0, 0.06));
     let n = s.inducer.resolution_px;
@@ -161,7 +152,7 @@ fn adds_inducer_and_caustic_gain(four_loads: bool, share: f32, set_later: bool) 
                 0.0
             };
             let expected = (k_alpha + g) * l_r;
-            let got = srgb_to_linear(frame.eyes[e][i]);
+            let got = vitreous_optics::srgb::to_linear(frame.eyes[e][i]);
             let err = (got - expected).abs() / l_r;
             assert!(
                 err <= 0.02,

@@ -40,15 +40,6 @@ fn black(width: u32, height: u32, linear: bool) -> Image {
     Image::new(width, height, data).unwrap()
 }
 
-fn srgb_to_linear(b: u8) -> f32 {
-    let c = b as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// Renders one stereo frame of `scene` with `look`; returns the eye images.
 fn render(scene: &Scene, setup: &DefocusSetup, input: &FrameInput, look: Look) -> [Vec<u8>; 2] {
     let ctx = vitreous_tests::validated_context();
@@ -98,7 +89,10 @@ fn refracted_blur_matches_the_literal_convolution() {
     let photo = &scene.background.photo;
     let (pw, ph) = (photo.width as usize, photo.height as usize);
     let grey: Vec<f32> = match &photo.data {
-        PixelData::Srgb8(b) => b.chunks_exact(4).map(|p| srgb_to_linear(p[0])).collect(),
+        PixelData::Srgb8(b) => b
+            .chunks_exact(4)
+            .map(|p| vitreous_optics::srgb::to_linear(p[0]))
+            .collect(),
         PixelData::LinearF32(_) => unreachable!("photos are sRGB"),
     };
     // One K_g on a slice of the stack, one between slices (linear blending of neighbouring
@@ -141,7 +135,7 @@ fn refracted_blur_matches_the_literal_convolution() {
                 };
                 let expected = transmission * bilinear(&blurred, pw, ph, uv);
                 let i = ((y * W + x) * 4) as usize;
-                let got = srgb_to_linear(gpu[0][i]);
+                let got = vitreous_optics::srgb::to_linear(gpu[0][i]);
                 err += f64::from((got - expected).abs());
                 n += 1;
             }
@@ -176,7 +170,8 @@ fn bilinear(img: &[f32], w: usize, h: usize, uv: Vec2) -> f32 {
 
 /// Variance of the Laplacian of the left eye's luminance over the central half of the image.
 fn laplacian_variance(rgba: &[u8]) -> f64 {
-    let l = |x: u32, y: u32| srgb_to_linear(rgba[((y * W + x) * 4) as usize]) as f64;
+    let l =
+        |x: u32, y: u32| vitreous_optics::srgb::to_linear(rgba[((y * W + x) * 4) as usize]) as f64;
     let mut values = Vec::new();
     for y in H / 4..3 * H / 4 {
         for x in W / 4..3 * W / 4 {

@@ -29,15 +29,6 @@ fn sphere_scene(k: f32, d_m: f32) -> Scene {
     s
 }
 
-fn srgb_to_linear(v: u8) -> f32 {
-    let c = f32::from(v) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// Where a floor texel centre lies in the world.
 fn texel_world(scene: &Scene, fields: &InducerFields, x: u32, y: u32) -> Vec3 {
     let n = fields.resolution_px as f32;
@@ -250,7 +241,7 @@ fn eye_image_adds_k_alpha_times_a_uniform_floor() {
     const GREY: u8 = 200;
     let mut s = sphere_scene(0.3, 0.14);
     s.floor.photo = Image::new(8, 8, PixelData::Srgb8([GREY, GREY, GREY, 255].repeat(64))).unwrap();
-    let l_r = srgb_to_linear(GREY);
+    let l_r = vitreous_optics::srgb::to_linear(GREY);
     let (w, h) = (320u32, 240u32);
     let mut r = scene_renderer(&s, w, h);
     let eyes = top_down_eyes(&s);
@@ -267,7 +258,7 @@ fn eye_image_adds_k_alpha_times_a_uniform_floor() {
         uv,
     } in floor_pixels(&s, &eyes, &off)
     {
-        let got = srgb_to_linear(on.eyes[e][i]);
+        let got = vitreous_optics::srgb::to_linear(on.eyes[e][i]);
         let expected = fields.gain_bilinear(uv) * l_r;
         let err = (got - expected).abs() / l_r;
         assert!(err <= 0.02, "eye {e} pixel ({x}, {y}): {got} vs {expected}");
@@ -323,8 +314,8 @@ fn glass_sphere_preview_shows_a_shadow_on_the_real_floor() {
                         .project_to_pixel(Vec3::new(xo, floor_y, z), Vec2::new(w as f32, h as f32))
                         .unwrap();
                     let j = ((px.y as u32 * w + px.x as u32) * 4) as usize;
-                    p += srgb_to_linear(preview[j]);
-                    q += srgb_to_linear(world[e][j]);
+                    p += vitreous_optics::srgb::to_linear(preview[j]);
+                    q += vitreous_optics::srgb::to_linear(world[e][j]);
                     count += 1;
                 }
             }

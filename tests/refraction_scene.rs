@@ -231,16 +231,6 @@ fn narrowest_width(pixels: &[(i32, i32)]) -> f64 {
     (12.0 * lambda_min.max(0.0) + 1.0).sqrt()
 }
 
-/// Linear light of an sRGB-encoded byte.
-fn linear(b: u8) -> f64 {
-    let v = f64::from(b) / 255.0;
-    if v <= 0.04045 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// Every marker image seen whole through the shipped sphere (at least `MIN_PIXELS` pixels,
 /// clear of the silhouette, the image's edge and other markers' images) lands within `bar_px`
 /// of the reference in each eye; returns the largest distance.
@@ -284,7 +274,9 @@ fn markers_land_within(eyes: [EyeParams; 2], refraction: Refraction, bar_px: f64
             let reference = markers[k].sum / markers[k].weight;
             let (mut sum, mut weight) = (DVec2::ZERO, 0.0);
             for &(x, y) in r {
-                let l = linear(images[e][((y as u32 * SIZE.0 + x as u32) * 4) as usize]);
+                let l = f64::from(vitreous_optics::srgb::to_linear(
+                    images[e][((y as u32 * SIZE.0 + x as u32) * 4) as usize],
+                ));
                 sum += DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5) * l;
                 weight += l;
             }

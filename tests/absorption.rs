@@ -8,7 +8,7 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 use vitreous_optics::absorption::Attenuation;
 use vitreous_optics::camera::{EyeParams, Fov};
 use vitreous_optics::refraction::Refraction;
-use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sample};
+use vitreous_optics::sphere_check::{RefractionSample, SphereScene, refraction_sample};
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, LightDesc, Look, PlaneDesc, Reflection, Renderer, SceneDesc};
 use vitreous_tests::{

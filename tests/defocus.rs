@@ -13,7 +13,7 @@ use vitreous_frames::look::LookPlanner;
 use vitreous_frames::render_desc;
 use vitreous_gaze::blur::blur_reference;
 use vitreous_gaze::{GazeConfig, GazeImage};
-use vitreous_render::reference::{RefractionSample, refraction_sample};
+use vitreous_optics::sphere_check::{RefractionSample, refraction_sample};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{Defocus, Look, Reflection, Renderer};
 use vitreous_scene::{Image, PixelData, Scene, gaze_image_of_target, load_scene};
@@ -118,7 +118,7 @@ fn refracted_blur_matches_the_literal_convolution() {
             .map(|(a, b)| (a - b).abs())
             .sum::<f32>()
             / grey.len() as f32;
-        let sphere = vitreous_frames::reference_view::sphere_of(&scene);
+        let sphere = vitreous_frames::sphere_check_view::sphere_of(&scene);
         let size = Vec2::new(W as f32, H as f32);
         let camera = render_desc::eye_params(&input.views[0]);
         let (mut err, mut n) = (0.0f64, 0usize);

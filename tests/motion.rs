@@ -322,7 +322,7 @@ fn moving_light_replay_recomputes_the_inducer_only_when_something_moved() {
         at_samples: false,
         progress: false,
         reflection: vitreous_render::Reflection::Phong,
-        reference: false,
+        sphere_check: false,
         compare_reference: false,
         gaze: Default::default(),
     })

@@ -8,7 +8,7 @@
 use glam::{Mat4, Quat, Vec2, Vec3};
 use vitreous_optics::camera::{EyeParams, Fov};
 use vitreous_optics::refraction::Refraction;
-use vitreous_render::reference::{SphereScene, marker_centroid};
+use vitreous_optics::sphere_check::{SphereScene, marker_centroid};
 use vitreous_render::renderer::Want;
 use vitreous_render::{FrameParams, LightDesc, Look, PlaneDesc, Reflection, Renderer, SceneDesc};
 use vitreous_tests::{MeshData, linear, mesh_ref, render_once, scene_desc, srgb, uv_sphere};

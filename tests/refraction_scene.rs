@@ -8,7 +8,7 @@
 use glam::{DVec2, Quat, Vec2, Vec3};
 use vitreous_optics::camera::{EyeParams, Fov};
 use vitreous_optics::refraction::Refraction;
-use vitreous_render::reference::{RefractionSample, refraction_sample};
+use vitreous_optics::sphere_check::{RefractionSample, refraction_sample};
 
 use crate::refraction::{
     CENTER, DISPARITY, IOR, IPD, RADIUS, Shot, background_plane, reference_scene, render_shot,

@@ -28,7 +28,7 @@ fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOptions {
         at_samples: false,
         progress: false,
         reflection: vitreous_render::Reflection::Phong,
-        reference: false,
+        sphere_check: false,
         compare_reference: false,
         gaze: Default::default(),
     }

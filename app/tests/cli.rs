@@ -449,7 +449,7 @@ fn a_corrupt_bake_names_its_scene_and_the_command_that_bakes_it_again() {
 fn a_reference_of_the_saved_frames_while_saving_none_is_refused_up_front() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("out");
-    for option in ["--compare-reference", "--reference"] {
+    for option in ["--compare-reference", "--sphere-check"] {
         let out = vitreous(
             &[
                 "replay",

@@ -70,7 +70,7 @@ fn recorded_edits_offset_the_keyframes_and_move_the_scene_once_each() {
         at_samples: true,
         progress: false,
         reflection: vitreous_render::Reflection::Phong,
-        reference: false,
+        sphere_check: false,
         compare_reference: false,
         gaze: Default::default(),
     })

@@ -17,7 +17,9 @@
 //! - [`display`]: what the display takes away from the glass's light, and the segmented
 //!   dimmer's panel as the eye meets it; [`srgb`]: the sRGB transfer function;
 //! - [`live_caustics`]: the settings of the caustic gain map computed per pose, and their
-//!   limits.
+//!   limits;
+//! - [`sphere_check`]: the sphere check, what each pixel of an eye image samples from the
+//!   background through an analytic sphere, which the GPU's refraction layer is tested against.
 //!
 //! The renderer (`vitreous-render`) draws with these and tests its GPU output against them; the
 //! scene loader, the physical reference and the caustics baker use them without Vulkan.
@@ -31,5 +33,6 @@ pub mod optics;
 pub mod radial_map;
 pub mod refraction;
 pub mod solid;
+pub mod sphere_check;
 pub mod srgb;
 pub mod two_surface;

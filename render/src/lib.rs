@@ -45,7 +45,6 @@ mod owned;
 mod pipeline;
 pub mod pose;
 pub mod present;
-pub mod reference;
 pub mod renderer;
 pub mod ripmap;
 pub mod scene;

@@ -22,7 +22,7 @@
 //! | [`gaze_watch`] | whether the eye tracker gives usable samples: its dropouts |
 //! | [`output`] | files a command writes: frame PNGs, previews, whole or not at all |
 //! | [`input_files`] | the files a command reads, which none of its outputs may name |
-//! | [`reference_view`] | a replay's eye images beside the paper's reference |
+//! | [`sphere_check_view`] | a replay's eye images beside the sphere check's |
 //! | [`setup`] | what every command does before its loop: size check, the trace |
 //! | [`validation`] | what the Vulkan validation layers reported |
 //! | [`spread`] | the median and spread of a timing |
@@ -43,11 +43,11 @@ pub mod interrupt;
 pub mod look;
 pub mod motion_clock;
 pub mod output;
-pub mod reference_view;
 pub mod render_desc;
 pub mod resident;
 pub mod scene_edit;
 pub mod setup;
+pub mod sphere_check_view;
 pub mod spread;
 pub mod test_frame;
 pub mod validation;

@@ -48,7 +48,7 @@ pub fn frame_file_names(frame: u64) -> [String; 4] {
 }
 
 /// Whether `name` is a file a replay or `vitreous reference` writes among its frame images:
-/// `NNNNNN-left.png`, `NNNNNN-right-preview.png`, `NNNNNN-left-reference.png`,
+/// `NNNNNN-left.png`, `NNNNNN-right-preview.png`, `NNNNNN-left-sphere-check.png`,
 /// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`, ..., `reference.json`, or a temporary file
 /// of an atomic write.
 pub fn is_frame_file_name(name: &str) -> bool {
@@ -64,7 +64,7 @@ pub fn is_frame_file_name(name: &str) -> bool {
     digits.len() >= 6
         && digits.bytes().all(|b| b.is_ascii_digit())
         && EYE_NAMES.iter().any(|eye| {
-            ["", "-preview", "-reference", "-real", "-seen"]
+            ["", "-preview", "-sphere-check", "-real", "-seen"]
                 .iter()
                 .any(|k| rest == format!("{eye}{k}"))
         })
@@ -134,7 +134,7 @@ mod tests {
         for name in [
             "000000-left.png",
             "000030-right-preview.png",
-            "000060-left-reference.png",
+            "000060-left-sphere-check.png",
             "000060-left-real.png",
             "000060-right-seen.png",
             "1234567-right.png",

@@ -61,10 +61,10 @@ pub struct ReplayArgs {
     #[arg(long, value_enum, default_value_t = ReflectionArg::Phong)]
     pub reflection: ReflectionArg,
     /// Also write each saved eye image under the paper's and under two-surface refraction
-    /// beside the CPU ray-traced two-surface refraction layer (for sphere scenes: the
-    /// object's bounding sphere is traced).
-    #[arg(long)]
-    pub reference: bool,
+    /// beside the sphere check's two-surface refraction layer, computed on the CPU (for
+    /// sphere scenes: the object's bounding sphere is traced). `--reference` is its old name.
+    #[arg(long, alias = "reference")]
+    pub sphere_check: bool,
     /// Also render the physical reference of every saved frame (as `vitreous reference`:
     /// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`) and report in summary.json ꟻLIP and
     /// PSNR per region of what the eye sees (the display's light over the seen image) against
@@ -120,7 +120,7 @@ pub fn replay_command(a: ReplayArgs) -> Result<()> {
         at_samples: a.at_samples,
         progress: !a.quiet,
         reflection: a.reflection.into(),
-        reference: a.reference,
+        sphere_check: a.sphere_check,
         compare_reference: a.compare_reference,
         gaze: GazeSettings {
             filter: a.filter,

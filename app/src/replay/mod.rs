@@ -3,7 +3,7 @@
 //! `frames.csv` and `summary.json`.
 //!
 //! Over 600 lines: the replay's checks of its options and inputs, its sink (saving, the
-//! reference beside the frames, the recording's edits and events) and its summary around the
+//! sphere check beside the frames, the recording's edits and events) and its summary around the
 //! one loop; the saving, the physical reference and the summary's types are apart already.
 
 use std::fs;
@@ -29,9 +29,9 @@ use vitreous_frames::look::GazeSettings;
 use vitreous_frames::look::LookPlanner;
 use vitreous_frames::motion_clock::MotionClock;
 use vitreous_frames::output::{self, write_atomic};
-use vitreous_frames::reference_view::side_by_side;
 use vitreous_frames::render_desc;
 use vitreous_frames::setup::{check_size, load_recording};
+use vitreous_frames::sphere_check_view::side_by_side;
 use vitreous_frames::spread::Spread;
 use vitreous_frames::validation::ValidationSummary;
 use vitreous_scene::effects::EffectSet;
@@ -73,8 +73,8 @@ pub struct ReplayOptions {
     pub progress: bool,
     /// How the reflected image is drawn when per-eye refraction is on.
     pub reflection: Reflection,
-    /// Also write each saved eye image beside the CPU reference of its refraction layer.
-    pub reference: bool,
+    /// Also write each saved eye image beside the sphere check of its refraction layer.
+    pub sphere_check: bool,
     /// Also render the physical reference of every saved frame (`vitreous reference`) and
     /// measure what the eye sees against it.
     pub compare_reference: bool,
@@ -89,9 +89,9 @@ struct Saver<'a> {
     display: vitreous_frames::wearer::WearerView,
     /// Decides each frame's look (gaze-dependent defocus).
     planner: LookPlanner,
-    /// The scene, when the CPU reference is written beside each saved eye.
-    reference: Option<&'a Scene>,
-    /// With the reference: the scene under the other refraction model, drawn again for each
+    /// The scene, when the sphere check is written beside each saved eye.
+    sphere_check: Option<&'a Scene>,
+    /// With the sphere check: the scene under the other refraction model, drawn again for each
     /// saved frame.
     other: Option<OtherRefraction>,
     save_every: u64,
@@ -114,7 +114,7 @@ struct Saver<'a> {
 }
 
 /// A second renderer with the scene under the refraction model the scene does not use, for
-/// `--reference`'s paper / two-surface / ray-traced images.
+/// `--sphere-check`'s paper / two-surface / ray-traced images.
 struct OtherRefraction {
     /// The renderer.
     renderer: Renderer,
@@ -240,7 +240,7 @@ impl FrameSink for Saver<'_> {
                 let files = physical.measure(&self.dir, input, readback)?;
                 self.saved.extend(files);
             }
-            if let Some(scene) = self.reference {
+            if let Some(scene) = self.sphere_check {
                 let size = (readback.width, readback.height);
                 let other = match &mut self.other {
                     Some(o) => o.draw(input)?.map(|eyes| (eyes, o.scene_model)),
@@ -261,7 +261,7 @@ impl FrameSink for Saver<'_> {
                     };
                     let image = side_by_side(scene, input, eye, &gpu, traced, size);
                     let png = output::encode_png(&image, size.0 * (gpu.len() as u32 + 1), size.1)?;
-                    let file = format!("{:06}-{name}-reference.png", input.index);
+                    let file = format!("{:06}-{name}-sphere-check.png", input.index);
                     write_atomic(&self.dir.join(&file), &png)?;
                     self.saved.push(format!("frames/{file}"));
                 }
@@ -292,7 +292,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     if options.save_every == 0 {
         for (asked, option) in [
             (options.compare_reference, "--compare-reference"),
-            (options.reference, "--reference"),
+            (options.sphere_check, "--sphere-check"),
         ] {
             if asked {
                 bail!(
@@ -354,7 +354,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     .context("preparing the renderer")?;
     render_desc::enable_live_caustics(&mut renderer, &scene, effects.caustics)
         .context("preparing live caustics")?;
-    let other = if options.reference {
+    let other = if options.sphere_check {
         let mut other_scene = scene.clone();
         other_scene.object.refraction = match scene.object.refraction {
             Refraction::Paper => Refraction::TwoSurface,
@@ -421,7 +421,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     let mut saver = Saver {
         dir: frames_dir,
         display: vitreous_frames::wearer::WearerView::of_scene(&scene),
-        reference: options.reference.then_some(&scene),
+        sphere_check: options.sphere_check.then_some(&scene),
         other,
         save_every: options.save_every,
         planner,

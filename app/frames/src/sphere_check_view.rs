@@ -1,12 +1,12 @@
-//! The debug output of `vitreous replay --reference`: each saved eye image under the paper's
-//! refraction and under two-surface refraction, beside the CPU ray tracer's two-surface
-//! refraction layer (render/src/reference.rs), for scenes whose object is a sphere (the
-//! reference traces the analytic sphere of the object's bounding sphere), tinted by the
-//! glass's absorption along each ray's path inside.
+//! The debug output of `vitreous replay --sphere-check`: each saved eye image under the
+//! paper's refraction and under two-surface refraction, beside the sphere check's two-surface
+//! refraction layer (`vitreous_optics::sphere_check`, computed on the CPU), for scenes whose
+//! object is a sphere (the check traces the analytic sphere of the object's bounding sphere),
+//! tinted by the glass's absorption along each ray's path inside.
 
 use glam::{Vec2, Vec3};
 use vitreous_optics::refraction::Refraction;
-use vitreous_render::reference::{RefractionSample, SphereScene, refraction_sample};
+use vitreous_optics::sphere_check::{RefractionSample, SphereScene, refraction_sample};
 use vitreous_trace::FrameInput;
 
 use crate::output::{linear_to_srgb, srgb_to_linear};
@@ -30,7 +30,7 @@ pub fn sphere_of(scene: &Scene) -> SphereScene {
 }
 
 /// An RGBA8 image as wide as `gpu.len() + 1` eye images: the GPU's eye images left to right
-/// (paper, then two-surface refraction), then the CPU reference of the refraction layer under
+/// (paper, then two-surface refraction), then the sphere check of the refraction layer under
 /// `refraction` (the background photo's texel at `(u_c, v_c)` times the absorption along the
 /// path inside, black off the sphere, grey where the ray misses the photo).
 pub fn side_by_side(

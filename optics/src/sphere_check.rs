@@ -1,14 +1,15 @@
-//! CPU reference of the refraction layer for an analytic sphere: what each pixel of an eye
-//! image samples from the registered background photo, under the paper's model (eq. 7-8) or
-//! two-surface refraction (`vitreous_optics::two_surface`, with the absorption of a tinted glass).
-//! Tests compare the GPU against it; `vitreous replay --reference` writes it beside the GPU image.
+//! The sphere check: what each pixel of an eye image samples from the registered background
+//! photo through an analytic sphere, under the paper's model (eq. 7-8) or two-surface
+//! refraction ([`crate::two_surface`], with the absorption of a tinted glass), computed on the
+//! CPU. The GPU's refraction layer is tested against it; `vitreous replay --sphere-check`
+//! writes it beside the GPU image.
 
+use crate::absorption::Attenuation;
+use crate::camera::EyeParams;
+use crate::optics::{fresnel, plane_uv, ray_sphere, refract_heckbert};
+use crate::refraction::Refraction;
+use crate::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, pass_through};
 use glam::{Mat4, Vec2, Vec3};
-use vitreous_optics::absorption::Attenuation;
-use vitreous_optics::camera::EyeParams;
-use vitreous_optics::optics::{fresnel, plane_uv, ray_sphere, refract_heckbert};
-use vitreous_optics::refraction::Refraction;
-use vitreous_optics::two_surface::{Ball, MAX_INTERNAL_REFLECTIONS, pass_through};
 
 /// An analytic glass sphere in front of a registered background plane.
 #[derive(Clone, Copy, Debug)]
@@ -127,8 +128,8 @@ pub fn marker_centroid(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::camera::Fov;
     use glam::Quat;
-    use vitreous_optics::camera::Fov;
 
     #[test]
     fn the_centre_ray_refracts_straight_to_the_plane_centre() {

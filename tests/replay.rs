@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
-use vitreous::compare::frame_of_image;
 use vitreous::replay::{ReplayOptions, replay};
+use vitreous_compare::frame_of_image;
 use vitreous_frames::render_desc::eye_params;
 use vitreous_scene::load_scene;
 use vitreous_tests::{lit_centroid, workspace};

@@ -144,7 +144,7 @@ enum Command {
     },
     /// How far an image is from a reference: FLIP and PSNR over the whole view and, with a
     /// scene, per region (the object's disc, shadow and caustic, inducer ramp, rest).
-    Compare(vitreous::compare::CompareArgs),
+    Compare(vitreous::compare_cmd::CompareArgs),
     /// What a real glass object would look like in the scene, per eye (CPU ray tracer), beside
     /// what the eye sees with nothing there: the physical reference `compare` measures against.
     Reference(vitreous::reference_cmd::ReferenceArgs),
@@ -394,7 +394,7 @@ fn run(cli: Cli) -> Result<()> {
             }
         },
         Command::Study { command } => vitreous::study::cli::run(command),
-        Command::Compare(args) => vitreous::compare::compare_command(args),
+        Command::Compare(args) => vitreous::compare_cmd::compare_command(args),
         Command::Reference(args) => vitreous::reference_cmd::reference_command(args),
     }
 }

@@ -403,6 +403,15 @@ impl Viewer {
         let half = Vec3::X * (self.ipd_m / 2.0);
         [head.transform_point(-half), head.transform_point(half)]
     }
+
+    /// Left and right eye positions at the neutral head: the head at `head_position_m`,
+    /// looking down -z.
+    pub fn neutral_eye_positions_m(&self) -> [Vec3; 2] {
+        self.eye_positions_m(&Pose {
+            position: self.head_position_m,
+            orientation: Quat::IDENTITY,
+        })
+    }
 }
 
 /// Per-eye output.

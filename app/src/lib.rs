@@ -1,10 +1,11 @@
 //! vitreous: perception-based virtual glass for optical see-through head-mounted displays.
 //!
 //! The commands of the `vitreous` binary (`run`, `view`, `replay`, `bench`, `soak`, `trace`,
-//! `study`, `compare`, `reference`), each wiring the libraries that do the work: the frame
-//! loop in `vitreous-frames`, scenes in `vitreous-scene`, the gaze pipeline in `vitreous-gaze`,
-//! studies in `vitreous-study`, the physical reference in `vitreous-reference`, image comparison
-//! in `vitreous-compare`, rendering in `vitreous-render` and the XR backends in `vitreous-xr`. A library here so that the tests
+//! `study`, `compare`, `reference`, `bake`), each wiring the libraries that do the work: the
+//! frame loop in `vitreous-frames`, scenes in `vitreous-scene`, the gaze pipeline in
+//! `vitreous-gaze`, studies in `vitreous-study`, the physical reference in `vitreous-reference`,
+//! image comparison in `vitreous-compare`, the caustic bake in `vitreous-caustics`, rendering in
+//! `vitreous-render` and the XR backends in `vitreous-xr`. A library here so that the tests
 //! reach the commands' own parts.
 
 pub mod bench;

@@ -1,7 +1,8 @@
 //! The `vitreous` command: the clap definitions of the subcommands and their dispatch to the
 //! library. `run`, `view`, `replay` and `study` define their options beside their code
-//! (`run::RunArgs`, `view::ViewArgs`, `replay::ReplayArgs`, `study::cli`); the work itself is
-//! in the library, one module per command.
+//! (`run::RunArgs`, `view::ViewArgs`, `replay::ReplayArgs`, `study::cli`), `bake` in the
+//! baker's crate (`vitreous_caustics::command`); the work itself is in the libraries, one
+//! module per command.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -148,6 +149,9 @@ enum Command {
     /// What a real glass object would look like in the scene, per eye (CPU ray tracer), beside
     /// what the eye sees with nothing there: the physical reference `compare` measures against.
     Reference(vitreous::reference_cmd::ReferenceArgs),
+    /// Bake the caustic gain map G that a scene's glass object throws onto the real floor
+    /// (docs/caustics.md), by default into the `bakes` folder beside the scene's folder.
+    Bake(vitreous_caustics::command::BakeArgs),
     /// Trace tools.
     Trace {
         #[command(subcommand)]
@@ -396,6 +400,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Study { command } => vitreous::study::cli::run(command),
         Command::Compare(args) => vitreous::compare_cmd::compare_command(args),
         Command::Reference(args) => vitreous::reference_cmd::reference_command(args),
+        Command::Bake(args) => vitreous_caustics::command::bake_command(args),
     }
 }
 

@@ -19,9 +19,13 @@
 //!
 //! Accumulation is in 64-bit fixed point with atomic adds, which commute, so a bake is
 //! bit-identical for a given input whatever the thread count or scheduling.
+//!
+//! [`command`] is `vitreous bake SCENE` (and this crate's own `vitreous-caustics bake`): the
+//! options, the default output, progress, the printed figures and the self-check.
 
 pub mod bake;
 pub mod bake_file;
+pub mod command;
 pub mod emission;
 pub mod optics;
 mod splat;

@@ -122,7 +122,7 @@ enum Command {
         #[arg(long, conflicts_with = "effects")]
         all_effects: bool,
         /// Largest growth of resident memory after warm-up that passes, percent.
-        #[arg(long, value_name = "PERCENT", default_value_t = vitreous::soak::MAX_GROWTH_PERCENT,
+        #[arg(long, value_name = "PERCENT", default_value_t = vitreous_frames::soak::MAX_GROWTH_PERCENT,
               allow_negative_numbers = true, value_parser = parse_growth_percent)]
         max_growth: f64,
         /// Eye image size.
@@ -307,11 +307,11 @@ fn run(cli: Cli) -> Result<()> {
             recreate,
             no_validation,
         } => {
-            use vitreous::soak::{SoakEffects, SoakLength};
+            use vitreous_frames::soak::{SoakEffects, SoakLength};
             if !(minutes.is_finite() && minutes > 0.0 && minutes <= 7.0 * 24.0 * 60.0) {
                 bail!("--minutes must be more than 0 and at most a week, got {minutes}");
             }
-            let options = vitreous::soak::SoakOptions {
+            let options = vitreous_frames::soak::SoakOptions {
                 scene: PathBuf::new(),
                 effects: match (effects, all_effects) {
                     (Some(set), _) => SoakEffects::Set(set),

@@ -11,7 +11,7 @@ use vitreous_scene::effects::EffectSet;
 use vitreous_tests::{compose_once, neutral_eyes, shipped_scene, validated_context};
 
 fn linear(v: u8) -> f32 {
-    vitreous_frames::output::srgb_to_linear(v)
+    vitreous_optics::srgb::to_linear(v)
 }
 
 /// One 8-bit sRGB step at `v`, in linear light.

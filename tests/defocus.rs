@@ -6,7 +6,6 @@
 use std::path::Path;
 
 use glam::Vec2;
-use vitreous::trace_cmd::synth_params_for;
 use vitreous_frames::blur_stack::DefocusSetup;
 use vitreous_frames::frame_loop::{self, FramePlan, FrameSink};
 use vitreous_frames::look::LookPlanner;
@@ -16,6 +15,7 @@ use vitreous_gaze::{GazeConfig, GazeImage};
 use vitreous_optics::sphere_check::{RefractionSample, refraction_sample};
 use vitreous_render::renderer::{FrameResult, Want};
 use vitreous_render::{Defocus, Look, Reflection, Renderer};
+use vitreous_scene::synth_params_for;
 use vitreous_scene::{Image, PixelData, Scene, gaze_image_of_target, load_scene};
 use vitreous_tests::render_once;
 use vitreous_trace::FrameInput;

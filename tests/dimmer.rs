@@ -47,9 +47,7 @@ fn left(scene: &vitreous_scene::Scene, composition: Composition) -> Left {
     let seen = view.see(&readback.eyes[0], world, [SIZE.0, SIZE.1]);
     let linear = |rgba: &[u8]| -> Vec<Vec3> {
         rgba.chunks_exact(4)
-            .map(|p| {
-                Vec3::from_array([0, 1, 2].map(|c| vitreous_frames::output::srgb_to_linear(p[c])))
-            })
+            .map(|p| Vec3::from_array([0, 1, 2].map(|c| vitreous_optics::srgb::to_linear(p[c]))))
             .collect()
     };
     Left {

@@ -250,7 +250,7 @@ fn fields_are_clear_while_the_light_is_below_the_floor_and_come_back_after() {
     assert!(
         dark.distance_m
             .iter()
-            .all(|&d| d == vitreous_render::floor::FAR_M),
+            .all(|&d| d == vitreous_optics::floor::FAR_M),
         "distances without a shadow"
     );
     renderer.set_pose(render_desc::scene_pose(&scene, &rest));

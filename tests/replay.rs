@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
-use vitreous::compare::frame_of_image;
 use vitreous::replay::{ReplayOptions, replay};
+use vitreous_compare::frame_of_image;
 use vitreous_frames::render_desc::eye_params;
 use vitreous_scene::load_scene;
 use vitreous_tests::{lit_centroid, workspace};
@@ -76,11 +76,9 @@ fn check_geometry(scene_name: &str, trace: Option<&str>, check: Check) {
     let samples = match &opts.trace {
         Some(t) => read_trace(t).unwrap(),
         None => {
-            vitreous_trace::synth::synthesize_with_truth(&vitreous::trace_cmd::synth_params_for(
-                &scene,
-            ))
-            .unwrap()
-            .samples
+            vitreous_trace::synth::synthesize_with_truth(&vitreous_scene::synth_params_for(&scene))
+                .unwrap()
+                .samples
         }
     };
     let mut backend = NullBackend::new(
@@ -217,7 +215,7 @@ fn frames_csv_follows_the_synthetic_traces_alternating_fixation() {
     let scene = load_scene(&workspace().join("config/scenes/visual-effects.toml")).unwrap();
     let params = vitreous_trace::synth::SynthParams {
         duration_s: 12.0,
-        ..vitreous::trace_cmd::synth_params_for(&scene)
+        ..vitreous_scene::synth_params_for(&scene)
     };
     let truth = vitreous_trace::synth::synthesize_with_truth(&params).unwrap();
     assert!(truth.phases.len() >= 4);

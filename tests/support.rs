@@ -355,9 +355,9 @@ fn linear_rgb(pixels: &[u8]) -> Vec<Vec3> {
         .chunks_exact(4)
         .map(|p| {
             Vec3::new(
-                vitreous_frames::output::srgb_to_linear(p[0]),
-                vitreous_frames::output::srgb_to_linear(p[1]),
-                vitreous_frames::output::srgb_to_linear(p[2]),
+                vitreous_optics::srgb::to_linear(p[0]),
+                vitreous_optics::srgb::to_linear(p[1]),
+                vitreous_optics::srgb::to_linear(p[2]),
             )
         })
         .collect()

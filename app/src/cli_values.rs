@@ -92,13 +92,13 @@ pub fn parse_frame_count_usize(s: &str) -> Result<usize, String> {
 /// A pass count for `soak --passes`: at least the warm-up passes and the two compared after
 /// them.
 pub fn parse_pass_count(s: &str) -> Result<usize, String> {
-    let least = crate::soak::WARM_UP_PASSES + crate::soak::COMPARED_PASSES;
+    let least = vitreous_frames::soak::WARM_UP_PASSES + vitreous_frames::soak::COMPARED_PASSES;
     match s.trim().parse::<i128>() {
         Ok(n) if n >= least as i128 && n <= usize::MAX as i128 => Ok(n as usize),
         Ok(n) => Err(format!(
             "expected at least {least} passes ({} of warm-up, then {} compared), got {n}",
-            crate::soak::WARM_UP_PASSES,
-            crate::soak::COMPARED_PASSES
+            vitreous_frames::soak::WARM_UP_PASSES,
+            vitreous_frames::soak::COMPARED_PASSES
         )),
         Err(_) => Err(format!("expected a whole number of passes, got '{s}'")),
     }

@@ -1,7 +1,8 @@
 //! The `vitreous` command: the clap definitions of the subcommands and their dispatch to the
 //! library. `run`, `view`, `replay` and `study` define their options beside their code
-//! (`run::RunArgs`, `view::ViewArgs`, `replay::ReplayArgs`, `study::cli`); the work itself is
-//! in the library, one module per command.
+//! (`run::RunArgs`, `view::ViewArgs`, `replay::ReplayArgs`, `study::cli`), `bake` in the
+//! baker's crate (`vitreous_caustics::command`); the work itself is in the libraries, one
+//! module per command.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -121,7 +122,7 @@ enum Command {
         #[arg(long, conflicts_with = "effects")]
         all_effects: bool,
         /// Largest growth of resident memory after warm-up that passes, percent.
-        #[arg(long, value_name = "PERCENT", default_value_t = vitreous::soak::MAX_GROWTH_PERCENT,
+        #[arg(long, value_name = "PERCENT", default_value_t = vitreous_frames::soak::MAX_GROWTH_PERCENT,
               allow_negative_numbers = true, value_parser = parse_growth_percent)]
         max_growth: f64,
         /// Eye image size.
@@ -144,10 +145,13 @@ enum Command {
     },
     /// How far an image is from a reference: FLIP and PSNR over the whole view and, with a
     /// scene, per region (the object's disc, shadow and caustic, inducer ramp, rest).
-    Compare(vitreous::compare::CompareArgs),
+    Compare(vitreous::compare_cmd::CompareArgs),
     /// What a real glass object would look like in the scene, per eye (CPU ray tracer), beside
     /// what the eye sees with nothing there: the physical reference `compare` measures against.
     Reference(vitreous::reference_cmd::ReferenceArgs),
+    /// Bake the caustic gain map G that a scene's glass object throws onto the real floor
+    /// (docs/caustics.md), by default into the `bakes` folder beside the scene's folder.
+    Bake(vitreous_caustics::command::BakeArgs),
     /// Trace tools.
     Trace {
         #[command(subcommand)]
@@ -303,11 +307,11 @@ fn run(cli: Cli) -> Result<()> {
             recreate,
             no_validation,
         } => {
-            use vitreous::soak::{SoakEffects, SoakLength};
+            use vitreous_frames::soak::{SoakEffects, SoakLength};
             if !(minutes.is_finite() && minutes > 0.0 && minutes <= 7.0 * 24.0 * 60.0) {
                 bail!("--minutes must be more than 0 and at most a week, got {minutes}");
             }
-            let options = vitreous::soak::SoakOptions {
+            let options = vitreous_frames::soak::SoakOptions {
                 scene: PathBuf::new(),
                 effects: match (effects, all_effects) {
                     (Some(set), _) => SoakEffects::Set(set),
@@ -394,8 +398,9 @@ fn run(cli: Cli) -> Result<()> {
             }
         },
         Command::Study { command } => vitreous::study::cli::run(command),
-        Command::Compare(args) => vitreous::compare::compare_command(args),
+        Command::Compare(args) => vitreous::compare_cmd::compare_command(args),
         Command::Reference(args) => vitreous::reference_cmd::reference_command(args),
+        Command::Bake(args) => vitreous_caustics::command::bake_command(args),
     }
 }
 

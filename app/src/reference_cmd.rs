@@ -9,18 +9,18 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use glam::{Quat, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
-use serde::{Deserialize, Serialize};
-use vitreous_reference::{EyeImage, FloorLight, PhotonParams, Window, World, render_eye};
+use vitreous_reference::{
+    EyeImage, EyeRecord, FrameReport, PhotonParams, ReferenceSettings, Report, render_reference,
+    srgb_rgba,
+};
 use vitreous_scene::{Placement, Scene, load_scene};
-use vitreous_trace::{EyeView, Fov};
+use vitreous_trace::EyeView;
 use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
 
 use vitreous_frames::input_files::InputFiles;
 use vitreous_frames::motion_clock::MotionClock;
-use vitreous_frames::output::{
-    EYE_NAMES, encode_png, is_frame_file_name, linear_to_srgb, write_atomic,
-};
+use vitreous_frames::output::{EYE_NAMES, encode_png, is_frame_file_name, write_atomic};
 use vitreous_frames::render_desc::eye_params;
 use vitreous_frames::setup::{check_size, load_recording};
 
@@ -133,145 +133,18 @@ fn parse_photons(s: &str) -> std::result::Result<f32, String> {
     }
 }
 
-/// One eye's camera in `reference.json`.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
-pub struct EyeRecord {
-    /// The eye's position, metres.
-    pub position_m: [f32; 3],
-    /// The view's orientation, quaternion x, y, z, w.
-    pub orientation_xyzw: [f32; 4],
-    /// Field of view: left, right, up, down edge angles, radians.
-    pub fov_rad: [f32; 4],
-}
-
-impl EyeRecord {
-    /// The record of `view`.
-    pub fn of(view: &EyeView) -> EyeRecord {
-        let f = view.fov;
-        EyeRecord {
-            position_m: view.pose.position.to_array(),
-            orientation_xyzw: view.pose.orientation.to_array(),
-            fov_rad: [
-                f.angle_left_rad,
-                f.angle_right_rad,
-                f.angle_up_rad,
-                f.angle_down_rad,
-            ],
-        }
-    }
-
-    /// The eye's view.
-    pub fn view(&self) -> EyeView {
-        let [l, r, u, d] = self.fov_rad;
-        EyeView {
-            pose: vitreous_trace::Pose {
-                position: Vec3::from_array(self.position_m),
-                orientation: Quat::from_array(self.orientation_xyzw).normalize(),
-            },
-            fov: Fov {
-                angle_left_rad: l,
-                angle_right_rad: r,
-                angle_up_rad: u,
-                angle_down_rad: d,
-            },
-        }
-    }
-}
-
-/// One written frame of `reference.json`.
-#[derive(Debug, Serialize, Deserialize)]
-pub struct FrameReport {
-    /// Frame index (as the replay's of the same trace and rate).
-    pub frame: u64,
-    /// Display time, ns (0 without a trace).
-    pub time_ns: i64,
-    /// Left and right eye.
-    pub eyes: [EyeRecord; 2],
-    /// Object centre and light, metres.
-    pub object_position_m: [f32; 3],
-    /// The object's orientation, quaternion x, y, z, w.
-    pub object_rotation_xyzw: [f32; 4],
-    /// The light, metres.
-    pub light_position_m: [f32; 3],
-    /// Photons traced for the floor light (0: no floor light, e.g. share 0).
-    pub photons: u64,
-    /// Standard error of the floor light ratio where the object changes it.
-    pub floor_light_noise: f32,
-    /// Files written.
-    pub files: Vec<String>,
-    /// Seconds spent on the frame.
-    pub seconds: f64,
-}
-
-impl FrameReport {
-    /// Where the object and the light were.
-    pub fn placement(&self) -> Placement {
-        Placement {
-            object_position_m: Vec3::from_array(self.object_position_m),
-            object_rotation: Quat::from_array(self.object_rotation_xyzw).normalize(),
-            light_position_m: Vec3::from_array(self.light_position_m),
-        }
-    }
-}
-
-/// `reference.json`, written last: its absence means the run did not finish.
-#[derive(Debug, Serialize, Deserialize)]
-pub struct Report {
-    /// The version of vitreous that wrote it.
-    pub vitreous_version: String,
-    /// The scene file.
-    pub scene: String,
-    /// [`Scene::hash`] of the scene.
-    pub scene_hash: String,
-    /// The trace, or `neutral head`.
-    pub trace: String,
-    /// Eye image size, pixels.
-    pub width_px: u32,
-    /// Eye image size, pixels.
-    pub height_px: u32,
-    /// Positions averaged per pixel.
-    pub samples_per_pixel: u32,
-    /// Side of the floor light's texels, mm.
-    pub texel_mm: f32,
-    /// Photons per texel of floor under the object's cone.
-    pub photons_per_texel: f32,
-    /// `[light] share`.
-    pub light_share: f32,
-    /// `analytic ball` or `closed mesh`.
-    pub object: String,
-    /// Every frame written.
-    pub frames: Vec<FrameReport>,
-}
-
-impl Report {
-    /// The report of `frames` of `scene` (read from `scene_path`) seen along `trace` (or
-    /// `neutral head`), rendered at `size` with `settings`.
-    pub fn new(
-        scene: &Scene,
-        scene_path: &Path,
-        trace: String,
-        size: (u32, u32),
-        settings: &ReferenceSettings,
-        frames: Vec<FrameReport>,
-    ) -> Report {
-        Report {
-            vitreous_version: env!("CARGO_PKG_VERSION").into(),
-            scene: scene_path.display().to_string(),
-            scene_hash: scene.hash.clone(),
-            trace,
-            width_px: size.0,
-            height_px: size.1,
-            samples_per_pixel: settings.samples_per_side * settings.samples_per_side,
-            texel_mm: settings.photons.texel_m * 1000.0,
-            photons_per_texel: settings.photons.photons_per_texel,
-            light_share: scene.light.share,
-            object: if scene.object.is_ball() {
-                "analytic ball".into()
-            } else {
-                "closed mesh".into()
-            },
-            frames,
-        }
+/// One eye's camera in `reference.json`, from its view.
+pub fn eye_record(view: &EyeView) -> EyeRecord {
+    let f = view.fov;
+    EyeRecord {
+        position_m: view.pose.position.to_array(),
+        orientation_xyzw: view.pose.orientation.to_array(),
+        fov_rad: [
+            f.angle_left_rad,
+            f.angle_right_rad,
+            f.angle_up_rad,
+            f.angle_down_rad,
+        ],
     }
 }
 
@@ -332,12 +205,12 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
     for frame in &frames {
         let started = Instant::now();
         let eyes = args.eye.indices();
+        let cameras: Vec<_> = eyes.iter().map(|&e| eye_params(&frame.views[e])).collect();
         let rendered = render_reference(
             &scene,
-            &frame.views,
+            &cameras,
             &frame.placement,
             (width, height),
-            eyes,
             &settings,
         )?;
         let mut files = Vec::new();
@@ -353,7 +226,7 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
         reports.push(FrameReport {
             frame: frame.index,
             time_ns: frame.time_ns,
-            eyes: frame.views.each_ref().map(EyeRecord::of),
+            eyes: frame.views.each_ref().map(eye_record),
             object_position_m: frame.placement.object_position_m.to_array(),
             object_rotation_xyzw: frame.placement.object_rotation.to_array(),
             light_position_m: frame.placement.light_position_m.to_array(),
@@ -388,87 +261,6 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
     Ok(())
 }
 
-/// How the physical reference is rendered.
-#[derive(Clone, Copy, Debug)]
-pub struct ReferenceSettings {
-    /// Positions along each side of a pixel averaged for its light.
-    pub samples_per_side: u32,
-    /// How the floor's light is traced.
-    pub photons: PhotonParams,
-}
-
-impl Default for ReferenceSettings {
-    fn default() -> Self {
-        ReferenceSettings {
-            samples_per_side: 3,
-            photons: PhotonParams::default(),
-        }
-    }
-}
-
-/// One frame of the physical reference, for some eyes.
-pub struct ReferenceFrame {
-    /// The real scene with the real object, per eye asked for (linear).
-    pub real: Vec<EyeImage>,
-    /// The real scene with nothing there, per eye asked for (linear).
-    pub seen: Vec<EyeImage>,
-    /// Photons traced for the floor's light (0 without).
-    pub photons: u64,
-    /// Standard error of the floor's light ratio where the object changes it.
-    pub noise: f32,
-}
-
-/// Renders the physical reference of `scene` with its object and light at `placement`, seen
-/// by `eyes` (indices into `views`) at `size`.
-pub fn render_reference(
-    scene: &Scene,
-    views: &[EyeView; 2],
-    placement: &Placement,
-    (width, height): (u32, u32),
-    eyes: &[usize],
-    settings: &ReferenceSettings,
-) -> Result<ReferenceFrame> {
-    let world = World::of(scene, placement).with_context(|| {
-        format!(
-            "{}: the object {} is not a closed solid",
-            scene.path.display(),
-            scene.object.model_path.display()
-        )
-    })?;
-    let floor_light = if world.light_share > 0.0 {
-        FloorLight::trace(&world, &settings.photons)
-    } else {
-        None
-    };
-    let (photons, noise) = floor_light
-        .as_ref()
-        .map_or((0, 0.0), |l| (l.photons(), l.noise()));
-    let world = World {
-        floor_light,
-        ..world
-    };
-    let seen = world.without_object();
-    let whole = Window {
-        x: 0,
-        y: 0,
-        width,
-        height,
-    };
-    let (mut real_images, mut seen_images) = (Vec::new(), Vec::new());
-    for &eye in eyes {
-        let camera = eye_params(&views[eye]);
-        let n = settings.samples_per_side;
-        real_images.push(render_eye(&world, &camera, (width, height), whole, n));
-        seen_images.push(render_eye(&seen, &camera, (width, height), whole, n));
-    }
-    Ok(ReferenceFrame {
-        real: real_images,
-        seen: seen_images,
-        photons,
-        noise,
-    })
-}
-
 /// A frame to render: its index and time, both eyes' cameras and where the object and light are.
 struct Frame {
     index: u64,
@@ -481,17 +273,16 @@ struct Frame {
 /// frames at the rate that are saved, placed as the replay places them.
 fn frames_to_render(scene: &Scene, args: &ReferenceArgs) -> Result<Vec<Frame>> {
     let Some(trace) = &args.trace else {
-        let head = vitreous_trace::Pose {
-            position: scene.viewer.head_position_m,
-            orientation: Quat::IDENTITY,
-        };
-        let views = scene.viewer.eye_positions_m(&head).map(|p: Vec3| EyeView {
-            pose: vitreous_trace::Pose {
-                position: p,
-                orientation: Quat::IDENTITY,
-            },
-            fov: scene.output.fov,
-        });
+        let views = scene
+            .viewer
+            .neutral_eye_positions_m()
+            .map(|p: Vec3| EyeView {
+                pose: vitreous_trace::Pose {
+                    position: p,
+                    orientation: Quat::IDENTITY,
+                },
+                fov: scene.output.fov,
+            });
         return Ok(vec![Frame {
             index: 0,
             time_ns: 0,
@@ -539,22 +330,6 @@ fn frames_to_render(scene: &Scene, args: &ReferenceArgs) -> Result<Vec<Frame>> {
         bail!("--save-every {} writes none of the frames", args.save_every);
     }
     Ok(frames)
-}
-
-/// A linear eye image as sRGB RGBA8.
-pub fn srgb_rgba(image: &EyeImage) -> Vec<u8> {
-    image
-        .rgb
-        .iter()
-        .flat_map(|c| {
-            [
-                linear_to_srgb(c.x),
-                linear_to_srgb(c.y),
-                linear_to_srgb(c.z),
-                255,
-            ]
-        })
-        .collect()
 }
 
 /// Writes a linear eye image as an sRGB PNG.

@@ -10,9 +10,7 @@ use vitreous_trace::synth::{SynthError, SynthParams, synthesize_with_truth};
 
 use vitreous_frames::input_files::InputFiles;
 use vitreous_frames::output::write_atomic;
-use vitreous_scene::{REFRACTED_TARGET, SURFACE_TARGET, load_scene};
-
-pub use vitreous_scene::synth_params_for;
+use vitreous_scene::{REFRACTED_TARGET, SURFACE_TARGET, load_scene, synth_params_for};
 
 /// Writes `samples` as a trace file at `out` (atomically).
 pub fn write_trace_file(samples: &[TraceSample], out: &Path) -> Result<()> {

@@ -256,7 +256,7 @@ fn unknown_and_unimplemented_effects_are_refused() {
         &["replay", &missing, "--effects", "b", "--quiet"],
         dir.path(),
     );
-    assert_clean_failure(&out, &["no-such-bake.exr", "vitreous-caustics -- bake"]);
+    assert_clean_failure(&out, &["no-such-bake.exr", "vitreous bake"]);
     assert!(!dir.path().join("out").exists());
 }
 
@@ -433,7 +433,7 @@ fn a_corrupt_bake_names_its_scene_and_the_command_that_bakes_it_again() {
         &["replay", &scene, "--effects", "c", "--frames", "1"],
         dir.path(),
     );
-    let command = format!("`cargo run --release -p vitreous-caustics -- bake {scene} -o {broken}`");
+    let command = format!("`vitreous bake {scene} -o {broken}`");
     assert_clean_failure(
         &out,
         &[
@@ -467,4 +467,48 @@ fn a_reference_of_the_saved_frames_while_saving_none_is_refused_up_front() {
         assert_clean_failure(&out, &[option, "--save-every 0 saves none"]);
         assert!(!out_dir.exists(), "output folder created with {option}");
     }
+}
+
+#[test]
+fn bake_writes_a_bake_its_scene_loads() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene_path = scene("glass-sphere.toml");
+    let output = dir.path().join("sphere.exr");
+    let out = vitreous(
+        &[
+            "bake",
+            &scene_path,
+            "-o",
+            output.to_str().unwrap(),
+            "--resolution",
+            "32",
+            "--budget",
+            "4096",
+            "--no-self-check",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("sphere.exr"), "{stdout}");
+    let scene = vitreous_scene::load_scene(Path::new(&scene_path)).unwrap();
+    let bake = vitreous_scene::caustics::read_bake(&output, &scene.hash).unwrap();
+    assert_eq!((bake.width_px, bake.height_px), (32, 32));
+    assert!(bake.gain.iter().any(|&g| g > 0.0));
+}
+
+#[test]
+fn bake_of_a_missing_scene_names_it_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("x.exr");
+    let out = vitreous(
+        &["bake", "nowhere.toml", "-o", output.to_str().unwrap()],
+        dir.path(),
+    );
+    assert_clean_failure(&out, &["nowhere.toml"]);
+    assert!(!output.exists());
 }

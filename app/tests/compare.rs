@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use vitreous::compare::{Eye, Region, regions};
+use vitreous_compare::{Eye, Region, regions};
 use vitreous_frames::output::encode_png;
 use vitreous_scene::load_scene;
 

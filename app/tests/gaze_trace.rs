@@ -2,7 +2,8 @@
 //! truth), blinks, the real SRanipal recordings, and the plot.
 
 use glam::Vec3;
-use vitreous::trace_analyze::{AnalyzeConfig, FILTER_COLOURS, Truth, analyze, plot, replay};
+use vitreous::trace_analyze::{FILTER_COLOURS, Truth, analyze, plot};
+use vitreous_gaze::analysis::{AnalyzeConfig, replay};
 use vitreous_gaze::{FilterKind, GazeConfig, GazeImage, GazeOverride, ImageDistances};
 use vitreous_trace::synth::{FixationTarget, SynthParams, SynthTrace, synthesize_with_truth};
 

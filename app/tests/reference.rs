@@ -20,9 +20,9 @@ fn pixel(path: &Path, x: u32, y: u32) -> glam::Vec3 {
     let image = image::open(path).unwrap().to_rgb8();
     let p = image.get_pixel(x, y);
     glam::Vec3::new(
-        vitreous_frames::output::srgb_to_linear(p[0]),
-        vitreous_frames::output::srgb_to_linear(p[1]),
-        vitreous_frames::output::srgb_to_linear(p[2]),
+        vitreous_optics::srgb::to_linear(p[0]),
+        vitreous_optics::srgb::to_linear(p[1]),
+        vitreous_optics::srgb::to_linear(p[2]),
     )
 }
 

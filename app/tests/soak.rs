@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use vitreous::soak::{SoakEffects, SoakLength, SoakOptions, soak};
+use vitreous_frames::soak::{SoakEffects, SoakLength, SoakOptions, soak};
 use vitreous_scene::effects::EffectSet;
 
 fn workspace() -> PathBuf {
@@ -13,7 +13,7 @@ fn workspace() -> PathBuf {
 }
 
 /// One short pass of `scene` in condition c, validation on.
-fn one_pass(scene: &str) -> vitreous::soak::SoakReport {
+fn one_pass(scene: &str) -> vitreous_frames::soak::SoakReport {
     let options = SoakOptions {
         scene: workspace().join("config/scenes").join(scene),
         effects: SoakEffects::Set(EffectSet::parse("c").expect("condition c")),
@@ -24,7 +24,7 @@ fn one_pass(scene: &str) -> vitreous::soak::SoakReport {
         validation: true,
         recreate: false,
         report: None,
-        max_growth_percent: vitreous::soak::MAX_GROWTH_PERCENT,
+        max_growth_percent: vitreous_frames::soak::MAX_GROWTH_PERCENT,
     };
     let mut passes = 0;
     let report = soak(&options, |_| passes += 1).unwrap_or_else(|e| panic!("{e:#}"));

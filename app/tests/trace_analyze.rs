@@ -7,7 +7,8 @@ use std::process::Command;
 
 use glam::Vec3;
 use serde_json::Value;
-use vitreous::trace_analyze::{AnalyzeConfig, Truth, analyze};
+use vitreous::trace_analyze::{Truth, analyze, config_for_scene};
+use vitreous_gaze::analysis::AnalyzeConfig;
 use vitreous_gaze::{FilterKind, ImageDistances};
 use vitreous_trace::format::TraceWriter;
 use vitreous_trace::synth::{FixationTarget, SynthParams, synthesize_with_truth};
@@ -341,7 +342,7 @@ fn default_decision_holds_on_real_recordings_in_the_shipped_scenes() {
             .unwrap();
         let (mut switches, mut minutes) = (0, 0.0);
         for (name, samples) in &recordings {
-            let mut config = AnalyzeConfig::for_scene(&scene);
+            let mut config = config_for_scene(&scene);
             config.filters = vec![FilterKind::default(), FilterKind::PAPER];
             let report = analyze(samples, Truth::FromRawDepth, &config);
             let (default, mean20) = (&report.filters[0], &report.filters[1]);

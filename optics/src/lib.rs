@@ -11,7 +11,8 @@
 //!   caustics baker trace through; [`convex`]: whether a mesh bounds one convex body, the facet
 //!   planes of a cut gem and where a ray inside leaves them, convex hulls in the plane;
 //!   [`radial_map`]: an object's surface seen from its centre;
-//! - [`absorption`]: Beer-Lambert inside a tinted glass;
+//! - [`absorption`]: Beer-Lambert inside a tinted glass; [`floor`]: the floor's equations
+//!   (eq. 2-5: the inducer's ramp, gain and light, the exact distance to the shadow's edge);
 //! - [`camera`]: an eye's camera: its view, its projection from an OpenXR field of view, the
 //!   rays through its pixels;
 //! - [`display`]: what the display takes away from the glass's light, and the segmented
@@ -28,6 +29,7 @@ pub mod absorption;
 pub mod camera;
 pub mod convex;
 pub mod display;
+pub mod floor;
 pub mod live_caustics;
 pub mod optics;
 pub mod radial_map;

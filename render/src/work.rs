@@ -20,9 +20,12 @@
 //! Recording happens on the thread that calls [`crate::Renderer::submit`]; the tally lives in
 //! the context and is taken at the end of each frame's recording. The queries that count the
 //! invocations are in [`crate::statistics`]; this module holds only the counts, so the context
-//! that keeps the tally depends on nothing else of the renderer through it.
+//! that keeps the tally depends on nothing else of the renderer through it. [`counts`] names
+//! them and takes their mean over frames (`vitreous bench`).
 
 use std::sync::atomic::{AtomicU64, Ordering};
+
+pub mod counts;
 
 /// The work of one frame, counted (`work.rs`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -5,7 +5,6 @@
 use rayon::prelude::*;
 
 use crate::defocus_model::DefocusModel;
-use crate::output::{linear_to_srgb, srgb_to_linear};
 use vitreous_gaze::GazeImage;
 use vitreous_gaze::blur::{PUPIL_MAX_MM, gaussian_kernel};
 use vitreous_scene::{Image, PixelData, Scene};
@@ -99,7 +98,10 @@ pub fn build_stack(image: &Image, max_k_g_px: f32) -> BlurStack {
         .into_par_iter()
         .map(|i| {
             let blurred = blur_separable(&linear, w, h, i as f32 * step_px);
-            blurred.iter().map(|&c| linear_to_srgb(c)).collect()
+            blurred
+                .iter()
+                .map(|&c| vitreous_optics::srgb::from_linear(c))
+                .collect()
         })
         .collect();
     BlurStack {
@@ -176,9 +178,9 @@ pub fn to_linear(image: &Image) -> Vec<f32> {
             .chunks_exact(4)
             .flat_map(|p| {
                 [
-                    srgb_to_linear(p[0]),
-                    srgb_to_linear(p[1]),
-                    srgb_to_linear(p[2]),
+                    vitreous_optics::srgb::to_linear(p[0]),
+                    vitreous_optics::srgb::to_linear(p[1]),
+                    vitreous_optics::srgb::to_linear(p[2]),
                     p[3] as f32 / 255.0,
                 ]
             })

@@ -23,10 +23,12 @@
 //! | [`output`] | files a command writes: frame PNGs, previews, whole or not at all |
 //! | [`input_files`] | the files a command reads, which none of its outputs may name |
 //! | [`sphere_check_view`] | a replay's eye images beside the sphere check's |
+//! | [`readback_check`] | whether a submitted image shows the object, and nothing where the blend mode needs none |
 //! | [`setup`] | what every command does before its loop: size check, the trace |
 //! | [`validation`] | what the Vulkan validation layers reported |
 //! | [`spread`] | the median and spread of a timing |
 //! | [`resident`] | the process's resident memory, sampled over a session's frames |
+//! | [`soak`] | a trace replayed again and again on one device: resident memory, heap, validation |
 //! | [`interrupt`] | Ctrl-C and SIGTERM end a headless run after the current frame |
 //! | [`test_frame`] | frame inputs for tests |
 
@@ -43,10 +45,12 @@ pub mod interrupt;
 pub mod look;
 pub mod motion_clock;
 pub mod output;
+pub mod readback_check;
 pub mod render_desc;
 pub mod resident;
 pub mod scene_edit;
 pub mod setup;
+pub mod soak;
 pub mod sphere_check_view;
 pub mod spread;
 pub mod test_frame;

@@ -9,8 +9,6 @@ use anyhow::{Context, Result};
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::{ExtendedColorType, ImageEncoder};
 use vitreous_render::Readback;
-/// sRGB-encoded byte to linear light (where the photos are decoded, in the scene crate).
-pub use vitreous_scene::srgb_to_linear;
 
 /// Eye names in output file names, left then right.
 pub const EYE_NAMES: [&str; 2] = ["left", "right"];
@@ -35,7 +33,7 @@ pub fn encode_png(rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
 
 /// Linear light to sRGB bytes, and the additive display's see-through (in `wearer`, with the
 /// dimmers).
-pub use crate::wearer::{linear_to_srgb, see_through};
+pub use crate::wearer::see_through;
 
 /// The files of one saved frame.
 pub fn frame_file_names(frame: u64) -> [String; 4] {

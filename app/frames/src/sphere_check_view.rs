@@ -9,7 +9,6 @@ use vitreous_optics::refraction::Refraction;
 use vitreous_optics::sphere_check::{RefractionSample, SphereScene, refraction_sample};
 use vitreous_trace::FrameInput;
 
-use crate::output::{linear_to_srgb, srgb_to_linear};
 use crate::render_desc::eye_params;
 use vitreous_scene::{PixelData, Scene};
 
@@ -84,7 +83,9 @@ pub fn side_by_side(
 /// An sRGB texel seen through glass that leaves `absorption` of each linear channel (sRGB
 /// bytes round-trip exactly, so clear glass leaves the texel as it is).
 fn absorbed(rgba: [u8; 4], absorption: Vec3) -> [u8; 4] {
-    let through = |byte: u8, t: f32| linear_to_srgb(srgb_to_linear(byte) * t);
+    let through = |byte: u8, t: f32| {
+        vitreous_optics::srgb::from_linear(vitreous_optics::srgb::to_linear(byte) * t)
+    };
     [
         through(rgba[0], absorption.x),
         through(rgba[1], absorption.y),

@@ -7,19 +7,16 @@
 
 use vitreous_optics::display::dimmer::{DimmerDesc, Panel};
 
-use vitreous_scene::srgb_to_linear;
-
-/// Linear light (clamped to 0..1) to an sRGB-encoded byte.
-pub use vitreous_optics::srgb::from_linear as linear_to_srgb;
-
 /// What the wearer perceives: the display's light added to the real world's, in linear light
 /// (an optical see-through display can only add). Both inputs and the output are sRGB RGBA8.
 pub fn see_through(eye: &[u8], world: &[u8]) -> Vec<u8> {
-    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+    let lut: Vec<f32> = (0..=255u8).map(vitreous_optics::srgb::to_linear).collect();
     eye.chunks_exact(4)
         .zip(world.chunks_exact(4))
         .flat_map(|(e, w)| {
-            let add = |c: usize| linear_to_srgb(lut[e[c] as usize] + lut[w[c] as usize]);
+            let add = |c: usize| {
+                vitreous_optics::srgb::from_linear(lut[e[c] as usize] + lut[w[c] as usize])
+            };
             [add(0), add(1), add(2), 255]
         })
         .collect()
@@ -95,7 +92,9 @@ impl WearerView {
             .chunks_exact(4)
             .zip(&passed)
             .flat_map(|(w, &p)| {
-                let c = |c: usize| linear_to_srgb(p * srgb_to_linear(w[c]));
+                let c = |c: usize| {
+                    vitreous_optics::srgb::from_linear(p * vitreous_optics::srgb::to_linear(w[c]))
+                };
                 [c(0), c(1), c(2), 255]
             })
             .collect()
@@ -108,13 +107,15 @@ impl WearerView {
             return see_through(eye, world);
         }
         // One rounding to 8 bits, of the sum: the dimmed world is not rounded on its own.
-        let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+        let lut: Vec<f32> = (0..=255u8).map(vitreous_optics::srgb::to_linear).collect();
         let passed = self.passed(eye, size);
         eye.chunks_exact(4)
             .zip(world.chunks_exact(4))
             .zip(&passed)
             .flat_map(|((e, w), &p)| {
-                let c = |c: usize| linear_to_srgb(lut[e[c] as usize] + p * lut[w[c] as usize]);
+                let c = |c: usize| {
+                    vitreous_optics::srgb::from_linear(lut[e[c] as usize] + p * lut[w[c] as usize])
+                };
                 [c(0), c(1), c(2), 255]
             })
             .collect()
@@ -133,7 +134,10 @@ mod tests {
         assert_eq!(plain, see_through(&eye, &world));
         let dimmed = WearerView::new(None, Some(0.5), [40.0, 30.0]).see(&eye, &world, [2, 1]);
         // Half the world's light (0.216 linear -> 0.108) and all the display's.
-        assert_eq!(dimmed[0], linear_to_srgb(0.5 * srgb_to_linear(128)));
+        assert_eq!(
+            dimmed[0],
+            vitreous_optics::srgb::from_linear(0.5 * vitreous_optics::srgb::to_linear(128))
+        );
         assert_eq!(&dimmed[4..7], &[255, 255, 255]);
     }
 
@@ -144,7 +148,9 @@ mod tests {
         let eye = [1u8, 1, 1, 0];
         let world = [27u8, 27, 27, 255];
         let seen = WearerView::new(None, Some(0.5), [40.0, 30.0]).see(&eye, &world, [1, 1]);
-        let want = linear_to_srgb(srgb_to_linear(1) + 0.5 * srgb_to_linear(27));
+        let want = vitreous_optics::srgb::from_linear(
+            vitreous_optics::srgb::to_linear(1) + 0.5 * vitreous_optics::srgb::to_linear(27),
+        );
         assert_eq!(seen[..3], [want; 3]);
         let rounded_twice = see_through(
             &eye,

@@ -16,8 +16,11 @@
 //! the tracker's vergence noise and how far apart the two images are in it (`d'`).
 //!
 //! [`blur`] then turns d_f into the blur of the image not looked at (eq. 10-14).
+//! [`analysis`] replays a whole trace through the pipeline per filter and scores how fast and
+//! how steadily each decision follows the gaze (`vitreous trace analyze`).
 //! `docs/gaze.md` maps each equation to its function.
 
+pub mod analysis;
 pub mod blur;
 pub mod evidence;
 pub mod filter;

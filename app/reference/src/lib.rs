@@ -1,6 +1,7 @@
 //! vitreous-reference: what a real glass object would look like in a scene, from a CPU ray
 //! tracer; the physical reference the display's images are judged against (`vitreous
-//! reference`, then `vitreous compare`).
+//! reference` and `replay --compare-reference` write its frames, then `vitreous compare`
+//! measures against them).
 //!
 //! The real world is the scene's registration: the floor and background photos are the
 //! radiances the eye receives from the real floor and wall without the object (what the
@@ -35,14 +36,20 @@
 //! | [`floor_light`] | the floor's light traced from the point light: the object's shadow and caustic |
 //! | [`light_map`] | that light as a map over the floor |
 //! | [`eye`] | an eye image: pixels supersampled over a stratified grid |
+//! | [`frame`] | one frame: the floor's light, then each eye's real and seen images |
+//! | [`report`] | `reference.json`: the frames' eye cameras, placements and files |
 
 pub mod eye;
 pub mod floor_light;
+pub mod frame;
 pub mod light_map;
+pub mod report;
 pub mod trace;
 pub mod world;
 
 pub use eye::{EyeImage, Window, render_eye};
 pub use floor_light::PhotonParams;
+pub use frame::{NotClosed, ReferenceFrame, ReferenceSettings, render_reference, srgb_rgba};
 pub use light_map::FloorLight;
+pub use report::{EyeRecord, FrameReport, Report};
 pub use world::{Glass, Picture, Surface, World};

@@ -8,7 +8,7 @@ use glam::{Mat4, Vec2, Vec3};
 use vitreous_optics::absorption::Attenuation;
 use vitreous_optics::solid::SolidError;
 use vitreous_optics::two_surface::{Ball, Body, MeshBody};
-use vitreous_scene::{Image, PixelData, Placement, RealPlane, Scene, srgb_to_linear};
+use vitreous_scene::{Image, PixelData, Placement, RealPlane, Scene};
 
 use crate::light_map::FloorLight;
 
@@ -55,9 +55,9 @@ impl Picture {
                 .chunks_exact(4)
                 .map(|p| {
                     Vec3::new(
-                        srgb_to_linear(p[0]),
-                        srgb_to_linear(p[1]),
-                        srgb_to_linear(p[2]),
+                        vitreous_optics::srgb::to_linear(p[0]),
+                        vitreous_optics::srgb::to_linear(p[1]),
+                        vitreous_optics::srgb::to_linear(p[2]),
                     )
                 })
                 .collect(),

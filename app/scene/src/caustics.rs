@@ -1,7 +1,8 @@
 //! The caustics bake file (paper Sec. 3.1.2, eq. 6; docs/caustics.md): a single-channel linear
 //! f32 OpenEXR image of the caustic gain G, ZIP compressed, row 0 = the floor photo's top edge,
 //! with the scene hash and the bake parameters as text attributes. Written by the baker
-//! (`vitreous-caustics`, which re-exports this module) and read by the renderer's app.
+//! (`vitreous-caustics`, which re-exports this module, run as `vitreous bake`) and read by the
+//! renderer's app.
 
 use std::path::{Path, PathBuf};
 
@@ -114,7 +115,7 @@ pub enum BakeError {
     /// The scene names no bake (`[caustics] bake`) but the caustics were asked for.
     #[error(
         "the scene {scene} names no caustics bake: add `[caustics] bake = \"../bakes/<name>.exr\"` \
-         and bake it with `cargo run --release -p vitreous-caustics -- bake {scene}`"
+         and bake it with `vitreous bake {scene}`"
     )]
     NotNamed {
         /// The scene file.
@@ -204,10 +205,7 @@ fn rebake(scene: &Option<PathBuf>, path: &Path) -> String {
     let scene = scene
         .as_ref()
         .map_or("<scene.toml>".to_owned(), |s| s.display().to_string());
-    format!(
-        "cargo run --release -p vitreous-caustics -- bake {scene} -o {}",
-        path.display()
-    )
+    format!("vitreous bake {scene} -o {}", path.display())
 }
 
 impl BakeError {
@@ -391,7 +389,7 @@ mod tests {
         let path = dir.path().join("b.exr");
         let err = read_bake(&path, "x").unwrap_err();
         assert!(matches!(err, BakeError::Missing { .. }), "{err}");
-        assert!(err.to_string().contains("vitreous-caustics -- bake"));
+        assert!(err.to_string().contains("vitreous bake"));
 
         std::fs::write(&path, b"not an exr").unwrap();
         let err = read_bake(&path, "x").unwrap_err();
@@ -408,10 +406,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("b.exr");
         let scene = Path::new("config/scenes/s.toml");
-        let command = format!(
-            "`cargo run --release -p vitreous-caustics -- bake config/scenes/s.toml -o {}`",
-            path.display()
-        );
+        let command = format!("`vitreous bake config/scenes/s.toml -o {}`", path.display());
         let missing = read_bake(&path, "x").unwrap_err().in_scene(scene);
         std::fs::write(&path, b"not an exr").unwrap();
         let corrupt = read_bake(&path, "x").unwrap_err().in_scene(scene);

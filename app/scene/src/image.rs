@@ -12,9 +12,6 @@ pub const MAX_IMAGE_SIZE_PX: u32 = 16384;
 /// this limit).
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 24;
 
-/// sRGB-encoded byte to linear light.
-pub use vitreous_optics::srgb::to_linear as srgb_to_linear;
-
 /// A decoded image, rows top to bottom, RGBA interleaved.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {

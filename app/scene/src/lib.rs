@@ -55,9 +55,7 @@ pub use fixation::{
     FixationPoints, MeshLens, REFRACTED_TARGET, SURFACE_TARGET, ViewingGeometry,
     gaze_image_of_target, synth_params_for,
 };
-pub use image::{
-    Image, ImageError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIZE_PX, PixelData, srgb_to_linear,
-};
+pub use image::{Image, ImageError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIZE_PX, PixelData};
 pub use load::{load_scene, load_scene_from};
 pub use mesh::{Mesh, load_mesh};
 pub use motion::{LightKey, MAX_KEYFRAMES, MAX_TIME_S, Motion, ObjectKey, Placement};
@@ -403,6 +401,15 @@ impl Viewer {
     pub fn eye_positions_m(&self, head: &Pose) -> [Vec3; 2] {
         let half = Vec3::X * (self.ipd_m / 2.0);
         [head.transform_point(-half), head.transform_point(half)]
+    }
+
+    /// Left and right eye positions at the neutral head: the head at `head_position_m`,
+    /// looking down -z.
+    pub fn neutral_eye_positions_m(&self) -> [Vec3; 2] {
+        self.eye_positions_m(&Pose {
+            position: self.head_position_m,
+            orientation: Quat::IDENTITY,
+        })
     }
 }
 

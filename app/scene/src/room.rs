@@ -8,7 +8,8 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::{Image, PixelData, RealPlane, srgb_to_linear as linear};
+use crate::{Image, PixelData, RealPlane};
+use vitreous_optics::srgb::to_linear as linear;
 
 /// The unit direction of texel centre `(x, y)` of a `w` x `h` latitude-longitude map: u = 0.5
 /// looks down -z, u grows towards +x, v = 0 straight up (shaders/glass.wgsl `latlong_uv`).

@@ -2,7 +2,6 @@
 //! one process on one device, so their ratio is meaningful on a shared, noisy machine; and each
 //! variant's counted work (`counts.rs`), which is the same run after run.
 
-mod counts;
 mod table;
 
 use std::path::PathBuf;
@@ -13,6 +12,7 @@ use serde::Serialize;
 use vitreous_optics::refraction::Refraction;
 use vitreous_render::floor::FieldPassesMs;
 use vitreous_render::renderer::Want;
+use vitreous_render::work::counts::{WorkCounts, mean_counts};
 use vitreous_render::{ContextOptions, FrameWork, GpuContext, Look, Reflection, Renderer};
 use vitreous_trace::FrameInput;
 use vitreous_xr::Backend;
@@ -27,8 +27,6 @@ use vitreous_gaze::GazeConfig;
 use vitreous_gaze::blur::check_pupil_diameter_m;
 use vitreous_scene::effects::EffectSet;
 use vitreous_scene::{CausticsMode, load_scene, synth_params_for};
-
-pub use counts::{WorkCounts, mean_counts};
 
 /// Frames of each variant rendered before timing starts (shaders compile on first use on
 /// some drivers, lavapipe among them).

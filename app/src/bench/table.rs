@@ -2,8 +2,9 @@
 
 use std::fmt::Write as _;
 
-use super::{BenchReport, VariantResult, WorkCounts};
+use super::{BenchReport, VariantResult};
 use vitreous_frames::spread::Spread;
+use vitreous_render::work::counts::WorkCounts;
 
 /// A column: its header, and its cell for a variant.
 type Column<'a> = (&'a str, Box<dyn Fn(&VariantResult) -> String + 'a>);

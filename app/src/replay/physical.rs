@@ -6,13 +6,14 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use vitreous_compare::{ReferenceFigures, against_reference, rgb_of};
+use vitreous_reference::{FrameReport, ReferenceSettings, Report, render_reference, srgb_rgba};
 use vitreous_trace::FrameInput;
 
-use crate::compare::{ReferenceFigures, against_reference, rgb_of};
-use crate::reference_cmd::{
-    EyeRecord, FrameReport, ReferenceSettings, Report, render_reference, srgb_rgba,
-};
+use crate::reference_cmd::eye_record;
 use vitreous_frames::output::{self, write_atomic};
+use vitreous_frames::render_desc::eye_params;
+use vitreous_frames::wearer::WearerView;
 use vitreous_scene::{Placement, Scene};
 
 /// `--compare-reference`: the saved frames' placements until they finish, and the figures.
@@ -45,12 +46,12 @@ impl Physical {
         let (_, placement) = self.pending.swap_remove(k);
         let size = (readback.width, readback.height);
         let started = Instant::now();
+        let cameras = input.views.each_ref().map(eye_params);
         let frame = render_reference(
             &self.scene,
-            &input.views,
+            &cameras,
             &placement,
             size,
-            &[0, 1],
             &ReferenceSettings::default(),
         )?;
         let mut files = Vec::new();
@@ -65,11 +66,14 @@ impl Physical {
                 )?;
                 files.push(format!("frames/{file}"));
             }
+            // The display's light over the seen image, as the scene's display shows it.
+            let display = WearerView::of_scene(&self.scene);
+            let shown = rgb_of(&display.see(&readback.eyes[eye], &seen, [size.0, size.1]));
             let [regions, nothing_drawn, additive_limit] = against_reference(
                 &self.scene,
-                &input.views[eye],
+                &cameras[eye],
                 &placement,
-                [&rgb_of(&real), &rgb_of(&seen), &readback.eyes[eye]],
+                [&rgb_of(&real), &rgb_of(&seen), &shown],
                 size,
             )?;
             self.figures.push(ReferenceFigures {
@@ -83,7 +87,7 @@ impl Physical {
         self.reports.push(FrameReport {
             frame: input.index,
             time_ns: input.time_ns,
-            eyes: input.views.each_ref().map(EyeRecord::of),
+            eyes: input.views.each_ref().map(eye_record),
             object_position_m: placement.object_position_m.to_array(),
             object_rotation_xyzw: placement.object_rotation.to_array(),
             light_position_m: placement.light_position_m.to_array(),

@@ -106,7 +106,7 @@ pub struct ReplaySummary {
     pub final_placement: Option<FinalPlacement>,
     /// With `--compare-reference`: each saved frame's eyes measured against the physical
     /// reference (`null` without).
-    pub compare_reference: Option<Vec<crate::compare::ReferenceFigures>>,
+    pub compare_reference: Option<Vec<vitreous_compare::ReferenceFigures>>,
     /// Every frame's timing.
     pub per_frame: Vec<FrameRecord>,
 }

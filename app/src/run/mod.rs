@@ -18,10 +18,11 @@
 //! by [`LiveConditions`]: the next effect condition among those this build implements, and the
 //! forced gaze image (surface, refracted, auto).
 //!
-//! Parts: `cli.rs` (the command line), `controls.rs` (keyboard edits), `xr_session.rs`
-//! (runtime, renderer and session owned together, the device made through the runtime by
-//! `vitreous_xr`'s `XrDeviceCreator`), `readback.rs` (the readback check), `sink.rs` (what is
-//! done with each frame), `recording.rs` (the recorded trace and its replay check), `summary.rs` (what the run reports), `interruptions.rs` (what a misbehaving headset
+//! Parts: `cli.rs` (the command line), `controls.rs` (keyboard edits), `device.rs` (Vulkan
+//! through the runtime), `xr_session.rs` (runtime, renderer and session owned together),
+//! `sink.rs` (what is done with each frame; the readback check is
+//! `vitreous_frames::readback_check`), `recording.rs` (the recorded trace and its replay
+//! check), `summary.rs` (what the run reports), `interruptions.rs` (what a misbehaving headset
 //! did: each session event logged, recorded, counted), `reconnect.rs` (asking the runtime again
 //! after a loss); the conditions and live commands are
 //! `vitreous_frames::conditions`. This file sets the session up, runs it and writes the summary.
@@ -33,7 +34,6 @@
 mod cli;
 mod controls;
 mod interruptions;
-mod readback;
 mod reconnect;
 mod recording;
 mod room_light;
@@ -58,9 +58,6 @@ use vitreous_xr::openxr::{
 
 pub use cli::{RunArgs, run_command};
 pub use interruptions::{InterruptionSummary, NotRenderedFrames, Reconnect};
-pub use readback::{
-    AWAY_RADII, LIT_THRESHOLD, MIN_AWAY_FRACTION, MIN_OBJECT_FRACTION, ReadbackCheck,
-};
 pub use reconnect::{RECONNECT_S_DEFAULT, RECONNECT_S_MAX};
 pub use recording::ReplayCheck;
 pub use summary::{GazeSamples, RunSummary};
@@ -404,7 +401,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         };
         let closed = xr.close(|renderer| {
             let centroids = options.readback_check.then(|| {
-                room_light::floor_centroids(
+                vitreous_frames::readback_check::floor_centroids(
                     renderer,
                     scene.floor.world_from_plane(),
                     final_light,
@@ -607,39 +604,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
     summary.validation.check(None)?;
     if options.readback_check {
         match &summary.readback {
-            Some(c) if c.passed => {}
-            Some(c) => bail!(
-                "readback check failed ({} blend): frame {} shows the object in {:.1} % of its \
-                 region ({} of {} px; expected at least {:.0} %), {:.1} % of the pixels away \
-                 from it as the blend mode needs (expected at least {:.0} %: {}), {} px with \
-                 alpha above 0{}",
-                c.blend,
-                c.frame,
-                c.object_fraction * 100.0,
-                c.object_px,
-                c.region_px,
-                MIN_OBJECT_FRACTION * 100.0,
-                c.away_fraction * 100.0,
-                MIN_AWAY_FRACTION * 100.0,
-                if info.blend.needs_world_behind() {
-                    "the real-world photos"
-                } else {
-                    "black"
-                },
-                c.alpha_nonzero_px,
-                match (
-                    info.blend.uses_source_alpha(),
-                    c.dimmed_points_alpha.is_empty()
-                ) {
-                    (true, true) => " (expected none)".to_owned(),
-                    (true, false) => format!(
-                        " ({} of them away from it, expected none; the dimmer's alpha at the \
-                         object's and its shadow's centres {:?}, expected above 0)",
-                        c.alpha_away_px, c.dimmed_points_alpha
-                    ),
-                    (false, _) => String::new(),
-                }
-            ),
+            Some(c) => c.verdict(info.blend)?,
             None => bail!("readback check: no frame was read back (the session ended first)"),
         }
     }

@@ -9,7 +9,6 @@ use vitreous_trace::light::LightEstimate;
 use vitreous_trace::{Blend, Command, FrameInput};
 use vitreous_xr::FrameEndHints;
 
-use super::readback::{self, ReadbackCheck, check_readback};
 use super::recording::trace_sample;
 use super::room_light;
 use vitreous_frames::conditions::LiveConditions;
@@ -18,6 +17,7 @@ use vitreous_frames::focus::FocusFollower;
 use vitreous_frames::frame_log::FrameLog;
 use vitreous_frames::frame_loop::{FramePlan, FrameSink};
 use vitreous_frames::motion_clock::MotionClock;
+use vitreous_frames::readback_check::{self, ReadbackCheck, check_readback};
 use vitreous_frames::resident::ResidentSampler;
 use vitreous_frames::scene_edit::SceneEdit;
 
@@ -101,11 +101,11 @@ impl RunSink<'_> {
 
     /// With a segmented dimmer, what it must darken: the object's centre and the centre of
     /// its shadow (where the ray from the light through the centre meets the floor).
-    pub(super) fn dimmed(&self) -> Option<readback::Dimmed> {
+    pub(super) fn dimmed(&self) -> Option<readback_check::Dimmed> {
         let (panel, light, floor, normal) = self.dimmer_shadow?;
         let to_center = self.object_center_m - light;
         let t = (floor - light).dot(normal) / to_center.dot(normal);
-        Some(readback::Dimmed {
+        Some(readback_check::Dimmed {
             points: vec![self.object_center_m, light + to_center * t],
             panel,
         })

@@ -9,7 +9,8 @@ use vitreous_frames::spread::Spread;
 use vitreous_frames::validation::ValidationSummary;
 use vitreous_gaze::separability::SeparabilitySummary;
 
-use super::{ReadbackCheck, ReplayCheck};
+use super::ReplayCheck;
+use vitreous_frames::readback_check::ReadbackCheck;
 
 /// What `vitreous run` reports (and writes to summary.json).
 #[derive(Clone, Debug, Serialize)]
@@ -117,7 +118,7 @@ pub struct RunSummary {
     pub room_light: Option<super::room_light::RoomLight>,
     /// With `--readback-check`: where the shadow and the caustic lay on the floor at the end
     /// (`null` otherwise).
-    pub floor_centroids: Option<super::room_light::FloorCentroids>,
+    pub floor_centroids: Option<vitreous_frames::readback_check::FloorCentroids>,
     /// Changes of the gaze-image decision between surface and refracted (see `frames.csv`).
     pub gaze_image_switches: u64,
     /// How far apart the two images are in the tracker's vergence noise, the noise estimated

@@ -16,9 +16,9 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use vitreous_trace::TraceSample;
 
-use super::{
-    AnalyzeConfig, RawSample, ReplayedFrame, Truth, load_inputs, raw_samples, replay,
-    timeline_from_phases, timeline_from_raw_depth,
+use super::{Truth, load_inputs, timeline_from_phases};
+use vitreous_gaze::analysis::{
+    AnalyzeConfig, RawSample, ReplayedFrame, raw_samples, replay, timeline_from_raw_depth,
 };
 use vitreous_gaze::fixation::{DEFAULT_MIN_FIXATION_MS, DEFAULT_VELOCITY_DEG_S, fixation_spans};
 use vitreous_gaze::{FilterKind, GazeImage};

@@ -7,7 +7,6 @@ use vitreous_render::Readback;
 
 use super::input::EyesShown;
 use crate::font::FONT_TTF;
-use vitreous_frames::output::{linear_to_srgb, srgb_to_linear};
 
 /// Height of the overlay's text, pixels.
 const TEXT_PX: f32 = 14.0;
@@ -28,10 +27,10 @@ impl SeeThrough {
     pub fn new() -> SeeThrough {
         let mut to_linear = [0.0; 256];
         for (i, v) in to_linear.iter_mut().enumerate() {
-            *v = srgb_to_linear(i as u8);
+            *v = vitreous_optics::srgb::to_linear(i as u8);
         }
         let to_srgb = (0..=LINEAR_STEPS)
-            .map(|i| linear_to_srgb(i as f32 / LINEAR_STEPS as f32))
+            .map(|i| vitreous_optics::srgb::from_linear(i as f32 / LINEAR_STEPS as f32))
             .collect();
         SeeThrough { to_linear, to_srgb }
     }

@@ -48,7 +48,7 @@
 //!
 //! # Modules
 //! - `geometry`: the floor's frame, the shadow projection (eq. 1) and the overlay's rectangles;
-//! - `reference`: eq. 2-5 and the exact distance field on the CPU;
+//! - eq. 2-5 and the exact distance field on the CPU are `vitreous_optics::floor`;
 //! - `fields`: the floor-space images, the push constants and the fields read back;
 //! - `mask`: the shadow mask's pipelines, and the hull of a convex mesh's shadow;
 //! - `distance_transform`: the nearest shadow texel of every texel (compute);
@@ -73,7 +73,6 @@ mod overlay;
 mod pass;
 mod progress;
 mod readback;
-mod reference;
 mod smoothing;
 mod triangle_grid;
 
@@ -86,7 +85,3 @@ pub(crate) use fields::{FieldTarget, Stamps};
 pub use geometry::{caustic_rect, overlay_rect, planar_shadow};
 pub(crate) use pass::InducerPass;
 pub(crate) use progress::Prepared;
-pub use reference::{
-    FAR_M, edge_distance_m, exact_edge_distances, inducer_gain, inducer_light, perceived_floor,
-    ramp,
-};

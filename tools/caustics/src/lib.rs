@@ -23,9 +23,13 @@
 //! The closed-mesh tracer (`vitreous_optics::solid` and its BVH) and the interface optics
 //! (Snell, mirror reflection, the exact Fresnel reflectance) are `vitreous-optics`', shared with
 //! the two-surface refraction reference.
+//!
+//! [`command`] is `vitreous bake SCENE` (and this crate's own `vitreous-caustics bake`): the
+//! options, the default output, progress, the printed figures and the self-check.
 
 pub mod bake;
 pub mod bake_file;
+pub mod command;
 pub mod emission;
 mod splat;
 mod trace;

@@ -1,15 +1,13 @@
-//! `vitreous-caustics`: bakes a scene's caustic gain map (paper eq. 6) to an EXR, and
-//! compares bakes.
+//! `vitreous-caustics`: bakes a scene's caustic gain map (paper eq. 6) to an EXR (as `vitreous
+//! bake`, through the same `command::bake_command`), and compares bakes.
 
-use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
 use vitreous_caustics::bake_file::read_bake_unchecked;
-use vitreous_caustics::{BakeOutput, BakeParams, CausticScene, bake, compare, write_bake};
+use vitreous_caustics::command::{BakeArgs, bake_command};
+use vitreous_caustics::compare;
 
 #[derive(Parser)]
 #[command(
@@ -25,32 +23,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Bake a scene's caustic gain map G (docs/caustics.md).
-    Bake {
-        /// The scene file (TOML).
-        scene: PathBuf,
-        /// Output EXR [default: config/bakes/<scene name>.exr next to the scene's folder].
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// Texels per side of the floor map.
-        #[arg(long, default_value_t = 1980)]
-        resolution: u32,
-        /// Grid rays to trace from the light.
-        #[arg(long, default_value_t = BakeParams::default().budget_rays)]
-        budget: u64,
-        /// Seed (rotates the ray grid); the same seed gives a byte-identical file.
-        #[arg(long, default_value_t = 0)]
-        seed: u64,
-        /// Also bake a reference with this many times the budget and print the RMS
-        /// difference against it (16 for the issue's figure; slow).
-        #[arg(long)]
-        reference_factor: Option<u64>,
-        /// Most reflections and refractions on one light path.
-        #[arg(long, default_value_t = BakeParams::default().max_interactions)]
-        max_interactions: u32,
-        /// Skip the quick self-check (a quarter-budget bake compared with the result).
-        #[arg(long)]
-        no_self_check: bool,
-    },
+    Bake(BakeArgs),
     /// Print the RMS difference of a bake against a reference bake.
     Compare {
         /// The bake to judge.
@@ -68,27 +41,7 @@ enum Command {
 
 fn main() -> Result<()> {
     match Cli::parse().command {
-        Command::Bake {
-            scene,
-            output,
-            resolution,
-            budget,
-            seed,
-            reference_factor,
-            max_interactions,
-            no_self_check,
-        } => {
-            let params = BakeParams {
-                width_px: resolution,
-                height_px: resolution,
-                budget_rays: budget,
-                seed,
-                max_interactions,
-                ..BakeParams::default()
-            };
-            let output = output.unwrap_or_else(|| default_output(&scene));
-            run_bake(&scene, &output, &params, reference_factor, !no_self_check)
-        }
+        Command::Bake(args) => bake_command(args),
         Command::Compare {
             test,
             reference,
@@ -129,144 +82,4 @@ fn main() -> Result<()> {
             Ok(())
         }
     }
-}
-
-/// `config/scenes/x.toml` -> `config/bakes/x.exr`.
-fn default_output(scene: &Path) -> PathBuf {
-    let stem = scene
-        .file_stem()
-        .map(|s| s.to_os_string())
-        .unwrap_or_else(|| "bake".into());
-    let dir = scene
-        .parent()
-        .and_then(Path::parent)
-        .unwrap_or(Path::new("."));
-    dir.join("bakes").join(stem).with_extension("exr")
-}
-
-fn progress_bar(label: &str) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(1);
-    bar.set_style(
-        ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} rows {elapsed_precise}")
-            .expect("static template")
-            .progress_chars("=> "),
-    );
-    bar.set_message(label.to_owned());
-    bar
-}
-
-fn bake_with_bar(scene: &CausticScene, params: &BakeParams, label: &str) -> Result<BakeOutput> {
-    let bar = progress_bar(label);
-    let out = bake(scene, params, &|done, total| {
-        bar.set_length(total);
-        bar.set_position(done);
-    })
-    .with_context(|| format!("baking caustics for {}", scene.source.display()))?;
-    bar.finish_and_clear();
-    Ok(out)
-}
-
-fn run_bake(
-    scene_path: &Path,
-    output: &Path,
-    params: &BakeParams,
-    reference_factor: Option<u64>,
-    self_check: bool,
-) -> Result<()> {
-    let scene = vitreous_scene::load_scene(scene_path)
-        .with_context(|| format!("loading scene {}", scene_path.display()))?;
-    let scene = CausticScene::from_scene(&scene);
-    let out = bake_with_bar(&scene, params, "bake")?;
-    let write_start = Instant::now();
-    write_bake(output, &out.bake)?;
-    let write_s = write_start.elapsed().as_secs_f64();
-
-    let l = &out.ledger;
-    let pct = |x: f64| 100.0 * x / l.emitted;
-    println!("baked {} -> {}", scene_path.display(), output.display());
-    println!(
-        "  {} x {} texels, {} grid rays ({} x {} cells), seed {}",
-        params.width_px,
-        params.height_px,
-        (params.grid_cells() as u64 + 1).pow(2),
-        params.grid_cells(),
-        params.grid_cells(),
-        params.seed
-    );
-    println!(
-        "  flux in the cone: direct {:.2} %, to the floor {:.2} %, reflected away {:.2} %, \
-         transmitted away {:.2} %, interaction limit {:.4} %, pruned {:.4} % (sum {:.9} %)",
-        pct(l.direct),
-        pct(l.floor),
-        pct(l.reflected_away),
-        pct(l.transmitted_away),
-        pct(l.interaction_limit),
-        pct(l.pruned),
-        pct(l.accounted())
-    );
-    let peak = out.bake.gain.iter().copied().fold(0.0f32, f32::max);
-    let region = out
-        .bake
-        .gain
-        .iter()
-        .filter(|&&g| g > vitreous_caustics::bake::CAUSTIC_REGION_GAIN)
-        .count();
-    println!(
-        "  peak gain {peak:.2}, {region} texels with G > {}",
-        vitreous_caustics::bake::CAUSTIC_REGION_GAIN
-    );
-    println!(
-        "  bake time {:.2} s (+ {:.2} s writing the EXR)",
-        out.elapsed.as_secs_f64(),
-        write_s
-    );
-
-    if self_check {
-        let quarter = BakeParams {
-            budget_rays: (params.budget_rays / 4).max(9),
-            ..*params
-        };
-        let q = bake_with_bar(&scene, &quarter, "self-check")?;
-        let c = compare(
-            &q.bake.gain,
-            &out.bake.gain,
-            vitreous_caustics::bake::CAUSTIC_REGION_GAIN,
-        )
-        .expect("same size");
-        println!(
-            "  self-check: a quarter-budget bake differs by {:.2} % relative RMS ({:.2} % per \
-             texel) over {} caustic texels; since 4x the budget cuts the error 2-4x, this is \
-             an upper estimate of this bake's error against a 16x reference [{:.2} s]",
-            c.rel_rms * 100.0,
-            c.rel_rms_per_texel * 100.0,
-            c.region_texels,
-            q.elapsed.as_secs_f64()
-        );
-    }
-    if let Some(factor) = reference_factor {
-        let reference = BakeParams {
-            budget_rays: params.budget_rays.saturating_mul(factor.max(1)),
-            ..*params
-        };
-        let r = bake_with_bar(&scene, &reference, "reference")?;
-        let c = compare(
-            &out.bake.gain,
-            &r.bake.gain,
-            vitreous_caustics::bake::CAUSTIC_REGION_GAIN,
-        )
-        .expect("same size");
-        println!(
-            "  against a {factor}x-budget reference: relative RMS {:.3} %, per-texel relative \
-             RMS {:.3} %, over {} caustic texels (G_ref > {}) [reference took {:.2} s]",
-            c.rel_rms * 100.0,
-            c.rel_rms_per_texel * 100.0,
-            c.region_texels,
-            vitreous_caustics::bake::CAUSTIC_REGION_GAIN,
-            r.elapsed.as_secs_f64()
-        );
-    }
-    Ok(())
 }

@@ -6,11 +6,10 @@
 
 use glam::{Quat, Vec2, Vec3};
 use serde::Serialize;
-use vitreous_render::floor::{FAR_M, exact_edge_distances};
+use vitreous_optics::camera::EyeParams;
+use vitreous_optics::floor::{FAR_M, exact_edge_distances};
+use vitreous_reference::EyeRecord;
 use vitreous_scene::{Placement, Scene};
-use vitreous_trace::EyeView;
-
-use vitreous_frames::render_desc::eye_params;
 
 /// A region of the eye image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -62,11 +61,22 @@ pub enum Eye {
 }
 
 impl Eye {
-    /// 0 for the left eye, 1 for the right (as in `EYE_NAMES` and a frame's views).
+    /// Both eyes, left first (as a frame's views).
+    pub const ALL: [Eye; 2] = [Eye::Left, Eye::Right];
+
+    /// 0 for the left eye, 1 for the right (as a frame's views).
     pub fn index(self) -> usize {
         match self {
             Eye::Left => 0,
             Eye::Right => 1,
+        }
+    }
+
+    /// `left` or `right`, as the frame files and reports name the eye.
+    pub fn name(self) -> &'static str {
+        match self {
+            Eye::Left => "left",
+            Eye::Right => "right",
         }
     }
 }
@@ -74,33 +84,32 @@ impl Eye {
 /// The region of every pixel of a `width` x `height` image of `eye` at the scene's neutral
 /// head (looking down -z from `viewer.head_position_m`), row by row.
 pub fn regions(scene: &Scene, eye: Eye, width: u32, height: u32) -> Vec<Region> {
-    let head = vitreous_trace::Pose {
-        position: scene.viewer.head_position_m,
-        orientation: Quat::IDENTITY,
-    };
-    let [left, right] = scene.viewer.eye_positions_m(&head);
-    let position = if eye == Eye::Left { left } else { right };
-    let view = EyeView {
-        pose: vitreous_trace::Pose {
-            position,
-            orientation: Quat::IDENTITY,
-        },
-        fov: scene.output.fov,
-    };
-    regions_of(scene, &view, &scene.rest_placement(), width, height)
+    let position = scene.viewer.neutral_eye_positions_m()[eye.index()];
+    let fov = scene.output.fov;
+    let camera = EyeRecord {
+        position_m: position.to_array(),
+        orientation_xyzw: Quat::IDENTITY.to_array(),
+        fov_rad: [
+            fov.angle_left_rad,
+            fov.angle_right_rad,
+            fov.angle_up_rad,
+            fov.angle_down_rad,
+        ],
+    }
+    .camera();
+    regions_of(scene, &camera, &scene.rest_placement(), width, height)
 }
 
-/// The region of every pixel of a `width` x `height` image seen by `view`, with the object and
-/// the light at `placement`, row by row. The caustic counts only at the scene's resting
+/// The region of every pixel of a `width` x `height` image seen by `camera`, with the object
+/// and the light at `placement`, row by row. The caustic counts only at the scene's resting
 /// placement, which its bake is for.
 pub fn regions_of(
     scene: &Scene,
-    view: &EyeView,
+    camera: &EyeParams,
     placement: &Placement,
     width: u32,
     height: u32,
 ) -> Vec<Region> {
-    let camera = eye_params(view);
     let floor = FloorRegions::new(scene, placement);
     let floor_from_world = scene.floor.world_from_plane().inverse();
     let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
@@ -108,7 +117,7 @@ pub fn regions_of(
     for y in 0..height {
         for x in 0..width {
             let dir = rays.direction(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            let origin = view.pose.position;
+            let origin = camera.position_m;
             out.push(classify(
                 scene,
                 placement,

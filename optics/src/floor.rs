@@ -1,7 +1,7 @@
 //! The floor passes' equations on the CPU (METHOD.md section 1, paper eq. 2-5): each in one
 //! function, which the GPU passes mirror (shaders/shared/inducer_ramp.wgsl, floor_overlay.wgsl) and
 //! are tested against, and which CPU code computing the same quantity calls. Eq. 1, the
-//! shadow region, is the planar projection in [`super::geometry::planar_shadow`].
+//! shadow region, is the planar projection in `vitreous_render`'s `floor::geometry::planar_shadow`.
 
 use glam::Vec2;
 

@@ -7,10 +7,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
+use vitreous_reference::{FrameReport, Report};
 use vitreous_scene::Scene;
 
-use crate::reference_cmd::{FrameReport, Report};
-use vitreous_frames::output::EYE_NAMES;
+use crate::regions::Eye;
 
 /// The file beside a reference image that lists its frames.
 pub const REFERENCE_JSON: &str = "reference.json";
@@ -60,8 +60,8 @@ pub fn frame_of_image(image: &Path) -> Result<Option<Listed>> {
     };
     let (scene, scene_hash) = (report.scene, report.scene_hash);
     Ok(report.frames.into_iter().find_map(|frame| {
-        let eye = EYE_NAMES.iter().position(|e| {
-            let stem = format!("{:06}-{e}", frame.frame);
+        let eye = Eye::ALL.iter().position(|e| {
+            let stem = format!("{:06}-{}", frame.frame, e.name());
             name == format!("{stem}.png") || name == format!("{stem}-real.png")
         })?;
         Some(Listed {
@@ -100,10 +100,10 @@ pub fn frame_for_scene(image: &Path, scene: &Scene, eye: Option<usize>) -> Resul
     if let Some(eye) = eye.filter(|&e| e != listed.eye) {
         bail!(
             "--eye {}, but {} lists {} as the {} eye of frame {}: leave --eye out",
-            EYE_NAMES[eye],
+            Eye::ALL[eye].name(),
             listed.file.display(),
             image.display(),
-            EYE_NAMES[listed.eye],
+            Eye::ALL[listed.eye].name(),
             listed.frame.frame
         );
     }

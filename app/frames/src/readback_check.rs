@@ -1,4 +1,4 @@
-//! The readback check of `vitreous run --readback-check`: one submitted swapchain image read
+//! The readback check (`vitreous run --readback-check`): one submitted swapchain image read
 //! back; the object's projected disc is searched for lit pixels (the run drew the object where
 //! the headset looks), and the pixels away from it are checked against what the blend mode
 //! needs there: black on ADDITIVE and ALPHA_BLEND (nothing added to the world), the scene's
@@ -6,9 +6,16 @@
 //! colour over alpha 0, so the world shows through), unless the scene drives a segmented
 //! dimmer: then the alpha must be above 0 where the object and its shadow are, and 0 (with
 //! nothing drawn) away from both, past the panel's reach around them.
+//!
+//! At the run's end the check also reads back where the shadow and the caustic lie on the
+//! floor ([`FloorCentroids`]), for a check against an independent computation of both.
 
+use anyhow::Result;
+use glam::{DVec2, Vec3};
 use serde::Serialize;
-use vitreous_trace::{Blend, FrameInput};
+use vitreous_render::Renderer;
+use vitreous_trace::Blend;
+use vitreous_trace::FrameInput;
 
 /// What the readback of a submitted swapchain image showed.
 #[derive(Clone, Debug, Serialize)]
@@ -44,6 +51,46 @@ pub struct ReadbackCheck {
     pub passed: bool,
 }
 
+impl ReadbackCheck {
+    /// An error saying what the check found, unless it [`passed`](Self::passed); `blend` is
+    /// the blend mode the image was composed for.
+    pub fn verdict(&self, blend: Blend) -> anyhow::Result<()> {
+        let c = self;
+        if c.passed {
+            return Ok(());
+        }
+        anyhow::bail!(
+            "readback check failed ({} blend): frame {} shows the object in {:.1} % of its \
+             region ({} of {} px; expected at least {:.0} %), {:.1} % of the pixels away \
+             from it as the blend mode needs (expected at least {:.0} %: {}), {} px with \
+             alpha above 0{}",
+            c.blend,
+            c.frame,
+            c.object_fraction * 100.0,
+            c.object_px,
+            c.region_px,
+            MIN_OBJECT_FRACTION * 100.0,
+            c.away_fraction * 100.0,
+            MIN_AWAY_FRACTION * 100.0,
+            if blend.needs_world_behind() {
+                "the real-world photos"
+            } else {
+                "black"
+            },
+            c.alpha_nonzero_px,
+            match (blend.uses_source_alpha(), c.dimmed_points_alpha.is_empty()) {
+                (true, true) => " (expected none)".to_owned(),
+                (true, false) => format!(
+                    " ({} of them away from it, expected none; the dimmer's alpha at the \
+                     object's and its shadow's centres {:?}, expected above 0)",
+                    c.alpha_away_px, c.dimmed_points_alpha
+                ),
+                (false, _) => String::new(),
+            }
+        )
+    }
+}
+
 /// How different (sRGB steps) a pixel must be to count as the object's.
 pub const LIT_THRESHOLD: u8 = 8;
 /// Share of the object's region that must show it.
@@ -57,7 +104,7 @@ pub const MIN_AWAY_FRACTION: f64 = 0.8;
 /// What a segmented dimmer must darken: world points (the object's centre, its shadow's), and
 /// the panel.
 #[derive(Clone, Debug)]
-pub(super) struct Dimmed {
+pub struct Dimmed {
     /// The points.
     pub points: Vec<glam::Vec3>,
     /// The panel.
@@ -69,7 +116,7 @@ pub(super) struct Dimmed {
 /// darken (the scene has one; it counts only on ALPHA_BLEND): then a pixel is away when it lies
 /// outside the rectangle of [`AWAY_RADII`] object radii and the panel's reach (with a cell)
 /// around every point.
-pub(super) fn check_readback(
+pub fn check_readback(
     input: &FrameInput,
     rb: &vitreous_render::Readback,
     center_m: glam::Vec3,
@@ -218,10 +265,89 @@ pub(super) fn check_readback(
     }
 }
 
+/// Where the shadow and the caustic lie on the floor, from the renderer's fields.
+#[derive(Clone, Debug, Serialize)]
+pub struct FloorCentroids {
+    /// The corner of the floor's texel grids (its texel (0, 0)'s outer corner), metres.
+    pub origin_m: [f32; 3],
+    /// The grids' full width along their x, metres (a world vector).
+    pub u_m: [f32; 3],
+    /// The grids' full height along their y, metres (a world vector).
+    pub v_m: [f32; 3],
+    /// Side of the shadow inducer's grid, texels.
+    pub shadow_resolution_px: u32,
+    /// Texels in the shadow.
+    pub shadow_texels: u64,
+    /// The shadow's centroid, texels from the corner (`null`: no shadow).
+    pub shadow_centroid_px: Option<[f64; 2]>,
+    /// Side of the caustic map, texels (`null`: no caustics computed live).
+    pub caustic_resolution_px: Option<u32>,
+    /// The caustic gain's centroid, texels from the corner, weighted by the gain.
+    pub caustic_centroid_px: Option<[f64; 2]>,
+    /// The light's position the fields were computed for, metres.
+    pub light_position_m: [f32; 3],
+    /// The object's centre, metres.
+    pub object_center_m: [f32; 3],
+    /// The object's bounding-sphere radius, metres.
+    pub object_radius_m: f32,
+}
+
+/// The weighted centroid of a square grid of side `n` (texel centres at `i + 0.5`).
+fn centroid(n: u32, weight: impl Fn(usize) -> f64) -> Option<DVec2> {
+    let mut sum = DVec2::ZERO;
+    let mut total = 0.0;
+    for y in 0..n {
+        for x in 0..n {
+            let w = weight((y * n + x) as usize);
+            if w > 0.0 {
+                sum += DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5) * w;
+                total += w;
+            }
+        }
+    }
+    (total > 0.0).then(|| sum / total)
+}
+
+/// Reads back the shadow inducer's fields and the live caustic map (the last computed) and
+/// finds their centroids; the floor's grid from `world_from_plane`.
+pub fn floor_centroids(
+    renderer: &mut Renderer,
+    world_from_plane: glam::Mat4,
+    light_position_m: Vec3,
+    object_center_m: Vec3,
+    object_radius_m: f32,
+) -> Result<FloorCentroids> {
+    let fields = renderer.inducer_fields()?;
+    let n = fields.resolution_px;
+    let shadow = centroid(n, |i| f64::from(fields.mask[i]));
+    let caustic = renderer.live_caustic_gain()?.and_then(|gain| {
+        let side = (gain.len() as f64).sqrt().round() as u32;
+        (side * side == gain.len() as u32 && side > 0)
+            .then(|| (side, centroid(side, |i| f64::from(gain[i]).max(0.0))))
+    });
+    // Texel (x, y) of an n-grid is at plane-local (u - 0.5, 0.5 - v).
+    let origin = world_from_plane.transform_point3(Vec3::new(-0.5, 0.5, 0.0));
+    let u = world_from_plane.transform_vector3(Vec3::X);
+    let v = world_from_plane.transform_vector3(Vec3::NEG_Y);
+    Ok(FloorCentroids {
+        origin_m: origin.to_array(),
+        u_m: u.to_array(),
+        v_m: v.to_array(),
+        shadow_resolution_px: n,
+        shadow_texels: fields.mask.iter().filter(|&&m| m == 1).count() as u64,
+        shadow_centroid_px: shadow.map(|c| c.to_array()),
+        caustic_resolution_px: caustic.map(|(side, _)| side),
+        caustic_centroid_px: caustic.and_then(|(_, c)| c).map(|c| c.to_array()),
+        light_position_m: light_position_m.to_array(),
+        object_center_m: object_center_m.to_array(),
+        object_radius_m,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::test_frame as frame;
+    use crate::test_frame::test_frame as frame;
 
     const W: u32 = 32;
     const H: u32 = 32;
@@ -410,5 +536,18 @@ mod tests {
             None,
         );
         assert!(!c.passed && c.region_px == 0);
+    }
+
+    #[test]
+    fn the_centroid_weighs_texel_centres() {
+        // Two texels of a 4-grid: (1, 2) with weight 1 and (3, 2) with weight 3.
+        let c = centroid(4, |i| match i {
+            9 => 1.0,
+            11 => 3.0,
+            _ => 0.0,
+        })
+        .unwrap();
+        assert!((c - DVec2::new(3.0, 2.5)).length() < 1e-12, "{c}");
+        assert_eq!(centroid(4, |_| 0.0), None);
     }
 }

@@ -1,11 +1,11 @@
-//! The bench's counted work: for each variant, the mean per timed frame of what the renderer
-//! recorded and of each pass's shader invocations (`vitreous_render::work`). Timings on a
-//! shared machine scatter by tens of percent; these counts are the same run after run, so a
-//! test can hold them to a committed expectation (tests/cost.rs).
+//! Counted work by name (`vitreous bench`'s counts): the mean per frame of what the renderer
+//! recorded and of each pass's shader invocations ([`super`]). Timings on a shared machine
+//! scatter by tens of percent; these counts are the same run after run, so a test can hold
+//! them to a committed expectation (tests/cost.rs).
 
 use std::collections::BTreeMap;
 
-use vitreous_render::{FrameWork, Invocations, ShaderCost};
+use super::{FrameWork, Invocations, ShaderCost};
 
 /// Named counts, mean per frame, in a stable order. Names: `render_passes`, `draws`,
 /// `vertices`, `dispatches`, `workgroups`, `uploaded_bytes` (recorded, the same on every
@@ -14,11 +14,11 @@ use vitreous_render::{FrameWork, Invocations, ShaderCost};
 /// `eye_glass`, and `eye_glass_covered`: the glass drawn without the environment's lookup where
 /// the frame proved every refracted ray reaches the background photo) and shader stage
 /// (`vertex`, `fragment`, `compute`), and the work of the eye passes' fragments, their
-/// invocations times the static cost of one (`vitreous_render::work::ShaderCost`):
+/// invocations times the static cost of one ([`ShaderCost`]):
 /// `glass_fetches`, `glass_texels`, `glass_instructions` (both of the glass's pipelines), and
 /// the same for the floor overlay (`floor_*`); where the frames count their work with live
 /// caustics on, what the live map's computation did (`caustic_photons.traced`,
-/// `caustic_photons.splatted`, `caustic_smoothing.texels`: `vitreous_render::PhotonWork`).
+/// `caustic_photons.splatted`, `caustic_smoothing.texels`: [`super::PhotonWork`]).
 pub type WorkCounts = BTreeMap<String, f64>;
 
 /// The mean per frame of `frames`' work; empty without frames.
@@ -113,7 +113,7 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use vitreous_render::{PassInvocations, RecordedWork, ShaderCost};
+    use crate::work::{PassInvocations, RecordedWork, ShaderCost};
 
     #[test]
     fn counts_are_means_per_frame_and_fetches_follow_each_glass_pipelines_fragments() {
@@ -144,7 +144,7 @@ mod tests {
                 instructions: 50,
             }),
             overlay_shader: None,
-            photons: (draws == 4).then_some(vitreous_render::PhotonWork {
+            photons: (draws == 4).then_some(crate::work::PhotonWork {
                 traced: 8,
                 splatted: 20,
                 smoothed_texels: 64,

@@ -7,8 +7,8 @@ use std::fmt;
 use serde::Serialize;
 
 use super::{Gap, SETTLE_NS, TruthTimeline};
-use vitreous_gaze::separability::SEPARABLE;
-use vitreous_gaze::{FilterKind, ImageDistances, Separability};
+use crate::separability::SEPARABLE;
+use crate::{FilterKind, ImageDistances, Separability};
 
 /// The figures of one filter on one trace.
 #[derive(Clone, Debug, PartialEq)]

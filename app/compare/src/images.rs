@@ -9,7 +9,7 @@ use anyhow::{Context, Result, bail};
 const MAX_PIXELS: u64 = vitreous_scene::MAX_IMAGE_PIXELS;
 
 /// An image as read.
-pub(super) struct Png {
+pub struct Png {
     /// The file.
     pub path: PathBuf,
     /// Width, pixels.
@@ -69,7 +69,7 @@ impl Png {
 
     /// The pixels without their alpha, sRGB RGB8.
     pub fn rgb(&self) -> Vec<u8> {
-        super::rgb_of(&self.rgba)
+        crate::rgb_of(&self.rgba)
     }
 
     /// Why the comparison leaves this image's alpha out, when some pixel is not opaque

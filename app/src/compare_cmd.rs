@@ -1,24 +1,20 @@
 //! `vitreous compare REFERENCE TEST`: how far an image is from a reference, as ꟻLIP (NVIDIA's
 //! perceptual difference evaluator, `nv-flip`; mean over pixels, 0 identical, lower is
 //! closer) and PSNR (8-bit sRGB, all three channels), over the whole view and, with a scene,
-//! region by region (`regions.rs`: the object's disc, the shadow and caustic, the inducer's
-//! ramp, the rest); with what the eye sees when nothing is drawn, the same figures for it and
-//! for the additive limit beside the test's; optionally the ꟻLIP error map as a PNG.
-
-mod flip;
-mod images;
-mod listed;
-mod regions;
+//! region by region (the object's disc, the shadow and caustic, the inducer's ramp, the rest);
+//! with what the eye sees when nothing is drawn, the same figures for it and for the additive
+//! limit beside the test's; optionally the ꟻLIP error map as a PNG. The figures, the regions
+//! and the images read are `vitreous-compare`'s; here the options, the display's light over
+//! the seen image as the scene's display shows it, and the table.
 
 use std::path::PathBuf;
 
 use anyhow::{Result, bail};
-use serde::Serialize;
+use vitreous_compare::{
+    Comparison, Eye, Png, RegionFigures, additive_limit, compare, flip, frame_for_scene,
+    reference_json_beside, regions, regions_of, rgb_of, scene_pixels_per_degree,
+};
 
-pub use listed::{Listed, REFERENCE_JSON, frame_for_scene, frame_of_image, reference_json_beside};
-pub use regions::{Eye, Region, regions, regions_of};
-
-use images::Png;
 use vitreous_frames::input_files::InputFiles;
 use vitreous_frames::output::{EYE_NAMES, encode_png, write_atomic};
 use vitreous_frames::wearer::WearerView;
@@ -91,57 +87,6 @@ fn parse_ppd(s: &str) -> std::result::Result<f32, String> {
     }
 }
 
-/// The figures of one region.
-#[derive(Clone, Debug, Serialize)]
-pub struct RegionFigures {
-    /// The region (`whole` for the whole view).
-    pub region: String,
-    /// Pixels in it.
-    pub pixels: u64,
-    /// Mean ꟻLIP over its pixels (`None` when it has none).
-    pub flip_mean: Option<f64>,
-    /// PSNR over its pixels, dB (`None` when it has none or the images are equal there).
-    pub psnr_db: Option<f64>,
-}
-
-/// What `vitreous compare` reports.
-#[derive(Clone, Debug, Serialize)]
-pub struct Comparison {
-    /// The reference image.
-    pub reference: String,
-    /// The measured image.
-    pub test: String,
-    /// Image size, pixels.
-    pub width_px: u32,
-    /// Image size, pixels.
-    pub height_px: u32,
-    /// Pixels per degree ꟻLIP was run at.
-    pub pixels_per_degree: f32,
-    /// The scene whose regions split the figures, if any.
-    pub scene: Option<String>,
-    /// Where the regions were seen from: `neutral head, left eye`, or the frame and eye of
-    /// the `reference.json` beside the reference image.
-    pub regions_from: Option<String>,
-    /// Whether TEST was the display's light, added to the seen image (`--display`).
-    pub display_added_to_seen: bool,
-    /// The whole view first, then each region of the scene.
-    pub regions: Vec<RegionFigures>,
-    /// With `--seen`: the same figures for what the eye sees with nothing drawn.
-    pub nothing_drawn: Option<Vec<RegionFigures>>,
-    /// With `--seen`: the same figures for the additive limit, max(seen, reference) per pixel
-    /// and channel.
-    pub additive_limit: Option<Vec<RegionFigures>>,
-}
-
-/// The closest a display that only adds light can bring `seen` to `reference`: the larger of
-/// the two in every channel of every pixel (sRGB encoding keeps the order of linear light).
-pub fn additive_limit(seen: &[u8], reference: &[u8]) -> Vec<u8> {
-    seen.iter()
-        .zip(reference)
-        .map(|(&a, &b)| a.max(b))
-        .collect()
-}
-
 /// What the eye sees with `display` (sRGB RGBA8, alpha what a dimmer takes away) shown over
 /// `seen` (sRGB RGB8) on the display `view`: sRGB RGB8.
 fn add_light(view: &WearerView, display: &[u8], seen: &[u8], size: (u32, u32)) -> Vec<u8> {
@@ -150,101 +95,6 @@ fn add_light(view: &WearerView, display: &[u8], seen: &[u8], size: (u32, u32)) -
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
     rgb_of(&view.see(display, &rgba, [size.0, size.1]))
-}
-
-/// PSNR of 8-bit values, dB; `None` when they are equal.
-fn psnr(squared_error: f64, values: u64) -> Option<f64> {
-    (squared_error > 0.0 && values > 0)
-        .then(|| 10.0 * (255.0f64 * 255.0 / (squared_error / values as f64)).log10())
-}
-
-/// Compares `test` with `reference`: ꟻLIP's error map and the figures per region (`labels`:
-/// each pixel's region, or none for the whole view only).
-pub fn compare(
-    reference: &[u8],
-    test: &[u8],
-    (width, height): (u32, u32),
-    ppd: f32,
-    labels: Option<&[Region]>,
-) -> Result<(Vec<f32>, Vec<RegionFigures>)> {
-    let error = flip::error_map(reference, test, (width, height), ppd)?;
-    let squared: Vec<f64> = reference
-        .chunks_exact(3)
-        .zip(test.chunks_exact(3))
-        .map(|(a, b)| {
-            a.iter()
-                .zip(b)
-                .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
-                .sum()
-        })
-        .collect();
-    let figures = |name: &str, keep: &dyn Fn(usize) -> bool| {
-        let (mut pixels, mut flip, mut se) = (0u64, 0f64, 0f64);
-        for i in (0..error.len()).filter(|&i| keep(i)) {
-            pixels += 1;
-            flip += f64::from(error[i]);
-            se += squared[i];
-        }
-        RegionFigures {
-            region: name.to_owned(),
-            pixels,
-            flip_mean: (pixels > 0).then(|| flip / pixels as f64),
-            psnr_db: psnr(se, pixels * 3),
-        }
-    };
-    let mut out = vec![figures("whole", &|_| true)];
-    if let Some(labels) = labels {
-        for region in Region::ALL {
-            out.push(figures(region.name(), &|i| labels[i] == region));
-        }
-    }
-    Ok((error, out))
-}
-
-/// The figures of one eye of one frame against the physical reference: what the eye sees with
-/// the display's light over the seen image, the seen image itself, and the additive limit.
-#[derive(Clone, Debug, Serialize)]
-pub struct ReferenceFigures {
-    /// Frame index.
-    pub frame: u64,
-    /// `left` or `right`.
-    pub eye: &'static str,
-    /// The display's light over the seen image, whole view then each region.
-    pub regions: Vec<RegionFigures>,
-    /// The seen image (nothing drawn).
-    pub nothing_drawn: Vec<RegionFigures>,
-    /// The additive limit, max(seen, reference).
-    pub additive_limit: Vec<RegionFigures>,
-}
-
-/// Measures `display` (RGB8, the display's light) over `seen` (RGB8, what the eye sees with
-/// nothing drawn) against `real` (RGB8, the physical reference), region by region for `view`
-/// with the object and light at `placement`, at the scene's pixels per degree.
-pub fn against_reference(
-    scene: &vitreous_scene::Scene,
-    view: &vitreous_trace::EyeView,
-    placement: &vitreous_scene::Placement,
-    images: [&[u8]; 3],
-    (w, h): (u32, u32),
-) -> Result<[Vec<RegionFigures>; 3]> {
-    let [real, seen, display] = images;
-    let fov = scene.output.fov;
-    let ppd = w as f32 / (fov.angle_right_rad - fov.angle_left_rad).to_degrees();
-    let labels = regions_of(scene, view, placement, w, h);
-    let rows = |image: &[u8]| compare(real, image, (w, h), ppd, Some(&labels)).map(|r| r.1);
-    let view = WearerView::of_scene(scene);
-    Ok([
-        rows(&add_light(&view, display, seen, (w, h)))?,
-        rows(seen)?,
-        rows(&additive_limit(seen, real))?,
-    ])
-}
-
-/// RGBA8 pixels without their alpha.
-pub fn rgb_of(rgba: &[u8]) -> Vec<u8> {
-    rgba.chunks_exact(4)
-        .flat_map(|p| [p[0], p[1], p[2]])
-        .collect()
 }
 
 /// How the wearer of `scene`'s display sees (added light without a scene), with the dimmer's
@@ -345,10 +195,7 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         tracing::warn!("{warning}");
     }
     let ppd = args.ppd.unwrap_or_else(|| match &scene {
-        Some(s) => {
-            let fov = s.output.fov;
-            w as f32 / (fov.angle_right_rad - fov.angle_left_rad).to_degrees()
-        }
+        Some(s) => scene_pixels_per_degree(s, w),
         None => flip::DEFAULT_PIXELS_PER_DEGREE,
     });
     let (labels, regions_from) = match &scene {
@@ -356,7 +203,7 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
             Some(listed) => (
                 Some(regions_of(
                     s,
-                    &listed.frame.eyes[listed.eye].view(),
+                    &listed.frame.eyes[listed.eye].camera(),
                     &listed.frame.placement(),
                     w,
                     h,

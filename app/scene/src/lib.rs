@@ -22,7 +22,6 @@
 //! | `image`, `mesh`, `accessor` | the assets: photos and HDRIs; glTF and OBJ meshes |
 //! | `motion` | keyframed object motion |
 //! | `fixation` | where a viewer of the scene looks (the synthetic traces' targets) |
-//! | [`room`] | the environment map with the scene's floor and wall written in |
 //! | [`effects`] | the effect sets a scene or a study condition turns on |
 //! | [`caustics`] | the caustic bake file format (eq. 6's gain map), read and written |
 //! | [`files`] | where a scene's files are read from (the disk, or a test's memory) |
@@ -39,7 +38,6 @@ mod image;
 mod load;
 mod mesh;
 mod motion;
-pub mod room;
 
 use std::path::{Path, PathBuf};
 
@@ -379,8 +377,8 @@ pub struct Environment {
     pub path: PathBuf,
     /// `environment.cube_map`: reserved; checked to exist and hashed, not decoded.
     pub cube_map_path: Option<PathBuf>,
-    /// `environment.room`: the floor and background photos are written into `latlong` as
-    /// seen from the object's centre ([`room`]).
+    /// `environment.room`: the glass traces the floor and background photos as the room it
+    /// refracts and reflects; a ray that meets neither sees `latlong`, the world beyond them.
     pub room: bool,
 }
 

@@ -277,11 +277,6 @@ impl Loader<'_> {
             None => None,
         };
         let room = raw.environment.room.as_ref().is_some_and(|r| *r.get_ref());
-        let latlong = if room {
-            crate::room::with_room(&latlong, object.center_m, &floor, &background)
-        } else {
-            latlong
-        };
         let environment = Environment {
             latlong,
             path: env_path,

@@ -16,6 +16,7 @@ pub mod font;
 pub mod reference_cmd;
 pub mod replay;
 pub mod run;
+pub mod sheet_cmd;
 pub mod soak;
 pub mod study;
 pub mod trace_analyze;

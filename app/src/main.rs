@@ -149,6 +149,9 @@ enum Command {
     /// What a real glass object would look like in the scene, per eye (CPU ray tracer), beside
     /// what the eye sees with nothing there: the physical reference `compare` measures against.
     Reference(vitreous::reference_cmd::ReferenceArgs),
+    /// One picture of what the wearer sees beside a real glass object, with the disc's and the
+    /// shadow's FLIP, for `replay --compare-reference` runs side by side.
+    Sheet(vitreous::sheet_cmd::SheetArgs),
     /// Bake the caustic gain map G that a scene's glass object throws onto the real floor
     /// (docs/caustics.md), by default into the `bakes` folder beside the scene's folder.
     Bake(vitreous_caustics::command::BakeArgs),
@@ -400,6 +403,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Study { command } => vitreous::study::cli::run(command),
         Command::Compare(args) => vitreous::compare_cmd::compare_command(args),
         Command::Reference(args) => vitreous::reference_cmd::reference_command(args),
+        Command::Sheet(args) => vitreous::sheet_cmd::sheet_command(args),
         Command::Bake(args) => vitreous_caustics::command::bake_command(args),
     }
 }

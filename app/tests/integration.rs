@@ -17,6 +17,7 @@ mod scene_edits;
 mod scene_errors;
 mod scene_load;
 mod scene_shipped;
+mod sheet;
 mod soak;
 mod study_analyze;
 mod study_run;

@@ -2,11 +2,10 @@
 //! the see-through preview as `replay` writes it), scaled into the window, with the overlay
 //! text on top.
 
-use ab_glyph::{Font, FontRef, PxScale, ScaleFont, point};
 use vitreous_render::Readback;
 
 use super::input::EyesShown;
-use crate::font::FONT_TTF;
+use crate::font::TextBox;
 
 /// Height of the overlay's text, pixels.
 const TEXT_PX: f32 = 14.0;
@@ -117,71 +116,21 @@ pub fn compose(
 
 /// Draws lines of text in the window's top left corner on a darkened box.
 pub struct Overlay {
-    /// The parsed font.
-    font: FontRef<'static>,
+    /// The text's font and size.
+    text: TextBox,
 }
 
 impl Overlay {
     /// The overlay with the embedded font.
     pub fn new() -> anyhow::Result<Overlay> {
-        let font = FontRef::try_from_slice(FONT_TTF)
-            .map_err(|_| anyhow::anyhow!("the embedded DejaVu Sans font could not be parsed"))?;
-        Ok(Overlay { font })
+        Ok(Overlay {
+            text: TextBox::new(TEXT_PX)?,
+        })
     }
 
     /// Draws `lines` into `out` (RGBA8, `width` x `height`).
     pub fn draw(&self, out: &mut [u8], width: u32, height: u32, lines: &[String]) {
-        if lines.is_empty() {
-            return;
-        }
-        let scale = PxScale::from(TEXT_PX);
-        let scaled = self.font.as_scaled(scale);
-        let line_h = scaled.height() + scaled.line_gap();
-        let text_w = lines
-            .iter()
-            .map(|l| {
-                l.chars()
-                    .map(|c| scaled.h_advance(self.font.glyph_id(c)))
-                    .sum::<f32>()
-            })
-            .fold(0.0f32, f32::max);
-        let (box_w, box_h) = (
-            ((text_w + 12.0) as u32).min(width),
-            ((line_h * lines.len() as f32 + 8.0) as u32).min(height),
-        );
-        for y in 0..box_h as usize {
-            for x in 0..box_w as usize {
-                let px = &mut out[(y * width as usize + x) * 4..][..3];
-                for c in px {
-                    *c /= 3;
-                }
-            }
-        }
-        for (n, line) in lines.iter().enumerate() {
-            let mut x = 6.0;
-            let baseline = 4.0 + scaled.ascent() + line_h * n as f32;
-            for c in line.chars() {
-                let id = self.font.glyph_id(c);
-                let glyph = id.with_scale_and_position(scale, point(x, baseline));
-                x += scaled.h_advance(id);
-                let Some(outline) = self.font.outline_glyph(glyph) else {
-                    continue;
-                };
-                let bounds = outline.px_bounds();
-                outline.draw(|gx, gy, coverage| {
-                    let px = bounds.min.x as i64 + i64::from(gx);
-                    let py = bounds.min.y as i64 + i64::from(gy);
-                    if px < 0 || py < 0 || px >= i64::from(width) || py >= i64::from(height) {
-                        return;
-                    }
-                    let i = (py as usize * width as usize + px as usize) * 4;
-                    for c in &mut out[i..i + 3] {
-                        let v = f32::from(*c) + (255.0 - f32::from(*c)) * coverage;
-                        *c = v.min(255.0) as u8;
-                    }
-                });
-            }
-        }
+        self.text.draw(out, (width, height), (0, 0), lines);
     }
 }
 

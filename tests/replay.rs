@@ -30,6 +30,7 @@ fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOptions {
         reflection: vitreous_render::Reflection::Phong,
         sphere_check: false,
         compare_reference: false,
+        compare_shifts_deg: Vec::new(),
         gaze: Default::default(),
     }
 }

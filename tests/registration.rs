@@ -12,22 +12,12 @@ use vitreous_tests::workspace;
 fn measured(scene: &Path, size: (u32, u32), out: &Path) -> serde_json::Value {
     let opts = ReplayOptions {
         scene: scene.to_path_buf(),
-        trace: None,
-        out: out.to_path_buf(),
         frames: Some(1),
         save_every: 1,
         size: Some(size),
-        validate: true,
-        effects: None,
-        device: None,
-        frame_rate_hz: 60.0,
-        at_samples: false,
-        progress: false,
-        reflection: vitreous_render::Reflection::Phong,
-        sphere_check: false,
         compare_reference: true,
         compare_shifts_deg: vec![0.125, 0.25],
-        gaze: Default::default(),
+        ..crate::replay::options("unused.toml", None, out)
     };
     replay(&opts).expect("replay succeeds with validation on");
     let json: serde_json::Value =

@@ -134,8 +134,8 @@ fn bad_shifts_and_rolls_are_refused_naming_the_option() {
         dir.path(),
     );
     assert_clean_failure(&out, &["--display"]);
-    let out = vitreous(
-        &[
+    let without_scene = |extra: &[&str]| {
+        let mut args = vec![
             "compare",
             "r.png",
             "t.png",
@@ -144,24 +144,11 @@ fn bad_shifts_and_rolls_are_refused_naming_the_option() {
             "--display",
             "--shift-deg",
             "1,0",
-        ],
-        dir.path(),
-    );
-    assert_clean_failure(&out, &["--scene", "--ppd"]);
-    let out = vitreous(
-        &[
-            "compare",
-            "r.png",
-            "t.png",
-            "--seen",
-            "s.png",
-            "--display",
-            "--shift-deg",
-            "1,0",
-            "--ppd",
-            "4",
-        ],
-        dir.path(),
-    );
+        ];
+        args.extend_from_slice(extra);
+        vitreous(&args, dir.path())
+    };
+    assert_clean_failure(&without_scene(&[]), &["--scene", "--ppd"]);
+    let out = without_scene(&["--ppd", "4"]);
     assert!(out.status.success(), "{out:?}");
 }

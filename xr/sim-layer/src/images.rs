@@ -424,13 +424,42 @@ pub fn write_wearer_views(
         .map_err(|e| format!("reading the world picture {}: {e}", world.display()))?
         .to_rgb8();
     let mut written = Vec::new();
+    // With a registration error, also the view as it would be without one, beside it.
+    let errors: &[([f32; 2], &str)] = if registration_deg == [0.0, 0.0] {
+        &[([0.0, 0.0], "")]
+    } else {
+        &[(registration_deg, ""), ([0.0, 0.0], "-registered")]
+    };
     for (i, view) in views.iter().enumerate() {
+        for &(error, suffix) in errors {
+            written.push(write_wearer_view(
+                dir, i, suffix, view, blend, &world, panel, error,
+            )?);
+        }
+    }
+    Ok(written)
+}
+
+/// Writes view `i` as the wearer sees it with the registration error `error_deg`, named
+/// `wearer-left{suffix}.png`, `wearer-right{suffix}.png`, `wearer-view2{suffix}.png`, ....
+#[allow(clippy::too_many_arguments)]
+fn write_wearer_view(
+    dir: &Path,
+    i: usize,
+    suffix: &str,
+    view: &ViewImage,
+    blend: sys::EnvironmentBlendMode,
+    world: &image::RgbImage,
+    panel: &SimPanel,
+    error_deg: [f32; 2],
+) -> Result<PathBuf, String> {
+    {
         let name = match i {
-            0 => "wearer-left.png".to_owned(),
-            1 => "wearer-right.png".to_owned(),
-            n => format!("wearer-view{n}.png"),
+            0 => format!("wearer-left{suffix}.png"),
+            1 => format!("wearer-right{suffix}.png"),
+            n => format!("wearer-view{n}{suffix}.png"),
         };
-        let rgb = wearer_view(view, blend, &world, panel, registration_deg);
+        let rgb = wearer_view(view, blend, world, panel, error_deg);
         let picture = image::RgbImage::from_raw(view.size.0, view.size.1, rgb)
             .ok_or("a wearer's view of the wrong size")?;
         let mut png = Vec::new();
@@ -440,9 +469,8 @@ pub fn write_wearer_views(
         let path = dir.join(&name);
         vitreous_trace::atomic_file::write(&path, &png)
             .map_err(|e| format!("writing {}: {e}", path.display()))?;
-        written.push(path);
+        Ok(path)
     }
-    Ok(written)
 }
 
 #[cfg(test)]
@@ -583,6 +611,42 @@ mod tests {
         assert_eq!(at(&shifted, 38), 188);
         // Beyond the view's edge the display has nothing: the world as it is.
         assert_eq!(at(&shifted, 3), 188);
+    }
+
+    #[test]
+    fn with_a_registration_error_the_registered_view_is_written_beside_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let world = dir.path().join("world.png");
+        image::RgbImage::from_pixel(8, 8, image::Rgb([188, 188, 188]))
+            .save(&world)
+            .unwrap();
+        let sharp = SimPanel {
+            cells: [64, 48],
+            blur_deg: 0.0,
+        };
+        let v = view(|x, _| if (20..30).contains(&x) { 255 } else { 0 }, 0);
+        let blend = sys::EnvironmentBlendMode::ALPHA_BLEND;
+        let names = |error| {
+            write_wearer_views(
+                dir.path(),
+                &world,
+                std::slice::from_ref(&v),
+                blend,
+                &sharp,
+                error,
+            )
+            .unwrap()
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+        };
+        assert_eq!(names([0.0, 0.0]), ["wearer-left.png"]);
+        assert_eq!(
+            names([5.0, 0.0]),
+            ["wearer-left.png", "wearer-left-registered.png"]
+        );
+        let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
+        assert_ne!(read("wearer-left.png"), read("wearer-left-registered.png"));
     }
 
     #[test]

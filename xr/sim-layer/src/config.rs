@@ -28,7 +28,8 @@
 //!   `VITREOUS_SIM_PANEL` (`cells_across,cells_down,blur_deg`, default `64,48,1.5`) where the
 //!   alpha asks, and the image's light added; with `VITREOUS_SIM_REGISTRATION` (`x_deg,y_deg`,
 //!   right and down, each within 10 degrees) the app's light and panel land that far from the
-//!   world, as a registration error puts them (to the nearest pixel).
+//!   world, as a registration error puts them (to the nearest pixel), and the view without
+//!   the error is written beside it (`wearer-left-registered.png`, ...).
 //! - `VITREOUS_SIM_FAULTS`: a fault schedule (`crate::faults::schedule`): what a misbehaving
 //!   headset does to the session, and when; `VITREOUS_SIM_FAULT_LOG`: the CSV file the layer
 //!   logs each fault and what the app did about it to (`crate::faults::log`).

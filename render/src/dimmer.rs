@@ -5,7 +5,7 @@
 //! With a dimmer, the eye passes draw into this pass's own `drawn` images (colour, with the
 //! floor's shadow as alpha, and depth), not into the frame's target. Then, outside any render
 //! pass, three compute dispatches per eye make the panel (shaders/dimmer_panel.wgsl: what each
-//! cell wants, spread by the panel's spread (or eroded), and the share the eye loses through the blurred
+//! cell wants, spread one cell or eroded, and the share the eye loses through the blurred
 //! panel); then inside the frame's own eye pass one full-screen triangle writes the light and
 //! the alpha (shaders/dimmer_resolve.wgsl). The model it assumes is
 //! [`vitreous_optics::display::dimmer`]'s, which the see-through preview also applies.

@@ -152,3 +152,34 @@ fn bad_shifts_and_rolls_are_refused_naming_the_option() {
     let out = without_scene(&["--ppd", "4"]);
     assert!(out.status.success(), "{out:?}");
 }
+
+#[test]
+fn replay_refuses_bad_shift_angles_naming_the_option() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = ml2();
+    let scene = scene.to_str().unwrap();
+    for (extra, says) in [
+        (
+            vec!["--compare-reference", "--compare-shift-deg", "0"],
+            "above 0",
+        ),
+        (
+            vec!["--compare-reference", "--compare-shift-deg", "0.1,nan"],
+            "--compare-shift-deg",
+        ),
+        (
+            vec!["--compare-reference", "--compare-shift-deg", "12"],
+            "at most 10",
+        ),
+        (vec!["--compare-shift-deg", "0.125"], "--compare-reference"),
+    ] {
+        let mut args = vec!["replay", scene, "--frames", "1", "--out", "out"];
+        args.extend_from_slice(&extra);
+        let out = vitreous(&args, dir.path());
+        assert_clean_failure(&out, &[says]);
+        assert!(
+            !dir.path().join("out").exists(),
+            "nothing written: {extra:?}"
+        );
+    }
+}

@@ -8,10 +8,10 @@
 //   needs most, max_c (1 - G_c / B_c); on the floor, the shadow's share the overlay wrote as
 //   alpha. Clamped to the panel's largest attenuation, each cell keeps the largest its pixels
 //   want (an atomic max on the bits of non-negative floats, which order as the floats do).
-// - `spread`, one per cell: the largest want within the panel's reach (render/src/dimmer/
-//   model.rs `Panel::reach`), so that the blurred panel still covers every pixel that wants
-//   darkening; what the wider patch takes away around it is given back as light by the
-//   resolve (dimmer_resolve.wgsl).
+// - `spread`, one per cell: the largest want within the panel's spread (optics/src/display/
+//   dimmer.rs `Panel::spread_wants`: one cell, less under a registration error), or with a
+//   negative spread the least (an erosion); what the blurred patch takes away beyond the
+//   target is given back as light by the resolve (dimmer_resolve.wgsl).
 // - `soften`, one per point of the grid FINE times finer than the cells: the share the eye
 //   loses through the panel, the cells' values weighted by the Gaussian's mass over each (as
 //   `Panel::soften`).
@@ -68,17 +68,24 @@ fn spread(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let c = vec2<i32>(vec2<u32>(id.x % cells().x, id.x / cells().x));
-    let reach = vec2<i32>(dimmer.blur.zw);
-    let lo = max(c - reach, vec2<i32>(0));
-    let hi = min(c + reach, vec2<i32>(cells()) - 1);
+    // A negative reach erodes: the least want within it (cells beyond the panel want none).
+    let erode = dimmer.blur.z < 0.0;
+    let reach = abs(vec2<i32>(dimmer.blur.zw));
+    let lo = c - reach;
+    let hi = c + reach;
     var most = 0.0;
+    var least = 1.0;
     for (var y = lo.y; y <= hi.y; y++) {
         for (var x = lo.x; x <= hi.x; x++) {
-            let w = atomicLoad(&wanted[layer() * n + u32(y) * cells().x + u32(x)]);
-            most = max(most, bitcast<f32>(w));
+            var w = 0.0;
+            if x >= 0 && y >= 0 && x < i32(cells().x) && y < i32(cells().y) {
+                w = bitcast<f32>(atomicLoad(&wanted[layer() * n + u32(y) * cells().x + u32(x)]));
+            }
+            most = max(most, w);
+            least = min(least, w);
         }
     }
-    panel[layer() * n + id.x] = most;
+    panel[layer() * n + id.x] = select(most, least, erode);
 }
 
 // The error function (Abramowitz and Stegun 7.1.26), as optics/src/display/dimmer.rs `erf`.

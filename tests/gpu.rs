@@ -16,6 +16,7 @@ mod live_maps;
 mod motion;
 mod refraction;
 mod refraction_scene;
+mod registration;
 mod render_smoke;
 mod replay;
 mod room;

@@ -324,6 +324,7 @@ fn moving_light_replay_recomputes_the_inducer_only_when_something_moved() {
         reflection: vitreous_render::Reflection::Phong,
         sphere_check: false,
         compare_reference: false,
+        compare_shifts_deg: Vec::new(),
         gaze: Default::default(),
     })
     .expect("replay");

@@ -13,7 +13,7 @@ use vitreous_trace::format::read_trace;
 use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
 
-fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOptions {
+pub(crate) fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOptions {
     ReplayOptions {
         scene: workspace().join("config/scenes").join(scene),
         trace: trace.map(|t| workspace().join("config/traces").join(t)),
@@ -30,6 +30,7 @@ fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOptions {
         reflection: vitreous_render::Reflection::Phong,
         sphere_check: false,
         compare_reference: false,
+        compare_shifts_deg: Vec::new(),
         gaze: Default::default(),
     }
 }

@@ -3,7 +3,9 @@
 //! closer) and PSNR (8-bit sRGB, all three channels), over the whole view and, with a scene,
 //! region by region (the object's disc, the shadow and caustic, the inducer's ramp, the rest);
 //! with what the eye sees when nothing is drawn, the same figures for it and for the additive
-//! limit beside the test's; optionally the ꟻLIP error map as a PNG. The figures, the regions
+//! limit beside the test's; with the display's light and panel misregistered by a given angle
+//! (`--shift-deg`, `--roll-deg`), the ring around the object beside the regions; optionally
+//! the ꟻLIP error map as a PNG. The figures, the regions
 //! and the images read are `vitreous-compare`'s; here the options, the display's light over
 //! the seen image as the scene's display shows it, and the table.
 
@@ -11,13 +13,14 @@ use std::path::PathBuf;
 
 use anyhow::{Result, bail};
 use vitreous_compare::{
-    Comparison, Eye, Png, RegionFigures, additive_limit, compare, flip, frame_for_scene,
-    reference_json_beside, regions, regions_of, rgb_of, scene_pixels_per_degree,
+    Comparison, Eye, Labels, Png, RegionFigures, additive_limit, compare, flip, frame_for_scene,
+    neutral_camera, reference_json_beside, rgb_of, scene_pixels_per_degree,
 };
 
 use vitreous_frames::input_files::InputFiles;
 use vitreous_frames::output::{EYE_NAMES, encode_png, write_atomic};
 use vitreous_frames::wearer::WearerView;
+use vitreous_optics::display::registration::{self, Misregistration};
 
 /// Options of `vitreous compare` (docs/cli.md).
 #[derive(clap::Args, Debug)]
@@ -55,6 +58,17 @@ pub struct CompareArgs {
     #[arg(long, value_name = "DEG", requires = "display", allow_negative_numbers = true,
           value_parser = parse_blur)]
     pub panel_blur_deg: Option<f32>,
+    /// With --display: the display's light and its dimmer's panel land this far from where
+    /// they belong against the seen image, degrees right and down (`X,Y`; each at most 10), as
+    /// a registration error puts them; the regions stay the real world's.
+    #[arg(long, value_name = "X,Y", requires = "display", allow_negative_numbers = true,
+          value_parser = parse_shift)]
+    pub shift_deg: Option<[f32; 2]>,
+    /// With --display: the display's image also turned this far about the view's centre,
+    /// degrees (clockwise as the eye sees it; at most 45).
+    #[arg(long, value_name = "DEG", requires = "display", allow_negative_numbers = true,
+          value_parser = parse_roll)]
+    pub roll_deg: Option<f32>,
     /// Write the ꟻLIP error map here (PNG, the magma colour map: black no error, yellow most).
     #[arg(long, value_name = "FILE")]
     pub map: Option<PathBuf>,
@@ -78,6 +92,29 @@ fn parse_blur(s: &str) -> std::result::Result<f32, String> {
     }
 }
 
+fn parse_shift(s: &str) -> std::result::Result<[f32; 2], String> {
+    let limit = registration::MAX_SHIFT_DEG;
+    let bad = || format!("expected X,Y in degrees, each from -{limit} to {limit}, found {s:?}");
+    let values: Vec<f32> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f32>().map_err(|_| bad()))
+        .collect::<std::result::Result<_, _>>()?;
+    match values[..] {
+        [x, y] if Misregistration::new([x, y], 0.0).is_ok() => Ok([x, y]),
+        _ => Err(bad()),
+    }
+}
+
+fn parse_roll(s: &str) -> std::result::Result<f32, String> {
+    let limit = registration::MAX_ROLL_DEG;
+    match s.parse::<f32>() {
+        Ok(v) if Misregistration::new([0.0, 0.0], v).is_ok() => Ok(v),
+        _ => Err(format!(
+            "expected a roll from -{limit} to {limit} degrees, found {s:?}"
+        )),
+    }
+}
+
 fn parse_ppd(s: &str) -> std::result::Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && (1.0..=1000.0).contains(&v) => Ok(v),
@@ -88,13 +125,20 @@ fn parse_ppd(s: &str) -> std::result::Result<f32, String> {
 }
 
 /// What the eye sees with `display` (sRGB RGBA8, alpha what a dimmer takes away) shown over
-/// `seen` (sRGB RGB8) on the display `view`: sRGB RGB8.
-fn add_light(view: &WearerView, display: &[u8], seen: &[u8], size: (u32, u32)) -> Vec<u8> {
+/// `seen` (sRGB RGB8) on the display `view`, misregistered by `error` at `ppd` pixels per
+/// degree: sRGB RGB8.
+fn add_light(
+    view: &WearerView,
+    display: &[u8],
+    seen: &[u8],
+    size: (u32, u32),
+    (error, ppd): (&Misregistration, f32),
+) -> Vec<u8> {
     let rgba: Vec<u8> = seen
         .chunks_exact(3)
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
-    rgb_of(&view.see(display, &rgba, [size.0, size.1]))
+    rgb_of(&view.see_misregistered(display, &rgba, [size.0, size.1], error, ppd))
 }
 
 /// How the wearer of `scene`'s display sees (added light without a scene), with the dimmer's
@@ -174,13 +218,33 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         .as_deref()
         .map(|path| Png::read_like(path, &reference))
         .transpose()?;
+    let ppd = args.ppd.unwrap_or_else(|| match &scene {
+        Some(s) => scene_pixels_per_degree(s, w),
+        None => flip::DEFAULT_PIXELS_PER_DEGREE,
+    });
+    let misregistration = Misregistration::new(
+        args.shift_deg.unwrap_or_default(),
+        args.roll_deg.unwrap_or_default(),
+    )?;
+    if !misregistration.is_none() && scene.is_none() && args.ppd.is_none() {
+        bail!(
+            "--shift-deg and --roll-deg need the image's pixels per degree: add --scene SCENE \
+             or --ppd PPD"
+        );
+    }
     // The display light over the seen image, as the scene's display composes them (its
-    // dimmers, when it has any; else added).
+    // dimmers, when it has any; else added), where the registration error puts it.
     let (test_rgb, test_alpha_used) = match &seen {
         Some(seen) if args.display => {
             let view = wearer_view(scene.as_ref(), args.panel_blur_deg)?;
             (
-                add_light(&view, &test.rgba, &seen.rgb(), (w, h)),
+                add_light(
+                    &view,
+                    &test.rgba,
+                    &seen.rgb(),
+                    (w, h),
+                    (&misregistration, ppd),
+                ),
                 view.panel.is_some(),
             )
         }
@@ -194,14 +258,10 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
     for warning in ignored.into_iter().flatten() {
         tracing::warn!("{warning}");
     }
-    let ppd = args.ppd.unwrap_or_else(|| match &scene {
-        Some(s) => scene_pixels_per_degree(s, w),
-        None => flip::DEFAULT_PIXELS_PER_DEGREE,
-    });
     let (labels, regions_from) = match &scene {
         Some(s) => match frame_for_scene(&args.reference, s, args.eye.map(Eye::index))? {
             Some(listed) => (
-                Some(regions_of(
+                Some(Labels::of(
                     s,
                     &listed.frame.eyes[listed.eye].camera(),
                     &listed.frame.placement(),
@@ -218,7 +278,13 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
             None => {
                 let eye = args.eye.unwrap_or(Eye::Left);
                 (
-                    Some(regions(s, eye, w, h)),
+                    Some(Labels::of(
+                        s,
+                        &neutral_camera(s, eye),
+                        &s.rest_placement(),
+                        w,
+                        h,
+                    )),
                     Some(format!("neutral head, {} eye", EYE_NAMES[eye.index()])),
                 )
             }
@@ -226,9 +292,8 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         None => (None, None),
     };
     let reference = reference.rgb();
-    let (error, figures) = compare(&reference, &test_rgb, (w, h), ppd, labels.as_deref())?;
-    let rows =
-        |image: &[u8]| compare(&reference, image, (w, h), ppd, labels.as_deref()).map(|r| r.1);
+    let (error, figures) = compare(&reference, &test_rgb, (w, h), ppd, labels.as_ref())?;
+    let rows = |image: &[u8]| compare(&reference, image, (w, h), ppd, labels.as_ref()).map(|r| r.1);
     let seen = seen.map(|s| s.rgb());
     let nothing_drawn = seen.as_deref().map(rows).transpose()?;
     let limit = seen
@@ -252,6 +317,11 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         scene: args.scene.as_ref().map(|p| p.display().to_string()),
         regions_from,
         display_added_to_seen: args.display,
+        misregistration_deg: (!misregistration.is_none()).then_some([
+            misregistration.shift_deg[0],
+            misregistration.shift_deg[1],
+            misregistration.roll_deg,
+        ]),
         regions: figures,
         nothing_drawn,
         additive_limit: limit,
@@ -270,10 +340,12 @@ fn table(report: &Comparison) -> String {
     let mut out = format!(
         "{}{} against {} ({}x{}, {:.1} pixels per degree{})\n{:<16} {:>9} {:>10} {:>10}",
         report.test,
-        if report.display_added_to_seen {
-            " over the seen image"
-        } else {
-            ""
+        match (report.display_added_to_seen, report.misregistration_deg) {
+            (true, Some([x, y, roll])) => format!(
+                " over the seen image, misregistered {x} degrees right, {y} down, {roll} turned"
+            ),
+            (true, None) => " over the seen image".to_owned(),
+            _ => String::new(),
         },
         report.reference,
         report.width_px,

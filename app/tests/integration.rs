@@ -8,6 +8,7 @@ mod gaze_filter;
 mod gaze_trace;
 mod gaze_vergence;
 mod interrupted;
+mod misregistration;
 mod numeric_options;
 mod outputs;
 mod reference;

@@ -156,12 +156,43 @@ fn a_dimmer_display_takes_magic_leap_2s_defaults_and_refuses_what_it_cannot_be()
         good_text()
     );
     let (_dir, _path, scene) = load_text(&text);
-    let dimmer = scene.unwrap().dimmer.expect("a dimmer");
+    let scene = scene.unwrap();
+    let dimmer = scene.dimmer.expect("a dimmer");
     assert_eq!(
         (dimmer.cells, dimmer.blur_deg, dimmer.max),
         ([32, 24], 2.0, 0.5)
     );
+    // The registration error the display is planned for: the default, or the scene's, also
+    // handed to the dimmer.
+    assert_eq!(scene.registration_error_deg, 0.125);
+    assert_eq!(dimmer.registration_error_deg, 0.125);
+    let text = format!(
+        "{}\n[display]\nmodel = \"dimmer\"\nregistration_error_deg = 0.5\n",
+        good_text()
+    );
+    let (_dir, _path, scene) = load_text(&text);
+    let scene = scene.unwrap();
+    assert_eq!(scene.registration_error_deg, 0.5);
+    assert_eq!(scene.dimmer.unwrap().registration_error_deg, 0.5);
     let cases = [
+        (
+            "registration_error_deg = -0.1",
+            "registration_error_deg =",
+            "display.registration_error_deg",
+            ">= 0",
+        ),
+        (
+            "registration_error_deg = nan",
+            "registration_error_deg =",
+            "display.registration_error_deg",
+            "found NaN",
+        ),
+        (
+            "model = \"dimmer\"\nregistration_error_deg = 6",
+            "registration_error_deg =",
+            "display.registration_error_deg",
+            "<= 5",
+        ),
         (
             "model = \"lcd\"",
             "model = \"lcd\"",

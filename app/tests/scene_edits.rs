@@ -72,6 +72,7 @@ fn recorded_edits_offset_the_keyframes_and_move_the_scene_once_each() {
         reflection: vitreous_render::Reflection::Phong,
         sphere_check: false,
         compare_reference: false,
+        compare_shifts_deg: Vec::new(),
         gaze: Default::default(),
     })
     .expect("replay");

@@ -5,7 +5,7 @@
 //! With a dimmer, the eye passes draw into this pass's own `drawn` images (colour, with the
 //! floor's shadow as alpha, and depth), not into the frame's target. Then, outside any render
 //! pass, three compute dispatches per eye make the panel (shaders/dimmer_panel.wgsl: what each
-//! cell wants, spread by the blur's reach, and the share the eye loses through the blurred
+//! cell wants, spread one cell or eroded, and the share the eye loses through the blurred
 //! panel); then inside the frame's own eye pass one full-screen triangle writes the light and
 //! the alpha (shaders/dimmer_resolve.wgsl). The model it assumes is
 //! [`vitreous_optics::display::dimmer`]'s, which the see-through preview also applies.
@@ -236,7 +236,7 @@ impl DimmerPass {
     /// The push constants of eye `index`.
     fn push(&self, eye: &EyeParams, index: usize) -> DimmerPush {
         let panel = self.panel_of(eye);
-        let reach = panel.reach();
+        let spread = panel.spread as f32;
         let [cx, cy] = self.desc.cells;
         DimmerPush {
             world_from_clip: eye.clip_from_world().inverse().to_cols_array(),
@@ -247,12 +247,7 @@ impl DimmerPass {
                 cx as f32,
                 cy as f32,
             ],
-            blur: [
-                panel.sigma[0],
-                panel.sigma[1],
-                reach[0] as f32,
-                reach[1] as f32,
-            ],
+            blur: [panel.sigma[0], panel.sigma[1], spread, spread],
             limits: [self.desc.max, FINE as f32, 0.0, 0.0],
         }
     }

@@ -8,7 +8,8 @@ struct Dimmer {
     position: vec4<f32>,
     // x, y: the eye image's size in pixels; z, w: the panel's cells across and down.
     size: vec4<f32>,
-    // x, y: the blur's standard deviation in cells, across and down; z, w: the reach in cells.
+    // x, y: the blur's standard deviation in cells, across and down; z, w: the spread in cells
+    // (`Panel::spread`; negative: an erosion).
     blur: vec4<f32>,
     // x: the largest share a cell takes away; y: grid points per cell side (FINE).
     limits: vec4<f32>,

@@ -9,7 +9,7 @@ use vitreous_optics::camera::EyeParams;
 use vitreous_scene::{Placement, Scene};
 
 use crate::flip;
-use crate::regions::{Region, regions_of};
+use crate::regions::{Labels, Region};
 
 /// The figures of one region.
 #[derive(Clone, Debug, Serialize)]
@@ -44,6 +44,10 @@ pub struct Comparison {
     pub regions_from: Option<String>,
     /// Whether TEST was the display's light, added to the seen image (`--display`).
     pub display_added_to_seen: bool,
+    /// With `--shift-deg` or `--roll-deg`: how far the display's light and panel landed from
+    /// where they belong, degrees: right, down, and turned.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub misregistration_deg: Option<[f32; 3]>,
     /// The whole view first, then each region of the scene.
     pub regions: Vec<RegionFigures>,
     /// With `--seen`: the same figures for what the eye sees with nothing drawn.
@@ -69,13 +73,14 @@ fn psnr(squared_error: f64, values: u64) -> Option<f64> {
 }
 
 /// Compares `test` with `reference`: ꟻLIP's error map and the figures per region (`labels`:
-/// each pixel's region, or none for the whole view only).
+/// each pixel's region and the ring around the object, rows after the whole view's; or none
+/// for the whole view only).
 pub fn compare(
     reference: &[u8],
     test: &[u8],
     (width, height): (u32, u32),
     ppd: f32,
-    labels: Option<&[Region]>,
+    labels: Option<&Labels>,
 ) -> Result<(Vec<f32>, Vec<RegionFigures>)> {
     let error = flip::error_map(reference, test, (width, height), ppd)?;
     let squared: Vec<f64> = reference
@@ -105,8 +110,9 @@ pub fn compare(
     let mut out = vec![figures("whole", &|_| true)];
     if let Some(labels) = labels {
         for region in Region::ALL {
-            out.push(figures(region.name(), &|i| labels[i] == region));
+            out.push(figures(region.name(), &|i| labels.regions[i] == region));
         }
+        out.push(figures("around", &|i| labels.around[i]));
     }
     Ok((error, out))
 }
@@ -125,6 +131,21 @@ pub struct ReferenceFigures {
     pub nothing_drawn: Vec<RegionFigures>,
     /// The additive limit, max(seen, reference).
     pub additive_limit: Vec<RegionFigures>,
+    /// The display's light over the seen image with the display misregistered, one entry per
+    /// registration error asked for (`replay --compare-shift-deg`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub misregistered: Vec<ShiftedFigures>,
+}
+
+/// The figures of what the eye sees with the display's light and panel misregistered.
+#[derive(Clone, Debug, Serialize)]
+pub struct ShiftedFigures {
+    /// How far the display's image lands from where it belongs, degrees, right and down.
+    pub shift_deg: [f32; 2],
+    /// How far it is turned about the view's centre, degrees.
+    pub roll_deg: f32,
+    /// Whole view, each region, the ring.
+    pub regions: Vec<RegionFigures>,
 }
 
 /// Measures `shown` (RGB8, what the eye sees: the display's light over the seen image) and
@@ -139,14 +160,53 @@ pub fn against_reference(
     (w, h): (u32, u32),
 ) -> Result<[Vec<RegionFigures>; 3]> {
     let [real, seen, shown] = images;
-    let ppd = scene_pixels_per_degree(scene, w);
-    let labels = regions_of(scene, camera, placement, w, h);
-    let rows = |image: &[u8]| compare(real, image, (w, h), ppd, Some(&labels)).map(|r| r.1);
+    let against = Against::new(scene, camera, placement, real, (w, h));
     Ok([
-        rows(shown)?,
-        rows(seen)?,
-        rows(&additive_limit(seen, real))?,
+        against.rows(shown)?,
+        against.rows(seen)?,
+        against.rows(&additive_limit(seen, real))?,
     ])
+}
+
+/// One eye's physical reference with its regions, to measure several images against.
+pub struct Against<'a> {
+    /// The reference, RGB8.
+    real: &'a [u8],
+    /// Its regions and the ring around the object.
+    labels: Labels,
+    /// Its size, pixels.
+    size: (u32, u32),
+    /// The scene's pixels per degree at that size.
+    ppd: f32,
+}
+
+impl<'a> Against<'a> {
+    /// `real` (RGB8, `size`) seen by `camera`, with the object and light at `placement`.
+    pub fn new(
+        scene: &Scene,
+        camera: &EyeParams,
+        placement: &Placement,
+        real: &'a [u8],
+        size: (u32, u32),
+    ) -> Against<'a> {
+        Against {
+            real,
+            labels: Labels::of(scene, camera, placement, size.0, size.1),
+            size,
+            ppd: scene_pixels_per_degree(scene, size.0),
+        }
+    }
+
+    /// The figures of `image` (RGB8) against the reference: the whole view, each region, the
+    /// ring.
+    pub fn rows(&self, image: &[u8]) -> Result<Vec<RegionFigures>> {
+        compare(self.real, image, self.size, self.ppd, Some(&self.labels)).map(|r| r.1)
+    }
+
+    /// The pixels per degree the figures are measured at.
+    pub fn pixels_per_degree(&self) -> f32 {
+        self.ppd
+    }
 }
 
 /// The pixels per degree of a `width`-pixel image across the scene's horizontal field of view.

@@ -6,7 +6,7 @@
 //! | module | what it is |
 //! |---|---|
 //! | [`figures`] | the figures per region, the additive limit, a frame measured against the physical reference, the reports |
-//! | [`regions`] | where in an eye image the object's disc, the shadow and caustic, the inducer's ramp and the rest lie |
+//! | [`regions`] | where in an eye image the object's disc, the shadow and caustic, the inducer's ramp and the rest lie, and the ring around the disc |
 //! | [`listed`] | which frame and eye a reference image is, from the `reference.json` beside it |
 //! | [`images`] | the PNG images compared, read with every error naming the file |
 //! | [`flip`] | ꟻLIP itself, and its colour map for the error map |
@@ -18,9 +18,9 @@ pub mod listed;
 pub mod regions;
 
 pub use figures::{
-    Comparison, ReferenceFigures, RegionFigures, additive_limit, against_reference, compare,
-    rgb_of, scene_pixels_per_degree,
+    Against, Comparison, ReferenceFigures, RegionFigures, ShiftedFigures, additive_limit,
+    against_reference, compare, rgb_of, scene_pixels_per_degree,
 };
 pub use images::Png;
 pub use listed::{Listed, REFERENCE_JSON, frame_for_scene, frame_of_image, reference_json_beside};
-pub use regions::{Eye, Region, regions, regions_of};
+pub use regions::{Eye, Labels, RING_DEG, Region, neutral_camera, regions, regions_of, ring_of};

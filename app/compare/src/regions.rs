@@ -84,9 +84,20 @@ impl Eye {
 /// The region of every pixel of a `width` x `height` image of `eye` at the scene's neutral
 /// head (looking down -z from `viewer.head_position_m`), row by row.
 pub fn regions(scene: &Scene, eye: Eye, width: u32, height: u32) -> Vec<Region> {
+    regions_of(
+        scene,
+        &neutral_camera(scene, eye),
+        &scene.rest_placement(),
+        width,
+        height,
+    )
+}
+
+/// The camera of `eye` at the scene's neutral head.
+pub fn neutral_camera(scene: &Scene, eye: Eye) -> EyeParams {
     let position = scene.viewer.neutral_eye_positions_m()[eye.index()];
     let fov = scene.output.fov;
-    let camera = EyeRecord {
+    EyeRecord {
         position_m: position.to_array(),
         orientation_xyzw: Quat::IDENTITY.to_array(),
         fov_rad: [
@@ -96,8 +107,70 @@ pub fn regions(scene: &Scene, eye: Eye, width: u32, height: u32) -> Vec<Region> 
             fov.angle_down_rad,
         ],
     }
-    .camera();
-    regions_of(scene, &camera, &scene.rest_placement(), width, height)
+    .camera()
+}
+
+/// How wide the ring around the object's disc is ([`Labels::around`]), degrees: 80 pixels at
+/// 32 pixels per degree, the reach of a registration error's ghost and of a dimmer's halo.
+pub const RING_DEG: f32 = 2.5;
+
+/// Every pixel's region, and the ring around the object's disc (which overlaps the regions
+/// outside it).
+#[derive(Clone, Debug)]
+pub struct Labels {
+    /// Each pixel's region, row by row.
+    pub regions: Vec<Region>,
+    /// Whether each pixel lies outside the object's disc, within [`RING_DEG`] of its outline.
+    pub around: Vec<bool>,
+}
+
+impl Labels {
+    /// The labels of a `width` x `height` image seen by `camera`, with the object and the
+    /// light at `placement`.
+    pub fn of(
+        scene: &Scene,
+        camera: &EyeParams,
+        placement: &Placement,
+        width: u32,
+        height: u32,
+    ) -> Labels {
+        Labels {
+            regions: regions_of(scene, camera, placement, width, height),
+            around: ring_of(scene, camera, placement, width, height, RING_DEG),
+        }
+    }
+}
+
+/// Whether each pixel of a `width` x `height` image seen by `camera` lies outside the object's
+/// disc (its bounding sphere at `placement`) and within `ring_deg` of its outline, row by row.
+pub fn ring_of(
+    scene: &Scene,
+    camera: &EyeParams,
+    placement: &Placement,
+    width: u32,
+    height: u32,
+    ring_deg: f32,
+) -> Vec<bool> {
+    let to_centre = placement.object_position_m - camera.position_m;
+    let distance = to_centre.length();
+    let radius = scene.object.radius_m;
+    // Inside the sphere every direction is the disc.
+    let outline = if distance > radius {
+        (radius / distance).asin()
+    } else {
+        std::f32::consts::PI
+    };
+    let reach = outline + ring_deg.to_radians();
+    let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
+    let mut out = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let dir = rays.direction(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let angle = dir.angle_between(to_centre);
+            out.push(angle > outline && angle <= reach);
+        }
+    }
+    out
 }
 
 /// The region of every pixel of a `width` x `height` image seen by `camera`, with the object

@@ -451,9 +451,10 @@ mod tests {
         Dimmed {
             points,
             panel: vitreous_optics::display::dimmer::DimmerDesc {
-                cells: [64, 64],
+                cells: [16, 16],
                 blur_deg: 1.0,
                 max: 0.9,
+                registration_error_deg: 0.0,
             },
         }
     }
@@ -461,9 +462,9 @@ mod tests {
     #[test]
     fn a_dimmer_needs_alpha_at_the_object_and_its_shadow_and_none_far_away() {
         // A 0.03 m object 1 m ahead: a disc of about 1 px radius; the image dims the 4 px
-        // around it, where the shadow's point (1.6 px below) lies too. A panel of 64 x 64 cells
-        // over the 57-degree view with a blur of 1 degree reaches 4 cells (with one more,
-        // 2.5 px): away is beyond about 4.5 px.
+        // around it, where the shadow's point (1.6 px below) lies too. A panel of 16 x 16 cells
+        // (2 px each) spreads a want one cell (with one more, 4 px): away is beyond about
+        // 5 px.
         let dimmed = image([0, 0, 0, 0], [200, 200, 200, 180]);
         let shadow = glam::Vec3::new(0.0, -0.05, -1.0);
         let c = check_readback(

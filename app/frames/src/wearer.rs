@@ -5,7 +5,9 @@
 //! eye image's pixels there (as a runtime would drive it), seen through the panel's blur
 //! (vitreous_optics::display::dimmer).
 
+use glam::Vec2;
 use vitreous_optics::display::dimmer::{DimmerDesc, Panel};
+use vitreous_optics::display::registration::Misregistration;
 
 /// What the wearer perceives: the display's light added to the real world's, in linear light
 /// (an optical see-through display can only add). Both inputs and the output are sRGB RGBA8.
@@ -122,6 +124,71 @@ impl WearerView {
     }
 }
 
+impl WearerView {
+    /// What the eye sees of `eye` over `world` (as [`WearerView::see`]) when the display's light
+    /// and its panel land `error` away from where they belong, at `ppd` pixels per degree:
+    /// every pixel of the world meets the display's light and panel of the point
+    /// [`Misregistration::display_point`] gives (bilinear between pixels; beyond the display's
+    /// edge no light and no panel).
+    pub fn see_misregistered(
+        &self,
+        eye: &[u8],
+        world: &[u8],
+        size: [u32; 2],
+        error: &Misregistration,
+        ppd: f32,
+    ) -> Vec<u8> {
+        if error.is_none() {
+            return self.see(eye, world, size);
+        }
+        let lut: Vec<f32> = (0..=255u8).map(vitreous_optics::srgb::to_linear).collect();
+        let passed = self.passed(eye, size);
+        let outside = 1.0 - self.global_dimmer;
+        let [w, h] = size;
+        // The display's light (linear RGB) and the share of the world it passes at pixel i.
+        let texel = |x: i64, y: i64| -> [f32; 4] {
+            if x < 0 || y < 0 || x >= i64::from(w) || y >= i64::from(h) {
+                return [0.0, 0.0, 0.0, outside];
+            }
+            let i = (y as usize) * w as usize + x as usize;
+            let e = &eye[i * 4..i * 4 + 3];
+            [
+                lut[e[0] as usize],
+                lut[e[1] as usize],
+                lut[e[2] as usize],
+                passed[i],
+            ]
+        };
+        let mut out = Vec::with_capacity(world.len());
+        for (i, px) in world.chunks_exact(4).enumerate() {
+            let (x, y) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
+            let p = error.display_point(Vec2::new(x, y), size, ppd) - Vec2::splat(0.5);
+            let (x0, y0) = (p.x.floor(), p.y.floor());
+            let (fx, fy) = (p.x - x0, p.y - y0);
+            let (x0, y0) = (x0 as i64, y0 as i64);
+            let mut sum = [0.0f32; 4];
+            for (dx, dy, weight) in [
+                (0, 0, (1.0 - fx) * (1.0 - fy)),
+                (1, 0, fx * (1.0 - fy)),
+                (0, 1, (1.0 - fx) * fy),
+                (1, 1, fx * fy),
+            ] {
+                if weight > 0.0 {
+                    let t = texel(x0 + dx, y0 + dy);
+                    for (s, v) in sum.iter_mut().zip(t) {
+                        *s += weight * v;
+                    }
+                }
+            }
+            let c = |c: usize| {
+                vitreous_optics::srgb::from_linear(sum[c] + sum[3] * lut[px[c] as usize])
+            };
+            out.extend([c(0), c(1), c(2), 255]);
+        }
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -165,6 +232,7 @@ mod tests {
             cells: [16, 12],
             blur_deg: 2.5,
             max: 1.0,
+            registration_error_deg: 0.0,
         };
         let view = WearerView::new(Some(desc), None, [40.0, 30.0]);
         let (w, h) = (160u32, 120u32);
@@ -188,5 +256,53 @@ mod tests {
             at(60, 60)
         );
         assert_eq!(at(5, 5), 200);
+    }
+
+    #[test]
+    fn a_misregistered_display_lands_its_light_and_panel_elsewhere() {
+        let desc = DimmerDesc {
+            cells: [16, 12],
+            blur_deg: 0.5,
+            max: 1.0,
+            registration_error_deg: 0.0,
+        };
+        let view = WearerView::new(Some(desc), None, [40.0, 30.0]);
+        let (w, h) = (160u32, 120u32);
+        // A bright light and full alpha over the middle 4 x 4 cells (pixels 60-99, 40-79).
+        let mut eye = vec![0u8; (w * h * 4) as usize];
+        for y in 40..80 {
+            for x in 60..100 {
+                eye[((y * w + x) * 4) as usize..((y * w + x) * 4 + 4) as usize]
+                    .copy_from_slice(&[250, 250, 250, 255]);
+            }
+        }
+        let world = vec![100u8; (w * h * 4) as usize];
+        let size = [w, h];
+        let ppd = 4.0;
+        let none = Misregistration::default();
+        assert_eq!(
+            view.see_misregistered(&eye, &world, size, &none, ppd),
+            view.see(&eye, &world, size)
+        );
+        // Two degrees right (8 px): the light's left edge moves from x = 60 to 68.
+        let right = Misregistration::new([2.0, 0.0], 0.0).unwrap();
+        let moved = view.see_misregistered(&eye, &world, size, &right, ppd);
+        let plain = view.see(&eye, &world, size);
+        let at = |img: &[u8], x: u32, y: u32| img[((y * w + x) * 4) as usize];
+        assert_eq!(at(&plain, 64, 60), 250);
+        // There the world as it is now (the panel moved too), and the light 8 px further on.
+        assert!(
+            at(&moved, 64, 60).abs_diff(100) < 5,
+            "{}",
+            at(&moved, 64, 60)
+        );
+        assert_eq!(at(&moved, 72, 60), 250);
+        assert!(at(&plain, 104, 60).abs_diff(100) < 5 && at(&moved, 104, 60) >= 250);
+        // The shifted image is the plain one moved by 8 px, away from the edges.
+        for y in 10..110 {
+            for x in 20..140 {
+                assert_eq!(at(&moved, x + 8, y), at(&plain, x, y), "{x} {y}");
+            }
+        }
     }
 }

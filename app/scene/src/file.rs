@@ -104,6 +104,7 @@ pub(crate) struct DisplayToml {
     pub dimmer_cells: Option<Spanned<Vec<f32>>>,
     pub dimmer_blur_deg: Option<Spanned<f32>>,
     pub dimmer_max: Option<Spanned<f32>>,
+    pub registration_error_deg: Option<Spanned<f32>>,
 }
 
 /// `[motion]`: keyframes of the object and the light.

@@ -98,6 +98,10 @@ pub struct Scene {
     pub global_dimmer: Option<f32>,
     /// The display's segmented dimmer (`[display] model = "dimmer"`), when it has one.
     pub dimmer: Option<vitreous_optics::display::dimmer::DimmerDesc>,
+    /// How far the display's light may land from where the real world is, degrees, one
+    /// standard deviation per axis (`[display] registration_error_deg`); the dimmer's panel
+    /// and light are planned for it.
+    pub registration_error_deg: f32,
     /// The shadow inducer's parameters.
     pub inducer: Inducer,
     /// The caustic bake (eq. 6): where it is and, once [`Scene::load_caustics`] ran, its

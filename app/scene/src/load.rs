@@ -475,6 +475,7 @@ impl Loader<'_> {
             compensation: display.compensation,
             global_dimmer: display.global_dimmer,
             dimmer: display.dimmer,
+            registration_error_deg: display.registration_error_deg,
             caustics,
             warnings,
             motion,

@@ -71,6 +71,12 @@ pub struct ReplayArgs {
     /// it, beside the seen image's and the additive limit's.
     #[arg(long)]
     pub compare_reference: bool,
+    /// With --compare-reference: also measure what the eye sees with the display's light and
+    /// its dimmer's panel misregistered by each of these angles (degrees, comma-separated,
+    /// each above 0 and at most 10), shifted right, left, down and up in turn.
+    #[arg(long, value_name = "DEG,...", requires = "compare_reference", value_delimiter = ',',
+          value_parser = parse_shift_angle)]
+    pub compare_shift_deg: Vec<f32>,
     /// Gaze image: auto (from the wearer's fixation depth), or forced to surface or
     /// refracted, as the paper's experimenter did; default: the scene's `[gaze] image`.
     #[arg(long, value_name = "IMAGE")]
@@ -122,6 +128,7 @@ pub fn replay_command(a: ReplayArgs) -> Result<()> {
         reflection: a.reflection.into(),
         sphere_check: a.sphere_check,
         compare_reference: a.compare_reference,
+        compare_shifts_deg: a.compare_shift_deg,
         gaze: GazeSettings {
             filter: a.filter,
             image: a.gaze_image,
@@ -154,6 +161,17 @@ fn written_line(saved: &[String], out: &std::path::Path) -> String {
     )];
     parts.extend(files.iter().map(|f| f.to_string()));
     format!("wrote {} and {last} to {}", parts.join(", "), out.display())
+}
+
+/// One angle of `--compare-shift-deg`.
+fn parse_shift_angle(s: &str) -> std::result::Result<f32, String> {
+    let limit = vitreous_optics::display::registration::MAX_SHIFT_DEG;
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= limit => Ok(v),
+        _ => Err(format!(
+            "expected angles above 0 and at most {limit} degrees, found {s:?}"
+        )),
+    }
 }
 
 #[cfg(test)]

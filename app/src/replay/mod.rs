@@ -78,6 +78,9 @@ pub struct ReplayOptions {
     /// Also render the physical reference of every saved frame (`vitreous reference`) and
     /// measure what the eye sees against it.
     pub compare_reference: bool,
+    /// With `compare_reference`: also measure with the display's light and panel misregistered
+    /// by each of these angles (degrees), right, left, down and up.
+    pub compare_shifts_deg: Vec<f32>,
     /// Depth filter and gaze-image override of the gaze pipeline (used with defocus).
     pub gaze: GazeSettings,
 }
@@ -442,6 +445,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
             }
             Physical {
                 scene,
+                shifts_deg: options.compare_shifts_deg.clone(),
                 pending: Vec::new(),
                 figures: Vec::new(),
                 reports: Vec::new(),

@@ -1,12 +1,14 @@
 //! `replay --compare-reference`: the physical reference of every saved frame, written beside
 //! it, and what the eye sees measured against it; a `reference.json` beside them says which
-//! frame and eye each reference image is, so `vitreous compare` finds their regions.
+//! frame and eye each reference image is, so `vitreous compare` finds their regions. With
+//! `--compare-shift-deg`, the same figures with the display misregistered by each angle.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use vitreous_compare::{ReferenceFigures, against_reference, rgb_of};
+use vitreous_compare::{Against, ReferenceFigures, ShiftedFigures, additive_limit, rgb_of};
+use vitreous_optics::display::registration::Misregistration;
 use vitreous_reference::{FrameReport, ReferenceSettings, Report, render_reference, srgb_rgba};
 use vitreous_trace::FrameInput;
 
@@ -20,6 +22,8 @@ use vitreous_scene::{Placement, Scene};
 pub(super) struct Physical {
     /// The scene, with its caustic bake read when it has one (the caustic is a region).
     pub(super) scene: Scene,
+    /// The registration errors to measure beside the registered display, degrees.
+    pub(super) shifts_deg: Vec<f32>,
     /// Saved frames in flight: index and where the object and light were.
     pub(super) pending: Vec<(u64, Placement)>,
     /// Each finished saved frame's figures, per eye.
@@ -68,20 +72,36 @@ impl Physical {
             }
             // The display's light over the seen image, as the scene's display shows it.
             let display = WearerView::of_scene(&self.scene);
-            let shown = rgb_of(&display.see(&readback.eyes[eye], &seen, [size.0, size.1]));
-            let [regions, nothing_drawn, additive_limit] = against_reference(
-                &self.scene,
-                &cameras[eye],
-                &placement,
-                [&rgb_of(&real), &rgb_of(&seen), &shown],
-                size,
-            )?;
+            let real = rgb_of(&real);
+            let against = Against::new(&self.scene, &cameras[eye], &placement, &real, size);
+            let shown = |error: &Misregistration| {
+                rgb_of(&display.see_misregistered(
+                    &readback.eyes[eye],
+                    &seen,
+                    [size.0, size.1],
+                    error,
+                    against.pixels_per_degree(),
+                ))
+            };
+            let seen_rgb = rgb_of(&seen);
+            let mut misregistered = Vec::new();
+            for &angle in &self.shifts_deg {
+                for shift_deg in [[angle, 0.0], [-angle, 0.0], [0.0, angle], [0.0, -angle]] {
+                    let error = Misregistration::new(shift_deg, 0.0)?;
+                    misregistered.push(ShiftedFigures {
+                        shift_deg,
+                        roll_deg: 0.0,
+                        regions: against.rows(&shown(&error))?,
+                    });
+                }
+            }
             self.figures.push(ReferenceFigures {
                 frame: input.index,
                 eye: name,
-                regions,
-                nothing_drawn,
-                additive_limit,
+                regions: against.rows(&shown(&Misregistration::default()))?,
+                nothing_drawn: against.rows(&seen_rgb)?,
+                additive_limit: against.rows(&additive_limit(&seen_rgb, &real))?,
+                misregistered,
             });
         }
         self.reports.push(FrameReport {

@@ -55,6 +55,8 @@ pub enum Action {
     Eyes,
     /// Switch between the display's light and the see-through preview.
     Preview,
+    /// The next registration error the see-through preview shows the display with.
+    Misregister,
     /// Show or hide the overlay.
     Overlay,
     /// List the keys.
@@ -103,6 +105,10 @@ pub const KEYS: &[(&str, &str)] = &[
     ("N", "noise on the gaze rays on / off"),
     ("V", "eyes: both, left, right"),
     ("P", "display light / see-through preview"),
+    (
+        "X",
+        "preview's registration error: none, 0.125, 0.25 deg right",
+    ),
     ("H", "overlay on / off"),
     (
         "K / L / J",
@@ -136,6 +142,7 @@ pub fn action_for_key(name: &str, shift: bool) -> Option<Action> {
         "n" => Action::Noise,
         "v" => Action::Eyes,
         "p" => Action::Preview,
+        "x" => Action::Misregister,
         "h" => Action::Overlay,
         "f1" => Action::Help,
         "r" => Action::Recentre,

@@ -28,6 +28,11 @@ use vitreous_frames::director::Director;
 use vitreous_frames::frame_loop::{FramePlan, FrameSink};
 use vitreous_frames::motion_clock::MotionClock;
 use vitreous_frames::scene_edit::SceneEdit;
+use vitreous_optics::display::registration::Misregistration;
+
+/// The registration errors the see-through preview cycles through (key X), degrees to the
+/// right: none, and the two the realism figures are measured at (docs/display.md).
+const MISREGISTRATION_DEG: [f32; 3] = [0.0, 0.125, 0.25];
 use vitreous_frames::validation::ValidationSummary;
 use vitreous_gaze::{FilterKind, FixationDepth, GazeOverride};
 use vitreous_scene::Scene;
@@ -62,6 +67,8 @@ pub struct ViewSink<'d> {
     shared: Rc<RefCell<Shared>>,
     /// Show the see-through preview instead of the display's light.
     preview: bool,
+    /// The preview's registration error: an index of [`MISREGISTRATION_DEG`].
+    misregistration: usize,
     /// Show the overlay.
     show_overlay: bool,
     /// List the keys in the overlay.
@@ -138,6 +145,7 @@ impl<'d> ViewSink<'d> {
             presenter,
             shared,
             preview: options.preview,
+            misregistration: 0,
             show_overlay: options.overlay,
             help: false,
             see: SeeThrough::new(),
@@ -349,6 +357,15 @@ impl<'d> ViewSink<'d> {
                     "display light alone".into()
                 }
             }
+            Action::Misregister => {
+                self.misregistration = (self.misregistration + 1) % MISREGISTRATION_DEG.len();
+                let deg = MISREGISTRATION_DEG[self.misregistration];
+                if deg == 0.0 {
+                    "preview registered".into()
+                } else {
+                    format!("preview with the display {deg} degrees right of the world")
+                }
+            }
             Action::Overlay => {
                 self.show_overlay = !self.show_overlay;
                 return None;
@@ -527,6 +544,31 @@ impl FrameSink for ViewSink<'_> {
             _ => None,
         };
         let world = dimmed.as_ref().or(readback.world.as_ref());
+        // Misregistered, the display's light and panel over the world, composed here.
+        let shift_deg = MISREGISTRATION_DEG[self.misregistration];
+        let misregistered = match (&readback.world, self.preview && shift_deg > 0.0) {
+            (Some(world), true) => {
+                let size = [readback.width, readback.height];
+                let fov = vitreous_frames::wearer::scene_fov_deg(&self.loaded.scene);
+                let error = Misregistration::new([shift_deg, 0.0], 0.0)?;
+                let mut shown = readback.clone();
+                shown.eyes = [0, 1].map(|e| {
+                    display.see_misregistered(
+                        &readback.eyes[e],
+                        &world[e],
+                        size,
+                        &error,
+                        readback.width as f32 / fov[0],
+                    )
+                });
+                Some(shown)
+            }
+            _ => None,
+        };
+        let (readback, preview) = match &misregistered {
+            Some(shown) => (shown, None),
+            None => (readback, preview),
+        };
         let overlay = &self.overlay;
         let ready = self.shared.borrow().window_ready;
         let shown = self.presenter.present(ready, |out, w, h| {

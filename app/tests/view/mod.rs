@@ -570,3 +570,43 @@ fn the_preview_of_a_dimmer_scene_shows_the_glass_darker_than_the_world_behind_it
         "the wall at luma {d} with the dimmer, {a} without"
     );
 }
+
+#[test]
+fn key_x_shows_the_preview_with_the_display_misregistered() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene("glass-sphere-ml2.toml");
+    // Key X twice: the display 0.25 degrees right of the world.
+    let script = dir.path().join("x.script");
+    std::fs::write(&script, "1 key x\n2 key x\n6 key escape\n").unwrap();
+    let (before, after) = (
+        dir.path().join("registered.png"),
+        dir.path().join("shifted.png"),
+    );
+    let common = ["--effects", "none", "--preview", "--screenshot"];
+    let mut args = common.to_vec();
+    args.extend([before.to_str().unwrap(), "--frames", "6"]);
+    view(&xvfb, &scene, &args, dir.path());
+    let mut args = common.to_vec();
+    args.extend([
+        after.to_str().unwrap(),
+        "--script",
+        script.to_str().unwrap(),
+    ]);
+    args.extend(["--frames", "100"]);
+    let out = view(&xvfb, &scene, &args, dir.path());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("0.25 degrees right of the world"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (a, b) = (Shot::read(&before), Shot::read(&after));
+    let (inside, outside) = regions(&glass_discs(&scene));
+    let diff = |&(x, y): &(u32, u32)| (a.luma(x, y) - b.luma(x, y)).abs();
+    let inside_diff = inside.iter().map(diff).sum::<f32>() / inside.len() as f32;
+    assert!(inside_diff > 2.0, "the glass changed by {inside_diff}");
+    // Far from the glass (the wall's top rows) the display draws nothing: the same world.
+    let top: Vec<(u32, u32)> = outside.into_iter().filter(|&(_, y)| y < 40).collect();
+    let top_diff = top.iter().map(diff).sum::<f32>() / top.len() as f32;
+    assert!(top_diff < 0.5, "the wall changed by {top_diff}");
+}

@@ -26,7 +26,10 @@
 //!   to each view), the last frame as the wearer would see it: `wearer-left.png`,
 //!   `wearer-right.png`, the world dimmed by a segmented dimmer panel of
 //!   `VITREOUS_SIM_PANEL` (`cells_across,cells_down,blur_deg`, default `64,48,1.5`) where the
-//!   alpha asks, and the image's light added.
+//!   alpha asks, and the image's light added; with `VITREOUS_SIM_REGISTRATION` (`x_deg,y_deg`,
+//!   right and down, each within 10 degrees) the app's light and panel land that far from the
+//!   world, as a registration error puts them (to the nearest pixel), and the view without
+//!   the error is written beside it (`wearer-left-registered.png`, ...).
 //! - `VITREOUS_SIM_FAULTS`: a fault schedule (`crate::faults::schedule`): what a misbehaving
 //!   headset does to the session, and when; `VITREOUS_SIM_FAULT_LOG`: the CSV file the layer
 //!   logs each fault and what the app did about it to (`crate::faults::log`).
@@ -69,6 +72,10 @@ pub const IMAGES_VAR: &str = "VITREOUS_SIM_IMAGES";
 pub const WORLD_VAR: &str = "VITREOUS_SIM_WORLD";
 /// Environment variable giving the simulated dimmer panel: cells across, down, blur (degrees).
 pub const PANEL_VAR: &str = "VITREOUS_SIM_PANEL";
+
+/// Environment variable giving the registration error of the wearer's view: degrees right,
+/// down.
+pub const REGISTRATION_VAR: &str = "VITREOUS_SIM_REGISTRATION";
 
 /// Environment variable naming the fault schedule.
 pub const FAULTS_VAR: &str = "VITREOUS_SIM_FAULTS";
@@ -175,6 +182,9 @@ pub struct Config {
     pub world: Option<PathBuf>,
     /// The simulated segmented dimmer's panel.
     pub panel: SimPanel,
+    /// How far the app's light and panel land from the world in the wearer's view, degrees
+    /// right and down.
+    pub registration_deg: [f32; 2],
     /// The fault schedule file.
     pub faults: Option<PathBuf>,
     /// The fault log file.
@@ -228,6 +238,23 @@ pub fn parse_panel(value: &str) -> Result<SimPanel, ConfigError> {
         cells: [cell(across)?, cell(down)?],
         blur_deg,
     })
+}
+
+/// Parses `VITREOUS_SIM_REGISTRATION`.
+pub fn parse_registration(value: &str) -> Result<[f32; 2], ConfigError> {
+    let bad = || ConfigError {
+        var: REGISTRATION_VAR,
+        value: value.to_owned(),
+        expected: "x_deg,y_deg: two numbers from -10 to 10 degrees (right, down)",
+    };
+    let parts: Vec<f32> = value
+        .split(',')
+        .map(|v| v.trim().parse::<f32>().map_err(|_| bad()))
+        .collect::<Result<_, _>>()?;
+    match parts[..] {
+        [x, y] if [x, y].iter().all(|v| v.is_finite() && v.abs() <= 10.0) => Ok([x, y]),
+        _ => Err(bad()),
+    }
 }
 
 /// The room's light, as `VITREOUS_SIM_LIGHT` gives it.
@@ -356,6 +383,10 @@ impl Config {
             world: get(WORLD_VAR).map(PathBuf::from),
             panel: get(PANEL_VAR)
                 .map(|v| parse_panel(&v))
+                .transpose()?
+                .unwrap_or_default(),
+            registration_deg: get(REGISTRATION_VAR)
+                .map(|v| parse_registration(&v))
                 .transpose()?
                 .unwrap_or_default(),
             faults: get(FAULTS_VAR).map(PathBuf::from),
@@ -493,6 +524,17 @@ mod tests {
         for bad in ["0,0,0,1", "0,0,0,1,0", "a,0,0,1,1", "0,0,nan,1,1"] {
             let e = config(&[(PLANES_VAR, bad)]).unwrap_err();
             assert_eq!(e.var, PLANES_VAR, "{bad}");
+        }
+    }
+
+    #[test]
+    fn a_registration_error_is_two_angles_and_a_bad_one_names_the_variable() {
+        assert_eq!(config(&[]).unwrap().registration_deg, [0.0, 0.0]);
+        let c = config(&[(REGISTRATION_VAR, "0.25, -0.125")]).unwrap();
+        assert_eq!(c.registration_deg, [0.25, -0.125]);
+        for bad in ["1", "1,2,3", "nan,0", "0,11", "a,b"] {
+            let e = config(&[(REGISTRATION_VAR, bad)]).unwrap_err();
+            assert_eq!(e.var, REGISTRATION_VAR, "{bad}");
         }
     }
 

@@ -270,28 +270,42 @@ pub fn panel_darkening(view: &ViewImage, panel: &SimPanel) -> Vec<f32> {
 }
 
 /// What the wearer sees of `view` over `world` (8-bit sRGB RGB, any size, scaled to the
-/// view's): 8-bit sRGB RGB of the view's size.
+/// view's) with the view's light and panel landing `registration_deg` (right, down; to the
+/// nearest pixel) from where the world is: 8-bit sRGB RGB of the view's size.
 pub fn wearer_view(
     view: &ViewImage,
     blend: sys::EnvironmentBlendMode,
     world: &image::RgbImage,
     panel: &SimPanel,
+    registration_deg: [f32; 2],
 ) -> Vec<u8> {
     let (w, h) = (view.size.0 as usize, view.size.1 as usize);
     let darkening =
         (blend == sys::EnvironmentBlendMode::ALPHA_BLEND).then(|| panel_darkening(view, panel));
     let keeps_world = blend != sys::EnvironmentBlendMode::OPAQUE;
     let (ww, wh) = world.dimensions();
+    // The view's pixel that lands on each of the world's, or none beyond the view's edge.
+    let shift = [0, 1].map(|a| {
+        (registration_deg[a] * [w, h][a] as f32 / view.fov_deg[a].max(1e-3)).round() as i64
+    });
+    let from = |x: usize, y: usize| {
+        let (sx, sy) = (x as i64 - shift[0], y as i64 - shift[1]);
+        (sx >= 0 && sy >= 0 && sx < w as i64 && sy < h as i64).then_some((sx as usize, sy as usize))
+    };
     let mut out = Vec::with_capacity(w * h * 3);
     for y in 0..h {
         for x in 0..w {
-            let (light, _) = view.linear(x, y);
+            let source = from(x, y);
+            let light = source.map_or([0.0; 3], |(sx, sy)| view.linear(sx, sy).0);
             let seen = if keeps_world {
                 let p = world.get_pixel(
                     ((x * ww as usize) / w) as u32,
                     ((y * wh as usize) / h) as u32,
                 );
-                let kept = darkening.as_ref().map_or(1.0, |d| 1.0 - d[y * w + x]);
+                let kept = match (&darkening, source) {
+                    (Some(d), Some((sx, sy))) => 1.0 - d[sy * w + sx],
+                    _ => 1.0,
+                };
                 p.0.map(|v| srgb_to_linear(f32::from(v) / 255.0) * kept)
             } else {
                 [0.0; 3]
@@ -404,18 +418,48 @@ pub fn write_wearer_views(
     views: &[ViewImage],
     blend: sys::EnvironmentBlendMode,
     panel: &SimPanel,
+    registration_deg: [f32; 2],
 ) -> Result<Vec<PathBuf>, String> {
     let world = image::open(world)
         .map_err(|e| format!("reading the world picture {}: {e}", world.display()))?
         .to_rgb8();
     let mut written = Vec::new();
+    // With a registration error, also the view as it would be without one, beside it.
+    let errors: &[([f32; 2], &str)] = if registration_deg == [0.0, 0.0] {
+        &[([0.0, 0.0], "")]
+    } else {
+        &[(registration_deg, ""), ([0.0, 0.0], "-registered")]
+    };
     for (i, view) in views.iter().enumerate() {
+        for &(error, suffix) in errors {
+            written.push(write_wearer_view(
+                dir, i, suffix, view, blend, &world, panel, error,
+            )?);
+        }
+    }
+    Ok(written)
+}
+
+/// Writes view `i` as the wearer sees it with the registration error `error_deg`, named
+/// `wearer-left{suffix}.png`, `wearer-right{suffix}.png`, `wearer-view2{suffix}.png`, ....
+#[allow(clippy::too_many_arguments)]
+fn write_wearer_view(
+    dir: &Path,
+    i: usize,
+    suffix: &str,
+    view: &ViewImage,
+    blend: sys::EnvironmentBlendMode,
+    world: &image::RgbImage,
+    panel: &SimPanel,
+    error_deg: [f32; 2],
+) -> Result<PathBuf, String> {
+    {
         let name = match i {
-            0 => "wearer-left.png".to_owned(),
-            1 => "wearer-right.png".to_owned(),
-            n => format!("wearer-view{n}.png"),
+            0 => format!("wearer-left{suffix}.png"),
+            1 => format!("wearer-right{suffix}.png"),
+            n => format!("wearer-view{n}{suffix}.png"),
         };
-        let rgb = wearer_view(view, blend, &world, panel);
+        let rgb = wearer_view(view, blend, world, panel, error_deg);
         let picture = image::RgbImage::from_raw(view.size.0, view.size.1, rgb)
             .ok_or("a wearer's view of the wrong size")?;
         let mut png = Vec::new();
@@ -425,9 +469,8 @@ pub fn write_wearer_views(
         let path = dir.join(&name);
         vitreous_trace::atomic_file::write(&path, &png)
             .map_err(|e| format!("writing {}: {e}", path.display()))?;
-        written.push(path);
+        Ok(path)
     }
-    Ok(written)
 }
 
 #[cfg(test)]
@@ -519,15 +562,91 @@ mod tests {
         // Half the pixels alpha 1 with no light: black there on ALPHA_BLEND; the world
         // elsewhere; the world plus the light on ADDITIVE.
         let v = view(|x, _| if x < 32 { 255 } else { 0 }, 0);
-        let seen = wearer_view(&v, sys::EnvironmentBlendMode::ALPHA_BLEND, &world, &sharp);
+        let seen = wearer_view(
+            &v,
+            sys::EnvironmentBlendMode::ALPHA_BLEND,
+            &world,
+            &sharp,
+            [0.0; 2],
+        );
         assert_eq!(seen[0], 0);
         assert_eq!(seen[(10 * 64 + 40) * 3], 188);
         let lit = view(|_, _| 0, 64);
-        let added = wearer_view(&lit, sys::EnvironmentBlendMode::ADDITIVE, &world, &sharp);
+        let added = wearer_view(
+            &lit,
+            sys::EnvironmentBlendMode::ADDITIVE,
+            &world,
+            &sharp,
+            [0.0; 2],
+        );
         assert!(added[0] > 188);
         // The image alone: linear 64/255 is sRGB 137.
-        let opaque = wearer_view(&lit, sys::EnvironmentBlendMode::OPAQUE, &world, &sharp);
+        let opaque = wearer_view(
+            &lit,
+            sys::EnvironmentBlendMode::OPAQUE,
+            &world,
+            &sharp,
+            [0.0; 2],
+        );
         assert_eq!(opaque[0], 137);
+    }
+
+    #[test]
+    fn a_registration_error_moves_the_dimmed_patch_with_the_light_and_leaves_the_world() {
+        let world = image::RgbImage::from_pixel(64, 48, image::Rgb([188, 188, 188]));
+        let sharp = SimPanel {
+            cells: [64, 48],
+            blur_deg: 0.0,
+        };
+        // Alpha 1 over x 20..30: the panel's dark patch; 64 px over 40 degrees, so 5 degrees
+        // right is 8 px.
+        let v = view(|x, _| if (20..30).contains(&x) { 255 } else { 0 }, 0);
+        let blend = sys::EnvironmentBlendMode::ALPHA_BLEND;
+        let at = |img: &[u8], x: usize| img[(10 * 64 + x) * 3];
+        let registered = wearer_view(&v, blend, &world, &sharp, [0.0; 2]);
+        let shifted = wearer_view(&v, blend, &world, &sharp, [5.0, 0.0]);
+        assert_eq!((at(&registered, 20), at(&registered, 29)), (0, 0));
+        assert_eq!((at(&shifted, 20), at(&shifted, 27)), (188, 188));
+        assert_eq!((at(&shifted, 28), at(&shifted, 37)), (0, 0));
+        assert_eq!(at(&shifted, 38), 188);
+        // Beyond the view's edge the display has nothing: the world as it is.
+        assert_eq!(at(&shifted, 3), 188);
+    }
+
+    #[test]
+    fn with_a_registration_error_the_registered_view_is_written_beside_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let world = dir.path().join("world.png");
+        image::RgbImage::from_pixel(8, 8, image::Rgb([188, 188, 188]))
+            .save(&world)
+            .unwrap();
+        let sharp = SimPanel {
+            cells: [64, 48],
+            blur_deg: 0.0,
+        };
+        let v = view(|x, _| if (20..30).contains(&x) { 255 } else { 0 }, 0);
+        let blend = sys::EnvironmentBlendMode::ALPHA_BLEND;
+        let names = |error| {
+            write_wearer_views(
+                dir.path(),
+                &world,
+                std::slice::from_ref(&v),
+                blend,
+                &sharp,
+                error,
+            )
+            .unwrap()
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+        };
+        assert_eq!(names([0.0, 0.0]), ["wearer-left.png"]);
+        assert_eq!(
+            names([5.0, 0.0]),
+            ["wearer-left.png", "wearer-left-registered.png"]
+        );
+        let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
+        assert_ne!(read("wearer-left.png"), read("wearer-left-registered.png"));
     }
 
     #[test]

@@ -22,10 +22,13 @@ impl ViewSink<'_> {
                     .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
                 self.looks.condition(),
                 shared.eyes,
-                if self.preview {
-                    "see-through preview"
-                } else {
-                    "display light"
+                match (self.preview, self.misregistration) {
+                    (false, _) => "display light".to_owned(),
+                    (true, 0) => "see-through preview".to_owned(),
+                    (true, i) => format!(
+                        "see-through preview, display {} deg right",
+                        super::MISREGISTRATION_DEG[i]
+                    ),
                 },
             ),
             format!(

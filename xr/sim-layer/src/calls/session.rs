@@ -190,6 +190,7 @@ fn finish_images(images: &Mutex<SessionImages>, config: &Config) {
             &record.last,
             record.last_blend,
             &config.panel,
+            config.registration_deg,
         ) {
             report(format!("the wearer's view: {e}"));
         }

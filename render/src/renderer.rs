@@ -421,7 +421,7 @@ impl Renderer {
                 slot.statistics = Some(statistics::statistics_pool(&self.ctx)?);
             }
         }
-        // And the positions the glass shades, where its pixels decide how many.
+        // And the positions the glass shades, where it shades a ball's light in parts.
         self.glass.count_positions(&self.ctx)?;
         Ok(true)
     }

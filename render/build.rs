@@ -2,7 +2,8 @@
 //! Nothing is checked in as SPIR-V and no external shader tool is needed. Pipeline-overridable
 //! constants take their defaults, and the entry points of [`VARIANTS`] are compiled again with
 //! some set, for the pipelines that need (or can skip) the code they guard; every glass fragment
-//! entry point also with `SUPERSAMPLED` set. Code shared by several shaders lives in
+//! entry point also with `SUPERSAMPLED` set (and those that count the positions they shade with
+//! `COUNTED` too). Code shared by several shaders lives in
 //! `../shaders/shared` and is appended to each that names it in a
 //! `// #include shared/<file>.wgsl` line ([`with_includes`]). Beside each entry point's SPIR-V
 //! it writes the static cost of one invocation (`<name>.cost.rs`, build/shader_cost.rs), which
@@ -384,6 +385,27 @@ fn main() {
                 })
                 .collect();
             outputs.extend(compensated);
+            // The environment looks of a ball in the room over several positions, which shade
+            // its light in two parts each over as many positions as it needs
+            // (shared/glass_positions.wgsl), again counting the positions they shade (`COUNTED`),
+            // for the frames that count their work.
+            let counted: Vec<_> = outputs
+                .iter()
+                .filter(|(_, suffix, _)| {
+                    suffix.ends_with("ball.room.supersampled")
+                        || suffix.ends_with("ball.room.supersampled.compensated")
+                })
+                .map(|(constants, suffix, _)| {
+                    let mut constants = constants.clone();
+                    constants.insert("COUNTED".to_owned(), 1.0);
+                    (
+                        constants,
+                        format!("{suffix}.counted"),
+                        Some("fs_two_surface_environment_"),
+                    )
+                })
+                .collect();
+            outputs.extend(counted);
         }
         for (constants, suffix, only) in outputs {
             let (module, info) =

@@ -40,9 +40,10 @@
 // two more fetches of the room.
 //
 // Supersampling (`[output] glass_samples`, beyond the paper): the pixel's light is the mean over
-// an n x n grid of view rays inside it (`supersampled`), so that the glass's image is what the
-// eye averages over the pixel where the glass minifies the room, where its image jumps from the
-// wall to the floor and at a ball's outline.
+// an n x n grid of view rays inside it (`supersampled`, shared/glass_positions.wgsl), so that the
+// glass's image is what the eye averages over the pixel where the glass minifies the room, where
+// its image jumps from the wall to the floor and at a ball's outline; a ball in the room shades
+// its first image over the whole grid and the rest of its light over the positions it needs.
 //
 // Eq. 6 over the glass (`[display] compensation = "background"`, beyond the paper): the display
 // should add only what the eye does not already see, max(T - B, 0), with T the glass's light
@@ -55,13 +56,15 @@
 // #include shared/seen.wgsl
 // #include shared/ripmap.wgsl
 // #include shared/compensation.wgsl
+// #include shared/glass_positions.wgsl
 
 struct Eye {
     clip_from_world: mat4x4<f32>,
     // xyz: the eye's position in the world (metres); w: eye index (0 left, 1 right).
     position: vec4<f32>,
     // xyz: where refraction to the background plane is seen from: this eye (disparity), or
-    // the point between the eyes (defocus without disparity).
+    // the point between the eyes (defocus without disparity); w: the frame's slot, where the
+    // positions shaded are counted (`COUNTED`).
     refraction_origin: vec4<f32>,
 };
 
@@ -139,6 +142,11 @@ override COMPENSATED: bool = false;
 // models that can be proved (the paper's, and two surfaces through a ball) with it set too.
 override COVERED: bool = false;
 
+// The positions a pixel shades are counted on the device (`vitreous bench`, the frames that
+// count their work; render/src/glass/counted.rs): a pipeline constant, so that ordinary frames
+// neither pay for the atomics nor declare the buffer.
+override COUNTED: bool = false;
+
 var<push_constant> eye: Eye;
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(0) @binding(1) var env_map: texture_2d<f32>;
@@ -156,6 +164,9 @@ var<push_constant> eye: Eye;
 @group(0) @binding(7) var<storage, read> facet_planes: array<vec4<f32>>;
 // The floor photo (sharp), seen through the glass when the room is a refraction target.
 @group(0) @binding(8) var floor_photo: texture_2d<f32>;
+// Per frame slot (`eye.refraction_origin.w`): the positions shaded, then the fragments that
+// shaded them (`COUNTED`).
+@group(0) @binding(9) var<storage, read_write> shaded: array<atomic<u32>>;
 // What the eye already sees (`COMPENSATED`, render/src/compensation.rs): the floor and
 // background planes and both photos packed side by side (shared/seen.wgsl), and with several
 // positions per pixel their ripmaps (shared/ripmap.wgsl).
@@ -291,8 +302,9 @@ fn beyond_passage(passage: Passage) -> vec3<f32> {
 fn beyond(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     if ROOM {
         return room(origin, dir);
+    } else {
+        return environment(dir);
     }
-    return environment(dir);
 }
 
 const MAX_INTERNAL_REFLECTIONS: i32 = 4;
@@ -309,9 +321,10 @@ fn radial_surface(d: vec3<f32>) -> vec4<f32> {
     let unit = normalize(d);
     if BALL {
         return vec4<f32>(g.radial.w, unit);
+    } else {
+        let texel = textureSampleLevel(radial_map, wrap_sampler, latlong_uv(unit), 0.0);
+        return vec4<f32>(g.radial.w + texel.a, normalize(texel.rgb + unit));
     }
-    let texel = textureSampleLevel(radial_map, wrap_sampler, latlong_uv(unit), 0.0);
-    return vec4<f32>(g.radial.w + texel.a, normalize(texel.rgb + unit));
 }
 
 // Far crossing of the ray p + t d (d unit) with the sphere of radius r about the origin.
@@ -359,20 +372,27 @@ struct Passage {
 // leaves the object: x the distance t, yzw the outward unit normal there. Exact for a convex
 // polyhedron (`CONVEX`, its planes) and a ball; otherwise found on the radial map.
 fn find_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
+    // Each model's way in a branch of its own, none after another's return: what a pipeline
+    // constant rules out is no code of its pipeline, nor of its counted cost.
     if CONVEX {
         return convex_exit(p, d);
+    } else if BALL {
+        // The entry lies on the ball (`front_surface`): the exit of the sphere through it is
+        // the exit (a device that runs a loop's first pass for every lane, as lavapipe does,
+        // would still pay for a secant step of the search below).
+        let t = sphere_exit(p, d, length(p));
+        return vec4<f32>(t, normalize(p + d * t));
+    } else {
+        return radial_exit(p, d);
     }
-    // f(t) = |p + t d| - r(p + t d) vanishes at the exit. First the exit of the sphere
-    // through the entry (exact for a ball: one fetch), then secant steps on f, or the
-    // sphere of the last radius where a secant step would go backwards.
+}
+
+// Where the ray p + t d leaves the object of the radial map (`find_exit`): f(t) = |p + t d| -
+// r(p + t d) vanishes at the exit. First the exit of the sphere through the entry, then secant
+// steps on f, or the sphere of the last radius where a secant step would go backwards.
+fn radial_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     var t = sphere_exit(p, d, length(p));
     var s = radial_surface(p + d * t);
-    if BALL {
-        // The entry lies on the ball (`front_surface`): the first estimate is its exit. The
-        // search below would stop at once, but a device that runs a loop's first pass for
-        // every lane (lavapipe) would still pay for a secant step.
-        return vec4<f32>(t, s.yzw);
-    }
     var f = length(p + d * t) - s.x;
     var t_prev = t;
     var f_prev = f;
@@ -599,43 +619,6 @@ fn seen_behind(in: VertexOut) -> vec3<f32> {
     return seen;
 }
 
-// The glass's light over a pixel (`SUPERSAMPLED`): the mean of `shade_ray` over a regular
-// n x n grid of positions inside it (n = `in.samples`), each a view ray of its own through the
-// surface found as at the pixel's centre, with the vertex outputs carried there by their screen
-// derivatives. Where a position's ray passes beside a ball (its front surface is the sphere
-// through its vertices), the glass adds nothing there: the pixel's edge is covered in part.
-fn supersampled(
-    in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool, alpha: f32,
-) -> vec3<f32> {
-    let n = in.samples;
-    let dx = VertexOut(vec4<f32>(0.0), dpdx(in.world_pos), dpdx(in.world_normal), vec2<f32>(0.0),
-        dpdx(in.curve), 0u);
-    let dy = VertexOut(vec4<f32>(0.0), dpdy(in.world_pos), dpdy(in.world_normal), vec2<f32>(0.0),
-        dpdy(in.curve), 0u);
-    var sum = vec3<f32>(0.0);
-    for (var i = 0u; i < n * n; i++) {
-        let offset = (vec2<f32>(f32(i % n), f32(i / n)) + 0.5) / f32(n) - 0.5;
-        var at = in;
-        at.world_pos += dx.world_pos * offset.x + dy.world_pos * offset.y;
-        at.world_normal += dx.world_normal * offset.x + dy.world_normal * offset.y;
-        at.curve += dx.curve * offset.x + dy.curve * offset.y;
-        if !misses_ball(at) {
-            sum += shade_ray(at, two_surface_model, to_background, phong, alpha);
-        }
-    }
-    return sum / f32(n * n);
-}
-
-// The eye's ray through `in.world_pos` passes beside the sphere `front_surface` would put it
-// on (a ball's vertices, `in.curve.y` 1).
-fn misses_ball(in: VertexOut) -> bool {
-    let from_centre = eye.position.xyz - g.center_world.xyz;
-    let d = normalize(in.world_pos - eye.position.xyz);
-    let b = dot(from_centre, d);
-    let c = dot(from_centre, from_centre) - in.curve.x * in.curve.x;
-    return in.curve.y > 0.5 && b * b - c < 0.0;
-}
-
 // The glass's light along one view ray, but for the surface's own (eq. 9's
 // `(1 - alpha) C_b`, the refraction and reflection).
 fn shade_ray(
@@ -677,9 +660,9 @@ fn shade_ray(
             // (render/src/coverage.rs; only the background looks are compiled with COVERED).
             let uv = background_uv(passage.exit, passage.direction);
             seen = textureSampleLevel(background, clamp_sampler, uv.xy, 0.0).rgb;
-        } else {
+        } else if to_background && !ROOM {
             var uv = vec3<f32>(0.0);
-            if to_background && passage.escaped > 0.0 && !ROOM {
+            if passage.escaped > 0.0 {
                 uv = background_uv(passage.exit, passage.direction);
             }
             if uv.z > 0.0 {
@@ -688,6 +671,8 @@ fn shade_ray(
             } else {
                 seen = beyond_passage(passage);
             }
+        } else {
+            seen = beyond_passage(passage);
         }
         var light = seen * passage.transmission;
         if ROOM {

@@ -1,9 +1,11 @@
 //! The cost guard: every condition's counted work per frame (`vitreous bench`'s `work`: passes,
 //! draws, dispatches, uploaded bytes, each pass's shader invocations and the glass's and
-//! floor's fetches, texels and instructions) held to the expectation committed in
-//! `tests/cost-expected.json`, with 5 % margin; and each condition's work over the baseline's
-//! (O2, or a) held to its committed ratio the same way, so that a cheaper baseline the method
-//! does not follow fails too. Counts, not times: the same run after run on one driver.
+//! floor's fetches, texels and instructions, and where the glass counts them the positions it
+//! shades) held to the expectation committed in `tests/cost-expected.json`, with 5 % margin;
+//! and each condition's work over the baseline's (O2, or a) held to its committed ratio the same
+//! way, so that a cheaper baseline the method does not follow fails too. Counts, not times: the
+//! same run after run on one driver. In the realism scenes the glass shades the rest of a
+//! ball's light over the whole grid only where a pixel needs it (`positions_where_they_matter`).
 //!
 //! After a deliberate change of cost, write the new expectation with
 //! `VITREOUS_UPDATE_COST=1 cargo test -p vitreous-tests --test gpu cost` and say why in the
@@ -53,11 +55,14 @@ struct Case {
     /// where a condition has defocus, and as many as the expectation was recorded after where
     /// the light circles (the counted frames' poses); the bench's own few elsewhere.
     warm_up: usize,
+    /// The glass shades a ball's light in the room in parts and counts its positions.
+    positions: bool,
 }
 
 /// The study's conditions (with two-surface O5), the floor's, the live scene's moving light,
-/// and the segmented dimmer's panel and resolve (glass-sphere-ml2.toml).
-const CASES: [Case; 4] = [
+/// the segmented dimmer's panel and resolve (glass-sphere-ml2.toml), and the realism scene's
+/// glass over several positions per pixel (glass-sphere-real.toml).
+const CASES: [Case; 5] = [
     Case {
         name: "visual-effects O3 O4 O5",
         scene: "visual-effects.toml",
@@ -65,6 +70,7 @@ const CASES: [Case; 4] = [
         moving: false,
         two_surface: true,
         warm_up: 40,
+        positions: false,
     },
     Case {
         name: "glass-sphere b c",
@@ -73,6 +79,7 @@ const CASES: [Case; 4] = [
         moving: false,
         two_surface: false,
         warm_up: vitreous::bench::WARM_UP_FRAMES,
+        positions: false,
     },
     Case {
         name: "moving-light c moving",
@@ -81,6 +88,7 @@ const CASES: [Case; 4] = [
         moving: true,
         two_surface: false,
         warm_up: 40,
+        positions: false,
     },
     Case {
         name: "glass-sphere-ml2 dimmer",
@@ -89,8 +97,52 @@ const CASES: [Case; 4] = [
         moving: false,
         two_surface: true,
         warm_up: vitreous::bench::WARM_UP_FRAMES,
+        positions: true,
+    },
+    Case {
+        name: "glass-sphere-real",
+        scene: "glass-sphere-real.toml",
+        effects: &[],
+        moving: false,
+        two_surface: false,
+        warm_up: vitreous::bench::WARM_UP_FRAMES,
+        positions: true,
     },
 ];
+
+/// Positions along each side of a glass pixel in the realism scenes (`[output] glass_samples`).
+const GLASS_SAMPLES: f64 = 4.0;
+
+/// Where the glass shades a ball's light in the room in parts (shaders/shared/glass_positions.wgsl),
+/// each variant that counted its positions shades the first image over the whole grid of every
+/// covered pixel, and the rest over it only where a pixel needs it: on average under half the
+/// grid (the rim and the highlight; a 2 x 2 grid elsewhere). The lines of the variants that do
+/// not; and whether any variant counted.
+fn positions_where_they_matter(
+    counts: &BTreeMap<String, BTreeMap<String, f64>>,
+) -> (Vec<String>, bool) {
+    let grid = GLASS_SAMPLES * GLASS_SAMPLES;
+    let mut failures = Vec::new();
+    let mut counted = false;
+    for (variant, c) in counts {
+        let Some(&pixels) = c.get("glass_positions.pixels").filter(|&&p| p > 0.0) else {
+            continue;
+        };
+        counted = true;
+        let (rest, first) = (c["glass_positions"], c["glass_positions.first_images"]);
+        if first != grid * pixels {
+            failures.push(format!(
+                "{variant}: {first} positions of the first image for {pixels} pixels"
+            ));
+        }
+        if rest >= 0.5 * grid * pixels || rest < pixels {
+            failures.push(format!(
+                "{variant}: {rest} positions of the rest for {pixels} pixels"
+            ));
+        }
+    }
+    (failures, counted)
+}
 
 fn expectation_path() -> PathBuf {
     workspace().join("tests/cost-expected.json")
@@ -159,7 +211,17 @@ fn every_conditions_counted_work_stays_within_its_expectation() {
             case.name
         );
         driver = report.driver.clone();
-        measured.insert(case.name.to_owned(), json!(counts(&report)));
+        let counts = counts(&report);
+        if case.positions {
+            let (failures, counted) = positions_where_they_matter(&counts);
+            assert!(
+                counted,
+                "{}: no variant counted the glass's positions",
+                case.name
+            );
+            assert!(failures.is_empty(), "{}: {failures:#?}", case.name);
+        }
+        measured.insert(case.name.to_owned(), json!(counts));
     }
     let measured = json!({ "driver": driver, "cases": measured });
     if std::env::var_os("VITREOUS_UPDATE_COST").is_some() {
@@ -208,6 +270,38 @@ fn compare(expected: &Value, measured: &Value) -> Vec<String> {
         }
     }
     failures
+}
+
+#[test]
+fn the_guard_fails_a_glass_that_shades_the_whole_grid_everywhere() {
+    let variant = |rest: f64, first: f64| {
+        BTreeMap::from([(
+            "none".to_owned(),
+            BTreeMap::from([
+                ("glass_positions".to_owned(), rest),
+                ("glass_positions.first_images".to_owned(), first),
+                ("glass_positions.pixels".to_owned(), 100.0),
+            ]),
+        )])
+    };
+    // A fifth of the pixels at the whole grid, the rest at 2 x 2: 640 of the rest.
+    assert_eq!(
+        positions_where_they_matter(&variant(640.0, 1600.0)),
+        (vec![], true)
+    );
+    // Every pixel at the whole grid, or the first image short of it.
+    assert_eq!(
+        positions_where_they_matter(&variant(1600.0, 1600.0))
+            .0
+            .len(),
+        1
+    );
+    assert_eq!(
+        positions_where_they_matter(&variant(640.0, 100.0)).0.len(),
+        1
+    );
+    // Nothing counted.
+    assert!(!positions_where_they_matter(&BTreeMap::new()).1);
 }
 
 #[test]

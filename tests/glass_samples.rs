@@ -1,13 +1,16 @@
 //! The glass over several positions per pixel (`[output] glass_samples`) on the machine's
 //! Vulkan device with validation on, against the physical reference's CPU ray tracer, which
 //! averages each pixel over its own grid: the glass's pixels come closer to the real ball's
-//! pixel averages than one position per pixel does, and the real floor or wall taken away
+//! pixel averages than one position per pixel does (inside the disc, where the ball minifies the
+//! room, and at the pixels that need several positions most: its outline, and the line where its
+//! image turns from one photo to another), and the real floor or wall taken away
 //! (`[display] compensation = "background"`) is the one over the pixel's footprint, as is the
 //! world the see-through preview shows.
 
 use glam::{Vec2, Vec3};
 use vitreous_optics::camera::EyeParams;
 use vitreous_optics::display::Compensation;
+use vitreous_optics::optics::refract;
 use vitreous_reference::world::PhotoHit;
 use vitreous_reference::{EyeImage, Window, World, render_eye};
 use vitreous_scene::Scene;
@@ -118,6 +121,100 @@ fn more_positions_per_pixel_bring_the_glass_to_the_real_balls_pixel_average() {
         four < 0.06 * mean,
         "4 x 4 positions are {four} off the real ball's {mean}"
     );
+}
+
+/// What the eye's ray along `dir` from `origin` meets beyond the scene's ball, refracted in and
+/// out of it by Snell's law: 0 beside the ball, 1 the floor, 2 the wall, 3 neither.
+fn target_through_ball(scene: &Scene, world: &World, origin: Vec3, dir: Vec3) -> u8 {
+    let (centre, radius, ior) = (
+        scene.object.center_m,
+        scene.object.radius_m,
+        scene.object.ior,
+    );
+    let from_centre = origin - centre;
+    let b = from_centre.dot(dir);
+    let c = from_centre.length_squared() - radius * radius;
+    if b * b - c < 0.0 {
+        return 0;
+    }
+    let entry = from_centre + dir * (-b - (b * b - c).sqrt());
+    let Some(inside) = refract(dir, entry / radius, 1.0 / ior) else {
+        return 3;
+    };
+    let exit = entry + inside * (-2.0 * entry.dot(inside));
+    let Some(leaving) = refract(inside, -exit / radius, ior) else {
+        return 3;
+    };
+    match world.photo_hit(exit + centre, leaving) {
+        Some((_, PhotoHit::Floor(_))) => 1,
+        Some((_, PhotoHit::Background(_))) => 2,
+        None => 3,
+    }
+}
+
+/// The pixels of `window` whose four corners' rays meet the ball in part (the outline), and
+/// those whose corners all meet it but see different targets through it (where its image turns
+/// from the wall to the floor, or from a photo to neither), as (index in the window, index in
+/// the whole image).
+type Pixels = Vec<(usize, usize)>;
+fn outline_and_seams(scene: &Scene, camera: &EyeParams, window: Window) -> (Pixels, Pixels) {
+    let world = World::of(scene, &scene.rest_placement()).unwrap();
+    let rays = camera.pixel_rays(Vec2::new(SIZE.0 as f32, SIZE.1 as f32));
+    let (mut outline, mut seams) = (Vec::new(), Vec::new());
+    for y in 0..window.height {
+        for x in 0..window.width {
+            let (px, py) = (window.x + x, window.y + y);
+            let corners = [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(cx, cy)| {
+                let dir = rays.direction(Vec2::new((px + cx) as f32, (py + cy) as f32));
+                target_through_ball(scene, &world, camera.position_m, dir)
+            });
+            let at = ((y * window.width + x) as usize, (py * SIZE.0 + px) as usize);
+            if corners.contains(&0) && corners.iter().any(|&t| t != 0) {
+                outline.push(at);
+            } else if !corners.contains(&0) && corners.iter().any(|&t| t != corners[0]) {
+                seams.push(at);
+            }
+        }
+    }
+    (outline, seams)
+}
+
+#[test]
+fn the_pixels_that_need_several_positions_are_shaded_at_several() {
+    // The glass shades a ball's light in the room in parts, each over the positions it needs
+    // (shaders/shared/glass_positions.wgsl): at its outline and along the line where its image
+    // turns from one photo to another it must come closer to the real ball than one position
+    // per pixel does.
+    let scene = shipped_scene("glass-sphere-real.toml");
+    let camera = neutral_eyes(&scene)[0];
+    let window = around_the_ball(&scene, &camera);
+    let world = World::of(&scene, &scene.rest_placement()).unwrap();
+    let real = reference(&world, &camera, window, 5);
+    let (outline, seams) = outline_and_seams(&scene, &camera, window);
+    assert!(outline.len() > 40, "{} outline pixels", outline.len());
+    assert!(seams.len() > 10, "{} seam pixels", seams.len());
+    let one = left_eye_light(&with_samples(&scene, 1, Compensation::None), SIZE);
+    let four = left_eye_light(&with_samples(&scene, 4, Compensation::None), SIZE);
+    let errors = [("outline", &outline), ("seams", &seams)].map(|(name, pixels)| {
+        let (e1, e4) = (
+            mean_error(&one, &real.rgb, pixels),
+            mean_error(&four, &real.rgb, pixels),
+        );
+        eprintln!(
+            "{name} ({} px): GPU error with 1 position per pixel {e1:.4}, with 4 x 4 {e4:.4}",
+            pixels.len()
+        );
+        (name, e1, e4)
+    });
+    // At the outline most of what is left is the rim's own light (the room a real ball reflects
+    // at grazing incidence, which the Phong look does not draw), the same at any number of
+    // positions; what they take away is the pixel's partial cover.
+    for ((name, e1, e4), share) in errors.into_iter().zip([0.9, 0.5]) {
+        assert!(
+            e4 < share * e1,
+            "{name}: {e4} with 4 x 4 against {e1} with one"
+        );
+    }
 }
 
 #[test]

@@ -200,6 +200,9 @@ pub struct GpuContext {
     pub timestamp_period_ns: Option<f32>,
     /// Whether the device counts shader invocations (pipeline-statistics queries, enabled).
     pub pipeline_statistics: bool,
+    /// Whether fragment shaders may write storage buffers and use atomics on them
+    /// (`fragmentStoresAndAtomics`): the glass counts the positions it shades with them.
+    pub fragment_atomics: bool,
     /// The work recorded into command buffers, counted as it is recorded.
     pub(crate) work: WorkTally,
 }
@@ -303,9 +306,12 @@ impl GpuContext {
         // Pipeline-statistics queries (counted work, `work.rs`) where the device has them.
         // SAFETY: `physical` belongs to the live `instance`.
         let features = unsafe { instance.get_physical_device_features(physical) };
+        // And atomics in fragment shaders, where the glass counts the positions it shades.
         let features = vk::PhysicalDeviceFeatures::default()
-            .pipeline_statistics_query(features.pipeline_statistics_query == vk::TRUE);
+            .pipeline_statistics_query(features.pipeline_statistics_query == vk::TRUE)
+            .fragment_stores_and_atomics(features.fragment_stores_and_atomics == vk::TRUE);
         let pipeline_statistics = features.pipeline_statistics_query == vk::TRUE;
+        let fragment_atomics = features.fragment_stores_and_atomics == vk::TRUE;
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&device_exts)
@@ -394,6 +400,7 @@ impl GpuContext {
             driver,
             timestamp_period_ns,
             pipeline_statistics,
+            fragment_atomics,
             work: WorkTally::default(),
         };
         tracing::info!(

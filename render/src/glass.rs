@@ -2,12 +2,14 @@
 //! by a Fresnel term (METHOD.md section 6; shaders/glass.wgsl); refraction to the background
 //! plane (eq. 7-8), or through both surfaces of the object (two-surface, with its radial map).
 //!
-//! Just over 600 lines, one idea: the pass and what its pipelines read (the variant table, the
+//! Under 700 lines, one idea: the pass and what its pipelines read (the variant table, the
 //! push constants, the globals, the radial map and facet planes it uploads for the exit),
 //! built once per scene; its tests check that table against the shaders. What a frame draws
 //! with them, and the recording, is `glass/draws.rs`; a ball's triangles in patches, each
-//! drawn where it can show, `glass/patches.rs`.
+//! drawn where it can show, `glass/patches.rs`; the positions a ball's pixels shade, counted on
+//! the device, `glass/counted.rs`.
 
+mod counted;
 mod draws;
 mod patches;
 
@@ -191,6 +193,15 @@ pub struct GlassPass {
     _radial_map: Image,
     /// The facet planes of a convex faceted object (two-surface refraction), or one plane.
     _planes: Buffer,
+    /// The render pass and layout the pipelines were made for (the counting ones are made
+    /// when the frames start counting).
+    render_pass: vk::RenderPass,
+    /// Where the glass shades a ball's light in two parts, each over as many positions as it
+    /// needs: the row of `shaders::GLASS_FS_COUNTED` of the model; the counting pipelines of the
+    /// environment looks, once the frames count (`counted.rs`); and the counters they add to.
+    counted_row: Option<usize>,
+    counted_pipelines: Vec<Owned<vk::Pipeline>>,
+    counter: counted::PositionCounter,
 }
 
 impl GlassPass {
@@ -222,6 +233,7 @@ impl GlassPass {
                 (6, image, fragment),
                 (7, vk::DescriptorType::STORAGE_BUFFER, fragment),
                 (8, image, fragment),
+                (9, vk::DescriptorType::STORAGE_BUFFER, fragment),
             ],
         )?;
         let set_layouts: Vec<_> = std::iter::once(set_layout.raw())
@@ -229,32 +241,6 @@ impl GlassPass {
             .collect();
         let layout =
             pipeline::layout_of_sets(ctx, &set_layouts, stages, size_of::<EyePush>() as u32)?;
-        let f = 4;
-        let attributes = [
-            vk::VertexInputAttributeDescription {
-                location: 0,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 1,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 3 * f,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 2,
-                binding: 0,
-                format: vk::Format::R32G32_SFLOAT,
-                offset: 6 * f,
-            },
-        ];
-        let bindings = [vk::VertexInputBindingDescription {
-            binding: 0,
-            stride: VERTEX_STRIDE,
-            input_rate: vk::VertexInputRate::VERTEX,
-        }];
         let (radial_map, radial, ball) = upload_radial_map(ctx, desc)?;
         let (planes, convex) = upload_facet_planes(ctx, desc, radial)?;
         // Clear glass gets the two-surface pipelines without the absorption's exponentials, a
@@ -286,22 +272,7 @@ impl GlassPass {
                 .iter()
                 .flat_map(|&c| GlassVariant::ALL.iter().map(move |v| (c, v.index())))
         };
-        let create = |fragment| {
-            pipeline::create(
-                ctx,
-                &PipelineSpec {
-                    render_pass,
-                    layout: layout.raw(),
-                    vertex: (shaders::GLASS_VS, c"vs_main"),
-                    fragment,
-                    bindings: &bindings,
-                    attributes: &attributes,
-                    cull: vk::CullModeFlags::BACK,
-                    depth: Depth::Nearest,
-                    blend: Blend::ReplaceColor,
-                },
-            )
-        };
+        let create = |fragment| create_pipeline(ctx, render_pass, layout.raw(), fragment);
         let pipelines = entries()
             .map(|(c, v)| create(shaders::GLASS_FS[c][shaded][v]))
             .collect::<Result<Vec<_>>>()?;
@@ -337,7 +308,7 @@ impl GlassPass {
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
                 (vk::DescriptorType::SAMPLED_IMAGE, 5),
                 (vk::DescriptorType::SAMPLER, 2),
-                (vk::DescriptorType::STORAGE_BUFFER, 1),
+                (vk::DescriptorType::STORAGE_BUFFER, 2),
             ],
         )?;
         let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
@@ -383,6 +354,8 @@ impl GlassPass {
         descriptors::write_image(ctx, set, 5, surface);
         descriptors::write_image(ctx, set, 6, radial_map.view);
         descriptors::write_storage_buffer(ctx, set, 7, planes.buffer);
+        let counter = counted::PositionCounter::new(ctx)?;
+        descriptors::write_storage_buffer(ctx, set, 9, counter.buffer());
         descriptors::write_image(ctx, set, 8, scene.photos[0].view);
         Ok(GlassPass {
             pipelines,
@@ -416,7 +389,20 @@ impl GlassPass {
             globals,
             _radial_map: radial_map,
             _planes: planes,
+            render_pass,
+            counted_row: shaders::counted_row(shaded),
+            counted_pipelines: Vec::new(),
+            counter,
         })
+    }
+
+    /// One of the pass's pipelines: its vertex shader and `fragment`.
+    fn create_pipeline(
+        &self,
+        ctx: &GpuContext,
+        fragment: shaders::GlassEntry,
+    ) -> Result<Owned<vk::Pipeline>> {
+        create_pipeline(ctx, self.render_pass, self.layout.raw(), fragment)
     }
 
     /// Records the update of the object's transform and the light's position to `pose`, for
@@ -493,6 +479,13 @@ impl GlassPass {
     /// The static cost of one fragment drawn with the pipeline `pick` names (with `covered`,
     /// the one without the environment's lookup where the look has it).
     pub fn cost(&self, pick: Pick) -> ShaderCost {
+        if let (Some(row), Some(_)) = (self.counted_row, self.counted_pipeline(pick)) {
+            // What each pixel shades beyond one position of each part is counted on the device
+            // (`GlassPass::read_positions`).
+            let compensated = usize::from(pick.compensated && self.compensation.is_some());
+            return shaders::GLASS_FS_COUNTED_COST[compensated][row]
+                [usize::from(pick.variant.phong)];
+        }
         match self
             .covered_entry(pick.variant, pick.compensated)
             .filter(|_| pick.covered)
@@ -501,6 +494,55 @@ impl GlassPass {
             None => self.costs[self.entry(pick.variant, pick.compensated)],
         }
     }
+}
+
+/// A glass pipeline drawing into `render_pass` with `layout`: the vertex shader and `fragment`.
+fn create_pipeline(
+    ctx: &GpuContext,
+    render_pass: vk::RenderPass,
+    layout: vk::PipelineLayout,
+    fragment: shaders::GlassEntry,
+) -> Result<Owned<vk::Pipeline>> {
+    let f = 4;
+    let attributes = [
+        vk::VertexInputAttributeDescription {
+            location: 0,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 0,
+        },
+        vk::VertexInputAttributeDescription {
+            location: 1,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 3 * f,
+        },
+        vk::VertexInputAttributeDescription {
+            location: 2,
+            binding: 0,
+            format: vk::Format::R32G32_SFLOAT,
+            offset: 6 * f,
+        },
+    ];
+    let bindings = [vk::VertexInputBindingDescription {
+        binding: 0,
+        stride: VERTEX_STRIDE,
+        input_rate: vk::VertexInputRate::VERTEX,
+    }];
+    pipeline::create(
+        ctx,
+        &PipelineSpec {
+            render_pass,
+            layout,
+            vertex: (shaders::GLASS_VS, c"vs_main"),
+            fragment,
+            bindings: &bindings,
+            attributes: &attributes,
+            cull: vk::CullModeFlags::BACK,
+            depth: Depth::Nearest,
+            blend: Blend::ReplaceColor,
+        },
+    )
 }
 
 /// World metres per model unit of the object's uniform scale (the shader measures the path

@@ -69,4 +69,6 @@ pub use scene::{
     BlurStackDesc, CausticsDesc, InducerDesc, LightDesc, MeshRef, PlaneDesc, SceneDesc, TexelData,
     TextureDesc,
 };
-pub use work::{FrameWork, Invocations, PassInvocations, PhotonWork, RecordedWork, ShaderCost};
+pub use work::{
+    FrameWork, GlassPositions, Invocations, PassInvocations, PhotonWork, RecordedWork, ShaderCost,
+};

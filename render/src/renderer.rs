@@ -120,6 +120,8 @@ struct Pending {
 
 /// Per-frame resources, used round-robin; freed on drop.
 struct FrameSlot {
+    /// Its place among the renderer's slots (where the glass counts its positions).
+    index: usize,
     /// Command buffer recorded anew each use (freed with the renderer's command pool).
     cmd: vk::CommandBuffer,
     /// Signalled when the slot's last submission finished.
@@ -296,6 +298,7 @@ impl Renderer {
                 MemoryLocation::GpuToCpu,
             )?;
             slots.push(FrameSlot {
+                index: slots.len(),
                 cmd,
                 fence,
                 queries,
@@ -418,6 +421,8 @@ impl Renderer {
                 slot.statistics = Some(statistics::statistics_pool(&self.ctx)?);
             }
         }
+        // And the positions the glass shades, where it shades a ball's light in parts.
+        self.glass.count_positions(&self.ctx)?;
         Ok(true)
     }
 
@@ -543,6 +548,10 @@ impl Renderer {
                     }),
                 overlay_shader: ((look.inducer || look.caustics) && !look.blank)
                     .then(|| self.inducer.overlay_cost(look.caustics)),
+                // Filled in from the device's counters once the frame finished.
+                glass_positions: glass
+                    .as_ref()
+                    .and_then(|g| self.glass.counted_positions(g.pick)),
             };
             let cmds = [slot.cmd];
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
@@ -653,6 +662,12 @@ impl Renderer {
             }),
             _ => None,
         };
+        let glass_positions = match pending.recorded.glass_positions {
+            Some(counted) if pending.counted => {
+                Some(self.glass.read_positions(slot_index, counted)?)
+            }
+            _ => None,
+        };
         let bytes = if pending.want.eyes {
             Some(slot.readback.mapped()?)
         } else {
@@ -681,6 +696,7 @@ impl Renderer {
             work: FrameWork {
                 invocations,
                 photons,
+                glass_positions,
                 ..pending.recorded
             },
             readback,

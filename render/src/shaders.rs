@@ -141,6 +141,26 @@ macro_rules! covered_rows {
     };
 }
 
+/// The environment looks of two surfaces compiled with the constants `<suffix>` names.
+macro_rules! counted_row {
+    ($suffix:expr) => {
+        [
+            glass_entry!("two_surface", "environment_fresnel", $suffix),
+            glass_entry!("two_surface", "environment_phong", $suffix),
+        ]
+    };
+}
+
+/// The costs of [`counted_row!`]'s entry points.
+macro_rules! counted_cost_row {
+    ($suffix:expr) => {
+        [
+            cost!(concat!("glass.fs_two_surface_environment_fresnel", $suffix)),
+            cost!(concat!("glass.fs_two_surface_environment_phong", $suffix)),
+        ]
+    };
+}
+
 /// One glass fragment entry point: its SPIR-V and its name.
 macro_rules! glass_entry {
     ($model:literal, $look:literal, $suffix:expr) => {
@@ -194,6 +214,62 @@ pub const GLASS_FS_COVERED_COST: [[[ShaderCost; 2]; 6]; 2] = [
     covered_rows!(covered_cost_row, ""),
     covered_rows!(covered_cost_row, ".compensated"),
 ];
+
+/// The environment looks (fresnel, Phong) of the rows of [`GLASS_FS`] that shade a ball's light
+/// in the room in two parts, each over as many positions as it needs (two surfaces through a
+/// clear ball and through an absorbing one, over several positions per pixel:
+/// shaders/shared/glass_positions.wgsl), compiled with `COUNTED`: they count the positions they
+/// shade, for the frames that count their work. `[compensated][row][phong]`.
+pub const GLASS_FS_COUNTED: [[[GlassEntry; 2]; 2]; 2] = [
+    [
+        counted_row!(".ball.room.supersampled.counted"),
+        counted_row!(".absorbing.ball.room.supersampled.counted"),
+    ],
+    [
+        counted_row!(".ball.room.supersampled.compensated.counted"),
+        counted_row!(".absorbing.ball.room.supersampled.compensated.counted"),
+    ],
+];
+/// The static cost of one invocation of each of [`GLASS_FS_COUNTED`]'s entry points.
+pub const GLASS_FS_COUNTED_COST: [[[ShaderCost; 2]; 2]; 2] = [
+    [
+        counted_cost_row!(".ball.room.supersampled.counted"),
+        counted_cost_row!(".absorbing.ball.room.supersampled.counted"),
+    ],
+    [
+        counted_cost_row!(".ball.room.supersampled.compensated.counted"),
+        counted_cost_row!(".absorbing.ball.room.supersampled.compensated.counted"),
+    ],
+];
+
+/// The static cost of one position of each part of a ball's light in the rows of
+/// [`GLASS_FS_COUNTED`] (shaders/shared/glass_positions.wgsl), from the entry points that shade
+/// one: `[row][part]`, the parts the first image, the rest in an environment-reflection look and
+/// in a Phong look.
+pub const GLASS_PART_COST: [[ShaderCost; 3]; 2] = [
+    [
+        cost!("glass.fs_two_surface_first_image.ball.room"),
+        cost!("glass.fs_two_surface_rest_fresnel.ball.room"),
+        cost!("glass.fs_two_surface_rest_phong.ball.room"),
+    ],
+    [
+        cost!("glass.fs_two_surface_first_image.absorbing.ball.room"),
+        cost!("glass.fs_two_surface_rest_fresnel.absorbing.ball.room"),
+        cost!("glass.fs_two_surface_rest_phong.absorbing.ball.room"),
+    ],
+];
+
+/// The row of [`GLASS_FS_COUNTED`] of the model in row `model` of [`GLASS_FS`], if it shades a
+/// ball's light in the room in two parts.
+pub const fn counted_row(model: usize) -> Option<usize> {
+    // Two surfaces through a clear ball (3) and an absorbing one (4), with the room (+7), over
+    // several positions (+14).
+    match model {
+        24 => Some(0),
+        25 => Some(1),
+        _ => None,
+    }
+}
 
 /// The row of [`GLASS_FS_COVERED`] of the model in row `model` of [`GLASS_FS`], if it has
 /// one.

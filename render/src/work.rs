@@ -15,7 +15,8 @@
 //!
 //! - **counted by the shaders** ([`PhotonWork`]): the live caustic map's photons traced and
 //!   splatted and the texels its smoothing wrote, with integer atomics and the smoothing's tile
-//!   bits, once the frame finished. Exact on every device.
+//!   bits, once the frame finished; and the positions inside its pixels the glass shaded
+//!   ([`GlassPositions`]), with integer atomics. Exact on every device.
 //!
 //! Recording happens on the thread that calls [`crate::Renderer::submit`]; the tally lives in
 //! the context and is taken at the end of each frame's recording. The queries that count the
@@ -48,6 +49,10 @@ pub struct FrameWork {
     /// frame counted invocations with live caustics on; all 0 on a frame that did not
     /// compute the map.
     pub photons: Option<PhotonWork>,
+    /// The positions the glass shaded, counted on the device: `None` unless the frame counted
+    /// invocations and drew the glass with a pipeline whose pixels decide how many positions
+    /// they shade (shaders/shared/glass_positions.wgsl).
+    pub glass_positions: Option<GlassPositions>,
 }
 
 /// One computation of the live caustic map, counted on the device by the trace that counts
@@ -62,6 +67,41 @@ pub struct PhotonWork {
     /// Texels of the map the smoothing wrote (its tiles that may hold a gain; every texel
     /// where it skips none).
     pub smoothed_texels: u64,
+}
+
+/// The positions inside its pixels that the glass shaded in one frame, both eyes, counted on
+/// the device by the pipelines that shade a ball's light in two parts, each over as many
+/// positions as it needs (`COUNTED` in shaders/shared/glass_positions.wgsl), with integer
+/// atomics: exact on every device. Only the pixels the glass covers count (a device's helper
+/// invocations write nothing). The static cost of the pipeline ([`FrameWork::glass_shader`])
+/// charges every fragment invocation one position of each part; each further one of a pixel
+/// is charged [`GlassPositions::each`] or [`GlassPositions::each_first_image`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GlassPositions {
+    /// Positions shaded for the rest of the light: the surface's reflection and the light the
+    /// exit reflects back inside.
+    pub shaded: u64,
+    /// Positions shaded for the first image: the room refracted through both surfaces.
+    pub first_images: u64,
+    /// The covered pixels that shaded them.
+    pub pixels: u64,
+    /// The static cost of one position of the rest.
+    pub each: ShaderCost,
+    /// The static cost of one position of the first image.
+    pub each_first_image: ShaderCost,
+}
+
+impl GlassPositions {
+    /// What the pixels shaded beyond one position of each part each, at their static costs:
+    /// fetches, texels and instructions.
+    pub fn further(&self) -> [u64; 3] {
+        let rest = self.shaded.saturating_sub(self.pixels);
+        let first = self.first_images.saturating_sub(self.pixels);
+        let of = |f: fn(ShaderCost) -> u32| {
+            rest * u64::from(f(self.each)) + first * u64::from(f(self.each_first_image))
+        };
+        [of(|c| c.fetches), of(|c| c.texels), of(|c| c.instructions)]
+    }
 }
 
 /// Work recorded into one frame's command buffer.

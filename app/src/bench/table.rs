@@ -146,6 +146,12 @@ impl BenchReport {
                 ),
                 ("glass texels", Box::new(count("glass_texels"))),
                 ("glass instr", Box::new(count("glass_instructions"))),
+                // Where the glass shades a ball's light in parts over the positions each needs.
+                (
+                    "first image pos",
+                    Box::new(count("glass_positions.first_images")),
+                ),
+                ("rest pos", Box::new(count("glass_positions"))),
                 ("field frags", Box::new(count("mask.fragment_invocations"))),
                 ("compute inv", Box::new(sum(".compute_invocations"))),
             ]);

@@ -157,9 +157,10 @@ impl GlassPass {
         let covered = self
             .covered_entry(pick.variant, pick.compensated)
             .filter(|_| pick.covered);
-        let pipeline = match covered {
-            Some(entry) => self.covered_pipelines[entry].raw(),
-            None => self.pipelines[self.entry(pick.variant, pick.compensated)].raw(),
+        let pipeline = match (covered, self.counted_pipeline(pick)) {
+            (Some(entry), _) => self.covered_pipelines[entry].raw(),
+            (None, Some(counting)) => counting,
+            (None, None) => self.pipelines[self.entry(pick.variant, pick.compensated)].raw(),
         };
         let sets: Vec<_> = std::iter::once(self.set)
             .chain(self.compensation.as_ref().map(CompensationSet::set))

@@ -107,6 +107,9 @@ impl Renderer {
             if let Some(pool) = queries {
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 1);
             }
+            if statistics.0.is_some() {
+                self.glass.record_clear(&self.ctx, cmd, slot.index);
+            }
             let (drawn_pass, drawn_framebuffers) = match dimmer {
                 Some(dimmer) => {
                     dimmer.record_before_drawing(&self.ctx, cmd);
@@ -134,7 +137,9 @@ impl Renderer {
                 });
                 // The glass with the environment's lookup, then where the proof leaves it out,
                 // each counted on its own.
-                let push = EyePush::new(&params.eyes, index, &params.look);
+                let mut push = EyePush::new(&params.eyes, index, &params.look);
+                // Where the glass counts the positions it shades (the frames that count).
+                push.refraction_origin[3] = slot.index as f32;
                 for covered in [false, true] {
                     statistics.around(d, cmd, query + 1 + u32::from(covered), || {
                         if let Some(glass) = glass {
@@ -145,6 +150,9 @@ impl Renderer {
                     });
                 }
                 d.cmd_end_render_pass(cmd);
+            }
+            if statistics.0.is_some() {
+                self.glass.record_counted(&self.ctx, cmd);
             }
             if let Some(dimmer) = dimmer {
                 dimmer.record_panel(&self.ctx, cmd, &params.eyes);

@@ -16,7 +16,12 @@ use super::{FrameWork, Invocations, ShaderCost};
 /// (`vertex`, `fragment`, `compute`), and the work of the eye passes' fragments, their
 /// invocations times the static cost of one ([`ShaderCost`]):
 /// `glass_fetches`, `glass_texels`, `glass_instructions` (both of the glass's pipelines), and
-/// the same for the floor overlay (`floor_*`); where the frames count their work with live
+/// the same for the floor overlay (`floor_*`); where the glass shades a ball's light in two
+/// parts, each over as many positions as it needs, the positions of the rest
+/// (`glass_positions`) and of the first image (`glass_positions.first_images`) and the covered
+/// pixels that shaded them (`glass_positions.pixels`), counted on the device
+/// ([`super::GlassPositions`]), what a pixel shaded beyond one position of each charged to
+/// `glass_*` at their static costs; where the frames count their work with live
 /// caustics on, what the live map's computation did (`caustic_photons.traced`,
 /// `caustic_photons.splatted`, `caustic_smoothing.texels`: [`super::PhotonWork`]).
 pub type WorkCounts = BTreeMap<String, f64>;
@@ -89,13 +94,26 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
                     .map(|&(fragments, cost)| fragments * u64::from(of(cost.unwrap_or_default())))
                     .sum::<u64>()
             };
+            // What the glass's pixels shaded beyond their first whole position and first image.
+            let [fetches, texels, instructions] = match (pass, frame.glass_positions) {
+                ("glass", Some(p)) => p.further(),
+                _ => [0; 3],
+            };
             for (what, value) in [
-                ("fetches", total(|c| c.fetches)),
-                ("texels", total(|c| c.texels)),
-                ("instructions", total(|c| c.instructions)),
+                ("fetches", total(|c| c.fetches) + fetches),
+                ("texels", total(|c| c.texels) + texels),
+                ("instructions", total(|c| c.instructions) + instructions),
             ] {
                 counts.push((format!("{pass}_{what}"), value as f64));
             }
+        }
+        if let Some(p) = frame.glass_positions {
+            counts.push(("glass_positions".to_owned(), p.shaded as f64));
+            counts.push((
+                "glass_positions.first_images".to_owned(),
+                p.first_images as f64,
+            ));
+            counts.push(("glass_positions.pixels".to_owned(), p.pixels as f64));
         }
     }
     if let Some(photons) = frame.photons {
@@ -113,7 +131,7 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::work::{PassInvocations, RecordedWork, ShaderCost};
+    use crate::work::{GlassPositions, PassInvocations, RecordedWork, ShaderCost};
 
     #[test]
     fn counts_are_means_per_frame_and_fetches_follow_each_glass_pipelines_fragments() {
@@ -149,6 +167,7 @@ mod tests {
                 splatted: 20,
                 smoothed_texels: 64,
             }),
+            glass_positions: None,
         };
         let counts = mean_counts(&[frame(2, 100), frame(4, 300)]);
         assert_eq!(counts["draws"], 3.0);
@@ -166,6 +185,63 @@ mod tests {
     }
 
     #[test]
+    fn the_glass_is_charged_each_position_a_pixel_shaded_beyond_its_first() {
+        let each = ShaderCost {
+            fetches: 2,
+            texels: 8,
+            instructions: 40,
+        };
+        let each_first_image = ShaderCost {
+            fetches: 1,
+            texels: 4,
+            instructions: 10,
+        };
+        let frame = |positions: Option<(u64, u64, u64)>| FrameWork {
+            recorded: RecordedWork::default(),
+            invocations: Some(PassInvocations {
+                eye_glass: Invocations {
+                    fragment: 50,
+                    ..Invocations::default()
+                },
+                ..PassInvocations::default()
+            }),
+            glass_shader: Some(ShaderCost {
+                fetches: 3,
+                texels: 12,
+                instructions: 100,
+            }),
+            glass_covered_shader: None,
+            overlay_shader: None,
+            photons: None,
+            glass_positions: positions.map(|(shaded, first_images, pixels)| GlassPositions {
+                shaded,
+                first_images,
+                pixels,
+                each,
+                each_first_image,
+            }),
+        };
+        // 40 covered pixels, each with the first image at 16 positions (600 beyond their
+        // first), the rest at 16 positions in 10 of them and at 4 in 30 (240 beyond).
+        let counts = mean_counts(&[frame(Some((10 * 16 + 30 * 4, 40 * 16, 40)))]);
+        assert_eq!(counts["glass_positions"], 280.0);
+        assert_eq!(counts["glass_positions.first_images"], 640.0);
+        assert_eq!(counts["glass_positions.pixels"], 40.0);
+        assert_eq!(counts["glass_fetches"], 150.0 + 240.0 * 2.0 + 600.0);
+        assert_eq!(counts["glass_texels"], 600.0 + 240.0 * 8.0 + 600.0 * 4.0);
+        assert_eq!(
+            counts["glass_instructions"],
+            5000.0 + 240.0 * 40.0 + 600.0 * 10.0
+        );
+        // Every pixel at one position of each: the static cost alone.
+        let one = mean_counts(&[frame(Some((40, 40, 40)))]);
+        assert_eq!(one["glass_instructions"], 5000.0);
+        let uncounted = mean_counts(&[frame(None)]);
+        assert_eq!(uncounted["glass_instructions"], 5000.0);
+        assert!(!uncounted.contains_key("glass_positions"));
+    }
+
+    #[test]
     fn without_invocation_counts_only_the_recorded_work_is_named() {
         let frame = FrameWork {
             recorded: RecordedWork {
@@ -177,6 +253,7 @@ mod tests {
             glass_covered_shader: None,
             overlay_shader: None,
             photons: None,
+            glass_positions: None,
         };
         let counts = mean_counts(&[frame]);
         assert_eq!(counts["dispatches"], 5.0);

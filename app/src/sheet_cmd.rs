@@ -115,12 +115,19 @@ pub fn sheet_command(args: SheetArgs) -> Result<()> {
         .iter()
         .fold((1, 1), |(w, h), b| (w.max(b.size.0), h.max(b.size.1)));
     let text = TextBox::new(CAPTION_PX)?;
-    let columns: Vec<Column> = runs
+    let mut columns: Vec<Column> = runs
         .iter()
         .zip(&boxes)
         .enumerate()
         .map(|(i, (run, crop))| run.column(crop.centred(size), size, args.labels.get(i)))
         .collect::<Result<_>>()?;
+    for column in &mut columns {
+        column.caption = column
+            .caption
+            .iter()
+            .flat_map(|line| wrap(&text, line, size.0))
+            .collect();
+    }
 
     let title = vec![format!(
         "frame {}, {eye} eye: above, what the wearer sees; below, a real glass object there \
@@ -410,6 +417,22 @@ impl Run {
     }
 }
 
+/// `line` broken between words into lines whose box is at most `width` pixels wide (a word
+/// wider than that on a line of its own).
+fn wrap(text: &TextBox, line: &str, width: u32) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in line.split(' ') {
+        match lines.last_mut() {
+            Some(last) if text.size(&[format!("{last} {word}")]).0 <= width => {
+                last.push(' ');
+                last.push_str(word);
+            }
+            _ => lines.push(word.to_owned()),
+        }
+    }
+    lines
+}
+
 /// The rectangle `(lo, hi)` (hi exclusive) that holds `pixels` but for the share `tail` of them
 /// at each side along each axis (not empty).
 fn bounds(pixels: &[(u32, u32)], tail: f32) -> ((u32, u32), (u32, u32)) {
@@ -453,6 +476,22 @@ mod tests {
         // Larger than the image: the image.
         let whole = crop.centred((1000, 1000));
         assert_eq!((whole.at, whole.size), ((0, 0), (320, 240)));
+    }
+
+    #[test]
+    fn captions_wrap_between_words_to_the_columns_width() {
+        let text = TextBox::new(CAPTION_PX).unwrap();
+        let line = "the paper's conditions (glass-sphere, inducer + caustics)";
+        let whole = text.size(&[line.to_owned()]).0;
+        assert_eq!(wrap(&text, line, whole), vec![line.to_owned()]);
+        let wrapped = wrap(&text, line, whole / 2);
+        assert!(wrapped.len() >= 2, "{wrapped:?}");
+        assert_eq!(wrapped.join(" "), line);
+        assert!(
+            wrapped
+                .iter()
+                .all(|l| text.size(&[l.clone()]).0 <= whole / 2)
+        );
     }
 
     #[test]

@@ -490,7 +490,7 @@ mod tests {
         assert!(
             wrapped
                 .iter()
-                .all(|l| text.size(&[l.clone()]).0 <= whole / 2)
+                .all(|l| text.size(std::slice::from_ref(l)).0 <= whole / 2)
         );
     }
 

@@ -23,7 +23,7 @@ const SAY_EVERY: Duration = Duration::from_secs(5);
 /// Asks for the runtime and the headset again until they are back, for at most `limit`: the
 /// new runtime and how long it took; `None` when the app stopped waiting (Ctrl-C, or `end`
 /// set). Fails when they are not back in time, or when the runtime answers with anything but
-/// "not available now".
+/// "not available now" or "could not start" (a runtime starting again after a crash).
 pub(super) fn runtime_again(
     options: &OpenXrOptions,
     limit: Duration,
@@ -41,7 +41,7 @@ pub(super) fn runtime_again(
         }
         match Runtime::new(options) {
             Ok(runtime) => return Ok(Some((runtime, started.elapsed()))),
-            Err(e) if e.is_unavailable() => {
+            Err(e) if e.may_come_back_after_loss() => {
                 if started.elapsed() >= limit {
                     return Err(e).with_context(|| {
                         format!(

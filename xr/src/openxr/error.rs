@@ -53,6 +53,17 @@ pub enum OpenXrError {
         /// What it returned.
         result: xr::sys::Result,
     },
+    /// `xrCreateInstance` failed with `XR_ERROR_INITIALIZATION_FAILED` or
+    /// `XR_ERROR_RUNTIME_FAILURE`: the runtime could not start. At the first start that is the
+    /// end (`detail` says why and what to do); after a loss the runtime may be starting again,
+    /// and is asked again for a while ([`OpenXrError::may_come_back_after_loss`]).
+    #[error("{detail}")]
+    InstanceFailed {
+        /// What xrCreateInstance returned.
+        result: xr::sys::Result,
+        /// The error as the first start reports it.
+        detail: Box<OpenXrError>,
+    },
     /// No head-mounted display is connected.
     #[error("no head-mounted display: {0}")]
     NoHmd(String),
@@ -88,6 +99,13 @@ impl OpenXrError {
     /// (after a lost session or runtime, the app asks again for a while).
     pub fn is_unavailable(&self) -> bool {
         matches!(self, OpenXrError::Unavailable { .. })
+    }
+
+    /// Whether, after a lost session or runtime, asking again may work: the runtime or the
+    /// headset is away for now, or the runtime failed to start (one that is starting again
+    /// after a crash or an update answers so until it is ready).
+    pub fn may_come_back_after_loss(&self) -> bool {
+        self.is_unavailable() || matches!(self, OpenXrError::InstanceFailed { .. })
     }
 }
 

@@ -207,7 +207,15 @@ impl Runtime {
                     };
                 }
                 let from_env = std::env::var("XR_ENABLE_API_LAYERS").ok();
-                error::instance_error(&e.to_string(), &layers, from_env.as_deref())
+                let detail = error::instance_error(&e.to_string(), &layers, from_env.as_deref());
+                match e {
+                    xr::sys::Result::ERROR_INITIALIZATION_FAILED
+                    | xr::sys::Result::ERROR_RUNTIME_FAILURE => OpenXrError::InstanceFailed {
+                        result: e,
+                        detail: Box::new(detail),
+                    },
+                    _ => detail,
+                }
             })?;
         let props = instance.properties().xr("xrGetInstanceProperties")?;
         let system = instance

@@ -83,8 +83,8 @@ pub enum Fault {
     /// many seconds.
     SessionLoss(f64),
     /// `XrEventDataInstanceLossPending`; every call on the instance then fails with
-    /// `XR_ERROR_INSTANCE_LOST`, and `xrCreateInstance` with `XR_ERROR_RUNTIME_UNAVAILABLE` for
-    /// this many seconds.
+    /// `XR_ERROR_INSTANCE_LOST`, and `xrCreateInstance` with `XR_ERROR_RUNTIME_UNAVAILABLE`, then
+    /// `XR_ERROR_INITIALIZATION_FAILED`, for this many seconds.
     InstanceLoss(f64),
     /// `XrEventDataReferenceSpaceChangePending` for every LOCAL and STAGE space type the
     /// session made.

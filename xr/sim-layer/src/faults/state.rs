@@ -127,7 +127,8 @@ impl Virtual {
 enum Outage {
     /// After a session loss: `xrGetSystem` fails with `XR_ERROR_FORM_FACTOR_UNAVAILABLE`.
     Headset,
-    /// After an instance loss: `xrCreateInstance` fails with `XR_ERROR_RUNTIME_UNAVAILABLE`.
+    /// After an instance loss: `xrCreateInstance` fails with `XR_ERROR_RUNTIME_UNAVAILABLE`, then
+    /// with `XR_ERROR_INITIALIZATION_FAILED` (a runtime starting again, not ready yet).
     Runtime,
 }
 
@@ -152,6 +153,8 @@ pub struct Faults {
     lost_instances: HashSet<u64>,
     /// Until when what is refused.
     outage: Option<(Outage, Instant)>,
+    /// Calls refused in the current outage.
+    outage_refusals: u32,
     /// Frames still to be told not to render.
     no_render_left: u64,
     /// Frames to skip before the app's next one.
@@ -188,6 +191,7 @@ impl Faults {
             instance_events: HashMap::new(),
             lost_instances: HashSet::new(),
             outage: None,
+            outage_refusals: 0,
             no_render_left: 0,
             late_pending: 0,
             timeouts_left: 0,
@@ -453,10 +457,21 @@ impl Faults {
             .then_some(sys::Result::ERROR_FORM_FACTOR_UNAVAILABLE)
     }
 
-    /// The result `xrCreateInstance` gets while the runtime is gone, if it is.
+    /// The result `xrCreateInstance` gets while the runtime is gone, if it is: unavailable the
+    /// first time, then failing to initialise, as a runtime that is starting again answers
+    /// until it is ready.
     pub fn create_instance(&mut self, now: Instant) -> Option<sys::Result> {
-        self.refused_during(Outage::Runtime, now, "xrCreateInstance")
-            .then_some(sys::Result::ERROR_RUNTIME_UNAVAILABLE)
+        let refused = self.refused_during(Outage::Runtime, now, "xrCreateInstance");
+        refused.then_some(match self.outage_refusals {
+            1 => sys::Result::ERROR_RUNTIME_UNAVAILABLE,
+            _ => sys::Result::ERROR_INITIALIZATION_FAILED,
+        })
+    }
+
+    /// Refuses what an outage of `kind` refuses until `until`.
+    fn begin_outage(&mut self, kind: Outage, until: Instant) {
+        self.outage = Some((kind, until));
+        self.outage_refusals = 0;
     }
 
     /// Whether `call` is refused by an outage of `kind` at `now` (logged).
@@ -464,6 +479,7 @@ impl Faults {
         match self.outage {
             Some((k, until)) if k == kind && now < until => {
                 self.log.push(("unavailable", call.to_owned()));
+                self.outage_refusals += 1;
                 true
             }
             Some((_, until)) if now >= until => {

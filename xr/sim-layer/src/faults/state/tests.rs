@@ -167,6 +167,11 @@ fn an_instance_loss_is_announced_once_and_the_runtime_is_away_for_the_outage() {
         f.create_instance(now),
         Some(sys::Result::ERROR_RUNTIME_UNAVAILABLE)
     );
+    // Then starting again, not ready yet, until the outage ends.
+    assert_eq!(
+        f.create_instance(now + Duration::from_millis(500)),
+        Some(sys::Result::ERROR_INITIALIZATION_FAILED)
+    );
     assert_eq!(f.create_instance(now + Duration::from_secs(1)), None);
     // The runtime hands the destroyed instance's handle, and its session's, out again.
     f.instance_destroyed(INSTANCE);

@@ -15,7 +15,7 @@ impl Faults {
         let time_ns = self.latest_display_ns.unwrap_or(0);
         if let Some(s) = self.instance_events.remove(&instance) {
             self.lost_instances.insert(instance);
-            self.outage = Some((Outage::Runtime, now + secs(s)));
+            self.begin_outage(Outage::Runtime, now + secs(s));
             self.log.push(("instance-loss", format!("{s}")));
             return Some(Event::InstanceLoss {
                 loss_time_ns: time_ns,
@@ -75,7 +75,7 @@ impl Faults {
                 Pending::Loss(s) => {
                     v.lost = true;
                     v.shown = Some(sys::SessionState::LOSS_PENDING);
-                    self.outage = Some((Outage::Headset, now + secs(s)));
+                    self.begin_outage(Outage::Headset, now + secs(s));
                     self.log.push(("state", "LOSS_PENDING".to_owned()));
                     Event::State {
                         session,

@@ -148,17 +148,26 @@ pub fn sheet_command(args: SheetArgs) -> Result<()> {
         p.copy_from_slice(&[24, 24, 24, 255]);
     }
     text.draw(&mut sheet, (width, height), (GAP, 0), &title);
+    let row = |r: u32| title_h + GAP + r * (size.1 + GAP);
     for (i, column) in columns.iter().enumerate() {
         let x = GAP + i as u32 * (column.size.0 + GAP);
-        for (row, tile) in column.tiles.iter().enumerate() {
-            let y = title_h + GAP + row as u32 * (column.size.1 + GAP);
-            blit(&mut sheet, width, tile, column.size, (x, y));
+        for (r, tile) in column.tiles.iter().enumerate() {
+            blit(&mut sheet, width, tile, column.size, (x, row(r as u32)));
         }
-        let y = title_h + GAP + 2 * (column.size.1 + GAP);
+        let y = row(2);
         text.draw(&mut sheet, (width, height), (x, y), &column.caption);
     }
     write_atomic(&args.out, &encode_png(&sheet, width, height)?)?;
-    println!("wrote {}", args.out.display());
+    println!(
+        "wrote {}: {} columns of {} x {} pixel tiles, what the wearer sees from y = {}, the \
+         reference from y = {}",
+        args.out.display(),
+        columns.len(),
+        size.0,
+        size.1,
+        row(0),
+        row(1)
+    );
     Ok(())
 }
 

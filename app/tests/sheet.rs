@@ -138,7 +138,18 @@ fn each_run_is_a_column_with_its_physical_reference_under_what_the_wearer_sees()
     );
     assert!(paper_at[0].0 < real_at[0].0, "{paper_at:?} {real_at:?}");
     assert_eq!(paper_at[0].1, real_at[0].1);
-    assert!(real_at[0].1 > h / 3, "{real_at:?} in a sheet {w} x {h}");
+    // The lower row, as the command says where it lies.
+    let said = String::from_utf8_lossy(&out.stdout);
+    let number_after = |key: &str| -> u32 {
+        let rest = &said[said.find(key).unwrap_or_else(|| panic!("{said}")) + key.len()..];
+        let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+        digits.parse().unwrap_or_else(|_| panic!("{said}"))
+    };
+    let (tile_h, lower) = (number_after(" x "), number_after("reference from y = "));
+    assert!(
+        (lower..lower + tile_h).contains(&real_at[0].1),
+        "{real_at:?} in a sheet {w} x {h}: {said}"
+    );
 }
 
 #[test]

@@ -32,3 +32,4 @@ pub mod registry;
 pub mod submitted;
 pub mod timeline;
 pub mod two_call;
+pub mod wearer;

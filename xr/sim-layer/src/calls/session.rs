@@ -184,7 +184,7 @@ fn finish_images(images: &Mutex<SessionImages>, config: &Config) {
     if let Some(world) = &config.world {
         if record.last.is_empty() {
             report("no submitted view was read back: no wearer's view written");
-        } else if let Err(e) = crate::images::write_wearer_views(
+        } else if let Err(e) = crate::wearer::write_wearer_views(
             &record.dir,
             world,
             &record.last,

@@ -20,11 +20,11 @@
 // docs/equations.md): the ray refracts in at the front, crosses the glass and refracts out at
 // the back, total internal reflection followed for up to MAX_INTERNAL_REFLECTIONS bounces
 // (then the environment), with exact Fresnel at both interfaces and Beer-Lambert absorption
-// over the path inside (glTF KHR_materials_volume). The exit is found against the
-// object's radial map (optics/src/radial_map.rs `radial_map`): the distance from the object's
-// centre to its surface and the normal there, per direction. Starting from the sphere through
-// the entry point, secant steps on the ray's height above the surface: one fetch for a ball, a
-// few for a faceted stone.
+// over the path inside (glTF KHR_materials_volume). The exit is found on the object's own
+// triangles (`mesh_hit`: a bounding-volume hierarchy in a storage buffer, render/src/glass/mesh.rs),
+// and a ray that leaves an object that is not convex is followed into it again where it meets
+// it (a torus's far side, a goblet's stem); a ball and a convex gem leave analytically (the
+// sphere, the facet planes).
 //
 // Texture fetches per covered pixel: baseline 3 (refracted and reflected environment, surface);
 // with background refraction (disparity and/or defocus) and Phong reflection 2 (background
@@ -87,14 +87,15 @@ struct Globals {
     shading: vec4<f32>,
     // Inverse of world_from_model.
     model_from_world: mat4x4<f32>,
-    // xyz: the object's centre, its bounding box's (model units), also the radial map's; w: the
-    // radial map's reference radius.
+    // xyz: the object's centre, its bounding box's (model units), the origin of the frame the
+    // exit is found in; w: the largest distance of a vertex from it (a ball's radius).
     radial: vec4<f32>,
     // xyz: the object's centre in the world (metres).
     center_world: vec4<f32>,
     // rgb: absorption inside the glass, halvings per model unit (Beer-Lambert, 2^(-rgb L):
     // the coefficient per world metre times the model's scale over ln 2; 0 in a channel that
-    // absorbs nothing, where 2^0 = 1 leaves it exactly as it was).
+    // absorbs nothing, where 2^0 = 1 leaves it exactly as it was); w: 1 where the object is a
+    // ball (`front_surface` takes the sphere through its vertices), else 0.
     absorption: vec4<f32>,
     // Maps the world into the floor plane's frame, where its photo covers the unit square
     // [-0.5, 0.5]^2 at z = 0 (top edge away from the viewer).
@@ -106,15 +107,14 @@ struct Globals {
 // compiles the fs_two_surface_* entry points with it set too).
 override ABSORBING: bool = false;
 
-// The object is a ball about the radial map's centre (its map is the sphere of radius
-// `g.radial.w` with radial normals, optics/src/radial_map.rs `RadialMap::ball`): a pipeline
-// constant, so that a ball's pipeline finds its surface without the map's fetch.
+// The object is a ball about its centre (the sphere of radius `g.radial.w` with radial normals,
+// optics/src/radial_map.rs `RadialMap::ball`): a pipeline constant, so that a ball's pipeline
+// finds its surface analytically.
 override BALL: bool = false;
 
 // The object is a flat-shaded convex polyhedron (a cut gem) whose facet planes are `facet_planes`
 // (optics/src/convex.rs `facet_planes`): a pipeline constant, so that its pipeline finds
-// where a ray leaves exactly, without the radial map (whose filtered texels round every
-// facet edge).
+// where a ray leaves exactly, without a search of its triangles.
 override CONVEX: bool = false;
 
 // The floor and background photos are the room the glass refracts and reflects (`[environment]
@@ -156,10 +156,13 @@ var<push_constant> eye: Eye;
 @group(0) @binding(3) var background: texture_2d<f32>;
 @group(0) @binding(4) var clamp_sampler: sampler;
 @group(0) @binding(5) var surface: texture_2d<f32>;
-// The object's surface seen from its centre (two-surface refraction; 1 texel otherwise): rgb
-// the outward normal minus the direction, a the radius minus the reference radius.
-@group(0) @binding(6) var radial_map: texture_2d<f32>;
-// The facet planes of a convex object (model frame, about the radial map's centre): xyz the
+// The object's triangles in a bounding-volume hierarchy (two-surface refraction through a mesh,
+// model frame about `g.radial.xyz`; render/src/glass/mesh.rs writes it, one word otherwise):
+// element 0 x the first triangle's element (bitcast); node i at 1 + 2i: (low corner, first
+// child or triangle slot), (high corner, triangle count, 0 for an inner node); triangle slot k
+// at that first element + 6k: corner 0, edge 1, edge 2, the corners' outward unit normals.
+@group(0) @binding(6) var<storage, read> mesh: array<vec4<f32>>;
+// The facet planes of a convex object (model frame, about the object's centre): xyz the
 // outward unit normal, w the plane's distance from the centre. One unused plane otherwise.
 @group(0) @binding(7) var<storage, read> facet_planes: array<vec4<f32>>;
 // The floor photo (sharp), seen through the glass when the room is a refraction target.
@@ -181,8 +184,8 @@ struct VertexOut {
     @location(0) world_pos: vec3<f32>,
     @location(1) world_normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
-    // x: the vertex's distance from the object's centre (world metres); y: 1 where the vertex
-    // normal points away from the centre (a ball's vertex), else 0. Interpolated: see
+    // x: the vertex's distance from the object's centre (world metres); y: 1 where the object
+    // is a ball and the vertex normal points away from the centre, else 0. Interpolated: see
     // `front_surface`.
     @location(3) curve: vec2<f32>,
     // Positions along each side of a pixel (`SUPERSAMPLED`), `g.shading.w` at every vertex: the
@@ -209,7 +212,8 @@ fn vs_main(
     out.uv = uv;
     let centred = position - g.radial.xyz;
     var radial = 0.0;
-    if dot(normal, centred) > RADIAL_NORMAL_COS * length(normal) * length(centred) {
+    if g.absorption.w > 0.5
+        && dot(normal, centred) > RADIAL_NORMAL_COS * length(normal) * length(centred) {
         radial = 1.0;
     }
     out.curve = vec2<f32>(length(world.xyz - g.center_world.xyz), radial);
@@ -312,20 +316,10 @@ const MAX_INTERNAL_REFLECTIONS: i32 = 4;
 // where the exit reflects most, the second still shows (ꟻLIP in glass-sphere-real's disc 0.274
 // with one, 0.268 with two, 0.267 with three or six: docs/realism.md).
 const ECHOES: i32 = 2;
-// Radial-map steps per exit at most; a ball needs one.
-const EXIT_STEPS: i32 = 8;
-
-// The surface along model direction d from the map centre: x the radius, yzw the outward
-// unit normal (model frame).
-fn radial_surface(d: vec3<f32>) -> vec4<f32> {
-    let unit = normalize(d);
-    if BALL {
-        return vec4<f32>(g.radial.w, unit);
-    } else {
-        let texel = textureSampleLevel(radial_map, wrap_sampler, latlong_uv(unit), 0.0);
-        return vec4<f32>(g.radial.w + texel.a, normalize(texel.rgb + unit));
-    }
-}
+// Entries into the object along one path at most (`MESH`, an object that is not convex: the
+// first and the re-entries after it leaves, as a ray through a torus's hole or past a goblet's
+// cup into its stem; then the room beyond, whatever the object).
+const MAX_ENTRIES: i32 = 4;
 
 // Far crossing of the ray p + t d (d unit) with the sphere of radius r about the origin.
 fn sphere_exit(p: vec3<f32>, d: vec3<f32>, r: f32) -> f32 {
@@ -368,9 +362,9 @@ struct Passage {
     echoes: vec3<f32>,
 };
 
-// Where the ray p + t d (from inside, d unit; model frame about the radial map's centre)
-// leaves the object: x the distance t, yzw the outward unit normal there. Exact for a convex
-// polyhedron (`CONVEX`, its planes) and a ball; otherwise found on the radial map.
+// Where the ray p + t d (from inside, d unit; model frame about the object's centre) leaves
+// the object: x the distance t, yzw the outward unit normal there. Exact for a convex
+// polyhedron (`CONVEX`, its planes), a ball and any closed mesh (its triangles, `mesh_exit`).
 fn find_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     // Each model's way in a branch of its own, none after another's return: what a pipeline
     // constant rules out is no code of its pipeline, nor of its counted cost.
@@ -383,83 +377,214 @@ fn find_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
         let t = sphere_exit(p, d, length(p));
         return vec4<f32>(t, normalize(p + d * t));
     } else {
-        return radial_exit(p, d);
+        return mesh_exit(p, d);
     }
 }
 
-// Where the ray p + t d leaves the object of the radial map (`find_exit`): f(t) = |p + t d| -
-// r(p + t d) vanishes at the exit. First the exit of the sphere through the entry, then secant
-// steps on f, or the sphere of the last radius where a secant step would go backwards.
-fn radial_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
-    var t = sphere_exit(p, d, length(p));
-    var s = radial_surface(p + d * t);
-    var f = length(p + d * t) - s.x;
-    var t_prev = t;
-    var f_prev = f;
-    for (var i = 1; i < EXIT_STEPS; i++) {
-        if abs(f) <= 1e-4 * s.x {
-            break;
+// Where a search of the object's triangles (`mesh_hit`) meets none.
+const NO_HIT: f32 = 3.0e38;
+
+// Offset along a ray leaving a point of the surface before the next search, model units (the
+// models are about one unit across): the triangle it leaves is not met again.
+const MESH_EPS: f32 = 1e-5;
+
+// Depth of the hierarchy's search stack: render/src/glass/mesh.rs refuses a deeper hierarchy.
+const MESH_STACK: u32 = 32u;
+
+// Nodes one search visits at most: a guard against a malformed buffer (a search through a
+// shipped model visits a few dozen).
+const MESH_VISITS: u32 = 4096u;
+
+// The nodes and triangles this invocation's searches visited and tested (`COUNTED`).
+var<private> mesh_nodes: u32;
+var<private> mesh_triangles: u32;
+
+// Distance along the ray p + t / inv (t >= 0) to the box [lo, hi], or NO_HIT where it passes
+// beside it.
+fn box_entry(lo: vec3<f32>, hi: vec3<f32>, p: vec3<f32>, inv: vec3<f32>) -> f32 {
+    let t0 = (lo - p) * inv;
+    let t1 = (hi - p) * inv;
+    let near = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
+    let far = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    return select(NO_HIT, near, near <= far);
+}
+
+// The nearest meeting of the ray p + t d (t > 0, d unit; model frame about the object's centre)
+// with the object's triangles (twin of optics/src/solid/bvh.rs `Bvh::closest` and
+// optics/src/two_surface.rs `MeshBody::hit`, either side of a triangle): x the distance t (NO_HIT
+// where it meets none), yzw the corners' outward normals interpolated there, as the rasteriser
+// interpolates them over the front surface.
+fn mesh_hit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
+    // A direction along an axis: its reciprocal large rather than infinite (the boxes' slabs
+    // then still order correctly).
+    let inv = 1.0 / select(d, vec3<f32>(1e-30), abs(d) < vec3<f32>(1e-30));
+    let base = bitcast<u32>(mesh[0].x);
+    var best = NO_HIT;
+    var best_at = 0u;
+    var best_uv = vec2<f32>(0.0);
+    var stack: array<u32, MESH_STACK>;
+    stack[0] = 0u;
+    var depth = 1u;
+    var visits = 0u;
+    while depth > 0u && visits < MESH_VISITS {
+        visits += 1u;
+        depth -= 1u;
+        let node = stack[depth];
+        let low = mesh[1u + 2u * node];
+        let high = mesh[2u + 2u * node];
+        if box_entry(low.xyz, high.xyz, p, inv) >= best {
+            continue;
         }
-        var t_next = sphere_exit(p, d, s.x);
-        if i > 1 && abs(f - f_prev) > 1e-12 {
-            let secant = t - f * (t - t_prev) / (f - f_prev);
-            if secant > 0.0 {
-                t_next = secant;
+        let first = bitcast<u32>(low.w);
+        let count = bitcast<u32>(high.w);
+        if count > 0u {
+            // Möller-Trumbore, either side.
+            for (var k = 0u; k < count; k++) {
+                let at = base + 6u * (first + k);
+                let e1 = mesh[at + 1u].xyz;
+                let e2 = mesh[at + 2u].xyz;
+                let q = cross(d, e2);
+                let det = dot(e1, q);
+                let s = p - mesh[at].xyz;
+                let u = dot(s, q) / det;
+                let r = cross(s, e1);
+                let v = dot(d, r) / det;
+                let t = dot(e2, r) / det;
+                if det != 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < best {
+                    best = t;
+                    best_at = at;
+                    best_uv = vec2<f32>(u, v);
+                }
+            }
+            mesh_triangles += count;
+        } else {
+            let left = box_entry(mesh[1u + 2u * first].xyz, mesh[2u + 2u * first].xyz, p, inv);
+            let right = box_entry(
+                mesh[3u + 2u * first].xyz, mesh[4u + 2u * first].xyz, p, inv);
+            // The farther child first, so that the nearer is searched first.
+            let near_first = left <= right;
+            let far = select(first, first + 1u, near_first);
+            let far_t = max(left, right);
+            let near_t = min(left, right);
+            if far_t < best && depth < MESH_STACK {
+                stack[depth] = far;
+                depth += 1u;
+            }
+            if near_t < best && depth < MESH_STACK {
+                stack[depth] = select(first + 1u, first, near_first);
+                depth += 1u;
             }
         }
-        t_prev = t;
-        f_prev = f;
-        t = t_next;
-        s = radial_surface(p + d * t);
-        f = length(p + d * t) - s.x;
     }
-    return vec4<f32>(t, s.yzw);
+    mesh_nodes += visits;
+    if best >= NO_HIT {
+        return vec4<f32>(NO_HIT, 0.0, 0.0, 0.0);
+    }
+    let normal = mesh[best_at + 3u].xyz * (1.0 - best_uv.x - best_uv.y)
+        + mesh[best_at + 4u].xyz * best_uv.x + mesh[best_at + 5u].xyz * best_uv.y;
+    return vec4<f32>(best, normalize(normal));
+}
+
+// Where the ray p + t d from inside the mesh leaves it (`find_exit`; twin of
+// optics/src/two_surface.rs `MeshBody::leave`): searched from MESH_EPS along, past the triangle
+// the ray starts on. Where the search meets nothing (a ray grazing in at the outline is outside
+// already), the ray goes on straight from where it is (t 0, the normal along it).
+fn mesh_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
+    let hit = mesh_hit(p + d * MESH_EPS, d);
+    if hit.x >= NO_HIT {
+        return vec4<f32>(0.0, d);
+    }
+    return vec4<f32>(hit.x + MESH_EPS, hit.yzw);
+}
+
+// Light inside the glass on its way to the surface (`two_surface`), model frame about the
+// object's centre.
+struct Inside {
+    // Where it is, and its unit direction.
+    p: vec3<f32>,
+    d: vec3<f32>,
+    // The share of the light the interfaces passed so far (exact Fresnel).
+    transmission: f32,
+    // Length of the path inside so far, model units.
+    path: f32,
+    // 1 once it left the object (p the exit, d the direction after it), 0 while inside or
+    // given up inside.
+    escaped: f32,
+    // At the last exit: the light arriving there, its reflectance, and the direction of what it
+    // reflects back inside (the echoes').
+    arriving: f32,
+    reflectance: f32,
+    echo_d: vec3<f32>,
+};
+
+// `light` followed to where it leaves the object: at each meeting with the surface it refracts
+// out, or beyond the critical angle is reflected totally, MAX_INTERNAL_REFLECTIONS times at most
+// (then given up inside).
+fn to_the_outside(light: Inside, ior: f32) -> Inside {
+    var s = light;
+    for (var bounce = 0; bounce <= MAX_INTERNAL_REFLECTIONS; bounce++) {
+        let exit = find_exit(s.p, s.d);
+        s.p += s.d * exit.x;
+        s.path += exit.x;
+        let outward = exit.yzw;
+        let leaving = refract(s.d, -outward, ior);
+        if dot(leaving, leaving) > 0.0 {
+            s.arriving = s.transmission;
+            s.reflectance = fresnel_exact(dot(s.d, outward), ior);
+            s.echo_d = reflect(s.d, outward);
+            s.transmission *= 1.0 - s.reflectance;
+            s.d = leaving;
+            s.escaped = 1.0;
+            break;
+        }
+        s.d = reflect(s.d, outward);
+    }
+    return s;
 }
 
 // Two-surface refraction (twin of optics/src/two_surface.rs pass_through): the unit ray
 // `incident` meets the front surface at `entry` (world) with unit normal `normal` facing it.
 fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
     var out: Passage;
-    var fresnel_transmission = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
-    // Length of the path inside, model units, internal reflections included.
-    var inside = 0.0;
-    out.escaped = 0.0;
     let inside_world = refract(incident, normal, 1.0 / ior);
-    var p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
-    var d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
-    // The light arriving at the exit, and the exit's reflectance, for the echo.
-    var arriving = 0.0;
-    var reflectance = 0.0;
-    var echo_d = d;
-    for (var bounce = 0; bounce <= MAX_INTERNAL_REFLECTIONS; bounce++) {
-        let exit = find_exit(p, d);
-        p += d * exit.x;
-        inside += exit.x;
-        let outward = exit.yzw;
-        let leaving = refract(d, -outward, ior);
-        if dot(leaving, leaving) > 0.0 {
-            arriving = fresnel_transmission;
-            reflectance = fresnel_exact(dot(d, outward), ior);
-            echo_d = reflect(d, outward);
-            fresnel_transmission *= 1.0 - reflectance;
-            d = leaving;
-            out.escaped = 1.0;
-            break;
+    let p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
+    let d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
+    let entered = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
+    var s = to_the_outside(Inside(p, d, entered, 0.0, 0.0, 0.0, 0.0, d), ior);
+    if !BALL {
+        if !CONVEX {
+            // Out of an object that is not convex, the ray may meet it again: in there, and on
+            // to where it leaves again.
+            for (var entries = 1; entries < MAX_ENTRIES; entries++) {
+                if s.escaped == 0.0 {
+                    break;
+                }
+                let again = mesh_hit(s.p + s.d * MESH_EPS, s.d);
+                if again.x >= NO_HIT {
+                    break;
+                }
+                s.p += s.d * (again.x + MESH_EPS);
+                let facing = select(-again.yzw, again.yzw, dot(s.d, again.yzw) < 0.0);
+                s.transmission *= 1.0 - fresnel_exact(-dot(s.d, facing), 1.0 / ior);
+                s.d = normalize(refract(s.d, facing, 1.0 / ior));
+                s.escaped = 0.0;
+                s = to_the_outside(s, ior);
+            }
         }
-        d = reflect(d, outward);
     }
-    out.transmission = vec3<f32>(fresnel_transmission);
+    out.escaped = s.escaped;
+    out.transmission = vec3<f32>(s.transmission);
     if ABSORBING {
-        out.transmission *= exp2(-g.absorption.rgb * inside);
+        out.transmission *= exp2(-g.absorption.rgb * s.path);
     }
     out.echoes = vec3<f32>(0.0);
     if ROOM && out.escaped > 0.0 {
         // The light the exit reflects back inside, followed to its next ECHOES meetings with
         // the surface: at each, the share that leaves sees the room, the rest goes on inside.
-        var q = p;
-        var e = echo_d;
-        var carried = arriving * reflectance;
-        var path = inside;
+        var q = s.p;
+        var e = s.echo_d;
+        var carried = s.arriving * s.reflectance;
+        var path = s.path;
         for (var k = 0; k < ECHOES; k++) {
             let exit = find_exit(q, e);
             q += e * exit.x;
@@ -479,8 +604,8 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
             e = reflect(e, exit.yzw);
         }
     }
-    out.exit = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
-    out.direction = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);
+    out.exit = (g.world_from_model * vec4<f32>(s.p + g.radial.xyz, 1.0)).xyz;
+    out.direction = normalize((g.world_from_model * vec4<f32>(s.d, 0.0)).xyz);
     return out;
 }
 
@@ -505,7 +630,7 @@ fn ball_passage(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f
     let passed = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
     out.transmission = vec3<f32>(passed * passed);
     if ABSORBING {
-        // `g.absorption` is per model unit: the map's radius over the world's.
+        // `g.absorption` is per model unit: the model's radius over the world's.
         out.transmission *= exp2(-g.absorption.rgb * (across * g.radial.w / radius));
     }
     out.escaped = 1.0;
@@ -516,12 +641,13 @@ fn ball_passage(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f
 }
 
 // The front surface under a fragment: world position and unit normal (not yet facing the
-// eye). Where the vertex normals point away from the object's centre, as a ball's do, the
+// eye). Where the object is a ball (its vertex normals point away from its centre), the
 // surface between the vertices is taken as the sphere about the centre through them (radius
 // interpolated) rather than the flat triangle, and the eye's ray is intersected with it: a
 // tessellated ball then refracts as the ball itself (a 96 x 48 sphere's flat triangles
-// misplaced refracted images by pixels near the fold). Elsewhere (faceted stones, general
-// meshes) the triangle and its interpolated normal, blended across triangles that touch both.
+// misplaced refracted images by pixels near the fold). Elsewhere (faceted stones, any other
+// mesh, even where a vertex normal happens to point away from the centre, as on a torus's outer
+// equator) the triangle and its interpolated normal, as the CPU's mesh tracer takes it.
 struct Front {
     position: vec3<f32>,
     normal: vec3<f32>,

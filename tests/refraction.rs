@@ -531,7 +531,7 @@ fn two_surface_light_through_the_diamond_lands_where_the_mesh_tracer_says() {
     let body = MeshBody::new(&world, &world_normals, &indices).expect("a closed diamond");
     // The round brilliant's 57 facets and 16 girdle segments: the renderer leaves it through
     // these planes (glass.wgsl `convex_exit`), not through its radial map.
-    let center = vitreous_optics::radial_map::mesh_center(&positions);
+    let center = vitreous_optics::solid::mesh_center(&positions);
     let planes = vitreous_optics::convex::facet_planes(&positions, &normals, &indices, center)
         .expect("the diamond is flat-shaded and convex");
     assert_eq!(planes.len(), 57 + 16);

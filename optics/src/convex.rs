@@ -1,6 +1,6 @@
 //! Faceted convex objects (a cut gem): the planes of their facets, so that the glass shader
-//! finds where a ray inside leaves them exactly (shaders/glass.wgsl `convex_exit`), without
-//! the radial map, whose filtered texels round every facet edge over a texel.
+//! finds where a ray inside leaves them exactly (shaders/glass.wgsl `convex_exit`) from a loop
+//! over the planes, without a search of the triangles.
 
 use std::collections::HashMap;
 

@@ -10,7 +10,6 @@
 //! - [`solid`] (with its BVH, [`solid::bvh`]): closed triangle meshes the mesh tracers and the
 //!   caustics baker trace through; [`convex`]: whether a mesh bounds one convex body, the facet
 //!   planes of a cut gem and where a ray inside leaves them, convex hulls in the plane;
-//!   [`radial_map`]: an object's surface seen from its centre;
 //! - [`absorption`]: Beer-Lambert inside a tinted glass; [`floor`]: the floor's equations
 //!   (eq. 2-5: the inducer's ramp, gain and light, the exact distance to the shadow's edge);
 //! - [`camera`]: an eye's camera: its view, its projection from an OpenXR field of view, the
@@ -32,7 +31,6 @@ pub mod display;
 pub mod floor;
 pub mod live_caustics;
 pub mod optics;
-pub mod radial_map;
 pub mod refraction;
 pub mod solid;
 pub mod sphere_check;

@@ -18,12 +18,6 @@ use crate::solid::{Solid, SolidError};
 /// of shaders/glass.wgsl RADIAL_NORMAL_COS).
 pub const RADIAL_NORMAL_COS: f32 = 0.9999;
 
-/// Whether the unit `normal` at `corner` (relative to the object's centre) points away from
-/// the centre.
-pub(crate) fn radial_normal(corner: Vec3, normal: Vec3) -> bool {
-    normal.dot(corner) > RADIAL_NORMAL_COS * corner.length()
-}
-
 /// Internal reflections followed at most before a ray still inside is given up to the
 /// environment (a brilliant sends most light out within three).
 pub const MAX_INTERNAL_REFLECTIONS: u32 = 4;
@@ -87,49 +81,15 @@ impl MeshBody {
         Ok(MeshBody { solid, bvh })
     }
 
-    /// The nearest surface point along a ray, with the interpolated outward normal.
+    /// The nearest surface point along a ray, with the outward shading normal interpolated
+    /// across its triangle as the rasteriser interpolates it (and the glass shader's search,
+    /// shaders/glass.wgsl `mesh_hit`).
     fn hit(&self, origin_m: Vec3, dir: Vec3) -> Option<(f32, Vec3)> {
-        self.hit_with_curve(origin_m, dir)
-            .map(|h| (h.t_m, h.normal))
-    }
-
-    /// The nearest triangle along a ray, with what the glass shader interpolates across it
-    /// (`front_surface` in shaders/glass.wgsl): the distance from the origin of coordinates
-    /// (the object's centre, for a body built centred) and the weight of the corners whose
-    /// normals point away from it.
-    pub(crate) fn hit_with_curve(&self, origin_m: Vec3, dir: Vec3) -> Option<CurvedHit> {
         let hit = self.bvh.closest(origin_m, dir, f32::INFINITY)?;
-        let corners = self.solid.triangles_m[hit.triangle as usize];
         let normals = self.solid.corner_normals[hit.triangle as usize];
-        let weights = [1.0 - hit.u - hit.v, hit.u, hit.v];
-        let mut normal = Vec3::ZERO;
-        let (mut curved_radius, mut curved) = (0.0, 0.0);
-        for k in 0..3 {
-            normal += normals[k] * weights[k];
-            curved_radius += corners[k].length() * weights[k];
-            if radial_normal(corners[k], normals[k]) {
-                curved += weights[k];
-            }
-        }
-        Some(CurvedHit {
-            t_m: hit.t_m,
-            normal: normal.normalize(),
-            curved_radius,
-            curved,
-        })
+        let normal = normals[0] * (1.0 - hit.u - hit.v) + normals[1] * hit.u + normals[2] * hit.v;
+        Some((hit.t_m, normal.normalize()))
     }
-}
-
-/// A ray's hit on a mesh triangle ([`MeshBody::hit_with_curve`]).
-pub(crate) struct CurvedHit {
-    /// Ray parameter of the flat triangle's point.
-    pub t_m: f32,
-    /// Interpolated outward unit normal.
-    pub normal: Vec3,
-    /// The corners' distances from the origin, interpolated.
-    pub curved_radius: f32,
-    /// The weight of the corners whose normals point away from the origin (0..1).
-    pub curved: f32,
 }
 
 impl Body for MeshBody {
@@ -159,6 +119,9 @@ pub struct Passage {
     pub escaped: bool,
     /// Total internal reflections on the way.
     pub internal_reflections: u32,
+    /// Times the ray entered the body: 1, more where it left a body that is not convex and met
+    /// it again ([`MAX_ENTRIES`] at most).
+    pub entries: u32,
     /// Fraction of the light that follows this path: (1 - F) at the entry and at the exit,
     /// exact Fresnel for unpolarised light (total internal reflection loses nothing).
     pub transmission: f32,
@@ -176,10 +139,17 @@ impl Passage {
     }
 }
 
+/// Entries into the body along one path at most (the first included): out of a body that is
+/// not convex, a ray may meet it again (through a torus's hole, past a goblet's cup into its
+/// stem) and is followed in there; after the last, it goes on as if the body were not there
+/// (twin of shaders/glass.wgsl MAX_ENTRIES).
+pub const MAX_ENTRIES: u32 = 4;
+
 /// Traces the unit view ray `dir` from `origin_m` through `body` of relative index `ior`:
 /// refraction in (Snell), then at each meeting with the surface from inside either refraction
 /// out or, beyond the critical angle, total internal reflection, at most
-/// `max_internal_reflections` times. `None` when the ray misses the body.
+/// `max_internal_reflections` times each time inside; out of the body, into it again where the
+/// ray meets it again, up to [`MAX_ENTRIES`] entries. `None` when the ray misses the body.
 pub fn pass_through(
     body: &impl Body,
     origin_m: Vec3,
@@ -189,34 +159,64 @@ pub fn pass_through(
 ) -> Option<Passage> {
     let (t, entry_normal) = body.enter(origin_m, dir)?;
     let entry_m = origin_m + dir * t;
-    // A shading normal can face away from a grazing ray: refract about the side it meets.
-    let facing = if dir.dot(entry_normal) < 0.0 {
-        entry_normal
-    } else {
-        -entry_normal
+    let mut passage = Passage {
+        entry_m,
+        entry_normal,
+        exit_m: entry_m,
+        direction: dir,
+        escaped: false,
+        internal_reflections: 0,
+        entries: 0,
+        transmission: 1.0,
+        inside_m: 0.0,
     };
-    let cos_in = -dir.dot(facing);
-    let mut transmission = 1.0 - fresnel_reflectance(cos_in, 1.0 / ior);
-    let mut inside = refract(dir, facing, 1.0 / ior).unwrap_or(dir);
-    let mut at = entry_m;
-    let mut inside_m = 0.0;
-    let mut internal_reflections = 0;
-    loop {
-        let Some((t, normal)) = body.leave(at, inside) else {
-            // Numerically outside already (a grazing entry): carry on straight.
-            return Some(Passage {
-                entry_m,
-                entry_normal,
-                exit_m: at,
-                direction: inside,
-                escaped: true,
-                internal_reflections,
-                transmission,
-                inside_m,
-            });
+    let mut normal = entry_normal;
+    for entries in 1..=MAX_ENTRIES {
+        passage.entries = entries;
+        // A shading normal can face away from a grazing ray: refract about the side it meets.
+        let facing = if passage.direction.dot(normal) < 0.0 {
+            normal
+        } else {
+            -normal
         };
-        at += inside * t;
-        inside_m += t;
+        let cos_in = -passage.direction.dot(facing);
+        passage.transmission *= 1.0 - fresnel_reflectance(cos_in, 1.0 / ior);
+        passage.direction =
+            refract(passage.direction, facing, 1.0 / ior).unwrap_or(passage.direction);
+        passage.escaped = false;
+        to_the_outside(body, &mut passage, ior, max_internal_reflections);
+        if !passage.escaped || entries == MAX_ENTRIES {
+            break;
+        }
+        let from = passage.exit_m + passage.direction * EPS_M;
+        let Some((t, again)) = body.enter(from, passage.direction) else {
+            break;
+        };
+        passage.exit_m = from + passage.direction * t;
+        normal = again;
+    }
+    Some(passage)
+}
+
+/// The light of `passage`, inside `body` at `passage.exit_m` going `passage.direction`, followed
+/// to where it leaves (`escaped`, the direction after) or is given up inside after
+/// `max_internal_reflections` total internal reflections.
+fn to_the_outside(
+    body: &impl Body,
+    passage: &mut Passage,
+    ior: f32,
+    max_internal_reflections: u32,
+) {
+    let mut reflections = 0;
+    loop {
+        let inside = passage.direction;
+        let Some((t, normal)) = body.leave(passage.exit_m, inside) else {
+            // Numerically outside already (a grazing entry): carry on straight.
+            passage.escaped = true;
+            return;
+        };
+        passage.exit_m += inside * t;
+        passage.inside_m += t;
         // The outward normal faces the outside; the ray meets it from inside.
         let facing = if inside.dot(normal) > 0.0 {
             -normal
@@ -226,33 +226,18 @@ pub fn pass_through(
         let cos_out = -inside.dot(facing);
         match refract(inside, facing, ior) {
             Some(out) => {
-                transmission *= 1.0 - fresnel_reflectance(cos_out, ior);
-                return Some(Passage {
-                    entry_m,
-                    entry_normal,
-                    exit_m: at,
-                    direction: out,
-                    escaped: true,
-                    internal_reflections,
-                    transmission,
-                    inside_m,
-                });
-            }
-            None if internal_reflections < max_internal_reflections => {
-                inside = reflect(inside, facing).normalize();
-                internal_reflections += 1;
+                passage.transmission *= 1.0 - fresnel_reflectance(cos_out, ior);
+                passage.direction = out;
+                passage.escaped = true;
+                return;
             }
             None => {
-                return Some(Passage {
-                    entry_m,
-                    entry_normal,
-                    exit_m: at,
-                    direction: reflect(inside, facing).normalize(),
-                    escaped: false,
-                    internal_reflections,
-                    transmission,
-                    inside_m,
-                });
+                passage.direction = reflect(inside, facing).normalize();
+                if reflections == max_internal_reflections {
+                    return;
+                }
+                reflections += 1;
+                passage.internal_reflections += 1;
             }
         }
     }

@@ -28,8 +28,8 @@
 use glam::{Mat4, Vec2, Vec3};
 use vitreous_optics::camera::EyeParams;
 use vitreous_optics::optics::{plane_photo_point, refract, refract_heckbert};
-use vitreous_optics::radial_map::mesh_center;
 use vitreous_optics::refraction::Refraction;
+use vitreous_optics::solid::mesh_center;
 use vitreous_optics::two_surface::RADIAL_NORMAL_COS;
 
 use crate::scene::{MeshRef, SceneDesc};

@@ -1,16 +1,18 @@
 //! The glass object pass, baseline method: environment-map reflection and refraction blended
 //! by a Fresnel term (METHOD.md section 6; shaders/glass.wgsl); refraction to the background
-//! plane (eq. 7-8), or through both surfaces of the object (two-surface, with its radial map).
+//! plane (eq. 7-8), or through both surfaces of the object (two-surface: a ball's sphere, a
+//! convex gem's facet planes, or any closed mesh's triangles).
 //!
 //! Under 700 lines, one idea: the pass and what its pipelines read (the variant table, the
-//! push constants, the globals, the radial map and facet planes it uploads for the exit),
+//! push constants, the globals, the facet planes and triangles it uploads for the exit),
 //! built once per scene; its tests check that table against the shaders. What a frame draws
 //! with them, and the recording, is `glass/draws.rs`; a ball's triangles in patches, each
 //! drawn where it can show, `glass/patches.rs`; the positions a ball's pixels shade, counted on
-//! the device, `glass/counted.rs`.
+//! the device, `glass/counted.rs`; a mesh's triangles for the shader's search, `glass/mesh.rs`.
 
 mod counted;
 mod draws;
+mod mesh;
 mod patches;
 
 use draws::Proof;
@@ -22,8 +24,8 @@ use glam::Vec4;
 use vitreous_optics::camera::EyeParams;
 use vitreous_optics::convex;
 use vitreous_optics::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
-use vitreous_optics::radial_map::{RADIAL_MAP_HEIGHT, RADIAL_MAP_WIDTH, mesh_center, radial_map};
 use vitreous_optics::refraction::Refraction;
+use vitreous_optics::solid::mesh_center;
 
 use crate::compensation::CompensationSet;
 use crate::context::GpuContext;
@@ -31,7 +33,7 @@ use crate::coverage::{self, PhotoCoverage};
 use crate::descriptors;
 use crate::error::Result;
 use crate::look::{Look, Reflection};
-use crate::memory::{Buffer, Image, upload_texture};
+use crate::memory::Buffer;
 use crate::owned::Owned;
 use crate::pipeline::{self, Blend, Depth, PipelineSpec};
 use crate::pose::ScenePose;
@@ -130,7 +132,8 @@ struct Globals {
     center_world: [f32; 4],
     /// rgb: absorption inside the glass in halvings per model unit (Beer-Lambert, two-surface
     /// refraction: the coefficient per world metre times the model's uniform scale over ln 2,
-    /// for the shader's exp2; 0 for clear glass); w unused.
+    /// for the shader's exp2; 0 for clear glass); w: 1 where the object is a ball, whose front
+    /// surface the shader takes as the sphere through its vertices, else 0.
     absorption: [f32; 4],
     /// Maps the world into the floor plane's frame (its photo on the unit square at z = 0).
     floor_from_world: [f32; 16],
@@ -189,8 +192,9 @@ pub struct GlassPass {
     globals_buffer: Buffer,
     /// What the buffer was created with; [`GlassPass::record_pose`] changes only the pose.
     globals: Globals,
-    /// The object's radial map (two-surface refraction), or one texel.
-    _radial_map: Image,
+    /// The object's triangles in their hierarchy (two-surface refraction through a mesh), or
+    /// one unused element.
+    _mesh: Buffer,
     /// The facet planes of a convex faceted object (two-surface refraction), or one plane.
     _planes: Buffer,
     /// The render pass and layout the pipelines were made for (the counting ones are made
@@ -230,7 +234,7 @@ impl GlassPass {
                 (3, image, fragment),
                 (4, sampler, fragment),
                 (5, image, fragment),
-                (6, image, fragment),
+                (6, vk::DescriptorType::STORAGE_BUFFER, fragment),
                 (7, vk::DescriptorType::STORAGE_BUFFER, fragment),
                 (8, image, fragment),
                 (9, vk::DescriptorType::STORAGE_BUFFER, fragment),
@@ -241,10 +245,11 @@ impl GlassPass {
             .collect();
         let layout =
             pipeline::layout_of_sets(ctx, &set_layouts, stages, size_of::<EyePush>() as u32)?;
-        let (radial_map, radial, ball) = upload_radial_map(ctx, desc)?;
+        let (radial, ball) = object_frame(desc);
         let (planes, convex) = upload_facet_planes(ctx, desc, radial)?;
+        let mesh = mesh::upload(ctx, searched_mesh(desc, radial, ball || convex)?)?;
         // Clear glass gets the two-surface pipelines without the absorption's exponentials, a
-        // ball the ones without the radial map's fetch, a convex faceted object the ones that
+        // ball the ones that take its sphere, a convex faceted object the ones that
         // leave it through its facet planes; a scene whose photos are the room the ones that
         // trace it.
         let clear = desc.attenuation.is_clear();
@@ -306,9 +311,9 @@ impl GlassPass {
             1,
             &[
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
-                (vk::DescriptorType::SAMPLED_IMAGE, 5),
+                (vk::DescriptorType::SAMPLED_IMAGE, 4),
                 (vk::DescriptorType::SAMPLER, 2),
-                (vk::DescriptorType::STORAGE_BUFFER, 2),
+                (vk::DescriptorType::STORAGE_BUFFER, 3),
             ],
         )?;
         let set = descriptors::allocate_set(ctx, pool.raw(), set_layout.raw())?;
@@ -336,7 +341,7 @@ impl GlassPass {
             center_world: [0.0; 4],
             absorption: (desc.attenuation.coefficient_per_m()
                 * (metres_per_model_unit(desc) * std::f32::consts::LOG2_E))
-                .extend(0.0)
+                .extend(if ball { 1.0 } else { 0.0 })
                 .to_array(),
             floor_from_world: desc.floor.world_from_plane.inverse().to_cols_array(),
         }
@@ -352,7 +357,7 @@ impl GlassPass {
         let [background, surface] = blurred;
         descriptors::write_texture(ctx, set, 3, 4, background, scene.photo_sampler());
         descriptors::write_image(ctx, set, 5, surface);
-        descriptors::write_image(ctx, set, 6, radial_map.view);
+        descriptors::write_storage_buffer(ctx, set, 6, mesh.buffer);
         descriptors::write_storage_buffer(ctx, set, 7, planes.buffer);
         let counter = counted::PositionCounter::new(ctx)?;
         descriptors::write_storage_buffer(ctx, set, 9, counter.buffer());
@@ -387,7 +392,7 @@ impl GlassPass {
             set,
             globals_buffer,
             globals,
-            _radial_map: radial_map,
+            _mesh: mesh,
             _planes: planes,
             render_pass,
             counted_row: shaders::counted_row(shaded),
@@ -554,64 +559,43 @@ fn metres_per_model_unit(desc: &SceneDesc) -> f32 {
         .cbrt()
 }
 
-/// Uploads the object's radial map (half floats, which filter linearly on every device) for
-/// two-surface refraction, or one zero texel for the paper's model; and the map's centre
-/// (model units) and reference radius as the shader's `radial` vector, and whether the map is a
-/// ball's.
-fn upload_radial_map(ctx: &GpuContext, desc: &SceneDesc) -> Result<(Image, [f32; 4], bool)> {
-    let m = desc.mesh;
-    let (texels, extent, radial, ball) = if desc.refraction == Refraction::TwoSurface {
-        let map = radial_map(
-            m.positions,
-            m.normals,
-            m.indices,
-            RADIAL_MAP_WIDTH,
-            RADIAL_MAP_HEIGHT,
-        )
-        .map_err(|e| {
-            crate::error::RenderError::InvalidInput(format!(
-                "two-surface refraction needs a closed mesh: {e}"
-            ))
-        })?;
-        if !map.star_shaped {
-            tracing::warn!(
-                "two-surface refraction: the object is not star-shaped about its centre; the \
-                 exit is found on its outermost surface"
-            );
+/// The object's frame for the exit: its centre (model units, its bounding box's) and the largest
+/// distance of a vertex from it (a ball's radius) as the shader's `radial` vector, and whether
+/// the object is a ball about it (`coverage::ball`: the shader then takes the sphere).
+fn object_frame(desc: &SceneDesc) -> ([f32; 4], bool) {
+    match coverage::ball(&desc.mesh) {
+        Some((center, radius)) => (center.extend(radius).to_array(), true),
+        None => {
+            let center = mesh_center(desc.mesh.positions);
+            let radius = desc
+                .mesh
+                .positions
+                .iter()
+                .map(|&p| (p - center).length())
+                .fold(0.0f32, f32::max);
+            (
+                center.extend(radius.max(f32::MIN_POSITIVE)).to_array(),
+                false,
+            )
         }
-        let ball = map.ball();
-        (
-            map.texels,
-            vk::Extent2D {
-                width: map.width,
-                height: map.height,
-            },
-            map.center.extend(map.radius).to_array(),
-            ball,
-        )
-    } else {
-        (
-            vec![0.0; 4],
-            vk::Extent2D {
-                width: 1,
-                height: 1,
-            },
-            mesh_center(m.positions).extend(1.0).to_array(),
-            false,
-        )
-    };
-    let halves: Vec<u8> = texels
-        .iter()
-        .flat_map(|&f| half::f16::from_f32(f).to_le_bytes())
-        .collect();
-    let image = upload_texture(
-        ctx,
-        "radial map",
-        vk::Format::R16G16B16A16_SFLOAT,
-        extent,
-        &halves,
-    )?;
-    Ok((image, radial, ball))
+    }
+}
+
+/// The elements of the mesh the shader searches (`mesh.rs`), where two-surface refraction
+/// leaves the object through its triangles: an object that is not `analytic` (a ball or a convex
+/// faceted object).
+fn searched_mesh(desc: &SceneDesc, radial: [f32; 4], analytic: bool) -> Result<Option<Vec<Vec4>>> {
+    if desc.refraction != Refraction::TwoSurface || analytic {
+        return Ok(None);
+    }
+    let center = glam::Vec3::new(radial[0], radial[1], radial[2]);
+    let elements = mesh::elements(&desc.mesh, center)?;
+    tracing::debug!(
+        "two-surface refraction: the exit searched among the object's triangles ({} buffer \
+         elements)",
+        elements.len()
+    );
+    Ok(Some(elements))
 }
 
 /// Uploads the facet planes of a flat-shaded convex object about the radial map's centre

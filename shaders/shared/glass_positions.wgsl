@@ -99,7 +99,7 @@ fn rest_of_light(at: VertexOut, phong: bool, alpha: f32) -> vec3<f32> {
             let reflects = fresnel_exact(dot(e, outward), ior);
             var share = vec3<f32>(carried * (1.0 - reflects));
             if ABSORBING {
-                // `g.absorption` is per model unit: the map's radius over the world's.
+                // `g.absorption` is per model unit: the model's radius over the world's.
                 share *= exp2(-g.absorption.rgb * (path * g.radial.w / radius));
             }
             echoes += room(q + g.center_world.xyz, normalize(leaving)) * share;

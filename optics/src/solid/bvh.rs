@@ -156,6 +156,54 @@ impl Bvh {
     }
 }
 
+/// One node of [`Bvh::flat`]'s hierarchy: its box, and either its left child (an inner node,
+/// `count` 0; the right child follows it) or its first triangle slot and triangle count (a leaf).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlatNode {
+    /// The box's low corner.
+    pub lo: Vec3,
+    /// The box's high corner.
+    pub hi: Vec3,
+    /// Inner node: index of the left child; leaf: first slot in the triangle order.
+    pub first: u32,
+    /// Triangles of a leaf; 0 for an inner node.
+    pub count: u32,
+}
+
+impl Bvh {
+    /// The hierarchy as flat arrays, for a traversal elsewhere (the glass shader's,
+    /// shaders/glass.wgsl `mesh_hit`): the nodes, the root first, and for each triangle slot the
+    /// index of its triangle in the list given to [`Bvh::new`].
+    pub fn flat(&self) -> (Vec<FlatNode>, Vec<u32>) {
+        let nodes = self
+            .nodes
+            .iter()
+            .map(|n| FlatNode {
+                lo: n.lo,
+                hi: n.hi,
+                first: n.first,
+                count: n.count,
+            })
+            .collect();
+        (nodes, self.tris.iter().map(|t| t.id).collect())
+    }
+
+    /// Depth of the hierarchy: nodes on the longest path from the root to a leaf.
+    pub fn depth(&self) -> usize {
+        fn below(nodes: &[Node], at: usize) -> usize {
+            let n = &nodes[at];
+            // An inner node's children come after it (an empty hierarchy's root is a leaf).
+            if n.count > 0 || n.first as usize <= at {
+                1
+            } else {
+                let l = n.first as usize;
+                1 + below(nodes, l).max(below(nodes, l + 1))
+            }
+        }
+        below(&self.nodes, 0)
+    }
+}
+
 /// Entry distance of the ray into the node's box, or infinity when it misses.
 #[inline]
 fn slab(node: &Node, origin: Vec3, inv: Vec3) -> f32 {

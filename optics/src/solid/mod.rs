@@ -16,6 +16,21 @@ use std::collections::HashMap;
 use glam::Vec3;
 use thiserror::Error;
 
+/// The object's centre: the middle of its bounding box (model units); the origin of the frame
+/// the glass shader finds where a ray leaves the object in.
+pub fn mesh_center(positions: &[Vec3]) -> Vec3 {
+    let (lo, hi) = positions
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
+            (l.min(p), h.max(p))
+        });
+    if lo.is_finite() && hi.is_finite() {
+        (lo + hi) / 2.0
+    } else {
+        Vec3::ZERO
+    }
+}
+
 /// Why a triangle mesh is not a closed solid.
 #[derive(Debug, Error)]
 pub enum SolidError {

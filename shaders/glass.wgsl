@@ -294,9 +294,7 @@ fn room(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 // target: the room from where it left (`ROOM`), else, or when given up inside, the environment.
 fn beyond_passage(passage: Passage) -> vec3<f32> {
     if ROOM {
-        if passage.escaped > 0.0 {
-            return room(passage.exit, passage.direction);
-        }
+        return room(passage.exit, passage.direction);
     }
     return environment(passage.direction);
 }
@@ -311,7 +309,7 @@ fn beyond(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     }
 }
 
-const MAX_INTERNAL_REFLECTIONS: i32 = 4;
+const MAX_INTERNAL_REFLECTIONS: i32 = 8;
 // Partial internal reflections after the exit followed with the room (`ROOM`): at a ball's rim,
 // where the exit reflects most, the second still shows (ꟻLIP in glass-sphere-real's disc 0.274
 // with one, 0.268 with two, 0.267 with three or six: docs/realism.md).
@@ -487,14 +485,16 @@ fn mesh_hit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
 
 // Where the ray p + t d from inside the mesh leaves it (`find_exit`; twin of
 // optics/src/two_surface.rs `MeshBody::leave`): searched from MESH_EPS along, past the triangle
-// the ray starts on. Where the search meets nothing (a ray grazing in at the outline is outside
-// already), the ray goes on straight from where it is (t 0, the normal along it).
+// the ray starts on; the normal there turned to face along the ray, as the physical reference
+// turns it (where shading normals bend a grazing ray's reflection out through the surface, the
+// next triangle it meets faces it). Where the search meets nothing (such a ray out in the open),
+// x is -1: the light is lost, as in the reference.
 fn mesh_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     let hit = mesh_hit(p + d * MESH_EPS, d);
     if hit.x >= NO_HIT {
-        return vec4<f32>(0.0, d);
+        return vec4<f32>(-1.0, d);
     }
-    return vec4<f32>(hit.x + MESH_EPS, hit.yzw);
+    return vec4<f32>(hit.x + MESH_EPS, select(-hit.yzw, hit.yzw, dot(hit.yzw, d) >= 0.0));
 }
 
 // Light inside the glass on its way to the surface (`two_surface`), model frame about the
@@ -524,6 +524,17 @@ fn to_the_outside(light: Inside, ior: f32) -> Inside {
     var s = light;
     for (var bounce = 0; bounce <= MAX_INTERNAL_REFLECTIONS; bounce++) {
         let exit = find_exit(s.p, s.d);
+        if !BALL {
+            if !CONVEX {
+                if exit.x < 0.0 {
+                    // Out of the mesh already, meeting nothing (`mesh_exit`): lost.
+                    s.transmission = 0.0;
+                    s.arriving = 0.0;
+                    s.escaped = 1.0;
+                    break;
+                }
+            }
+        }
         s.p += s.d * exit.x;
         s.path += exit.x;
         let outward = exit.yzw;
@@ -542,8 +553,106 @@ fn to_the_outside(light: Inside, ior: f32) -> Inside {
     return s;
 }
 
+// Meetings with the surface a branch of the light through a mesh is followed to at most
+// (`follow`): a thin wall's or a stem's reflections leave within a few.
+const BRANCH_MEETINGS: i32 = 6;
+
+// The room's light along a branch of the light through a mesh in the room (`MESH_BRANCHES`):
+// from `start` (model frame about the object's centre) along the unit `dir`, inside the glass
+// or out of it, followed without splitting (at each meeting with the surface the share that
+// passes, all of it reflected beyond the critical angle) to BRANCH_MEETINGS meetings at most;
+// the room where it leaves for good (times the share that passed and, absorbing, the path's
+// absorption), nothing where it is still inside then, or lost (`mesh_exit`).
+fn follow(start: vec3<f32>, dir: vec3<f32>, from_inside: bool, ior: f32) -> vec3<f32> {
+    var p = start;
+    var d = dir;
+    var inside = from_inside;
+    var passed = 1.0;
+    var path = 0.0;
+    for (var k = 0; k < BRANCH_MEETINGS; k++) {
+        if inside {
+            let exit = mesh_exit(p, d);
+            if exit.x < 0.0 {
+                return vec3<f32>(0.0);
+            }
+            p += d * exit.x;
+            path += exit.x;
+            let leaving = refract(d, -exit.yzw, ior);
+            if dot(leaving, leaving) > 0.0 {
+                passed *= 1.0 - fresnel_exact(dot(d, exit.yzw), ior);
+                d = normalize(leaving);
+                inside = false;
+            } else {
+                d = reflect(d, exit.yzw);
+            }
+        } else {
+            let hit = mesh_hit(p + d * MESH_EPS, d);
+            if hit.x >= NO_HIT {
+                break;
+            }
+            p += d * (hit.x + MESH_EPS);
+            let facing = select(-hit.yzw, hit.yzw, dot(d, hit.yzw) < 0.0);
+            passed *= 1.0 - fresnel_exact(-dot(d, facing), 1.0 / ior);
+            d = normalize(refract(d, facing, 1.0 / ior));
+            inside = true;
+        }
+    }
+    if inside {
+        return vec3<f32>(0.0);
+    }
+    var light = vec3<f32>(passed);
+    if ABSORBING {
+        light *= exp2(-g.absorption.rgb * path);
+    }
+    let leaves_at = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
+    return room(leaves_at, normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz)) * light;
+}
+
+// The share of the light of `s` that is still left after its path inside, per channel (its
+// absorption, `ABSORBING`).
+fn absorbed(s: Inside) -> vec3<f32> {
+    var left = vec3<f32>(1.0);
+    if ABSORBING {
+        left = exp2(-g.absorption.rgb * s.path);
+    }
+    return left;
+}
+
+// The light the exit of `s` reflects back inside (a ball or a convex gem in the room), followed
+// to its next ECHOES meetings with the surface: at each, the share that leaves sees the room,
+// the rest goes on inside.
+fn echoes_of(s: Inside, ior: f32) -> vec3<f32> {
+    var echoes = vec3<f32>(0.0);
+    var q = s.p;
+    var e = s.echo_d;
+    var carried = s.arriving * s.reflectance;
+    var path = s.path;
+    for (var k = 0; k < ECHOES; k++) {
+        let exit = find_exit(q, e);
+        q += e * exit.x;
+        path += exit.x;
+        let leaving = refract(e, -exit.yzw, ior);
+        if dot(leaving, leaving) > 0.0 {
+            let reflected = fresnel_exact(dot(e, exit.yzw), ior);
+            var share = vec3<f32>(carried * (1.0 - reflected));
+            if ABSORBING {
+                share *= exp2(-g.absorption.rgb * path);
+            }
+            let leaves_at = (g.world_from_model * vec4<f32>(q + g.radial.xyz, 1.0)).xyz;
+            let towards = normalize((g.world_from_model * vec4<f32>(leaving, 0.0)).xyz);
+            echoes += room(leaves_at, towards) * share;
+            carried *= reflected;
+        }
+        e = reflect(e, exit.yzw);
+    }
+    return echoes;
+}
+
 // Two-surface refraction (twin of optics/src/two_surface.rs pass_through): the unit ray
 // `incident` meets the front surface at `entry` (world) with unit normal `normal` facing it.
+// Through a mesh in the room, the light each later meeting with the surface splits off (the
+// share an exit reflects back inside, the share a re-entry reflects away) is followed too
+// (`follow`), as the echoes of a ball's exit are.
 fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f32) -> Passage {
     var out: Passage;
     let inside_world = refract(incident, normal, 1.0 / ior);
@@ -551,59 +660,48 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     let d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
     let entered = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
     var s = to_the_outside(Inside(p, d, entered, 0.0, 0.0, 0.0, 0.0, d), ior);
-    if !BALL {
-        if !CONVEX {
-            // Out of an object that is not convex, the ray may meet it again: in there, and on
-            // to where it leaves again.
-            for (var entries = 1; entries < MAX_ENTRIES; entries++) {
-                if s.escaped == 0.0 {
-                    break;
-                }
-                let again = mesh_hit(s.p + s.d * MESH_EPS, s.d);
-                if again.x >= NO_HIT {
-                    break;
-                }
-                s.p += s.d * (again.x + MESH_EPS);
-                let facing = select(-again.yzw, again.yzw, dot(s.d, again.yzw) < 0.0);
-                s.transmission *= 1.0 - fresnel_exact(-dot(s.d, facing), 1.0 / ior);
-                s.d = normalize(refract(s.d, facing, 1.0 / ior));
-                s.escaped = 0.0;
-                s = to_the_outside(s, ior);
+    out.echoes = vec3<f32>(0.0);
+    if BALL {
+        if ROOM && s.escaped > 0.0 {
+            out.echoes = echoes_of(s, ior);
+        }
+    } else if CONVEX {
+        if ROOM && s.escaped > 0.0 {
+            out.echoes = echoes_of(s, ior);
+        }
+    } else {
+        // Out of an object that is not convex, the ray may meet it again: in there, and on to
+        // where it leaves again.
+        for (var entries = 1; entries <= MAX_ENTRIES; entries++) {
+            if s.escaped == 0.0 {
+                break;
             }
+            if ROOM {
+                out.echoes += follow(s.p, s.echo_d, true, ior)
+                    * (s.arriving * s.reflectance) * absorbed(s);
+            }
+            if entries == MAX_ENTRIES {
+                break;
+            }
+            let again = mesh_hit(s.p + s.d * MESH_EPS, s.d);
+            if again.x >= NO_HIT {
+                break;
+            }
+            s.p += s.d * (again.x + MESH_EPS);
+            let facing = select(-again.yzw, again.yzw, dot(s.d, again.yzw) < 0.0);
+            let reflects = fresnel_exact(-dot(s.d, facing), 1.0 / ior);
+            if ROOM {
+                out.echoes += follow(s.p, reflect(s.d, facing), false, ior)
+                    * (s.transmission * reflects) * absorbed(s);
+            }
+            s.transmission *= 1.0 - reflects;
+            s.d = normalize(refract(s.d, facing, 1.0 / ior));
+            s.escaped = 0.0;
+            s = to_the_outside(s, ior);
         }
     }
     out.escaped = s.escaped;
-    out.transmission = vec3<f32>(s.transmission);
-    if ABSORBING {
-        out.transmission *= exp2(-g.absorption.rgb * s.path);
-    }
-    out.echoes = vec3<f32>(0.0);
-    if ROOM && out.escaped > 0.0 {
-        // The light the exit reflects back inside, followed to its next ECHOES meetings with
-        // the surface: at each, the share that leaves sees the room, the rest goes on inside.
-        var q = s.p;
-        var e = s.echo_d;
-        var carried = s.arriving * s.reflectance;
-        var path = s.path;
-        for (var k = 0; k < ECHOES; k++) {
-            let exit = find_exit(q, e);
-            q += e * exit.x;
-            path += exit.x;
-            let leaving = refract(e, -exit.yzw, ior);
-            if dot(leaving, leaving) > 0.0 {
-                let reflected = fresnel_exact(dot(e, exit.yzw), ior);
-                var share = vec3<f32>(carried * (1.0 - reflected));
-                if ABSORBING {
-                    share *= exp2(-g.absorption.rgb * path);
-                }
-                let leaves_at = (g.world_from_model * vec4<f32>(q + g.radial.xyz, 1.0)).xyz;
-                let towards = normalize((g.world_from_model * vec4<f32>(leaving, 0.0)).xyz);
-                out.echoes += room(leaves_at, towards) * share;
-                carried *= reflected;
-            }
-            e = reflect(e, exit.yzw);
-        }
-    }
+    out.transmission = vec3<f32>(s.transmission) * absorbed(s);
     out.exit = (g.world_from_model * vec4<f32>(s.p + g.radial.xyz, 1.0)).xyz;
     out.direction = normalize((g.world_from_model * vec4<f32>(s.d, 0.0)).xyz);
     return out;

@@ -200,3 +200,14 @@ fn light_through_a_torus_lands_where_the_mesh_tracer_says() {
         "too little light crosses the hole into the far side: {again}"
     );
 }
+
+#[test]
+fn light_through_a_goblet_lands_where_the_mesh_tracer_says() {
+    let again =
+        markers_land_where_the_mesh_tracer_says("goblet-real.toml", Quat::from_rotation_x(0.2));
+    eprintln!(
+        "goblet: {:.1} % of the markers' light entered twice",
+        100.0 * again
+    );
+    assert!(again > 0.05, "too little light crosses the cup: {again}");
+}

@@ -18,9 +18,10 @@ use crate::solid::{Solid, SolidError};
 /// of shaders/glass.wgsl RADIAL_NORMAL_COS).
 pub const RADIAL_NORMAL_COS: f32 = 0.9999;
 
-/// Internal reflections followed at most before a ray still inside is given up to the
-/// environment (a brilliant sends most light out within three).
-pub const MAX_INTERNAL_REFLECTIONS: u32 = 4;
+/// Internal reflections followed at most each time a ray is inside before it is given up (a
+/// brilliant sends most light out within three; a torus or a goblet's stem guides some further;
+/// twin of shaders/glass.wgsl MAX_INTERNAL_REFLECTIONS).
+pub const MAX_INTERNAL_REFLECTIONS: u32 = 8;
 
 /// Self-intersection offset along a ray leaving a surface point, metres.
 const EPS_M: f32 = 1e-6;
@@ -211,7 +212,10 @@ fn to_the_outside(
     loop {
         let inside = passage.direction;
         let Some((t, normal)) = body.leave(passage.exit_m, inside) else {
-            // Numerically outside already (a grazing entry): carry on straight.
+            // Out of the body already, meeting nothing (a grazing entry, or shading normals
+            // that bend a ray out through the surface): the light is lost, as in the physical
+            // reference.
+            passage.transmission = 0.0;
             passage.escaped = true;
             return;
         };

@@ -19,6 +19,9 @@ impl Loader<'_> {
         for buffer in &model.buffers {
             self.hash_part("object.model buffer", buffer);
         }
+        for warning in &model.warnings {
+            tracing::warn!("{}: {warning}", model_path.display());
+        }
 
         let (lo, hi) = model.mesh.bounds();
         let largest_extent = (hi - lo).max_element();

@@ -52,6 +52,12 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
     path.display().to_string()
 }
 
+/// `vitreous replay SCENE --out OUT_DIR --quiet` run in `cwd`.
+fn replay_into(scene: &str, out_dir: &Path, cwd: &Path) -> Output {
+    let out_dir = out_dir.to_str().unwrap();
+    vitreous(&["replay", scene, "--out", out_dir, "--quiet"], cwd)
+}
+
 #[test]
 fn malformed_scene_names_file_and_line_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -61,16 +67,7 @@ fn malformed_scene_names_file_and_line_and_writes_nothing() {
         "[object]\nmodel = \"x.glb\"\ndiameter_m = oops\n",
     );
     let out_dir = dir.path().join("out");
-    let out = vitreous(
-        &[
-            "replay",
-            &bad,
-            "--out",
-            out_dir.to_str().unwrap(),
-            "--quiet",
-        ],
-        dir.path(),
-    );
+    let out = replay_into(&bad, &out_dir, dir.path());
     assert_clean_failure(&out, &["bad.toml", ":3:"]);
     assert!(!out_dir.exists(), "output folder created on bad input");
 }
@@ -469,25 +466,20 @@ fn a_reference_of_the_saved_frames_while_saving_none_is_refused_up_front() {
     }
 }
 
+/// `vitreous bake SCENE -o OUTPUT` run in `cwd`, small and quick: 32 x 32 texels, 4096 rays,
+/// no self-check.
+fn bake_into(scene: &str, output: &Path, cwd: &Path) -> Output {
+    let output = output.to_str().unwrap();
+    let small = ["--resolution", "32", "--budget", "4096", "--no-self-check"];
+    vitreous(&[&["bake", scene, "-o", output][..], &small].concat(), cwd)
+}
+
 #[test]
 fn bake_writes_a_bake_its_scene_loads() {
     let dir = tempfile::tempdir().unwrap();
     let scene_path = scene("glass-sphere.toml");
     let output = dir.path().join("sphere.exr");
-    let out = vitreous(
-        &[
-            "bake",
-            &scene_path,
-            "-o",
-            output.to_str().unwrap(),
-            "--resolution",
-            "32",
-            "--budget",
-            "4096",
-            "--no-self-check",
-        ],
-        dir.path(),
-    );
+    let out = bake_into(&scene_path, &output, dir.path());
     assert!(
         out.status.success(),
         "{}",
@@ -571,16 +563,7 @@ fn a_glass_modelled_as_one_sheet_is_refused_with_how_to_close_it() {
     assert!(text.contains("model = \"cup.gltf\"") && text.contains("two-surface"));
     let cup_scene = write(dir.path(), "cup.toml", &text);
     let out_dir = dir.path().join("out");
-    let out = vitreous(
-        &[
-            "replay",
-            &cup_scene,
-            "--out",
-            out_dir.to_str().unwrap(),
-            "--quiet",
-        ],
-        dir.path(),
-    );
+    let out = replay_into(&cup_scene, &out_dir, dir.path());
     let needles = [
         "cup.toml",
         "object.model",
@@ -603,16 +586,7 @@ fn a_glass_modelled_as_one_sheet_is_refused_with_how_to_close_it() {
         &text.replace("refraction = \"two-surface\"", ""),
     );
     let bake = dir.path().join("cup.exr");
-    let out = vitreous(
-        &[
-            "bake",
-            &paper,
-            "-o",
-            bake.to_str().unwrap(),
-            "--no-self-check",
-        ],
-        dir.path(),
-    );
+    let out = bake_into(&paper, &bake, dir.path());
     assert_clean_failure(
         &out,
         &needles

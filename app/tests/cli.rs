@@ -52,6 +52,12 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
     path.display().to_string()
 }
 
+/// `vitreous replay SCENE --out OUT_DIR --quiet` run in `cwd`.
+fn replay_into(scene: &str, out_dir: &Path, cwd: &Path) -> Output {
+    let out_dir = out_dir.to_str().unwrap();
+    vitreous(&["replay", scene, "--out", out_dir, "--quiet"], cwd)
+}
+
 #[test]
 fn malformed_scene_names_file_and_line_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -61,16 +67,7 @@ fn malformed_scene_names_file_and_line_and_writes_nothing() {
         "[object]\nmodel = \"x.glb\"\ndiameter_m = oops\n",
     );
     let out_dir = dir.path().join("out");
-    let out = vitreous(
-        &[
-            "replay",
-            &bad,
-            "--out",
-            out_dir.to_str().unwrap(),
-            "--quiet",
-        ],
-        dir.path(),
-    );
+    let out = replay_into(&bad, &out_dir, dir.path());
     assert_clean_failure(&out, &["bad.toml", ":3:"]);
     assert!(!out_dir.exists(), "output folder created on bad input");
 }
@@ -469,25 +466,20 @@ fn a_reference_of_the_saved_frames_while_saving_none_is_refused_up_front() {
     }
 }
 
+/// `vitreous bake SCENE -o OUTPUT` run in `cwd`, small and quick: 32 x 32 texels, 4096 rays,
+/// no self-check.
+fn bake_into(scene: &str, output: &Path, cwd: &Path) -> Output {
+    let output = output.to_str().unwrap();
+    let small = ["--resolution", "32", "--budget", "4096", "--no-self-check"];
+    vitreous(&[&["bake", scene, "-o", output][..], &small].concat(), cwd)
+}
+
 #[test]
 fn bake_writes_a_bake_its_scene_loads() {
     let dir = tempfile::tempdir().unwrap();
     let scene_path = scene("glass-sphere.toml");
     let output = dir.path().join("sphere.exr");
-    let out = vitreous(
-        &[
-            "bake",
-            &scene_path,
-            "-o",
-            output.to_str().unwrap(),
-            "--resolution",
-            "32",
-            "--budget",
-            "4096",
-            "--no-self-check",
-        ],
-        dir.path(),
-    );
+    let out = bake_into(&scene_path, &output, dir.path());
     assert!(
         out.status.success(),
         "{}",
@@ -511,4 +503,96 @@ fn bake_of_a_missing_scene_names_it_and_writes_nothing() {
     );
     assert_clean_failure(&out, &["nowhere.toml"]);
     assert!(!output.exists());
+}
+
+/// A drinking glass modelled as one sheet, as a first model often is: a cylinder wall and a
+/// bottom disc of `segments` sides, open at the top and without thickness (glTF with an
+/// external buffer `cup.bin`, flat normals).
+fn write_single_sheet_cup(dir: &Path, segments: u16) {
+    let (radius, height) = (0.04f32, 0.1f32);
+    let mut positions = vec![[0.0, 0.0, 0.0]];
+    for ring in [0.0, height] {
+        for k in 0..segments {
+            let a = std::f32::consts::TAU * f32::from(k) / f32::from(segments);
+            positions.push([radius * a.cos(), ring, -radius * a.sin()]);
+        }
+    }
+    let mut indices: Vec<u16> = Vec::new();
+    for k in 0..segments {
+        let (bottom, next) = (1 + k, 1 + (k + 1) % segments);
+        let (top, next_top) = (bottom + segments, next + segments);
+        indices.extend([0, next, bottom]);
+        indices.extend([bottom, next, next_top, bottom, next_top, top]);
+    }
+    let mut bytes: Vec<u8> = positions
+        .iter()
+        .flatten()
+        .flat_map(|c: &f32| c.to_le_bytes())
+        .collect();
+    let index_offset = bytes.len();
+    bytes.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    std::fs::write(dir.join("cup.bin"), &bytes).unwrap();
+    let gltf = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+        "nodes":[{{"name":"Cup","mesh":0}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+        "buffers":[{{"byteLength":{},"uri":"cup.bin"}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":{index_offset}}},
+                       {{"buffer":0,"byteOffset":{index_offset},"byteLength":{}}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":{},"type":"VEC3",
+                       "min":[-{radius},0,-{radius}],"max":[{radius},{height},{radius}]}},
+                     {{"bufferView":1,"componentType":5123,"count":{},"type":"SCALAR"}}]}}"#,
+        bytes.len(),
+        bytes.len() - index_offset,
+        positions.len(),
+        indices.len()
+    );
+    std::fs::write(dir.join("cup.gltf"), gltf).unwrap();
+}
+
+#[test]
+fn a_glass_modelled_as_one_sheet_is_refused_with_how_to_close_it() {
+    let dir = tempfile::tempdir().unwrap();
+    write_single_sheet_cup(dir.path(), 24);
+    // glass-sphere-real.toml (two-surface refraction) with the cup in place of the ball.
+    let config = workspace().join("config").display().to_string();
+    let text = std::fs::read_to_string(scene("glass-sphere-real.toml"))
+        .unwrap()
+        .replace("\"../models/sphere.glb\"", "\"cup.gltf\"")
+        .replace("\"../", &format!("\"{config}/"));
+    assert!(text.contains("model = \"cup.gltf\"") && text.contains("two-surface"));
+    let cup_scene = write(dir.path(), "cup.toml", &text);
+    let out_dir = dir.path().join("out");
+    let out = replay_into(&cup_scene, &out_dir, dir.path());
+    let needles = [
+        "cup.toml",
+        "object.model",
+        "cup.gltf",
+        "closed solid",
+        "24 edge(s)",
+        "Solidify",
+        "Merge by Distance",
+    ];
+    let message = assert_clean_failure(&out, &needles);
+    assert!(
+        !out_dir.exists(),
+        "output written for a refused scene: {message}"
+    );
+    // The paper's refraction draws any triangles, but its caustics are light through the
+    // volume: the bake refuses the sheet in the same words.
+    let paper = write(
+        dir.path(),
+        "cup-paper.toml",
+        &text.replace("refraction = \"two-surface\"", ""),
+    );
+    let bake = dir.path().join("cup.exr");
+    let out = bake_into(&paper, &bake, dir.path());
+    assert_clean_failure(
+        &out,
+        &needles
+            .map(|n| n.replace("cup.toml", "cup-paper.toml"))
+            .each_ref()
+            .map(String::as_str),
+    );
+    assert!(!bake.exists());
 }

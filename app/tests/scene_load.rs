@@ -110,6 +110,24 @@ fn refraction_defaults_to_the_paper_and_reads_two_surface() {
         "diameter_m = 0.5",
         "diameter_m = 0.5\nrefraction = \"two-surface\"",
     );
+    // The sample's planes enclose no volume, which two-surface refraction needs.
+    std::fs::write(&path, &two).unwrap();
+    let err = load_scene(&path).unwrap_err();
+    assert_eq!(err.field(), Some("object.model"), "{err}");
+    assert!(
+        err.to_string().contains("does not enclose a volume"),
+        "{err}"
+    );
+    let sphere = repo("config/models/sphere.glb");
+    let two = two
+        .lines()
+        .map(|line| match line.starts_with("model =") {
+            true => format!("model = '{}'", sphere.display()),
+            false => line.to_owned(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(two.contains("sphere.glb"), "{two}");
     std::fs::write(&path, &two).unwrap();
     let scene = load_scene(&path).unwrap();
     assert_eq!(

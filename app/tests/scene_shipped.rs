@@ -165,6 +165,57 @@ fn every_shipped_bake_belongs_to_its_scene() {
 }
 
 #[test]
+fn the_goblet_stands_where_the_ball_rests_with_the_real_glass_settings() {
+    let goblet = load("goblet-real.toml");
+    let real = load("glass-sphere-real.toml");
+    let object = &goblet.object;
+    assert_eq!(
+        object.refraction,
+        vitreous_optics::refraction::Refraction::TwoSurface
+    );
+    assert!(goblet.environment.room);
+    assert_eq!(goblet.compensation, real.compensation);
+    assert_eq!(goblet.light.share, real.light.share);
+    assert_eq!(goblet.output.glass_samples, real.output.glass_samples);
+    assert_eq!(goblet.environment.path, real.environment.path);
+    for (a, b) in [
+        (&goblet.floor, &real.floor),
+        (&goblet.background, &real.background),
+    ] {
+        assert_eq!((a.size_m, a.pose), (b.size_m, b.pose));
+    }
+    assert_eq!(object.ior, 1.5);
+    // 100 mm tall, foot on the table top under the ball's centre, narrower than tall.
+    let world: Vec<Vec3> = object
+        .mesh
+        .positions
+        .iter()
+        .map(|&p| object.world_from_model.transform_point3(p))
+        .collect();
+    let (lo, hi) = world.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    assert!((hi.y - lo.y - 0.10).abs() < 1e-5, "height {}", hi.y - lo.y);
+    assert!((hi.x - lo.x) < 0.07 && (hi.z - lo.z) < 0.07, "{lo} {hi}");
+    assert!(
+        (lo.y - goblet.floor.pose.position.y).abs() < 1e-5,
+        "foot at {}",
+        lo.y
+    );
+    assert_eq!(
+        (object.center_m.x, object.center_m.z),
+        (real.object.center_m.x, real.object.center_m.z)
+    );
+    // Not a ball: two-surface refraction traces the mesh itself.
+    assert!(!object.is_ball() && object.lens.is_some());
+    assert!(sphere_in_view(&goblet, object.center_m, object.radius_m));
+    assert!(
+        (goblet.light.position_m - (object.center_m + Vec3::new(0.0, 1.0, -1.0))).length() < 1e-6
+    );
+}
+
+#[test]
 fn visual_effects_keeps_the_papers_distances() {
     let scene = load("visual-effects.toml");
     let object = &scene.object;

@@ -54,13 +54,55 @@ impl Mesh {
     }
 }
 
-/// A loaded model: the mesh, the first KHR_materials_ior and KHR_materials_volume found, and
-/// the buffer bytes (for the scene hash).
+/// A loaded model: the mesh, the first KHR_materials_ior and KHR_materials_volume found, the
+/// buffer bytes (for the scene hash) and what the user should know about its materials.
 pub(crate) struct LoadedModel {
     pub mesh: Mesh,
     pub ior: Option<f32>,
     pub volume: Option<VolumeAttenuation>,
     pub buffers: Vec<Vec<u8>>,
+    /// Materials drawn as glass although the file says they are not ([`material_warnings`]).
+    pub warnings: Vec<String>,
+}
+
+/// A material a triangle primitive uses: its name for messages and its
+/// `KHR_materials_transmission` factor (None without the extension).
+#[derive(Clone, Debug, PartialEq)]
+struct UsedMaterial {
+    /// `materials[i] 'name'`, or `the default material`.
+    label: String,
+    /// `transmissionFactor`, when the material has the extension.
+    transmission: Option<f32>,
+}
+
+/// vitreous draws the whole model as one glass object. A material that lets no light through
+/// (`transmissionFactor` 0), or one without the extension in a model whose other materials
+/// are glass, is a part the user meant to be opaque (a metal stem, a label): it is drawn as
+/// glass all the same, and the user is told so. A model with no transmission anywhere is
+/// taken as glass without a word (most exporters write none unless asked).
+fn material_warnings(used: &[UsedMaterial]) -> Vec<String> {
+    let glass = used
+        .iter()
+        .find(|m| m.transmission.is_some_and(|t| t > 0.0));
+    used.iter()
+        .filter_map(|m| match (m.transmission, glass) {
+            (Some(t), _) if t <= 0.0 => Some(format!(
+                "{} has KHR_materials_transmission transmissionFactor {t} (opaque), but the \
+                 whole model is drawn as one glass object, so its triangles are glass too; give \
+                 it transmission 1 (Blender: Transmission Weight 1), or leave its faces out of \
+                 the model",
+                m.label
+            )),
+            (None, Some(glass)) => Some(format!(
+                "{} has no KHR_materials_transmission while {} is glass, but the whole model \
+                 is drawn as one glass object, so its triangles are glass too; give it \
+                 transmission 1 (Blender: Transmission Weight 1), or leave its faces out of the \
+                 model",
+                m.label, glass.label
+            )),
+            _ => None,
+        })
+        .collect()
 }
 
 /// A material's `KHR_materials_volume` attenuation, checked: white light travelling
@@ -157,6 +199,7 @@ fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
         mesh: Mesh::default(),
         ior: None,
         volume: None,
+        materials: Vec::new(),
         visits: 0,
     };
     let mut ancestors = Vec::new();
@@ -166,11 +209,13 @@ fn load_gltf_inner(bytes: &[u8], base: &Path) -> Result<LoadedModel, String> {
     if out.mesh.indices.is_empty() {
         return Err("the scene has no triangles (no mesh nodes, or only empty meshes)".into());
     }
+    let warnings = material_warnings(&out.materials);
     Ok(LoadedModel {
         mesh: out.mesh,
         ior: out.ior,
         volume: out.volume,
         buffers,
+        warnings,
     })
 }
 
@@ -305,6 +350,8 @@ struct Builder<'a> {
     mesh: Mesh,
     ior: Option<f32>,
     volume: Option<VolumeAttenuation>,
+    /// Every material a triangle primitive uses, once each, in the order first met.
+    materials: Vec<UsedMaterial>,
     visits: usize,
 }
 
@@ -367,6 +414,18 @@ impl Builder<'_> {
         }
         if self.volume.is_none() {
             self.volume = volume_attenuation(&primitive.material())?;
+        }
+        let material = primitive.material();
+        let label = match (material.index(), material.name()) {
+            (Some(i), Some(name)) => format!("material {i} '{name}'"),
+            (Some(i), None) => format!("material {i}"),
+            (None, _) => "the default material".to_owned(),
+        };
+        if !self.materials.iter().any(|m| m.label == label) {
+            self.materials.push(UsedMaterial {
+                label,
+                transmission: material.transmission().map(|t| t.transmission_factor()),
+            });
         }
         let position_acc = primitive
             .get(&gltf::Semantic::Positions)

@@ -43,20 +43,21 @@ pub enum SolidError {
     /// Some edges are not shared by exactly two triangles.
     #[error(
         "the object's mesh does not enclose a volume: {open_edges} edge(s) are not shared by \
-         exactly two triangles (one near {example_m} m); close the holes, or join duplicated \
-         vertices"
+         exactly two triangles (one near {example_m}); glass must be a closed solid: give a \
+         surface modelled as a single sheet its thickness (in Blender, the Solidify modifier), \
+         close any holes, and merge duplicated vertices (Blender: Merge by Distance)"
     )]
     OpenMesh {
         /// Number of welded edges used by one, or more than two, triangles.
         open_edges: usize,
-        /// Midpoint of one such edge, in the frame of the positions given.
+        /// Midpoint of one such edge, in the frame and units of the positions given.
         example_m: Vec3,
     },
     /// Neighbouring triangles disagree about which side is outside.
     #[error(
         "the object's mesh is inconsistently wound: {edges} edge(s) are traversed in the same \
-         direction by both triangles (one near {example_m} m); make every face \
-         counter-clockwise seen from outside"
+         direction by both triangles (one near {example_m}); make every face \
+         counter-clockwise seen from outside (Blender: Recalculate Outside)"
     )]
     InconsistentWinding {
         /// Number of such edges.
@@ -367,6 +368,12 @@ pub(crate) mod tests {
         assert!(
             matches!(err, SolidError::OpenMesh { open_edges: 4, .. }),
             "{err}"
+        );
+        // The message says how to close it, in the words of the tool most models come from.
+        let message = err.to_string();
+        assert!(
+            message.contains("Solidify") && message.contains("Merge by Distance"),
+            "{message}"
         );
         let mut i2 = i.clone();
         i2.swap(1, 2);

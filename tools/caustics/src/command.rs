@@ -88,13 +88,25 @@ fn progress_bar(label: &str) -> ProgressBar {
     bar
 }
 
-fn bake_with_bar(scene: &CausticScene, params: &BakeParams, label: &str) -> Result<BakeOutput> {
+/// Bakes `scene` with a progress bar; an error names the scene file and its `model`.
+fn bake_with_bar(
+    scene: &CausticScene,
+    model: &Path,
+    params: &BakeParams,
+    label: &str,
+) -> Result<BakeOutput> {
     let bar = progress_bar(label);
     let out = bake(scene, params, &|done, total| {
         bar.set_length(total);
         bar.set_position(done);
     })
-    .with_context(|| format!("baking caustics for {}", scene.source.display()))?;
+    .with_context(|| {
+        format!(
+            "baking caustics for {} (object.model {})",
+            scene.source.display(),
+            model.display()
+        )
+    })?;
     bar.finish_and_clear();
     Ok(out)
 }
@@ -108,8 +120,9 @@ fn run_bake(
 ) -> Result<()> {
     let scene = vitreous_scene::load_scene(scene_path)
         .with_context(|| format!("loading scene {}", scene_path.display()))?;
+    let model = scene.object.model_path.clone();
     let scene = CausticScene::from_scene(&scene);
-    let out = bake_with_bar(&scene, params, "bake")?;
+    let out = bake_with_bar(&scene, &model, params, "bake")?;
     let write_start = Instant::now();
     write_bake(output, &out.bake)?;
     let write_s = write_start.elapsed().as_secs_f64();
@@ -159,7 +172,7 @@ fn run_bake(
             budget_rays: (params.budget_rays / 4).max(9),
             ..*params
         };
-        let q = bake_with_bar(&scene, &quarter, "self-check")?;
+        let q = bake_with_bar(&scene, &model, &quarter, "self-check")?;
         let c = compare(
             &q.bake.gain,
             &out.bake.gain,
@@ -181,7 +194,7 @@ fn run_bake(
             budget_rays: params.budget_rays.saturating_mul(factor.max(1)),
             ..*params
         };
-        let r = bake_with_bar(&scene, &reference, "reference")?;
+        let r = bake_with_bar(&scene, &model, &reference, "reference")?;
         let c = compare(
             &out.bake.gain,
             &r.bake.gain,

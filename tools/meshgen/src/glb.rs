@@ -199,7 +199,7 @@ pub fn write(path: &Path, mesh: &Mesh, name: &str, material: &GlassMaterial) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{diamond, sphere, torus};
+    use crate::{diamond, goblet, sphere, torus};
     use glam::Vec2;
 
     /// Minimal .glb reader: checks the container and returns the JSON and the BIN chunk.
@@ -361,6 +361,14 @@ mod tests {
         round_trip(
             &torus::mesh(torus::DEFAULT_MINOR_RADIUS, 96, 48).unwrap(),
             1.51,
+        );
+    }
+
+    #[test]
+    fn goblet_glb_reads_back_identically() {
+        round_trip(
+            &goblet::mesh(&goblet::Proportions::default(), goblet::DEFAULT_SEGMENTS).unwrap(),
+            1.5,
         );
     }
 

@@ -4,13 +4,16 @@
 //! cargo run -p vitreous-meshgen -- sphere  -o config/models/sphere.glb
 //! cargo run -p vitreous-meshgen -- diamond -o config/models/diamond.glb
 //! cargo run -p vitreous-meshgen -- torus   -o config/models/torus.glb
+//! cargo run -p vitreous-meshgen -- goblet  -o config/models/goblet.glb
 //! ```
 //!
-//! Every model is 1.0 across (the renderer scales it), centred on the origin with +y up, and
-//! carries one glass material (`KHR_materials_transmission` 1.0 plus `KHR_materials_ior`).
+//! Every model is 1.0 across its largest extent (the scene's `diameter_m` scales it; the
+//! goblet's largest extent is its height), centred on the origin with +y up, and carries one
+//! glass material (`KHR_materials_transmission` 1.0 plus `KHR_materials_ior`).
 
 mod diamond;
 mod glb;
+mod goblet;
 mod mesh;
 mod sphere;
 mod torus;
@@ -39,6 +42,9 @@ enum Shape {
     Diamond(DiamondArgs),
     /// Glass torus of unit outer diameter lying flat (axis +y).
     Torus(TorusArgs),
+    /// Glass goblet of unit height standing on +y: bowl with a wall, rounded rim, solid stem,
+    /// foot (not convex, not star-shaped).
+    Goblet(GobletArgs),
 }
 
 /// Options of `sphere`.
@@ -107,6 +113,20 @@ struct TorusArgs {
     minor_segments: u32,
 }
 
+/// Options of `goblet`.
+#[derive(Debug, Args)]
+struct GobletArgs {
+    /// Output .glb path.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Index of refraction.
+    #[arg(long, default_value_t = 1.5)]
+    ior: f32,
+    /// Segments around the vertical axis.
+    #[arg(long, default_value_t = goblet::DEFAULT_SEGMENTS)]
+    segments: u32,
+}
+
 /// Writes `mesh` as `name` with a glass material and prints what was written.
 fn save(output: &Path, mesh: &Mesh, name: &str, ior: f32) -> Result<()> {
     let material = GlassMaterial {
@@ -168,6 +188,10 @@ fn main() -> Result<()> {
             let mesh = torus::mesh(a.minor_radius, a.major_segments, a.minor_segments)?;
             save(&a.output, &mesh, "torus", a.ior)
         }
+        Shape::Goblet(a) => {
+            let mesh = goblet::mesh(&goblet::Proportions::default(), a.segments)?;
+            save(&a.output, &mesh, "goblet", a.ior)
+        }
     }
 }
 
@@ -194,6 +218,10 @@ mod tests {
         }
         match parse(&["meshgen", "torus", "-o", "t.glb", "--minor-radius", "0.1"]) {
             Shape::Torus(a) => assert_eq!((a.ior, a.minor_radius), (1.51, 0.1)),
+            other => panic!("{other:?}"),
+        }
+        match parse(&["meshgen", "goblet", "-o", "g.glb"]) {
+            Shape::Goblet(a) => assert_eq!((a.ior, a.segments), (1.5, 48)),
             other => panic!("{other:?}"),
         }
     }

@@ -1,6 +1,7 @@
 //! The `[object]` table: the model, its placement, refraction and absorption.
 
 use vitreous_optics::refraction::{Refraction, RefractionParseError};
+use vitreous_optics::solid::Solid;
 
 use super::*;
 
@@ -17,6 +18,9 @@ impl Loader<'_> {
         })?;
         for buffer in &model.buffers {
             self.hash_part("object.model buffer", buffer);
+        }
+        for warning in &model.warnings {
+            tracing::warn!("{}: {warning}", model_path.display());
         }
 
         let (lo, hi) = model.mesh.bounds();
@@ -108,6 +112,27 @@ impl Loader<'_> {
                     .invalid(r.span(), "object.refraction", e.to_string())
             })?,
         };
+
+        // Two-surface refraction follows the light through the glass's volume, which a mesh
+        // that does not close (a cup modelled as one sheet) does not have; the renderer would
+        // refuse it too, without naming the scene.
+        if refraction == Refraction::TwoSurface
+            && let Err(e) = Solid::new(
+                &model.mesh.positions,
+                &model.mesh.normals,
+                &model.mesh.indices,
+            )
+        {
+            return Err(self.src.asset(
+                raw.model.span(),
+                "object.model",
+                &model_path,
+                format!(
+                    "two-surface refraction (`object.refraction`) follows the light through \
+                     the object's volume: {e}"
+                ),
+            ));
+        }
 
         let surface_texture = match &raw.surface_texture {
             Some(rel) => Some(self.photo("object.surface_texture", rel)?),

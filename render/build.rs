@@ -406,6 +406,27 @@ fn main() {
                 })
                 .collect();
             outputs.extend(counted);
+            // Every look of two surfaces through a mesh (neither a ball nor a convex gem), again
+            // counting the nodes and triangles its searches visit and test (`COUNTED`).
+            let mesh_counted: Vec<_> = outputs
+                .iter()
+                .filter(|(_, suffix, _)| {
+                    let model = suffix
+                        .trim_end_matches(".compensated")
+                        .trim_end_matches(".supersampled");
+                    ["", ".absorbing", ".room", ".absorbing.room"].contains(&model)
+                })
+                .map(|(constants, suffix, _)| {
+                    let mut constants = constants.clone();
+                    constants.insert("COUNTED".to_owned(), 1.0);
+                    (
+                        constants,
+                        format!("{suffix}.counted"),
+                        Some("fs_two_surface_"),
+                    )
+                })
+                .collect();
+            outputs.extend(mesh_counted);
         }
         for (constants, suffix, only) in outputs {
             let (module, info) =

@@ -142,9 +142,10 @@ override COMPENSATED: bool = false;
 // models that can be proved (the paper's, and two surfaces through a ball) with it set too.
 override COVERED: bool = false;
 
-// The positions a pixel shades are counted on the device (`vitreous bench`, the frames that
-// count their work; render/src/glass/counted.rs): a pipeline constant, so that ordinary frames
-// neither pay for the atomics nor declare the buffer.
+// The positions a ball's pixel shades, or the nodes and triangles a mesh's searches visit and
+// test, are counted on the device (`vitreous bench`, the frames that count their work;
+// render/src/glass/counted.rs): a pipeline constant, so that ordinary frames neither pay for
+// the atomics nor declare the buffer.
 override COUNTED: bool = false;
 
 var<push_constant> eye: Eye;
@@ -167,8 +168,9 @@ var<push_constant> eye: Eye;
 @group(0) @binding(7) var<storage, read> facet_planes: array<vec4<f32>>;
 // The floor photo (sharp), seen through the glass when the room is a refraction target.
 @group(0) @binding(8) var floor_photo: texture_2d<f32>;
-// Per frame slot (`eye.refraction_origin.w`): the positions shaded, then the fragments that
-// shaded them (`COUNTED`).
+// Per frame slot (`eye.refraction_origin.w`), four words (`COUNTED`): a ball's positions of the
+// rest and of the first image, then the fragments that shaded them; or a mesh's nodes visited,
+// triangles tested, and the fragments.
 @group(0) @binding(9) var<storage, read_write> shaded: array<atomic<u32>>;
 // What the eye already sees (`COMPENSATED`, render/src/compensation.rs): the floor and
 // background planes and both photos packed side by side (shared/seen.wgsl), and with several
@@ -407,6 +409,31 @@ fn box_entry(lo: vec3<f32>, hi: vec3<f32>, p: vec3<f32>, inv: vec3<f32>) -> f32 
     return select(NO_HIT, near, near <= far);
 }
 
+// Where the ray p + t d (t > 0) meets the triangle whose elements start at `at` in `mesh`, either
+// side (Möller-Trumbore): x the distance t, NO_HIT where it passes beside; yz the barycentric
+// weights of corners 1 and 2.
+fn triangle_hit(at: u32, p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
+    let e1 = mesh[at + 1u].xyz;
+    let e2 = mesh[at + 2u].xyz;
+    let q = cross(d, e2);
+    let det = dot(e1, q);
+    let s = p - mesh[at].xyz;
+    let u = dot(s, q) / det;
+    let r = cross(s, e1);
+    let v = dot(d, r) / det;
+    let t = dot(e2, r) / det;
+    let hit = det != 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0;
+    return vec3<f32>(select(NO_HIT, t, hit), u, v);
+}
+
+// Distances along the ray p + t / inv to the boxes of the children of the inner node whose left
+// child is `first` (`box_entry`): x the left's, y the right's.
+fn children_entries(first: u32, p: vec3<f32>, inv: vec3<f32>) -> vec2<f32> {
+    let left = box_entry(mesh[1u + 2u * first].xyz, mesh[2u + 2u * first].xyz, p, inv);
+    let right = box_entry(mesh[3u + 2u * first].xyz, mesh[4u + 2u * first].xyz, p, inv);
+    return vec2<f32>(left, right);
+}
+
 // The nearest meeting of the ray p + t d (t > 0, d unit; model frame about the object's centre)
 // with the object's triangles (twin of optics/src/solid/bvh.rs `Bvh::closest` and
 // optics/src/two_surface.rs `MeshBody::hit`, either side of a triangle): x the distance t (NO_HIT
@@ -436,39 +463,25 @@ fn mesh_hit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
         let first = bitcast<u32>(low.w);
         let count = bitcast<u32>(high.w);
         if count > 0u {
-            // Möller-Trumbore, either side.
             for (var k = 0u; k < count; k++) {
                 let at = base + 6u * (first + k);
-                let e1 = mesh[at + 1u].xyz;
-                let e2 = mesh[at + 2u].xyz;
-                let q = cross(d, e2);
-                let det = dot(e1, q);
-                let s = p - mesh[at].xyz;
-                let u = dot(s, q) / det;
-                let r = cross(s, e1);
-                let v = dot(d, r) / det;
-                let t = dot(e2, r) / det;
-                if det != 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < best {
-                    best = t;
+                let hit = triangle_hit(at, p, d);
+                if hit.x < best {
+                    best = hit.x;
                     best_at = at;
-                    best_uv = vec2<f32>(u, v);
+                    best_uv = hit.yz;
                 }
             }
             mesh_triangles += count;
         } else {
-            let left = box_entry(mesh[1u + 2u * first].xyz, mesh[2u + 2u * first].xyz, p, inv);
-            let right = box_entry(
-                mesh[3u + 2u * first].xyz, mesh[4u + 2u * first].xyz, p, inv);
+            let entries = children_entries(first, p, inv);
             // The farther child first, so that the nearer is searched first.
-            let near_first = left <= right;
-            let far = select(first, first + 1u, near_first);
-            let far_t = max(left, right);
-            let near_t = min(left, right);
-            if far_t < best && depth < MESH_STACK {
-                stack[depth] = far;
+            let near_first = entries.x <= entries.y;
+            if max(entries.x, entries.y) < best && depth < MESH_STACK {
+                stack[depth] = select(first, first + 1u, near_first);
                 depth += 1u;
             }
-            if near_t < best && depth < MESH_STACK {
+            if min(entries.x, entries.y) < best && depth < MESH_STACK {
                 stack[depth] = select(first + 1u, first, near_first);
                 depth += 1u;
             }
@@ -495,6 +508,24 @@ fn mesh_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
         return vec4<f32>(-1.0, d);
     }
     return vec4<f32>(hit.x + MESH_EPS, select(-hit.yzw, hit.yzw, dot(hit.yzw, d) >= 0.0));
+}
+
+// The cost of one node a search visits and of one triangle it tests (render/src/glass.rs charges
+// each the device counted, `COUNTED`): entry points no pipeline draws with.
+@fragment
+fn fs_two_surface_mesh_node(in: VertexOut) -> @location(0) vec4<f32> {
+    let node = u32(in.uv.x);
+    let inv = 1.0 / in.world_normal;
+    let low = mesh[1u + 2u * node];
+    let high = mesh[2u + 2u * node];
+    let entry = box_entry(low.xyz, high.xyz, in.world_pos, inv);
+    let entries = children_entries(bitcast<u32>(low.w), in.world_pos, inv);
+    return vec4<f32>(entry, entries, bitcast<f32>(high.w));
+}
+
+@fragment
+fn fs_two_surface_mesh_triangle(in: VertexOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(triangle_hit(u32(in.uv.x), in.world_pos, in.world_normal), 1.0);
 }
 
 // Light inside the glass on its way to the surface (`two_surface`), model frame about the
@@ -825,6 +856,18 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
     var out = alpha * surface_texel.rgb + light;
     if COMPENSATED {
         out = max(out - seen_behind(in), vec3<f32>(0.0));
+    }
+    if COUNTED && two_surface_model {
+        if !BALL {
+            if !CONVEX {
+                // The nodes and triangles the mesh's searches visited and tested (`mesh_hit`),
+                // and the fragment.
+                let slot = 4u * u32(eye.refraction_origin.w);
+                atomicAdd(&shaded[slot], mesh_nodes);
+                atomicAdd(&shaded[slot + 1u], mesh_triangles);
+                atomicAdd(&shaded[slot + 2u], 1u);
+            }
+        }
     }
     return vec4<f32>(out, 1.0);
 }

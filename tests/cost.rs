@@ -5,7 +5,9 @@
 //! and each condition's work over the baseline's (O2, or a) held to its committed ratio the same
 //! way, so that a cheaper baseline the method does not follow fails too. Counts, not times: the
 //! same run after run on one driver. In the realism scenes the glass shades the rest of a
-//! ball's light over the whole grid only where a pixel needs it (`positions_where_they_matter`).
+//! ball's light over the whole grid only where a pixel needs it (`positions_where_they_matter`);
+//! a mesh's searches count the nodes and triangles they visit and test (`glass_mesh.*`), held
+//! like every other count, so that a hierarchy that searches more fails.
 //!
 //! After a deliberate change of cost, write the new expectation with
 //! `VITREOUS_UPDATE_COST=1 cargo test -p vitreous-tests --test gpu cost` and say why in the
@@ -57,12 +59,15 @@ struct Case {
     warm_up: usize,
     /// The glass shades a ball's light in the room in parts and counts its positions.
     positions: bool,
+    /// The glass searches a mesh's triangles for the exit and counts the nodes and triangles.
+    mesh: bool,
 }
 
 /// The study's conditions (with two-surface O5), the floor's, the live scene's moving light,
 /// the segmented dimmer's panel and resolve (glass-sphere-ml2.toml), and the realism scene's
-/// glass over several positions per pixel (glass-sphere-real.toml).
-const CASES: [Case; 5] = [
+/// glass over several positions per pixel (glass-sphere-real.toml), and a mesh's searches of its
+/// triangles with those settings (goblet-real.toml).
+const CASES: [Case; 6] = [
     Case {
         name: "visual-effects O3 O4 O5",
         scene: "visual-effects.toml",
@@ -71,6 +76,7 @@ const CASES: [Case; 5] = [
         two_surface: true,
         warm_up: 40,
         positions: false,
+        mesh: false,
     },
     Case {
         name: "glass-sphere b c",
@@ -80,6 +86,7 @@ const CASES: [Case; 5] = [
         two_surface: false,
         warm_up: vitreous::bench::WARM_UP_FRAMES,
         positions: false,
+        mesh: false,
     },
     Case {
         name: "moving-light c moving",
@@ -89,6 +96,7 @@ const CASES: [Case; 5] = [
         two_surface: false,
         warm_up: 40,
         positions: false,
+        mesh: false,
     },
     Case {
         name: "glass-sphere-ml2 dimmer",
@@ -98,6 +106,7 @@ const CASES: [Case; 5] = [
         two_surface: true,
         warm_up: vitreous::bench::WARM_UP_FRAMES,
         positions: true,
+        mesh: false,
     },
     Case {
         name: "glass-sphere-real",
@@ -107,6 +116,17 @@ const CASES: [Case; 5] = [
         two_surface: false,
         warm_up: vitreous::bench::WARM_UP_FRAMES,
         positions: true,
+        mesh: false,
+    },
+    Case {
+        name: "goblet-real",
+        scene: "goblet-real.toml",
+        effects: &[],
+        moving: false,
+        two_surface: false,
+        warm_up: vitreous::bench::WARM_UP_FRAMES,
+        positions: false,
+        mesh: true,
     },
 ];
 
@@ -220,6 +240,16 @@ fn every_conditions_counted_work_stays_within_its_expectation() {
                 case.name
             );
             assert!(failures.is_empty(), "{}: {failures:#?}", case.name);
+        }
+        if case.mesh {
+            for (variant, c) in &counts {
+                let fragments = c.get("glass_mesh.fragments").copied().unwrap_or(0.0);
+                assert!(
+                    fragments > 0.0 && c["glass_mesh.nodes"] > fragments,
+                    "{} {variant}: no search of the mesh's triangles counted ({c:?})",
+                    case.name
+                );
+            }
         }
         measured.insert(case.name.to_owned(), json!(counts));
     }

@@ -204,6 +204,10 @@ pub struct GlassPass {
     /// needs: the row of `shaders::GLASS_FS_COUNTED` of the model; the counting pipelines of the
     /// environment looks, once the frames count (`counted.rs`); and the counters they add to.
     counted_row: Option<usize>,
+    /// Where the glass searches a mesh's triangles for the exit: the row of
+    /// `shaders::GLASS_FS_MESH_COUNTED` of the model, whose counting pipelines (every look)
+    /// `counted_pipelines` holds once the frames count.
+    mesh_row: Option<usize>,
     counted_pipelines: Vec<Owned<vk::Pipeline>>,
     counter: counted::PositionCounter,
 }
@@ -396,6 +400,7 @@ impl GlassPass {
             _planes: planes,
             render_pass,
             counted_row: shaders::counted_row(shaded),
+            mesh_row: shaders::mesh_counted_row(shaded),
             counted_pipelines: Vec::new(),
             counter,
         })
@@ -490,6 +495,12 @@ impl GlassPass {
             let compensated = usize::from(pick.compensated && self.compensation.is_some());
             return shaders::GLASS_FS_COUNTED_COST[compensated][row]
                 [usize::from(pick.variant.phong)];
+        }
+        if let (Some(row), Some(_)) = (self.mesh_row, self.counted_pipeline(pick)) {
+            // The nodes and triangles each fragment's searches visit and test are counted on
+            // the device (`GlassPass::read_mesh`).
+            let compensated = usize::from(pick.compensated && self.compensation.is_some());
+            return shaders::GLASS_FS_MESH_COUNTED_COST[compensated][row][pick.variant.index()];
         }
         match self
             .covered_entry(pick.variant, pick.compensated)

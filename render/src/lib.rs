@@ -70,5 +70,6 @@ pub use scene::{
     TextureDesc,
 };
 pub use work::{
-    FrameWork, GlassPositions, Invocations, PassInvocations, PhotonWork, RecordedWork, ShaderCost,
+    FrameWork, GlassPositions, Invocations, MeshSearch, PassInvocations, PhotonWork, RecordedWork,
+    ShaderCost,
 };

@@ -521,6 +521,7 @@ impl Renderer {
                 glass_positions: glass
                     .as_ref()
                     .and_then(|g| self.glass.counted_positions(g.pick)),
+                glass_mesh: glass.as_ref().and_then(|g| self.glass.counted_mesh(g.pick)),
             };
             let cmds = [slot.cmd];
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
@@ -637,6 +638,10 @@ impl Renderer {
             }
             _ => None,
         };
+        let glass_mesh = match pending.recorded.glass_mesh {
+            Some(counted) if pending.counted => Some(self.glass.read_mesh(slot_index, counted)?),
+            _ => None,
+        };
         let bytes = if pending.want.eyes {
             Some(slot.readback.mapped()?)
         } else {
@@ -666,6 +671,7 @@ impl Renderer {
                 invocations,
                 photons,
                 glass_positions,
+                glass_mesh,
                 ..pending.recorded
             },
             readback,

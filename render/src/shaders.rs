@@ -161,6 +161,47 @@ macro_rules! counted_cost_row {
     };
 }
 
+/// Every look of two surfaces, in `glass::GlassVariant::index` order, compiled with the constants
+/// `<suffix>` names.
+macro_rules! mesh_counted_row {
+    ($suffix:expr) => {
+        [
+            glass_entry!("two_surface", "environment_fresnel", $suffix),
+            glass_entry!("two_surface", "environment_phong", $suffix),
+            glass_entry!("two_surface", "background_fresnel", $suffix),
+            glass_entry!("two_surface", "background_phong", $suffix),
+        ]
+    };
+}
+
+/// The costs of [`mesh_counted_row!`]'s entry points.
+macro_rules! mesh_counted_cost_row {
+    ($suffix:expr) => {
+        [
+            cost!(concat!("glass.fs_two_surface_environment_fresnel", $suffix)),
+            cost!(concat!("glass.fs_two_surface_environment_phong", $suffix)),
+            cost!(concat!("glass.fs_two_surface_background_fresnel", $suffix)),
+            cost!(concat!("glass.fs_two_surface_background_phong", $suffix)),
+        ]
+    };
+}
+
+/// The rows of [`GLASS_FS_MESH_COUNTED`] or its costs, the suffixes ending in `$tail`.
+macro_rules! mesh_counted_rows {
+    ($row:ident, $tail:literal) => {
+        [
+            $row!(concat!($tail, ".counted")),
+            $row!(concat!(".absorbing", $tail, ".counted")),
+            $row!(concat!(".room", $tail, ".counted")),
+            $row!(concat!(".absorbing.room", $tail, ".counted")),
+            $row!(concat!(".supersampled", $tail, ".counted")),
+            $row!(concat!(".absorbing.supersampled", $tail, ".counted")),
+            $row!(concat!(".room.supersampled", $tail, ".counted")),
+            $row!(concat!(".absorbing.room.supersampled", $tail, ".counted")),
+        ]
+    };
+}
+
 /// One glass fragment entry point: its SPIR-V and its name.
 macro_rules! glass_entry {
     ($model:literal, $look:literal, $suffix:expr) => {
@@ -258,6 +299,46 @@ pub const GLASS_PART_COST: [[ShaderCost; 3]; 2] = [
         cost!("glass.fs_two_surface_rest_phong.absorbing.ball.room"),
     ],
 ];
+
+/// Every look of the rows of [`GLASS_FS`] of two surfaces through a mesh (neither a ball nor a
+/// convex gem: clear, absorbing, each with and without the room, each over one position and
+/// several), compiled with `COUNTED`: they count the nodes and triangles the mesh's searches
+/// visit and test (shaders/glass.wgsl `mesh_hit`), for the frames that count their work.
+/// `[compensated][row][variant]`.
+pub const GLASS_FS_MESH_COUNTED: [[[GlassEntry; 4]; 8]; 2] = [
+    mesh_counted_rows!(mesh_counted_row, ""),
+    mesh_counted_rows!(mesh_counted_row, ".compensated"),
+];
+/// The static cost of one invocation of each of [`GLASS_FS_MESH_COUNTED`]'s entry points.
+pub const GLASS_FS_MESH_COUNTED_COST: [[[ShaderCost; 4]; 8]; 2] = [
+    mesh_counted_rows!(mesh_counted_cost_row, ""),
+    mesh_counted_rows!(mesh_counted_cost_row, ".compensated"),
+];
+/// The static cost of one node a mesh's search visits and of one triangle it tests, from the
+/// entry points that do one each (shaders/glass.wgsl `fs_two_surface_mesh_node`,
+/// `fs_two_surface_mesh_triangle`).
+pub const GLASS_MESH_COST: [ShaderCost; 2] = [
+    cost!("glass.fs_two_surface_mesh_node"),
+    cost!("glass.fs_two_surface_mesh_triangle"),
+];
+
+/// The row of [`GLASS_FS_MESH_COUNTED`] of the model in row `model` of [`GLASS_FS`], if it
+/// leaves a mesh through its triangles.
+pub const fn mesh_counted_row(model: usize) -> Option<usize> {
+    // Two surfaces through a clear mesh (1) and an absorbing one (2), with the room (+7), over
+    // several positions (+14).
+    match model {
+        1 => Some(0),
+        2 => Some(1),
+        8 => Some(2),
+        9 => Some(3),
+        15 => Some(4),
+        16 => Some(5),
+        22 => Some(6),
+        23 => Some(7),
+        _ => None,
+    }
+}
 
 /// The row of [`GLASS_FS_COUNTED`] of the model in row `model` of [`GLASS_FS`], if it shades a
 /// ball's light in the room in two parts.

@@ -53,6 +53,10 @@ pub struct FrameWork {
     /// invocations and drew the glass with a pipeline whose pixels decide how many positions
     /// they shade (shaders/shared/glass_positions.wgsl).
     pub glass_positions: Option<GlassPositions>,
+    /// The searches of the object's triangles, counted on the device: `None` unless the frame
+    /// counted invocations and drew a mesh whose exit is searched among its triangles
+    /// (shaders/glass.wgsl `mesh_hit`).
+    pub glass_mesh: Option<MeshSearch>,
 }
 
 /// One computation of the live caustic map, counted on the device by the trace that counts
@@ -99,6 +103,38 @@ impl GlassPositions {
         let first = self.first_images.saturating_sub(self.pixels);
         let of = |f: fn(ShaderCost) -> u32| {
             rest * u64::from(f(self.each)) + first * u64::from(f(self.each_first_image))
+        };
+        [of(|c| c.fetches), of(|c| c.texels), of(|c| c.instructions)]
+    }
+}
+
+/// The searches of the object's triangles in one frame, both eyes, counted on the device by the
+/// pipelines that leave a mesh through its triangles (`COUNTED` in shaders/glass.wgsl
+/// `mesh_hit`), with integer atomics: exact on every device. The static cost of the pipeline
+/// ([`FrameWork::glass_shader`]) counts one pass of each search's loops per fragment; every
+/// node visited and triangle tested is charged [`MeshSearch::each_node`] or
+/// [`MeshSearch::each_triangle`] on top.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MeshSearch {
+    /// Nodes of the bounding-volume hierarchy the searches visited.
+    pub nodes: u64,
+    /// Triangles they tested.
+    pub triangles: u64,
+    /// The covered pixels' fragments that searched.
+    pub fragments: u64,
+    /// The static cost of visiting one node.
+    pub each_node: ShaderCost,
+    /// The static cost of testing one triangle.
+    pub each_triangle: ShaderCost,
+}
+
+impl MeshSearch {
+    /// What the searches cost at the static costs of a node and a triangle: fetches, texels and
+    /// instructions.
+    pub fn charged(&self) -> [u64; 3] {
+        let of = |f: fn(ShaderCost) -> u32| {
+            self.nodes * u64::from(f(self.each_node))
+                + self.triangles * u64::from(f(self.each_triangle))
         };
         [of(|c| c.fetches), of(|c| c.texels), of(|c| c.instructions)]
     }

@@ -152,6 +152,9 @@ impl BenchReport {
                     Box::new(count("glass_positions.first_images")),
                 ),
                 ("rest pos", Box::new(count("glass_positions"))),
+                // Where the glass searches a mesh's triangles for the exit.
+                ("mesh nodes", Box::new(count("glass_mesh.nodes"))),
+                ("mesh tris", Box::new(count("glass_mesh.triangles"))),
                 ("field frags", Box::new(count("mask.fragment_invocations"))),
                 ("compute inv", Box::new(sum(".compute_invocations"))),
             ]);

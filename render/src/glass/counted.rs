@@ -4,7 +4,10 @@
 //! shaders/shared/glass_positions.wgsl), the frames that count their work draw with the same
 //! pipelines compiled with `COUNTED`, whose fragments add their positions and themselves to the
 //! frame slot's counters with integer atomics. Ordinary frames draw with the pipelines without
-//! them, which neither pay for the atomics nor read the buffer.
+//! them, which neither pay for the atomics nor read the buffer. The same for an object whose exit
+//! is searched among its triangles (any look of a mesh that is neither a ball nor a convex gem):
+//! its counting pipelines add the nodes and triangles its searches visited and tested
+//! (shaders/glass.wgsl `mesh_hit`) and the fragment.
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -15,10 +18,11 @@ use crate::error::Result;
 use crate::memory::{Buffer, memory_barrier};
 use crate::renderer::PIPELINE_DEPTH;
 use crate::shaders;
-use crate::work::GlassPositions;
+use crate::work::{GlassPositions, MeshSearch};
 
 /// Bytes of one frame slot's counters: the positions of the rest of the light, those of the
-/// first image, the pixels that shaded them, and a word unused (`u32` each).
+/// first image, the pixels that shaded them, and a word unused (`u32` each); for a mesh, the
+/// nodes visited, the triangles tested, the fragments, and the word unused.
 const SLOT_BYTES: u64 = 16;
 
 /// The counters, four words per frame slot, in memory the host reads once the frame finished.
@@ -45,38 +49,53 @@ impl PositionCounter {
 }
 
 impl GlassPass {
-    /// From now on, draws the pipelines that shade a ball's light in two parts with their
-    /// counting twins (made here, once), so that [`GlassPass::read_positions`] reads what a
-    /// frame shaded. Nothing to do for a scene without such pipelines or on a device whose
-    /// fragment shaders cannot use atomics.
+    /// From now on, draws the pipelines that shade a ball's light in two parts, or that search a
+    /// mesh's triangles, with their counting twins (made here, once), so that
+    /// [`GlassPass::read_positions`] and [`GlassPass::read_mesh`] read what a frame shaded.
+    /// Nothing to do for a scene without such pipelines or on a device whose fragment shaders
+    /// cannot use atomics.
     pub fn count_positions(&mut self, ctx: &GpuContext) -> Result<()> {
-        let (Some(row), true) = (self.counted_row, ctx.fragment_atomics) else {
-            return Ok(());
-        };
-        if !self.counted_pipelines.is_empty() {
+        if !ctx.fragment_atomics || !self.counted_pipelines.is_empty() {
             return Ok(());
         }
-        // The environment looks (the background looks shade every position whole), fresnel then
-        // Phong, then with compensation the same two again.
         let compensated: &[usize] = if self.compensation.is_some() {
             &[0, 1]
         } else {
             &[0]
         };
-        self.counted_pipelines = compensated
-            .iter()
-            .flat_map(|&c| (0..2).map(move |phong| (c, phong)))
-            .map(|(c, phong)| self.create_pipeline(ctx, shaders::GLASS_FS_COUNTED[c][row][phong]))
+        let entries: Vec<shaders::GlassEntry> = match (self.counted_row, self.mesh_row) {
+            // A ball's environment looks (the background looks shade every position whole),
+            // fresnel then Phong, then with compensation the same two again.
+            (Some(row), _) => compensated
+                .iter()
+                .flat_map(|&c| (0..2).map(move |phong| shaders::GLASS_FS_COUNTED[c][row][phong]))
+                .collect(),
+            // A mesh's every look, then with compensation the same four again.
+            (None, Some(row)) => compensated
+                .iter()
+                .flat_map(|&c| shaders::GLASS_FS_MESH_COUNTED[c][row])
+                .collect(),
+            (None, None) => return Ok(()),
+        };
+        self.counted_pipelines = entries
+            .into_iter()
+            .map(|entry| self.create_pipeline(ctx, entry))
             .collect::<Result<Vec<_>>>()?;
         Ok(())
     }
 
     /// The counting pipeline that draws `pick` in place of its own, where the frames count.
     pub(super) fn counted_pipeline(&self, pick: Pick) -> Option<vk::Pipeline> {
-        let compensated = pick.compensated && self.compensation.is_some();
-        let index = usize::from(compensated) * 2 + usize::from(pick.variant.phong);
-        (!pick.covered && !pick.variant.background && !self.counted_pipelines.is_empty())
-            .then(|| self.counted_pipelines[index].raw())
+        if self.counted_pipelines.is_empty() || pick.covered {
+            return None;
+        }
+        let compensated = usize::from(pick.compensated && self.compensation.is_some());
+        if self.mesh_row.is_some() {
+            let index = compensated * 4 + pick.variant.index();
+            return Some(self.counted_pipelines[index].raw());
+        }
+        let index = compensated * 2 + usize::from(pick.variant.phong);
+        (!pick.variant.background).then(|| self.counted_pipelines[index].raw())
     }
 
     /// What a frame that draws `pick` counts, where a counting pipeline draws it: the static
@@ -88,6 +107,18 @@ impl GlassPass {
             each: shaders::GLASS_PART_COST[row][1 + usize::from(pick.variant.phong)],
             each_first_image: shaders::GLASS_PART_COST[row][0],
             ..GlassPositions::default()
+        })
+    }
+
+    /// What a frame that draws `pick` counts of a mesh's searches, where a counting pipeline
+    /// draws it: the static costs of a node and a triangle ([`MeshSearch`]), the counts 0 until
+    /// [`GlassPass::read_mesh`].
+    pub fn counted_mesh(&self, pick: Pick) -> Option<MeshSearch> {
+        self.mesh_row?;
+        self.counted_pipeline(pick).map(|_| MeshSearch {
+            each_node: shaders::GLASS_MESH_COST[0],
+            each_triangle: shaders::GLASS_MESH_COST[1],
+            ..MeshSearch::default()
         })
     }
 
@@ -152,17 +183,35 @@ impl GlassPass {
     /// What the frame of slot `slot` shaded with a counting pipeline, once it finished:
     /// `counted` ([`GlassPass::counted_positions`]) with the device's counts.
     pub fn read_positions(&self, slot: usize, counted: GlassPositions) -> Result<GlassPositions> {
+        let [shaded, first_images, pixels] = self.read_slot(slot)?;
+        Ok(GlassPositions {
+            shaded,
+            first_images,
+            pixels,
+            ..counted
+        })
+    }
+
+    /// What the frame of slot `slot` searched with a counting pipeline, once it finished:
+    /// `counted` ([`GlassPass::counted_mesh`]) with the device's counts.
+    pub fn read_mesh(&self, slot: usize, counted: MeshSearch) -> Result<MeshSearch> {
+        let [nodes, triangles, fragments] = self.read_slot(slot)?;
+        Ok(MeshSearch {
+            nodes,
+            triangles,
+            fragments,
+            ..counted
+        })
+    }
+
+    /// The first three counters of slot `slot`.
+    fn read_slot(&self, slot: usize) -> Result<[u64; 3]> {
         let bytes = self.counter.buffer.mapped()?;
         let at = slot * SLOT_BYTES as usize;
         let word = |i: usize| {
             let w = &bytes[at + 4 * i..at + 4 * i + 4];
             u64::from(u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
         };
-        Ok(GlassPositions {
-            shaded: word(0),
-            first_images: word(1),
-            pixels: word(2),
-            ..counted
-        })
+        Ok([word(0), word(1), word(2)])
     }
 }

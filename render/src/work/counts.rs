@@ -99,6 +99,14 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
                 ("glass", Some(p)) => p.further(),
                 _ => [0; 3],
             };
+            // What the mesh's searches visited and tested.
+            let [fetches, texels, instructions] = match (pass, frame.glass_mesh) {
+                ("glass", Some(m)) => {
+                    let [f, t, i] = m.charged();
+                    [fetches + f, texels + t, instructions + i]
+                }
+                _ => [fetches, texels, instructions],
+            };
             for (what, value) in [
                 ("fetches", total(|c| c.fetches) + fetches),
                 ("texels", total(|c| c.texels) + texels),
@@ -114,6 +122,11 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
                 p.first_images as f64,
             ));
             counts.push(("glass_positions.pixels".to_owned(), p.pixels as f64));
+        }
+        if let Some(m) = frame.glass_mesh {
+            counts.push(("glass_mesh.nodes".to_owned(), m.nodes as f64));
+            counts.push(("glass_mesh.triangles".to_owned(), m.triangles as f64));
+            counts.push(("glass_mesh.fragments".to_owned(), m.fragments as f64));
         }
     }
     if let Some(photons) = frame.photons {
@@ -131,7 +144,7 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::work::{GlassPositions, PassInvocations, RecordedWork, ShaderCost};
+    use crate::work::{GlassPositions, MeshSearch, PassInvocations, RecordedWork, ShaderCost};
 
     #[test]
     fn counts_are_means_per_frame_and_fetches_follow_each_glass_pipelines_fragments() {
@@ -168,6 +181,7 @@ mod tests {
                 smoothed_texels: 64,
             }),
             glass_positions: None,
+            glass_mesh: None,
         };
         let counts = mean_counts(&[frame(2, 100), frame(4, 300)]);
         assert_eq!(counts["draws"], 3.0);
@@ -220,6 +234,7 @@ mod tests {
                 each,
                 each_first_image,
             }),
+            glass_mesh: None,
         };
         // 40 covered pixels, each with the first image at 16 positions (600 beyond their
         // first), the rest at 16 positions in 10 of them and at 4 in 30 (240 beyond).
@@ -242,6 +257,56 @@ mod tests {
     }
 
     #[test]
+    fn the_glass_is_charged_each_node_and_triangle_its_mesh_searches_visited() {
+        let frame = |mesh: Option<(u64, u64)>| FrameWork {
+            recorded: RecordedWork::default(),
+            invocations: Some(PassInvocations {
+                eye_glass: Invocations {
+                    fragment: 50,
+                    ..Invocations::default()
+                },
+                ..PassInvocations::default()
+            }),
+            glass_shader: Some(ShaderCost {
+                fetches: 3,
+                texels: 12,
+                instructions: 100,
+            }),
+            glass_covered_shader: None,
+            overlay_shader: None,
+            photons: None,
+            glass_positions: None,
+            glass_mesh: mesh.map(|(nodes, triangles)| MeshSearch {
+                nodes,
+                triangles,
+                fragments: 40,
+                each_node: ShaderCost {
+                    fetches: 0,
+                    texels: 0,
+                    instructions: 30,
+                },
+                each_triangle: ShaderCost {
+                    fetches: 0,
+                    texels: 0,
+                    instructions: 25,
+                },
+            }),
+        };
+        let counts = mean_counts(&[frame(Some((1000, 300)))]);
+        assert_eq!(counts["glass_mesh.nodes"], 1000.0);
+        assert_eq!(counts["glass_mesh.triangles"], 300.0);
+        assert_eq!(counts["glass_mesh.fragments"], 40.0);
+        assert_eq!(counts["glass_fetches"], 150.0);
+        assert_eq!(
+            counts["glass_instructions"],
+            5000.0 + 1000.0 * 30.0 + 300.0 * 25.0
+        );
+        let uncounted = mean_counts(&[frame(None)]);
+        assert_eq!(uncounted["glass_instructions"], 5000.0);
+        assert!(!uncounted.contains_key("glass_mesh.nodes"));
+    }
+
+    #[test]
     fn without_invocation_counts_only_the_recorded_work_is_named() {
         let frame = FrameWork {
             recorded: RecordedWork {
@@ -254,6 +319,7 @@ mod tests {
             overlay_shader: None,
             photons: None,
             glass_positions: None,
+            glass_mesh: None,
         };
         let counts = mean_counts(&[frame]);
         assert_eq!(counts["dispatches"], 5.0);

@@ -749,7 +749,39 @@ fn ball_passage(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f
 struct Front {
     position: vec3<f32>,
     normal: vec3<f32>,
+    // False where a position of the pixel's grid (`SUPERSAMPLED`) sees past the object.
+    found: bool,
 };
+
+// Where the ray p + t d (from outside, d unit; model frame about the object's centre) enters
+// the convex object of `facet_planes`: x the distance t (NO_HIT where it passes beside), yzw
+// the outward unit normal there.
+fn convex_entry(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
+    var t_in = 0.0;
+    var n_in = vec3<f32>(0.0);
+    var t_out = 3.0e38;
+    let count = arrayLength(&facet_planes);
+    for (var i = 0u; i < count; i++) {
+        let plane = facet_planes[i];
+        let along = dot(plane.xyz, d);
+        let inside = plane.w - dot(plane.xyz, p);
+        if along < -1e-7 {
+            let t = inside / along;
+            if t > t_in {
+                t_in = t;
+                n_in = plane.xyz;
+            }
+        } else if along > 1e-7 {
+            t_out = min(t_out, inside / along);
+        } else if inside < 0.0 {
+            t_out = -1.0;
+        }
+    }
+    if t_in > t_out || dot(n_in, n_in) == 0.0 {
+        return vec4<f32>(NO_HIT, d);
+    }
+    return vec4<f32>(t_in, n_in);
+}
 
 fn front_surface(in: VertexOut) -> Front {
     // The object's transform is a similarity (uniform scale), so the sphere about its centre is
@@ -763,6 +795,27 @@ fn front_surface(in: VertexOut) -> Front {
     var out: Front;
     out.position = mix(in.world_pos, on_sphere + g.center_world.xyz, weight);
     out.normal = normalize(mix(normalize(in.world_normal), on_sphere / in.curve.x, weight));
+    out.found = true;
+    if SUPERSAMPLED && !BALL {
+        // A position of the pixel's grid carried off the rasterised triangle by the screen
+        // derivatives lies on the triangle's plane, not on the object (outside a convex
+        // surface, inside a concave one): its own view ray finds where it meets the object,
+        // or that it passes beside it.
+        let p0 = (g.model_from_world * vec4<f32>(eye.position.xyz, 1.0)).xyz - g.radial.xyz;
+        let dm = normalize((g.model_from_world * vec4<f32>(d, 0.0)).xyz);
+        var hit: vec4<f32>;
+        if CONVEX {
+            hit = convex_entry(p0, dm);
+        } else {
+            hit = mesh_hit(p0, dm);
+        }
+        if hit.x >= NO_HIT {
+            out.found = false;
+            return out;
+        }
+        out.position = (g.world_from_model * vec4<f32>(p0 + dm * hit.x + g.radial.xyz, 1.0)).xyz;
+        out.normal = normalize((g.normal_from_model * vec4<f32>(hit.yzw, 0.0)).xyz);
+    }
     return out;
 }
 
@@ -849,6 +902,9 @@ fn shade_ray(
     in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool, alpha: f32,
 ) -> vec3<f32> {
     let front = front_surface(in);
+    if SUPERSAMPLED && !front.found {
+        return vec3<f32>(0.0);
+    }
     let world_pos = front.position;
     let incident = normalize(world_pos - eye.position.xyz);
     var n = front.normal;

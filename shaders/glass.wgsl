@@ -314,6 +314,12 @@ const MAX_INTERNAL_REFLECTIONS: i32 = 8;
 // where the exit reflects most, the second still shows (ꟻLIP in glass-sphere-real's disc 0.274
 // with one, 0.268 with two, 0.267 with three or six: docs/realism.md).
 const ECHOES: i32 = 2;
+// A convex gem's: a brilliant (ior 2.42) returns most of its light after several internal
+// reflections, each exit passing a share out (tmp-diamond's disc gap 0.50 with 2, see
+// app/compare/examples/gap_study.rs).
+const CONVEX_ECHOES: i32 = 8;
+// Total internal reflections a convex gem's main path is followed through.
+const CONVEX_INTERNAL_REFLECTIONS: i32 = 16;
 // Entries into the object along one path at most (`MESH`, an object that is not convex: the
 // first and the re-entries after it leaves, as a ray through a torus's hole or past a goblet's
 // cup into its stem; then the room beyond, whatever the object).
@@ -522,7 +528,8 @@ struct Inside {
 // (then given up inside).
 fn to_the_outside(light: Inside, ior: f32) -> Inside {
     var s = light;
-    for (var bounce = 0; bounce <= MAX_INTERNAL_REFLECTIONS; bounce++) {
+    let bounces = select(MAX_INTERNAL_REFLECTIONS, CONVEX_INTERNAL_REFLECTIONS, CONVEX);
+    for (var bounce = 0; bounce <= bounces; bounce++) {
         let exit = find_exit(s.p, s.d);
         if !BALL {
             if !CONVEX {
@@ -627,7 +634,8 @@ fn echoes_of(s: Inside, ior: f32) -> vec3<f32> {
     var e = s.echo_d;
     var carried = s.arriving * s.reflectance;
     var path = s.path;
-    for (var k = 0; k < ECHOES; k++) {
+    let meetings = select(ECHOES, CONVEX_ECHOES, CONVEX);
+    for (var k = 0; k < meetings; k++) {
         let exit = find_exit(q, e);
         q += e * exit.x;
         path += exit.x;

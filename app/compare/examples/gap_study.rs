@@ -203,8 +203,12 @@ impl Tracer<'_> {
     /// `to_the_outside`: (position, direction, transmission, escaped, arriving, reflectance,
     /// echo direction, lost).
     fn to_the_outside(&self, s: &mut GpuState) {
+        self.to_the_outside_n(s, 8);
+    }
+
+    fn to_the_outside_n(&self, s: &mut GpuState, max_tir: u32) {
         let glass = self.glass();
-        for _bounce in 0..=8 {
+        for _bounce in 0..=max_tir {
             let Some((t, normal)) = glass.shape.leave(s.p, s.d) else {
                 s.transmission = 0.0;
                 s.arriving = 0.0;
@@ -333,6 +337,60 @@ impl Tracer<'_> {
     }
 }
 
+impl Tracer<'_> {
+    /// The GPU's convex path (`two_surface` with CONVEX: front reflection, main path with
+    /// `max_tir` total internal reflections, then `echoes_of` with `echoes` meetings).
+    fn gpu_convex(&self, at: Vec3, dir: Vec3, normal: Vec3, echoes: u32, max_tir: u32) -> Vec3 {
+        let glass = self.glass();
+        let ior = glass.ior;
+        let facing = if dir.dot(normal) < 0.0 { normal } else { -normal };
+        let f0 = fresnel_reflectance(-dir.dot(facing), 1.0 / ior);
+        let front = self.room(at + facing * EPS_M, reflect(dir, facing), true).0 * f0;
+        let Some(inward) = refract(dir, facing, 1.0 / ior) else {
+            return front;
+        };
+        let mut s = GpuState {
+            p: at - facing * EPS_M,
+            d: inward,
+            transmission: 1.0 - f0,
+            escaped: false,
+            arriving: 0.0,
+            reflectance: 0.0,
+            echo_d: inward,
+            lost: false,
+            gave_up: false,
+            n_out: Vec3::ZERO,
+        };
+        self.to_the_outside_n(&mut s, max_tir);
+        if s.lost {
+            return front;
+        }
+        if !s.escaped {
+            return front + self.world.environment_radiance(s.d) * s.transmission;
+        }
+        let main = self.room(s.p + s.n_out * EPS_M, s.d, true).0 * s.transmission;
+        let mut light = Vec3::ZERO;
+        let mut q = s.p - s.n_out * EPS_M;
+        let mut e = s.echo_d;
+        let mut carried = s.arriving * s.reflectance;
+        for _ in 0..echoes {
+            let Some((t, normal)) = glass.shape.leave(q, e) else {
+                break;
+            };
+            q += e * t;
+            let outward = if e.dot(normal) >= 0.0 { normal } else { -normal };
+            if let Some(leaving) = refract(e, -outward, ior) {
+                let r = fresnel_reflectance(e.dot(outward), ior);
+                light += self.room(q + outward * EPS_M, leaving, true).0 * (carried * (1.0 - r));
+                carried *= r;
+            }
+            e = reflect(e, outward);
+            q -= outward * EPS_M;
+        }
+        front + main + light
+    }
+}
+
 struct GpuState {
     p: Vec3,
     d: Vec3,
@@ -365,9 +423,15 @@ fn main() -> anyhow::Result<()> {
         let img = image::open(p)?.to_rgb8();
         Ok((img.width(), img.height(), img.into_raw()))
     };
-    let (w, h, real8) = read(&real_path)?;
+    let (w, h, mut real8) = read(&real_path)?;
     let (_, _, seen8) = read(&dir.join("000000-left-seen.png"))?;
-    let (_, _, preview8) = read(&dir.join("000000-left-preview.png"))?;
+    // What the eye sees with the GPU's display light (eq. 6 over the seen image, additive).
+    let (_, _, left8) = read(&dir.join("000000-left.png"))?;
+    let preview8: Vec<u8> = left8
+        .iter()
+        .zip(&seen8)
+        .map(|(&l, &s)| srgb8(lin8(l) + lin8(s)))
+        .collect();
     let gpu_t = args.get(3).map(|p| read(Path::new(p))).transpose()?;
     let samples: u32 = std::env::var("SAMPLES").ok().and_then(|s| s.parse().ok()).unwrap_or(3);
 
@@ -463,6 +527,43 @@ fn main() -> anyhow::Result<()> {
             })
             .collect()
     };
+    // REF_SAMPLES: the reference over the disc traced again with that many positions along
+    // each side of a pixel (a converged reference), everything measured against it.
+    if let Some(nr) = std::env::var("REF_SAMPLES").ok().and_then(|s| s.parse::<u32>().ok()) {
+        let t0 = std::time::Instant::now();
+        let trace = |idx: &[usize]| -> Vec<Vec3> {
+            let tm = Tracer { world: &world_mod, knobs: full, cut_weight: 0.0.into() };
+            idx.iter()
+                .map(|&i| {
+                    let (x, y) = ((i as u32 % w) as f32, (i as u32 / w) as f32);
+                    let mut b = Bins::default();
+                    for j in 0..nr {
+                        for k in 0..nr {
+                            let off = Vec2::new((k as f32 + 0.5) / nr as f32, (j as f32 + 0.5) / nr as f32);
+                            let d = rays.direction(Vec2::new(x, y) + off);
+                            tm.outside(&mut b, camera.position_m, d, Vec3::ONE, 1.0, 0, 0, false);
+                        }
+                    }
+                    b.total() / (nr * nr) as f32
+                })
+                .collect()
+        };
+        let half = disc.len() / 2;
+        let vals: Vec<Vec3> = std::thread::scope(|sc| {
+            let a = sc.spawn(|| trace(&disc[..half]));
+            let b = trace(&disc[half..]);
+            let mut a = a.join().unwrap();
+            a.extend(b);
+            a
+        });
+        for (k, &i) in disc.iter().enumerate() {
+            for c in 0..3 {
+                real8[i * 3 + c] = srgb8(vals[k][c]);
+            }
+        }
+        eprintln!("reference at {nr}x{nr} over the disc in {:.1}s", t0.elapsed().as_secs_f32());
+    }
+    let real8 = real8;
     let t0 = std::time::Instant::now();
     let half = disc.len() / 2;
     let pxs: Vec<Px> = std::thread::scope(|sc| {
@@ -530,6 +631,44 @@ fn main() -> anyhow::Result<()> {
     report("GPU emulation (front+main+branches), floor lit", &|p| p.gpu[0] + p.gpu[1] + p.gpu[2]);
     report("GPU emulation, floor photo (as the GPU)", &|p| p.gpu_photo[0] + p.gpu_photo[1] + p.gpu_photo[2]);
     report("GPU emulation, no branches, floor photo", &|p| p.gpu_photo[0] + p.gpu_photo[1] + if p.cover < 0.999 { p.gpu_photo[2] } else { Vec3::ZERO });
+    if std::env::var("CONVEX").is_ok() {
+        for (echoes, max_tir) in [(0, 8), (2, 8), (4, 8), (8, 8), (2, 16), (8, 16), (16, 32)] {
+            let vals: Vec<Vec3> = {
+                let tp = Tracer { world: &world_photo, knobs: full, cut_weight: 0.0.into() };
+                disc.iter()
+                    .map(|&i| {
+                        let (x, y) = ((i as u32 % w) as f32, (i as u32 / w) as f32);
+                        let n = samples;
+                        let mut sum = Vec3::ZERO;
+                        for j in 0..n {
+                            for k in 0..n {
+                                let off = Vec2::new((k as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                                let d = rays.direction(Vec2::new(x, y) + off);
+                                let o = camera.position_m;
+                                let glass = world_photo.glass.as_ref().unwrap();
+                                let photo = world_photo.photo_hit(o, d);
+                                if let Some((t, normal)) = glass.shape.enter(o, d)
+                                    && photo.is_none_or(|(tp, _)| t < tp)
+                                {
+                                    sum += tp.gpu_convex(o + d * t, d, normal, echoes, max_tir);
+                                } else {
+                                    sum += tp.room(o, d, false).0;
+                                }
+                            }
+                        }
+                        sum / (n * n) as f32
+                    })
+                    .collect()
+            };
+            let name = format!("GPU convex emulation, floor photo, ECHOES {echoes}, TIR {max_tir}");
+            let f = flip_disc(&shown_of(&|p: &Px| {
+                let k = pxs.iter().position(|q| std::ptr::eq(q, p)).unwrap();
+                vals[k]
+            }));
+            let m = sil.iter().map(|&k| vals[k].dot(Vec3::ONE) / 3.0).sum::<f32>() / sil.len() as f32;
+            println!("{name:58} sil mean {m:.4}  disc flip {f:.4}  gap {:.3}", gap(f));
+        }
+    }
     let end_names = ["floor", "wall", "env", "none"];
     println!("reference full, silhouette mean by order x end:");
     for o in 0..ORDERS {

@@ -309,7 +309,7 @@ fn beyond(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     }
 }
 
-const MAX_INTERNAL_REFLECTIONS: i32 = 8;
+const MAX_INTERNAL_REFLECTIONS: i32 = 16;
 // Partial internal reflections after the exit followed with the room (`ROOM`): at a ball's rim,
 // where the exit reflects most, the second still shows (ꟻLIP in glass-sphere-real's disc 0.274
 // with one, 0.268 with two, 0.267 with three or six: docs/realism.md).

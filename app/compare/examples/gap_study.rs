@@ -203,7 +203,8 @@ impl Tracer<'_> {
     /// `to_the_outside`: (position, direction, transmission, escaped, arriving, reflectance,
     /// echo direction, lost).
     fn to_the_outside(&self, s: &mut GpuState) {
-        self.to_the_outside_n(s, 8);
+        let n = std::env::var("MESH_TIR").ok().and_then(|s| s.parse().ok()).unwrap_or(8);
+        self.to_the_outside_n(s, n);
     }
 
     fn to_the_outside_n(&self, s: &mut GpuState, max_tir: u32) {
@@ -280,7 +281,11 @@ impl Tracer<'_> {
         let ior = glass.ior;
         let facing = if dir.dot(normal) < 0.0 { normal } else { -normal };
         let f0 = fresnel_reflectance(-dir.dot(facing), 1.0 / ior);
-        let front = self.room(at + facing * EPS_M, reflect(dir, facing), true).0 * f0;
+        let front = if std::env::var("FRONT_FOLLOW").is_ok() {
+            self.follow(at + facing * EPS_M, reflect(dir, facing), false, branch_meetings) * f0
+        } else {
+            self.room(at + facing * EPS_M, reflect(dir, facing), true).0 * f0
+        };
         let Some(inward) = refract(dir, facing, 1.0 / ior) else {
             return [front, Vec3::ZERO, Vec3::ZERO];
         };
@@ -329,6 +334,8 @@ impl Tracer<'_> {
         } else if s.escaped {
             let from = s.p + s.n_out * EPS_M;
             self.room(from, s.d, true).0 * s.transmission
+        } else if std::env::var("GIVEUP_ZERO").is_ok() {
+            Vec3::ZERO
         } else {
             // Given up inside: the environment along the last direction.
             self.world.environment_radiance(s.d) * s.transmission
@@ -449,6 +456,7 @@ fn main() -> anyhow::Result<()> {
     let rays = camera.pixel_rays(Vec2::new(w as f32, h as f32));
     let full = Knobs { max_interfaces: 16, min_weight: 1e-4 };
     let deep = Knobs { max_interfaces: 64, min_weight: 1e-6 };
+    let me: u32 = std::env::var("MAX_ENTRIES").ok().and_then(|s| s.parse().ok()).unwrap_or(4);
     let bm: u32 = std::env::var("BRANCH_MEETINGS").ok().and_then(|s| s.parse().ok()).unwrap_or(6);
 
     // Per disc pixel: [ref full mod bins], [ref photo bins], [ref deep bins], gpu emu parts,
@@ -499,8 +507,8 @@ fn main() -> anyhow::Result<()> {
                             if px.y.is_nan() {
                                 px.y = at.y;
                             }
-                            let g = tm.gpu(at, d, normal, bm, 4);
-                            let gp = tp.gpu(at, d, normal, bm, 4);
+                            let g = tm.gpu(at, d, normal, bm, me);
+                            let gp = tp.gpu(at, d, normal, bm, me);
                             for q in 0..3 {
                                 px.gpu[q] += g[q];
                                 px.gpu_photo[q] += gp[q];
@@ -532,7 +540,8 @@ fn main() -> anyhow::Result<()> {
     if let Some(nr) = std::env::var("REF_SAMPLES").ok().and_then(|s| s.parse::<u32>().ok()) {
         let t0 = std::time::Instant::now();
         let trace = |idx: &[usize]| -> Vec<Vec3> {
-            let tm = Tracer { world: &world_mod, knobs: full, cut_weight: 0.0.into() };
+            let knobs = if std::env::var("REF_DEEP").is_ok() { deep } else { full };
+            let tm = Tracer { world: &world_mod, knobs, cut_weight: 0.0.into() };
             idx.iter()
                 .map(|&i| {
                     let (x, y) = ((i as u32 % w) as f32, (i as u32 / w) as f32);
@@ -617,6 +626,25 @@ fn main() -> anyhow::Result<()> {
         "disc {} px, silhouette (fully covered) {} px; flip nothing {:.4} limit {:.4}; GPU actual preview {:.4} gap {:.3}",
         disc.len(), sil.len(), nothing, limit, gpu_actual, gap(gpu_actual)
     );
+    {
+        // Where the GPU's error lies: disc pixels by how much of them the glass covers.
+        let e = vitreous_compare::flip::error_map(&real8, &preview8, (w, h), ppd).unwrap();
+        let el = vitreous_compare::flip::error_map(&real8, &limit_img, (w, h), ppd).unwrap();
+        for (name, lo, hi) in [("none", -1.0, 0.001), ("partly", 0.001, 0.999), ("whole", 0.999, 2.0)] {
+            let set: Vec<usize> = (0..disc.len()).filter(|&k| pxs[k].cover > lo && pxs[k].cover <= hi).collect();
+            let sum: f64 = set.iter().map(|&k| f64::from(e[disc[k]])).sum();
+            let lim: f64 = set.iter().map(|&k| f64::from(el[disc[k]])).sum();
+            let seen_sum: f64 = {
+                let es = vitreous_compare::flip::error_map(&real8, &seen8, (w, h), ppd).unwrap();
+                set.iter().map(|&k| f64::from(es[disc[k]])).sum()
+            };
+            let gpu_glass = set.iter().filter(|&&k| (0..3).any(|c| left8[disc[k] * 3 + c] > 0)).count();
+            println!(
+                "  covered {name:6}: {:5} px ({} with GPU light); share of disc FLIP sum: GPU {:.4} limit {:.4} nothing {:.4}",
+                set.len(), gpu_glass, sum / disc.len() as f64, lim / disc.len() as f64, seen_sum / disc.len() as f64
+            );
+        }
+    }
     let report = |name: &str, t: &dyn Fn(&Px) -> Vec3| {
         let f = flip_disc(&shown_of(t));
         println!("{name:58} sil mean {:.4}  disc flip {:.4}  gap {:.3}", mean(t, &sil), f, gap(f));

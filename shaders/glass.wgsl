@@ -911,6 +911,11 @@ fn shade_ray(
 ) -> vec3<f32> {
     let front = front_surface(in);
     if SUPERSAMPLED && !front.found {
+        // A position beside the object: with eq. 6 the eye sees the room itself there, which
+        // `seen_behind` takes away over the whole pixel, so the pixel's light holds it too.
+        if COMPENSATED {
+            return seen_along(eye.position.xyz, normalize(in.world_pos - eye.position.xyz));
+        }
         return vec3<f32>(0.0);
     }
     let world_pos = front.position;

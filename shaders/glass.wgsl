@@ -311,11 +311,17 @@ fn beyond(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     }
 }
 
-const MAX_INTERNAL_REFLECTIONS: i32 = 8;
+const MAX_INTERNAL_REFLECTIONS: i32 = 16;
 // Partial internal reflections after the exit followed with the room (`ROOM`): at a ball's rim,
 // where the exit reflects most, the second still shows (ꟻLIP in glass-sphere-real's disc 0.274
 // with one, 0.268 with two, 0.267 with three or six: docs/realism.md).
 const ECHOES: i32 = 2;
+// A convex gem's: a brilliant (ior 2.42) returns most of its light after several internal
+// reflections, each exit passing a share out (tmp-diamond's disc gap 0.50 with 2, see
+// app/compare/examples/gap_study.rs).
+const CONVEX_ECHOES: i32 = 8;
+// Total internal reflections a convex gem's main path is followed through.
+const CONVEX_INTERNAL_REFLECTIONS: i32 = 16;
 // Entries into the object along one path at most (`MESH`, an object that is not convex: the
 // first and the re-entries after it leaves, as a ray through a torus's hole or past a goblet's
 // cup into its stem; then the room beyond, whatever the object).
@@ -553,7 +559,8 @@ struct Inside {
 // (then given up inside).
 fn to_the_outside(light: Inside, ior: f32) -> Inside {
     var s = light;
-    for (var bounce = 0; bounce <= MAX_INTERNAL_REFLECTIONS; bounce++) {
+    let bounces = select(MAX_INTERNAL_REFLECTIONS, CONVEX_INTERNAL_REFLECTIONS, CONVEX);
+    for (var bounce = 0; bounce <= bounces; bounce++) {
         let exit = find_exit(s.p, s.d);
         if !BALL {
             if !CONVEX {
@@ -658,7 +665,8 @@ fn echoes_of(s: Inside, ior: f32) -> vec3<f32> {
     var e = s.echo_d;
     var carried = s.arriving * s.reflectance;
     var path = s.path;
-    for (var k = 0; k < ECHOES; k++) {
+    let meetings = select(ECHOES, CONVEX_ECHOES, CONVEX);
+    for (var k = 0; k < meetings; k++) {
         let exit = find_exit(q, e);
         q += e * exit.x;
         path += exit.x;
@@ -780,7 +788,39 @@ fn ball_passage(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f
 struct Front {
     position: vec3<f32>,
     normal: vec3<f32>,
+    // False where a position of the pixel's grid (`SUPERSAMPLED`) sees past the object.
+    found: bool,
 };
+
+// Where the ray p + t d (from outside, d unit; model frame about the object's centre) enters
+// the convex object of `facet_planes`: x the distance t (NO_HIT where it passes beside), yzw
+// the outward unit normal there.
+fn convex_entry(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
+    var t_in = 0.0;
+    var n_in = vec3<f32>(0.0);
+    var t_out = 3.0e38;
+    let count = arrayLength(&facet_planes);
+    for (var i = 0u; i < count; i++) {
+        let plane = facet_planes[i];
+        let along = dot(plane.xyz, d);
+        let inside = plane.w - dot(plane.xyz, p);
+        if along < -1e-7 {
+            let t = inside / along;
+            if t > t_in {
+                t_in = t;
+                n_in = plane.xyz;
+            }
+        } else if along > 1e-7 {
+            t_out = min(t_out, inside / along);
+        } else if inside < 0.0 {
+            t_out = -1.0;
+        }
+    }
+    if t_in > t_out || dot(n_in, n_in) == 0.0 {
+        return vec4<f32>(NO_HIT, d);
+    }
+    return vec4<f32>(t_in, n_in);
+}
 
 fn front_surface(in: VertexOut) -> Front {
     // The object's transform is a similarity (uniform scale), so the sphere about its centre is
@@ -794,6 +834,27 @@ fn front_surface(in: VertexOut) -> Front {
     var out: Front;
     out.position = mix(in.world_pos, on_sphere + g.center_world.xyz, weight);
     out.normal = normalize(mix(normalize(in.world_normal), on_sphere / in.curve.x, weight));
+    out.found = true;
+    if SUPERSAMPLED && !BALL {
+        // A position of the pixel's grid carried off the rasterised triangle by the screen
+        // derivatives lies on the triangle's plane, not on the object (outside a convex
+        // surface, inside a concave one): its own view ray finds where it meets the object,
+        // or that it passes beside it.
+        let p0 = (g.model_from_world * vec4<f32>(eye.position.xyz, 1.0)).xyz - g.radial.xyz;
+        let dm = normalize((g.model_from_world * vec4<f32>(d, 0.0)).xyz);
+        var hit: vec4<f32>;
+        if CONVEX {
+            hit = convex_entry(p0, dm);
+        } else {
+            hit = mesh_hit(p0, dm);
+        }
+        if hit.x >= NO_HIT {
+            out.found = false;
+            return out;
+        }
+        out.position = (g.world_from_model * vec4<f32>(p0 + dm * hit.x + g.radial.xyz, 1.0)).xyz;
+        out.normal = normalize((g.normal_from_model * vec4<f32>(hit.yzw, 0.0)).xyz);
+    }
     return out;
 }
 
@@ -892,6 +953,14 @@ fn shade_ray(
     in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool, alpha: f32,
 ) -> vec3<f32> {
     let front = front_surface(in);
+    if SUPERSAMPLED && !front.found {
+        // A position beside the object: with eq. 6 the eye sees the room itself there, which
+        // `seen_behind` takes away over the whole pixel, so the pixel's light holds it too.
+        if COMPENSATED {
+            return seen_along(eye.position.xyz, normalize(in.world_pos - eye.position.xyz));
+        }
+        return vec3<f32>(0.0);
+    }
     let world_pos = front.position;
     let incident = normalize(world_pos - eye.position.xyz);
     var n = front.normal;

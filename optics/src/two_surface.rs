@@ -21,7 +21,7 @@ pub const RADIAL_NORMAL_COS: f32 = 0.9999;
 /// Internal reflections followed at most each time a ray is inside before it is given up (a
 /// brilliant sends most light out within three; a torus or a goblet's stem guides some further;
 /// twin of shaders/glass.wgsl MAX_INTERNAL_REFLECTIONS).
-pub const MAX_INTERNAL_REFLECTIONS: u32 = 8;
+pub const MAX_INTERNAL_REFLECTIONS: u32 = 16;
 
 /// Self-intersection offset along a ray leaving a surface point, metres.
 const EPS_M: f32 = 1e-6;

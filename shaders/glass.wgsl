@@ -317,8 +317,8 @@ const MAX_INTERNAL_REFLECTIONS: i32 = 16;
 // with one, 0.268 with two, 0.267 with three or six: docs/realism.md).
 const ECHOES: i32 = 2;
 // A convex gem's: a brilliant (ior 2.42) returns most of its light after several internal
-// reflections, each exit passing a share out (tmp-diamond's disc gap 0.50 with 2, see
-// app/compare/examples/gap_study.rs).
+// reflections, each exit passing a share out (the diamond in glass-sphere-real's settings: disc
+// gap 0.50 with 2, 0.42 with 8; docs/realism.md).
 const CONVEX_ECHOES: i32 = 8;
 // Total internal reflections a convex gem's main path is followed through.
 const CONVEX_INTERNAL_REFLECTIONS: i32 = 16;
@@ -788,8 +788,9 @@ fn ball_passage(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f
 struct Front {
     position: vec3<f32>,
     normal: vec3<f32>,
-    // False where a position of the pixel's grid (`SUPERSAMPLED`) sees past the object.
-    found: bool,
+    // True where a position of the pixel's grid (`SUPERSAMPLED`) sees past the object (false
+    // as the struct starts: no store in the pipelines that never search).
+    missed: bool,
 };
 
 // Where the ray p + t d (from outside, d unit; model frame about the object's centre) enters
@@ -822,7 +823,7 @@ fn convex_entry(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(t_in, n_in);
 }
 
-fn front_surface(in: VertexOut) -> Front {
+fn front_surface(in: VertexOut, two_surface_model: bool) -> Front {
     // The object's transform is a similarity (uniform scale), so the sphere about its centre is
     // a sphere in the world too, and the eye's ray meets it without leaving the world frame.
     let from_centre = eye.position.xyz - g.center_world.xyz;
@@ -834,26 +835,35 @@ fn front_surface(in: VertexOut) -> Front {
     var out: Front;
     out.position = mix(in.world_pos, on_sphere + g.center_world.xyz, weight);
     out.normal = normalize(mix(normalize(in.world_normal), on_sphere / in.curve.x, weight));
-    out.found = true;
-    if SUPERSAMPLED && !BALL {
-        // A position of the pixel's grid carried off the rasterised triangle by the screen
-        // derivatives lies on the triangle's plane, not on the object (outside a convex
-        // surface, inside a concave one): its own view ray finds where it meets the object,
-        // or that it passes beside it.
-        let p0 = (g.model_from_world * vec4<f32>(eye.position.xyz, 1.0)).xyz - g.radial.xyz;
-        let dm = normalize((g.model_from_world * vec4<f32>(d, 0.0)).xyz);
-        var hit: vec4<f32>;
-        if CONVEX {
-            hit = convex_entry(p0, dm);
-        } else {
-            hit = mesh_hit(p0, dm);
+    // Each condition its own `if`, so that a pipeline constant that rules one out rules out
+    // the search too (in the paper's pipelines and a ball's, and in their counted cost).
+    if SUPERSAMPLED {
+        if two_surface_model {
+            if !BALL {
+                // A position of the pixel's grid carried off the rasterised triangle by the
+                // screen derivatives lies on the triangle's plane, not on the object (outside a
+                // convex surface, inside a concave one), where a passage through both surfaces
+                // would start on the wrong side: its own view ray finds where it meets the
+                // object (its facet planes, or its triangles), or that it passes beside it. (The
+                // paper's one surface refracts at the triangle's plane, as it always did.)
+                let p0 = (g.model_from_world * vec4<f32>(eye.position.xyz, 1.0)).xyz
+                    - g.radial.xyz;
+                let dm = normalize((g.model_from_world * vec4<f32>(d, 0.0)).xyz);
+                var hit: vec4<f32>;
+                if CONVEX {
+                    hit = convex_entry(p0, dm);
+                } else {
+                    hit = mesh_hit(p0, dm);
+                }
+                if hit.x >= NO_HIT {
+                    out.missed = true;
+                    return out;
+                }
+                out.position = (g.world_from_model
+                    * vec4<f32>(p0 + dm * hit.x + g.radial.xyz, 1.0)).xyz;
+                out.normal = normalize((g.normal_from_model * vec4<f32>(hit.yzw, 0.0)).xyz);
+            }
         }
-        if hit.x >= NO_HIT {
-            out.found = false;
-            return out;
-        }
-        out.position = (g.world_from_model * vec4<f32>(p0 + dm * hit.x + g.radial.xyz, 1.0)).xyz;
-        out.normal = normalize((g.normal_from_model * vec4<f32>(hit.yzw, 0.0)).xyz);
     }
     return out;
 }
@@ -918,7 +928,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
     if COMPENSATED {
         out = max(out - seen_behind(in), vec3<f32>(0.0));
     }
-    if COUNTED && two_surface_model {
+    if COUNTED {
         if !BALL {
             if !CONVEX {
                 // The nodes and triangles the mesh's searches visited and tested (`mesh_hit`),
@@ -952,14 +962,17 @@ fn seen_behind(in: VertexOut) -> vec3<f32> {
 fn shade_ray(
     in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool, alpha: f32,
 ) -> vec3<f32> {
-    let front = front_surface(in);
-    if SUPERSAMPLED && !front.found {
-        // A position beside the object: with eq. 6 the eye sees the room itself there, which
-        // `seen_behind` takes away over the whole pixel, so the pixel's light holds it too.
-        if COMPENSATED {
-            return seen_along(eye.position.xyz, normalize(in.world_pos - eye.position.xyz));
+    let front = front_surface(in, two_surface_model);
+    if SUPERSAMPLED {
+        if front.missed {
+            // A position beside the object: with eq. 6 the eye sees the room itself there,
+            // which `seen_behind` takes away over the whole pixel, so the pixel's light holds
+            // it too.
+            if COMPENSATED {
+                return seen_along(eye.position.xyz, normalize(in.world_pos - eye.position.xyz));
+            }
+            return vec3<f32>(0.0);
         }
-        return vec3<f32>(0.0);
     }
     let world_pos = front.position;
     let incident = normalize(world_pos - eye.position.xyz);

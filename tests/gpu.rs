@@ -13,6 +13,7 @@ mod inducer;
 mod live_caustics;
 mod live_caustics_sweep;
 mod live_maps;
+mod mesh_light;
 mod mesh_refraction;
 mod motion;
 mod refraction;

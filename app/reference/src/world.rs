@@ -12,8 +12,11 @@ use vitreous_scene::{Image, PixelData, Placement, RealPlane, Scene};
 
 use crate::light_map::FloorLight;
 
-/// Most interfaces one path meets; deeper branches carry no light.
-pub const MAX_INTERFACES: u32 = 16;
+/// Most interfaces one path meets (total internal reflections included); deeper branches carry
+/// no light. A cut gem guides light through dozens of total internal reflections: at 16 the
+/// diamond's light (ior 2.42) was 11 % short of what 64 finds, a goblet's 8 %; the branches'
+/// weight (`MIN_WEIGHT`) ends most paths long before.
+pub const MAX_INTERFACES: u32 = 64;
 
 /// Branches carrying less than this fraction of the ray's light are not followed.
 pub const MIN_WEIGHT: f32 = 1e-4;

@@ -405,6 +405,10 @@ const MESH_VISITS: u32 = 4096u;
 var<private> mesh_nodes: u32;
 var<private> mesh_triangles: u32;
 
+// The positions of this pixel's grid whose view ray passed beside a mesh or a gem
+// (`SUPERSAMPLED`, `front_surface`).
+var<private> missed_positions: u32;
+
 // Distance along the ray p + t / inv (t >= 0) to the box [lo, hi], or NO_HIT where it passes
 // beside it.
 fn box_entry(lo: vec3<f32>, hi: vec3<f32>, p: vec3<f32>, inv: vec3<f32>) -> f32 {
@@ -838,8 +842,8 @@ fn front_surface(in: VertexOut, two_surface_model: bool) -> Front {
     // Each condition its own `if`, so that a pipeline constant that rules one out rules out
     // the search too (in the paper's pipelines and a ball's, and in their counted cost).
     if SUPERSAMPLED {
-        if two_surface_model {
-            if !BALL {
+        if !BALL {
+            if two_surface_model {
                 // A position of the pixel's grid carried off the rasterised triangle by the
                 // screen derivatives lies on the triangle's plane, not on the object (outside a
                 // convex surface, inside a concave one), where a passage through both surfaces
@@ -925,9 +929,6 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         light = shade_ray(in, two_surface_model, to_background, phong, alpha);
     }
     var out = alpha * surface_texel.rgb + light;
-    if COMPENSATED {
-        out = max(out - seen_behind(in), vec3<f32>(0.0));
-    }
     if COUNTED {
         if !BALL {
             if !CONVEX {
@@ -938,6 +939,28 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
                 atomicAdd(&shaded[slot + 1u], mesh_triangles);
                 atomicAdd(&shaded[slot + 2u], 1u);
             }
+        }
+    }
+    if COMPENSATED {
+        // Each side of each pipeline constant its own line, so that the cost counted of every
+        // pipeline is the one fetch of `seen_behind`.
+        if SUPERSAMPLED {
+            if !BALL {
+                if two_surface_model {
+                    // Where positions of the grid passed beside a mesh or a gem, the eye sees
+                    // the real world there through no glass: it is taken away over the covered
+                    // share only.
+                    let grid = f32(in.samples * in.samples);
+                    let covered = (grid - f32(missed_positions)) / grid;
+                    out = max(out - seen_behind(in) * covered, vec3<f32>(0.0));
+                } else {
+                    out = max(out - seen_behind(in), vec3<f32>(0.0));
+                }
+            } else {
+                out = max(out - seen_behind(in), vec3<f32>(0.0));
+            }
+        } else {
+            out = max(out - seen_behind(in), vec3<f32>(0.0));
         }
     }
     return vec4<f32>(out, 1.0);
@@ -964,14 +987,15 @@ fn shade_ray(
 ) -> vec3<f32> {
     let front = front_surface(in, two_surface_model);
     if SUPERSAMPLED {
-        if front.missed {
-            // A position beside the object: with eq. 6 the eye sees the room itself there,
-            // which `seen_behind` takes away over the whole pixel, so the pixel's light holds
-            // it too.
-            if COMPENSATED {
-                return seen_along(eye.position.xyz, normalize(in.world_pos - eye.position.xyz));
+        if !BALL {
+            if two_surface_model {
+                if front.missed {
+                    // A position beside the object adds nothing; with eq. 6 the pixel takes away
+                    // the real world only over the share of its grid the object covers (`shade`).
+                    missed_positions += 1u;
+                    return vec3<f32>(0.0);
+                }
             }
-            return vec3<f32>(0.0);
         }
     }
     let world_pos = front.position;

@@ -26,10 +26,16 @@ const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 /// The Vulkan API version the renderer asks for.
 pub const API_VERSION: u32 = vk::API_VERSION_1_2;
 
-/// How long any fence wait may take before it is reported as [`RenderError::Timeout`]. The
-/// slowest legitimate wait is a first frame computing a 4096^2 floor field on a CPU device
-/// under validation (a few seconds on two cores); a GPU that is silent for this long is hung.
+/// How long any fence wait may take on a GPU before it is reported as
+/// [`RenderError::Timeout`]: the slowest frame of a real GPU is a small fraction of it, and a GPU
+/// that is silent for this long is hung.
 pub const FENCE_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// The same on a CPU device (lavapipe), whose frames take as long as the scene's work and the
+/// machine's load make them: a mesh searched at 16 positions per pixel at 1280 x 960 takes over
+/// 10 s a frame on two busy cores (goblet-real.toml), and only a device that makes no progress
+/// for this long is taken as hung.
+pub const CPU_FENCE_TIMEOUT: Duration = Duration::from_secs(300);
 
 /// How to set up the GPU context.
 #[derive(Clone, Debug, Default)]
@@ -205,6 +211,9 @@ pub struct GpuContext {
     pub fragment_atomics: bool,
     /// The work recorded into command buffers, counted as it is recorded.
     pub(crate) work: WorkTally,
+    /// How long a fence wait may take before it is a timeout: [`FENCE_TIMEOUT`], or
+    /// [`CPU_FENCE_TIMEOUT`] on a CPU device.
+    fence_timeout: Duration,
 }
 
 impl GpuContext {
@@ -382,7 +391,13 @@ impl GpuContext {
 
         guard.0 = None;
         guard.1 = None;
+        let fence_timeout = if props.device_type == vk::PhysicalDeviceType::CPU {
+            CPU_FENCE_TIMEOUT
+        } else {
+            FENCE_TIMEOUT
+        };
         let ctx = GpuContext {
+            fence_timeout,
             device_name: device_name(&instance, physical),
             entry,
             instance,
@@ -480,22 +495,23 @@ impl GpuContext {
         Arc::clone(self.allocator.as_ref().expect("allocator lives until drop"))
     }
 
-    /// Waits for `fence` for at most [`FENCE_TIMEOUT`]; `what` names the work in the timeout
-    /// error. A lost device is [`RenderError::DeviceLost`].
+    /// Waits for `fence` for at most [`FENCE_TIMEOUT`] ([`CPU_FENCE_TIMEOUT`] on a CPU device);
+    /// `what` names the work in the timeout error. A lost device is [`RenderError::DeviceLost`].
     pub(crate) fn wait_fence(&self, fence: vk::Fence, what: &'static str) -> Result<()> {
-        let nanos = FENCE_TIMEOUT.as_nanos() as u64;
+        let nanos = self.fence_timeout.as_nanos() as u64;
         // SAFETY: `fence` is a live fence of this device (the callers own it) and no other
         // thread resets it while we wait (they hold `&mut` or own it outright).
         match unsafe { self.device.wait_for_fences(&[fence], true, nanos) } {
             Err(vk::Result::TIMEOUT) => Err(RenderError::Timeout {
                 what,
-                seconds: FENCE_TIMEOUT.as_secs(),
+                seconds: self.fence_timeout.as_secs(),
             }),
             other => other.vk("vkWaitForFences"),
         }
     }
 
-    /// Records commands with `record`, submits them and waits (at most [`FENCE_TIMEOUT`])
+    /// Records commands with `record`, submits them and waits (at most [`FENCE_TIMEOUT`], or
+    /// [`CPU_FENCE_TIMEOUT`] on a CPU device)
     /// until they finished. On a timeout the command buffer and fence are leaked, not freed
     /// under the GPU, and the caller must leak what the commands use too
     /// ([`RenderError::gpu_may_still_run`]).

@@ -13,7 +13,8 @@
 //! the accesses across submissions (colour writes, then the transfer to the readback buffer).
 //! Readback results of a slot are valid once its fence has signalled, which
 //! [`Renderer::submit`] (for the frame `PIPELINE_DEPTH` earlier) and [`Renderer::flush`] wait
-//! for. Every fence wait gives up after [`context::FENCE_TIMEOUT`] with
+//! for. Every fence wait gives up after [`context::FENCE_TIMEOUT`] (on a CPU device
+//! [`context::CPU_FENCE_TIMEOUT`]) with
 //! [`RenderError::Timeout`]; a lost device is [`RenderError::DeviceLost`] wherever it shows.
 //!
 //! # Resources

@@ -6,13 +6,13 @@
 //! and whose stem and foot it meets past it. Three markers on the background photo, one per
 //! colour channel: each marker's image in each eye lands where the tracer says.
 
-use glam::{DVec2, Mat4, Quat, Vec2, Vec3};
+use glam::{DVec2, Quat, Vec2, Vec3};
 use vitreous_optics::refraction::Refraction;
 use vitreous_optics::two_surface::{MAX_INTERNAL_REFLECTIONS, MeshBody, pass_through};
 use vitreous_tests::MeshData;
 
 use crate::refraction::{
-    CENTER, DISPARITY, IOR, RADIUS, Shot, background_plane, head_eyes, render_shot,
+    CENTER, DISPARITY, IOR, RADIUS, Shot, background_plane, head_eyes, render_shot, shipped_model,
 };
 
 /// Eye image size.
@@ -64,26 +64,12 @@ fn rect_seen(uv: Vec2, xs: (u32, u32), ys: (u32, u32)) -> f32 {
 /// turned by `turn`: the mesh in the world, and the same in the frame `render_shot` places
 /// (scaled by RADIUS, half a turn about y, at CENTER).
 fn placed(scene: &str, turn: Quat) -> (MeshData, MeshData) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../config/scenes")
-        .join(scene);
-    let scene = vitreous_scene::load_scene(&path).expect("the shipped scene");
-    let m = scene.object.mesh;
-    let (lo, hi) = m
-        .positions
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
-            (l.min(p), h.max(p))
-        });
-    let scale = 2.0 * RADIUS / (hi - lo).max_element();
-    let world_from_model = Mat4::from_scale_rotation_translation(Vec3::splat(scale), turn, CENTER)
-        * Mat4::from_translation(-(lo + hi) / 2.0);
-    let world: Vec<Vec3> = m
-        .positions
+    let ((positions, normals, uvs, indices), world_from_model) = shipped_model(scene, turn);
+    let world: Vec<Vec3> = positions
         .iter()
         .map(|&p| world_from_model.transform_point3(p))
         .collect();
-    let normals: Vec<Vec3> = m.normals.iter().map(|&n| (turn * n).normalize()).collect();
+    let normals: Vec<Vec3> = normals.iter().map(|&n| (turn * n).normalize()).collect();
     let back = Quat::from_rotation_y(-std::f32::consts::PI);
     let shot: Vec<Vec3> = world
         .iter()
@@ -91,8 +77,8 @@ fn placed(scene: &str, turn: Quat) -> (MeshData, MeshData) {
         .collect();
     let shot_normals: Vec<Vec3> = normals.iter().map(|&n| back * n).collect();
     (
-        (world, normals, m.uvs.clone(), m.indices.clone()),
-        (shot, shot_normals, m.uvs, m.indices),
+        (world, normals, uvs.clone(), indices.clone()),
+        (shot, shot_normals, uvs, indices),
     )
 }
 

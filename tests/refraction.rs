@@ -494,9 +494,17 @@ fn the_shipped_sphere_places_the_marker_within_the_bar_in_both_models() {
 /// The round brilliant of the shipped diamond (config/models/diamond.glb) at the sphere's place,
 /// 150 mm across, table up, tilted a little: the mesh, its model-to-world transform.
 fn shipped_diamond() -> (MeshData, Mat4) {
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/diamond.toml");
-    let scene = vitreous_scene::load_scene(&path).expect("the diamond scene");
+    shipped_model("diamond.toml", Quat::from_rotation_z(0.1))
+}
+
+/// The model of the shipped scene `scene` (config/scenes) at the sphere's place, as wide as it
+/// (its bounding box's largest side 2 RADIUS, its centre at CENTER), turned by `turn`: the mesh,
+/// its model-to-world transform.
+pub(crate) fn shipped_model(scene: &str, turn: Quat) -> (MeshData, Mat4) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../config/scenes")
+        .join(scene);
+    let scene = vitreous_scene::load_scene(&path).expect("the shipped scene");
     let m = scene.object.mesh;
     let (lo, hi) = m
         .positions
@@ -505,11 +513,8 @@ fn shipped_diamond() -> (MeshData, Mat4) {
             (l.min(p), h.max(p))
         });
     let scale = 2.0 * RADIUS / (hi - lo).max_element();
-    let world_from_model = Mat4::from_scale_rotation_translation(
-        Vec3::splat(scale),
-        Quat::from_rotation_z(0.1),
-        CENTER,
-    ) * Mat4::from_translation(-(lo + hi) / 2.0);
+    let world_from_model = Mat4::from_scale_rotation_translation(Vec3::splat(scale), turn, CENTER)
+        * Mat4::from_translation(-(lo + hi) / 2.0);
     ((m.positions, m.normals, m.uvs, m.indices), world_from_model)
 }
 

@@ -198,19 +198,10 @@ mod tests {
         assert_eq!(counts["caustic_smoothing.texels"], 32.0);
     }
 
-    #[test]
-    fn the_glass_is_charged_each_position_a_pixel_shaded_beyond_its_first() {
-        let each = ShaderCost {
-            fetches: 2,
-            texels: 8,
-            instructions: 40,
-        };
-        let each_first_image = ShaderCost {
-            fetches: 1,
-            texels: 4,
-            instructions: 10,
-        };
-        let frame = |positions: Option<(u64, u64, u64)>| FrameWork {
+    /// A frame that drew 50 glass fragments at a static cost of 3 fetches, 12 texels and 100
+    /// instructions each, and counted nothing else.
+    fn fifty_glass_fragments() -> FrameWork {
+        FrameWork {
             recorded: RecordedWork::default(),
             invocations: Some(PassInvocations {
                 eye_glass: Invocations {
@@ -227,6 +218,24 @@ mod tests {
             glass_covered_shader: None,
             overlay_shader: None,
             photons: None,
+            glass_positions: None,
+            glass_mesh: None,
+        }
+    }
+
+    #[test]
+    fn the_glass_is_charged_each_position_a_pixel_shaded_beyond_its_first() {
+        let each = ShaderCost {
+            fetches: 2,
+            texels: 8,
+            instructions: 40,
+        };
+        let each_first_image = ShaderCost {
+            fetches: 1,
+            texels: 4,
+            instructions: 10,
+        };
+        let frame = |positions: Option<(u64, u64, u64)>| FrameWork {
             glass_positions: positions.map(|(shaded, first_images, pixels)| GlassPositions {
                 shaded,
                 first_images,
@@ -234,7 +243,7 @@ mod tests {
                 each,
                 each_first_image,
             }),
-            glass_mesh: None,
+            ..fifty_glass_fragments()
         };
         // 40 covered pixels, each with the first image at 16 positions (600 beyond their
         // first), the rest at 16 positions in 10 of them and at 4 in 30 (240 beyond).
@@ -259,23 +268,6 @@ mod tests {
     #[test]
     fn the_glass_is_charged_each_node_and_triangle_its_mesh_searches_visited() {
         let frame = |mesh: Option<(u64, u64)>| FrameWork {
-            recorded: RecordedWork::default(),
-            invocations: Some(PassInvocations {
-                eye_glass: Invocations {
-                    fragment: 50,
-                    ..Invocations::default()
-                },
-                ..PassInvocations::default()
-            }),
-            glass_shader: Some(ShaderCost {
-                fetches: 3,
-                texels: 12,
-                instructions: 100,
-            }),
-            glass_covered_shader: None,
-            overlay_shader: None,
-            photons: None,
-            glass_positions: None,
             glass_mesh: mesh.map(|(nodes, triangles)| MeshSearch {
                 nodes,
                 triangles,
@@ -291,6 +283,7 @@ mod tests {
                     instructions: 25,
                 },
             }),
+            ..fifty_glass_fragments()
         };
         let counts = mean_counts(&[frame(Some((1000, 300)))]);
         assert_eq!(counts["glass_mesh.nodes"], 1000.0);

@@ -10,8 +10,8 @@ use anyhow::{Context, Result, bail};
 use glam::{Quat, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use vitreous_reference::{
-    EyeImage, EyeRecord, FrameReport, PhotonParams, ReferenceSettings, Report, render_reference,
-    srgb_rgba,
+    EyeImage, EyeRecord, FrameReport, OBJECT_SAMPLES_PER_SIDE, PhotonParams, ReferenceSettings,
+    Report, render_reference, srgb_rgba,
 };
 use vitreous_scene::{Placement, Scene, load_scene};
 use vitreous_trace::EyeView;
@@ -63,6 +63,11 @@ pub struct ReferenceArgs {
     #[arg(long, value_name = "N", default_value_t = 3, allow_negative_numbers = true,
           value_parser = parse_samples)]
     pub samples: u32,
+    /// Samples along each side of a pixel the object may cover (where its bounding sphere,
+    /// widened by a pixel, lies): behind glass the light changes within a pixel.
+    #[arg(long, value_name = "N", default_value_t = OBJECT_SAMPLES_PER_SIDE,
+          allow_negative_numbers = true, value_parser = parse_samples)]
+    pub object_samples: u32,
     /// Side of the floor light's texels, millimetres.
     #[arg(long, value_name = "MM", default_value_t = 1.0, allow_negative_numbers = true,
           value_parser = parse_texel_mm)]
@@ -184,6 +189,7 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
         .with_context(|| format!("creating output folder {}", out.display()))?;
     let settings = ReferenceSettings {
         samples_per_side: args.samples,
+        object_samples_per_side: args.object_samples,
         photons: PhotonParams {
             texel_m: args.texel_mm / 1000.0,
             photons_per_texel: args.photons_per_texel,

@@ -47,9 +47,12 @@ pub mod report;
 pub mod trace;
 pub mod world;
 
-pub use eye::{EyeImage, Window, render_eye};
+pub use eye::{EyeImage, NearObject, Sampling, Window, render_eye};
 pub use floor_light::PhotonParams;
-pub use frame::{NotClosed, ReferenceFrame, ReferenceSettings, render_reference, srgb_rgba};
+pub use frame::{
+    NotClosed, OBJECT_SAMPLES_PER_SIDE, ReferenceFrame, ReferenceSettings, render_reference,
+    srgb_rgba,
+};
 pub use light_map::FloorLight;
 pub use report::{EyeRecord, FrameReport, Report};
 pub use world::{Glass, Picture, Surface, World};

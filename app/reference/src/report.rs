@@ -91,8 +91,12 @@ pub struct Report {
     pub width_px: u32,
     /// Eye image size, pixels.
     pub height_px: u32,
-    /// Positions averaged per pixel.
+    /// Positions averaged per pixel away from the object.
     pub samples_per_pixel: u32,
+    /// Positions averaged per pixel the object may cover (its bounding sphere's, widened by a
+    /// pixel); absent from references written when every pixel took `samples_per_pixel`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object_samples_per_pixel: Option<u32>,
     /// Side of the floor light's texels, mm.
     pub texel_mm: f32,
     /// Photons per texel of floor under the object's cone.
@@ -124,6 +128,9 @@ impl Report {
             width_px: size.0,
             height_px: size.1,
             samples_per_pixel: settings.samples_per_side * settings.samples_per_side,
+            object_samples_per_pixel: Some(
+                settings.object_samples_per_side * settings.object_samples_per_side,
+            ),
             texel_mm: settings.photons.texel_m * 1000.0,
             photons_per_texel: settings.photons.photons_per_texel,
             light_share: scene.light.share,

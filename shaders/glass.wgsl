@@ -90,7 +90,8 @@ struct Globals {
     // xyz: the object's centre, its bounding box's (model units), the origin of the frame the
     // exit is found in; w: the largest distance of a vertex from it (a ball's radius).
     radial: vec4<f32>,
-    // xyz: the object's centre in the world (metres).
+    // xyz: the object's centre in the world (metres); w: the light's share of the floor's
+    // light that the floor seen through a mesh takes lit by `floor_light` (0: the bare photo).
     center_world: vec4<f32>,
     // rgb: absorption inside the glass, halvings per model unit (Beer-Lambert, 2^(-rgb L):
     // the coefficient per world metre times the model's scale over ln 2; 0 in a channel that
@@ -172,6 +173,10 @@ var<push_constant> eye: Eye;
 // rest and of the first image, then the fragments that shaded them; or a mesh's nodes visited,
 // triangles tested, and the fragments.
 @group(0) @binding(9) var<storage, read_write> shaded: array<atomic<u32>>;
+// The point light's irradiance on the floor with the object over that without it (the caustic
+// bake's `E_with / E_without`, the floor photo's uvs): its shadow and its caustic. One texel of
+// 1 without a bake that holds it.
+@group(0) @binding(10) var floor_light: texture_2d<f32>;
 // What the eye already sees (`COMPENSATED`, render/src/compensation.rs): the floor and
 // background planes and both photos packed side by side (shared/seen.wgsl), and with several
 // positions per pixel their ripmaps (shared/ripmap.wgsl).
@@ -292,10 +297,32 @@ fn room(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     return environment(dir);
 }
 
+// What light that passed through an object other than a ball (two-surface refraction), or was
+// reflected off it, sees of the room where it leaves: as `room`, but the floor under the object
+// shows its shadow and caustic (the bake's `floor_light`, for the light's share of the floor's
+// light, while it holds: `g.center_world.w` above 0). A ball's images and the paper's model
+// keep the bare photo.
+fn room_through(origin: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    let share = g.center_world.w;
+    if share > 0.0 {
+        let floor = plane_hit(g.floor_from_world, origin, dir);
+        let wall = plane_hit(g.background_from_world, origin, dir);
+        if floor.w > 0.0 && (wall.w == 0.0 || floor.z < wall.z) {
+            let photo = textureSampleLevel(floor_photo, clamp_sampler, floor.xy, 0.0).rgb;
+            let ratio = textureSampleLevel(floor_light, clamp_sampler, floor.xy, 0.0).r;
+            return photo * (1.0 - share + share * ratio);
+        }
+    }
+    return room(origin, dir);
+}
+
 // What a two-surface passage sees beyond the glass where the background plane is not its
 // target: the room from where it left (`ROOM`), else, or when given up inside, the environment.
 fn beyond_passage(passage: Passage) -> vec3<f32> {
     if ROOM {
+        if !BALL {
+            return room_through(passage.exit, passage.direction);
+        }
         return room(passage.exit, passage.direction);
     }
     return environment(passage.direction);
@@ -647,7 +674,8 @@ fn follow(start: vec3<f32>, dir: vec3<f32>, from_inside: bool, ior: f32) -> vec3
         light *= exp2(-g.absorption.rgb * path);
     }
     let leaves_at = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
-    return room(leaves_at, normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz)) * light;
+    let towards = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);
+    return room_through(leaves_at, towards) * light;
 }
 
 // The share of the light of `s` that is still left after its path inside, per channel (its
@@ -683,7 +711,11 @@ fn echoes_of(s: Inside, ior: f32) -> vec3<f32> {
             }
             let leaves_at = (g.world_from_model * vec4<f32>(q + g.radial.xyz, 1.0)).xyz;
             let towards = normalize((g.world_from_model * vec4<f32>(leaving, 0.0)).xyz);
-            echoes += room(leaves_at, towards) * share;
+            if BALL {
+                echoes += room(leaves_at, towards) * share;
+            } else {
+                echoes += room_through(leaves_at, towards) * share;
+            }
             carried *= reflected;
         }
         e = reflect(e, exit.yzw);
@@ -1101,6 +1133,15 @@ fn shade_ray(
         reflected_image = g.light_colour.rgb * g.light.w * g.shading.z * specular;
     } else {
         reflected_image = fresnel * beyond(world_pos, reflected);
+        if ROOM {
+            if !BALL {
+                if two_surface_model {
+                    // Off an object other than a ball, the floor beside it in its shadow and
+                    // caustic as well (a ball's images keep the bare photo).
+                    reflected_image = fresnel * room_through(world_pos, reflected);
+                }
+            }
+        }
     }
 
     return (1.0 - alpha) * (1.0 - fresnel) * refracted_image + reflected_image;

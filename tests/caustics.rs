@@ -48,6 +48,7 @@ fn spot_bake(n: u32, centre: Vec2, peak: f32, hash: &str) -> Bake {
         width_px: n,
         height_px: n,
         gain,
+        light: None,
         scene_hash: hash.to_owned(),
         params: "method=test".into(),
     }

@@ -5,14 +5,21 @@
 //! a pixel meets the glass. Its mean light and its pixels come close to the real goblet's,
 //! bowl and stem alike.
 
-use glam::Vec2;
+use glam::{Mat4, Vec2, Vec3};
+use vitreous_frames::look::base_look;
+use vitreous_frames::render_desc::scene_desc;
 use vitreous_optics::camera::EyeParams;
 use vitreous_optics::display::Compensation;
 use vitreous_optics::two_surface::Body;
 use vitreous_reference::world::Glass;
-use vitreous_reference::{Window, World, render_eye};
+use vitreous_reference::{FloorLight, PhotonParams, Window, World, render_eye};
+use vitreous_render::{Composition, FrameParams, Reflection, ScenePose, Want};
 use vitreous_scene::Scene;
-use vitreous_tests::{left_eye_light, neutral_eyes, shipped_scene};
+use vitreous_scene::caustics::Bake;
+use vitreous_scene::effects::EffectSet;
+use vitreous_tests::{
+    compose_once, left_eye_light, neutral_eyes, scene_renderer, shipped_scene, workspace,
+};
 
 const SIZE: (u32, u32) = (640, 480);
 
@@ -40,8 +47,8 @@ fn covered(glass: &Glass, camera: &EyeParams, window: Window) -> Vec<(usize, usi
     out
 }
 
-/// The goblet's bounding box on the left eye's image, with a margin of 2 pixels.
-fn around_the_goblet(scene: &Scene, camera: &EyeParams) -> Window {
+/// The object's bounding box on the left eye's image, with a margin of 2 pixels.
+fn around_the_object(scene: &Scene, camera: &EyeParams) -> Window {
     let size = Vec2::new(SIZE.0 as f32, SIZE.1 as f32);
     let m = scene.object.world_from_model_at(
         scene.object.center_m,
@@ -52,7 +59,7 @@ fn around_the_goblet(scene: &Scene, camera: &EyeParams) -> Window {
         |(lo, hi), &p| {
             let at = camera
                 .project_to_pixel(m.transform_point3(p), size)
-                .expect("the goblet in view");
+                .expect("the object in view");
             (lo.min(at), hi.max(at))
         },
     );
@@ -70,7 +77,7 @@ fn the_goblets_light_comes_close_to_the_real_goblets() {
     let mut scene = shipped_scene("goblet-real.toml");
     scene.compensation = Compensation::None;
     let camera = neutral_eyes(&scene)[0];
-    let window = around_the_goblet(&scene, &camera);
+    let window = around_the_object(&scene, &camera);
     let world = World::of(&scene, &scene.rest_placement()).unwrap();
     let glass = world.glass.clone().expect("the goblet");
     let pixels = covered(&glass, &camera, window);
@@ -115,5 +122,136 @@ fn the_goblets_light_comes_close_to_the_real_goblets() {
     assert!(
         error_all < 0.35 * real_all,
         "the goblet's pixels are {error_all} off the real goblet's {real_all}"
+    );
+}
+
+/// `glass-sphere-real.toml` with the torus (100 mm, lying flat on the table) for its object and
+/// no bake, written into `dir` (its assets named by absolute paths).
+fn torus_in_the_room(dir: &std::path::Path) -> Scene {
+    let config = workspace().join("config");
+    let text = std::fs::read_to_string(config.join("scenes/glass-sphere-real.toml"))
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", config.display()))
+        .replace("sphere.glb", "torus.glb")
+        .replace("diameter_m = 0.08", "diameter_m = 0.10")
+        .replace(
+            "position_m = [0.0, -0.26, -1.5]",
+            "position_m = [0.0, -0.285, -1.5]",
+        )
+        .lines()
+        .filter(|line| !line.starts_with("bake = "))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let path = dir.join("torus-real.toml");
+    std::fs::write(&path, text).unwrap();
+    vitreous_scene::load_scene(&path).unwrap()
+}
+
+/// The floor under a torus lying on the table as its glass shows it: lit as the floor's light
+/// map says (its shadow and the bright ring of its caustic, for the light's half of the floor's
+/// light; here the physical reference's own, as a bake stores it) rather than the bare photo.
+/// Where the real torus's floor light changes what it shows, the GPU's changes the same way
+/// and comes closer to it; with the object moved away from where the map was made, the glass
+/// sees the bare photo again.
+#[test]
+fn the_floor_seen_through_a_torus_shows_its_shadow_and_caustic() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = torus_in_the_room(dir.path());
+    scene.compensation = Compensation::None;
+    let camera = neutral_eyes(&scene)[0];
+    let window = around_the_object(&scene, &camera);
+    let bare = World::of(&scene, &scene.rest_placement()).unwrap();
+    let lit = World {
+        floor_light: FloorLight::trace(&bare, &PhotonParams::default()),
+        ..bare.clone()
+    };
+    let floor_light = lit
+        .floor_light
+        .as_ref()
+        .expect("the reference's floor light");
+    let pixels = covered(bare.glass.as_ref().unwrap(), &camera, window);
+    let real_bare = render_eye(&bare, &camera, SIZE, window, 3);
+    let real_lit = render_eye(&lit, &camera, SIZE, window, 3);
+    let gpu_bare = left_eye_light(&scene, SIZE);
+    // The map over the floor photo's area, texel centres, as a bake lays it out.
+    let n = 1024u32;
+    let light = (0..n * n)
+        .map(|k| {
+            let uv = (Vec2::new((k % n) as f32, (k / n) as f32) + 0.5) / n as f32;
+            floor_light.ratio(uv).element_sum() / 3.0
+        })
+        .collect();
+    scene.caustics.gain = Some(Bake {
+        width_px: n,
+        height_px: n,
+        gain: vec![0.0; (n * n) as usize],
+        light: Some(light),
+        scene_hash: scene.hash.clone(),
+        params: "method=reference".into(),
+    });
+    let gpu_lit = left_eye_light(&scene, SIZE);
+    // The pixels inside the outline whose real light the floor's light changes visibly.
+    let changed: Vec<_> = pixels
+        .iter()
+        .filter(|&&(w, ..)| (real_lit.rgb[w] - real_bare.rgb[w]).abs().element_sum() > 0.03)
+        .collect();
+    let mean = |of: &dyn Fn(usize, usize) -> f32| {
+        changed.iter().map(|&&(w, i, _)| of(w, i)).sum::<f32>() / changed.len() as f32
+    };
+    let real_change = mean(&|w, _| (real_lit.rgb[w] - real_bare.rgb[w]).abs().element_sum());
+    let gpu_change = mean(&|w, i| {
+        let sign = (real_lit.rgb[w] - real_bare.rgb[w]).element_sum().signum();
+        (gpu_lit[i] - gpu_bare[i]).element_sum() * sign
+    });
+    let error_lit = mean(&|w, i| (gpu_lit[i] - real_lit.rgb[w]).abs().element_sum());
+    let error_bare = mean(&|w, i| (gpu_bare[i] - real_lit.rgb[w]).abs().element_sum());
+    eprintln!(
+        "floor light under the torus: {} of {} px changed by {real_change:.4} (mean |change|), \
+         the GPU's by {gpu_change:.4} the same way; error {error_bare:.4} with the bare photo, \
+         {error_lit:.4} lit",
+        changed.len(),
+        pixels.len()
+    );
+    assert!(changed.len() > 100, "{} pixels changed", changed.len());
+    assert!(
+        gpu_change > 0.5 * real_change,
+        "the GPU's light changed by {gpu_change} the real way where the real torus's changed by \
+         {real_change}"
+    );
+    assert!(
+        error_lit < 0.9 * error_bare,
+        "lit {error_lit} against {error_bare} with the bare photo"
+    );
+    // The torus moved 1 mm: the map no longer holds, and the glass sees the bare photo (the
+    // same image as without a map at that pose).
+    let moved = |scene: &Scene| {
+        let mut renderer = scene_renderer(scene, SIZE.0, SIZE.1);
+        let rest = ScenePose::of(&scene_desc(scene, None));
+        renderer.set_pose(ScenePose {
+            world_from_model: Mat4::from_translation(Vec3::X * 0.001) * rest.world_from_model,
+            ..rest
+        });
+        let params = FrameParams {
+            eyes: [camera, camera],
+            look: base_look(
+                &EffectSet::parse("none").unwrap(),
+                Reflection::EnvironmentFresnel,
+            ),
+        };
+        let want = Want {
+            eyes: true,
+            world: false,
+        };
+        compose_once(&mut renderer, &params, want, Composition::Additive)
+            .readback
+            .expect("read back")
+            .eyes[0]
+            .clone()
+    };
+    let lit_moved = moved(&scene);
+    scene.caustics.gain = None;
+    assert!(
+        lit_moved == moved(&scene),
+        "the map is read with the object away from where it was made"
     );
 }

@@ -145,6 +145,7 @@ fn failed_construction_unwinds_without_leaks_at_every_step() {
             width: 8,
             height: 8,
             gain: &gain,
+            light: None,
         }),
         ..scene_desc(
             mesh_ref(&sphere),

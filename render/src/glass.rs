@@ -8,15 +8,18 @@
 //! built once per scene; its tests check that table against the shaders. What a frame draws
 //! with them, and the recording, is `glass/draws.rs`; a ball's triangles in patches, each
 //! drawn where it can show, `glass/patches.rs`; the positions a ball's pixels shade, counted on
-//! the device, `glass/counted.rs`; a mesh's triangles for the shader's search, `glass/mesh.rs`.
+//! the device, `glass/counted.rs`; a mesh's triangles for the shader's search, `glass/mesh.rs`;
+//! the floor under the object as the glass sees it, `glass/floor_light.rs`.
 
 mod counted;
 mod draws;
+mod floor_light;
 mod mesh;
 mod patches;
 
 use draws::Proof;
 pub use draws::{GlassDraws, Pick};
+use floor_light::FloorLight;
 use patches::Patches;
 
 use ash::vk;
@@ -129,6 +132,9 @@ struct Globals {
     shading: [f32; 4],
     model_from_world: [f32; 16],
     radial: [f32; 4],
+    /// xyz: the object's centre in the world; w: the light's share of the floor's light that
+    /// the floor seen through a mesh takes lit by the bake (`glass/floor_light.rs`), 0 where the
+    /// bake holds no light or the object and light are away from where it was made.
     center_world: [f32; 4],
     /// rgb: absorption inside the glass in halvings per model unit (Beer-Lambert, two-surface
     /// refraction: the coefficient per world metre times the model's uniform scale over ln 2,
@@ -141,7 +147,7 @@ struct Globals {
 
 impl Globals {
     /// These globals with the object and light of `pose`.
-    fn posed(mut self, pose: &ScenePose) -> Globals {
+    fn posed(mut self, pose: &ScenePose, floor_light: &FloorLight) -> Globals {
         self.world_from_model = pose.world_from_model.to_cols_array();
         self.normal_from_model = pose.world_from_model.inverse().transpose().to_cols_array();
         self.model_from_world = pose.world_from_model.inverse().to_cols_array();
@@ -149,7 +155,7 @@ impl Globals {
         self.center_world = pose
             .world_from_model
             .transform_point3(center)
-            .extend(1.0)
+            .extend(floor_light.share_at(pose))
             .to_array();
         self.light = pose.light_position_m.extend(1.0).to_array();
         self
@@ -197,6 +203,8 @@ pub struct GlassPass {
     _mesh: Buffer,
     /// The facet planes of a convex faceted object (two-surface refraction), or one plane.
     _planes: Buffer,
+    /// The floor under the object as the glass sees it through a mesh in the room.
+    floor_light: FloorLight,
     /// The render pass and layout the pipelines were made for (the counting ones are made
     /// when the frames start counting).
     render_pass: vk::RenderPass,
@@ -242,6 +250,7 @@ impl GlassPass {
                 (7, vk::DescriptorType::STORAGE_BUFFER, fragment),
                 (8, image, fragment),
                 (9, vk::DescriptorType::STORAGE_BUFFER, fragment),
+                (10, image, fragment),
             ],
         )?;
         let set_layouts: Vec<_> = std::iter::once(set_layout.raw())
@@ -252,6 +261,7 @@ impl GlassPass {
         let (radial, ball) = object_frame(desc);
         let (planes, convex) = upload_facet_planes(ctx, desc, radial)?;
         let mesh = mesh::upload(ctx, searched_mesh(desc, radial, ball || convex)?)?;
+        let floor_light = FloorLight::new(ctx, desc)?;
         // Clear glass gets the two-surface pipelines without the absorption's exponentials, a
         // ball the ones that take its sphere, a convex faceted object the ones that
         // leave it through its facet planes; a scene whose photos are the room the ones that
@@ -315,7 +325,7 @@ impl GlassPass {
             1,
             &[
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
-                (vk::DescriptorType::SAMPLED_IMAGE, 4),
+                (vk::DescriptorType::SAMPLED_IMAGE, 5),
                 (vk::DescriptorType::SAMPLER, 2),
                 (vk::DescriptorType::STORAGE_BUFFER, 3),
             ],
@@ -349,7 +359,7 @@ impl GlassPass {
                 .to_array(),
             floor_from_world: desc.floor.world_from_plane.inverse().to_cols_array(),
         }
-        .posed(&ScenePose::of(desc));
+        .posed(&ScenePose::of(desc), &floor_light);
         let globals_buffer = Buffer::with_data(
             ctx,
             "glass globals",
@@ -366,6 +376,7 @@ impl GlassPass {
         let counter = counted::PositionCounter::new(ctx)?;
         descriptors::write_storage_buffer(ctx, set, 9, counter.buffer());
         descriptors::write_image(ctx, set, 8, scene.photos[0].view);
+        descriptors::write_image(ctx, set, 10, floor_light.image.view);
         Ok(GlassPass {
             pipelines,
             // The loop over a pixel's positions counts once in the static cost: each further
@@ -398,6 +409,7 @@ impl GlassPass {
             globals,
             _mesh: mesh,
             _planes: planes,
+            floor_light,
             render_pass,
             counted_row: shaders::counted_row(shaded),
             mesh_row: shaders::mesh_counted_row(shaded),
@@ -435,7 +447,7 @@ impl GlassPass {
                 .offset(0)
                 .size(vk::WHOLE_SIZE)
         };
-        let globals = self.globals.posed(pose);
+        let globals = self.globals.posed(pose, &self.floor_light);
         // The fields a pose changes all come before the absorption; the rest stays as made.
         let posed = &bytemuck::bytes_of(&globals)[..std::mem::offset_of!(Globals, absorption)];
         // SAFETY: the caller's contract (outside a render pass; the buffer outlives the

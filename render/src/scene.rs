@@ -127,6 +127,12 @@ pub struct CausticsDesc<'a> {
     pub height: u32,
     /// The gains, `width * height` of them.
     pub gain: &'a [f32],
+    /// The point light's irradiance on the floor with the object over that without it
+    /// (`E_with / E_without`, the same texels), when the bake holds it: through an object other
+    /// than a ball in the room, the glass sees the floor under it lit so (its shadow and
+    /// caustic, for the light's share of the floor's light) while the object and the light
+    /// are where the bake was made.
+    pub light: Option<&'a [f32]>,
 }
 // --- end caustics ---
 

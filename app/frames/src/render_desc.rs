@@ -200,6 +200,7 @@ pub fn scene_desc<'a>(scene: &'a Scene, defocus: Option<&'a DefocusSetup>) -> Sc
             width: bake.width_px,
             height: bake.height_px,
             gain: &bake.gain,
+            light: bake.light.as_deref(),
         }),
         compensation: scene.compensation,
         room: scene.environment.room,

@@ -15,8 +15,11 @@ use crate::files::{DiskFiles, SceneFiles};
 pub const SCENE_HASH_ATTRIBUTE: &str = "vitreous_scene_hash";
 /// Name of the header attribute holding the bake parameters (`key=value; ...`).
 pub const PARAMS_ATTRIBUTE: &str = "vitreous_caustics_params";
-/// Name of the single channel holding the gain.
+/// Name of the channel holding the gain.
 pub const GAIN_CHANNEL: &str = "Y";
+/// Name of the channel holding the floor's light with the object over its light without it,
+/// `E_with / E_without` (the shadow and the caustic both; absent from bakes made before it).
+pub const LIGHT_CHANNEL: &str = "light_ratio";
 
 /// A caustic gain map for one scene's floor.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,6 +31,11 @@ pub struct Bake {
     /// Relative caustic gain G >= 0 per texel, row-major: the corrected caustic overlay is
     /// `G * L_r` (eq. 6) where `L_r` is the floor photo's linear luminance at that texel.
     pub gain: Vec<f32>,
+    /// The point light's irradiance on the floor with the object over that without it,
+    /// `E_with / E_without >= 0` per texel, row-major as `gain` (below 1 in the shadow, above
+    /// in the caustic): what the glass sees of the floor under it. `None` in a bake made before
+    /// it was stored (and in live mode).
+    pub light: Option<Vec<f32>>,
     /// [`crate::Scene::hash`] of the scene it was baked for.
     pub scene_hash: String,
     /// The bake parameters, `key=value; ...` text.
@@ -140,8 +148,8 @@ pub enum BakeError {
     },
 }
 
-/// Writes `bake` to `path` (single channel `Y`, f32, ZIP, deterministic byte for byte),
-/// whole or not at all.
+/// Writes `bake` to `path` (channel `Y` as f32, and `light_ratio` as f16 when it has the
+/// light; ZIP, deterministic byte for byte), whole or not at all.
 pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError> {
     let write_err = |reason: String| BakeError::Write {
         path: path.to_path_buf(),
@@ -160,7 +168,25 @@ pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError
             size.1
         )));
     }
-    let channel = AnyChannel::new(GAIN_CHANNEL, FlatSamples::F32(bake.gain.clone()));
+    let mut channels = vec![AnyChannel::new(
+        GAIN_CHANNEL,
+        FlatSamples::F32(bake.gain.clone()),
+    )];
+    if let Some(light) = &bake.light {
+        if light.len() != bake.gain.len() {
+            return Err(write_err(format!(
+                "{} light ratios for {} x {} texels",
+                light.len(),
+                size.0,
+                size.1
+            )));
+        }
+        // Half floats: the renderer samples them so, and a ratio needs no more.
+        channels.push(AnyChannel::new(
+            LIGHT_CHANNEL,
+            FlatSamples::F16(light.iter().map(|&r| f16::from_f32(r)).collect()),
+        ));
+    }
     // One custom attribute per attribute map: exr keeps them in hash maps, and a single
     // entry per map keeps the header's byte order fixed.
     let mut layer_attributes = LayerAttributes::default();
@@ -172,7 +198,7 @@ pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError
         size,
         layer_attributes,
         Encoding::SMALL_LOSSLESS,
-        AnyChannels::sort(vec![channel].into()),
+        AnyChannels::sort(channels.into()),
     );
     let mut image = Image::from_layer(layer);
     image.attributes.other.insert(
@@ -323,30 +349,40 @@ fn decode_unguarded(bytes: &[u8]) -> std::result::Result<Bake, String> {
     let params = attr_text(&layer.attributes.other, PARAMS_ATTRIBUTE)
         .or_else(|| attr_text(&image.attributes.other, PARAMS_ATTRIBUTE))
         .unwrap_or_default();
-    let channel = layer
-        .channel_data
-        .list
-        .iter()
-        .find(|c| c.name.to_string() == GAIN_CHANNEL)
-        .ok_or_else(|| format!("it has no `{GAIN_CHANNEL}` channel"))?;
-    let gain: Vec<f32> = match &channel.sample_data {
-        FlatSamples::F32(v) => v.clone(),
-        FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
-        FlatSamples::U32(_) => return Err("the gain channel holds integers".into()),
-    };
     let (w, h) = (layer.size.width(), layer.size.height());
-    if gain.len() != w * h || w == 0 || h == 0 {
-        return Err(format!("{} samples for {w} x {h} texels", gain.len()));
-    }
-    if let Some(bad) = gain.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
-        return Err(format!(
-            "it holds a gain of {bad}; gains are finite and >= 0"
-        ));
-    }
+    // A channel's samples as f32, checked: as many as texels, finite and >= 0.
+    let samples = |name: &str, what: &str| -> std::result::Result<Option<Vec<f32>>, String> {
+        let Some(channel) = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+        else {
+            return Ok(None);
+        };
+        let values: Vec<f32> = match &channel.sample_data {
+            FlatSamples::F32(v) => v.clone(),
+            FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
+            FlatSamples::U32(_) => return Err(format!("the {what} channel holds integers")),
+        };
+        if values.len() != w * h || w == 0 || h == 0 {
+            return Err(format!("{} samples for {w} x {h} texels", values.len()));
+        }
+        if let Some(bad) = values.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
+            return Err(format!(
+                "it holds a {what} of {bad}; they are finite and >= 0"
+            ));
+        }
+        Ok(Some(values))
+    };
+    let gain = samples(GAIN_CHANNEL, "gain")?
+        .ok_or_else(|| format!("it has no `{GAIN_CHANNEL}` channel"))?;
+    let light = samples(LIGHT_CHANNEL, "light ratio")?;
     Ok(Bake {
         width_px: w as u32,
         height_px: h as u32,
         gain,
+        light,
         scene_hash,
         params,
     })
@@ -361,6 +397,8 @@ mod tests {
             width_px: 5,
             height_px: 3,
             gain: (0..15).map(|i| i as f32 * 0.5).collect(),
+            // Ratios half floats hold exactly.
+            light: Some((0..15).map(|i| i as f32 * 0.25).collect()),
             scene_hash: "abc123".into(),
             params: "method=test".into(),
         }
@@ -381,6 +419,42 @@ mod tests {
         assert_eq!(names, ["b.exr"]);
         assert_eq!(back.gain_at(4, 0), 2.0);
         assert!((back.sample(0.1, 1.0 / 6.0) - 0.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_bake_without_the_light_ratio_reads_as_before_and_a_bad_ratio_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("b.exr");
+        // A bake made before the floor's light was stored: the gain alone.
+        let old = Bake {
+            light: None,
+            ..sample()
+        };
+        write_bake(&path, &old).unwrap();
+        assert_eq!(read_bake(&path, "abc123").unwrap(), old);
+        // A negative or non-finite ratio is no light.
+        for bad in [-0.5, f32::NAN, f32::INFINITY] {
+            let mut light = vec![1.0; 15];
+            light[7] = bad;
+            let corrupt = Bake {
+                light: Some(light),
+                ..sample()
+            };
+            write_bake(&path, &corrupt).unwrap();
+            let err = read_bake(&path, "abc123").unwrap_err().to_string();
+            assert!(
+                err.contains("light ratio") && err.contains("b.exr"),
+                "{bad}: {err}"
+            );
+        }
+        // As many ratios as texels, or nothing is written.
+        let short = Bake {
+            light: Some(vec![1.0; 14]),
+            ..sample()
+        };
+        let err = write_bake(&dir.path().join("c.exr"), &short).unwrap_err();
+        assert!(err.to_string().contains("14 light ratios"), "{err}");
+        assert!(!dir.path().join("c.exr").exists());
     }
 
     #[test]

@@ -131,7 +131,8 @@ pub enum CausticsMode {
 #[derive(Clone, Debug, Default)]
 pub struct Caustics {
     /// The bake file, resolved against the scene's folder; `None` when the scene names none.
-    /// Not read (nor hashed) when the scene loads: only when the caustics are asked for.
+    /// Not read (nor hashed) when the scene loads: only when the caustics are asked for, or
+    /// the glass (an object other than a ball in the room) sees the floor's light under it.
     pub bake: Option<PathBuf>,
     /// The gain map, after [`Scene::load_caustics`] (zeros in live mode, filled per pose).
     pub gain: Option<crate::caustics::Bake>,
@@ -186,6 +187,7 @@ impl Scene {
                 width_px: n,
                 height_px: n,
                 gain: vec![0.0; n as usize * n as usize],
+                light: None,
                 scene_hash: self.hash.clone(),
                 params: "method=live".into(),
             });

@@ -210,6 +210,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport> {
     if options.effects.iter().any(|set| set.caustics) {
         scene.load_caustics()?;
     }
+    vitreous_frames::setup::load_bake_for_glass(&mut scene);
     check_size(options.size.0, options.size.1)?;
     if options.frames == 0 {
         bail!("--frames must be at least 1");

@@ -282,6 +282,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     if effects.caustics {
         scene.load_caustics()?;
     }
+    vitreous_frames::setup::load_bake_for_glass(&mut scene);
     let (width, height) = options
         .size
         .unwrap_or((scene.output.width_px, scene.output.height_px));

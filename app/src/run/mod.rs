@@ -205,6 +205,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             .collect::<Vec<_>>()
             .join(" > ")
     );
+    vitreous_frames::setup::load_bake_for_glass(&mut scene);
     let xr_options = OpenXrOptions {
         blend: options.blend,
         dimmer: scene.dimmer.is_some(),

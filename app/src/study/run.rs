@@ -347,6 +347,7 @@ pub fn scene_for(path: &std::path::Path, sets: &[EffectSet]) -> Result<Scene> {
             .load_caustics()
             .with_context(|| format!("a condition shows caustics in {}", path.display()))?;
     }
+    vitreous_frames::setup::load_bake_for_glass(&mut scene);
     Ok(scene)
 }
 

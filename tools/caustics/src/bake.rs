@@ -145,6 +145,20 @@ pub fn gain(through_rel: f32, blocked_rel: f32) -> f32 {
     if g < MIN_GAIN { 0.0 } else { g }
 }
 
+/// The floor's light with the object over that without it, `E_with / E_without = 1 -
+/// blocked_rel + through_rel` (never below 0: rounding in the full shadow): below 1 in the
+/// shadow, above in the caustic; what the glass sees of the floor under it.
+/// Within [`MIN_GAIN`] of 1 it is stored as 1 (the faint light the glass spreads over the
+/// whole floor, invisible, as the gain drops it), so that the EXR compresses.
+pub fn light_ratio(through_rel: f32, blocked_rel: f32) -> f32 {
+    let change = through_rel - blocked_rel;
+    if change.abs() < MIN_GAIN {
+        1.0
+    } else {
+        (1.0 + change).max(0.0)
+    }
+}
+
 /// Smallest gain kept: a brightening of 0.1 % of the floor is invisible (well under one
 /// 8-bit display step), and zeroing the faint light spread over the whole floor lets the EXR
 /// compress to a small file.
@@ -302,6 +316,13 @@ pub fn bake(
             width_px: params.width_px,
             height_px: params.height_px,
             gain: gain_map,
+            light: Some(
+                through_rel
+                    .iter()
+                    .zip(&blocked_rel)
+                    .map(|(&t, &b)| light_ratio(t, b))
+                    .collect(),
+            ),
             scene_hash: scene.scene_hash.clone(),
             params: params.describe(),
         },

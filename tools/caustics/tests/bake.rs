@@ -409,3 +409,49 @@ fn open_meshes_inner_lights_and_flat_floors_are_refused_clearly() {
     near.light_position_m = Vec3::new(0.0, 0.0205, 0.0);
     assert!(bake(&near, &p, &|_, _| {}).is_ok());
 }
+
+#[test]
+fn the_floor_light_is_the_gain_where_it_brightens_and_the_shadow_where_it_darkens() {
+    let out = run(&glass_sphere_like(0.4), &params(256, 40_000));
+    let light = out
+        .bake
+        .light
+        .as_ref()
+        .expect("the bake stores the floor's light");
+    assert_eq!(light.len(), out.bake.gain.len());
+    let (mut brighter, mut darker, mut darkest) = (0, 0, f32::INFINITY);
+    for (k, (&l, &g)) in light.iter().zip(&out.bake.gain).enumerate() {
+        // E_with / E_without = 1 - blocked + through; the gain its brightening over 1.
+        let exact = 1.0 - out.blocked_rel[k] + out.through_rel[k];
+        assert!(l >= 0.0 && l.is_finite(), "texel {k}: {l}");
+        if g > 0.0 {
+            assert!(
+                (l - (1.0 + g)).abs() <= 1e-5 * l,
+                "texel {k}: {l} against 1 + {g}"
+            );
+            brighter += 1;
+        } else if l < 1.0 {
+            assert!(
+                (l - exact.max(0.0)).abs() < 1e-6,
+                "texel {k}: {l} against {exact}"
+            );
+            darker += 1;
+            darkest = darkest.min(l);
+        } else {
+            // Unchanged: 1 exactly, within a thousandth of the bare floor's light.
+            assert_eq!(l, 1.0, "texel {k}");
+            assert!((exact - 1.0).abs() < 1e-3, "texel {k}: {exact}");
+        }
+    }
+    // The ball's shadow darkens a ring around its caustic (the light it reflects brightens
+    // the floor faintly all around); far from both the floor is bare.
+    assert!(
+        brighter > 100 && darker > 100,
+        "{brighter} brighter, {darker} darker"
+    );
+    assert!(
+        darkest < 0.5,
+        "the darkest texel keeps {darkest} of its light"
+    );
+    assert_eq!(light[0], 1.0);
+}

@@ -132,9 +132,8 @@ struct Globals {
     shading: [f32; 4],
     model_from_world: [f32; 16],
     radial: [f32; 4],
-    /// xyz: the object's centre in the world; w: the light's share of the floor's light that
-    /// the floor seen through a mesh takes lit by the bake (`glass/floor_light.rs`), 0 where the
-    /// bake holds no light or the object and light are away from where it was made.
+    /// xyz: the object's centre in the world; w: the light's share the floor seen through it
+    /// takes lit by the bake, or 0 (`glass/floor_light.rs`).
     center_world: [f32; 4],
     /// rgb: absorption inside the glass in halvings per model unit (Beer-Lambert, two-surface
     /// refraction: the coefficient per world metre times the model's uniform scale over ln 2,
@@ -188,9 +187,8 @@ pub struct GlassPass {
     layout: Owned<vk::PipelineLayout>,
     /// What the compensated pipelines read (`[display] compensation = "background"`).
     compensation: Option<CompensationSet>,
-    /// Pool the set lives in.
+    /// Pool the set lives in, and the set's layout.
     _pool: Owned<vk::DescriptorPool>,
-    /// Layout of the single descriptor set.
     _set_layout: Owned<vk::DescriptorSetLayout>,
     /// The descriptor set: globals, environment map, sampler.
     set: vk::DescriptorSet,
@@ -203,7 +201,7 @@ pub struct GlassPass {
     _mesh: Buffer,
     /// The facet planes of a convex faceted object (two-surface refraction), or one plane.
     _planes: Buffer,
-    /// The floor under the object as the glass sees it through a mesh in the room.
+    /// The floor under the object as the glass sees it (`glass/floor_light.rs`).
     floor_light: FloorLight,
     /// The render pass and layout the pipelines were made for (the counting ones are made
     /// when the frames start counting).

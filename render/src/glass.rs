@@ -132,8 +132,7 @@ struct Globals {
     shading: [f32; 4],
     model_from_world: [f32; 16],
     radial: [f32; 4],
-    /// xyz: the object's centre in the world; w: the light's share the floor seen through it
-    /// takes lit by the bake, or 0 (`glass/floor_light.rs`).
+    /// xyz: the object's centre in the world; w: the floor's lit share (`glass/floor_light.rs`).
     center_world: [f32; 4],
     /// rgb: absorption inside the glass in halvings per model unit (Beer-Lambert, two-surface
     /// refraction: the coefficient per world metre times the model's uniform scale over ln 2,

@@ -627,6 +627,70 @@ fn to_the_outside(light: Inside, ior: f32) -> Inside {
 // nodes searched).
 const BRANCH_MEETINGS: i32 = 16;
 
+// A branch of the light through a mesh (`follow`, `follow_once`): where it is and its unit
+// direction (model frame about the object's centre), whether it is inside, the share of its
+// light that passed the meetings so far, and its length inside.
+struct Branch {
+    p: vec3<f32>,
+    d: vec3<f32>,
+    inside: bool,
+    passed: f32,
+    path: f32,
+};
+
+// The branch `b`'s next meeting with the surface: inside, refracted out (or reflected totally
+// beyond the critical angle); outside, refracted in where it meets the object again. Returns the
+// direction of the share the meeting splits off (back inside after an exit, away after an entry)
+// and that share (w; 0 where it reflects totally), or w -1 where the branch ends: still inside
+// and meeting nothing (`mesh_exit`: lost), or outside and meeting nothing more.
+fn meet(b: ptr<function, Branch>, ior: f32) -> vec4<f32> {
+    let d = (*b).d;
+    if (*b).inside {
+        let exit = mesh_exit((*b).p, d);
+        if exit.x < 0.0 {
+            return vec4<f32>(d, -1.0);
+        }
+        (*b).p += d * exit.x;
+        (*b).path += exit.x;
+        let leaving = refract(d, -exit.yzw, ior);
+        if dot(leaving, leaving) > 0.0 {
+            let reflected = fresnel_exact(dot(d, exit.yzw), ior);
+            (*b).passed *= 1.0 - reflected;
+            (*b).d = normalize(leaving);
+            (*b).inside = false;
+            return vec4<f32>(reflect(d, exit.yzw), reflected);
+        }
+        (*b).d = reflect(d, exit.yzw);
+        return vec4<f32>(d, 0.0);
+    }
+    let hit = mesh_hit((*b).p + d * MESH_EPS, d);
+    if hit.x >= NO_HIT {
+        return vec4<f32>(d, -1.0);
+    }
+    (*b).p += d * (hit.x + MESH_EPS);
+    let facing = select(-hit.yzw, hit.yzw, dot(d, hit.yzw) < 0.0);
+    let reflected = fresnel_exact(-dot(d, facing), 1.0 / ior);
+    (*b).passed *= 1.0 - reflected;
+    (*b).d = normalize(refract(d, facing, 1.0 / ior));
+    (*b).inside = true;
+    return vec4<f32>(reflect(d, facing), reflected);
+}
+
+// The room where the branch `b` left the object for good (times the share that passed and,
+// absorbing, the path's absorption); nothing while it is still inside.
+fn left_for_good(b: Branch) -> vec3<f32> {
+    if b.inside {
+        return vec3<f32>(0.0);
+    }
+    var light = vec3<f32>(b.passed);
+    if ABSORBING {
+        light *= exp2(-g.absorption.rgb * b.path);
+    }
+    let leaves_at = (g.world_from_model * vec4<f32>(b.p + g.radial.xyz, 1.0)).xyz;
+    let towards = normalize((g.world_from_model * vec4<f32>(b.d, 0.0)).xyz);
+    return room_through(leaves_at, towards) * light;
+}
+
 // The room's light along a branch of a branch of the light through a mesh in the room:
 // from `start` (model frame about the object's centre) along the unit `dir`, inside the glass
 // or out of it, followed without splitting (at each meeting with the surface the share that
@@ -634,49 +698,13 @@ const BRANCH_MEETINGS: i32 = 16;
 // the room where it leaves for good (times the share that passed and, absorbing, the path's
 // absorption), nothing where it is still inside then, or lost (`mesh_exit`).
 fn follow_once(start: vec3<f32>, dir: vec3<f32>, from_inside: bool, ior: f32) -> vec3<f32> {
-    var p = start;
-    var d = dir;
-    var inside = from_inside;
-    var passed = 1.0;
-    var path = 0.0;
+    var b = Branch(start, dir, from_inside, 1.0, 0.0);
     for (var k = 0; k < BRANCH_MEETINGS; k++) {
-        if inside {
-            let exit = mesh_exit(p, d);
-            if exit.x < 0.0 {
-                return vec3<f32>(0.0);
-            }
-            p += d * exit.x;
-            path += exit.x;
-            let leaving = refract(d, -exit.yzw, ior);
-            if dot(leaving, leaving) > 0.0 {
-                passed *= 1.0 - fresnel_exact(dot(d, exit.yzw), ior);
-                d = normalize(leaving);
-                inside = false;
-            } else {
-                d = reflect(d, exit.yzw);
-            }
-        } else {
-            let hit = mesh_hit(p + d * MESH_EPS, d);
-            if hit.x >= NO_HIT {
-                break;
-            }
-            p += d * (hit.x + MESH_EPS);
-            let facing = select(-hit.yzw, hit.yzw, dot(d, hit.yzw) < 0.0);
-            passed *= 1.0 - fresnel_exact(-dot(d, facing), 1.0 / ior);
-            d = normalize(refract(d, facing, 1.0 / ior));
-            inside = true;
+        if meet(&b, ior).w < 0.0 {
+            break;
         }
     }
-    if inside {
-        return vec3<f32>(0.0);
-    }
-    var light = vec3<f32>(passed);
-    if ABSORBING {
-        light *= exp2(-g.absorption.rgb * path);
-    }
-    let leaves_at = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
-    let towards = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);
-    return room_through(leaves_at, towards) * light;
+    return left_for_good(b);
 }
 
 // A branch's own split-offs (`follow`) carrying less than this share of the eye's light are
@@ -696,64 +724,25 @@ const MIN_SPLIT: f32 = 0.002;
 // (`mesh_exit`), and the split-offs' light.
 fn follow(start: vec3<f32>, dir: vec3<f32>, from_inside: bool, ior: f32, weight: f32)
     -> vec3<f32> {
-    var p = start;
-    var d = dir;
-    var inside = from_inside;
-    var passed = 1.0;
-    var path = 0.0;
+    var b = Branch(start, dir, from_inside, 1.0, 0.0);
     var split = vec3<f32>(0.0);
     for (var k = 0; k < BRANCH_MEETINGS; k++) {
-        var reflected = 0.0;
-        var away = d;
-        if inside {
-            let exit = mesh_exit(p, d);
-            if exit.x < 0.0 {
-                return split;
-            }
-            p += d * exit.x;
-            path += exit.x;
-            let leaving = refract(d, -exit.yzw, ior);
-            if dot(leaving, leaving) > 0.0 {
-                reflected = fresnel_exact(dot(d, exit.yzw), ior);
-                away = reflect(d, exit.yzw);
-                d = normalize(leaving);
-                inside = false;
-            } else {
-                d = reflect(d, exit.yzw);
-            }
-        } else {
-            let hit = mesh_hit(p + d * MESH_EPS, d);
-            if hit.x >= NO_HIT {
-                break;
-            }
-            p += d * (hit.x + MESH_EPS);
-            let facing = select(-hit.yzw, hit.yzw, dot(d, hit.yzw) < 0.0);
-            reflected = fresnel_exact(-dot(d, facing), 1.0 / ior);
-            away = reflect(d, facing);
-            d = normalize(refract(d, facing, 1.0 / ior));
-            inside = true;
+        let passed = b.passed;
+        let away = meet(&b, ior);
+        if away.w < 0.0 {
+            break;
         }
-        if weight * passed * reflected >= MIN_SPLIT {
+        if weight * passed * away.w >= MIN_SPLIT {
             // The split-off starts where the branch now goes the other way: back inside after
             // an exit, outside after an entry.
-            var share = vec3<f32>(passed * reflected);
+            var share = vec3<f32>(passed * away.w);
             if ABSORBING {
-                share *= exp2(-g.absorption.rgb * path);
+                share *= exp2(-g.absorption.rgb * b.path);
             }
-            split += follow_once(p, away, !inside, ior) * share;
+            split += follow_once(b.p, away.xyz, !b.inside, ior) * share;
         }
-        passed *= 1.0 - reflected;
     }
-    if inside {
-        return split;
-    }
-    var light = vec3<f32>(passed);
-    if ABSORBING {
-        light *= exp2(-g.absorption.rgb * path);
-    }
-    let leaves_at = (g.world_from_model * vec4<f32>(p + g.radial.xyz, 1.0)).xyz;
-    let towards = normalize((g.world_from_model * vec4<f32>(d, 0.0)).xyz);
-    return split + room_through(leaves_at, towards) * light;
+    return split + left_for_good(b);
 }
 
 // The share of the light of `s` that is still left after its path inside, per channel (its

@@ -365,18 +365,30 @@ fn sphere_exit(p: vec3<f32>, d: vec3<f32>, r: f32) -> f32 {
 // distance t, yzw the outward unit normal (twin of optics/src/convex.rs convex_exit).
 fn convex_exit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     var exit = vec4<f32>(3.0e38, 0.0, 0.0, 0.0);
+    // Eight planes a round (optics/src/convex.rs `in_eights`: lavapipe's loop limit, `mesh_hit`).
     let count = arrayLength(&facet_planes);
-    for (var i = 0u; i < count; i++) {
-        let plane = facet_planes[i];
-        let along = dot(plane.xyz, d);
-        if along > 1e-7 {
-            let t = max((plane.w - dot(plane.xyz, p)) / along, 0.0);
-            if t < exit.x {
-                exit = vec4<f32>(t, plane.xyz);
-            }
-        }
+    for (var i = 0u; i < count; i += 8u) {
+        exit_through(&exit, facet_planes[i], p, d);
+        exit_through(&exit, facet_planes[i + 1u], p, d);
+        exit_through(&exit, facet_planes[i + 2u], p, d);
+        exit_through(&exit, facet_planes[i + 3u], p, d);
+        exit_through(&exit, facet_planes[i + 4u], p, d);
+        exit_through(&exit, facet_planes[i + 5u], p, d);
+        exit_through(&exit, facet_planes[i + 6u], p, d);
+        exit_through(&exit, facet_planes[i + 7u], p, d);
     }
     return exit;
+}
+
+// `exit` (`convex_exit`) where `plane` lies nearer ahead of p along d.
+fn exit_through(exit: ptr<function, vec4<f32>>, plane: vec4<f32>, p: vec3<f32>, d: vec3<f32>) {
+    let along = dot(plane.xyz, d);
+    if along > 1e-7 {
+        let t = max((plane.w - dot(plane.xyz, p)) / along, 0.0);
+        if t < (*exit).x {
+            *exit = vec4<f32>(t, plane.xyz);
+        }
+    }
 }
 
 struct Passage {
@@ -436,6 +448,10 @@ var<private> mesh_triangles: u32;
 // (`SUPERSAMPLED`, `front_surface`).
 var<private> missed_positions: u32;
 
+// The positions of this pixel's grids shaded through a mesh or a gem (`SUPERSAMPLED`,
+// `supersampled`).
+var<private> positions_shaded: u32;
+
 // Distance along the ray p + t / inv (t >= 0) to the box [lo, hi], or NO_HIT where it passes
 // beside it.
 fn box_entry(lo: vec3<f32>, hi: vec3<f32>, p: vec3<f32>, inv: vec3<f32>) -> f32 {
@@ -471,6 +487,79 @@ fn children_entries(first: u32, p: vec3<f32>, inv: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(left, right);
 }
 
+// A search of the object's triangles under way (`mesh_hit`): the nearest meeting so far (its
+// distance, NO_HIT while none, its triangle's first element and barycentric weights), the nodes
+// still to visit, and the nodes visited.
+struct Search {
+    best: f32,
+    best_at: u32,
+    best_uv: vec2<f32>,
+    stack: array<u32, MESH_STACK>,
+    depth: u32,
+    visits: u32,
+};
+
+// Triangles per leaf of the hierarchy at most (optics/src/solid/bvh.rs LEAF_SIZE; render/src/
+// glass/mesh.rs refuses a larger leaf): `visit` tests them without a loop.
+const LEAF_TRIANGLES: u32 = 4u;
+
+// The triangle whose elements start at `at`, tested against the ray p + t d (`triangle_hit`):
+// the search's nearest meeting where it is nearer.
+fn test_triangle(s: ptr<function, Search>, at: u32, p: vec3<f32>, d: vec3<f32>) {
+    let hit = triangle_hit(at, p, d);
+    if hit.x < (*s).best {
+        (*s).best = hit.x;
+        (*s).best_at = at;
+        (*s).best_uv = hit.yz;
+    }
+}
+
+// The search's next node, where one is left: passed over where its box lies beyond the nearest
+// meeting so far; a leaf's triangles tested; an inner node's children put on the stack, the
+// nearer last (searched first), each only where its box lies nearer than the nearest meeting.
+fn visit(s: ptr<function, Search>, p: vec3<f32>, d: vec3<f32>, inv: vec3<f32>, base: u32) {
+    if (*s).depth == 0u {
+        return;
+    }
+    (*s).visits += 1u;
+    (*s).depth -= 1u;
+    let node = (*s).stack[(*s).depth];
+    let low = mesh[1u + 2u * node];
+    let high = mesh[2u + 2u * node];
+    if box_entry(low.xyz, high.xyz, p, inv) >= (*s).best {
+        return;
+    }
+    let first = bitcast<u32>(low.w);
+    let count = bitcast<u32>(high.w);
+    if count > 0u {
+        // One triangle at least, LEAF_TRIANGLES at most.
+        let at = base + 6u * first;
+        test_triangle(s, at, p, d);
+        if count > 1u {
+            test_triangle(s, at + 6u, p, d);
+        }
+        if count > 2u {
+            test_triangle(s, at + 12u, p, d);
+        }
+        if count > 3u {
+            test_triangle(s, at + 18u, p, d);
+        }
+        mesh_triangles += count;
+    } else {
+        let entries = children_entries(first, p, inv);
+        // The farther child first, so that the nearer is searched first.
+        let near_first = entries.x <= entries.y;
+        if max(entries.x, entries.y) < (*s).best && (*s).depth < MESH_STACK {
+            (*s).stack[(*s).depth] = select(first, first + 1u, near_first);
+            (*s).depth += 1u;
+        }
+        if min(entries.x, entries.y) < (*s).best && (*s).depth < MESH_STACK {
+            (*s).stack[(*s).depth] = select(first + 1u, first, near_first);
+            (*s).depth += 1u;
+        }
+    }
+}
+
 // The nearest meeting of the ray p + t d (t > 0, d unit; model frame about the object's centre)
 // with the object's triangles (twin of optics/src/solid/bvh.rs `Bvh::closest` and
 // optics/src/two_surface.rs `MeshBody::hit`, either side of a triangle): x the distance t (NO_HIT
@@ -481,56 +570,27 @@ fn mesh_hit(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     // then still order correctly).
     let inv = 1.0 / select(d, vec3<f32>(1e-30), abs(d) < vec3<f32>(1e-30));
     let base = bitcast<u32>(mesh[0].x);
-    var best = NO_HIT;
-    var best_at = 0u;
-    var best_uv = vec2<f32>(0.0);
-    var stack: array<u32, MESH_STACK>;
-    stack[0] = 0u;
-    var depth = 1u;
-    var visits = 0u;
-    while depth > 0u && visits < MESH_VISITS {
-        visits += 1u;
-        depth -= 1u;
-        let node = stack[depth];
-        let low = mesh[1u + 2u * node];
-        let high = mesh[2u + 2u * node];
-        if box_entry(low.xyz, high.xyz, p, inv) >= best {
-            continue;
-        }
-        let first = bitcast<u32>(low.w);
-        let count = bitcast<u32>(high.w);
-        if count > 0u {
-            for (var k = 0u; k < count; k++) {
-                let at = base + 6u * (first + k);
-                let hit = triangle_hit(at, p, d);
-                if hit.x < best {
-                    best = hit.x;
-                    best_at = at;
-                    best_uv = hit.yz;
-                }
-            }
-            mesh_triangles += count;
-        } else {
-            let entries = children_entries(first, p, inv);
-            // The farther child first, so that the nearer is searched first.
-            let near_first = entries.x <= entries.y;
-            if max(entries.x, entries.y) < best && depth < MESH_STACK {
-                stack[depth] = select(first, first + 1u, near_first);
-                depth += 1u;
-            }
-            if min(entries.x, entries.y) < best && depth < MESH_STACK {
-                stack[depth] = select(first + 1u, first, near_first);
-                depth += 1u;
-            }
-        }
+    var s: Search;
+    s.best = NO_HIT;
+    s.stack[0] = 0u;
+    s.depth = 1u;
+    // Four visits a round, and a leaf's triangles tested without a loop: lavapipe ends every
+    // loop of an invocation once its loops together have run 65,535 rounds (gallivm's loop
+    // limiter, counted over a SIMD vector of invocations), silently, and a pixel's positions then
+    // go unshaded (docs/realism.md, "lavapipe's loop limit").
+    while s.depth > 0u && s.visits < MESH_VISITS {
+        visit(&s, p, d, inv, base);
+        visit(&s, p, d, inv, base);
+        visit(&s, p, d, inv, base);
+        visit(&s, p, d, inv, base);
     }
-    mesh_nodes += visits;
-    if best >= NO_HIT {
+    mesh_nodes += s.visits;
+    if s.best >= NO_HIT {
         return vec4<f32>(NO_HIT, 0.0, 0.0, 0.0);
     }
-    let normal = mesh[best_at + 3u].xyz * (1.0 - best_uv.x - best_uv.y)
-        + mesh[best_at + 4u].xyz * best_uv.x + mesh[best_at + 5u].xyz * best_uv.y;
-    return vec4<f32>(best, normalize(normal));
+    let normal = mesh[s.best_at + 3u].xyz * (1.0 - s.best_uv.x - s.best_uv.y)
+        + mesh[s.best_at + 4u].xyz * s.best_uv.x + mesh[s.best_at + 5u].xyz * s.best_uv.y;
+    return vec4<f32>(s.best, normalize(normal));
 }
 
 // Where the ray p + t d from inside the mesh leaves it (`find_exit`; twin of
@@ -901,30 +961,45 @@ struct Front {
 // the convex object of `facet_planes`: x the distance t (NO_HIT where it passes beside), yzw
 // the outward unit normal there.
 fn convex_entry(p: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
-    var t_in = 0.0;
+    // x the entry's distance, y the exit's; the entry's plane's normal.
+    var span = vec2<f32>(0.0, 3.0e38);
     var n_in = vec3<f32>(0.0);
-    var t_out = 3.0e38;
+    // Eight planes a round (`convex_exit`).
     let count = arrayLength(&facet_planes);
-    for (var i = 0u; i < count; i++) {
-        let plane = facet_planes[i];
-        let along = dot(plane.xyz, d);
-        let inside = plane.w - dot(plane.xyz, p);
-        if along < -1e-7 {
-            let t = inside / along;
-            if t > t_in {
-                t_in = t;
-                n_in = plane.xyz;
-            }
-        } else if along > 1e-7 {
-            t_out = min(t_out, inside / along);
-        } else if inside < 0.0 {
-            t_out = -1.0;
-        }
+    for (var i = 0u; i < count; i += 8u) {
+        enter_through(&span, &n_in, facet_planes[i], p, d);
+        enter_through(&span, &n_in, facet_planes[i + 1u], p, d);
+        enter_through(&span, &n_in, facet_planes[i + 2u], p, d);
+        enter_through(&span, &n_in, facet_planes[i + 3u], p, d);
+        enter_through(&span, &n_in, facet_planes[i + 4u], p, d);
+        enter_through(&span, &n_in, facet_planes[i + 5u], p, d);
+        enter_through(&span, &n_in, facet_planes[i + 6u], p, d);
+        enter_through(&span, &n_in, facet_planes[i + 7u], p, d);
     }
-    if t_in > t_out || dot(n_in, n_in) == 0.0 {
+    if span.x > span.y || dot(n_in, n_in) == 0.0 {
         return vec4<f32>(NO_HIT, d);
     }
-    return vec4<f32>(t_in, n_in);
+    return vec4<f32>(span.x, n_in);
+}
+
+// The span of the ray p + t d inside the planes so far (`convex_entry`) cut by `plane`.
+fn enter_through(
+    span: ptr<function, vec2<f32>>, n_in: ptr<function, vec3<f32>>, plane: vec4<f32>,
+    p: vec3<f32>, d: vec3<f32>,
+) {
+    let along = dot(plane.xyz, d);
+    let inside = plane.w - dot(plane.xyz, p);
+    if along < -1e-7 {
+        let t = inside / along;
+        if t > (*span).x {
+            (*span).x = t;
+            *n_in = plane.xyz;
+        }
+    } else if along > 1e-7 {
+        (*span).y = min((*span).y, inside / along);
+    } else if inside < 0.0 {
+        (*span).y = -1.0;
+    }
 }
 
 fn front_surface(in: VertexOut, two_surface_model: bool) -> Front {
@@ -1033,11 +1108,16 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
         if !BALL {
             if !CONVEX {
                 // The nodes and triangles the mesh's searches visited and tested (`mesh_hit`),
-                // and the fragment.
+                // the fragment, and the positions it shaded.
                 let slot = 4u * u32(eye.refraction_origin.w);
                 atomicAdd(&shaded[slot], mesh_nodes);
                 atomicAdd(&shaded[slot + 1u], mesh_triangles);
                 atomicAdd(&shaded[slot + 2u], 1u);
+                var positions = 1u;
+                if SUPERSAMPLED {
+                    positions = positions_shaded;
+                }
+                atomicAdd(&shaded[slot + 3u], positions);
             }
         }
     }
@@ -1050,7 +1130,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
                     // Where positions of the grid passed beside a mesh or a gem, the eye sees
                     // the real world there through no glass: it is taken away over the covered
                     // share only.
-                    let grid = f32(in.samples * in.samples);
+                    let grid = f32(positions_shaded);
                     let covered = (grid - f32(missed_positions)) / grid;
                     out = max(out - seen_behind(in) * covered, vec3<f32>(0.0));
                 } else {

@@ -14,6 +14,7 @@ mod live_caustics;
 mod live_caustics_sweep;
 mod live_maps;
 mod mesh_light;
+mod mesh_positions;
 mod mesh_refraction;
 mod motion;
 mod refraction;

@@ -18,7 +18,7 @@ use vitreous_scene::Scene;
 use vitreous_scene::caustics::Bake;
 use vitreous_scene::effects::EffectSet;
 use vitreous_tests::{
-    compose_once, left_eye_light, neutral_eyes, scene_renderer, shipped_scene, workspace,
+    compose_once, left_eye_light, neutral_eyes, scene_renderer, shipped_scene, torus_in_the_room,
 };
 
 const SIZE: (u32, u32) = (640, 480);
@@ -123,28 +123,6 @@ fn the_goblets_light_comes_close_to_the_real_goblets() {
         error_all < 0.35 * real_all,
         "the goblet's pixels are {error_all} off the real goblet's {real_all}"
     );
-}
-
-/// `glass-sphere-real.toml` with the torus (100 mm, lying flat on the table) for its object and
-/// no bake, written into `dir` (its assets named by absolute paths).
-fn torus_in_the_room(dir: &std::path::Path) -> Scene {
-    let config = workspace().join("config");
-    let text = std::fs::read_to_string(config.join("scenes/glass-sphere-real.toml"))
-        .unwrap()
-        .replace("\"../", &format!("\"{}/", config.display()))
-        .replace("sphere.glb", "torus.glb")
-        .replace("diameter_m = 0.08", "diameter_m = 0.10")
-        .replace(
-            "position_m = [0.0, -0.26, -1.5]",
-            "position_m = [0.0, -0.285, -1.5]",
-        )
-        .lines()
-        .filter(|line| !line.starts_with("bake = "))
-        .collect::<Vec<_>>()
-        .join("\n");
-    let path = dir.join("torus-real.toml");
-    std::fs::write(&path, text).unwrap();
-    vitreous_scene::load_scene(&path).unwrap()
 }
 
 /// The floor under a torus lying on the table as its glass shows it: lit as the floor's light

@@ -362,3 +362,25 @@ fn linear_rgb(pixels: &[u8]) -> Vec<Vec3> {
         })
         .collect()
 }
+
+/// `glass-sphere-real.toml` with the torus (100 mm, lying flat on the table) for its object and
+/// no bake, written into `dir` (its assets named by absolute paths).
+pub fn torus_in_the_room(dir: &std::path::Path) -> vitreous_scene::Scene {
+    let config = workspace().join("config");
+    let text = std::fs::read_to_string(config.join("scenes/glass-sphere-real.toml"))
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", config.display()))
+        .replace("sphere.glb", "torus.glb")
+        .replace("diameter_m = 0.08", "diameter_m = 0.10")
+        .replace(
+            "position_m = [0.0, -0.26, -1.5]",
+            "position_m = [0.0, -0.285, -1.5]",
+        )
+        .lines()
+        .filter(|line| !line.starts_with("bake = "))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let path = dir.join("torus-real.toml");
+    std::fs::write(&path, text).unwrap();
+    vitreous_scene::load_scene(&path).unwrap()
+}

@@ -10,6 +10,18 @@ use glam::{Vec2, Vec3, Vec4};
 /// with its girdle band): each internal reflection tests every plane once.
 pub const MAX_FACET_PLANES: usize = 256;
 
+/// A plane that no ray meets and that holds every point on its inner side (no normal, the
+/// centre a unit inside): what [`in_eights`] pads with.
+pub const NO_PLANE: Vec4 = Vec4::new(0.0, 0.0, 0.0, 1.0);
+
+/// `planes` padded with [`NO_PLANE`] to a whole number of eights (eight at least): the glass
+/// shader tests eight planes a round of its loops (shaders/glass.wgsl `convex_exit`), since
+/// lavapipe ends an invocation's loops once they have run 65,535 rounds together.
+pub fn in_eights(mut planes: Vec<Vec4>) -> Vec<Vec4> {
+    planes.resize(planes.len().max(1).next_multiple_of(8), NO_PLANE);
+    planes
+}
+
 /// Cosine above which a vertex normal counts as its triangle's face normal (flat shading).
 const FLAT_NORMAL_COS: f32 = 0.9999;
 
@@ -371,6 +383,31 @@ mod tests {
         // From a point on the -y face going up: leaves through +y, 1 away.
         let (t, normal) = convex_exit(&planes, Vec3::new(0.1, -0.5, 0.2), Vec3::Y).unwrap();
         assert!((t - 1.0).abs() < 1e-6 && normal == Vec3::Y, "{t} {normal}");
+    }
+
+    #[test]
+    fn planes_come_in_eights_that_change_no_exit() {
+        let (p, n, i) = crate::solid::flat_cube(1.0);
+        let planes = facet_planes(&p, &n, &i, Vec3::ZERO).expect("a convex faceted cube");
+        let padded = in_eights(planes.clone());
+        assert_eq!(padded.len(), 8);
+        assert_eq!(&padded[..6], &planes[..]);
+        assert_eq!(in_eights(Vec::new()), vec![NO_PLANE; 8]);
+        // The shader's exit: the nearest plane ahead; the padding is never ahead, and holds
+        // any point inside the cube inside it.
+        let exit = |planes: &[Vec4], p: Vec3, d: Vec3| {
+            planes
+                .iter()
+                .filter(|q| q.truncate().dot(d) > 1e-7)
+                .map(|q| (q.w - q.truncate().dot(p)) / q.truncate().dot(d))
+                .fold(f32::INFINITY, f32::min)
+        };
+        let (p0, d) = (
+            Vec3::new(0.1, -0.2, 0.05),
+            Vec3::new(0.3, 0.5, -0.8).normalize(),
+        );
+        assert_eq!(exit(&padded, p0, d), exit(&planes, p0, d));
+        assert!(padded[6..].iter().all(|q| q.w - q.truncate().dot(p0) > 0.0));
     }
 
     #[test]

@@ -638,7 +638,7 @@ fn upload_facet_planes(
         );
     }
     let convex = planes.is_some();
-    let planes = planes.unwrap_or_else(|| vec![Vec4::ZERO]);
+    let planes = convex::in_eights(planes.unwrap_or_default());
     let buffer = Buffer::with_data(
         ctx,
         "facet planes",

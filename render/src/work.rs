@@ -122,6 +122,10 @@ pub struct MeshSearch {
     pub triangles: u64,
     /// The covered pixels' fragments that searched.
     pub fragments: u64,
+    /// The positions inside their pixels those fragments shaded: a pixel's grid, and a grid
+    /// twice as fine where the first left its light uncertain
+    /// (shaders/shared/glass_positions.wgsl `needs_finer`).
+    pub positions: u64,
     /// The static cost of visiting one node.
     pub each_node: ShaderCost,
     /// The static cost of testing one triangle.

@@ -15,6 +15,9 @@
 // part, the exit reflecting more and more of the light back inside, the echoes' images the most
 // minified) and on the reflected highlight (`HIGHLIGHT`). Both follow the ball analytically, as
 // `shade_ray`'s two-surface passage through a ball does, each for its part alone.
+//
+// Through a mesh or a gem (two-surface, not a ball), a pixel whose n x n grid leaves its light
+// uncertain (`needs_finer`) shades a grid twice as fine too, and its light is the mean over both.
 
 // Share of the ball's radius off its centre beyond which a pixel shades the rest over the whole
 // grid.
@@ -165,8 +168,10 @@ fn rest_over_whole_grid(in: VertexOut, phong: bool) -> bool {
 // n x n grid of positions inside it (n = `in.samples`), each a view ray of its own through the
 // surface found as at the pixel's centre, with the vertex outputs carried there by their screen
 // derivatives; for a ball in the room in an environment look, its two parts each over its own
-// grid (above). Where a position's ray passes beside a ball (its front surface is the sphere
-// through its vertices), the glass adds nothing there: the pixel's edge is covered in part.
+// grid (above); through a mesh or a gem, a grid twice as fine too where the first leaves the
+// pixel's light uncertain (`needs_finer`). Where a position's ray passes beside a ball (its front
+// surface is the sphere through its vertices), the glass adds nothing there: the pixel's edge is
+// covered in part.
 fn supersampled(
     in: VertexOut, two_surface_model: bool, to_background: bool, phong: bool, alpha: f32,
 ) -> vec3<f32> {
@@ -180,16 +185,72 @@ fn supersampled(
     if BALL && ROOM && two_surface_model && !to_background {
         light = ball_parts(in, dx, dy, phong, alpha);
     } else {
+        // One loop over both grids, the finer one's positions added once the first is done
+        // (one `shade_ray` in the pipeline: lavapipe compiles each copy of it for minutes).
+        let finer = 2u * n;
+        var positions = grid;
         var sum = vec3<f32>(0.0);
-        for (var i = 0u; i < grid; i++) {
-            let at = moved(in, dx, dy, grid_position(i, n));
+        var squares = 0.0;
+        for (var i = 0u; i < positions; i++) {
+            var offset = grid_position(i, n);
+            // Each condition its own `if` (a pipeline constant rules the rest out).
+            if !BALL {
+                if two_surface_model {
+                    // Counted as they run (lavapipe's loop limit, `mesh_hit`).
+                    positions_shaded += 1u;
+                    if i >= grid {
+                        offset = grid_position(i - grid, finer);
+                    }
+                }
+            }
+            let at = moved(in, dx, dy, offset);
             if !misses_ball(at) {
-                sum += shade_ray(at, two_surface_model, to_background, phong, alpha);
+                let light = shade_ray(at, two_surface_model, to_background, phong, alpha);
+                sum += light;
+                if !BALL {
+                    if two_surface_model {
+                        let y = dot(light, LUMINANCE);
+                        squares += y * y;
+                    }
+                }
+            }
+            if !BALL {
+                if two_surface_model {
+                    // Through a mesh or a gem: where the grid's positions disagree, a finer
+                    // grid too (`needs_finer`).
+                    if i + 1u == grid && finer <= MAX_FINER_SIDE
+                        && needs_finer(sum, squares, grid) {
+                        positions += finer * finer;
+                    }
+                }
             }
         }
-        light = sum / f32(grid);
+        light = sum / f32(positions);
     }
     return light;
+}
+
+// Rec. 709 luminance of linear RGB.
+const LUMINANCE: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
+
+// Through a mesh or a gem, the light inside a pixel can change over less than a position's
+// spacing (an edge of a wall or a facet seen through several surfaces, light guided round a
+// ring, a thin stem's image): a pixel whose grid of positions leaves its mean this uncertain (the standard error of its luminance, linear)
+// shades a grid twice as fine too, and takes the mean over both. The torus's disc gap at
+// 640 x 480 (4 x 4 positions): 0.368 with none, 0.330 at this error (its pixels 2.5 times the
+// positions), 0.306 at 0.01 (4.2 times), 0.340 at 0.06, 0.310 with every pixel at 8 x 8.
+const FINER_ERROR: f32 = 0.03;
+
+// Positions along each side of the finer grid at most (lavapipe's loop limit, `mesh_hit`).
+const MAX_FINER_SIDE: u32 = 8u;
+
+// Whether a pixel's grid of `grid` positions, their light's sum `sum` and the sum of its
+// luminance squared `squares`, leaves its mean's luminance more uncertain than FINER_ERROR.
+fn needs_finer(sum: vec3<f32>, squares: f32, grid: u32) -> bool {
+    let count = f32(grid);
+    let mean = dot(sum, LUMINANCE) / count;
+    let variance = max(squares / count - mean * mean, 0.0);
+    return variance > FINER_ERROR * FINER_ERROR * count;
 }
 
 // A ball's light over the pixel at `in` in the room (`supersampled`), its screen derivatives

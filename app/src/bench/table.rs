@@ -155,6 +155,7 @@ impl BenchReport {
                 // Where the glass searches a mesh's triangles for the exit.
                 ("mesh nodes", Box::new(count("glass_mesh.nodes"))),
                 ("mesh tris", Box::new(count("glass_mesh.triangles"))),
+                ("mesh pos", Box::new(count("glass_mesh.positions"))),
                 ("field frags", Box::new(count("mask.fragment_invocations"))),
                 ("compute inv", Box::new(sum(".compute_invocations"))),
             ]);

@@ -22,7 +22,7 @@ use crate::work::{GlassPositions, MeshSearch};
 
 /// Bytes of one frame slot's counters: the positions of the rest of the light, those of the
 /// first image, the pixels that shaded them, and a word unused (`u32` each); for a mesh, the
-/// nodes visited, the triangles tested, the fragments, and the word unused.
+/// nodes visited, the triangles tested, the fragments, and the positions they shaded.
 const SLOT_BYTES: u64 = 16;
 
 /// The counters, four words per frame slot, in memory the host reads once the frame finished.
@@ -183,7 +183,7 @@ impl GlassPass {
     /// What the frame of slot `slot` shaded with a counting pipeline, once it finished:
     /// `counted` ([`GlassPass::counted_positions`]) with the device's counts.
     pub fn read_positions(&self, slot: usize, counted: GlassPositions) -> Result<GlassPositions> {
-        let [shaded, first_images, pixels] = self.read_slot(slot)?;
+        let [shaded, first_images, pixels, _] = self.read_slot(slot)?;
         Ok(GlassPositions {
             shaded,
             first_images,
@@ -195,23 +195,24 @@ impl GlassPass {
     /// What the frame of slot `slot` searched with a counting pipeline, once it finished:
     /// `counted` ([`GlassPass::counted_mesh`]) with the device's counts.
     pub fn read_mesh(&self, slot: usize, counted: MeshSearch) -> Result<MeshSearch> {
-        let [nodes, triangles, fragments] = self.read_slot(slot)?;
+        let [nodes, triangles, fragments, positions] = self.read_slot(slot)?;
         Ok(MeshSearch {
             nodes,
             triangles,
             fragments,
+            positions,
             ..counted
         })
     }
 
-    /// The first three counters of slot `slot`.
-    fn read_slot(&self, slot: usize) -> Result<[u64; 3]> {
+    /// The four counters of slot `slot`.
+    fn read_slot(&self, slot: usize) -> Result<[u64; 4]> {
         let bytes = self.counter.buffer.mapped()?;
         let at = slot * SLOT_BYTES as usize;
         let word = |i: usize| {
             let w = &bytes[at + 4 * i..at + 4 * i + 4];
             u64::from(u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
         };
-        Ok([word(0), word(1), word(2)])
+        Ok([word(0), word(1), word(2), word(3)])
     }
 }

@@ -16,6 +16,9 @@ use crate::scene::MeshRef;
 /// Depth of the shader's search stack (glass.wgsl `MESH_STACK`): a deeper hierarchy is refused.
 const SEARCH_STACK: usize = 32;
 
+/// Triangles per leaf the shader tests (glass.wgsl `visit`, without a loop) at most.
+const LEAF_TRIANGLES: u32 = 4;
+
 /// Elements (`vec4<f32>`) per triangle: corner 0, edge 1, edge 2, the corners' normals.
 const TRIANGLE_ELEMENTS: usize = 6;
 
@@ -35,6 +38,13 @@ pub(super) fn elements(mesh: &MeshRef, center: Vec3) -> Result<Vec<Vec4>> {
         )));
     }
     let (nodes, order) = bvh.flat();
+    if let Some(leaf) = nodes.iter().find(|n| n.count > LEAF_TRIANGLES) {
+        return Err(RenderError::InvalidInput(format!(
+            "two-surface refraction: a leaf of the object's bounding-volume hierarchy holds {} \
+             triangles; the shader tests {LEAF_TRIANGLES} at most",
+            leaf.count
+        )));
+    }
     let first_triangle = 1 + 2 * nodes.len();
     let bits = |u: u32| f32::from_bits(u);
     let mut out = Vec::with_capacity(first_triangle + TRIANGLE_ELEMENTS * order.len());

@@ -127,6 +127,7 @@ fn frame_counts(frame: &FrameWork) -> Vec<(String, f64)> {
             counts.push(("glass_mesh.nodes".to_owned(), m.nodes as f64));
             counts.push(("glass_mesh.triangles".to_owned(), m.triangles as f64));
             counts.push(("glass_mesh.fragments".to_owned(), m.fragments as f64));
+            counts.push(("glass_mesh.positions".to_owned(), m.positions as f64));
         }
     }
     if let Some(photons) = frame.photons {
@@ -272,6 +273,7 @@ mod tests {
                 nodes,
                 triangles,
                 fragments: 40,
+                positions: 640,
                 each_node: ShaderCost {
                     fetches: 0,
                     texels: 0,
@@ -289,6 +291,7 @@ mod tests {
         assert_eq!(counts["glass_mesh.nodes"], 1000.0);
         assert_eq!(counts["glass_mesh.triangles"], 300.0);
         assert_eq!(counts["glass_mesh.fragments"], 40.0);
+        assert_eq!(counts["glass_mesh.positions"], 640.0);
         assert_eq!(counts["glass_fetches"], 150.0);
         assert_eq!(
             counts["glass_instructions"],

@@ -21,12 +21,22 @@ use vitreous_tests::{
     compose_once, left_eye_light, neutral_eyes, scene_renderer, shipped_scene, torus_in_the_room,
 };
 
+/// The goblet's image size.
 const SIZE: (u32, u32) = (640, 480);
+
+/// The torus's image size: a quarter of the goblet's pixels (lavapipe shades a torus pixel for
+/// tens of milliseconds), still hundreds of them inside its outline.
+const TORUS_SIZE: (u32, u32) = (320, 240);
 
 /// The pixels of `window` whose every corner's ray, and the centre's, meets `glass`: as (index
 /// in the window, index in the whole image, row from the window's top).
-fn covered(glass: &Glass, camera: &EyeParams, window: Window) -> Vec<(usize, usize, u32)> {
-    let rays = camera.pixel_rays(Vec2::new(SIZE.0 as f32, SIZE.1 as f32));
+fn covered(
+    glass: &Glass,
+    camera: &EyeParams,
+    window: Window,
+    size: (u32, u32),
+) -> Vec<(usize, usize, u32)> {
+    let rays = camera.pixel_rays(Vec2::new(size.0 as f32, size.1 as f32));
     let meets = |x: f32, y: f32| {
         glass
             .shape
@@ -39,7 +49,7 @@ fn covered(glass: &Glass, camera: &EyeParams, window: Window) -> Vec<(usize, usi
             let (px, py) = ((window.x + x) as f32, (window.y + y) as f32);
             let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)];
             if corners.iter().all(|&(dx, dy)| meets(px + dx, py + dy)) {
-                let index = ((window.y + y) * SIZE.0 + window.x + x) as usize;
+                let index = ((window.y + y) * size.0 + window.x + x) as usize;
                 out.push(((y * window.width + x) as usize, index, y));
             }
         }
@@ -47,9 +57,9 @@ fn covered(glass: &Glass, camera: &EyeParams, window: Window) -> Vec<(usize, usi
     out
 }
 
-/// The object's bounding box on the left eye's image, with a margin of 2 pixels.
-fn around_the_object(scene: &Scene, camera: &EyeParams) -> Window {
-    let size = Vec2::new(SIZE.0 as f32, SIZE.1 as f32);
+/// The object's bounding box on the left eye's image of `size`, with a margin of 2 pixels.
+fn around_the_object(scene: &Scene, camera: &EyeParams, size: (u32, u32)) -> Window {
+    let pixels = Vec2::new(size.0 as f32, size.1 as f32);
     let m = scene.object.world_from_model_at(
         scene.object.center_m,
         scene.rest_placement().object_rotation,
@@ -58,7 +68,7 @@ fn around_the_object(scene: &Scene, camera: &EyeParams) -> Window {
         (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
         |(lo, hi), &p| {
             let at = camera
-                .project_to_pixel(m.transform_point3(p), size)
+                .project_to_pixel(m.transform_point3(p), pixels)
                 .expect("the object in view");
             (lo.min(at), hi.max(at))
         },
@@ -67,8 +77,8 @@ fn around_the_object(scene: &Scene, camera: &EyeParams) -> Window {
     Window {
         x: x0,
         y: y0,
-        width: ((hi.x + 2.0) as u32).min(SIZE.0) - x0,
-        height: ((hi.y + 2.0) as u32).min(SIZE.1) - y0,
+        width: ((hi.x + 2.0) as u32).min(size.0) - x0,
+        height: ((hi.y + 2.0) as u32).min(size.1) - y0,
     }
 }
 
@@ -77,10 +87,10 @@ fn the_goblets_light_comes_close_to_the_real_goblets() {
     let mut scene = shipped_scene("goblet-real.toml");
     scene.compensation = Compensation::None;
     let camera = neutral_eyes(&scene)[0];
-    let window = around_the_object(&scene, &camera);
+    let window = around_the_object(&scene, &camera, SIZE);
     let world = World::of(&scene, &scene.rest_placement()).unwrap();
     let glass = world.glass.clone().expect("the goblet");
-    let pixels = covered(&glass, &camera, window);
+    let pixels = covered(&glass, &camera, window, SIZE);
     assert!(
         pixels.len() > 500,
         "{} pixels inside the outline",
@@ -137,7 +147,7 @@ fn the_floor_seen_through_a_torus_shows_its_shadow_and_caustic() {
     let mut scene = torus_in_the_room(dir.path());
     scene.compensation = Compensation::None;
     let camera = neutral_eyes(&scene)[0];
-    let window = around_the_object(&scene, &camera);
+    let window = around_the_object(&scene, &camera, TORUS_SIZE);
     let bare = World::of(&scene, &scene.rest_placement()).unwrap();
     let lit = World {
         floor_light: FloorLight::trace(&bare, &PhotonParams::default()),
@@ -147,10 +157,10 @@ fn the_floor_seen_through_a_torus_shows_its_shadow_and_caustic() {
         .floor_light
         .as_ref()
         .expect("the reference's floor light");
-    let pixels = covered(bare.glass.as_ref().unwrap(), &camera, window);
-    let real_bare = render_eye(&bare, &camera, SIZE, window, 3);
-    let real_lit = render_eye(&lit, &camera, SIZE, window, 3);
-    let gpu_bare = left_eye_light(&scene, SIZE);
+    let pixels = covered(bare.glass.as_ref().unwrap(), &camera, window, TORUS_SIZE);
+    let real_bare = render_eye(&bare, &camera, TORUS_SIZE, window, 3);
+    let real_lit = render_eye(&lit, &camera, TORUS_SIZE, window, 3);
+    let gpu_bare = left_eye_light(&scene, TORUS_SIZE);
     // The map over the floor photo's area, texel centres, as a bake lays it out.
     let n = 1024u32;
     let light = (0..n * n)
@@ -167,7 +177,7 @@ fn the_floor_seen_through_a_torus_shows_its_shadow_and_caustic() {
         scene_hash: scene.hash.clone(),
         params: "method=reference".into(),
     });
-    let gpu_lit = left_eye_light(&scene, SIZE);
+    let gpu_lit = left_eye_light(&scene, TORUS_SIZE);
     // The pixels inside the outline whose real light the floor's light changes visibly.
     let changed: Vec<_> = pixels
         .iter()
@@ -190,7 +200,7 @@ fn the_floor_seen_through_a_torus_shows_its_shadow_and_caustic() {
         changed.len(),
         pixels.len()
     );
-    assert!(changed.len() > 100, "{} pixels changed", changed.len());
+    assert!(changed.len() > 40, "{} pixels changed", changed.len());
     assert!(
         gpu_change > 0.5 * real_change,
         "the GPU's light changed by {gpu_change} the real way where the real torus's changed by \
@@ -201,9 +211,9 @@ fn the_floor_seen_through_a_torus_shows_its_shadow_and_caustic() {
         "lit {error_lit} against {error_bare} with the bare photo"
     );
     // The torus moved 1 mm: the map no longer holds, and the glass sees the bare photo (the
-    // same image as without a map at that pose).
+    // same image as without a map at that pose; a small one, to compare).
     let moved = |scene: &Scene| {
-        let mut renderer = scene_renderer(scene, SIZE.0, SIZE.1);
+        let mut renderer = scene_renderer(scene, 160, 120);
         let rest = ScenePose::of(&scene_desc(scene, None));
         renderer.set_pose(ScenePose {
             world_from_model: Mat4::from_translation(Vec3::X * 0.001) * rest.world_from_model,

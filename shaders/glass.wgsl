@@ -705,30 +705,29 @@ struct Branch {
 // and meeting nothing (`mesh_exit`: lost), or outside and meeting nothing more.
 fn meet(b: ptr<function, Branch>, ior: f32) -> vec4<f32> {
     let d = (*b).d;
-    if (*b).inside {
-        let exit = mesh_exit((*b).p, d);
-        if exit.x < 0.0 {
-            return vec4<f32>(d, -1.0);
-        }
-        (*b).p += d * exit.x;
-        (*b).path += exit.x;
-        let leaving = refract(d, -exit.yzw, ior);
-        if dot(leaving, leaving) > 0.0 {
-            let reflected = fresnel_exact(dot(d, exit.yzw), ior);
-            (*b).passed *= 1.0 - reflected;
-            (*b).d = normalize(leaving);
-            (*b).inside = false;
-            return vec4<f32>(reflect(d, exit.yzw), reflected);
-        }
-        (*b).d = reflect(d, exit.yzw);
-        return vec4<f32>(d, 0.0);
-    }
+    // One search whether inside or out (lavapipe inlines every call: one copy of the search
+    // here, not one for each side).
     let hit = mesh_hit((*b).p + d * MESH_EPS, d);
     if hit.x >= NO_HIT {
         return vec4<f32>(d, -1.0);
     }
     (*b).p += d * (hit.x + MESH_EPS);
-    let facing = select(-hit.yzw, hit.yzw, dot(d, hit.yzw) < 0.0);
+    // The normal there turned to face along the ray (`mesh_exit`).
+    let along = select(-hit.yzw, hit.yzw, dot(hit.yzw, d) >= 0.0);
+    if (*b).inside {
+        (*b).path += hit.x + MESH_EPS;
+        let leaving = refract(d, -along, ior);
+        if dot(leaving, leaving) > 0.0 {
+            let reflected = fresnel_exact(dot(d, along), ior);
+            (*b).passed *= 1.0 - reflected;
+            (*b).d = normalize(leaving);
+            (*b).inside = false;
+            return vec4<f32>(reflect(d, along), reflected);
+        }
+        (*b).d = reflect(d, along);
+        return vec4<f32>(d, 0.0);
+    }
+    let facing = -along;
     let reflected = fresnel_exact(-dot(d, facing), 1.0 / ior);
     (*b).passed *= 1.0 - reflected;
     (*b).d = normalize(refract(d, facing, 1.0 / ior));
@@ -873,34 +872,35 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
         }
     } else {
         // Out of an object that is not convex, the ray may meet it again: in there, and on to
-        // where it leaves again.
-        for (var entries = 1; entries <= MAX_ENTRIES; entries++) {
-            if s.escaped == 0.0 {
+        // where it leaves again. Its meetings in turn, each splitting a share off: an exit (even
+        // k) reflects one back inside, a re-entry (odd k) one away, followed at one call site
+        // (lavapipe inlines every call: one copy of `follow` and its searches, not two).
+        for (var k = 0; k < 2 * MAX_ENTRIES - 1; k++) {
+            let entering = k % 2 == 1;
+            var facing = vec3<f32>(0.0);
+            var reflects = 0.0;
+            if entering {
+                let again = mesh_hit(s.p + s.d * MESH_EPS, s.d);
+                if again.x >= NO_HIT {
+                    break;
+                }
+                s.p += s.d * (again.x + MESH_EPS);
+                facing = select(-again.yzw, again.yzw, dot(s.d, again.yzw) < 0.0);
+                reflects = fresnel_exact(-dot(s.d, facing), 1.0 / ior);
+            } else if s.escaped == 0.0 {
                 break;
             }
             if ROOM {
-                let weight = s.arriving * s.reflectance;
-                out.echoes += follow(s.p, s.echo_d, true, ior, weight) * weight * absorbed(s);
+                let weight = select(s.arriving * s.reflectance, s.transmission * reflects, entering);
+                let split = select(s.echo_d, reflect(s.d, facing), entering);
+                out.echoes += follow(s.p, split, !entering, ior, weight) * weight * absorbed(s);
             }
-            if entries == MAX_ENTRIES {
-                break;
+            if entering {
+                s.transmission *= 1.0 - reflects;
+                s.d = normalize(refract(s.d, facing, 1.0 / ior));
+                s.escaped = 0.0;
+                s = to_the_outside(s, ior);
             }
-            let again = mesh_hit(s.p + s.d * MESH_EPS, s.d);
-            if again.x >= NO_HIT {
-                break;
-            }
-            s.p += s.d * (again.x + MESH_EPS);
-            let facing = select(-again.yzw, again.yzw, dot(s.d, again.yzw) < 0.0);
-            let reflects = fresnel_exact(-dot(s.d, facing), 1.0 / ior);
-            if ROOM {
-                let weight = s.transmission * reflects;
-                out.echoes += follow(s.p, reflect(s.d, facing), false, ior, weight) * weight
-                    * absorbed(s);
-            }
-            s.transmission *= 1.0 - reflects;
-            s.d = normalize(refract(s.d, facing, 1.0 / ior));
-            s.escaped = 0.0;
-            s = to_the_outside(s, ior);
         }
     }
     out.escaped = s.escaped;

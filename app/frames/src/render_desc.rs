@@ -144,7 +144,9 @@ pub fn texture(image: &Image) -> TextureDesc<'_> {
     }
 }
 
-/// The renderer for `scene` (with its defocus stacks when given) at `width` x `height` per eye.
+/// The renderer for `scene` (with its defocus stacks when given) at `width` x `height` per eye,
+/// said before and after: the driver compiles every pipeline here, which for a mesh's glass on
+/// a CPU device (lavapipe) takes a minute or more the first time.
 pub fn renderer_for(
     ctx: vitreous_render::GpuContext,
     scene: &Scene,
@@ -153,8 +155,12 @@ pub fn renderer_for(
     height: u32,
 ) -> anyhow::Result<vitreous_render::Renderer> {
     use anyhow::Context;
-    vitreous_render::Renderer::new(ctx, &scene_desc(scene, defocus), width, height)
-        .context("preparing the renderer")
+    tracing::info!("preparing the renderer for {width}x{height} (the driver compiles its shaders)");
+    let started = std::time::Instant::now();
+    let renderer = vitreous_render::Renderer::new(ctx, &scene_desc(scene, defocus), width, height)
+        .context("preparing the renderer")?;
+    tracing::info!("renderer ready in {:.1} s", started.elapsed().as_secs_f64());
+    Ok(renderer)
 }
 
 /// The renderer's view of a scene, with the blur stacks of `defocus` when defocus is used.

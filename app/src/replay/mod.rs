@@ -349,13 +349,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
     let (device, driver) = (ctx.device_name.clone(), ctx.driver.clone());
     let (planner, defocus) =
         vitreous_frames::look::planner_for(&scene, &effects, options.reflection, &options.gaze)?;
-    let mut renderer = Renderer::new(
-        ctx,
-        &render_desc::scene_desc(&scene, defocus.as_ref()),
-        width,
-        height,
-    )
-    .context("preparing the renderer")?;
+    let mut renderer = render_desc::renderer_for(ctx, &scene, defocus.as_ref(), width, height)?;
     render_desc::enable_live_caustics(&mut renderer, &scene, effects.caustics)
         .context("preparing live caustics")?;
     let other = if options.sphere_check {

@@ -283,15 +283,13 @@ impl GlassPass {
         } else {
             &[0]
         };
-        let entries = || {
-            compensated
-                .iter()
-                .flat_map(|&c| GlassVariant::ALL.iter().map(move |v| (c, v.index())))
-        };
+        let entries: Vec<_> = compensated
+            .iter()
+            .flat_map(|&c| GlassVariant::ALL.iter().map(move |v| (c, v.index())))
+            .collect();
         let create = |fragment| create_pipeline(ctx, render_pass, layout.raw(), fragment);
-        let pipelines = entries()
-            .map(|(c, v)| create(shaders::GLASS_FS[c][shaded][v]))
-            .collect::<Result<Vec<_>>>()?;
+        let pipelines =
+            pipeline::in_parallel(&entries, |&(c, v)| create(shaders::GLASS_FS[c][shaded][v]))?;
         // The proof and its pipelines where the model has them compiled and the object is a
         // ball.
         let coverage = shaders::covered_row(shaded).and_then(|_| PhotoCoverage::of(desc, ball));
@@ -379,8 +377,9 @@ impl GlassPass {
             // The loop over a pixel's positions counts once in the static cost: each further
             // position is charged as one more one-position shader (its surface fetch, which the
             // loop does not repeat, included).
-            costs: entries()
-                .map(|(c, v)| {
+            costs: entries
+                .iter()
+                .map(|&(c, v)| {
                     shaders::GLASS_FS_COST[c][shaded][v]
                         .with_runs(shaders::GLASS_FS_COST[0][model][v], samples * samples)
                 })

@@ -67,6 +67,12 @@ pub fn warm_up(
         views,
         gaze: None,
     };
+    tracing::info!(
+        "drawing each of the {} looks once before the session (a driver such as lavapipe \
+         finishes its shaders at their first draw)",
+        looks.len()
+    );
+    let started = std::time::Instant::now();
     for look in looks {
         renderer.submit_composed(
             &frame_params(&input, *look),
@@ -76,6 +82,7 @@ pub fn warm_up(
     }
     renderer.flush()?;
     renderer.recompute_floor();
+    tracing::info!("looks drawn in {:.1} s", started.elapsed().as_secs_f64());
     Ok(())
 }
 

@@ -860,21 +860,24 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
     let p = (g.model_from_world * vec4<f32>(entry, 1.0)).xyz - g.radial.xyz;
     let d = normalize((g.model_from_world * vec4<f32>(inside_world, 0.0)).xyz);
     let entered = 1.0 - fresnel_exact(-dot(incident, normal), 1.0 / ior);
-    var s = to_the_outside(Inside(p, d, entered, 0.0, 0.0, 0.0, 0.0, d), ior);
+    var s = Inside(p, d, entered, 0.0, 0.0, 0.0, 0.0, d);
     out.echoes = vec3<f32>(0.0);
     if BALL {
+        s = to_the_outside(s, ior);
         if ROOM && s.escaped > 0.0 {
             out.echoes = echoes_of(s, ior);
         }
     } else if CONVEX {
+        s = to_the_outside(s, ior);
         if ROOM && s.escaped > 0.0 {
             out.echoes = echoes_of(s, ior);
         }
     } else {
         // Out of an object that is not convex, the ray may meet it again: in there, and on to
         // where it leaves again. Its meetings in turn, each splitting a share off: an exit (even
-        // k) reflects one back inside, a re-entry (odd k) one away, followed at one call site
-        // (lavapipe inlines every call: one copy of `follow` and its searches, not two).
+        // k, after the way to it inside) reflects one back inside, a re-entry (odd k) one away;
+        // each written once (lavapipe inlines every call: one copy of `to_the_outside` and of
+        // `follow` with their searches, not two).
         for (var k = 0; k < 2 * MAX_ENTRIES - 1; k++) {
             let entering = k % 2 == 1;
             var facing = vec3<f32>(0.0);
@@ -887,8 +890,11 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
                 s.p += s.d * (again.x + MESH_EPS);
                 facing = select(-again.yzw, again.yzw, dot(s.d, again.yzw) < 0.0);
                 reflects = fresnel_exact(-dot(s.d, facing), 1.0 / ior);
-            } else if s.escaped == 0.0 {
-                break;
+            } else {
+                s = to_the_outside(s, ior);
+                if s.escaped == 0.0 {
+                    break;
+                }
             }
             if ROOM {
                 let weight = select(s.arriving * s.reflectance, s.transmission * reflects, entering);
@@ -899,7 +905,6 @@ fn two_surface(entry: vec3<f32>, incident: vec3<f32>, normal: vec3<f32>, ior: f3
                 s.transmission *= 1.0 - reflects;
                 s.d = normalize(refract(s.d, facing, 1.0 / ior));
                 s.escaped = 0.0;
-                s = to_the_outside(s, ior);
             }
         }
     }

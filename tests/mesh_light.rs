@@ -6,19 +6,18 @@
 //! bowl and stem alike.
 
 use glam::{Mat4, Vec2, Vec3};
-use vitreous_frames::look::base_look;
 use vitreous_frames::render_desc::scene_desc;
 use vitreous_optics::camera::EyeParams;
 use vitreous_optics::display::Compensation;
 use vitreous_optics::two_surface::Body;
 use vitreous_reference::world::Glass;
 use vitreous_reference::{FloorLight, PhotonParams, Window, World, render_eye};
-use vitreous_render::{Composition, FrameParams, Reflection, ScenePose, Want};
+use vitreous_render::{Composition, ScenePose, Want};
 use vitreous_scene::Scene;
 use vitreous_scene::caustics::Bake;
-use vitreous_scene::effects::EffectSet;
 use vitreous_tests::{
-    compose_once, left_eye_light, neutral_eyes, scene_renderer, shipped_scene, torus_in_the_room,
+    compose_once, left_eye_light, neutral_eyes, plain_params, scene_renderer, shipped_scene,
+    torus_in_the_room,
 };
 
 /// The goblet's image size.
@@ -219,13 +218,7 @@ fn the_floor_seen_through_a_torus_shows_its_shadow_and_caustic() {
             world_from_model: Mat4::from_translation(Vec3::X * 0.001) * rest.world_from_model,
             ..rest
         });
-        let params = FrameParams {
-            eyes: [camera, camera],
-            look: base_look(
-                &EffectSet::parse("none").unwrap(),
-                Reflection::EnvironmentFresnel,
-            ),
-        };
+        let params = plain_params(camera);
         let want = Want {
             eyes: true,
             world: false,

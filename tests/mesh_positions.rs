@@ -4,12 +4,10 @@
 //! word where a mesh's searches ran too many rounds), and a grid twice as fine only where the
 //! first grid's positions disagree.
 
-use vitreous_frames::look::base_look;
 use vitreous_optics::display::Compensation;
-use vitreous_render::{Composition, FrameParams, MeshSearch, Reflection, Want};
+use vitreous_render::{Composition, MeshSearch, Want};
 use vitreous_scene::Scene;
-use vitreous_scene::effects::EffectSet;
-use vitreous_tests::{compose_once, neutral_eyes, scene_renderer, torus_in_the_room};
+use vitreous_tests::{compose_once, neutral_eyes, plain_params, scene_renderer, torus_in_the_room};
 
 const SIZE: (u32, u32) = (320, 240);
 
@@ -21,14 +19,7 @@ fn counted(scene: &Scene) -> MeshSearch {
         renderer.count_invocations().unwrap(),
         "this device counts no invocations"
     );
-    let left = neutral_eyes(scene)[0];
-    let params = FrameParams {
-        eyes: [left, left],
-        look: base_look(
-            &EffectSet::parse("none").unwrap(),
-            Reflection::EnvironmentFresnel,
-        ),
-    };
+    let params = plain_params(neutral_eyes(scene)[0]);
     let want = Want {
         eyes: false,
         world: false,

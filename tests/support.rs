@@ -327,22 +327,27 @@ pub fn left_world_view(scene: &vitreous_scene::Scene, size: (u32, u32)) -> Vec<V
     linear_rgb(&frame.world.expect("the world views")[0])
 }
 
+/// A frame's parameters with both eyes at `eye`, no effects, environment reflection with
+/// Fresnel.
+pub fn plain_params(eye: vitreous_optics::camera::EyeParams) -> vitreous_render::FrameParams {
+    vitreous_render::FrameParams {
+        eyes: [eye, eye],
+        look: vitreous_frames::look::base_look(
+            &vitreous_scene::effects::EffectSet::parse("none").unwrap(),
+            vitreous_render::Reflection::EnvironmentFresnel,
+        ),
+    }
+}
+
 fn left_eye_frame(
     scene: &vitreous_scene::Scene,
     size: (u32, u32),
     world: bool,
 ) -> vitreous_render::Readback {
-    use vitreous_render::{Composition, FrameParams, Reflection, Renderer, Want};
+    use vitreous_render::{Composition, Renderer, Want};
     let desc = vitreous_frames::render_desc::scene_desc(scene, None);
     let mut r = Renderer::new(validated_context(), &desc, size.0, size.1).expect("renderer");
-    let left = neutral_eyes(scene)[0];
-    let params = FrameParams {
-        eyes: [left, left],
-        look: vitreous_frames::look::base_look(
-            &vitreous_scene::effects::EffectSet::parse("none").unwrap(),
-            Reflection::EnvironmentFresnel,
-        ),
-    };
+    let params = plain_params(neutral_eyes(scene)[0]);
     let want = Want { eyes: true, world };
     compose_once(&mut r, &params, want, Composition::Additive)
         .readback

@@ -38,6 +38,7 @@ use crate::error::Result;
 use crate::look::{Look, Reflection};
 use crate::memory::Buffer;
 use crate::owned::Owned;
+use crate::parallel;
 use crate::pipeline::{self, Blend, Depth, PipelineSpec};
 use crate::pose::ScenePose;
 use crate::scene::{GpuScene, SceneDesc, VERTEX_STRIDE};
@@ -289,7 +290,7 @@ impl GlassPass {
             .collect();
         let create = |fragment| create_pipeline(ctx, render_pass, layout.raw(), fragment);
         let pipelines =
-            pipeline::in_parallel(&entries, |&(c, v)| create(shaders::GLASS_FS[c][shaded][v]))?;
+            parallel::in_parallel(&entries, |&(c, v)| create(shaders::GLASS_FS[c][shaded][v]))?;
         // The proof and its pipelines where the model has them compiled and the object is a
         // ball.
         let coverage = shaders::covered_row(shaded).and_then(|_| PhotoCoverage::of(desc, ball));

@@ -43,6 +43,7 @@ mod glass;
 pub mod look;
 mod memory;
 mod owned;
+mod parallel;
 mod pipeline;
 pub mod pose;
 pub mod present;

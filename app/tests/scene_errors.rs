@@ -219,6 +219,11 @@ fn out_of_range_value_is_named() {
         );
         assert!(msg.contains(samples), "{msg}");
     }
+    for yaw in ["400", "-361", "\"east\""] {
+        let text = good_text().replace("map = '", &format!("yaw_deg = {yaw}\nmap = '"));
+        let msg = expect_error(&text, line_of(&text, "yaw_deg"), "environment.yaw_deg");
+        assert!(msg.contains(yaw.trim_matches('"')), "{msg}");
+    }
     let text = good_text().replace("diameter_m = 0.08", "diameter_m = 12.0");
     expect_error(&text, line_of(&text, "diameter_m"), "object.diameter_m");
     let text = good_text().replace("diameter_m = 0.08", "diameter_m = -0.1");

@@ -335,3 +335,52 @@ fn gltf_volume_attenuation_scales_with_the_object_and_the_scene_overrides_it() {
     assert_eq!(scene.object.attenuation, Attenuation::NONE);
     assert!(scene.object.attenuation.is_clear());
 }
+
+#[test]
+fn the_environment_map_turns_about_the_vertical() {
+    // The shipped room scene with its map turned a quarter (counter-clockwise from above):
+    // what the file holds ahead (-z, the middle column) is then seen to the left (-x, a quarter
+    // of the width), and a full turn is the file's map.
+    let path = repo("config/scenes/glass-sphere-real.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let turned_by = |yaw: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let copy = dir.path().join("turned.toml");
+        let text = text
+            .replace("room = true", &format!("room = true\nyaw_deg = {yaw}"))
+            .replace("\"../", &format!("\"{}/", repo("config").display()));
+        std::fs::write(&copy, text).unwrap();
+        load_scene(&copy).unwrap()
+    };
+    let file_scene = load_scene(&path).unwrap();
+    let file = &file_scene.environment;
+    assert_eq!(file.yaw_deg, 0.0);
+    let column = |env: &vitreous_scene::Environment, x: u32| -> Vec<f32> {
+        let vitreous_scene::PixelData::LinearF32(v) = &env.latlong.data else {
+            panic!("a float map");
+        };
+        let w = env.latlong.width;
+        (0..env.latlong.height)
+            .flat_map(|y| v[((y * w + x) * 4) as usize..][..3].to_vec())
+            .collect()
+    };
+    let w = file.latlong.width;
+    assert_eq!(w % 4, 0, "a width the test can turn by whole columns");
+    let quarter_scene = turned_by("90");
+    let quarter = &quarter_scene.environment;
+    assert_eq!(quarter.yaw_deg, 90.0);
+    assert_eq!(column(quarter, w / 4), column(file, w / 2));
+    assert_ne!(column(quarter, w / 2), column(file, w / 2));
+    let full = turned_by("-360");
+    assert_eq!(column(&full.environment, 7), column(file, 7));
+    // The physical reference sees the turned map: to the left what the file has ahead.
+    let world = |scene: &vitreous_scene::Scene| {
+        vitreous_reference::World::of(scene, &scene.rest_placement()).unwrap()
+    };
+    let ahead = Vec3::new(0.0, 0.3, -1.0).normalize();
+    let left = Vec3::new(-1.0, 0.3, 0.0).normalize();
+    assert_eq!(
+        world(&quarter_scene).environment_radiance(left),
+        world(&file_scene).environment_radiance(ahead)
+    );
+}

@@ -213,6 +213,7 @@ pub(crate) struct EnvironmentToml {
     pub map: Spanned<String>,
     pub cube_map: Option<Spanned<String>>,
     pub room: Option<Spanned<bool>>,
+    pub yaw_deg: Option<Spanned<f32>>,
 }
 
 /// `[viewer]`: the wearer.

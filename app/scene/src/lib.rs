@@ -20,6 +20,7 @@
 //! | `file` | the file's raw TOML shape |
 //! | `error` | the loader's errors, with file, line and field |
 //! | `image`, `mesh`, `accessor` | the assets: photos and HDRIs; glTF and OBJ meshes |
+//! | `latlong` | an environment map turned about the vertical (`[environment] yaw_deg`) |
 //! | `motion` | keyframed object motion |
 //! | `fixation` | where a viewer of the scene looks (the synthetic traces' targets) |
 //! | [`effects`] | the effect sets a scene or a study condition turns on |
@@ -35,6 +36,7 @@ mod file;
 pub mod files;
 mod fixation;
 mod image;
+mod latlong;
 mod load;
 mod mesh;
 mod motion;
@@ -377,8 +379,12 @@ impl RealPlane {
 /// The environment map.
 #[derive(Clone, Debug)]
 pub struct Environment {
-    /// Latitude-longitude map, linear RGBA f32, rows as stored in the file (top row = zenith).
+    /// Latitude-longitude map, linear RGBA f32, rows as stored in the file (top row = zenith),
+    /// turned by `yaw_deg` (the middle column looks down -z, +x a quarter of the width right).
     pub latlong: Image,
+    /// `environment.yaw_deg`: how far the file's map was turned about the vertical at load,
+    /// degrees, counter-clockwise seen from above.
+    pub yaw_deg: f32,
     /// The map's file.
     pub path: PathBuf,
     /// `environment.cube_map`: reserved; checked to exist and hashed, not decoded.

@@ -25,7 +25,7 @@ use super::{
     Caustics, CausticsMode, Environment, GazeChoice, Image, Inducer, IorSource, Light, MeshLens,
     Object, Output, RealPlane, Scene, SceneError, Viewer, euler_xyz_deg,
 };
-use super::{file, image, mesh};
+use super::{file, image, latlong, mesh};
 use crate::effects::EffectSet;
 use crate::files::{DiskFiles, SceneFiles};
 use vitreous_gaze::{FilterKind, FilterParseError, GazeOverride, PupilSource};
@@ -272,6 +272,14 @@ impl Loader<'_> {
             self.src
                 .asset(raw.environment.map.span(), "environment.map", &env_path, r)
         })?;
+        let yaw_deg = self.number(
+            "environment.yaw_deg",
+            raw.environment.yaw_deg.as_ref(),
+            0.0,
+            (-360.0, 360.0),
+            CLOSED,
+        )?;
+        let latlong = latlong::turned_about_vertical(latlong, yaw_deg);
         let cube_map_path = match &raw.environment.cube_map {
             Some(rel) => Some(self.read_asset("environment.cube_map", rel)?.0),
             None => None,
@@ -282,6 +290,7 @@ impl Loader<'_> {
             path: env_path,
             cube_map_path,
             room,
+            yaw_deg,
         };
 
         let v = &raw.viewer;

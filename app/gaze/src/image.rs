@@ -11,12 +11,19 @@
 //! log gap so it scales with the scene: for 0.6 m / 1.5 m and `h = 0.2` it is +-9.6 % about
 //! T = 0.95 m. With no current image (start-up, or after the tracker was lost) the first
 //! depth is compared with `T` alone.
+//!
+//! A decision is taken on a new tracker sample only ([`ImageSelector::update_on`]): the image
+//! distances move with the head every frame, and a depth held from an earlier sample (through a
+//! blink, while the tracker is out or doubted, on a frame between two samples) measures nothing
+//! new about the gaze, so the head's movement alone never switches the image.
 
 use std::fmt;
 use std::str::FromStr;
 
 use glam::Vec3;
 use thiserror::Error;
+
+use crate::vergence::FixationDepth;
 
 /// Default hysteresis band, as a fraction of the log gap between threshold and image.
 pub const DEFAULT_BAND: f32 = 0.2;
@@ -95,6 +102,8 @@ pub struct ImageSelector {
     pub band: f32,
     /// The current decision.
     current: GazeImage,
+    /// Tracker time of the sample the current decision was taken on.
+    decided_on_ns: Option<i64>,
 }
 
 impl ImageSelector {
@@ -108,6 +117,7 @@ impl ImageSelector {
                 DEFAULT_BAND
             },
             current: GazeImage::Unknown,
+            decided_on_ns: None,
         }
     }
 
@@ -123,6 +133,28 @@ impl ImageSelector {
         let t = d.threshold_m();
         let toward = |target: f32| t * (target / t).powf(self.band);
         (toward(d.refracted_m), toward(d.surface_m))
+    }
+
+    /// Updates the decision with this frame's filtered depth, on a sample it has not decided
+    /// on yet; a depth held from the sample of the current decision keeps it (module docs).
+    pub fn update_on(&mut self, filtered: &FixationDepth) -> GazeImage {
+        match *filtered {
+            FixationDepth::Unknown => {
+                self.decided_on_ns = None;
+                self.update(None)
+            }
+            FixationDepth::Known {
+                depth_m,
+                sample_time_ns,
+            } => {
+                if self.decided_on_ns == Some(sample_time_ns) && self.current != GazeImage::Unknown
+                {
+                    return self.current;
+                }
+                self.decided_on_ns = Some(sample_time_ns);
+                self.update(Some(depth_m))
+            }
+        }
     }
 
     /// Updates the decision with this frame's filtered depth (`None`: unknown).
@@ -157,6 +189,7 @@ impl ImageSelector {
     /// Forgets the current decision.
     pub fn reset(&mut self) {
         self.current = GazeImage::Unknown;
+        self.decided_on_ns = None;
     }
 }
 
@@ -236,6 +269,28 @@ mod tests {
         assert_eq!(s.update(Some(down * 0.99)), GazeImage::Surface);
         assert_eq!(s.update(None), GazeImage::Unknown);
         assert_eq!(s.update(Some(t * 1.01)), GazeImage::Refracted);
+    }
+
+    #[test]
+    fn a_held_depth_keeps_the_decision_as_the_head_moves() {
+        let known = |depth_m, sample_time_ns| FixationDepth::Known {
+            depth_m,
+            sample_time_ns,
+        };
+        let mut s = ImageSelector::new(D, 0.2);
+        assert_eq!(s.update_on(&known(0.8, 1)), GazeImage::Surface);
+        // The head moves back: the images are farther, 0.8 m is now past where the selector
+        // leaves the surface. The same sample decides nothing new...
+        s.distances = ImageDistances {
+            surface_m: 0.3,
+            refracted_m: 0.6,
+        };
+        assert_eq!(s.update_on(&known(0.8, 1)), GazeImage::Surface);
+        // ...a new sample at that depth does.
+        assert_eq!(s.update_on(&known(0.8, 2)), GazeImage::Refracted);
+        // Unknown forgets; the next known depth decides even on an old sample's time.
+        assert_eq!(s.update_on(&FixationDepth::Unknown), GazeImage::Unknown);
+        assert_eq!(s.update_on(&known(0.35, 2)), GazeImage::Surface);
     }
 
     #[test]

@@ -86,10 +86,14 @@ pub(crate) fn load_text(
     (dir, path, result)
 }
 
-/// The 1-based line of the first line containing `needle`.
+/// The 1-based line of the first line containing `needle` outside single-quoted strings (the
+/// scenes' paths are written so, and a checkout's folder names may hold any needle: "nan",
+/// "-1"), else of the first containing it anywhere (a needle in a path).
 pub(crate) fn line_of(text: &str, needle: &str) -> usize {
-    text.lines()
-        .position(|l| l.contains(needle))
+    let unquoted = |l: &str| l.split('\'').step_by(2).collect::<String>();
+    let first = |hit: &dyn Fn(&str) -> bool| text.lines().position(hit);
+    first(&|l| unquoted(l).contains(needle))
+        .or_else(|| first(&|l| l.contains(needle)))
         .unwrap_or_else(|| panic!("{needle} not in text"))
         + 1
 }

@@ -3,11 +3,14 @@
 // Three dispatches, in order:
 //
 // - `want`, one invocation per pixel of the eye image the eye passes drew (before the dimmer):
-//   where the glass was drawn (the only depth writer) the target is the glass's light G, and
-//   the share to take away is what brings the real background B down to it in the channel that
-//   needs most, max_c (1 - G_c / B_c); on the floor, the shadow's share the overlay wrote as
-//   alpha. Clamped to the panel's largest attenuation, each cell keeps the largest its pixels
-//   want (an atomic max on the bits of non-negative floats, which order as the floats do).
+//   where the glass was drawn (the only depth writer) the target is the glass's light G over
+//   the share k of the pixel it covers and the real world over the rest (less the floor's
+//   shadow there), and the share to take away is what brings the real background B down to it
+//   in the channel that needs most: with the glass's alpha A = k + (1 - k) s m (laid over the
+//   overlay's, render/src/glass.rs), max_c (A - G_c / B_c) (A = 1 where the glass covers the
+//   whole pixel); on the floor, the shadow's share the overlay wrote as alpha.
+//   Clamped to the panel's largest attenuation, each cell keeps the largest its pixels want (an
+//   atomic max on the bits of non-negative floats, which order as the floats do).
 // - `spread`, one per cell: the largest want within the panel's spread (optics/src/display/
 //   dimmer.rs `Panel::spread_wants`: one cell, less under a registration error), or with a
 //   negative spread the least (an erosion); what the blurred patch takes away beyond the
@@ -50,7 +53,7 @@ fn want(@builtin(global_invocation_id) id: vec3<u32>) {
     var share = drawn_here.a;
     if textureLoad(drawn_depth, vec2<i32>(id.xy), l, 0) < 1.0 {
         let b = seen_along(dimmer.position.xyz, ray(id.xy));
-        let dark = select(vec3<f32>(0.0), 1.0 - drawn_here.rgb / max(b, vec3<f32>(1e-6)), b > vec3<f32>(1e-4));
+        let dark = select(vec3<f32>(0.0), drawn_here.a - drawn_here.rgb / max(b, vec3<f32>(1e-6)), b > vec3<f32>(1e-4));
         share = max(max(dark.r, dark.g), dark.b);
     }
     share = clamp(share, 0.0, dimmer.limits.x);

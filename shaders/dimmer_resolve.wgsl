@@ -4,8 +4,10 @@
 // leak compensation for optical see-through displays using a single-layer transmissive spatial
 // light modulator", IEEE TVCG 2017; radiometric compensation as in Grossberg et al., CVPR
 // 2004): L = max(T - B (1 - D), 0), with B the real world behind the pixel, D the share the
-// soft panel takes away there, and T the glass's light where it was drawn, else the real world
-// with the floor's shadow taken away and the overlay's light added: T = B (1 - a) + E. Where
+// soft panel takes away there, and T the real world with the share a taken away and the light
+// E drawn added, T = B (1 - a) + E: on the floor a is the shadow's share and E the overlay's
+// light; under the glass E is its light and a the share of the pixel it covers (over the
+// floor's share beneath), all of it where it covers the whole pixel. Where
 // the panel takes away more than the target needs (the soft edge's halo) the light gives it
 // back; where it takes away less (inside a small dark patch) the eye sees the leak. The alpha
 // is the pixel's cell of the panel: what the display's dimmer should take away.
@@ -50,9 +52,10 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> Resolved {
     let l = i32(dimmer.position.w);
     let drawn_here = textureLoad(drawn, vec2<i32>(px), l, 0);
     let depth = textureLoad(drawn_depth, vec2<i32>(px), l, 0);
-    let glass = depth < 1.0;
-    // What the target takes away from B (all of it under the glass, whose light is all of T).
-    let a = select(drawn_here.a, 1.0, glass);
+    // What the target takes away from B: the floor's shadow share, under the glass the share
+    // of the pixel it covers laid over that (dimmer_panel.wgsl), all of it where it covers the
+    // whole pixel (its light all of T).
+    let a = drawn_here.a;
     let d = soft_at(frag.xy);
     let cells = vec2<u32>(dimmer.size.zw);
     let c = min(px * cells / vec2<u32>(dimmer.size.xy), cells - 1u);

@@ -212,6 +212,26 @@ fn vs_main(
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
 ) -> VertexOut {
+    return vertex_out(position, normal, uv);
+}
+
+// The vertex shader of a ball drawn on its proxy (render/src/glass/proxy.rs: a coarse
+// polyhedron about the ball, every face outside its sphere): `vs_main`'s outputs but for
+// `curve`, the sphere's own radius (world metres; the object's transform is a similarity)
+// wherever the proxy lies, and 1 (a ball).
+@vertex
+fn vs_ball_proxy(
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+) -> VertexOut {
+    var out = vertex_out(position, normal, uv);
+    let radius = (g.world_from_model * vec4<f32>(g.radial.w, 0.0, 0.0, 0.0)).xyz;
+    out.curve = vec2<f32>(length(radius), 1.0);
+    return out;
+}
+
+fn vertex_out(position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> VertexOut {
     var out: VertexOut;
     let world = g.world_from_model * vec4<f32>(position, 1.0);
     out.world_pos = world.xyz;
@@ -451,6 +471,9 @@ var<private> missed_positions: u32;
 // The positions of this pixel's grids shaded through a mesh or a gem (`SUPERSAMPLED`,
 // `supersampled`).
 var<private> positions_shaded: u32;
+// The share of the pixel the glass covers, where its pipeline knows it (a ball's parts,
+// `ball_parts`): the alpha it outputs.
+var<private> covered_share: f32 = 1.0;
 
 // Distance along the ray p + t / inv (t >= 0) to the box [lo, hi], or NO_HIT where it passes
 // beside it.
@@ -1146,6 +1169,15 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
             }
         } else {
             out = max(out - seen_behind(in), vec3<f32>(0.0));
+        }
+    }
+    // Alpha: the share of the pixel the glass covers, where the pipeline knows it (each
+    // pipeline constant its own `if`, so that the others' counted cost is as it was).
+    if SUPERSAMPLED {
+        if BALL {
+            if ROOM {
+                return vec4<f32>(out, covered_share);
+            }
         }
     }
     return vec4<f32>(out, 1.0);

@@ -160,7 +160,7 @@ fn the_dimmer_darkens_the_real_shadow_and_gives_back_its_halo() {
                     && v >= 0
                     && u < SIZE.0 as i32
                     && v < SIZE.1 as i32
-                    && alpha[(v as u32 * SIZE.0 + u as u32) as usize] > 200
+                    && alpha[(v as u32 * SIZE.0 + u as u32) as usize] > 128
             })
         })
     };
@@ -187,4 +187,67 @@ fn the_dimmer_darkens_the_real_shadow_and_gives_back_its_halo() {
             assert!((seen[i] - world[i]).abs().max_element() < 1e-6);
         }
     }
+}
+
+/// The share of the left eye's pixel `(x, y)` the ball covers: of the glass's grid of positions
+/// in it (`[output] glass_samples` along each side, as shaders/shared/glass_positions.wgsl
+/// places them), those whose rays meet the ball's sphere.
+fn covered(scene: &vitreous_scene::Scene, x: u32, y: u32) -> f32 {
+    let eye = neutral_eyes(scene)[0];
+    let (c, r) = (scene.object.center_m, scene.object.radius_m);
+    let n = scene.output.glass_samples;
+    let size = Vec2::new(SIZE.0 as f32, SIZE.1 as f32);
+    let meeting = (0..n * n)
+        .filter(|i| {
+            let offset = (Vec2::new((i % n) as f32, (i / n) as f32) + 0.5) / n as f32;
+            let dir = eye.pixel_ray(Vec2::new(x as f32, y as f32) + offset, size);
+            let to = c - eye.position_m;
+            (to - dir * to.dot(dir)).length() < r
+        })
+        .count();
+    meeting as f32 / (n * n) as f32
+}
+
+#[test]
+fn at_the_balls_outline_the_eye_sees_the_real_world_through_the_share_the_glass_leaves() {
+    // A pixel the ball covers in part: the glass's light there is the covered share's (its
+    // positions beside the ball add nothing), and the rest of the pixel is the real world's.
+    let scene = shipped_scene("glass-sphere-ml2.toml");
+    assert!(scene.output.glass_samples > 1);
+    let dimmed = left(&scene, Composition::AlphaBlend);
+    // The glass's own light: the same scene on an additive display, nothing taken away.
+    let mut additive_scene = scene.clone();
+    additive_scene.dimmer = None;
+    additive_scene.compensation = vitreous_optics::display::Compensation::None;
+    let glass = left(&additive_scene, Composition::Additive);
+    // The outline's upper half (the wall and table behind it, no shadow), a quarter to three
+    // quarters covered.
+    let eye = neutral_eyes(&scene)[0];
+    let size = Vec2::new(SIZE.0 as f32, SIZE.1 as f32);
+    let centre = eye.project_to_pixel(scene.object.center_m, size).unwrap();
+    let outline: Vec<(usize, f32)> = (0..SIZE.0 * SIZE.1)
+        .filter(|&i| ((i / SIZE.0) as f32) < centre.y - 2.0)
+        .map(|i| (i as usize, covered(&scene, i % SIZE.0, i / SIZE.0)))
+        .filter(|&(_, k)| (0.25..=0.75).contains(&k))
+        .collect();
+    assert!(outline.len() > 15, "{} outline pixels", outline.len());
+    // What the eye sees there: the glass's light and the world through the share it leaves,
+    // G + (1 - k) B. Taking the whole of such a pixel for the glass would leave G alone: off by
+    // the whole of (1 - k) B.
+    let (mut off, mut through) = (0.0, 0.0);
+    for &(i, k) in &outline {
+        let world = dimmed.world[i] * (1.0 - k);
+        off += (dimmed.seen[i] - (glass.light[i] + world))
+            .abs()
+            .element_sum();
+        through += world.element_sum();
+    }
+    eprintln!(
+        "{} outline pixels: the world through them {through:.3}, the eye's view off by {off:.3}",
+        outline.len()
+    );
+    assert!(
+        off < 0.25 * through,
+        "the eye's view at the outline is off by {off}, the world through it {through}"
+    );
 }

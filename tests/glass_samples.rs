@@ -14,7 +14,10 @@ use vitreous_optics::optics::refract;
 use vitreous_reference::world::PhotoHit;
 use vitreous_reference::{EyeImage, Window, World, render_eye};
 use vitreous_scene::Scene;
-use vitreous_tests::{left_eye_light, left_world_view, neutral_eyes, shipped_scene};
+use vitreous_scene::effects::EffectSet;
+use vitreous_tests::{
+    compose_once, left_eye_light, left_world_view, neutral_eyes, shipped_scene, validated_context,
+};
 
 const SIZE: (u32, u32) = (320, 240);
 
@@ -318,4 +321,99 @@ fn the_world_view_with_several_positions_per_pixel_is_the_real_one_over_the_foot
         footprint_error < 0.1 * light,
         "{footprint_error} of {light}"
     );
+}
+
+/// Pixels of the left eye's image of `(width, height)` none of whose positions of the glass's
+/// grid (`samples` along each side) meets the ball, whose centre passes the ball's centre within
+/// `reach` of its radius.
+fn beside_the_ball(
+    scene: &Scene,
+    camera: &EyeParams,
+    (width, height): (u32, u32),
+    (samples, reach): (u32, f32),
+) -> Vec<usize> {
+    let size = Vec2::new(width as f32, height as f32);
+    let (c, r) = (scene.object.center_m, scene.object.radius_m);
+    let off = |p: Vec2| {
+        let dir = camera.pixel_ray(p, size);
+        let to = c - camera.position_m;
+        (to - dir * to.dot(dir)).length()
+    };
+    (0..width * height)
+        .filter(|&i| {
+            let corner = Vec2::new((i % width) as f32, (i / width) as f32);
+            let misses = (0..samples * samples).all(|k| {
+                let grid = Vec2::new((k % samples) as f32, (k / samples) as f32);
+                off(corner + (grid + 0.5) / samples as f32) >= r
+            });
+            misses && off(corner + 0.5) < reach * r
+        })
+        .map(|i| i as usize)
+        .collect()
+}
+
+/// The left eye's display light (linear RGB) for `scene` at `size` with the floor's effects
+/// (the inducer and the caustic, `c`), both eyes at the neutral head's left eye, composed for
+/// an additive display, validation on.
+fn left_light_with_the_floors_effects(scene: &Scene, size: (u32, u32)) -> Vec<Vec3> {
+    use vitreous_render::{Composition, Reflection, Renderer, Want};
+    let desc = vitreous_frames::render_desc::scene_desc(scene, None);
+    let mut r = Renderer::new(validated_context(), &desc, size.0, size.1).expect("renderer");
+    let eye = neutral_eyes(scene)[0];
+    let params = vitreous_render::FrameParams {
+        eyes: [eye, eye],
+        look: vitreous_frames::look::base_look(
+            &EffectSet::parse("c").unwrap(),
+            Reflection::EnvironmentFresnel,
+        ),
+    };
+    let want = Want {
+        eyes: true,
+        world: false,
+    };
+    let frame = compose_once(&mut r, &params, want, Composition::Additive);
+    let eye = &frame.readback.expect("read back").eyes[0];
+    eye.chunks_exact(4)
+        .map(|p| Vec3::from_array([0, 1, 2].map(|c| vitreous_optics::srgb::to_linear(p[c]))))
+        .collect()
+}
+
+#[test]
+fn beside_the_ball_the_glass_leaves_what_the_floor_pass_drew() {
+    // The ball's pipelines with several positions per pixel draw it on a coarse polyhedron
+    // about its sphere (render/src/glass/proxy.rs) whose image reaches past the ball's outline:
+    // there the glass draws nothing, and the eye image holds what the floor pass drew (the
+    // inducer's ramp and the caustic), as with one position per pixel, drawn on the model.
+    let scene = with_samples(
+        &shipped_scene("glass-sphere-real.toml"),
+        4,
+        Compensation::None,
+    );
+    // Large enough that the polyhedron's image reaches pixels past the outline (its faces lie
+    // up to a few per cent of the radius beyond the sphere).
+    let size = (1280, 960);
+    let camera = neutral_eyes(&scene)[0];
+    let four = left_light_with_the_floors_effects(&scene, size);
+    let one =
+        left_light_with_the_floors_effects(&with_samples(&scene, 1, Compensation::None), size);
+    let beside = beside_the_ball(&scene, &camera, size, (4, 1.1));
+    let lit: Vec<usize> = beside
+        .iter()
+        .copied()
+        .filter(|&i| one[i].element_sum() > 0.01)
+        .collect();
+    eprintln!(
+        "{} pixels beside the ball, {} of them lit",
+        beside.len(),
+        lit.len()
+    );
+    assert!(lit.len() > 5, "{} lit pixels beside the ball", lit.len());
+    for &i in &beside {
+        assert!(
+            (four[i] - one[i]).abs().max_element() < 1e-3,
+            "pixel {i} beside the ball: {} with 4 x 4 positions, {} with one",
+            four[i],
+            one[i]
+        );
+    }
 }

@@ -7,28 +7,32 @@
 //! push constants, the globals, the facet planes and triangles it uploads for the exit),
 //! built once per scene; its tests check that table against the shaders. What a frame draws
 //! with them, and the recording, is `glass/draws.rs`; a ball's triangles in patches, each
-//! drawn where it can show, `glass/patches.rs`; the positions a ball's pixels shade, counted on
-//! the device, `glass/counted.rs`; a mesh's triangles for the shader's search, `glass/mesh.rs`;
-//! the floor under the object as the glass sees it, `glass/floor_light.rs`.
+//! drawn where it can show, `glass/patches.rs`; the coarse polyhedron a ball's light is drawn
+//! on where the shader takes it from the sphere alone, `glass/proxy.rs`; the positions a ball's
+//! pixels shade, counted on the device, `glass/counted.rs`; the object as the exit sees it,
+//! `glass/object.rs`; a mesh's triangles for the shader's search, `glass/mesh.rs`; the floor
+//! under the object as the glass sees it, `glass/floor_light.rs`.
 
 mod counted;
 mod draws;
 mod floor_light;
 mod mesh;
+mod object;
 mod patches;
+mod proxy;
 
 use draws::Proof;
 pub use draws::{GlassDraws, Pick};
 use floor_light::FloorLight;
+use object::{metres_per_model_unit, object_frame, searched_mesh, upload_facet_planes};
 use patches::Patches;
+use proxy::Proxy;
 
 use ash::vk;
 use glam::Vec4;
 use vitreous_optics::camera::EyeParams;
-use vitreous_optics::convex;
 use vitreous_optics::optics::{FRESNEL_BIAS, FRESNEL_POWER, FRESNEL_SCALE};
 use vitreous_optics::refraction::Refraction;
-use vitreous_optics::solid::mesh_center;
 
 use crate::compensation::CompensationSet;
 use crate::context::GpuContext;
@@ -182,6 +186,9 @@ pub struct GlassPass {
     /// Where the object is a ball: its triangles in patches, each drawn only where it can
     /// show, and the indices in their order.
     patches: Option<(Patches, Buffer)>,
+    /// Where the environment looks draw a ball's light from its sphere alone: the polyhedron
+    /// they draw it on (`proxy.rs`).
+    proxy: Option<Proxy>,
     /// Pipeline layout (the set, the compensation's set 1 with compensation, eye push
     /// constants).
     layout: Owned<vk::PipelineLayout>,
@@ -203,9 +210,10 @@ pub struct GlassPass {
     _planes: Buffer,
     /// The floor under the object as the glass sees it (`glass/floor_light.rs`).
     floor_light: FloorLight,
-    /// The render pass and layout the pipelines were made for (the counting ones are made
-    /// when the frames start counting).
+    /// The render pass, blend and layout the pipelines were made for (the counting ones are
+    /// made when the frames start counting).
     render_pass: vk::RenderPass,
+    blend: Blend,
     /// Where the glass shades a ball's light in two parts, each over as many positions as it
     /// needs: the row of `shaders::GLASS_FS_COUNTED` of the model; the counting pipelines of the
     /// environment looks, once the frames count (`counted.rs`); and the counters they add to.
@@ -288,9 +296,26 @@ impl GlassPass {
             .iter()
             .flat_map(|&c| GlassVariant::ALL.iter().map(move |v| (c, v.index())))
             .collect();
-        let create = |fragment| create_pipeline(ctx, render_pass, layout.raw(), fragment);
-        let pipelines =
-            parallel::in_parallel(&entries, |&(c, v)| create(shaders::GLASS_FS[c][shaded][v]))?;
+        // Where the shader takes a ball's light from its sphere alone (its two parts in the
+        // room, the environment looks), it is drawn on a proxy (`proxy.rs`); not where a
+        // surface texture needs the model's own coordinates.
+        let proxy = shaders::counted_row(shaded)
+            .filter(|_| desc.surface.is_none())
+            .map(|_| Proxy::new(ctx, glam::Vec3::from_slice(&radial[..3]), radial[3]))
+            .transpose()?;
+        // Drawn for a segmented dimmer, the glass's alpha is the share of a pixel it covers
+        // over the floor's (render/src/dimmer); otherwise the eye passes' alpha is kept.
+        let blend = match desc.dimmer {
+            Some(_) => Blend::ReplaceColorCoverAlpha,
+            None => Blend::ReplaceColor,
+        };
+        let create = |fragment, proxied| {
+            create_pipeline(ctx, (render_pass, blend), layout.raw(), (fragment, proxied))
+        };
+        let pipelines = parallel::in_parallel(&entries, |&(c, v)| {
+            let proxied = proxy.is_some() && !GlassVariant::ALL[v].background;
+            create(shaders::GLASS_FS[c][shaded][v], proxied)
+        })?;
         // The proof and its pipelines where the model has them compiled and the object is a
         // ball.
         let coverage = shaders::covered_row(shaded).and_then(|_| PhotoCoverage::of(desc, ball));
@@ -303,7 +328,7 @@ impl GlassPass {
             })
         };
         let covered_pipelines = covered()
-            .map(|(c, row, phong)| create(shaders::GLASS_FS_COVERED[c][row][phong]))
+            .map(|(c, row, phong)| create(shaders::GLASS_FS_COVERED[c][row][phong], false))
             .collect::<Result<Vec<_>>>()?;
         let patches = match coverage::ball(&desc.mesh) {
             Some((center, _)) => {
@@ -388,6 +413,7 @@ impl GlassPass {
             coverage,
             proved: std::cell::Cell::new([None; 2]),
             patches,
+            proxy,
             covered_pipelines,
             covered_costs: covered()
                 .map(|(c, row, phong)| {
@@ -408,6 +434,7 @@ impl GlassPass {
             _planes: planes,
             floor_light,
             render_pass,
+            blend,
             counted_row: shaders::counted_row(shaded),
             mesh_row: shaders::mesh_counted_row(shaded),
             counted_pipelines: Vec::new(),
@@ -420,8 +447,14 @@ impl GlassPass {
         &self,
         ctx: &GpuContext,
         fragment: shaders::GlassEntry,
+        proxied: bool,
     ) -> Result<Owned<vk::Pipeline>> {
-        create_pipeline(ctx, self.render_pass, self.layout.raw(), fragment)
+        create_pipeline(
+            ctx,
+            (self.render_pass, self.blend),
+            self.layout.raw(),
+            (fragment, proxied),
+        )
     }
 
     /// Records the update of the object's transform and the light's position to `pose`, for
@@ -521,12 +554,13 @@ impl GlassPass {
     }
 }
 
-/// A glass pipeline drawing into `render_pass` with `layout`: the vertex shader and `fragment`.
+/// A glass pipeline drawing into `render_pass` with `blend` and `layout`: the vertex shader (a
+/// ball's proxy's where `proxied`) and `fragment`.
 fn create_pipeline(
     ctx: &GpuContext,
-    render_pass: vk::RenderPass,
+    (render_pass, blend): (vk::RenderPass, Blend),
     layout: vk::PipelineLayout,
-    fragment: shaders::GlassEntry,
+    (fragment, proxied): (shaders::GlassEntry, bool),
 ) -> Result<Owned<vk::Pipeline>> {
     let f = 4;
     let attributes = [
@@ -559,93 +593,19 @@ fn create_pipeline(
         &PipelineSpec {
             render_pass,
             layout,
-            vertex: (shaders::GLASS_VS, c"vs_main"),
+            vertex: if proxied {
+                (shaders::GLASS_VS_BALL_PROXY, c"vs_ball_proxy")
+            } else {
+                (shaders::GLASS_VS, c"vs_main")
+            },
             fragment,
             bindings: &bindings,
             attributes: &attributes,
             cull: vk::CullModeFlags::BACK,
             depth: Depth::Nearest,
-            blend: Blend::ReplaceColor,
+            blend,
         },
     )
-}
-
-/// World metres per model unit of the object's uniform scale (the shader measures the path
-/// inside in model units).
-fn metres_per_model_unit(desc: &SceneDesc) -> f32 {
-    glam::Mat3::from_mat4(desc.world_from_model)
-        .determinant()
-        .abs()
-        .cbrt()
-}
-
-/// The object's frame for the exit: its centre (model units, its bounding box's) and the largest
-/// distance of a vertex from it (a ball's radius) as the shader's `radial` vector, and whether
-/// the object is a ball about it (`coverage::ball`: the shader then takes the sphere).
-fn object_frame(desc: &SceneDesc) -> ([f32; 4], bool) {
-    match coverage::ball(&desc.mesh) {
-        Some((center, radius)) => (center.extend(radius).to_array(), true),
-        None => {
-            let center = mesh_center(desc.mesh.positions);
-            let radius = desc
-                .mesh
-                .positions
-                .iter()
-                .map(|&p| (p - center).length())
-                .fold(0.0f32, f32::max);
-            (
-                center.extend(radius.max(f32::MIN_POSITIVE)).to_array(),
-                false,
-            )
-        }
-    }
-}
-
-/// The elements of the mesh the shader searches (`mesh.rs`), where two-surface refraction
-/// leaves the object through its triangles: an object that is not `analytic` (a ball or a convex
-/// faceted object).
-fn searched_mesh(desc: &SceneDesc, radial: [f32; 4], analytic: bool) -> Result<Option<Vec<Vec4>>> {
-    if desc.refraction != Refraction::TwoSurface || analytic {
-        return Ok(None);
-    }
-    let center = glam::Vec3::new(radial[0], radial[1], radial[2]);
-    let elements = mesh::elements(&desc.mesh, center)?;
-    tracing::debug!(
-        "two-surface refraction: the exit searched among the object's triangles ({} buffer \
-         elements)",
-        elements.len()
-    );
-    Ok(Some(elements))
-}
-
-/// Uploads the facet planes of a flat-shaded convex object about the radial map's centre
-/// (`radial`'s xyz) for two-surface refraction, and whether there are any: otherwise one
-/// plane that no pipeline reads.
-fn upload_facet_planes(
-    ctx: &GpuContext,
-    desc: &SceneDesc,
-    radial: [f32; 4],
-) -> Result<(Buffer, bool)> {
-    let m = desc.mesh;
-    let center = glam::Vec3::new(radial[0], radial[1], radial[2]);
-    let planes = (desc.refraction == Refraction::TwoSurface)
-        .then(|| convex::facet_planes(m.positions, m.normals, m.indices, center))
-        .flatten();
-    if let Some(p) = &planes {
-        tracing::debug!(
-            "two-surface refraction: a convex object of {} facet planes",
-            p.len()
-        );
-    }
-    let convex = planes.is_some();
-    let planes = convex::in_eights(planes.unwrap_or_default());
-    let buffer = Buffer::with_data(
-        ctx,
-        "facet planes",
-        bytemuck::cast_slice(&planes),
-        vk::BufferUsageFlags::STORAGE_BUFFER,
-    )?;
-    Ok((buffer, convex))
 }
 
 #[cfg(test)]

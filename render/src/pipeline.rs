@@ -25,6 +25,10 @@ pub enum Blend {
     /// Overwrite the colour and keep the target's alpha (the eye passes' alpha is the one
     /// their clear value sets, see [`crate::renderer::Composition`]).
     ReplaceColor,
+    /// Overwrite the colour, and lay the output's alpha over the target's (ONE,
+    /// ONE_MINUS_SRC_ALPHA): the share of the pixel the glass covers over the share of the
+    /// real world the floor beneath takes away (a segmented dimmer's, render/src/dimmer).
+    ReplaceColorCoverAlpha,
     /// Add to the target's colour (ONE, ONE) without touching alpha: light added on top.
     Add,
     /// Add to the target's colour and alpha (ONE, ONE): light added on top, and a share of
@@ -150,6 +154,15 @@ pub fn create(ctx: &GpuContext, spec: &PipelineSpec) -> Result<Owned<vk::Pipelin
             .color_write_mask(vk::ColorComponentFlags::RGBA),
         Blend::Replace => vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(false)
+            .color_write_mask(vk::ColorComponentFlags::RGBA),
+        Blend::ReplaceColorCoverAlpha => vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ZERO)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .alpha_blend_op(vk::BlendOp::ADD)
             .color_write_mask(vk::ColorComponentFlags::RGBA),
         Blend::ReplaceColor => vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(false)

@@ -221,6 +221,8 @@ macro_rules! glass_entry {
 pub type GlassEntry = (&'static [u8], &'static std::ffi::CStr);
 
 pub const GLASS_VS: &[u8] = spirv!("glass.vs_main");
+/// The glass's vertex shader for a ball drawn on its proxy (render/src/glass/proxy.rs).
+pub const GLASS_VS_BALL_PROXY: &[u8] = spirv!("glass.vs_ball_proxy");
 /// The glass pass's fragment entry points: `[compensated][model][variant]`. The model paper (0),
 /// two-surface (1), two-surface through absorbing glass (2: compiled with `ABSORBING` set),
 /// two-surface through a ball (3: `BALL`, no radial-map fetch) and through an absorbing ball

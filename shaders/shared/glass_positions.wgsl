@@ -16,6 +16,10 @@
 // minified) and on the reflected highlight (`HIGHLIGHT`). Both follow the ball analytically, as
 // `shade_ray`'s two-surface passage through a ball does, each for its part alone.
 //
+// Those pipelines' environment looks draw the ball on a proxy about it (render/src/glass/
+// proxy.rs): a pixel is the glass's where a position's ray meets the ball, its alpha the share
+// that do (`ball_parts`).
+//
 // Through a mesh or a gem (two-surface, not a ball), a pixel whose n x n grid leaves its light
 // uncertain (`needs_finer`) shades a grid twice as fine too, and its light is the mean over both.
 
@@ -46,16 +50,16 @@ fn on_ball(at: VertexOut) -> vec4<f32> {
 
 // The first image at the position `at`: the room seen through both surfaces of the ball, times
 // their transmittance (`ball_passage`), as `shade_ray` adds it but for the surface's
-// `(1 - alpha)`; nothing where the ray passes beside the ball.
-fn first_image(at: VertexOut) -> vec3<f32> {
+// `(1 - alpha)`, w 1; nothing (w 0) where the ray passes beside the ball.
+fn first_image(at: VertexOut) -> vec4<f32> {
     let hit = on_ball(at);
     if hit.w == 0.0 {
-        return vec3<f32>(0.0);
+        return vec4<f32>(0.0);
     }
     let entry = hit.xyz + g.center_world.xyz;
     let incident = normalize(entry - eye.position.xyz);
     let passage = ball_passage(entry, incident, normalize(hit.xyz / at.curve.x), g.optics.x);
-    return room(passage.exit, passage.direction) * passage.transmission;
+    return vec4<f32>(room(passage.exit, passage.direction) * passage.transmission, 1.0);
 }
 
 // The rest of the ball's light at the position `at`, as `shade_ray` adds it through two surfaces
@@ -117,7 +121,7 @@ fn rest_of_light(at: VertexOut, phong: bool, alpha: f32) -> vec3<f32> {
 // shades beyond its first at it): entry points no pipeline draws with.
 @fragment
 fn fs_two_surface_first_image(in: VertexOut) -> @location(0) vec4<f32> {
-    return vec4<f32>(first_image(in), 1.0);
+    return vec4<f32>(first_image(in).rgb, 1.0);
 }
 
 @fragment
@@ -258,7 +262,8 @@ fn needs_finer(sum: vec3<f32>, squares: f32, grid: u32) -> bool {
 fn ball_parts(in: VertexOut, dx: VertexOut, dy: VertexOut, phong: bool, alpha: f32) -> vec3<f32> {
     let n = in.samples;
     let grid = n * n;
-    var first = vec3<f32>(0.0);
+    // w: the positions whose rays meet the ball.
+    var first = vec4<f32>(0.0);
     for (var i = 0u; i < grid; i++) {
         first += first_image(moved(in, dx, dy, grid_position(i, n)));
     }
@@ -275,7 +280,15 @@ fn ball_parts(in: VertexOut, dx: VertexOut, dy: VertexOut, phong: bool, alpha: f
         atomicAdd(&shaded[slot + 1u], grid);
         atomicAdd(&shaded[slot + 2u], 1u);
     }
-    return (1.0 - alpha) * first / f32(grid) + rest / f32(rests);
+    // Drawn on its proxy (render/src/glass/proxy.rs), a pixel none of whose positions meets the
+    // ball is beside it: the glass draws nothing there. Elsewhere the share of its positions
+    // that meet the ball is the share of the pixel it covers (`covered_share`, the alpha a
+    // segmented dimmer's want and light read: dimmer_panel.wgsl).
+    if first.w == 0.0 {
+        discard;
+    }
+    covered_share = first.w / f32(grid);
+    return (1.0 - alpha) * first.rgb / f32(grid) + rest / f32(rests);
 }
 
 // The eye's ray through `in.world_pos` passes beside the sphere `front_surface` would put it

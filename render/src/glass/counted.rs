@@ -79,7 +79,7 @@ impl GlassPass {
         };
         self.counted_pipelines = entries
             .into_iter()
-            .map(|entry| self.create_pipeline(ctx, entry))
+            .map(|entry| self.create_pipeline(ctx, entry, self.proxy.is_some()))
             .collect::<Result<Vec<_>>>()?;
         Ok(())
     }

@@ -35,6 +35,8 @@ pub struct GlassDraws {
     pub rects: [[Vec<RectDraw>; 2]; 2],
     /// The eye images' size.
     pub extent: vk::Extent2D,
+    /// Whether the ball is drawn on its proxy (`proxy.rs`), the ranges its indices.
+    pub proxied: bool,
 }
 
 /// One rectangle of an eye's image (x, y, width, height, pixels) and the ranges of the pass's
@@ -75,6 +77,8 @@ impl GlassPass {
         (extent, index_count): (vk::Extent2D, u32),
     ) -> GlassDraws {
         let size = (extent.width, extent.height);
+        // The environment looks' pipelines draw a ball's light from its sphere alone.
+        let proxied = self.proxy.is_some() && !pick.variant.background;
         let pick = Pick {
             covered: false,
             ..pick
@@ -103,7 +107,11 @@ impl GlassPass {
                 tiles
             });
             let split = covered.split(shown, size, RECT_PX);
-            let seen = self.patches.as_ref().map(|(patches, _)| {
+            let patches = match &self.proxy {
+                Some(proxy) if proxied => Some(&proxy.patches),
+                _ => self.patches.as_ref().map(|(patches, _)| patches),
+            };
+            let seen = patches.map(|patches| {
                 (
                     patches,
                     patches.seen(pose.world_from_model, &eyes[index], size),
@@ -127,6 +135,7 @@ impl GlassPass {
             pick,
             rects,
             extent,
+            proxied,
         }
     }
 
@@ -194,8 +203,14 @@ impl GlassPass {
                 0,
                 bytemuck::bytes_of(push),
             );
-            d.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.buffer], &[0]);
-            let indices = self.patches.as_ref().map_or(&scene.indices, |(_, b)| b);
+            let (vertices, indices) = match &self.proxy {
+                Some(proxy) if draws.proxied => (&proxy.vertices, &proxy.indices),
+                _ => (
+                    &scene.vertices,
+                    self.patches.as_ref().map_or(&scene.indices, |(_, b)| b),
+                ),
+            };
+            d.cmd_bind_vertex_buffers(cmd, 0, &[vertices.buffer], &[0]);
             d.cmd_bind_index_buffer(cmd, indices.buffer, 0, vk::IndexType::UINT32);
             for draw in rects {
                 d.cmd_set_scissor(cmd, 0, &[rect(draw.rect)]);

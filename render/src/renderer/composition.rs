@@ -5,7 +5,8 @@
 /// blend modes).
 ///
 /// The glass and the real-world photos write colour only; the alpha of every pixel is the eye
-/// pass's clear alpha, set here.
+/// pass's clear alpha, set here. (In a scene with a segmented dimmer the glass lays the share
+/// of each pixel it covers over the alpha, for the dimmer's panel: over 1 it stays 1.)
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Composition {
     /// The display adds the image's light onto the real world (optical see-through, ADDITIVE):

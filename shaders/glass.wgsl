@@ -471,8 +471,9 @@ var<private> missed_positions: u32;
 // The positions of this pixel's grids shaded through a mesh or a gem (`SUPERSAMPLED`,
 // `supersampled`).
 var<private> positions_shaded: u32;
-// The share of the pixel the glass covers, where its pipeline knows it (a ball's parts,
-// `ball_parts`): the alpha it outputs.
+// The share of the pixel the glass covers, where its pipeline knows it (a ball's over several
+// positions: `ball_parts`, `supersampled`): the alpha it outputs, and the share of the real
+// world eq. 6 takes away.
 var<private> covered_share: f32 = 1.0;
 
 // Distance along the ray p + t / inv (t >= 0) to the box [lo, hi], or NO_HIT where it passes
@@ -1165,7 +1166,8 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
                     out = max(out - seen_behind(in), vec3<f32>(0.0));
                 }
             } else {
-                out = max(out - seen_behind(in), vec3<f32>(0.0));
+                // A ball's: over the share of the pixel it covers.
+                out = max(out - seen_behind(in) * covered_share, vec3<f32>(0.0));
             }
         } else {
             out = max(out - seen_behind(in), vec3<f32>(0.0));
@@ -1175,9 +1177,7 @@ fn shade(in: VertexOut, two_surface_model: bool, to_background: bool, phong: boo
     // pipeline constant its own `if`, so that the others' counted cost is as it was).
     if SUPERSAMPLED {
         if BALL {
-            if ROOM {
-                return vec4<f32>(out, covered_share);
-            }
+            return vec4<f32>(out, covered_share);
         }
     }
     return vec4<f32>(out, 1.0);

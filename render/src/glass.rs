@@ -186,8 +186,8 @@ pub struct GlassPass {
     /// Where the object is a ball: its triangles in patches, each drawn only where it can
     /// show, and the indices in their order.
     patches: Option<(Patches, Buffer)>,
-    /// Where the environment looks draw a ball's light from its sphere alone: the polyhedron
-    /// they draw it on (`proxy.rs`).
+    /// Where the pipelines take a ball from its sphere alone: the polyhedron every look draws
+    /// it on (`proxy.rs`).
     proxy: Option<Proxy>,
     /// Pipeline layout (the set, the compensation's set 1 with compensation, eye push
     /// constants).
@@ -296,13 +296,16 @@ impl GlassPass {
             .iter()
             .flat_map(|&c| GlassVariant::ALL.iter().map(move |v| (c, v.index())))
             .collect();
-        // Where the shader takes a ball's light from its sphere alone (its two parts in the
-        // room, the environment looks), it is drawn on a proxy (`proxy.rs`); not where a
-        // surface texture needs the model's own coordinates.
-        let proxy = shaders::counted_row(shaded)
-            .filter(|_| desc.surface.is_none())
-            .map(|_| Proxy::new(ctx, glam::Vec3::from_slice(&radial[..3]), radial[3]))
-            .transpose()?;
+        // Where the shader takes a ball from its sphere alone (through both surfaces, over
+        // several positions per pixel), every look draws it on a proxy (`proxy.rs`); not where
+        // a surface texture needs the model's own coordinates.
+        let proxy = (desc.refraction == Refraction::TwoSurface
+            && ball
+            && samples > 1
+            && desc.surface.is_none())
+        .then(|| Proxy::new(ctx, glam::Vec3::from_slice(&radial[..3]), radial[3]))
+        .transpose()?;
+        let proxied = proxy.is_some();
         // Drawn for a segmented dimmer, the glass's alpha is the share of a pixel it covers
         // over the floor's (render/src/dimmer); otherwise the eye passes' alpha is kept.
         let blend = match desc.dimmer {
@@ -313,7 +316,6 @@ impl GlassPass {
             create_pipeline(ctx, (render_pass, blend), layout.raw(), (fragment, proxied))
         };
         let pipelines = parallel::in_parallel(&entries, |&(c, v)| {
-            let proxied = proxy.is_some() && !GlassVariant::ALL[v].background;
             create(shaders::GLASS_FS[c][shaded][v], proxied)
         })?;
         // The proof and its pipelines where the model has them compiled and the object is a
@@ -328,7 +330,7 @@ impl GlassPass {
             })
         };
         let covered_pipelines = covered()
-            .map(|(c, row, phong)| create(shaders::GLASS_FS_COVERED[c][row][phong], false))
+            .map(|(c, row, phong)| create(shaders::GLASS_FS_COVERED[c][row][phong], proxied))
             .collect::<Result<Vec<_>>>()?;
         let patches = match coverage::ball(&desc.mesh) {
             Some((center, _)) => {

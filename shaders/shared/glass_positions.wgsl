@@ -16,9 +16,9 @@
 // minified) and on the reflected highlight (`HIGHLIGHT`). Both follow the ball analytically, as
 // `shade_ray`'s two-surface passage through a ball does, each for its part alone.
 //
-// Those pipelines' environment looks draw the ball on a proxy about it (render/src/glass/
+// A ball's pipelines over several positions draw it on a proxy about it (render/src/glass/
 // proxy.rs): a pixel is the glass's where a position's ray meets the ball, its alpha the share
-// that do (`ball_parts`).
+// that do (`ball_parts`, `supersampled`).
 //
 // Through a mesh or a gem (two-surface, not a ball), a pixel whose n x n grid leaves its light
 // uncertain (`needs_finer`) shades a grid twice as fine too, and its light is the mean over both.
@@ -217,6 +217,8 @@ fn supersampled(
                         squares += y * y;
                     }
                 }
+            } else if BALL {
+                missed_positions += 1u;
             }
             if !BALL {
                 if two_surface_model {
@@ -230,6 +232,14 @@ fn supersampled(
             }
         }
         light = sum / f32(positions);
+        if BALL {
+            // As `ball_parts`: beside the ball (drawn on its proxy) nothing; the share of the
+            // positions that meet it the share of the pixel it covers.
+            if missed_positions == grid {
+                discard;
+            }
+            covered_share = f32(grid - missed_positions) / f32(grid);
+        }
     }
     return light;
 }

@@ -77,8 +77,7 @@ impl GlassPass {
         (extent, index_count): (vk::Extent2D, u32),
     ) -> GlassDraws {
         let size = (extent.width, extent.height);
-        // The environment looks' pipelines draw a ball's light from its sphere alone.
-        let proxied = self.proxy.is_some() && !pick.variant.background;
+        let proxied = self.proxy.is_some();
         let pick = Pick {
             covered: false,
             ..pick

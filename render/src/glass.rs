@@ -183,8 +183,8 @@ pub struct GlassPass {
     covered_costs: Vec<ShaderCost>,
     /// Each eye's last proof and what it was made for.
     proved: std::cell::Cell<[Option<Proof>; 2]>,
-    /// Where the object is a ball: its triangles in patches, each drawn only where it can
-    /// show, and the indices in their order.
+    /// Where the object is a ball drawn on its own triangles: those in patches, each drawn only
+    /// where it can show, and the indices in their order.
     patches: Option<(Patches, Buffer)>,
     /// Where the pipelines take a ball from its sphere alone: the polyhedron every look draws
     /// it on (`proxy.rs`).
@@ -332,7 +332,8 @@ impl GlassPass {
         let covered_pipelines = covered()
             .map(|(c, row, phong)| create(shaders::GLASS_FS_COVERED[c][row][phong], proxied))
             .collect::<Result<Vec<_>>>()?;
-        let patches = match coverage::ball(&desc.mesh) {
+        // The model's triangles in patches, where they are drawn (a ball not on its proxy).
+        let patches = match coverage::ball(&desc.mesh).filter(|_| !proxied) {
             Some((center, _)) => {
                 let patches = Patches::new(desc.mesh.positions, desc.mesh.indices, center);
                 let bytes = bytemuck::cast_slice(&patches.indices);

@@ -35,12 +35,11 @@ pub struct GlassDraws {
     pub rects: [[Vec<RectDraw>; 2]; 2],
     /// The eye images' size.
     pub extent: vk::Extent2D,
-    /// Whether the ball is drawn on its proxy (`proxy.rs`), the ranges its indices.
-    pub proxied: bool,
 }
 
 /// One rectangle of an eye's image (x, y, width, height, pixels) and the ranges of the pass's
-/// indices drawn in it: the ball's patches that can show there (`patches.rs`), or the whole
+/// indices drawn in it: the ball's patches (its own triangles', or its proxy's: `proxy.rs`)
+/// that can show there (`patches.rs`), or the whole
 /// mesh.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RectDraw {
@@ -77,7 +76,6 @@ impl GlassPass {
         (extent, index_count): (vk::Extent2D, u32),
     ) -> GlassDraws {
         let size = (extent.width, extent.height);
-        let proxied = self.proxy.is_some();
         let pick = Pick {
             covered: false,
             ..pick
@@ -107,8 +105,8 @@ impl GlassPass {
             });
             let split = covered.split(shown, size, RECT_PX);
             let patches = match &self.proxy {
-                Some(proxy) if proxied => Some(&proxy.patches),
-                _ => self.patches.as_ref().map(|(patches, _)| patches),
+                Some(proxy) => Some(&proxy.patches),
+                None => self.patches.as_ref().map(|(patches, _)| patches),
             };
             let seen = patches.map(|patches| {
                 (
@@ -134,7 +132,6 @@ impl GlassPass {
             pick,
             rects,
             extent,
-            proxied,
         }
     }
 
@@ -203,8 +200,8 @@ impl GlassPass {
                 bytemuck::bytes_of(push),
             );
             let (vertices, indices) = match &self.proxy {
-                Some(proxy) if draws.proxied => (&proxy.vertices, &proxy.indices),
-                _ => (
+                Some(proxy) => (&proxy.vertices, &proxy.indices),
+                None => (
                     &scene.vertices,
                     self.patches.as_ref().map_or(&scene.indices, |(_, b)| b),
                 ),

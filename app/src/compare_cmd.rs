@@ -5,7 +5,7 @@
 //! with what the eye sees when nothing is drawn, the same figures for it and for the additive
 //! limit beside the test's; with the display's light and panel misregistered by a given angle
 //! (`--shift-deg`, `--roll-deg`), the ring around the object beside the regions; optionally
-//! the ꟻLIP error map as a PNG. The figures, the regions
+//! the ꟻLIP error map and the image measured (what the eye sees) as PNGs. The figures, the regions
 //! and the images read are `vitreous-compare`'s; here the options, the display's light over
 //! the seen image as the scene's display shows it, and the table.
 
@@ -72,6 +72,11 @@ pub struct CompareArgs {
     /// Write the ꟻLIP error map here (PNG, the magma colour map: black no error, yellow most).
     #[arg(long, value_name = "FILE")]
     pub map: Option<PathBuf>,
+    /// Write the image measured here (PNG, sRGB): with --display what the eye sees, the display's
+    /// light and panel over --seen where --shift-deg and --roll-deg put them; else TEST itself.
+    /// For another metric, or to look at a misregistered view.
+    #[arg(long, value_name = "FILE")]
+    pub wearer_view: Option<PathBuf>,
     /// Print the figures as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -193,7 +198,12 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         }
         None => None,
     };
-    if let Some(map) = &args.map {
+    let outputs: Vec<(&str, &PathBuf)> =
+        [("--map", &args.map), ("--wearer-view", &args.wearer_view)]
+            .into_iter()
+            .filter_map(|(option, path)| path.as_ref().map(|p| (option, p)))
+            .collect();
+    if !outputs.is_empty() {
         let mut inputs = InputFiles::new();
         inputs
             .add(&args.reference, "REFERENCE")
@@ -208,7 +218,17 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         if beside.exists() {
             inputs.add(&beside, "the reference.json beside REFERENCE");
         }
-        inputs.check_file("--map", map)?;
+        for (option, path) in &outputs {
+            inputs.check_file(option, path)?;
+        }
+        if let [(_, map), (_, view)] = outputs[..]
+            && map == view
+        {
+            bail!(
+                "--map and --wearer-view both name {}: give each its own file",
+                map.display()
+            );
+        }
     }
     let reference = Png::read(&args.reference)?;
     let (w, h) = (reference.width, reference.height);
@@ -300,13 +320,19 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         .as_deref()
         .map(|s| rows(&additive_limit(s, &reference)))
         .transpose()?;
-    if let Some(map) = &args.map {
-        let rgb = flip::magma(&error, (w, h));
-        let rgba: Vec<u8> = rgb
-            .chunks_exact(3)
-            .flat_map(|p| [p[0], p[1], p[2], 255])
-            .collect();
-        write_atomic(map, &encode_png(&rgba, w, h)?)?;
+    // Both images encoded before either is written: a failure leaves neither behind.
+    let map_png = match &args.map {
+        Some(_) => Some(encode_png(&opaque(&flip::magma(&error, (w, h))), w, h)?),
+        None => None,
+    };
+    let view_png = match &args.wearer_view {
+        Some(_) => Some(encode_png(&opaque(&test_rgb), w, h)?),
+        None => None,
+    };
+    for (path, png) in [(&args.map, map_png), (&args.wearer_view, view_png)] {
+        if let (Some(path), Some(png)) = (path, png) {
+            write_atomic(path, &png)?;
+        }
     }
     let report = Comparison {
         reference: args.reference.display().to_string(),
@@ -332,6 +358,13 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         print!("{}", table(&report));
     }
     Ok(())
+}
+
+/// RGB pixels as opaque RGBA, for a PNG.
+fn opaque(rgb: &[u8]) -> Vec<u8> {
+    rgb.chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect()
 }
 
 /// The report as a text table: one line per region, with the nothing-drawn and additive-limit

@@ -47,19 +47,16 @@ fn lit_square(dir: &Path) {
     write_rgba(&dir.join("t.png"), &light, w, h);
 }
 
+/// `compare r.png t.png --seen s.png --display` and then `extra`.
+fn over_seen<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["compare", "r.png", "t.png", "--seen", "s.png", "--display"];
+    args.extend_from_slice(extra);
+    args
+}
+
 fn shifted(dir: &Path, extra: &[&str]) -> serde_json::Value {
     let scene = ml2();
-    let mut args = vec![
-        "compare",
-        "r.png",
-        "t.png",
-        "--seen",
-        "s.png",
-        "--display",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--json",
-    ];
+    let mut args = over_seen(&["--scene", scene.to_str().unwrap(), "--json"]);
     args.extend_from_slice(extra);
     json(&args, dir)
 }
@@ -135,16 +132,7 @@ fn bad_shifts_and_rolls_are_refused_naming_the_option() {
     );
     assert_clean_failure(&out, &["--display"]);
     let without_scene = |extra: &[&str]| {
-        let mut args = vec![
-            "compare",
-            "r.png",
-            "t.png",
-            "--seen",
-            "s.png",
-            "--display",
-            "--shift-deg",
-            "1,0",
-        ];
+        let mut args = over_seen(&["--shift-deg", "1,0"]);
         args.extend_from_slice(extra);
         vitreous(&args, dir.path())
     };
@@ -182,4 +170,79 @@ fn replay_refuses_bad_shift_angles_naming_the_option() {
             "nothing written: {extra:?}"
         );
     }
+}
+
+/// The RGB pixels of a PNG.
+fn read_rgb(path: &Path) -> Vec<u8> {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb8()
+        .into_raw()
+}
+
+#[test]
+fn the_image_measured_is_written_with_the_light_where_the_error_puts_it() {
+    let dir = tempfile::tempdir().unwrap();
+    lit_square(dir.path());
+    let (w, h) = (160usize, 120usize);
+    let view = dir.path().join("v.png");
+    let view_arg = view.to_str().unwrap();
+    // Registered, what the eye sees is the real scene within rounding.
+    shifted(dir.path(), &["--wearer-view", view_arg]);
+    let real = read_rgb(&dir.path().join("r.png"));
+    let seen = read_rgb(&view);
+    assert!(
+        real.iter().zip(&seen).all(|(a, b)| a.abs_diff(*b) <= 1),
+        "registered view differs from the real scene"
+    );
+    // A degree right (4 px at 4 pixels per degree): the square lit over columns 64..88.
+    shifted(
+        dir.path(),
+        &["--shift-deg", "1,0", "--wearer-view", view_arg],
+    );
+    let seen = read_rgb(&view);
+    let at = |x: usize, y: usize| seen[(y * w + x) * 3];
+    for y in 40..64 {
+        for x in 56..92 {
+            let lit = (64..88).contains(&x);
+            assert_eq!(at(x, y) > 150, lit, "pixel ({x}, {y}): {}", at(x, y));
+        }
+    }
+    assert_eq!(seen.len(), w * h * 3);
+    // Without --display the image measured is TEST itself.
+    std::fs::copy(dir.path().join("r.png"), dir.path().join("copy.png")).unwrap();
+    json(
+        &[
+            "compare",
+            "s.png",
+            "copy.png",
+            "--json",
+            "--wearer-view",
+            "v2.png",
+        ],
+        dir.path(),
+    );
+    assert_eq!(read_rgb(&dir.path().join("v2.png")), real);
+}
+
+#[test]
+fn the_image_measured_is_never_written_over_an_input_or_the_map() {
+    let dir = tempfile::tempdir().unwrap();
+    lit_square(dir.path());
+    let before = std::fs::read(dir.path().join("s.png")).unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = over_seen(&["--ppd", "4"]);
+        args.extend_from_slice(extra);
+        vitreous(&args, dir.path())
+    };
+    assert_clean_failure(
+        &run(&["--wearer-view", "s.png"]),
+        &["--wearer-view", "s.png", "is the input file"],
+    );
+    assert_eq!(std::fs::read(dir.path().join("s.png")).unwrap(), before);
+    assert_clean_failure(
+        &run(&["--wearer-view", "m.png", "--map", "m.png"]),
+        &["--map", "--wearer-view", "m.png"],
+    );
+    assert!(!dir.path().join("m.png").exists());
 }

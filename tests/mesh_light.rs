@@ -173,7 +173,7 @@ fn the_floor_seen_through_a_torus_shows_its_shadow_and_caustic() {
         height_px: n,
         gain: vec![0.0; (n * n) as usize],
         light: Some(light),
-        scene_hash: scene.hash.clone(),
+        inputs_hash: Some(scene.caustic_inputs_hash()),
         params: "method=reference".into(),
     });
     let gpu_lit = left_eye_light(&scene, TORUS_SIZE);

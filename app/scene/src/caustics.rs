@@ -1,17 +1,23 @@
 //! The caustics bake file (paper Sec. 3.1.2, eq. 6; docs/caustics.md): a single-channel linear
 //! f32 OpenEXR image of the caustic gain G, ZIP compressed, row 0 = the floor photo's top edge,
-//! with the scene hash and the bake parameters as text attributes. Written by the baker
+//! with the hash of its inputs (the object, the light and the floor: [`inputs_hash`]) and the
+//! bake parameters as text attributes. Written by the baker
 //! (`vitreous-caustics`, which re-exports this module, run as `vitreous bake`) and read by the
 //! renderer's app.
 
 use std::path::{Path, PathBuf};
 
 use exr::prelude::*;
+use glam::{Mat4, Vec3};
+use sha2::{Digest, Sha256};
 use thiserror::Error;
 
 use crate::files::{DiskFiles, SceneFiles};
 
-/// Name of the header attribute holding the scene hash.
+/// Name of the header attribute holding the hash of the bake's inputs ([`inputs_hash`]).
+pub const INPUTS_HASH_ATTRIBUTE: &str = "vitreous_caustic_inputs_hash";
+/// Name of the attribute that bakes made before [`INPUTS_HASH_ATTRIBUTE`] hold instead: the
+/// hash of the whole scene file and its assets, which any edit changed.
 pub const SCENE_HASH_ATTRIBUTE: &str = "vitreous_scene_hash";
 /// Name of the header attribute holding the bake parameters (`key=value; ...`).
 pub const PARAMS_ATTRIBUTE: &str = "vitreous_caustics_params";
@@ -36,8 +42,9 @@ pub struct Bake {
     /// in the caustic): what the glass sees of the floor under it. `None` in a bake made before
     /// it was stored (and in live mode).
     pub light: Option<Vec<f32>>,
-    /// [`crate::Scene::hash`] of the scene it was baked for.
-    pub scene_hash: String,
+    /// [`inputs_hash`] of the object, light and floor it was baked for; `None` in a bake made
+    /// before bakes stored it (such a bake is refused: [`BakeError::Outdated`]).
+    pub inputs_hash: Option<String>,
     /// The bake parameters, `key=value; ...` text.
     pub params: String,
 }
@@ -67,6 +74,50 @@ impl Bake {
         (g(0, 0) * (1.0 - fx) + g(1, 0) * fx) * (1.0 - fy)
             + (g(0, 1) * (1.0 - fx) + g(1, 1) * fx) * fy
     }
+}
+
+/// The hash of everything a caustic bake depends on: the object's mesh (model positions,
+/// normals and triangles), where the model goes (`world_from_model`: size, place, turn), its
+/// index of refraction, the light's position and the floor's rectangle in the world; exactly
+/// what the baker reads (`vitreous_caustics::CausticScene::from_scene`). Hex SHA-256 over
+/// the values' little-endian bytes, each part labelled. The photos, the environment, the
+/// viewer, the display, the effects and the file's comments do not change a caustic and are
+/// not in it: editing them keeps the bake.
+pub fn inputs_hash(
+    object: &crate::Object,
+    light_position_m: Vec3,
+    world_from_floor: Mat4,
+) -> String {
+    let mut hasher = Sha256::new();
+    let mut part = |label: &str, values: &mut dyn Iterator<Item = [u8; 4]>| {
+        hasher.update(label.as_bytes());
+        hasher.update([0]);
+        let bytes: Vec<u8> = values.flatten().collect();
+        hasher.update((bytes.len() as u64).to_le_bytes());
+        hasher.update(bytes);
+    };
+    let f32s = |v: &[f32]| v.iter().map(|x| x.to_le_bytes()).collect::<Vec<_>>();
+    let mesh = &object.mesh;
+    let positions: Vec<f32> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
+    let normals: Vec<f32> = mesh.normals.iter().flat_map(|n| n.to_array()).collect();
+    part("positions", &mut f32s(&positions).into_iter());
+    part("normals", &mut f32s(&normals).into_iter());
+    part("indices", &mut mesh.indices.iter().map(|i| i.to_le_bytes()));
+    part(
+        "world_from_model",
+        &mut f32s(&object.world_from_model.to_cols_array()).into_iter(),
+    );
+    part("ior", &mut f32s(&[object.ior]).into_iter());
+    part("light", &mut f32s(&light_position_m.to_array()).into_iter());
+    part(
+        "world_from_floor",
+        &mut f32s(&world_from_floor.to_cols_array()).into_iter(),
+    );
+    hasher
+        .finalize()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
 }
 
 /// Why a bake file cannot be used.
@@ -103,20 +154,35 @@ pub enum BakeError {
         /// The scene that names it, when known.
         scene: Option<PathBuf>,
     },
-    /// Baked for another scene (or the scene or its assets changed since).
+    /// Baked for another object, light or floor (or one of them changed since).
     #[error(
-        "the caustics bake {path}{} was made for a different scene (hash {found}, the scene's \
-         is {expected}); the scene or one of its assets changed since: re-bake with `{}`",
+        "the caustics bake {path}{} was baked for another object, light or floor (inputs hash \
+         {found}, the scene's is {expected}): the model, the object's size, place, turn or index \
+         of refraction, the light or the floor changed since; re-bake with `{}`",
         named_by(.scene),
         rebake(.scene, .path)
     )]
     WrongScene {
         /// The file.
         path: PathBuf,
-        /// The hash of the scene being rendered.
+        /// The hash of the scene's caustic inputs.
         expected: String,
         /// The hash stored in the file.
         found: String,
+        /// The scene that names it, when known.
+        scene: Option<PathBuf>,
+    },
+    /// Made by an earlier version, which stored the whole scene's hash, not its inputs'.
+    #[error(
+        "the caustics bake {path}{} was made by an earlier vitreous: it holds the hash of the \
+         whole scene file (`{SCENE_HASH_ATTRIBUTE}`), not of the caustic's inputs \
+         (`{INPUTS_HASH_ATTRIBUTE}`); re-bake with `{}`",
+        named_by(.scene),
+        rebake(.scene, .path)
+    )]
+    Outdated {
+        /// The file.
+        path: PathBuf,
         /// The scene that names it, when known.
         scene: Option<PathBuf>,
     },
@@ -151,6 +217,23 @@ pub enum BakeError {
 /// Writes `bake` to `path` (channel `Y` as f32, and `light_ratio` as f16 when it has the
 /// light; ZIP, deterministic byte for byte), whole or not at all.
 pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError> {
+    let inputs_hash = bake
+        .inputs_hash
+        .as_deref()
+        .ok_or_else(|| BakeError::Write {
+            path: path.to_path_buf(),
+            reason: "the bake has no inputs hash".to_owned(),
+        })?;
+    write_with_hash(path, bake, (INPUTS_HASH_ATTRIBUTE, inputs_hash))
+}
+
+/// [`write_bake`] with the hash under the attribute given (a test writes a bake as earlier
+/// versions did).
+fn write_with_hash(
+    path: &Path,
+    bake: &Bake,
+    (attribute, hash): (&str, &str),
+) -> std::result::Result<(), BakeError> {
     let write_err = |reason: String| BakeError::Write {
         path: path.to_path_buf(),
         reason,
@@ -201,10 +284,10 @@ pub fn write_bake(path: &Path, bake: &Bake) -> std::result::Result<(), BakeError
         AnyChannels::sort(channels.into()),
     );
     let mut image = Image::from_layer(layer);
-    image.attributes.other.insert(
-        text(SCENE_HASH_ATTRIBUTE)?,
-        AttributeValue::Text(text(&bake.scene_hash)?),
-    );
+    image
+        .attributes
+        .other
+        .insert(text(attribute)?, AttributeValue::Text(text(hash)?));
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| write_err(e.to_string()))?;
     }
@@ -257,23 +340,29 @@ impl BakeError {
                 found,
                 scene: named,
             },
+            BakeError::Outdated { path, .. } => BakeError::Outdated { path, scene: named },
             other => other,
         }
     }
 }
 
-/// Reads a bake and checks it belongs to the scene with hash `expected_scene_hash`.
-pub fn read_bake(path: &Path, expected_scene_hash: &str) -> std::result::Result<Bake, BakeError> {
+/// Reads a bake and checks it was baked for the inputs with hash `expected_inputs_hash`
+/// ([`inputs_hash`], [`crate::Scene::caustic_inputs_hash`]).
+pub fn read_bake(path: &Path, expected_inputs_hash: &str) -> std::result::Result<Bake, BakeError> {
     let bake = read_bake_unchecked(path)?;
-    if bake.scene_hash != expected_scene_hash {
-        return Err(BakeError::WrongScene {
+    match &bake.inputs_hash {
+        None => Err(BakeError::Outdated {
             path: path.to_path_buf(),
-            expected: expected_scene_hash.to_owned(),
-            found: bake.scene_hash,
             scene: None,
-        });
+        }),
+        Some(found) if found != expected_inputs_hash => Err(BakeError::WrongScene {
+            path: path.to_path_buf(),
+            expected: expected_inputs_hash.to_owned(),
+            found: found.clone(),
+            scene: None,
+        }),
+        Some(_) => Ok(bake),
     }
-    Ok(bake)
 }
 
 /// Reads a bake without checking which scene it belongs to (for comparisons).
@@ -343,9 +432,14 @@ fn decode_unguarded(bytes: &[u8]) -> std::result::Result<Bake, String> {
         })
     };
     let layer = &image.layer_data;
-    let scene_hash = attr_text(&image.attributes.other, SCENE_HASH_ATTRIBUTE)
-        .or_else(|| attr_text(&layer.attributes.other, SCENE_HASH_ATTRIBUTE))
-        .ok_or_else(|| format!("it has no `{SCENE_HASH_ATTRIBUTE}` attribute"))?;
+    let attribute = |name: &str| {
+        attr_text(&image.attributes.other, name)
+            .or_else(|| attr_text(&layer.attributes.other, name))
+    };
+    let inputs_hash = attribute(INPUTS_HASH_ATTRIBUTE);
+    if inputs_hash.is_none() && attribute(SCENE_HASH_ATTRIBUTE).is_none() {
+        return Err(format!("it has no `{INPUTS_HASH_ATTRIBUTE}` attribute"));
+    }
     let params = attr_text(&layer.attributes.other, PARAMS_ATTRIBUTE)
         .or_else(|| attr_text(&image.attributes.other, PARAMS_ATTRIBUTE))
         .unwrap_or_default();
@@ -383,7 +477,7 @@ fn decode_unguarded(bytes: &[u8]) -> std::result::Result<Bake, String> {
         height_px: h as u32,
         gain,
         light,
-        scene_hash,
+        inputs_hash,
         params,
     })
 }
@@ -399,7 +493,7 @@ mod tests {
             gain: (0..15).map(|i| i as f32 * 0.5).collect(),
             // Ratios half floats hold exactly.
             light: Some((0..15).map(|i| i as f32 * 0.25).collect()),
-            scene_hash: "abc123".into(),
+            inputs_hash: Some("abc123".into()),
             params: "method=test".into(),
         }
     }
@@ -473,6 +567,37 @@ mod tests {
         let err = read_bake(&path, "other").unwrap_err();
         assert!(matches!(err, BakeError::WrongScene { .. }), "{err}");
         assert!(err.to_string().contains("abc123") && err.to_string().contains("other"));
+    }
+
+    #[test]
+    fn a_bake_made_before_inputs_were_hashed_is_refused_as_outdated() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("old.exr");
+        write_with_hash(&path, &sample(), (SCENE_HASH_ATTRIBUTE, "abc123")).unwrap();
+        let old = read_bake_unchecked(&path).unwrap();
+        assert_eq!(old.inputs_hash, None);
+        assert_eq!(old.gain, sample().gain);
+        let err = read_bake(&path, "abc123")
+            .unwrap_err()
+            .in_scene(Path::new("s.toml"));
+        assert!(matches!(err, BakeError::Outdated { .. }), "{err}");
+        let text = err.to_string();
+        assert!(
+            text.contains("earlier vitreous") && text.contains("vitreous bake s.toml -o"),
+            "{text}"
+        );
+        // Neither hash: not a bake.
+        write_with_hash(&path, &sample(), ("something_else", "abc123")).unwrap();
+        let err = read_bake(&path, "abc123").unwrap_err();
+        assert!(matches!(err, BakeError::Corrupt { .. }), "{err}");
+        // A bake without a hash is not written.
+        let unhashed = Bake {
+            inputs_hash: None,
+            ..sample()
+        };
+        let err = write_bake(&dir.path().join("n.exr"), &unhashed).unwrap_err();
+        assert!(err.to_string().contains("no inputs hash"), "{err}");
+        assert!(!dir.path().join("n.exr").exists());
     }
 
     #[test]

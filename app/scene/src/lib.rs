@@ -176,8 +176,20 @@ impl Scene {
             .placement_at(time_s, self.rest_placement(), self.light_in_frame_m)
     }
 
+    /// The hash of what a caustic bake of this scene depends on
+    /// ([`crate::caustics::inputs_hash`]: the object's mesh, size, place, turn and index of
+    /// refraction, the light's position and the floor's rectangle, at rest).
+    pub fn caustic_inputs_hash(&self) -> String {
+        crate::caustics::inputs_hash(
+            &self.object,
+            self.light.position_m,
+            self.floor.world_from_plane(),
+        )
+    }
+
     /// Reads the scene's caustic bake into [`Caustics::gain`], checking that it was baked
-    /// for this scene (its stored hash equals [`Scene::hash`]). Errors name the file: no bake
+    /// for this scene's object, light and floor (its stored hash equals
+    /// [`Scene::caustic_inputs_hash`]). Errors name the file: no bake
     /// named, missing, corrupt, or made for another scene; a moving scene is refused. In live
     /// mode no file is read: the gain map is zeros of `[caustics] resolution_px`, which the
     /// renderer fills for each pose (`vitreous_frames::render_desc::enable_live_caustics`).
@@ -190,7 +202,7 @@ impl Scene {
                 height_px: n,
                 gain: vec![0.0; n as usize * n as usize],
                 light: None,
-                scene_hash: self.hash.clone(),
+                inputs_hash: Some(self.caustic_inputs_hash()),
                 params: "method=live".into(),
             });
             return Ok(());
@@ -207,8 +219,8 @@ impl Scene {
                 .ok_or_else(|| crate::caustics::BakeError::NotNamed {
                     scene: self.path.clone(),
                 })?;
-        let bake =
-            crate::caustics::read_bake(path, &self.hash).map_err(|e| e.in_scene(&self.path))?;
+        let bake = crate::caustics::read_bake(path, &self.caustic_inputs_hash())
+            .map_err(|e| e.in_scene(&self.path))?;
         self.caustics.gain = Some(bake);
         Ok(())
     }

@@ -119,7 +119,7 @@ impl FluxLedger {
 /// Everything a bake produces.
 #[derive(Clone, Debug)]
 pub struct BakeOutput {
-    /// The gain map with its scene hash and parameters.
+    /// The gain map with its inputs hash and parameters.
     pub bake: Bake,
     /// E_through / E_without per texel: light that met the object and reached the floor,
     /// relative to the unobstructed irradiance.
@@ -323,7 +323,7 @@ pub fn bake(
                     .map(|(&t, &b)| light_ratio(t, b))
                     .collect(),
             ),
-            scene_hash: scene.scene_hash.clone(),
+            inputs_hash: Some(scene.inputs_hash.clone()),
             params: params.describe(),
         },
         through_rel,

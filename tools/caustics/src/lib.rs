@@ -61,8 +61,9 @@ pub struct CausticScene {
     /// Floor: maps the unit square `[-0.5, 0.5]^2` (z = 0, local +y = photo top) onto the
     /// floor in the world; its local +z side is the visible side.
     pub world_from_floor: Mat4,
-    /// The scene's hash ([`vitreous_scene::Scene::hash`]), stored in the bake.
-    pub scene_hash: String,
+    /// The hash of the inputs above ([`vitreous_scene::Scene::caustic_inputs_hash`]), stored
+    /// in the bake.
+    pub inputs_hash: String,
     /// Where the scene came from, for messages.
     pub source: PathBuf,
 }
@@ -88,7 +89,7 @@ impl CausticScene {
             ior: scene.object.ior,
             light_position_m: scene.light.position_m,
             world_from_floor: scene.floor.world_from_plane(),
-            scene_hash: scene.hash.clone(),
+            inputs_hash: scene.caustic_inputs_hash(),
             source: scene.path.clone(),
         }
     }

@@ -68,8 +68,10 @@ fn main() -> Result<()> {
                 vitreous_trace::atomic_file::write(dir.join("reference.f32"), &raw(&r.gain))
                     .with_context(|| format!("writing {}", dir.join("reference.f32").display()))?;
             }
-            if t.scene_hash != r.scene_hash {
-                eprintln!("warning: the two bakes were made for different scenes");
+            if t.inputs_hash != r.inputs_hash {
+                eprintln!(
+                    "warning: the two bakes were made for different objects, lights or floors"
+                );
             }
             let c = compare(&t.gain, &r.gain, threshold).expect("sizes checked");
             println!(

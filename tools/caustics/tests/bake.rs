@@ -67,7 +67,7 @@ fn sphere_scene(radius_m: f32, ior: f32, light_m: Vec3, floor: Mat4) -> CausticS
         ior,
         light_position_m: light_m,
         world_from_floor: floor,
-        scene_hash: "test".into(),
+        inputs_hash: "test".into(),
         source: "test".into(),
     }
 }
@@ -265,7 +265,7 @@ fn every_unit_of_flux_is_accounted_for() {
         ior: 2.42,
         light_position_m: Vec3::new(0.3, 1.0, 0.2),
         world_from_floor: floor_at(0.0, 0.0, 0.0, 0.5),
-        scene_hash: "cube".into(),
+        inputs_hash: "cube".into(),
         source: "cube".into(),
     });
     for scene in &scenes {

@@ -488,7 +488,7 @@ fn bake_writes_a_bake_its_scene_loads() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("sphere.exr"), "{stdout}");
     let scene = vitreous_scene::load_scene(Path::new(&scene_path)).unwrap();
-    let bake = vitreous_scene::caustics::read_bake(&output, &scene.hash).unwrap();
+    let bake = vitreous_scene::caustics::read_bake(&output, &scene.caustic_inputs_hash()).unwrap();
     assert_eq!((bake.width_px, bake.height_px), (32, 32));
     assert!(bake.gain.iter().any(|&g| g > 0.0));
 }

@@ -13,7 +13,9 @@
 //! and table 2 %). Each of these in either tracer makes the test fail: the map mirrored (mean
 //! 1.2 %, pixels 20 %) or turned a quarter (3.9 %, 22 %), the ball at n = 1.50 (pixels 6.5 %),
 //! Schlick's approximation for the reflectance (mean 1.8 %), the lamp's shadow and caustic left
-//! out of the floor's light (0.7 %).
+//! out of the floor's light (0.7 %), each ray leaving a surface started 0.22 mm off it (pixels
+//! 2.5 %: Mitsuba 3 offsets by about that much at the ball's 1.5 m from the origin, its offset
+//! growing with the coordinates; docs/realism.md, "Against Mitsuba 3").
 
 use std::f32::consts::{PI, TAU};
 use std::path::Path;
@@ -304,7 +306,7 @@ fn the_balls_disc_matches_a_tracer_written_apart() {
         "the disc's mean light: ratio {ratio}"
     );
     assert!(
-        per_pixel < 0.03,
+        per_pixel < 0.01,
         "per-pixel difference {per_pixel} of the light"
     );
 }

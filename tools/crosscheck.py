@@ -1,6 +1,7 @@
 """The reference's image of a glass ball against Mitsuba 3's path tracer (tools/crosscheck).
 
-Reads the scene (TOML), the reference's reference.json and left-eye image, renders the pixels
+Reads the scene (TOML), the reference's reference.json and left-eye images (PNG and
+OpenEXR), renders the pixels
 about the ball with Mitsuba's `path` integrator over the same grid of positions per pixel and
 the same eye rays, with the room built as the reference's docs state it (the photos as emitting
 rectangles, decoded from sRGB; the environment map with its rows where docs/config.md puts
@@ -186,6 +187,8 @@ def main():
 
     base = np.asarray(Image.open(ref_dir / "000000-left.png").convert("RGB"))
     reference = srgb_to_linear(base.astype(np.float64))
+    reference_hdr = np.array(mi.Bitmap(str(ref_dir / "000000-left.exr")).convert(
+        mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False), dtype=np.float64)
     figures = {"scene": str(scene_path), "window_px": list(window), "per_side": per_side,
                "paths_per_position": paths, "disc_pixels": int(disc.sum()), "renders": {}}
     for name, scale, centred in (("in-place", 1.0, False), ("centred", SCALE, True)):
@@ -204,6 +207,7 @@ def main():
         figures["renders"][name] = {
             "image": image_path.name,
             "disc_mean_reference": mean_ref,
+            "disc_mean_reference_unclipped": reference_hdr[disc].sum(1).mean(),
             "disc_mean_8bit": eight_bit[disc].sum(1).mean(),
             "disc_mean_unclipped": hdr[disc].sum(1).mean(),
         }

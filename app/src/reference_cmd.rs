@@ -76,6 +76,11 @@ pub struct ReferenceArgs {
     #[arg(long, value_name = "N", default_value_t = 64.0, allow_negative_numbers = true,
           value_parser = parse_photons)]
     pub photons_per_texel: f32,
+    /// Also write each eye image as OpenEXR (`NNNNNN-EYE.exr`, `NNNNNN-EYE-seen.exr`): linear
+    /// RGB in 32-bit floats as traced, light above 1 kept (the PNGs clip it and round to 8
+    /// bits), for measuring against another renderer's light.
+    #[arg(long)]
+    pub exr: bool,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -222,9 +227,13 @@ pub fn reference_command(args: ReferenceArgs) -> Result<()> {
         let mut files = Vec::new();
         for (k, &eye) in eyes.iter().enumerate() {
             for (suffix, image) in [("", &rendered.real[k]), ("-seen", &rendered.seen[k])] {
-                let name = format!("{:06}-{}{suffix}.png", frame.index, EYE_NAMES[eye]);
-                write_png(&out.join(&name), image)?;
-                files.push(name);
+                let stem = format!("{:06}-{}{suffix}", frame.index, EYE_NAMES[eye]);
+                write_png(&out.join(format!("{stem}.png")), image)?;
+                files.push(format!("{stem}.png"));
+                if args.exr {
+                    write_exr(&out.join(format!("{stem}.exr")), image)?;
+                    files.push(format!("{stem}.exr"));
+                }
             }
             progress.inc(1);
         }
@@ -342,4 +351,22 @@ fn frames_to_render(scene: &Scene, args: &ReferenceArgs) -> Result<Vec<Frame>> {
 pub fn write_png(path: &Path, image: &EyeImage) -> Result<()> {
     let png = encode_png(&srgb_rgba(image), image.window.width, image.window.height)?;
     write_atomic(path, &png)
+}
+
+/// Writes a linear eye image as OpenEXR (RGB, 32-bit floats, lossless), encoded in memory and
+/// then written whole.
+pub fn write_exr(path: &Path, image: &EyeImage) -> Result<()> {
+    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+    let width = image.window.width as usize;
+    let pixels = SpecificChannels::rgb(|at: Vec2<usize>| {
+        let p = image.rgb[at.y() * width + at.x()];
+        (p.x, p.y, p.z)
+    });
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    Image::from_channels((width, image.window.height as usize), pixels)
+        .write()
+        .non_parallel()
+        .to_buffered(&mut bytes)
+        .with_context(|| format!("encoding {} as OpenEXR", path.display()))?;
+    write_atomic(path, bytes.get_ref())
 }

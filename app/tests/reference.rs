@@ -1,5 +1,6 @@
 //! `vitreous reference`: the physical reference's files, what it changes against the seen
-//! image (the ball's disc, its shadow), `compare` reading its frames, and bad input.
+//! image (the ball's disc, its shadow), `compare` reading its frames, its light unclipped in
+//! OpenEXR, and bad input.
 
 use std::path::{Path, PathBuf};
 
@@ -153,6 +154,75 @@ fn the_reference_shows_the_ball_and_half_its_lights_shadow_and_nothing_else() {
         cmp["nothing_drawn"][0]["flip_mean"]
     );
     assert!(cmp["regions"][0]["flip_mean"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn exr_keeps_the_light_the_png_clips() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ref");
+    let run = vitreous(
+        &[
+            "reference",
+            scene_path().to_str().unwrap(),
+            "--eye",
+            "left",
+            "--size",
+            "320x240",
+            "--samples",
+            "1",
+            "--object-samples",
+            "4",
+            "--photons-per-texel",
+            "8",
+            "--exr",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("reference.json")).unwrap()).unwrap();
+    assert_eq!(
+        report["frames"][0]["files"],
+        serde_json::json!([
+            "000000-left.png",
+            "000000-left.exr",
+            "000000-left-seen.png",
+            "000000-left-seen.exr"
+        ])
+    );
+    let mut above_one = 0;
+    for stem in ["000000-left", "000000-left-seen"] {
+        let exr = exr::prelude::read_first_rgba_layer_from_file(
+            out.join(format!("{stem}.exr")),
+            |size, _| vec![[0f32; 3]; size.width() * size.height()],
+            |pixels, at, (r, g, b, _): (f32, f32, f32, f32)| {
+                pixels[at.y() * 320 + at.x()] = [r, g, b];
+            },
+        )
+        .unwrap();
+        let size = exr.layer_data.size;
+        assert_eq!((size.width(), size.height()), (320, 240), "{stem}");
+        let light = &exr.layer_data.channel_data.pixels;
+        let png = image::open(out.join(format!("{stem}.png")))
+            .unwrap()
+            .to_rgb8();
+        // The PNG is the same light encoded to 8-bit sRGB, pixel for pixel.
+        for (p, l) in png.pixels().zip(light) {
+            let encoded = l.map(vitreous_optics::srgb::from_linear);
+            assert_eq!(p.0, encoded, "{stem}: {l:?}");
+        }
+        above_one += light.iter().flatten().filter(|&&v| v > 1.0).count();
+    }
+    // The grazing reflections at the ball's outline carry the sky's light above 1: the PNG
+    // clips it at 255, the OpenEXR keeps it.
+    assert!(above_one > 0, "no light above 1");
 }
 
 #[test]

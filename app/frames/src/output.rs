@@ -47,13 +47,16 @@ pub fn frame_file_names(frame: u64) -> [String; 4] {
 
 /// Whether `name` is a file a replay or `vitreous reference` writes among its frame images:
 /// `NNNNNN-left.png`, `NNNNNN-right-preview.png`, `NNNNNN-left-sphere-check.png`,
-/// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`, ..., `reference.json`, or a temporary file
-/// of an atomic write.
+/// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`, ..., the same as OpenEXR (`NNNNNN-left.exr`,
+/// `vitreous reference --exr`), `reference.json`, or a temporary file of an atomic write.
 pub fn is_frame_file_name(name: &str) -> bool {
     if (name.starts_with(".vitreous-") && name.ends_with(".partial")) || name == "reference.json" {
         return true;
     }
-    let Some(stem) = name.strip_suffix(".png") else {
+    let Some(stem) = name
+        .strip_suffix(".png")
+        .or_else(|| name.strip_suffix(".exr"))
+    else {
         return false;
     };
     let Some((digits, rest)) = stem.split_once('-') else {
@@ -135,6 +138,8 @@ mod tests {
             "000060-left-sphere-check.png",
             "000060-left-real.png",
             "000060-right-seen.png",
+            "000000-left.exr",
+            "000060-right-seen.exr",
             "1234567-right.png",
             "reference.json",
             ".vitreous-abc123.partial",
@@ -147,6 +152,7 @@ mod tests {
             "00003-left.png",
             "000030-middle.png",
             "x-left.png",
+            "000000-left.jpg",
         ] {
             assert!(!is_frame_file_name(name), "{name}");
         }

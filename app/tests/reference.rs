@@ -27,31 +27,32 @@ fn pixel(path: &Path, x: u32, y: u32) -> glam::Vec3 {
     )
 }
 
-#[test]
-fn the_reference_shows_the_ball_and_half_its_lights_shadow_and_nothing_else() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("ref");
-    let run = vitreous(
-        &[
-            "reference",
-            scene_path().to_str().unwrap(),
-            "--size",
-            "320x240",
-            "--samples",
-            "2",
-            "--photons-per-texel",
-            "8",
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        dir.path(),
-    );
+/// Runs `vitreous reference` of the scene at 320 x 240 with few photons and `args` into `out`,
+/// which must succeed.
+fn reference(cwd: &Path, out: &Path, args: &[&str]) {
+    let scene = scene_path();
+    let mut all = vec!["reference", scene.to_str().unwrap(), "--size", "320x240"];
+    all.extend([
+        "--photons-per-texel",
+        "8",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    all.extend(args);
+    let run = vitreous(&all, cwd);
     assert!(
         run.status.success(),
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
+}
+
+#[test]
+fn the_reference_shows_the_ball_and_half_its_lights_shadow_and_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ref");
+    reference(dir.path(), &out, &["--samples", "2"]);
     for eye in ["left", "right"] {
         for suffix in ["", "-seen"] {
             assert!(out.join(format!("000000-{eye}{suffix}.png")).is_file());
@@ -160,32 +161,16 @@ fn the_reference_shows_the_ball_and_half_its_lights_shadow_and_nothing_else() {
 fn exr_keeps_the_light_the_png_clips() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ref");
-    let run = vitreous(
-        &[
-            "reference",
-            scene_path().to_str().unwrap(),
-            "--eye",
-            "left",
-            "--size",
-            "320x240",
-            "--samples",
-            "1",
-            "--object-samples",
-            "4",
-            "--photons-per-texel",
-            "8",
-            "--exr",
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        dir.path(),
-    );
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let args = [
+        "--eye",
+        "left",
+        "--samples",
+        "1",
+        "--object-samples",
+        "4",
+        "--exr",
+    ];
+    reference(dir.path(), &out, &args);
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("reference.json")).unwrap()).unwrap();
     assert_eq!(

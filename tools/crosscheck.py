@@ -1,12 +1,12 @@
-"""The reference's image of a glass ball against Mitsuba 3's path tracer (tools/crosscheck).
+"""The reference's image of a glass object against Mitsuba 3's path tracer (tools/crosscheck).
 
 Reads the scene (TOML), the reference's reference.json and left-eye images (PNG and
-OpenEXR), renders the pixels
-about the ball with Mitsuba's `path` integrator over the same grid of positions per pixel and
+OpenEXR), renders the pixels about the object (an analytic ball, or a clear-glass .glb mesh
+with its vertex normals) with Mitsuba's `path` integrator over the same grid of positions per pixel and
 the same eye rays, with the room built as the reference's docs state it (the photos as emitting
 rectangles, decoded from sRGB; the environment map with its rows where docs/config.md puts
 them), and writes the reference's image with those pixels replaced, once with the world in the
-scene's metres and once moved so that the ball's centre is the origin and scaled by 1000.
+scene's metres and once moved so that the object's centre is the origin and scaled by 1000.
 Mitsuba starts each ray leaving a surface a distance off it that grows with the coordinates'
 size (about 0.2 mm at 1.5 m from the origin): the second render takes that out.
 
@@ -15,6 +15,7 @@ usage: crosscheck.py SCENE REFERENCE_DIR OUT_DIR PER_SIDE PATHS
 
 import json
 import math
+import struct
 import sys
 import tomllib
 from pathlib import Path
@@ -26,6 +27,9 @@ mi.set_variant("llvm_ad_rgb")
 from PIL import Image  # noqa: E402
 
 SCALE = 1000.0
+# Path segments: the reference's 256 interfaces (app/reference/src/world.rs MAX_INTERFACES) and
+# the last way out; a round brilliant's light is still 1 % short at 64.
+MAX_DEPTH = 257
 
 
 def fail(message):
@@ -65,6 +69,63 @@ def environment(path, out):
     mi.Bitmap(resampled.astype(np.float32)).write(str(out))
 
 
+def glb_mesh(path):
+    """Positions, normals and triangles of a binary glTF's triangle primitives (nodes without
+    transforms of their own; the shipped procedural models are so)."""
+    data = path.read_bytes()
+    if data[:4] != b"glTF":
+        fail(f"{path}: not a binary glTF (.glb); only .glb models are read here")
+    length = struct.unpack_from("<I", data, 12)[0]
+    gltf = json.loads(data[20:20 + length])
+    binary = data[20 + length + 8:]
+    for node in gltf.get("nodes", []):
+        if any(k in node for k in ("matrix", "translation", "rotation", "scale")):
+            fail(f"{path}: a node with its own transform; not read here")
+
+    def accessor(i, width):
+        a = gltf["accessors"][i]
+        view = gltf["bufferViews"][a["bufferView"]]
+        start = view.get("byteOffset", 0) + a.get("byteOffset", 0)
+        kind = {5126: np.float32, 5125: np.uint32, 5123: np.uint16}[a["componentType"]]
+        values = np.frombuffer(binary, kind, a["count"] * width, start)
+        return values.reshape(-1, width) if width > 1 else values
+
+    positions, normals, faces = [], [], []
+    for mesh in gltf["meshes"]:
+        for prim in mesh["primitives"]:
+            if prim.get("mode", 4) != 4 or "NORMAL" not in prim["attributes"]:
+                fail(f"{path}: a primitive that is not a triangle list with normals")
+            base = sum(len(p) for p in positions)
+            positions.append(accessor(prim["attributes"]["POSITION"], 3).astype(np.float64))
+            normals.append(accessor(prim["attributes"]["NORMAL"], 3).astype(np.float64))
+            faces.append(accessor(prim["indices"], 1).astype(np.uint32).reshape(-1, 3) + base)
+    return np.concatenate(positions), np.concatenate(normals), np.concatenate(faces)
+
+
+def rotation(degrees):
+    """docs/config.md's rotation_deg: about world x, then y, then z (Rz Ry Rx)."""
+    x, y, z = (math.radians(a) for a in degrees)
+    rx = np.array([[1, 0, 0], [0, math.cos(x), -math.sin(x)], [0, math.sin(x), math.cos(x)]])
+    ry = np.array([[math.cos(y), 0, math.sin(y)], [0, 1, 0], [-math.sin(y), 0, math.cos(y)]])
+    rz = np.array([[math.cos(z), -math.sin(z), 0], [math.sin(z), math.cos(z), 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def world_mesh(obj, scene_dir):
+    """The object's mesh in world metres (docs/config.md: T(position) R S T(-box centre)),
+    with its bounding sphere's centre and radius as `vitreous compare` takes them."""
+    positions, normals, faces = glb_mesh(scene_dir / obj["model"])
+    lo, hi = positions.min(0), positions.max(0)
+    box_centre = (lo + hi) / 2
+    scale = obj["diameter_m"] / (hi - lo).max() if "diameter_m" in obj else obj.get("scale", 1.0)
+    rot = rotation(obj.get("rotation_deg", [0.0, 0.0, 0.0]))
+    centre = np.array(obj["position_m"], dtype=np.float64)
+    world = (positions - box_centre) * scale @ rot.T + centre
+    world_normals = normals @ rot.T
+    radius = np.linalg.norm(positions - box_centre, axis=1).max() * scale
+    return world, world_normals, faces, centre, radius
+
+
 def plane_transform(base, table):
     size = table.get("size_m")
     position = table.get("position_m", [0.0, 0.0, 0.0])
@@ -75,7 +136,7 @@ def plane_transform(base, table):
             .rotate([1, 0, 0], rx).scale([size[0] / 2, size[1] / 2, 1.0]))
 
 
-def build(scene, scene_dir, centre, radius, env_file, scale, centred):
+def build(scene, scene_dir, centre, radius, mesh, env_file, scale, centred):
     T = mi.ScalarTransform4f
     shift = centre if centred else np.zeros(3)
     base = lambda: T().scale(scale).translate((-shift).tolist())  # noqa: E731
@@ -96,10 +157,21 @@ def build(scene, scene_dir, centre, radius, env_file, scale, centred):
     yaw = scene.get("environment", {}).get("yaw_deg", 0.0)
     world["environment"] = {"type": "envmap", "filename": str(env_file),
                             "to_world": T().rotate([0, 1, 0], 180.0 + yaw)}
-    world["ball"] = {"type": "sphere", "center": (scale * (centre - shift)).tolist(),
-                     "radius": radius * scale,
-                     "bsdf": {"type": "dielectric", "int_ior": scene["object"].get("ior", 1.5),
-                              "ext_ior": 1.0}}
+    glass = {"type": "dielectric", "int_ior": scene["object"].get("ior", 1.5), "ext_ior": 1.0}
+    if mesh is None:
+        world["object"] = {"type": "sphere", "center": (scale * (centre - shift)).tolist(),
+                           "radius": radius * scale, "bsdf": glass}
+    else:
+        positions, normals, faces = mesh
+        shape = mi.Mesh("object", len(positions), len(faces), has_vertex_normals=True)
+        params = mi.traverse(shape)
+        params["vertex_positions"] = mi.Float(
+            (scale * (positions - shift)).astype(np.float32).ravel())
+        params["vertex_normals"] = mi.Float(normals.astype(np.float32).ravel())
+        params["faces"] = mi.UInt32(faces.ravel())
+        params.update()
+        shape.set_bsdf(mi.load_dict(glass))
+        world["object"] = shape
     return mi.load_dict(world), shift
 
 
@@ -125,7 +197,7 @@ def eye_rays(eye, size):
 
 def render(world, shift, scale, eye, direction, window, per_side, paths):
     x0, y0, w, h = window
-    integrator = mi.load_dict({"type": "path", "max_depth": 128, "rr_depth": 1000})
+    integrator = mi.load_dict({"type": "path", "max_depth": MAX_DEPTH, "rr_depth": 1000})
     origin = scale * (np.array(eye["position_m"], dtype=np.float64) - shift)
     out = np.zeros((h, w, 3))
     rows = max(1, 400_000 // (w * per_side * per_side * paths))
@@ -154,22 +226,29 @@ def main():
     scene = tomllib.loads(scene_path.read_text())
     scene_dir = scene_path.parent
     report = json.loads((ref_dir / "reference.json").read_text())
-    if report.get("object") != "analytic ball":
-        fail(f"{scene_path}: the object is {report.get('object')!r}; Mitsuba's sphere stands "
-             "only for an analytic ball")
-    if "diameter_m" not in scene["object"]:
-        fail(f"{scene_path}: [object] diameter_m is needed for the ball's radius")
+    obj = scene["object"]
+    if "attenuation_distance_m" in obj or "surface_texture" in obj:
+        fail(f"{scene_path}: tinted or textured glass is not modelled here")
     if "environment" not in scene or "map" not in scene["environment"]:
         fail(f"{scene_path}: [environment] map is needed")
     frame = report["frames"][0]
     eye = frame["eyes"][0]
     size = (report["width_px"], report["height_px"])
-    centre = np.array(frame["object_position_m"], dtype=np.float64)
-    radius = scene["object"]["diameter_m"] / 2
+    if report.get("object") == "analytic ball":
+        if "diameter_m" not in obj:
+            fail(f"{scene_path}: [object] diameter_m is needed for the ball's radius")
+        centre = np.array(frame["object_position_m"], dtype=np.float64)
+        radius = obj["diameter_m"] / 2
+        mesh = None
+    else:
+        positions, normals, faces, centre, radius = world_mesh(obj, scene_dir)
+        mesh = (positions, normals, faces)
+        if np.abs(centre - np.array(frame["object_position_m"])).max() > 1e-6:
+            fail(f"{scene_path}: the object is placed elsewhere than position_m at rest")
     env_file = out_dir / "environment-mitsuba.exr"
     environment(scene_dir / scene["environment"]["map"], env_file)
 
-    # The window: the ball's outline and a few pixels around it.
+    # The window: the object's bounding sphere's outline and a few pixels around it.
     direction = eye_rays(eye, size)
     ys, xs = np.mgrid[0:size[1], 0:size[0]] + 0.5
     d = direction(xs, ys)
@@ -179,7 +258,7 @@ def main():
     disc = (along > 0) & (off < radius)
     near = (along > 0) & (off < radius * 1.15)
     if not disc.any():
-        fail("the ball is not in the left eye's view")
+        fail("the object is not in the left eye's view")
     rows, cols = np.nonzero(near)
     window = (int(cols.min()), int(rows.min()), int(cols.max() - cols.min() + 1),
               int(rows.max() - rows.min() + 1))
@@ -194,7 +273,7 @@ def main():
     for name, scale, centred in (("in-place", 1.0, False), ("centred", SCALE, True)):
         print(f"Mitsuba, {name}: {w} x {h} pixels, {per_side}x{per_side} positions x {paths} paths",
               file=sys.stderr)
-        world, shift = build(scene, scene_dir, centre, radius, env_file, scale, centred)
+        world, shift = build(scene, scene_dir, centre, radius, mesh, env_file, scale, centred)
         light = render(world, shift, scale, eye, direction, window, per_side, paths)
         image = base.copy()
         image[y0:y0 + h, x0:x0 + w] = linear_to_srgb8(light)

@@ -47,16 +47,18 @@ pub fn frame_file_names(frame: u64) -> [String; 4] {
 
 /// Whether `name` is a file a replay or `vitreous reference` writes among its frame images:
 /// `NNNNNN-left.png`, `NNNNNN-right-preview.png`, `NNNNNN-left-sphere-check.png`,
-/// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`, ..., the same as OpenEXR (`NNNNNN-left.exr`,
-/// `vitreous reference --exr`), `reference.json`, or a temporary file of an atomic write.
+/// `NNNNNN-left-real.png`, `NNNNNN-left-seen.png`, ..., the reference's images as OpenEXR
+/// (`NNNNNN-left.exr`, `NNNNNN-left-seen.exr`: `vitreous reference --exr`), `reference.json`, or a
+/// temporary file of an atomic write.
 pub fn is_frame_file_name(name: &str) -> bool {
     if (name.starts_with(".vitreous-") && name.ends_with(".partial")) || name == "reference.json" {
         return true;
     }
-    let Some(stem) = name
-        .strip_suffix(".png")
-        .or_else(|| name.strip_suffix(".exr"))
-    else {
+    let (stem, kinds): (&str, &[&str]) = if let Some(stem) = name.strip_suffix(".png") {
+        (stem, &["", "-preview", "-sphere-check", "-real", "-seen"])
+    } else if let Some(stem) = name.strip_suffix(".exr") {
+        (stem, &["", "-seen"])
+    } else {
         return false;
     };
     let Some((digits, rest)) = stem.split_once('-') else {
@@ -64,11 +66,9 @@ pub fn is_frame_file_name(name: &str) -> bool {
     };
     digits.len() >= 6
         && digits.bytes().all(|b| b.is_ascii_digit())
-        && EYE_NAMES.iter().any(|eye| {
-            ["", "-preview", "-sphere-check", "-real", "-seen"]
-                .iter()
-                .any(|k| rest == format!("{eye}{k}"))
-        })
+        && EYE_NAMES
+            .iter()
+            .any(|eye| kinds.iter().any(|k| rest == format!("{eye}{k}")))
 }
 
 /// Writes a saved frame's eye images and, when the world was read back, its previews (what the
@@ -153,6 +153,7 @@ mod tests {
             "000030-middle.png",
             "x-left.png",
             "000000-left.jpg",
+            "000000-left-preview.exr",
         ] {
             assert!(!is_frame_file_name(name), "{name}");
         }

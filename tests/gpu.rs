@@ -23,3 +23,4 @@ mod registration;
 mod render_smoke;
 mod replay;
 mod room;
+mod swapchain_formats;

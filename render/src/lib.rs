@@ -63,7 +63,7 @@ pub use error::{RenderError, Result};
 pub use floor as inducer;
 pub use floor::InducerFields;
 pub use look::{Defocus, FrameParams, Look, Reflection};
-pub use memory::{color_copy_region, layout_barrier, subresource_range};
+pub use memory::{Image, color_copy_region, layout_barrier, subresource_range};
 pub use pose::ScenePose;
 pub use present::{PresentWindow, Presented, Presenter};
 pub use renderer::{Composition, FrameResult, FrameTiming, Readback, Renderer, Want};

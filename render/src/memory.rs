@@ -281,7 +281,7 @@ impl Image {
 
     /// A view of one layer of this image, owned by the caller (it must drop before the
     /// image).
-    pub fn layer_view(&self, ctx: &GpuContext, layer: u32) -> Result<Owned<vk::ImageView>> {
+    pub(crate) fn layer_view(&self, ctx: &GpuContext, layer: u32) -> Result<Owned<vk::ImageView>> {
         let info = vk::ImageViewCreateInfo::default()
             .image(self.image)
             .view_type(vk::ImageViewType::TYPE_2D)

@@ -31,6 +31,7 @@ use crate::work::{FrameWork, PhotonWork};
 use crate::world::WorldPass;
 
 mod composition;
+mod convert;
 mod copy;
 mod external;
 mod live;
@@ -117,6 +118,8 @@ struct Pending {
     /// Whether a live caustic map it computed copied what it counted into the slot's
     /// `photons`.
     photons: bool,
+    /// How the eye images it read back store their texels (an external image's format).
+    eye_texels: convert::Texels,
 }
 
 /// Per-frame resources, used round-robin; freed on drop.
@@ -551,6 +554,10 @@ impl Renderer {
             recorded,
             counted: self.slots[slot_index].statistics.is_some(),
             photons: self.slots[slot_index].photons.is_some(),
+            eye_texels: draw
+                .filter(|d| d.image != external::OWN_TARGET)
+                .and(self.external.as_ref())
+                .map_or(convert::Texels::OWN, external::External::texels),
         });
         self.next_sequence += 1;
         Ok(previous)
@@ -652,7 +659,11 @@ impl Renderer {
             Readback {
                 width: self.extent.width,
                 height: self.extent.height,
-                eyes: [bytes[..n].to_vec(), bytes[n..2 * n].to_vec()],
+                eyes: [&bytes[..n], &bytes[n..2 * n]].map(|eye| {
+                    let mut eye = eye.to_vec();
+                    pending.eye_texels.to_own(&mut eye);
+                    eye
+                }),
                 world: pending
                     .want
                     .world

@@ -3,7 +3,7 @@
 //! lets go of the swapchain images, the session (which owns them) ends, then the renderer with
 //! the device, then the runtime. The order is this type's, not its caller's statements'.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use vitreous_render::{ContextOptions, GpuContext, Renderer};
 use vitreous_xr::openxr::ash::vk;
 use vitreous_xr::openxr::{
@@ -71,9 +71,10 @@ impl XrSession {
             format: images.format,
         };
         if !images.srgb {
-            bail!(
-                "the runtime offers only UNORM swapchain formats; vitreous renders into sRGB \
-                 images only for now (VkFormat {:?})",
+            // OpenXR reads a UNORM image as linear light: right, in 8 bits.
+            tracing::warn!(
+                "the runtime offers no sRGB swapchain format: frames are stored as linear \
+                 8-bit values ({:?}), so dark gradients band",
                 images.format
             );
         }

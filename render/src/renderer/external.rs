@@ -8,6 +8,10 @@
 //! expects back on release. A readback of such a frame copies the external image, so tests can
 //! check what was really handed to the runtime.
 //!
+//! Images of another 8-bit colour format (a runtime offering BGRA first, or only UNORM) get
+//! framebuffers over the renderer's own eye image instead, and each frame is blitted into the
+//! chosen image after its passes ([`super::convert`]).
+//!
 //! With [`Renderer::attach_external_with_depth`], the eye passes write their depth into
 //! external 2-layer depth images too (an OpenXR depth swapchain for
 //! XR_KHR_composition_layer_depth): the depth attachment is stored and left in
@@ -16,6 +20,7 @@
 
 use ash::vk;
 
+use super::convert::{self, Texels};
 use super::{Composition, FrameResult, Renderer, Want};
 use crate::error::{RenderError, Result, VkContext};
 use crate::look::FrameParams;
@@ -33,8 +38,11 @@ pub(super) struct External {
     _views: Vec<Owned<vk::ImageView>>,
     /// Per-layer views of the depth images (the renderer's own, or each external one's).
     _depth_views: Vec<Owned<vk::ImageView>>,
-    /// Render pass leaving colour in `COLOR_ATTACHMENT_OPTIMAL`.
+    /// Render pass leaving colour in `COLOR_ATTACHMENT_OPTIMAL` (in `TRANSFER_SRC_OPTIMAL`,
+    /// for the blit, when the images are of another format).
     render_pass: Owned<vk::RenderPass>,
+    /// The images' format.
+    format: vk::Format,
     /// The colour image of each slot, 2 layers each; not owned.
     pub(super) images: Vec<vk::Image>,
     /// Number of external colour images.
@@ -68,6 +76,17 @@ impl External {
     /// The render pass the external framebuffers belong to.
     pub(super) fn render_pass(&self) -> vk::RenderPass {
         self.render_pass.raw()
+    }
+
+    /// Whether frames are drawn into the renderer's own eye image and blitted into the
+    /// external one (its format is not the renderer's).
+    pub(super) fn blitted(&self) -> bool {
+        self.format != target::COLOR_FORMAT
+    }
+
+    /// How the images store their texels.
+    pub(super) fn texels(&self) -> Texels {
+        Texels::of(self.format).unwrap_or(Texels::OWN)
     }
 
     /// The left and right framebuffers of slot `slot`.
@@ -119,8 +138,11 @@ impl Renderer {
     /// (and, for readbacks, transfer-source) usage, such as an OpenXR swapchain's. Replaces
     /// images attached before. Depth goes to the renderer's own depth image.
     ///
-    /// `format` must be the renderer's colour format, `R8G8B8A8_SRGB` (shaders write linear
-    /// light and the image encodes it); other formats are refused with a clear error.
+    /// `format` is the renderer's colour format, `R8G8B8A8_SRGB` (shaders write linear light
+    /// and the image encodes it), drawn into directly; or `B8G8R8A8_SRGB`, `R8G8B8A8_UNORM` or
+    /// `B8G8R8A8_UNORM`, into which each frame is blitted from the renderer's own eye image
+    /// (then the images need transfer-destination usage too, and the device must blit into
+    /// the format). Other formats are refused with a clear error.
     ///
     /// # Safety
     /// The images must live, on this renderer's device, until [`Renderer::detach_external`]
@@ -147,11 +169,9 @@ impl Renderer {
         format: vk::Format,
         depth_images: &[vk::Image],
     ) -> Result<()> {
-        if format != target::COLOR_FORMAT {
-            return Err(RenderError::InvalidInput(format!(
-                "external images of format {format:?}: the renderer draws {:?} only",
-                target::COLOR_FORMAT
-            )));
+        let blitted = format != target::COLOR_FORMAT;
+        if blitted {
+            convert::check(&self.ctx, format)?;
         }
         if images.is_empty() {
             return Err(RenderError::InvalidInput(
@@ -162,8 +182,12 @@ impl Renderer {
         let ctx = &self.ctx;
         let render_pass = target::create_render_pass_storing_depth(
             ctx,
-            format,
-            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            target::COLOR_FORMAT,
+            if blitted {
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL
+            } else {
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL
+            },
             !depth_images.is_empty(),
         )?;
         let layer_view = |image: vk::Image,
@@ -212,8 +236,16 @@ impl Renderer {
         let mut slot_images = Vec::with_capacity(images.len() * depth_slots);
         let mut framebuffers = Vec::with_capacity(images.len() * depth_slots);
         for &image in images {
-            let left = layer_view(image, format, vk::ImageAspectFlags::COLOR, 0)?;
-            let right = layer_view(image, format, vk::ImageAspectFlags::COLOR, 1)?;
+            // Drawn into: the image itself, or the renderer's own eye image to blit from.
+            let (left, right) = if blitted {
+                let own = &self.eye_target.color;
+                (own.layer_view(ctx, 0)?, own.layer_view(ctx, 1)?)
+            } else {
+                (
+                    layer_view(image, format, vk::ImageAspectFlags::COLOR, 0)?,
+                    layer_view(image, format, vk::ImageAspectFlags::COLOR, 1)?,
+                )
+            };
             let color_views = [left.raw(), right.raw()];
             views.push(left);
             views.push(right);
@@ -235,6 +267,7 @@ impl Renderer {
             _views: views,
             _depth_views: depth_views,
             render_pass,
+            format,
             images: slot_images,
             color_count: images.len(),
             depth_count: depth_images.len(),

@@ -2,7 +2,7 @@
 
 use ash::vk;
 
-use super::{Composition, FrameSlot, QUERIES, Renderer, Want, copy, external};
+use super::{Composition, FrameSlot, QUERIES, Renderer, Want, convert, copy, external};
 use crate::blur_blend;
 use crate::floor::{FIELD_STAMPS, Prepared, Stamps};
 use crate::glass::{EyePush, GlassDraws};
@@ -58,6 +58,12 @@ impl Renderer {
                 self.render_pass.raw(),
             ),
         };
+        // An external image of another format: the passes draw into the renderer's own eye
+        // image (the external framebuffers' views), blitted into it at the end.
+        let blit_into = external
+            .zip(self.external.as_ref())
+            .filter(|(_, ext)| ext.blitted())
+            .map(|_| eye_image);
         let world_behind = composition.world_behind();
         let external_image = external.is_some() && self.external.is_some();
         let mut prepared = Prepared::default();
@@ -161,6 +167,11 @@ impl Renderer {
                     dimmer.record_resolve(&self.ctx, cmd, eye, index);
                     d.cmd_end_render_pass(cmd);
                 }
+            }
+            if let Some(to) = blit_into {
+                // The eye render pass left the own image in TRANSFER_SRC_OPTIMAL, its writes
+                // visible to transfer reads; `to` is an attached image of a checked format.
+                convert::record_blit(d, cmd, self.eye_target.color.image, to, self.extent);
             }
             if let Some(pool) = queries {
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 2);

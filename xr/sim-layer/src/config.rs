@@ -10,6 +10,9 @@
 //! - `VITREOUS_SIM_BUTTONS`: a script of controller button presses (`crate::controller`).
 //! - `VITREOUS_SIM_EYE_MAX`: `WxH`, the largest eye image the headset offers (each view's
 //!   recommended and largest image rectangle are clamped to it).
+//! - `VITREOUS_SIM_FORMATS`: comma list of `rgba8-srgb`, `bgra8-srgb`, `rgba8-unorm`,
+//!   `bgra8-unorm`: the only swapchain colour formats the headset offers, in its order of
+//!   preference (`crate::calls::swapchain`).
 //! - `VITREOUS_SIM_ML_FRAME`: `1` to offer Magic Leap 2's frame controls (XR_ML_frame_end_info,
 //!   XR_ML_global_dimmer): what the app chains to `xrEndFrame` is recorded, not passed on.
 //! - `VITREOUS_SIM_PLANES`: `x,y,z,w,d` level rectangles facing up, separated by `;` (centre in
@@ -34,7 +37,7 @@
 //!   headset does to the session, and when; `VITREOUS_SIM_FAULT_LOG`: the CSV file the layer
 //!   logs each fault and what the app did about it to (`crate::faults::log`).
 //!
-//! Just over 600 lines: one parser per variable, beside the field it fills, with the error that
+//! About 750 lines: one parser per variable, beside the field it fills, with the error that
 //! names the variable; the tests are most of the rest.
 
 use std::ffi::CStr;
@@ -55,6 +58,8 @@ pub const SUBMITTED_VAR: &str = "VITREOUS_SIM_SUBMITTED";
 pub const BUTTONS_VAR: &str = "VITREOUS_SIM_BUTTONS";
 /// Environment variable giving the largest eye image, `WxH` pixels.
 pub const EYE_MAX_VAR: &str = "VITREOUS_SIM_EYE_MAX";
+/// Environment variable listing the swapchain colour formats the headset offers.
+pub const FORMATS_VAR: &str = "VITREOUS_SIM_FORMATS";
 /// Whether the layer offers Magic Leap 2's frame controls, XR_ML_frame_end_info and
 /// XR_ML_global_dimmer (`1` or `0`; unset: not).
 pub const ML_FRAME_VAR: &str = "VITREOUS_SIM_ML_FRAME";
@@ -84,6 +89,15 @@ pub const FAULT_LOG_VAR: &str = "VITREOUS_SIM_FAULT_LOG";
 
 /// The sides `VITREOUS_SIM_EYE_MAX` takes, pixels.
 pub const EYE_MAX_RANGE: std::ops::RangeInclusive<u32> = 16..=16384;
+
+/// The swapchain colour formats `VITREOUS_SIM_FORMATS` names, with their `VkFormat` values
+/// (the four 8-bit colour formats `crate::images::TexelLayout::of` reads).
+pub const FORMAT_NAMES: [(&str, i64); 4] = [
+    ("rgba8-srgb", 43),  // VK_FORMAT_R8G8B8A8_SRGB
+    ("bgra8-srgb", 50),  // VK_FORMAT_B8G8R8A8_SRGB
+    ("rgba8-unorm", 37), // VK_FORMAT_R8G8B8A8_UNORM
+    ("bgra8-unorm", 44), // VK_FORMAT_B8G8R8A8_UNORM
+];
 
 /// An eye-tracking extension the layer can provide.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -169,6 +183,9 @@ pub struct Config {
     pub buttons: Option<PathBuf>,
     /// The largest eye image offered, width and height in pixels (`None`: the runtime's).
     pub eye_max: Option<(u32, u32)>,
+    /// The swapchain colour formats offered (`VkFormat` values, of [`FORMAT_NAMES`]), in the
+    /// headset's order of preference, without repeats (`None`: the runtime's).
+    pub formats: Option<Vec<i64>>,
     /// XR_ML_frame_end_info and XR_ML_global_dimmer are the layer's: taken out of the
     /// instance's extensions and each frame's `XrFrameEndInfo` chain, and recorded.
     pub ml_frame: bool,
@@ -374,6 +391,7 @@ impl Config {
             submitted: get(SUBMITTED_VAR).map(PathBuf::from),
             buttons: get(BUTTONS_VAR).map(PathBuf::from),
             eye_max: get(EYE_MAX_VAR).map(|v| parse_eye_max(&v)).transpose()?,
+            formats: get(FORMATS_VAR).map(|v| parse_formats(&v)).transpose()?,
             planes: get(PLANES_VAR)
                 .map(|v| parse_planes(&v))
                 .transpose()?
@@ -490,6 +508,33 @@ pub fn parse_eye_max(value: &str) -> Result<(u32, u32), ConfigError> {
             value: value.to_owned(),
             expected: "WxH in pixels, each side 16 to 16384 (e.g. 1440x1760)",
         })
+}
+
+/// Parses `VITREOUS_SIM_FORMATS`: a comma list of names of [`FORMAT_NAMES`], at least one,
+/// each at most once, into their `VkFormat` values in the order listed.
+pub fn parse_formats(value: &str) -> Result<Vec<i64>, ConfigError> {
+    let bad = || ConfigError {
+        var: FORMATS_VAR,
+        value: value.to_owned(),
+        expected: "a comma list of rgba8-srgb, bgra8-srgb, rgba8-unorm, bgra8-unorm, at least \
+                   one, each at most once (e.g. bgra8-srgb,bgra8-unorm)",
+    };
+    let mut out = Vec::new();
+    for item in items(value) {
+        let format = FORMAT_NAMES
+            .iter()
+            .find(|(name, _)| *name == item)
+            .map(|&(_, f)| f)
+            .ok_or_else(bad)?;
+        if out.contains(&format) {
+            return Err(bad());
+        }
+        out.push(format);
+    }
+    if out.is_empty() {
+        return Err(bad());
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -639,6 +684,55 @@ mod tests {
             let e = config(&[(EYE_MAX_VAR, bad)]).unwrap_err();
             assert_eq!(e.var, EYE_MAX_VAR, "{bad}");
             assert!(e.to_string().contains("16 to 16384"), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_formats_are_parsed_in_order_and_checked() {
+        assert_eq!(config(&[]).unwrap().formats, None);
+        let c = config(&[(FORMATS_VAR, " BGRA8-SRGB, bgra8-unorm ")]).unwrap();
+        assert_eq!(c.formats, Some(vec![50, 44]));
+        assert_eq!(
+            parse_formats("rgba8-unorm,rgba8-srgb,bgra8-unorm,bgra8-srgb"),
+            Ok(vec![37, 43, 44, 50])
+        );
+        for bad in [
+            ",",
+            " , ",
+            "rgba16f",
+            "bgra8-srgb,bgra8",
+            "bgra8-srgb,bgra8-srgb",
+            "rgba8-unorm,RGBA8-UNORM",
+        ] {
+            let e = config(&[(FORMATS_VAR, bad)]).unwrap_err();
+            assert_eq!(e.var, FORMATS_VAR, "{bad}");
+            assert!(e.to_string().contains("VITREOUS_SIM_FORMATS="), "{e}");
+            assert!(e.to_string().contains("each at most once"), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_format_names_are_the_vulkan_formats_the_layer_reads() {
+        use ash::vk::Format as F;
+        let values: Vec<i64> = FORMAT_NAMES.iter().map(|&(_, f)| f).collect();
+        let vulkan = [
+            F::R8G8B8A8_SRGB,
+            F::B8G8R8A8_SRGB,
+            F::R8G8B8A8_UNORM,
+            F::B8G8R8A8_UNORM,
+        ];
+        assert_eq!(
+            values,
+            vulkan.map(|f| i64::from(f.as_raw())).to_vec(),
+            "names in the order of FORMAT_NAMES"
+        );
+        for (name, f) in FORMAT_NAMES {
+            let layout = crate::images::TexelLayout::of(f).unwrap();
+            assert_eq!(
+                (layout.bgra, layout.srgb),
+                (name.starts_with("bgra"), name.ends_with("srgb")),
+                "{name}"
+            );
         }
     }
 

@@ -165,6 +165,13 @@ pub fn own_function(name: &[u8]) -> Option<(Option<GazeExtension>, Option<pfn::V
                 pfn::WaitSwapchainImage
             ),
         ),
+        b"xrEnumerateSwapchainFormats" => (
+            None,
+            entry!(
+                calls::swapchain::enumerate_swapchain_formats,
+                pfn::EnumerateSwapchainFormats
+            ),
+        ),
         b"xrCreateSwapchain" => (
             None,
             entry!(calls::swapchain::create_swapchain, pfn::CreateSwapchain),

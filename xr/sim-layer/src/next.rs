@@ -54,6 +54,8 @@ pub struct NextTable {
     pub get_input_source_localized_name: pfn::GetInputSourceLocalizedName,
     /// `xrSyncActions`.
     pub sync_actions: pfn::SyncActions,
+    /// `xrEnumerateSwapchainFormats`.
+    pub enumerate_swapchain_formats: pfn::EnumerateSwapchainFormats,
     /// `xrCreateSwapchain`.
     pub create_swapchain: pfn::CreateSwapchain,
     /// `xrDestroySwapchain`.
@@ -182,6 +184,12 @@ impl NextTable {
                 pfn::GetActionStateBoolean
             ),
             sync_actions: load!(gipa, instance, c"xrSyncActions", pfn::SyncActions),
+            enumerate_swapchain_formats: load!(
+                gipa,
+                instance,
+                c"xrEnumerateSwapchainFormats",
+                pfn::EnumerateSwapchainFormats
+            ),
             create_swapchain: load!(gipa, instance, c"xrCreateSwapchain", pfn::CreateSwapchain),
             destroy_swapchain: load!(gipa, instance, c"xrDestroySwapchain", pfn::DestroySwapchain),
             enumerate_swapchain_images: load!(
@@ -286,5 +294,29 @@ impl NextTable {
         }
         modes.truncate(n as usize);
         Ok(modes)
+    }
+
+    /// The runtime's swapchain formats for a session, in its order of preference (two calls).
+    pub fn runtime_swapchain_formats(
+        &self,
+        session: sys::Session,
+    ) -> Result<Vec<i64>, sys::Result> {
+        let mut n = 0u32;
+        // SAFETY: the table was loaded for the chain of `session`'s instance; a null array
+        // with capacity 0 asks for the count.
+        let r =
+            unsafe { (self.enumerate_swapchain_formats)(session, 0, &mut n, std::ptr::null_mut()) };
+        if r.into_raw() < 0 {
+            return Err(r);
+        }
+        let mut formats = vec![0i64; n as usize];
+        // SAFETY: `formats` holds `n` writable elements.
+        let r =
+            unsafe { (self.enumerate_swapchain_formats)(session, n, &mut n, formats.as_mut_ptr()) };
+        if r.into_raw() < 0 {
+            return Err(r);
+        }
+        formats.truncate(n as usize);
+        Ok(formats)
     }
 }

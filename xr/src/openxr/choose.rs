@@ -216,13 +216,14 @@ pub mod vk_format {
 pub struct ColorFormat {
     /// The VkFormat value.
     pub vk_format: i64,
-    /// True for an `_SRGB` format (write linear light); false for `_UNORM` (the shader must
-    /// encode).
+    /// True for an `_SRGB` format (the image encodes the linear light written); false for
+    /// `_UNORM` (OpenXR reads the values as linear light, stored in 8 bits).
     pub srgb: bool,
 }
 
-/// Chooses the swapchain format from the runtime's list (its order is its preference):
-/// RGBA8 sRGB, then BGRA8 sRGB, then RGBA8/BGRA8 UNORM.
+/// Chooses the swapchain format from the runtime's list, whatever its order: RGBA8 sRGB (the
+/// renderer's own, drawn into directly), then BGRA8 sRGB, then RGBA8/BGRA8 UNORM (blitted
+/// into from the renderer's image).
 pub fn choose_format(offered: &[i64]) -> Option<ColorFormat> {
     use vk_format::*;
     [

@@ -429,7 +429,7 @@ pub struct SwapchainImages {
     pub images: Vec<vk::Image>,
     /// Their format.
     pub format: vk::Format,
-    /// Whether the format encodes sRGB itself.
+    /// Whether the format encodes sRGB itself (else OpenXR reads its values as linear light).
     pub srgb: bool,
     /// Size of each layer, pixels.
     pub size: (u32, u32),

@@ -1,7 +1,10 @@
 //! Swapchain calls, for reading back what the app submits (`VITREOUS_SIM_IMAGES`,
 //! [`crate::images`]): in a session whose images the layer reads, each swapchain is made with
 //! transfer-source usage too, its Vulkan images and acquired indices are kept, and the image
-//! the app releases is copied before the runtime gets it. Elsewhere the calls pass straight on.
+//! the app releases is copied before the runtime gets it. With `VITREOUS_SIM_FORMATS`, the
+//! formats are the simulated headset's: `xrEnumerateSwapchainFormats` lists only those of its
+//! formats the runtime offers, and `xrCreateSwapchain` refuses the colour formats the variable
+//! can name but does not list. Elsewhere the calls pass straight on.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -9,17 +12,72 @@ use std::sync::Arc;
 use ash::vk::Handle as _;
 use openxr::sys::{self, Handle};
 
+use crate::config::{Config, FORMAT_NAMES};
 use crate::faults;
 use crate::guard::{guard, report};
 use crate::images::{SharedImages, TexelLayout};
 use crate::next::NextTable;
 use crate::registry::{SwapchainState, registry};
+use crate::two_call;
 
-/// The next layer's functions for `session` and, when the layer reads its images, its record.
-fn session_of(session: u64) -> Option<(Arc<NextTable>, Option<SharedImages>)> {
+/// The next layer's functions for `session`, its record when the layer reads its images, and
+/// its instance's configuration.
+fn session_of(session: u64) -> Option<(Arc<NextTable>, Option<SharedImages>, Arc<Config>)> {
     let reg = registry();
     let (s, i) = reg.session(session)?;
-    Some((i.next.clone(), s.images.clone()))
+    Some((i.next.clone(), s.images.clone(), i.config.clone()))
+}
+
+/// The formats the app is offered: those of `wanted` (the headset's 8-bit colour formats, in
+/// its order of preference) that the runtime offers, then the runtime's formats the variable
+/// cannot name (depth, float colour) in its order; its other 8-bit colour formats are left out.
+pub fn offered(runtime: &[i64], wanted: &[i64]) -> Vec<i64> {
+    let nameable = |f: &i64| FORMAT_NAMES.iter().any(|&(_, n)| n == *f);
+    wanted
+        .iter()
+        .copied()
+        .filter(|f| runtime.contains(f))
+        .chain(runtime.iter().copied().filter(|f| !nameable(f)))
+        .collect()
+}
+
+/// Whether a headset offering only `listed` refuses a swapchain of `format`: one of the colour
+/// formats `VITREOUS_SIM_FORMATS` can name that it does not list. Every other format (depth,
+/// and any the variable cannot name) is left to the runtime.
+pub fn refuses(format: i64, listed: &[i64]) -> bool {
+    FORMAT_NAMES.iter().any(|&(_, f)| f == format) && !listed.contains(&format)
+}
+
+/// `xrEnumerateSwapchainFormats`: with `VITREOUS_SIM_FORMATS`, the listed formats the runtime
+/// offers, in the listed order, then its formats the variable cannot name ([`offered`]);
+/// unset, the runtime's.
+///
+/// # Safety
+/// As `xrEnumerateSwapchainFormats`.
+pub unsafe extern "system" fn enumerate_swapchain_formats(
+    session: sys::Session,
+    capacity: u32,
+    count: *mut u32,
+    formats: *mut i64,
+) -> sys::Result {
+    guard("xrEnumerateSwapchainFormats", || {
+        let Some((next, _, config)) = session_of(session.into_raw()) else {
+            return sys::Result::ERROR_HANDLE_INVALID;
+        };
+        let Some(wanted) = &config.formats else {
+            // SAFETY: the next layer's function with the app's arguments.
+            return unsafe {
+                (next.enumerate_swapchain_formats)(session, capacity, count, formats)
+            };
+        };
+        let runtime = match next.runtime_swapchain_formats(session) {
+            Ok(f) => f,
+            Err(r) => return r,
+        };
+        let list = offered(&runtime, wanted);
+        // SAFETY: the app's pointers, valid as the call defines them.
+        unsafe { two_call::answer_raw(&list, capacity, count, formats) }
+    })
 }
 
 /// The next layer's functions for `swapchain`'s session (the only instance's for a swapchain
@@ -75,7 +133,9 @@ pub unsafe extern "system" fn wait_swapchain_image(
     })
 }
 
-/// `xrCreateSwapchain`: with transfer-source usage added where the layer reads the images.
+/// `xrCreateSwapchain`: `XR_ERROR_SWAPCHAIN_FORMAT_UNSUPPORTED` for a colour format
+/// `VITREOUS_SIM_FORMATS` can name but does not list (when it is set), else passed on with
+/// transfer-source usage added where the layer reads the images.
 ///
 /// # Safety
 /// As `xrCreateSwapchain`.
@@ -85,13 +145,18 @@ pub unsafe extern "system" fn create_swapchain(
     swapchain: *mut sys::Swapchain,
 ) -> sys::Result {
     guard("xrCreateSwapchain", || {
-        let Some((next, images)) = session_of(session.into_raw()) else {
+        let Some((next, images, config)) = session_of(session.into_raw()) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
         // SAFETY: the app's structure, null or valid.
         let Some(app) = (unsafe { info.as_ref() }) else {
             return sys::Result::ERROR_VALIDATION_FAILURE;
         };
+        if let Some(listed) = &config.formats
+            && refuses(app.format, listed)
+        {
+            return sys::Result::ERROR_SWAPCHAIN_FORMAT_UNSUPPORTED;
+        }
         let mut asked = *app;
         if images.is_some() {
             asked.usage_flags |= sys::SwapchainUsageFlags::TRANSFER_SRC;
@@ -263,4 +328,77 @@ pub unsafe extern "system" fn release_swapchain_image(
         // SAFETY: the next layer's function with the app's arguments.
         unsafe { (next.release_swapchain_image)(swapchain, info) }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `VK_FORMAT_R8G8B8A8_UNORM`.
+    const RGBA_UNORM: i64 = 37;
+    /// `VK_FORMAT_R8G8B8A8_SRGB`.
+    const RGBA_SRGB: i64 = 43;
+    /// `VK_FORMAT_B8G8R8A8_UNORM`.
+    const BGRA_UNORM: i64 = 44;
+    /// `VK_FORMAT_B8G8R8A8_SRGB`.
+    const BGRA_SRGB: i64 = 50;
+    /// `VK_FORMAT_D32_SFLOAT`.
+    const D32: i64 = 126;
+    /// `VK_FORMAT_R16G16B16A16_SFLOAT`.
+    const RGBA16F: i64 = 97;
+
+    #[test]
+    fn the_headsets_formats_the_runtime_offers_are_listed_in_the_headsets_order() {
+        let runtime = [RGBA_SRGB, BGRA_SRGB, RGBA_UNORM, BGRA_UNORM, RGBA16F, D32];
+        // The runtime's depth and float formats stay, after the listed colour formats.
+        assert_eq!(
+            offered(&runtime, &[BGRA_SRGB, BGRA_UNORM]),
+            vec![BGRA_SRGB, BGRA_UNORM, RGBA16F, D32]
+        );
+        assert_eq!(
+            offered(&runtime, &[BGRA_UNORM, RGBA_SRGB]),
+            vec![BGRA_UNORM, RGBA_SRGB, RGBA16F, D32],
+            "the headset's order, not the runtime's"
+        );
+        // A listed format the runtime does not offer is left out; none left: no 8-bit colour.
+        assert_eq!(
+            offered(&[RGBA_SRGB, D32], &[BGRA_SRGB, RGBA_SRGB]),
+            vec![RGBA_SRGB, D32]
+        );
+        assert_eq!(offered(&[RGBA_SRGB, D32], &[BGRA_UNORM]), vec![D32]);
+        assert!(offered(&[], &[BGRA_SRGB]).is_empty());
+    }
+
+    #[test]
+    fn only_unlisted_eight_bit_colour_formats_are_refused() {
+        let listed = [BGRA_SRGB, BGRA_UNORM];
+        assert!(!refuses(BGRA_SRGB, &listed));
+        assert!(!refuses(BGRA_UNORM, &listed));
+        assert!(refuses(RGBA_SRGB, &listed));
+        assert!(refuses(RGBA_UNORM, &listed));
+        // Depth and formats the variable cannot name are the runtime's to decide.
+        assert!(!refuses(D32, &listed));
+        assert!(!refuses(RGBA16F, &listed));
+        assert!(!refuses(0, &listed));
+    }
+
+    #[test]
+    fn the_answer_follows_the_two_call_idiom() {
+        let list = offered(&[RGBA_SRGB, BGRA_SRGB], &[BGRA_SRGB, RGBA_SRGB]);
+        let mut n = 0u32;
+        // SAFETY: `n` is writable; a null array with capacity 0 asks for the count.
+        let r = unsafe { two_call::answer_raw(&list, 0, &mut n, std::ptr::null_mut()) };
+        assert_eq!((r, n), (sys::Result::SUCCESS, 2));
+        let mut out = [0i64; 1];
+        // SAFETY: `out` holds one writable element.
+        let r = unsafe { two_call::answer_raw(&list, 1, &mut n, out.as_mut_ptr()) };
+        assert_eq!((r, n), (sys::Result::ERROR_SIZE_INSUFFICIENT, 2));
+        let mut out = [0i64; 3];
+        // SAFETY: `out` holds three writable elements.
+        let r = unsafe { two_call::answer_raw(&list, 3, &mut n, out.as_mut_ptr()) };
+        assert_eq!(
+            (r, n, out),
+            (sys::Result::SUCCESS, 2, [BGRA_SRGB, RGBA_SRGB, 0])
+        );
+    }
 }

@@ -81,8 +81,14 @@ pub(in crate::openxr) unsafe fn start(
     let swapchain = session
         .create_swapchain(&xr::SwapchainCreateInfo {
             create_flags: xr::SwapchainCreateFlags::EMPTY,
+            // Another format than the renderer's is blitted into: transfer destination too.
             usage_flags: xr::SwapchainUsageFlags::COLOR_ATTACHMENT
-                | xr::SwapchainUsageFlags::TRANSFER_SRC,
+                | xr::SwapchainUsageFlags::TRANSFER_SRC
+                | if format.vk_format == choose::vk_format::R8G8B8A8_SRGB {
+                    xr::SwapchainUsageFlags::EMPTY
+                } else {
+                    xr::SwapchainUsageFlags::TRANSFER_DST
+                },
             format: format.vk_format as u32,
             sample_count: 1,
             width: w,

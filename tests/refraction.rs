@@ -477,6 +477,32 @@ fn two_surface_marker_matches_the_reference_for_a_turned_and_moved_head() {
     two_surface_marker_matches_the_reference(turned_head(), 2.0);
 }
 
+/// Canted displays with asymmetric fields of view, as some headsets have: each eye's view
+/// turned 6 degrees outwards (the left one left) and its field wider on the inner side, towards
+/// the other eye's, so that the two still overlap; the renderer must draw each eye from its
+/// own orientation and frustum.
+#[test]
+fn two_surface_marker_matches_the_reference_for_canted_displays() {
+    let cant = 6f32.to_radians();
+    let eye = |x: f32, turn: f32, fov: Fov| {
+        EyeParams::new(Vec3::new(x, 0.0, 0.0), Quat::from_rotation_y(turn), fov)
+    };
+    let left = Fov {
+        left_rad: -0.44,
+        right_rad: 0.62,
+        up_rad: 0.40,
+        down_rad: -0.46,
+    };
+    let right = Fov {
+        left_rad: -left.right_rad,
+        right_rad: -left.left_rad,
+        ..left
+    };
+    let canted = [eye(-IPD / 2.0, cant, left), eye(IPD / 2.0, -cant, right)];
+    marker_matches_the_reference(canted, 1.0, Refraction::TwoSurface, fine_sphere());
+    marker_matches_the_reference(canted, 1.0, Refraction::Paper, fine_sphere());
+}
+
 /// The turned and moved head of the two-surface tests.
 pub(crate) fn turned_head() -> [EyeParams; 2] {
     let turn = Quat::from_euler(glam::EulerRot::YXZ, 0.08, -0.05, 0.02);

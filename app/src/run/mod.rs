@@ -39,6 +39,7 @@ mod recording;
 mod room_light;
 mod sink;
 mod summary;
+mod views;
 mod xr_session;
 
 use std::fs;
@@ -365,6 +366,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         events: Vec::new(),
         last_time_ns: None,
         resident: ResidentSampler::new(RESIDENT_WARM_UP_FRAMES, RESIDENT_EVERY_FRAMES),
+        views: views::ViewWatch::default(),
     };
     let reconnect_limit =
         std::time::Duration::from_secs_f64(options.reconnect_s.unwrap_or(RECONNECT_S_DEFAULT));
@@ -500,6 +502,16 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         Some(path) => Some(replay_check(path, &sink.recorded, &scene)?),
         None => None,
     };
+    let headset_views = sink.views.summary(
+        scene.viewer.ipd_m,
+        &scene.output.fov,
+        replay_check.as_ref().map(|r| r.max_eye_position_m),
+    );
+    if let (Some(views), Some(path)) = (&headset_views, &options.record)
+        && let Some(warning) = views.replay_warning(&path.display().to_string())
+    {
+        tracing::warn!("{warning}");
+    }
     let interruptions = InterruptionSummary::new(
         &report,
         reconnects,
@@ -565,6 +577,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             0
         },
         replay_check,
+        headset_views,
         actions_attached: report.actions_attached,
         action_profiles: report.action_profiles.clone(),
         action_syncs: report.action_syncs,

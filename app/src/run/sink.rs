@@ -87,6 +87,8 @@ pub(super) struct RunSink<'d> {
     pub(super) last_time_ns: Option<i64>,
     /// Resident memory over the session's frames.
     pub(super) resident: ResidentSampler,
+    /// The headset's eye views, against the scene's.
+    pub(super) views: super::views::ViewWatch,
 }
 
 impl RunSink<'_> {
@@ -133,6 +135,7 @@ impl FrameSink for RunSink<'_> {
 
     fn started(&mut self, input: &FrameInput) -> Result<()> {
         self.watch_gaze(input);
+        self.views.watch(input);
         self.last_time_ns = Some(input.time_ns);
         if let Some(w) = &mut self.writer {
             w.write(&trace_sample(input))

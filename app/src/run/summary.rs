@@ -82,6 +82,8 @@ pub struct RunSummary {
     pub recorded_samples: u64,
     /// Replay of the recording against the session's views, when recorded.
     pub replay_check: Option<ReplayCheck>,
+    /// The headset's eye views against the scene's (`None`: no frame was drawn).
+    pub headset_views: Option<super::views::HeadsetViews>,
     /// The controller action set was created and attached.
     pub actions_attached: bool,
     /// Interaction profiles whose bindings the runtime accepted.
@@ -241,6 +243,21 @@ impl RunSummary {
                 m.last_frame,
                 m.growth_percent,
                 m.max_kib
+            );
+        }
+        if let Some(v) = &self.headset_views {
+            let _ = writeln!(
+                out,
+                "headset's eyes: {:.1} mm apart (scene {:.1}), turned {:.2}/{:.2} deg outwards; {}",
+                v.ipd_mm[1],
+                v.scene_ipd_mm,
+                v.toe_out_deg[0],
+                v.toe_out_deg[1],
+                if v.differences.is_empty() {
+                    "a replay draws the same views"
+                } else {
+                    "a replay of a recording draws other views"
+                }
             );
         }
         if let Some(r) = &self.replay_check {

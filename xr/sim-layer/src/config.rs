@@ -33,11 +33,14 @@
 //!   right and down, each within 10 degrees) the app's light and panel land that far from the
 //!   world, as a registration error puts them (to the nearest pixel), and the view without
 //!   the error is written beside it (`wearer-left-registered.png`, ...).
+//! - `VITREOUS_SIM_VIEWS`: `ipd_mm` or `ipd_mm,toe_out_deg`: the headset's eyes as
+//!   `xrLocateViews` answers them, that far apart about the runtime's midpoint and each turned
+//!   outwards by `toe_out_deg` (canted displays; `crate::views`).
 //! - `VITREOUS_SIM_FAULTS`: a fault schedule (`crate::faults::schedule`): what a misbehaving
 //!   headset does to the session, and when; `VITREOUS_SIM_FAULT_LOG`: the CSV file the layer
 //!   logs each fault and what the app did about it to (`crate::faults::log`).
 //!
-//! About 750 lines: one parser per variable, beside the field it fills, with the error that
+//! About 800 lines: one parser per variable, beside the field it fills, with the error that
 //! names the variable; the tests are most of the rest.
 
 use std::ffi::CStr;
@@ -81,6 +84,10 @@ pub const PANEL_VAR: &str = "VITREOUS_SIM_PANEL";
 /// Environment variable giving the registration error of the wearer's view: degrees right,
 /// down.
 pub const REGISTRATION_VAR: &str = "VITREOUS_SIM_REGISTRATION";
+
+/// Environment variable giving the headset's eye views: their distance apart (millimetres)
+/// and, optionally, how far each is turned outwards (degrees).
+pub const VIEWS_VAR: &str = "VITREOUS_SIM_VIEWS";
 
 /// Environment variable naming the fault schedule.
 pub const FAULTS_VAR: &str = "VITREOUS_SIM_FAULTS";
@@ -202,6 +209,8 @@ pub struct Config {
     /// How far the app's light and panel land from the world in the wearer's view, degrees
     /// right and down.
     pub registration_deg: [f32; 2],
+    /// The eyes `xrLocateViews` answers (`None`: the runtime's).
+    pub views: Option<SimViews>,
     /// The fault schedule file.
     pub faults: Option<PathBuf>,
     /// The fault log file.
@@ -272,6 +281,40 @@ pub fn parse_registration(value: &str) -> Result<[f32; 2], ConfigError> {
         [x, y] if [x, y].iter().all(|v| v.is_finite() && v.abs() <= 10.0) => Ok([x, y]),
         _ => Err(bad()),
     }
+}
+
+/// The headset's eye views, as `VITREOUS_SIM_VIEWS` gives them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimViews {
+    /// Distance between the eyes, metres.
+    pub ipd_m: f32,
+    /// How far each eye's view is turned outwards about the head's up axis, degrees.
+    pub toe_out_deg: f32,
+}
+
+/// Parses `VITREOUS_SIM_VIEWS`.
+pub fn parse_views(value: &str) -> Result<SimViews, ConfigError> {
+    let bad = || ConfigError {
+        var: VIEWS_VAR,
+        value: value.to_owned(),
+        expected: "ipd_mm[,toe_out_deg]: 40 to 90 millimetres, then -10 to 10 degrees",
+    };
+    let parts: Vec<f32> = value
+        .split(',')
+        .map(|v| v.trim().parse::<f32>().map_err(|_| bad()))
+        .collect::<Result<_, _>>()?;
+    let (ipd_mm, toe_out_deg) = match parts[..] {
+        [ipd] => (ipd, 0.0),
+        [ipd, toe] => (ipd, toe),
+        _ => return Err(bad()),
+    };
+    if !((40.0..=90.0).contains(&ipd_mm) && (-10.0..=10.0).contains(&toe_out_deg)) {
+        return Err(bad());
+    }
+    Ok(SimViews {
+        ipd_m: ipd_mm / 1000.0,
+        toe_out_deg,
+    })
 }
 
 /// The room's light, as `VITREOUS_SIM_LIGHT` gives it.
@@ -407,6 +450,7 @@ impl Config {
                 .map(|v| parse_registration(&v))
                 .transpose()?
                 .unwrap_or_default(),
+            views: get(VIEWS_VAR).map(|v| parse_views(&v)).transpose()?,
             faults: get(FAULTS_VAR).map(PathBuf::from),
             fault_log: get(FAULT_LOG_VAR).map(PathBuf::from),
             ml_frame: match get(ML_FRAME_VAR).as_deref().map(str::trim) {
@@ -580,6 +624,19 @@ mod tests {
         for bad in ["1", "1,2,3", "nan,0", "0,11", "a,b"] {
             let e = config(&[(REGISTRATION_VAR, bad)]).unwrap_err();
             assert_eq!(e.var, REGISTRATION_VAR, "{bad}");
+        }
+    }
+
+    #[test]
+    fn views_are_a_distance_and_a_turn_and_bad_ones_name_the_variable() {
+        assert_eq!(config(&[]).unwrap().views, None);
+        let v = config(&[(VIEWS_VAR, "58")]).unwrap().views.unwrap();
+        assert_eq!((v.ipd_m, v.toe_out_deg), (0.058, 0.0));
+        let v = config(&[(VIEWS_VAR, " 70 , 4.5 ")]).unwrap().views.unwrap();
+        assert_eq!((v.ipd_m, v.toe_out_deg), (0.07, 4.5));
+        for bad in ["39", "91", "63,11", "nan", "63,inf", "63,1,2", "a", "63,"] {
+            let e = config(&[(VIEWS_VAR, bad)]).unwrap_err();
+            assert_eq!(e.var, VIEWS_VAR, "{bad}");
         }
     }
 

@@ -32,4 +32,5 @@ pub mod registry;
 pub mod submitted;
 pub mod timeline;
 pub mod two_call;
+pub mod views;
 pub mod wearer;

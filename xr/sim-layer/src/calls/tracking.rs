@@ -58,7 +58,9 @@ pub fn head_in_world(reg: &Registry, space: u64, base: u64) -> Option<(u64, bool
 }
 
 /// `xrLocateViews`: refused when the session is lost (or the call is scheduled to fail), else
-/// passed on, the views' flags and poses then losing what this frame's head tracking lacks.
+/// passed on, the eyes then moved and turned as `VITREOUS_SIM_VIEWS` asks
+/// ([`crate::views`]) and the views' flags and poses losing what this frame's head tracking
+/// lacks.
 ///
 /// # Safety
 /// As `xrLocateViews`.
@@ -74,23 +76,33 @@ pub unsafe extern "system" fn locate_views(
         let Some(ctx) = SessionContext::of(&registry(), session.into_raw()) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
-        let Some((refused, loss)) =
-            faults::with(|f| (f.refuse("xrLocateViews", session.into_raw()), f.tracking()))
-        else {
-            // SAFETY: the next layer's function with the app's arguments.
-            return unsafe {
-                (ctx.next.locate_views)(session, info, state, capacity, count, views)
-            };
-        };
-        if let Some(r) = refused {
-            return r;
+        let faulted =
+            faults::with(|f| (f.refuse("xrLocateViews", session.into_raw()), f.tracking()));
+        if let Some((Some(refused), _)) = faulted {
+            return refused;
         }
         // SAFETY: the next layer's function with the app's arguments.
         let r = unsafe { (ctx.next.locate_views)(session, info, state, capacity, count, views) };
-        let Some(loss) = loss else {
+        if r.into_raw() < 0 {
+            return r;
+        }
+        let written = if capacity == 0 || views.is_null() || count.is_null() {
+            0
+        } else {
+            // SAFETY: on success `count` says how many of the app's views were written.
+            unsafe { *count }.min(capacity) as usize
+        };
+        if let Some(asked) = ctx.config.views
+            && written == 2
+        {
+            // SAFETY: the app's array of `capacity` views, these two filled.
+            let (left, right) = unsafe { (&mut *views, &mut *views.add(1)) };
+            [left.pose, right.pose] = crate::views::respaced([left.pose, right.pose], asked);
+        }
+        let Some((None, Some(loss))) = faulted else {
             return r;
         };
-        if r.into_raw() < 0 || state.is_null() {
+        if state.is_null() {
             return r;
         }
         // SAFETY: on success the runtime filled the app's view state.
@@ -101,13 +113,9 @@ pub unsafe extern "system" fn locate_views(
             TrackingLoss::Orientation => without_orientation(flags),
         };
         state.view_state_flags = sys::ViewStateFlags::from_raw(kept.into_raw());
-        if capacity > 0 && !views.is_null() && !count.is_null() {
-            // SAFETY: on success `count` says how many of the app's views were written.
-            let written = unsafe { *count }.min(capacity) as usize;
-            for i in 0..written {
-                // SAFETY: the app's array of `capacity` views, `written` of them filled.
-                lose(unsafe { &mut (*views.add(i)).pose }, loss);
-            }
+        for i in 0..written {
+            // SAFETY: the app's array of `capacity` views, `written` of them filled.
+            lose(unsafe { &mut (*views.add(i)).pose }, loss);
         }
         r
     })

@@ -311,6 +311,7 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         samples,
         edits,
         events,
+        views,
     } = recording;
     let mut inputs = InputFiles::new();
     inputs.add_scene(&scene, "SCENE");
@@ -339,7 +340,8 @@ pub fn replay(options: &ReplayOptions) -> Result<ReplaySummary> {
         },
     )
     .with_context(|| format!("replaying {trace_name}"))?
-    .with_events(events);
+    .with_events(events)
+    .with_views(views);
 
     let ctx = GpuContext::headless(&ContextOptions {
         validation: options.validate,

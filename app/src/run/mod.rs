@@ -296,11 +296,12 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         format!("{} ({})", ctx.device_name, ctx.driver)
     };
 
-    // Version 1.4 from the first line: every frame may carry the tracker's report, and the
-    // session's events (a headset taken off, frames not rendered) go between the samples.
+    // Version 1.5 from the first line: every frame may carry the tracker's report, and the
+    // session's events (a headset taken off, frames not rendered) and the eyes the headset
+    // drew from go between the samples.
     let writer = match &options.record {
         Some(path) => Some(
-            TraceWriter::create_version(path, TraceVersion::V1_4)
+            TraceWriter::create_version(path, TraceVersion::V1_5)
                 .with_context(|| format!("creating {}", path.display()))?,
         ),
         None => None,
@@ -367,6 +368,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         last_time_ns: None,
         resident: ResidentSampler::new(RESIDENT_WARM_UP_FRAMES, RESIDENT_EVERY_FRAMES),
         views: views::ViewWatch::default(),
+        recorded_views: None,
     };
     let reconnect_limit =
         std::time::Duration::from_secs_f64(options.reconnect_s.unwrap_or(RECONNECT_S_DEFAULT));
@@ -503,14 +505,20 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         None => None,
     };
     let headset_views = sink.views.summary(
-        scene.viewer.ipd_m,
         &scene.output.fov,
-        replay_check.as_ref().map(|r| r.max_eye_position_m),
+        replay_check
+            .as_ref()
+            .map(|r| (r.max_eye_position_m, r.max_eye_angle_deg)),
     );
-    if let (Some(views), Some(path)) = (&headset_views, &options.record)
-        && let Some(warning) = views.replay_warning(&path.display().to_string())
-    {
-        tracing::warn!("{warning}");
+    if let Some(views) = &headset_views {
+        if let Some(path) = &options.record
+            && let Some(warning) = views.replay_warning(&path.display().to_string())
+        {
+            tracing::warn!("{warning}");
+        }
+        if let Some(note) = views.field_note() {
+            tracing::info!("{note}");
+        }
     }
     let interruptions = InterruptionSummary::new(
         &report,

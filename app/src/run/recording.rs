@@ -1,11 +1,12 @@
-//! `vitreous run --record`: each frame's head pose and gaze written as a trace, and the check
-//! that a replay of that trace with the null backend reproduces the session's views.
+//! `vitreous run --record`: each frame's head pose and gaze written as a trace, with a views
+//! line whenever the eyes the headset drew from change, and the check that a replay of that
+//! trace with the null backend reproduces the session's views.
 
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
-use vitreous_trace::format::{TraceSample, read_trace};
+use vitreous_trace::format::{HeadView, TraceSample, ViewsRecord, read_recording};
 use vitreous_trace::{FrameInput, GazeSample, Pose};
 use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
@@ -23,9 +24,25 @@ pub struct ReplayCheck {
     pub max_head_position_m: f32,
     /// Largest head orientation difference, degrees.
     pub max_head_angle_deg: f32,
-    /// Largest eye position difference, metres (the replay puts eyes at the recorded gaze
-    /// origins, the runtime at its own eye positions: both should agree with the IPD).
+    /// Largest eye position difference, metres (the replay draws from the recorded views).
     pub max_eye_position_m: f32,
+    /// Largest difference of a view's orientation, degrees.
+    pub max_eye_angle_deg: f32,
+}
+
+/// The views line a frame needs recorded before its sample: the first frame's, then one
+/// whenever an eye moved or turned or its field changed against `last` (the eyes of the line
+/// written before).
+pub(super) fn views_due(input: &FrameInput, last: Option<&[HeadView; 2]>) -> Option<ViewsRecord> {
+    let eyes = input
+        .views
+        .each_ref()
+        .map(|v| HeadView::of(&input.head, &v.pose, v.fov));
+    let changed = last.is_none_or(|last| last.iter().zip(&eyes).any(|(a, b)| a.differs(b)));
+    changed.then_some(ViewsRecord {
+        time_ns: input.time_ns,
+        eyes,
+    })
 }
 
 /// A trace sample for a frame: its head pose and gaze (an invalid gaze at the frame time when
@@ -45,7 +62,9 @@ pub(super) fn replay_check(
     session: &[FrameInput],
     scene: &Scene,
 ) -> Result<ReplayCheck> {
-    let samples = read_trace(path).with_context(|| format!("reading back {}", path.display()))?;
+    let recording =
+        read_recording(path).with_context(|| format!("reading back {}", path.display()))?;
+    let samples = recording.samples;
     if samples.len() < 2 || session.len() < 2 {
         bail!("the recording {} has fewer than 2 samples", path.display());
     }
@@ -60,8 +79,10 @@ pub(super) fn replay_check(
             ipd_m: scene.viewer.ipd_m,
             at_samples: false,
         },
-    )?;
+    )?
+    .with_views(recording.views);
     let (mut frames, mut max_pos, mut max_ang, mut max_eye) = (0u64, 0f32, 0f32, 0f32);
+    let mut max_eye_angle = 0f32;
     while let Some(frame) = null.wait_frame()? {
         null.end_frame(&frame)?;
         let t = frame.time_ns;
@@ -94,8 +115,10 @@ pub(super) fn replay_check(
                 .to_degrees(),
         );
         for eye in 0..2 {
-            max_eye = max_eye
-                .max((frame.views[eye].pose.position - expected.views[eye].pose.position).length());
+            let (got, want) = (&frame.views[eye].pose, &expected.views[eye].pose);
+            max_eye = max_eye.max((got.position - want.position).length());
+            max_eye_angle =
+                max_eye_angle.max(got.orientation.angle_between(want.orientation).to_degrees());
         }
     }
     Ok(ReplayCheck {
@@ -104,6 +127,7 @@ pub(super) fn replay_check(
         max_head_position_m: max_pos,
         max_head_angle_deg: max_ang,
         max_eye_position_m: max_eye,
+        max_eye_angle_deg: max_eye_angle,
     })
 }
 

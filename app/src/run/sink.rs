@@ -9,7 +9,7 @@ use vitreous_trace::light::LightEstimate;
 use vitreous_trace::{Blend, Command, FrameInput};
 use vitreous_xr::FrameEndHints;
 
-use super::recording::trace_sample;
+use super::recording::{trace_sample, views_due};
 use super::room_light;
 use vitreous_frames::conditions::LiveConditions;
 use vitreous_frames::director::Director;
@@ -89,6 +89,8 @@ pub(super) struct RunSink<'d> {
     pub(super) resident: ResidentSampler,
     /// The headset's eye views, against the scene's.
     pub(super) views: super::views::ViewWatch,
+    /// The eyes of the last views line recorded.
+    pub(super) recorded_views: Option<[vitreous_trace::format::HeadView; 2]>,
 }
 
 impl RunSink<'_> {
@@ -138,6 +140,10 @@ impl FrameSink for RunSink<'_> {
         self.views.watch(input);
         self.last_time_ns = Some(input.time_ns);
         if let Some(w) = &mut self.writer {
+            if let Some(views) = views_due(input, self.recorded_views.as_ref()) {
+                w.write_views(&views).context("recording the views")?;
+                self.recorded_views = Some(views.eyes);
+            }
             w.write(&trace_sample(input))
                 .context("recording the trace")?;
             self.recorded.push(input.clone());

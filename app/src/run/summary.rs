@@ -248,15 +248,14 @@ impl RunSummary {
         if let Some(v) = &self.headset_views {
             let _ = writeln!(
                 out,
-                "headset's eyes: {:.1} mm apart (scene {:.1}), turned {:.2}/{:.2} deg outwards; {}",
+                "headset's eyes: {:.1} mm apart, turned {:.2}/{:.2} deg outwards; {}",
                 v.ipd_mm[1],
-                v.scene_ipd_mm,
                 v.toe_out_deg[0],
                 v.toe_out_deg[1],
-                if v.differences.is_empty() {
-                    "a replay draws the same views"
-                } else {
-                    "a replay of a recording draws other views"
+                match (&v.replay_eye_mm, v.differences.is_empty()) {
+                    (None, _) => "not recorded",
+                    (Some(_), true) => "the recording replays from them",
+                    (Some(_), false) => "the recording's replay draws from other eyes",
                 }
             );
         }

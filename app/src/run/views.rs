@@ -1,13 +1,14 @@
-//! The headset's eye views over a live session, held against the scene's.
+//! The headset's eye views over a live session, against a replay's.
 //!
 //! Live, each eye is drawn from the view the runtime locates: its own distance between the
-//! eyes, its displays' turn and fields of view. A recording keeps the head's pose and the gaze,
-//! not the views, so `vitreous replay` of it draws other eyes: at the running mean of the eye
-//! tracker's gaze origins (the scene's `[viewer] ipd_mm` apart before one is valid), parallel
-//! to the head, with the scene's `[output]` field of view (the null backend,
-//! `vitreous_xr::null`). [`ViewWatch`] measures the headset's eyes in the head's frame over
-//! the session, the summary records them, and a recorded session warns where its replay draws
-//! other views than the wearer saw.
+//! eyes, its displays' turn and fields of view. `--record` writes those eyes into the trace
+//! (version 1.5's views lines, in the head's frame) and `vitreous replay` of it draws from them,
+//! with the scene's `[output]` field of view (a replay's images are its own size); a trace
+//! without views lines replays from eyes at the running mean of the eye tracker's gaze origins,
+//! parallel (the null backend, `vitreous_xr::null`). [`ViewWatch`] measures the headset's eyes in
+//! the head's frame over the session; the summary records them, how far the replay of the
+//! recording put an eye from the headset's (its position and its view's direction), and a
+//! recorded session whose replay does not draw from the same eyes ends with a warning.
 
 use glam::Vec3;
 use serde::Serialize;
@@ -17,8 +18,8 @@ use vitreous_trace::{EyeView, Fov, FrameInput, Pose};
 /// 0.5 mm difference in the distance between the eyes, a tenth of the 5 mm between common
 /// ipd steps).
 pub const EYE_TOLERANCE_MM: f32 = 0.25;
-/// Largest turn of a view against the head, or difference of a field's edge, a replay may
-/// draw unremarked, degrees.
+/// Largest turn of a replay's view against the headset's, or difference of a field's edge,
+/// unremarked, degrees.
 pub const ANGLE_TOLERANCE_DEG: f32 = 0.1;
 
 /// The headset's eyes over the frames drawn (`summary.json`'s `headset_views`).
@@ -34,17 +35,19 @@ pub struct HeadsetViews {
     /// Each eye's field of view in its last frame: left, right, up, down edge, degrees (left,
     /// right eye).
     pub fov_deg: [[f32; 4]; 2],
-    /// The scene's distance between the eyes (`[viewer] ipd_mm`), where a replay puts the
-    /// eyes before the eye tracker gives an origin.
-    pub scene_ipd_mm: f32,
     /// The scene's field of view (`[output]`), what a replay draws.
     pub scene_fov_deg: [f32; 4],
-    /// Where a replay of the recording puts an eye farthest from the headset's, millimetres
+    /// The farthest the replay of the recording put an eye from the headset's, millimetres
     /// (`None`: not recorded).
     pub replay_eye_mm: Option<f32>,
-    /// Where a replay's views differ from the headset's (empty: the same, within
-    /// [`EYE_TOLERANCE_MM`] and [`ANGLE_TOLERANCE_DEG`]).
+    /// The most the replay of the recording turned a view from the headset's, degrees
+    /// (`None`: not recorded).
+    pub replay_eye_deg: Option<f32>,
+    /// Where the replay of the recording drew from other eyes than the headset (empty: the
+    /// same, within [`EYE_TOLERANCE_MM`] and [`ANGLE_TOLERANCE_DEG`], or not recorded).
     pub differences: Vec<String>,
+    /// Whether the headset's fields differ from the scene's, which a replay draws.
+    pub fields_differ: bool,
 }
 
 /// Watches each frame's views (module docs).
@@ -99,15 +102,10 @@ impl ViewWatch {
         self.frames += 1;
     }
 
-    /// What the frames showed against the scene's eyes, and, for a recorded session, how far
-    /// its replay put an eye from the headset's (`replay_eye_m`, metres; `None`: not
-    /// recorded). `None` when no frame was drawn.
-    pub fn summary(
-        &self,
-        scene_ipd_m: f32,
-        scene_fov: &Fov,
-        replay_eye_m: Option<f32>,
-    ) -> Option<HeadsetViews> {
+    /// What the frames showed, with, for a recorded session, the farthest its replay put an
+    /// eye from the headset's and the most it turned a view (`replay`: metres, degrees;
+    /// `None`: not recorded). `None` when no frame was drawn.
+    pub fn summary(&self, scene_fov: &Fov, replay: Option<(f32, f32)>) -> Option<HeadsetViews> {
         let fov = self.fov?;
         let n = self.frames as f64;
         let (least, sum, most) = self.ipd_m;
@@ -115,67 +113,67 @@ impl ViewWatch {
         let toe_out_deg = self.toe_out_rad.map(|t| (t / n).to_degrees() as f32);
         let fov_deg = fov.each_ref().map(degrees);
         let scene_fov_deg = degrees(scene_fov);
-        let scene_ipd_mm = scene_ipd_m * 1e3;
-        let replay_eye_mm = replay_eye_m.map(|m| m * 1e3);
+        let replay_eye_mm = replay.map(|(m, _)| m * 1e3);
+        let replay_eye_deg = replay.map(|(_, deg)| deg);
         let mut differences = Vec::new();
         if let Some(eye_mm) = replay_eye_mm.filter(|&mm| mm > EYE_TOLERANCE_MM) {
             differences.push(format!(
-                "the eyes {:.1} mm apart, up to {eye_mm:.1} mm from where a replay puts them \
-                 (the eye tracker's mean gaze origins; the scene's [viewer] ipd_mm = \
-                 {scene_ipd_mm:.1} before one is valid)",
+                "an eye up to {eye_mm:.2} mm from the headset's (its eyes {:.1} mm apart)",
                 ipd_mm[1]
             ));
         }
-        if toe_out_deg.iter().any(|t| t.abs() > ANGLE_TOLERANCE_DEG) {
+        if let Some(deg) = replay_eye_deg.filter(|&deg| deg > ANGLE_TOLERANCE_DEG) {
             differences.push(format!(
-                "the views turned {:.2} and {:.2} degrees outwards (a replay's are parallel)",
+                "a view turned up to {deg:.2} degrees from the headset's (its views {:.2} and \
+                 {:.2} degrees outwards)",
                 toe_out_deg[0], toe_out_deg[1]
             ));
         }
-        for (eye, edges) in ["left", "right"].iter().zip(&fov_deg) {
-            if edges
+        let fields_differ = fov_deg.iter().any(|edges| {
+            edges
                 .iter()
                 .zip(&scene_fov_deg)
                 .any(|(a, b)| (a - b).abs() > ANGLE_TOLERANCE_DEG)
-            {
-                differences.push(format!(
-                    "the {eye} eye's field {:.1}/{:.1}/{:.1}/{:.1} degrees left/right/up/down \
-                     (a replay draws the scene's {:.1}/{:.1}/{:.1}/{:.1})",
-                    edges[0],
-                    edges[1],
-                    edges[2],
-                    edges[3],
-                    scene_fov_deg[0],
-                    scene_fov_deg[1],
-                    scene_fov_deg[2],
-                    scene_fov_deg[3]
-                ));
-            }
-        }
+        });
         Some(HeadsetViews {
             frames: self.frames,
             ipd_mm,
             toe_out_deg,
             fov_deg,
-            scene_ipd_mm,
             scene_fov_deg,
             replay_eye_mm,
+            replay_eye_deg,
             differences,
+            fields_differ,
         })
     }
 }
 
 impl HeadsetViews {
-    /// The warning for a recorded session whose replay draws other views (`None`: the same).
+    /// The warning for a recorded session whose replay drew from other eyes (`None`: the
+    /// same).
     pub fn replay_warning(&self, recording: &str) -> Option<String> {
         if self.differences.is_empty() {
             return None;
         }
         Some(format!(
-            "a replay of {recording} draws other views than the headset did (a recording keeps \
-             the head and the gaze, not the views): the headset drew {}",
+            "the replay of {recording} does not draw from the headset's eyes: {}",
             self.differences.join("; ")
         ))
+    }
+
+    /// What a replay draws for the field of view, when it is not the headset's.
+    pub fn field_note(&self) -> Option<String> {
+        let [l, r] = &self.fov_deg;
+        let s = &self.scene_fov_deg;
+        self.fields_differ.then(|| {
+            format!(
+                "the headset's fields are {:.1}/{:.1}/{:.1}/{:.1} and {:.1}/{:.1}/{:.1}/{:.1} \
+                 degrees left/right/up/down; a replay draws the scene's [output] field, \
+                 {:.1}/{:.1}/{:.1}/{:.1}",
+                l[0], l[1], l[2], l[3], r[0], r[1], r[2], r[3], s[0], s[1], s[2], s[3]
+            )
+        })
     }
 }
 
@@ -212,49 +210,58 @@ mod tests {
     }
 
     #[test]
-    fn the_scenes_own_eyes_differ_in_nothing() {
+    fn eyes_replayed_where_they_were_differ_in_nothing() {
         let fov = Fov::symmetric(1.2, 0.9);
         let mut w = ViewWatch::default();
         for _ in 0..3 {
             w.watch(&frame(turned_head(), 0.063, 0.0, fov));
         }
-        let s = w.summary(0.063, &fov, Some(0.0001)).unwrap();
+        let s = w.summary(&fov, Some((0.0001, 0.01))).unwrap();
         assert_eq!(s.frames, 3);
         assert!((s.ipd_mm[1] - 63.0).abs() < 1e-3, "{s:?}");
         assert!(s.toe_out_deg.iter().all(|t| t.abs() < 1e-3), "{s:?}");
-        assert!(s.differences.is_empty(), "{s:?}");
+        assert!(s.differences.is_empty() && !s.fields_differ, "{s:?}");
         assert_eq!(s.replay_warning("r.trace"), None);
-        assert_eq!(ViewWatch::default().summary(0.063, &fov, None), None);
+        assert_eq!(s.field_note(), None);
+        assert_eq!(ViewWatch::default().summary(&fov, None), None);
     }
 
     #[test]
-    fn another_ipd_a_cant_and_a_field_are_each_named() {
+    fn the_headsets_eyes_are_measured_and_a_replay_elsewhere_is_named() {
         let fov = Fov::symmetric(1.2, 0.9);
         let mut w = ViewWatch::default();
         w.watch(&frame(turned_head(), 0.057, 3.0, Fov::symmetric(1.3, 0.9)));
         w.watch(&frame(turned_head(), 0.059, 3.0, Fov::symmetric(1.3, 0.9)));
-        let s = w.summary(0.063, &fov, Some(0.0025)).unwrap();
+        let s = w.summary(&fov, Some((0.0025, 3.0))).unwrap();
         assert!((s.ipd_mm[0] - 57.0).abs() < 1e-3 && (s.ipd_mm[2] - 59.0).abs() < 1e-3);
         assert!((s.ipd_mm[1] - 58.0).abs() < 1e-3);
         for t in s.toe_out_deg {
             assert!((t - 3.0).abs() < 1e-3, "{s:?}");
         }
-        assert_eq!(s.differences.len(), 4, "{:?}", s.differences);
+        assert_eq!(s.differences.len(), 2, "{:?}", s.differences);
         let warning = s.replay_warning("r.trace").unwrap();
         for part in [
-            "58.0 mm apart, up to 2.5 mm from where a replay puts them",
-            "3.00 and 3.00 degrees outwards",
-            "left eye's field",
             "r.trace",
+            "an eye up to 2.50 mm from the headset's (its eyes 58.0 mm apart)",
+            "a view turned up to 3.00 degrees from the headset's (its views 3.00 and 3.00",
         ] {
             assert!(warning.contains(part), "{part}: {warning}");
         }
-        // Not recorded: no replay to place the eyes, the turn and fields still named.
-        assert_eq!(w.summary(0.063, &fov, None).unwrap().differences.len(), 3);
-        // Within the tolerances: nothing named.
-        let mut w = ViewWatch::default();
-        w.watch(&frame(turned_head(), 0.0633, 0.05, fov));
-        let s = w.summary(0.063, &fov, Some(0.0002)).unwrap();
+        assert!(
+            s.field_note()
+                .unwrap()
+                .contains("-37.2/37.2/25.8/-25.8 and"),
+            "{:?}",
+            s.field_note()
+        );
+        // Replayed from the same eyes (a version 1.5 recording): measured, nothing named.
+        let s = w.summary(&fov, Some((0.0001, 0.001))).unwrap();
         assert!(s.differences.is_empty(), "{s:?}");
+        // Not recorded: no replay to compare.
+        let s = w.summary(&fov, None).unwrap();
+        assert!(
+            s.differences.is_empty() && s.replay_eye_mm.is_none(),
+            "{s:?}"
+        );
     }
 }

@@ -301,6 +301,24 @@ pub enum TraceError {
         /// What is wrong with it.
         reason: String,
     },
+    /// A views line (version 1.5) that cannot be read.
+    #[error("{file}:{line}: views line: {reason}")]
+    BadViews {
+        /// File name.
+        file: String,
+        /// Line number (1-based).
+        line: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// Views written into a trace whose version has no views lines.
+    #[error("{file}: a version {version} trace holds no views lines")]
+    ViewsNotInVersion {
+        /// File name.
+        file: String,
+        /// The version being written.
+        version: &'static str,
+    },
     /// An event written into a trace whose version has no event lines.
     #[error("{file}: a version {version} trace holds no session events")]
     EventsNotInVersion {

@@ -1,7 +1,8 @@
 //! The vitreous trace format, version 1 (and its minor versions: 1.1 adds the per-eye pupil
 //! diameters, 1.2 the scene-edit lines of live controls, 1.3 the tracker's own report of each
-//! sample, 1.4 the event lines of what happened to a live session between its samples): head
-//! poses and eye-tracker samples as UTF-8 text.
+//! sample, 1.4 the event lines of what happened to a live session between its samples, 1.5 the
+//! views lines of the eyes a headset drew from): head poses and eye-tracker samples as UTF-8
+//! text.
 //!
 //! One sample per line, comma-separated, after a version line and a column header line. The
 //! full description (every column, its unit and axes) is in `docs/trace-format.md`; the short
@@ -37,6 +38,7 @@ mod report;
 #[cfg(test)]
 mod test_traces;
 mod validate;
+mod views;
 mod write;
 
 use crate::frame::{GazeSample, Pose};
@@ -51,6 +53,7 @@ pub use read::{Recording, TraceReader, read_recording, read_trace, read_trace_wi
 pub use report::{behaviour_name, confidence_name};
 pub(crate) use validate::check_span;
 pub use validate::clean_ray;
+pub use views::{HeadView, MAX_EYE_OFFSET_M, VIEWS_FIELDS, VIEWS_TAG, ViewsRecord};
 pub use write::TraceWriter;
 
 /// The first line of every version-1 trace.
@@ -68,6 +71,9 @@ pub const VERSION_LINE_V1_3: &str = "# vitreous-trace v1.3";
 
 /// The first line of a version-1.4 trace (version 1.3 plus event lines).
 pub const VERSION_LINE_V1_4: &str = "# vitreous-trace v1.4";
+
+/// The first line of a version-1.5 trace (version 1.4 plus views lines).
+pub const VERSION_LINE_V1_5: &str = "# vitreous-trace v1.5";
 
 /// What the version line starts with, whatever the version.
 const VERSION_PREFIX: &str = "# vitreous-trace ";
@@ -153,6 +159,9 @@ pub enum TraceVersion {
     /// `# vitreous-trace v1.4`: version 1.3 (its columns, edit lines) and event lines
     /// ([`EventRecord`]): what happened to the live session between its samples.
     V1_4,
+    /// `# vitreous-trace v1.5`: version 1.4 and views lines ([`ViewsRecord`]): the eyes the
+    /// headset drew from.
+    V1_5,
 }
 
 impl TraceVersion {
@@ -161,7 +170,7 @@ impl TraceVersion {
         match self {
             TraceVersion::V1 => &COLUMNS,
             TraceVersion::V1_1 | TraceVersion::V1_2 => &COLUMNS_V1_1,
-            TraceVersion::V1_3 | TraceVersion::V1_4 => &COLUMNS_V1_3,
+            TraceVersion::V1_3 | TraceVersion::V1_4 | TraceVersion::V1_5 => &COLUMNS_V1_3,
         }
     }
 
@@ -173,6 +182,7 @@ impl TraceVersion {
             TraceVersion::V1_2 => VERSION_LINE_V1_2,
             TraceVersion::V1_3 => VERSION_LINE_V1_3,
             TraceVersion::V1_4 => VERSION_LINE_V1_4,
+            TraceVersion::V1_5 => VERSION_LINE_V1_5,
         }
     }
 
@@ -180,18 +190,26 @@ impl TraceVersion {
     pub fn has_edits(self) -> bool {
         matches!(
             self,
-            TraceVersion::V1_2 | TraceVersion::V1_3 | TraceVersion::V1_4
+            TraceVersion::V1_2 | TraceVersion::V1_3 | TraceVersion::V1_4 | TraceVersion::V1_5
         )
     }
 
     /// Whether the samples of this version carry the tracker's report.
     pub fn has_reports(self) -> bool {
-        matches!(self, TraceVersion::V1_3 | TraceVersion::V1_4)
+        matches!(
+            self,
+            TraceVersion::V1_3 | TraceVersion::V1_4 | TraceVersion::V1_5
+        )
     }
 
     /// Whether lines of this version may be session events.
     pub fn has_events(self) -> bool {
-        self == TraceVersion::V1_4
+        matches!(self, TraceVersion::V1_4 | TraceVersion::V1_5)
+    }
+
+    /// Whether lines of this version may be views lines.
+    pub fn has_views(self) -> bool {
+        self == TraceVersion::V1_5
     }
 }
 

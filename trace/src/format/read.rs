@@ -10,6 +10,7 @@ use super::edit::{EDIT_TAG, EditRecord, check_edit, parse_edit};
 use super::event::{EVENT_TAG, EventRecord, check_event, parse_event};
 use super::report::parse_report;
 use super::validate::{Preceding, check_sample};
+use super::views::{VIEWS_TAG, ViewsRecord, check_views, parse_views};
 use super::{
     COLUMNS, COLUMNS_V1_1, COMBINED, FIXATION, LEFT, PUPILS, RIGHT, TraceError, TraceSample,
     TraceVersion, VERSION_PREFIX, clean_ray,
@@ -87,7 +88,11 @@ fn parse_record(record: &Record<'_>, version: TraceVersion) -> Result<TraceSampl
     };
     let pupil_diameter_m = match version {
         TraceVersion::V1 => [None, None],
-        TraceVersion::V1_1 | TraceVersion::V1_2 | TraceVersion::V1_3 | TraceVersion::V1_4 => [
+        TraceVersion::V1_1
+        | TraceVersion::V1_2
+        | TraceVersion::V1_3
+        | TraceVersion::V1_4
+        | TraceVersion::V1_5 => [
             parse_pupil(record, PUPILS)?,
             parse_pupil(record, PUPILS + 1)?,
         ],
@@ -158,6 +163,8 @@ pub struct TraceReader<R: Read> {
     edits: Vec<EditRecord>,
     /// The event lines read so far (version 1.4), in file order.
     events: Vec<EventRecord>,
+    /// The views lines read so far (version 1.5), in file order.
+    views: Vec<ViewsRecord>,
     /// Time of the last edit or event line read.
     previous_line_ns: Option<i64>,
 }
@@ -187,6 +194,7 @@ impl<R: Read> TraceReader<R> {
             version: TraceVersion::V1,
             edits: Vec::new(),
             events: Vec::new(),
+            views: Vec::new(),
             previous_line_ns: None,
         };
         this.read_headers()?;
@@ -208,6 +216,12 @@ impl<R: Read> TraceReader<R> {
     /// once the iterator has ended), taken out of the reader.
     pub fn take_events(&mut self) -> Vec<EventRecord> {
         std::mem::take(&mut self.events)
+    }
+
+    /// The views lines read so far (the lines among the samples already read; all of them
+    /// once the iterator has ended), taken out of the reader.
+    pub fn take_views(&mut self) -> Vec<ViewsRecord> {
+        std::mem::take(&mut self.views)
     }
 
     /// The file name used in error messages.
@@ -232,6 +246,7 @@ impl<R: Read> TraceReader<R> {
             Some("v1.2") => self.version = TraceVersion::V1_2,
             Some("v1.3") => self.version = TraceVersion::V1_3,
             Some("v1.4") => self.version = TraceVersion::V1_4,
+            Some("v1.5") => self.version = TraceVersion::V1_5,
             Some(version) => {
                 return Err(TraceError::UnsupportedVersion {
                     file: name,
@@ -284,6 +299,14 @@ impl<R: Read> TraceReader<R> {
                 let event = check_event(record.file(), record.line(), &raw, latest)?;
                 self.previous_line_ns = Some(event.time_ns);
                 self.events.push(event);
+                continue;
+            }
+            if self.version.has_views() && record.field(0) == VIEWS_TAG {
+                let raw = parse_views(&record)?;
+                let latest = previous_ns.into_iter().chain(self.previous_line_ns).max();
+                let views = check_views(record.file(), record.line(), &raw, latest)?;
+                self.previous_line_ns = Some(views.time_ns);
+                self.views.push(views);
                 continue;
             }
             if !(self.version.has_edits() && record.field(0) == EDIT_TAG) {
@@ -348,6 +371,8 @@ pub struct Recording {
     pub edits: Vec<EditRecord>,
     /// The session events (none before version 1.4).
     pub events: Vec<EventRecord>,
+    /// The eyes the headset drew from (none before version 1.5).
+    pub views: Vec<ViewsRecord>,
 }
 
 /// Reads a whole trace file into memory, with its scene edits and session events.
@@ -358,6 +383,7 @@ pub fn read_recording(path: impl AsRef<Path>) -> Result<Recording, TraceError> {
         samples,
         edits: reader.take_edits(),
         events: reader.take_events(),
+        views: reader.take_views(),
     })
 }
 

@@ -7,6 +7,7 @@ use super::edit::{EditRecord, check_edit, format_edit};
 use super::event::{EventRecord, check_event, format_event};
 use super::report::write_report;
 use super::validate::{Preceding, check_sample};
+use super::views::{ViewsRecord, check_views, format_views};
 use super::{AtomicFile, TraceError, TraceSample, TraceVersion};
 use crate::frame::GazeRay;
 
@@ -214,15 +215,7 @@ impl<W: Write> TraceWriter<W> {
             self.previous.map(|p| p.time_ns()),
             self.previous_edit_ns,
         )?;
-        if self.written.is_some() {
-            self.buf = format_edit(&e);
-            self.flush_buf("writing edit")?;
-        } else {
-            self.pending_edits.push_str(&format_edit(&e));
-        }
-        self.previous_edit_ns = Some(e.time_ns);
-        self.line += 1;
-        Ok(())
+        self.write_between(e.time_ns, format_edit(&e), "writing edit")
     }
 
     /// Checks and writes one session event (a version-1.4 trace only), then flushes; before
@@ -235,20 +228,43 @@ impl<W: Write> TraceWriter<W> {
                 version: self.asked.version_line(),
             });
         }
-        let latest = self
-            .previous
+        let e = check_event(&self.name, self.line, event, self.latest_line_ns())?;
+        self.write_between(e.time_ns, format_event(&e), "writing event")
+    }
+
+    /// Checks and writes one views line (a version-1.5 trace only), then flushes; before the
+    /// first sample it waits for it, as an event does. Its time must not be before the
+    /// sample, edit, event or views line written before it.
+    pub fn write_views(&mut self, views: &ViewsRecord) -> Result<(), TraceError> {
+        if !self.asked.has_views() {
+            return Err(TraceError::ViewsNotInVersion {
+                file: self.name.clone(),
+                version: self.asked.version_line(),
+            });
+        }
+        let v = check_views(&self.name, self.line, views, self.latest_line_ns())?;
+        self.write_between(v.time_ns, format_views(&v), "writing views")
+    }
+
+    /// Time of the newest line written (sample, edit, event or views).
+    fn latest_line_ns(&self) -> Option<i64> {
+        self.previous
             .map(|p| p.time_ns())
             .into_iter()
             .chain(self.previous_edit_ns)
-            .max();
-        let e = check_event(&self.name, self.line, event, latest)?;
+            .max()
+    }
+
+    /// Writes a checked line that stands between the samples (an edit, event or views line at
+    /// `time_ns`) and flushes; before the first sample it waits for the header lines.
+    fn write_between(&mut self, time_ns: i64, line: String, what: &str) -> Result<(), TraceError> {
         if self.written.is_some() {
-            self.buf = format_event(&e);
-            self.flush_buf("writing event")?;
+            self.buf = line;
+            self.flush_buf(what)?;
         } else {
-            self.pending_edits.push_str(&format_event(&e));
+            self.pending_edits.push_str(&line);
         }
-        self.previous_edit_ns = Some(e.time_ns);
+        self.previous_edit_ns = Some(time_ns);
         self.line += 1;
         Ok(())
     }

@@ -10,10 +10,13 @@
 //! - the gaze is the newest sample whose `sample_time_ns` is at or before the frame time, so a
 //!   30 Hz tracker seen by a 90 Hz loop gives the same sample (same `sample_time_ns`) to about
 //!   three frames: samples are never invented or interpolated;
-//! - each eye's position in the head frame is the running mean of that eye's valid gaze-ray
-//!   origins over every gaze sample up to the frame time (±`ipd_m / 2` along head x until one
-//!   is valid); the eye views are the head pose moved to those positions, with the head's
-//!   orientation (displays are fixed to the head) and the configured field of view.
+//! - each eye's view is the one the recording's newest views line at or before the frame time
+//!   gives (version 1.5: the eyes the headset drew from, in the head's frame), with the
+//!   configured field of view (the replay's images are its own size); before any, or without
+//!   views lines, each eye's position in the head frame is the running mean of that eye's
+//!   valid gaze-ray origins over every gaze sample up to the frame time (±`ipd_m / 2` along
+//!   head x until one is valid), the view the head's orientation (displays fixed to the head,
+//!   parallel).
 //!
 //! Samples are pulled from the source only as far as needed, so a streaming [`TraceReader`]
 //! replays arbitrarily long traces in constant memory (apart from gaze samples repeated
@@ -27,7 +30,7 @@ use std::io::BufRead;
 
 use glam::Vec3;
 use thiserror::Error;
-use vitreous_trace::format::{EventRecord, TraceError, TraceReader, TraceSample};
+use vitreous_trace::format::{EventRecord, TraceError, TraceReader, TraceSample, ViewsRecord};
 use vitreous_trace::session_event::SessionEvent;
 use vitreous_trace::{Fov, FrameInput};
 
@@ -132,6 +135,11 @@ trait Samples: Iterator<Item = Result<TraceSample, TraceError>> + Send {
     fn take_events(&mut self) -> Vec<EventRecord> {
         Vec::new()
     }
+
+    /// The views lines read since the last call.
+    fn take_views(&mut self) -> Vec<ViewsRecord> {
+        Vec::new()
+    }
 }
 
 impl Samples for std::vec::IntoIter<Result<TraceSample, TraceError>> {}
@@ -139,6 +147,10 @@ impl Samples for std::vec::IntoIter<Result<TraceSample, TraceError>> {}
 impl<R: std::io::Read + Send> Samples for TraceReader<R> {
     fn take_events(&mut self) -> Vec<EventRecord> {
         TraceReader::take_events(self)
+    }
+
+    fn take_views(&mut self) -> Vec<ViewsRecord> {
+        TraceReader::take_views(self)
     }
 }
 
@@ -183,6 +195,10 @@ pub struct NullBackend {
     events: VecDeque<EventRecord>,
     /// Those that came with the frames handed out since the last [`Backend::take_events`].
     ready: Vec<SessionEvent>,
+    /// The recording's views lines not yet in force, oldest first.
+    views: VecDeque<ViewsRecord>,
+    /// The views in force: the newest line at or before the last frame.
+    views_now: Option<ViewsRecord>,
 }
 
 impl NullBackend {
@@ -200,6 +216,13 @@ impl NullBackend {
     /// with the first frame displayed at or after its time ([`Backend::take_events`]).
     pub fn with_events(mut self, events: Vec<EventRecord>) -> Self {
         self.events.extend(events);
+        self
+    }
+
+    /// Draws each frame from the eyes of `views` (a recording's, in time order): the newest
+    /// at or before the frame's time.
+    pub fn with_views(mut self, views: Vec<ViewsRecord>) -> Self {
+        self.views.extend(views);
         self
     }
 
@@ -255,6 +278,8 @@ impl NullBackend {
             done: false,
             events: VecDeque::new(),
             ready: Vec::new(),
+            views: VecDeque::new(),
+            views_now: None,
         };
         if !this.pull()? {
             return Err(NullError::EmptyTrace {

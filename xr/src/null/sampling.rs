@@ -108,14 +108,24 @@ impl NullBackend {
             self.count_gaze_up_to(self.buffer_base + g as u64);
         }
 
-        let eyes = self.eye_positions_head_m();
-        let views = eyes.map(|eye_m| EyeView {
-            pose: Pose {
-                position: head.transform_point(eye_m),
-                orientation: head.orientation,
-            },
-            fov: self.config.fov,
-        });
+        self.views.extend(self.source.take_views());
+        while let Some(v) = self.views.front().filter(|v| v.time_ns <= time_ns) {
+            self.views_now = Some(*v);
+            self.views.pop_front();
+        }
+        let views = match &self.views_now {
+            Some(recorded) => recorded.eyes.map(|eye| EyeView {
+                pose: eye.in_world(&head),
+                fov: self.config.fov,
+            }),
+            None => self.eye_positions_head_m().map(|eye_m| EyeView {
+                pose: Pose {
+                    position: head.transform_point(eye_m),
+                    orientation: head.orientation,
+                },
+                fov: self.config.fov,
+            }),
+        };
 
         // Frame times increase: samples before both the head bracket and the gaze are done.
         let keep_from = g.map_or(0, |g| g.min(a));

@@ -393,3 +393,70 @@ fn a_recordings_events_come_with_the_frames_they_came_with() {
     // 60 Hz frames: the first at or after 15 ms is at 16.67 ms.
     assert_eq!(with, vec![5_016_666_667]);
 }
+
+#[test]
+fn recorded_views_are_drawn_from_their_time_on_in_memory_and_streamed() {
+    use vitreous_trace::format::{HeadView, TraceVersion, ViewsRecord};
+    // Eyes 58 mm apart, each turned 2 degrees outwards, from 30 ms on (before: the default
+    // eyes, 63 mm apart and parallel).
+    let eye = |side: f32| HeadView {
+        pose: Pose {
+            position: Vec3::new(side * 0.029, 0.0, 0.0),
+            orientation: Quat::from_rotation_y(-side * 2f32.to_radians()),
+        },
+        fov: vitreous_trace::Fov::symmetric(1.5, 1.5),
+    };
+    let views = ViewsRecord {
+        time_ns: 5_030_000_000,
+        eyes: [eye(-1.0), eye(1.0)],
+    };
+    // A head turned 30 degrees: the eyes are placed and turned in its frame.
+    let trace: Vec<_> = (0..=10)
+        .map(|i| sample(5_000_000_000 + i * 10_000_000, Vec3::Y, 0.5))
+        .collect();
+    let config = NullConfig {
+        at_samples: true,
+        ..NullConfig::default()
+    };
+    let check = |frames: &[FrameInput]| {
+        assert_eq!(frames.len(), 11);
+        for f in frames {
+            let apart = f.views[0].pose.position.distance(f.views[1].pose.position);
+            let turn = f.views[0]
+                .pose
+                .orientation
+                .angle_between(f.views[1].pose.orientation)
+                .to_degrees();
+            let (want_apart, want_turn) = if f.time_ns < 5_030_000_000 {
+                (0.063, 0.0)
+            } else {
+                (0.058, 4.0)
+            };
+            assert!((apart - want_apart).abs() < 1e-6, "{}: {apart}", f.time_ns);
+            assert!((turn - want_turn).abs() < 1e-3, "{}: {turn}", f.time_ns);
+            // The left eye turned to the head's left; the field is the replay's own.
+            let left_forward = f.views[0].pose.orientation * Vec3::NEG_Z;
+            let head_left = f.head.orientation * Vec3::NEG_X;
+            if want_turn > 0.0 {
+                assert!(left_forward.dot(head_left) > 0.0);
+            }
+            assert_eq!(f.views[0].fov, NullConfig::default().fov);
+        }
+    };
+    let mut backend = NullBackend::new(trace.clone(), config)
+        .unwrap()
+        .with_views(vec![views]);
+    check(&run(&mut backend));
+    // The same from a version 1.5 file read as it is replayed.
+    let mut w = TraceWriter::with_version(Vec::new(), "v", TraceVersion::V1_5).unwrap();
+    for s in &trace {
+        if s.time_ns == views.time_ns {
+            w.write_views(&views).unwrap();
+        }
+        w.write(s).unwrap();
+    }
+    let text = w.finish().unwrap();
+    let reader = TraceReader::new(std::io::Cursor::new(text), "v").unwrap();
+    let mut backend = NullBackend::from_reader(reader, config).unwrap();
+    check(&run(&mut backend));
+}

@@ -317,7 +317,8 @@ fn frames_to_render(scene: &Scene, args: &ReferenceArgs) -> Result<Vec<Frame>> {
             at_samples: false,
         },
     )
-    .with_context(|| format!("replaying {name}"))?;
+    .with_context(|| format!("replaying {name}"))?
+    .with_views(recording.views);
     let mut motion = MotionClock::new(scene);
     let mut edits = std::collections::VecDeque::from(edits);
     let mut frames = Vec::new();

@@ -137,6 +137,31 @@ mod tests {
     use crate::run::test_frame as frame;
 
     #[test]
+    fn views_are_due_at_the_first_frame_and_when_they_change() {
+        let mut f = frame();
+        f.head.position = glam::Vec3::new(0.1, 1.6, 0.0);
+        f.views[0].pose.position = f.head.position - glam::Vec3::X * 0.029;
+        f.views[1].pose.position = f.head.position + glam::Vec3::X * 0.029;
+        let first = views_due(&f, None).expect("the first frame's views");
+        assert_eq!(first.time_ns, 5);
+        assert!(
+            (first.eyes[1].pose.position.x - 0.029).abs() < 1e-6,
+            "in the head's frame"
+        );
+        // The head moves with the eyes: nothing new.
+        let mut moved = f.clone();
+        moved.head.position.z -= 0.2;
+        for v in &mut moved.views {
+            v.pose.position.z -= 0.2;
+        }
+        assert_eq!(views_due(&moved, Some(&first.eyes)), None);
+        // The eyes 2 mm further apart: a new line.
+        moved.views[1].pose.position.x += 0.002;
+        let next = views_due(&moved, Some(&first.eyes)).expect("new views");
+        assert!((next.eyes[1].pose.position.x - 0.031).abs() < 1e-6);
+    }
+
+    #[test]
     fn a_frame_without_gaze_records_an_invalid_gaze_at_its_time() {
         let s = trace_sample(&frame());
         assert_eq!(s.gaze.sample_time_ns, 5);

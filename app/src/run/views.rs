@@ -12,6 +12,7 @@
 
 use glam::Vec3;
 use serde::Serialize;
+use vitreous_trace::format::HeadView;
 use vitreous_trace::{EyeView, Fov, FrameInput, Pose};
 
 /// Farthest an eye may be from where a replay puts it, unremarked, millimetres (half of a
@@ -61,11 +62,8 @@ pub struct ViewWatch {
 
 /// An eye's position and forward direction in the head's frame.
 fn in_head(head: &Pose, eye: &EyeView) -> (Vec3, Vec3) {
-    let inverse = head.orientation.inverse();
-    (
-        inverse * (eye.pose.position - head.position),
-        inverse * eye.pose.orientation * Vec3::NEG_Z,
-    )
+    let view = HeadView::of(head, &eye.pose, eye.fov).pose;
+    (view.position, view.orientation * Vec3::NEG_Z)
 }
 
 /// The fields' edges in degrees: left, right, up, down.

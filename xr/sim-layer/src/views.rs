@@ -9,47 +9,23 @@
 
 use glam::{Quat, Vec3};
 use openxr::sys;
+use vitreous_trace::Pose;
 
 use crate::config::SimViews;
-
-fn vec3(v: sys::Vector3f) -> Vec3 {
-    Vec3::new(v.x, v.y, v.z)
-}
-
-fn quat(q: sys::Quaternionf) -> Quat {
-    Quat::from_xyzw(q.x, q.y, q.z, q.w)
-}
-
-fn to_vector(v: Vec3) -> sys::Vector3f {
-    sys::Vector3f {
-        x: v.x,
-        y: v.y,
-        z: v.z,
-    }
-}
-
-fn to_quaternion(q: Quat) -> sys::Quaternionf {
-    sys::Quaternionf {
-        x: q.x,
-        y: q.y,
-        z: q.z,
-        w: q.w,
-    }
-}
+use crate::eye_geometry::{from_posef, to_posef};
 
 /// The two eyes' poses (left, right) as `views` asks, from the runtime's.
 pub fn respaced(poses: [sys::Posef; 2], views: SimViews) -> [sys::Posef; 2] {
-    let (p, q) = (
-        [vec3(poses[0].position), vec3(poses[1].position)],
-        [quat(poses[0].orientation), quat(poses[1].orientation)],
-    );
-    let head = q[0].normalize().slerp(q[1].normalize(), 0.5).normalize();
-    let middle = (p[0] + p[1]) / 2.0;
+    let [left, right] = poses.each_ref().map(from_posef);
+    let head = left.orientation.slerp(right.orientation, 0.5).normalize();
+    let middle = (left.position + right.position) / 2.0;
     let across = head * Vec3::X * (views.ipd_m / 2.0);
     let turn = views.toe_out_deg.to_radians();
-    let eye = |side: f32| sys::Posef {
-        position: to_vector(middle + across * side),
-        orientation: to_quaternion(head * Quat::from_rotation_y(-side * turn)),
+    let eye = |side: f32| {
+        to_posef(&Pose {
+            position: middle + across * side,
+            orientation: head * Quat::from_rotation_y(-side * turn),
+        })
     };
     [eye(-1.0), eye(1.0)]
 }
@@ -59,10 +35,10 @@ mod tests {
     use super::*;
 
     fn pose(position: Vec3, orientation: Quat) -> sys::Posef {
-        sys::Posef {
-            position: to_vector(position),
-            orientation: to_quaternion(orientation),
-        }
+        to_posef(&Pose {
+            position,
+            orientation,
+        })
     }
 
     #[test]
@@ -82,16 +58,14 @@ mod tests {
                 toe_out_deg: 4.0,
             },
         );
-        let (lp, rp) = (vec3(l.position), vec3(r.position));
+        let (l, r) = (from_posef(&l), from_posef(&r));
+        let (lp, rp) = (l.position, r.position);
         assert!((lp.distance(rp) - 0.058).abs() < 1e-6);
         assert!(((lp + rp) / 2.0).distance(centre) < 1e-6);
         assert!((rp - lp).normalize().dot(x) > 0.999_999);
         // Each view's forward (-z) turned 4 degrees outwards from the head's, about its y.
         let forward = head * Vec3::NEG_Z;
-        let (lf, rf) = (
-            quat(l.orientation) * Vec3::NEG_Z,
-            quat(r.orientation) * Vec3::NEG_Z,
-        );
+        let (lf, rf) = (l.orientation * Vec3::NEG_Z, r.orientation * Vec3::NEG_Z);
         for f in [lf, rf] {
             assert!((f.angle_between(forward).to_degrees() - 4.0).abs() < 1e-3);
         }

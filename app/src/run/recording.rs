@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use glam::Quat;
 use serde::Serialize;
 use vitreous_trace::format::{HeadView, TraceSample, ViewsRecord, read_recording};
 use vitreous_trace::{FrameInput, GazeSample, Pose};
@@ -28,6 +29,14 @@ pub struct ReplayCheck {
     pub max_eye_position_m: f32,
     /// Largest difference of a view's orientation, degrees.
     pub max_eye_angle_deg: f32,
+}
+
+/// The angle between two orientations, degrees, from the turn between them (its axis part's
+/// length against its scalar part): `Quat::angle_between` takes the arc cosine of a dot
+/// product, which in `f32` reads any difference below about 0.04 degrees as 0 or 0.0396.
+fn angle_deg(a: Quat, b: Quat) -> f32 {
+    let turn = a.inverse() * b;
+    (2.0 * turn.xyz().length().atan2(turn.w.abs())).to_degrees()
 }
 
 /// The views line a frame needs recorded before its sample: the first frame's, then one
@@ -107,18 +116,11 @@ pub(super) fn replay_check(
         };
         frames += 1;
         max_pos = max_pos.max((frame.head.position - expected.head.position).length());
-        max_ang = max_ang.max(
-            frame
-                .head
-                .orientation
-                .angle_between(expected.head.orientation)
-                .to_degrees(),
-        );
+        max_ang = max_ang.max(angle_deg(frame.head.orientation, expected.head.orientation));
         for eye in 0..2 {
             let (got, want) = (&frame.views[eye].pose, &expected.views[eye].pose);
             max_eye = max_eye.max((got.position - want.position).length());
-            max_eye_angle =
-                max_eye_angle.max(got.orientation.angle_between(want.orientation).to_degrees());
+            max_eye_angle = max_eye_angle.max(angle_deg(got.orientation, want.orientation));
         }
     }
     Ok(ReplayCheck {
@@ -135,6 +137,21 @@ pub(super) fn replay_check(
 mod tests {
     use super::*;
     use crate::run::test_frame as frame;
+
+    #[test]
+    fn small_turns_are_measured_below_the_arc_cosines_floor() {
+        let a = Quat::from_rotation_y(0.7);
+        for deg in [0.0f32, 0.001, 0.01, 0.1, 2.0, 30.0] {
+            let b = a * Quat::from_rotation_x(deg.to_radians());
+            assert!(
+                (angle_deg(a, b) - deg).abs() < 1e-4 + deg * 1e-4,
+                "{deg}: {}",
+                angle_deg(a, b)
+            );
+        }
+        // The same turn with the sign of a quaternion flipped.
+        assert!(angle_deg(a, -a) < 1e-4);
+    }
 
     #[test]
     fn views_are_due_at_the_first_frame_and_when_they_change() {

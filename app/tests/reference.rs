@@ -251,3 +251,106 @@ fn bad_reference_input_fails_cleanly_and_writes_nothing() {
         );
     }
 }
+
+#[test]
+fn a_recording_with_the_headsets_eyes_is_drawn_from_them() {
+    use vitreous_trace::format::{HeadView, TraceSample, TraceVersion, TraceWriter, ViewsRecord};
+    use vitreous_trace::{Fov, GazeSample, Pose};
+    let dir = tempfile::tempdir().unwrap();
+    let scene = load_scene(&scene_path()).unwrap();
+    // The head where the scene puts it, still, for three samples; the headset's eyes 58 mm
+    // apart and each turned 2 degrees outwards (the scene's are 63 mm apart, parallel).
+    let head = Pose {
+        position: scene.viewer.head_position_m,
+        orientation: Quat::IDENTITY,
+    };
+    let write = |path: &Path, views: bool| {
+        let mut w = TraceWriter::create_version(path, TraceVersion::V1_5).unwrap();
+        if views {
+            let eye = |side: f32| HeadView {
+                pose: Pose {
+                    position: glam::Vec3::X * 0.029 * side,
+                    orientation: Quat::from_rotation_y(-side * 2f32.to_radians()),
+                },
+                fov: Fov::symmetric(0.7, 0.5),
+            };
+            w.write_views(&ViewsRecord {
+                time_ns: 0,
+                eyes: [eye(-1.0), eye(1.0)],
+            })
+            .unwrap();
+        }
+        for k in 0..3 {
+            let t = k * 50_000_000;
+            w.write(&TraceSample {
+                time_ns: t,
+                head,
+                gaze: GazeSample::none(t),
+            })
+            .unwrap();
+        }
+        w.finish().unwrap();
+    };
+    let mut apart = Vec::new();
+    for views in [true, false] {
+        let trace = dir.path().join(format!("views-{views}.trace"));
+        write(&trace, views);
+        let out = dir.path().join(format!("ref-{views}"));
+        let scene = scene_path();
+        let run = vitreous(
+            &[
+                "reference",
+                scene.to_str().unwrap(),
+                "--trace",
+                trace.to_str().unwrap(),
+                "--frames",
+                "1",
+                "--size",
+                "64x48",
+                "--samples",
+                "1",
+                "--photons-per-texel",
+                "1",
+                "--quiet",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            dir.path(),
+        );
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let report: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("reference.json")).unwrap()).unwrap();
+        let eyes = &report["frames"][0]["eyes"];
+        let at = |e: usize, k: &str| -> Vec<f32> {
+            eyes[e][k]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap() as f32)
+                .collect()
+        };
+        let (l, r) = (at(0, "position_m"), at(1, "position_m"));
+        let (lq, rq) = (at(0, "orientation_xyzw"), at(1, "orientation_xyzw"));
+        let turn = |q: &[f32]| 2.0 * q[1].atan2(q[3]).to_degrees();
+        apart.push((
+            glam::Vec3::from_slice(&l).distance(glam::Vec3::from_slice(&r)) * 1000.0,
+            turn(&lq),
+            turn(&rq),
+        ));
+    }
+    let (with, without) = (apart[0], apart[1]);
+    assert!((with.0 - 58.0).abs() < 0.01, "{with:?}");
+    assert!(
+        (with.1 - 2.0).abs() < 0.01 && (with.2 + 2.0).abs() < 0.01,
+        "{with:?}"
+    );
+    assert!((without.0 - 63.0).abs() < 0.01, "{without:?}");
+    assert!(
+        without.1.abs() < 0.01 && without.2.abs() < 0.01,
+        "{without:?}"
+    );
+}

@@ -32,6 +32,14 @@ impl Pose {
     }
 }
 
+/// The angle of the turn from orientation `a` to `b`, radians, from the turn's axis part (its
+/// length against its scalar part). `Quat::angle_between` takes the arc cosine of a dot
+/// product, which in `f32` reads any turn below about 0.04 degrees as 0 or 0.0396 degrees.
+pub fn turn_between(a: Quat, b: Quat) -> f32 {
+    let turn = a.inverse() * b;
+    2.0 * turn.xyz().length().atan2(turn.w.abs())
+}
+
 /// A field of view as OpenXR gives it: four signed half-angles in radians
 /// (left and down are negative for a symmetric view).
 #[derive(Clone, Copy, Debug, PartialEq)]

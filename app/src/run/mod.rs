@@ -369,6 +369,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
         resident: ResidentSampler::new(RESIDENT_WARM_UP_FRAMES, RESIDENT_EVERY_FRAMES),
         views: views::ViewWatch::default(),
         recorded_views: None,
+        recorded_gaze_ns: None,
     };
     let reconnect_limit =
         std::time::Duration::from_secs_f64(options.reconnect_s.unwrap_or(RECONNECT_S_DEFAULT));
@@ -400,9 +401,14 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             .map_or(scene.placement_at(0.0).light_position_m, |p| {
                 glam::Vec3::from_array(p.light_position_m)
             });
-        let (continued_from, next_index, first_display_ns) = {
+        let (continued_from, next_index, first_display_ns, newest_gaze) = {
             let s = xr.session();
-            (s.world_from_space(), s.next_index(), s.first_display_ns())
+            (
+                s.world_from_space(),
+                s.next_index(),
+                s.first_display_ns(),
+                s.newest_gaze(),
+            )
         };
         let closed = xr.close(|renderer| {
             let centroids = options.readback_check.then(|| {
@@ -484,6 +490,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
                     first_display_ns,
                     world_from_space: continued_from,
                     waited_ms: waited.as_millis() as u64,
+                    newest_gaze,
                 }),
                 submitted,
             ),
@@ -501,7 +508,12 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
     sink.log.finish()?;
 
     let replay_check = match &options.record {
-        Some(path) => Some(replay_check(path, &sink.recorded, &scene)?),
+        Some(path) => Some(replay_check(
+            path,
+            &sink.recorded,
+            scene.output.fov,
+            scene.viewer.ipd_m,
+        )?),
         None => None,
     };
     let headset_views = sink.views.summary(
@@ -557,6 +569,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             frames: report.gaze_samples.frames,
             received: report.gaze_samples.received,
             fresh_frames: report.gaze_samples.fresh,
+            out_of_order: report.gaze_samples.out_of_order,
         },
         space_changes: report.space_changes,
         frames_abandoned: report.frames_abandoned,

@@ -8,11 +8,10 @@ use anyhow::{Context, Result, bail};
 use glam::Quat;
 use serde::Serialize;
 use vitreous_trace::format::{HeadView, TraceSample, ViewsRecord, read_recording};
-use vitreous_trace::{FrameInput, GazeSample, Pose};
+use vitreous_trace::frame::turn_between;
+use vitreous_trace::{Fov, FrameInput, GazeSample, Pose};
 use vitreous_xr::Backend;
 use vitreous_xr::null::{NullBackend, NullConfig};
-
-use vitreous_scene::Scene;
 
 /// How well a replay of the recording reproduces the session's views.
 #[derive(Clone, Debug, Serialize)]
@@ -31,12 +30,9 @@ pub struct ReplayCheck {
     pub max_eye_angle_deg: f32,
 }
 
-/// The angle between two orientations, degrees, from the turn between them (its axis part's
-/// length against its scalar part): `Quat::angle_between` takes the arc cosine of a dot
-/// product, which in `f32` reads any difference below about 0.04 degrees as 0 or 0.0396.
+/// The angle between two orientations, degrees ([`turn_between`]).
 fn angle_deg(a: Quat, b: Quat) -> f32 {
-    let turn = a.inverse() * b;
-    (2.0 * turn.xyz().length().atan2(turn.w.abs())).to_degrees()
+    turn_between(a, b).to_degrees()
 }
 
 /// The views line a frame needs recorded before its sample: the first frame's, then one
@@ -54,22 +50,30 @@ pub(super) fn views_due(input: &FrameInput, last: Option<&[HeadView; 2]>) -> Opt
     })
 }
 
-/// A trace sample for a frame: its head pose and gaze (an invalid gaze at the frame time when
-/// there is none).
-pub(super) fn trace_sample(input: &FrameInput) -> TraceSample {
+/// A trace sample for a frame: its head pose and gaze. A frame without gaze gets an invalid
+/// gaze stamped with the newest gaze time recorded before it, `newest_gaze_ns` (nothing new:
+/// a later frame's sample may be stamped before this frame's display time, and a trace's gaze
+/// times must not go back), or with its own time when none was.
+pub(super) fn trace_sample(input: &FrameInput, newest_gaze_ns: Option<i64>) -> TraceSample {
     TraceSample {
         time_ns: input.time_ns,
         head: input.head,
-        gaze: input.gaze.unwrap_or(GazeSample::none(input.time_ns)),
+        gaze: input
+            .gaze
+            .unwrap_or(GazeSample::none(newest_gaze_ns.unwrap_or(input.time_ns))),
     }
 }
 
 /// Replays the recording with the null backend at the session's mean frame rate and compares
-/// its views with the session's, interpolated at the replay's frame times.
+/// its views with the session's at the replay's frame times: the head interpolated between the
+/// session's frames, each eye where the earlier frame had it in the head.
+/// `fov` and `ipd_m` are the scene's (what a replay draws with where the recording has no
+/// views lines).
 pub(super) fn replay_check(
     path: &Path,
     session: &[FrameInput],
-    scene: &Scene,
+    fov: Fov,
+    ipd_m: f32,
 ) -> Result<ReplayCheck> {
     let recording =
         read_recording(path).with_context(|| format!("reading back {}", path.display()))?;
@@ -84,8 +88,8 @@ pub(super) fn replay_check(
         NullConfig {
             frame_rate_hz: rate_hz,
             max_frames: None,
-            fov: scene.output.fov,
-            ipd_m: scene.viewer.ipd_m,
+            fov,
+            ipd_m,
             at_samples: false,
         },
     )?
@@ -107,10 +111,13 @@ pub(super) fn replay_check(
                 position: p.position.lerp(q.position, f),
                 orientation: p.orientation.slerp(q.orientation, f),
             };
+            // The eyes keep frame a's place in the head until frame b (a views line holds
+            // from its time on), carried by the head between the two.
             let mut e = a.clone();
             e.head = lerp(&a.head, &session[b].head);
             for eye in 0..2 {
-                e.views[eye].pose = lerp(&a.views[eye].pose, &session[b].views[eye].pose);
+                let view = &a.views[eye];
+                e.views[eye].pose = HeadView::of(&a.head, &view.pose, view.fov).in_world(&e.head);
             }
             e
         };
@@ -179,9 +186,61 @@ mod tests {
     }
 
     #[test]
+    fn the_replay_check_follows_eyes_that_change_mid_session() {
+        use vitreous_trace::format::{TraceVersion, TraceWriter};
+        // 40 frames 50 ms apart, give or take 7 ms, the head moving and turning; the eyes 63
+        // mm apart and parallel, then from frame 20 on 58 mm apart and turned 2 degrees out.
+        let session: Vec<FrameInput> = (0..40i64)
+            .map(|i| {
+                let mut f = frame();
+                f.index = i as u64;
+                f.time_ns = 1_000_000_000 + i * 50_000_000 + (i * 37 % 15 - 7) * 1_000_000;
+                f.head = Pose {
+                    position: glam::Vec3::new(0.01 * i as f32, 1.6, -0.005 * i as f32),
+                    orientation: Quat::from_rotation_y(0.02 * i as f32),
+                };
+                let (half, turn) = if i < 20 { (0.0315, 0.0) } else { (0.029, 2f32) };
+                for (view, side) in f.views.iter_mut().zip([-1.0f32, 1.0]) {
+                    view.pose = HeadView {
+                        pose: Pose {
+                            position: glam::Vec3::X * half * side,
+                            orientation: Quat::from_rotation_y(-side * turn.to_radians()),
+                        },
+                        fov: view.fov,
+                    }
+                    .in_world(&f.head);
+                }
+                f
+            })
+            .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("recorded.trace");
+        let mut writer = TraceWriter::create_version(&path, TraceVersion::V1_5).unwrap();
+        let mut last = None;
+        for f in &session {
+            if let Some(views) = views_due(f, last.as_ref()) {
+                writer.write_views(&views).unwrap();
+                last = Some(views.eyes);
+            }
+            writer.write(&trace_sample(f, None)).unwrap();
+        }
+        writer.finish().unwrap();
+        let check = replay_check(&path, &session, Fov::symmetric(1.0, 1.0), 0.063).unwrap();
+        assert!(check.frames >= 38, "{check:?}");
+        // Between two frames the replay's eyes are where the earlier one had them (interpolating
+        // the session's eyes across the change would put them up to 2.5 mm and 2 degrees off).
+        assert!(check.max_eye_position_m < 2e-6, "{check:?}");
+        assert!(check.max_eye_angle_deg < 1e-3, "{check:?}");
+    }
+
+    #[test]
     fn a_frame_without_gaze_records_an_invalid_gaze_at_its_time() {
-        let s = trace_sample(&frame());
+        let s = trace_sample(&frame(), None);
         assert_eq!(s.gaze.sample_time_ns, 5);
+        assert!(!s.gaze.left.valid && !s.gaze.right.valid);
+        // After a sample stamped 3: nothing new, at 3.
+        let s = trace_sample(&frame(), Some(3));
+        assert_eq!(s.gaze.sample_time_ns, 3);
         assert!(!s.gaze.left.valid && !s.gaze.right.valid);
     }
 }

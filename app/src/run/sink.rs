@@ -91,6 +91,8 @@ pub(super) struct RunSink<'d> {
     pub(super) views: super::views::ViewWatch,
     /// The eyes of the last views line recorded.
     pub(super) recorded_views: Option<[vitreous_trace::format::HeadView; 2]>,
+    /// The newest gaze time recorded (a frame without gaze is stamped with it).
+    pub(super) recorded_gaze_ns: Option<i64>,
 }
 
 impl RunSink<'_> {
@@ -144,8 +146,9 @@ impl FrameSink for RunSink<'_> {
                 w.write_views(&views).context("recording the views")?;
                 self.recorded_views = Some(views.eyes);
             }
-            w.write(&trace_sample(input))
-                .context("recording the trace")?;
+            let sample = trace_sample(input, self.recorded_gaze_ns);
+            w.write(&sample).context("recording the trace")?;
+            self.recorded_gaze_ns = Some(sample.gaze.sample_time_ns);
             self.recorded.push(input.clone());
         }
         Ok(())

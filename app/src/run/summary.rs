@@ -285,4 +285,7 @@ pub struct GazeSamples {
     pub received: u64,
     /// Frames whose sample was newer than any before: a fresh sample.
     pub fresh_frames: u64,
+    /// Frames whose sample was stamped before one already used: they got the newest one
+    /// again (the recording's gaze times never go back).
+    pub out_of_order: u64,
 }

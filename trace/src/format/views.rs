@@ -19,7 +19,7 @@
 use glam::{Quat, Vec3};
 
 use super::{QUAT_NORM_TOLERANCE, TraceError};
-use crate::frame::{Fov, Pose};
+use crate::frame::{Fov, Pose, turn_between};
 use crate::records::Record;
 
 /// The first field of a views line.
@@ -101,7 +101,7 @@ impl HeadView {
             ]
         };
         self.pose.position.distance(other.pose.position) > POSITION_M
-            || self.pose.orientation.angle_between(other.pose.orientation) > ANGLE_RAD
+            || turn_between(self.pose.orientation, other.pose.orientation) > ANGLE_RAD
             || edges(&self.fov)
                 .iter()
                 .zip(edges(&other.fov))
@@ -392,5 +392,33 @@ mod tests {
         let mut wider = v;
         wider.fov.angle_left_rad -= 1e-3;
         assert!(v.differs(&wider));
+    }
+
+    #[test]
+    fn a_turned_eye_carried_by_a_moving_head_is_the_same_line() {
+        // An eye turned half a degree outwards, seen from a head that walks and turns: the
+        // round trip through the world moves it by f32 rounding only, which must not read as a
+        // turn (an arc cosine of the quaternions' dot product reads it as 0.04 degrees).
+        let fov = Fov::symmetric(1.0, 0.8);
+        let eye = HeadView {
+            pose: Pose {
+                position: Vec3::new(-0.02775, 0.0, 0.0),
+                orientation: Quat::from_rotation_y(0.5f32.to_radians()),
+            },
+            fov,
+        };
+        for k in 0..500 {
+            let t = k as f32 * 0.05;
+            let head = Pose {
+                position: Vec3::new(t.sin() * 0.3, 1.6 + 0.01 * t.cos(), -0.02 * t),
+                orientation: Quat::from_rotation_y(0.4 * t.sin()) * Quat::from_rotation_x(0.1 * t),
+            };
+            let again = HeadView::of(&head, &eye.in_world(&head), fov);
+            assert!(!eye.differs(&again), "head {k}: {again:?}");
+        }
+        // A hundredth of a degree more is a new line.
+        let mut turned = eye;
+        turned.pose.orientation *= Quat::from_rotation_y(0.01f32.to_radians());
+        assert!(eye.differs(&turned));
     }
 }

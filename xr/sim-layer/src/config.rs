@@ -292,6 +292,19 @@ pub struct SimViews {
     pub toe_out_deg: f32,
 }
 
+impl SimViews {
+    /// Eyes `ipd_mm` apart, each turned `toe_out_deg` outwards; `None` unless 40 to 90 mm apart
+    /// and turned -10 to 10 degrees.
+    pub fn new(ipd_mm: f32, toe_out_deg: f32) -> Option<SimViews> {
+        ((40.0..=90.0).contains(&ipd_mm) && (-10.0..=10.0).contains(&toe_out_deg)).then_some(
+            SimViews {
+                ipd_m: ipd_mm / 1000.0,
+                toe_out_deg,
+            },
+        )
+    }
+}
+
 /// Parses `VITREOUS_SIM_VIEWS`.
 pub fn parse_views(value: &str) -> Result<SimViews, ConfigError> {
     let bad = || ConfigError {
@@ -308,13 +321,7 @@ pub fn parse_views(value: &str) -> Result<SimViews, ConfigError> {
         [ipd, toe] => (ipd, toe),
         _ => return Err(bad()),
     };
-    if !((40.0..=90.0).contains(&ipd_mm) && (-10.0..=10.0).contains(&toe_out_deg)) {
-        return Err(bad());
-    }
-    Ok(SimViews {
-        ipd_m: ipd_mm / 1000.0,
-        toe_out_deg,
-    })
+    SimViews::new(ipd_mm, toe_out_deg).ok_or_else(bad)
 }
 
 /// The room's light, as `VITREOUS_SIM_LIGHT` gives it.

@@ -112,6 +112,9 @@ pub struct GazeTally {
     pub received: u64,
     /// Frames whose sample was newer than every earlier frame's: a fresh sample.
     pub fresh: u64,
+    /// Frames whose sample was stamped before one already used, given that one again
+    /// ([`GazeOrder`]).
+    pub out_of_order: u64,
     /// The newest sample time seen, nanoseconds.
     newest_ns: Option<i64>,
 }
@@ -122,6 +125,7 @@ impl GazeTally {
         self.frames += later.frames;
         self.received += later.received;
         self.fresh += later.fresh;
+        self.out_of_order += later.out_of_order;
         self.newest_ns = later.newest_ns.max(self.newest_ns);
     }
 
@@ -135,6 +139,43 @@ impl GazeTally {
         if self.newest_ns.is_none_or(|n| t > n) {
             self.fresh += 1;
             self.newest_ns = Some(t);
+        }
+    }
+}
+
+/// The frames' gaze in time order. A runtime may hand out a sample stamped before one the app
+/// already used: a tracker that stamped a blink with the display time and then stalls on an
+/// older sample, a clock that went back. Such a sample is not new; the frame gets the newest
+/// sample used so far again instead, as a tracker with no new sample answers, so the gaze
+/// filters and the recording (whose gaze times must not decrease) only see time go forward.
+/// It carries over to the next session after a loss ([`super::Continued`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GazeOrder {
+    /// The newest sample handed to a frame.
+    newest: Option<GazeSample>,
+}
+
+impl GazeOrder {
+    /// The order after a session whose newest sample was `newest`.
+    pub fn after(newest: Option<GazeSample>) -> GazeOrder {
+        GazeOrder { newest }
+    }
+
+    /// The newest sample handed to a frame so far.
+    pub fn newest(&self) -> Option<GazeSample> {
+        self.newest
+    }
+
+    /// The gaze a frame gets for the runtime's `gaze`, and whether it was out of order (the
+    /// newest sample given again instead).
+    pub fn order(&mut self, gaze: Option<GazeSample>) -> (Option<GazeSample>, bool) {
+        match (gaze, self.newest) {
+            (Some(g), Some(n)) if g.sample_time_ns < n.sample_time_ns => (Some(n), true),
+            (Some(g), _) => {
+                self.newest = Some(g);
+                (Some(g), false)
+            }
+            (None, _) => (None, false),
         }
     }
 }
@@ -350,6 +391,23 @@ mod tests {
             head: Pose::IDENTITY,
             gaze: GazeSample::binocular(gaze_ns, ray, ray),
         }
+    }
+
+    #[test]
+    fn a_sample_older_than_one_used_gives_the_newest_again() {
+        let at = |ns: i64, x: f32| sample(ns, ns, x).gaze;
+        // A blink stamped with the display time (100), then a stalled tracker's older sample.
+        let mut order = GazeOrder::after(Some(at(40, 0.1)));
+        assert_eq!(order.order(Some(at(50, 0.2))), (Some(at(50, 0.2)), false));
+        assert_eq!(order.order(Some(at(100, 0.0))), (Some(at(100, 0.0)), false));
+        assert_eq!(order.order(Some(at(53, 0.3))), (Some(at(100, 0.0)), true));
+        // The same time again is not out of order; no sample stays none.
+        assert_eq!(order.order(Some(at(100, 0.4))), (Some(at(100, 0.4)), false));
+        assert_eq!(order.order(None), (None, false));
+        assert_eq!(order.newest(), Some(at(100, 0.4)));
+        // Carried over a loss: the next session's first sample is held against it.
+        let mut next = GazeOrder::after(order.newest());
+        assert_eq!(next.order(Some(at(90, 0.5))), (Some(at(100, 0.4)), true));
     }
 
     #[test]

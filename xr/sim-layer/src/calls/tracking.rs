@@ -58,8 +58,8 @@ pub fn head_in_world(reg: &Registry, space: u64, base: u64) -> Option<(u64, bool
 }
 
 /// `xrLocateViews`: refused when the session is lost (or the call is scheduled to fail), else
-/// passed on, the eyes then moved and turned as `VITREOUS_SIM_VIEWS` asks
-/// ([`crate::views`]) and the views' flags and poses losing what this frame's head tracking
+/// passed on, the eyes then moved and turned as the newest `eyes` fault or `VITREOUS_SIM_VIEWS`
+/// asks ([`crate::views`]) and the views' flags and poses losing what this frame's head tracking
 /// lacks.
 ///
 /// # Safety
@@ -76,9 +76,14 @@ pub unsafe extern "system" fn locate_views(
         let Some(ctx) = SessionContext::of(&registry(), session.into_raw()) else {
             return sys::Result::ERROR_HANDLE_INVALID;
         };
-        let faulted =
-            faults::with(|f| (f.refuse("xrLocateViews", session.into_raw()), f.tracking()));
-        if let Some((Some(refused), _)) = faulted {
+        let faulted = faults::with(|f| {
+            (
+                f.refuse("xrLocateViews", session.into_raw()),
+                f.tracking(),
+                f.eyes(),
+            )
+        });
+        if let Some((Some(refused), ..)) = faulted {
             return refused;
         }
         // SAFETY: the next layer's function with the app's arguments.
@@ -92,14 +97,15 @@ pub unsafe extern "system" fn locate_views(
             // SAFETY: on success `count` says how many of the app's views were written.
             unsafe { *count }.min(capacity) as usize
         };
-        if let Some(asked) = ctx.config.views
+        let asked = faulted.and_then(|(_, _, eyes)| eyes).or(ctx.config.views);
+        if let Some(asked) = asked
             && written == 2
         {
             // SAFETY: the app's array of `capacity` views, these two filled.
             let (left, right) = unsafe { (&mut *views, &mut *views.add(1)) };
             [left.pose, right.pose] = crate::views::respaced([left.pose, right.pose], asked);
         }
-        let Some((None, Some(loss))) = faulted else {
+        let Some((None, Some(loss), _)) = faulted else {
             return r;
         };
         if state.is_null() {

@@ -13,6 +13,7 @@
 //! frame 580 runtime-failure xrLocateViews   # one call fails with XR_ERROR_RUNTIME_FAILURE
 //! frame 600 tracking-lost 20 10    # head position lost for 20 frames, then orientation for 10
 //! frame 700 gaze-dropout 2 invalid # the eye tracker drops out for 2 s (none, invalid or low)
+//! frame 760 eyes 58 2              # the eyes from now on 58 mm apart, each turned 2 degrees out
 //! chaos 7 2000                     # a random schedule of every fault over 2000 frames (seed 7)
 //! ```
 //!
@@ -24,6 +25,8 @@
 use std::fmt;
 
 use vitreous_trace::synth::SplitMix64;
+
+use crate::config::SimViews;
 
 /// When a fault starts.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,6 +107,10 @@ pub enum Fault {
     TrackingLost(u64, u64),
     /// The eye tracker drops out for this many seconds of display time.
     GazeDropout(f64, Dropout),
+    /// From now on `xrLocateViews` answers eyes this many millimetres apart, each view turned
+    /// this many degrees outwards (a wearer turning the headset's eye distance, or handing the
+    /// headset to someone else): as `VITREOUS_SIM_VIEWS`, whose eyes it replaces.
+    Eyes(f32, f32),
 }
 
 impl Fault {
@@ -121,6 +128,7 @@ impl Fault {
             Fault::RuntimeFailure(_) => "runtime-failure",
             Fault::TrackingLost(..) => "tracking-lost",
             Fault::GazeDropout(..) => "gaze-dropout",
+            Fault::Eyes(..) => "eyes",
         }
     }
 
@@ -147,6 +155,7 @@ impl fmt::Display for Fault {
             Fault::RuntimeFailure(call) => write!(f, " {call}"),
             Fault::TrackingLost(p, o) => write!(f, " {p} {o}"),
             Fault::GazeDropout(s, kind) => write!(f, " {s} {}", kind.name()),
+            Fault::Eyes(ipd, toe) => write!(f, " {ipd} {toe}"),
             Fault::Recentre => Ok(()),
         }
     }
@@ -307,11 +316,26 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
                 }
             },
         ),
+        ["eyes", ipd, toe @ ..] if toe.len() <= 1 => {
+            let number = |w: &str| w.parse::<f32>().ok().filter(|v| v.is_finite());
+            let (ipd_mm, toe_deg) = (number(ipd), toe.first().map_or(Some(0.0), |t| number(t)));
+            match (ipd_mm, toe_deg) {
+                (Some(i), Some(t)) if SimViews::new(i, t).is_some() => Fault::Eyes(i, t),
+                _ => {
+                    return Err(format!(
+                        "eyes: `{}` is not a distance of 40 to 90 millimetres, then optionally \
+                         a turn outwards of -10 to 10 degrees",
+                        words[1..].join(" ")
+                    ));
+                }
+            }
+        }
         [name, ..] => {
             return Err(format!(
                 "`{name}`: not a fault with those arguments (headset-off S, menu N, session-loss S, \
                  instance-loss S, recentre, no-render N, late N, image-timeout N, \
-                 runtime-failure CALL, tracking-lost N N, gaze-dropout S none|invalid|low)"
+                 runtime-failure CALL, tracking-lost N N, gaze-dropout S none|invalid|low, \
+                 eyes MM [DEG])"
             ));
         }
         [] => return Err("a trigger with no fault after it".into()),
@@ -321,10 +345,11 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
 /// A random schedule from `seed` over the app's first `frames` frames: every fault family at
 /// least once, in a shuffled order, then more drawn at random, each starting 60 to 160 frames
 /// after the one before ended (the app has time to recover and show frames in between).
-/// Outages last 0.5 to 3 s, a menu 10 to 60 frames, a dropout 0.3 to 3 s.
+/// Outages last 0.5 to 3 s, a menu 10 to 60 frames, a dropout 0.3 to 3 s; new eyes are 54 to
+/// 72 mm apart and turned 0 to 3 degrees outwards.
 pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
     let mut rng = SplitMix64(seed ^ 0x6368_616f_735f_7673);
-    let families = 11u64;
+    let families = 12u64;
     let mut order: Vec<u64> = (0..families).collect();
     rng.shuffle(&mut order);
     let mut out = Vec::new();
@@ -366,10 +391,15 @@ pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
                 let o = rng.below(20) + u64::from(p == 0);
                 (Fault::TrackingLost(p, o), p + o)
             }
-            _ => {
+            10 => {
                 let kind = [Dropout::None, Dropout::Invalid, Dropout::Low][rng.below(3) as usize];
                 let s = secs(&mut rng, 0.3, 3.0);
                 (Fault::GazeDropout(s, kind), (s * 20.0) as u64)
+            }
+            _ => {
+                let ipd = 54.0 + 0.5 * rng.below(37) as f32;
+                let toe = 0.5 * rng.below(7) as f32;
+                (Fault::Eyes(ipd, toe), 1)
             }
         };
         out.push(Scheduled {
@@ -399,13 +429,17 @@ mod tests {
             frame 580 runtime-failure xrLocateViews
             frame 600 tracking-lost 20 10
             frame 700 gaze-dropout 2 invalid
+            frame 710 eyes 58.5 2
+            frame 720 eyes 70
         ";
         let parsed = parse(text).unwrap();
-        assert_eq!(parsed.len(), 11);
+        assert_eq!(parsed.len(), 13);
         // Frame triggers first, in frame order; the time trigger after them.
         assert_eq!(parsed[0].to_string(), "frame 40 headset-off 3");
         assert_eq!(parsed[9].to_string(), "frame 700 gaze-dropout 2 invalid");
-        assert_eq!(parsed[10].to_string(), "at 9.5 session-loss 2");
+        assert_eq!(parsed[10].fault, Fault::Eyes(58.5, 2.0));
+        assert_eq!(parsed[11].to_string(), "frame 720 eyes 70 0");
+        assert_eq!(parsed[12].to_string(), "at 9.5 session-loss 2");
         for s in &parsed {
             assert_eq!(parse(&s.to_string()).unwrap(), vec![s.clone()]);
         }
@@ -433,6 +467,14 @@ mod tests {
                 "`blink` is not none, invalid or low",
             ),
             ("frame 3 tracking-lost 0 0", "no frame lost"),
+            (
+                "frame 3 eyes 30",
+                "eyes: `30` is not a distance of 40 to 90",
+            ),
+            ("frame 3 eyes 60 12", "eyes: `60 12` is not"),
+            ("frame 3 eyes 60 nan", "eyes: `60 nan` is not"),
+            ("frame 3 eyes", "`eyes`: not a fault"),
+            ("frame 3 eyes 60 1 2", "`eyes`: not a fault"),
             ("frame 3 explode", "`explode`: not a fault"),
             ("soon 3 menu 2", "`soon`: expected `frame N`"),
             ("frame 3", "a trigger with no fault after it"),
@@ -461,6 +503,7 @@ mod tests {
             "runtime-failure",
             "tracking-lost",
             "gaze-dropout",
+            "eyes",
         ] {
             assert!(
                 a.iter().any(|s| s.fault.name() == family),

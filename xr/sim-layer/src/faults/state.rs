@@ -17,6 +17,7 @@ use std::time::{Duration, Instant};
 use openxr::sys;
 
 use super::schedule::{Dropout, Fault, Scheduled, Trigger};
+use crate::config::SimViews;
 
 /// Something the layer hands the app through `xrPollEvent`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -169,6 +170,8 @@ pub struct Faults {
     tracking_now: Option<TrackingLoss>,
     /// Eye tracker dropouts: from, until (runtime time), how.
     dropouts: Vec<(i64, i64, Dropout)>,
+    /// The eyes the newest `eyes` fault gave the headset, if one has started.
+    eyes: Option<SimViews>,
     /// Lines for the fault log, taken by the caller.
     log: Vec<LogLine>,
 }
@@ -199,6 +202,7 @@ impl Faults {
             tracking_left: (0, 0),
             tracking_now: None,
             dropouts: Vec::new(),
+            eyes: None,
             log,
         }
     }
@@ -448,6 +452,7 @@ impl Faults {
                 self.dropouts.push((display_ns, end, kind));
                 self.log.push(("dropout", format!("{} {s}", kind.name())));
             }
+            Fault::Eyes(ipd_mm, toe_out_deg) => self.eyes = SimViews::new(ipd_mm, toe_out_deg),
         }
     }
 
@@ -542,6 +547,11 @@ impl Faults {
     /// What the head poses located this frame lack, if anything.
     pub fn tracking(&self) -> Option<TrackingLoss> {
         self.tracking_now
+    }
+
+    /// The eyes `xrLocateViews` answers since the newest `eyes` fault, if one has started.
+    pub fn eyes(&self) -> Option<SimViews> {
+        self.eyes
     }
 
     /// The eye tracker's dropout at runtime time `time_ns`, and when it started, if any.

@@ -30,7 +30,7 @@ use super::DepthOptions;
 use super::SessionOptions;
 use super::actions::Controls;
 use super::choose::{GazeSource, SpaceChoice};
-use super::gaze::{Gaze, GazeTally};
+use super::gaze::{Gaze, GazeOrder, GazeTally};
 use super::state::{EndReason, State};
 
 pub(super) use create::start;
@@ -188,6 +188,8 @@ pub struct Session {
     injected_rx: mpsc::Receiver<Command>,
     /// The gaze source (holds spaces/trackers of the session).
     gaze: Gaze,
+    /// The frames' gaze kept in time order.
+    gaze_order: GazeOrder,
     /// The app space the scene is placed in (STAGE or LOCAL).
     space: xr::Space,
     /// Its type, to match reference-space change events.
@@ -349,6 +351,11 @@ impl Session {
     /// The predicted display time of the session's first frame, nanoseconds.
     pub fn first_display_ns(&self) -> Option<i64> {
         self.first_display.map(|t| t.as_nanos())
+    }
+
+    /// The newest gaze sample a frame got.
+    pub fn newest_gaze(&self) -> Option<vitreous_trace::GazeSample> {
+        self.gaze_order.newest()
     }
 
     /// Where the application sends commands to be applied as if a live action gave them, at

@@ -266,6 +266,23 @@ fn a_dropout_covers_its_display_time_span() {
 }
 
 #[test]
+fn new_eyes_hold_from_their_frame_and_the_newest_wins() {
+    let now = Instant::now();
+    let mut f = focused("frame 2 eyes 58 2\nframe 4 eyes 70");
+    for want in [
+        None,
+        None,
+        Some((0.058, 2.0)),
+        Some((0.058, 2.0)),
+        Some((0.070, 0.0)),
+    ] {
+        frame(&mut f, now);
+        let got = f.eyes().map(|e| (e.ipd_m, e.toe_out_deg));
+        assert_eq!(got, want, "frame {}", f.frames - 1);
+    }
+}
+
+#[test]
 fn a_fault_that_walks_the_session_waits_for_the_one_before() {
     let now = Instant::now();
     let mut f = focused("frame 0 menu 5\nframe 1 headset-off 1");

@@ -326,6 +326,7 @@ fn moving_light_replay_recomputes_the_inducer_only_when_something_moved() {
         compare_reference: false,
         compare_shifts_deg: Vec::new(),
         gaze: Default::default(),
+        fields: Default::default(),
     })
     .expect("replay");
     assert_eq!(summary.frames, frames);

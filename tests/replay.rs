@@ -32,6 +32,7 @@ pub(crate) fn options(scene: &str, trace: Option<&str>, out: &Path) -> ReplayOpt
         compare_reference: false,
         compare_shifts_deg: Vec::new(),
         gaze: Default::default(),
+        fields: Default::default(),
     }
 }
 
@@ -321,5 +322,91 @@ fn compare_reference_measures_every_saved_eye_against_the_physical_reference() {
         let disc = flip(&f["regions"], "disc");
         assert!(disc < flip(&f["nothing_drawn"], "disc"), "{f}");
         assert!(disc >= flip(&f["additive_limit"], "disc"), "{f}");
+    }
+}
+
+#[test]
+fn recorded_fields_draw_each_eye_with_the_headsets_field() {
+    use vitreous::replay::Fields;
+    use vitreous_trace::format::{HeadView, TraceVersion, TraceWriter, ViewsRecord};
+    use vitreous_trace::{EyeView, Fov, GazeSample, Pose};
+    let dir = tempfile::tempdir().unwrap();
+    let scene = load_scene(&workspace().join("config/scenes/glass-sphere.toml")).unwrap();
+    // A headset whose fields are narrower than the scene's 40 x 30 degrees and lean outwards
+    // and down, mirrored between the eyes.
+    let field = |side: f32| Fov {
+        angle_left_rad: if side < 0.0 { -0.30 } else { -0.20 },
+        angle_right_rad: if side < 0.0 { 0.20 } else { 0.30 },
+        angle_up_rad: 0.10,
+        angle_down_rad: -0.25,
+    };
+    let eye = |side: f32| HeadView {
+        pose: Pose {
+            position: Vec3::X * 0.0315 * side,
+            orientation: glam::Quat::IDENTITY,
+        },
+        fov: field(side),
+    };
+    let head = Pose {
+        position: scene.viewer.head_position_m,
+        orientation: glam::Quat::IDENTITY,
+    };
+    let trace = dir.path().join("headset.trace");
+    let mut w = TraceWriter::create_version(&trace, TraceVersion::V1_5).unwrap();
+    w.write_views(&ViewsRecord {
+        time_ns: 0,
+        eyes: [eye(-1.0), eye(1.0)],
+    })
+    .unwrap();
+    for k in 0..3i64 {
+        let t = k * 20_000_000;
+        w.write(&vitreous_trace::format::TraceSample {
+            time_ns: t,
+            head,
+            gaze: GazeSample::none(t),
+        })
+        .unwrap();
+    }
+    w.finish().unwrap();
+    let out = dir.path().join("out");
+    let summary = replay(&ReplayOptions {
+        trace: Some(trace),
+        frames: Some(1),
+        save_every: 1,
+        size: None,
+        fields: Fields::Recorded,
+        ..options("glass-sphere.toml", None, &out)
+    })
+    .expect("replay succeeds with validation on");
+    // The scene's width, as high as makes the left field's pixels square.
+    let f = field(-1.0);
+    let aspect = (f.angle_up_rad.tan() - f.angle_down_rad.tan())
+        / (f.angle_right_rad.tan() - f.angle_left_rad.tan());
+    assert_eq!(summary.width_px, scene.output.width_px);
+    assert_eq!(summary.height_px, (1280.0 * aspect).round() as u32);
+    let size = Vec2::new(summary.width_px as f32, summary.height_px as f32);
+    for (k, name) in ["left", "right"].iter().enumerate() {
+        let side = [-1.0, 1.0][k];
+        let png = out.join("frames").join(format!("000000-{name}.png"));
+        let (rgba, width) = decode(&png);
+        let (centroid, count) = lit_centroid(&rgba, width, 8).expect("the ball is drawn");
+        assert!(count > 50, "{name}: {count} lit pixels");
+        let projected = |fov: Fov| {
+            eye_params(&EyeView {
+                pose: eye(side).in_world(&head),
+                fov,
+            })
+            .project_to_pixel(scene.object.center_m, size)
+            .unwrap()
+        };
+        let (recorded, scene_field) = (projected(field(side)), projected(scene.output.fov));
+        assert!(
+            (centroid - recorded).length() < 2.0,
+            "{name}: the ball at {centroid}, projected through the headset's field at {recorded}"
+        );
+        assert!(
+            (recorded - scene_field).length() > 50.0,
+            "{name}: the two fields put the ball at {recorded} and {scene_field}"
+        );
     }
 }

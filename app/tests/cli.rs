@@ -93,6 +93,33 @@ fn missing_trace_is_named_and_nothing_is_written() {
 }
 
 #[test]
+fn recorded_fields_need_a_recording_with_views_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let trace = workspace().join("config/traces/neutral-then-turned.csv");
+    let run = |fields: &str| {
+        vitreous(
+            &[
+                "replay",
+                &scene("glass-sphere.toml"),
+                "--trace",
+                trace.to_str().unwrap(),
+                "--fields",
+                fields,
+                "--out",
+                out_dir.to_str().unwrap(),
+                "--quiet",
+            ],
+            dir.path(),
+        )
+    };
+    let message = assert_clean_failure(&run("recorded"), &["neutral-then-turned.csv"]);
+    assert!(message.contains("no views lines"), "{message}");
+    assert_clean_failure(&run("headset"), &["--fields", "headset"]);
+    assert!(!out_dir.exists());
+}
+
+#[test]
 fn trace_with_nan_time_names_the_line() {
     let dir = tempfile::tempdir().unwrap();
     let header = vitreous_trace::format::COLUMNS.join(",");

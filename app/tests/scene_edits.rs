@@ -74,6 +74,7 @@ fn recorded_edits_offset_the_keyframes_and_move_the_scene_once_each() {
         compare_reference: false,
         compare_shifts_deg: Vec::new(),
         gaze: Default::default(),
+        fields: Default::default(),
     })
     .expect("replay");
     assert_eq!(summary.frames, 32);

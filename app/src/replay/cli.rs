@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use super::{GazeSettings, ReplayOptions, replay};
+use super::{Fields, GazeSettings, ReplayOptions, replay};
 use crate::cli_values::{
     ReflectionArg, number, parse_effects, parse_frame_count, parse_pupil_mm, parse_save_every,
     parse_size,
@@ -94,6 +94,11 @@ pub struct ReplayArgs {
     /// fixed diameter) or measured (the trace's pupil diameters, smoothed).
     #[arg(long = "pupil", value_name = "SOURCE")]
     pub pupil_source: Option<PupilSource>,
+    /// The field of view each eye is drawn with: the scene's (`[output]`), or, from a
+    /// recording's views lines (trace version 1.5), the headset's; with `recorded` and no
+    /// --size the image is the scene's width and as high as makes its pixels square.
+    #[arg(long, value_enum, default_value_t = Fields::Scene)]
+    pub fields: Fields,
 }
 
 /// Replays what `args` describe and prints where the output went (default
@@ -135,6 +140,7 @@ pub fn replay_command(a: ReplayArgs) -> Result<()> {
             pupil_mm: a.pupil_mm,
             pupil_source: a.pupil_source,
         },
+        fields: a.fields,
     })?;
     println!("{}", summary.summary_line());
     if let Some(s) = &summary.separability {

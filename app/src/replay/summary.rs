@@ -71,6 +71,12 @@ pub struct ReplaySummary {
     pub width_px: u32,
     /// Eye image height, pixels.
     pub height_px: u32,
+    /// The field of view the eyes were drawn with (`--fields`): the scene's, or the headset's
+    /// from the recording.
+    pub fields: super::Fields,
+    /// The scene's field (left, right, up, down edges, degrees): with `recorded` fields the
+    /// recording's first (left eye), each eye drawn with the line in force.
+    pub fov_deg: [f32; 4],
     /// Display frame rate replayed, hertz.
     pub frame_rate_hz: f64,
     /// Frames rendered.

@@ -12,7 +12,8 @@
 //!   three frames: samples are never invented or interpolated;
 //! - each eye's view is the one the recording's newest views line at or before the frame time
 //!   gives (version 1.5: the eyes the headset drew from, in the head's frame), with the
-//!   configured field of view (the replay's images are its own size); before any, or without
+//!   configured field of view (the replay's images are its own size) or, asked
+//!   ([`NullBackend::with_recorded_fields`]), the line's own; before any, or without
 //!   views lines, each eye's position in the head frame is the running mean of that eye's
 //!   valid gaze-ray origins over every gaze sample up to the frame time (±`ipd_m / 2` along
 //!   head x until one is valid), the view the head's orientation (displays fixed to the head,
@@ -199,6 +200,9 @@ pub struct NullBackend {
     views: VecDeque<ViewsRecord>,
     /// The views in force: the newest line at or before the last frame.
     views_now: Option<ViewsRecord>,
+    /// Whether a views line's fields are drawn ([`NullBackend::with_recorded_fields`]) rather
+    /// than the configured one.
+    recorded_fields: bool,
 }
 
 impl NullBackend {
@@ -223,6 +227,13 @@ impl NullBackend {
     /// at or before the frame's time.
     pub fn with_views(mut self, views: Vec<ViewsRecord>) -> Self {
         self.views.extend(views);
+        self
+    }
+
+    /// Draws each eye with the field of view of the views line in force (the headset's), not
+    /// the configured one; frames before the first views line keep the configured field.
+    pub fn with_recorded_fields(mut self) -> Self {
+        self.recorded_fields = true;
         self
     }
 
@@ -280,6 +291,7 @@ impl NullBackend {
             ready: Vec::new(),
             views: VecDeque::new(),
             views_now: None,
+            recorded_fields: false,
         };
         if !this.pull()? {
             return Err(NullError::EmptyTrace {

@@ -116,7 +116,11 @@ impl NullBackend {
         let views = match &self.views_now {
             Some(recorded) => recorded.eyes.map(|eye| EyeView {
                 pose: eye.in_world(&head),
-                fov: self.config.fov,
+                fov: if self.recorded_fields {
+                    eye.fov
+                } else {
+                    self.config.fov
+                },
             }),
             None => self.eye_positions_head_m().map(|eye_m| EyeView {
                 pose: Pose {

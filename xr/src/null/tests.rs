@@ -460,3 +460,48 @@ fn recorded_views_are_drawn_from_their_time_on_in_memory_and_streamed() {
     let mut backend = NullBackend::from_reader(reader, config).unwrap();
     check(&run(&mut backend));
 }
+
+#[test]
+fn recorded_fields_are_drawn_when_asked_from_the_lines_time_on() {
+    use vitreous_trace::Fov;
+    use vitreous_trace::format::{HeadView, ViewsRecord};
+    // A headset whose fields are asymmetric, each wider towards its own side.
+    let field = |side: f32| Fov {
+        angle_left_rad: if side < 0.0 { -0.45 } else { -0.35 },
+        angle_right_rad: if side < 0.0 { 0.35 } else { 0.45 },
+        angle_up_rad: 0.3,
+        angle_down_rad: -0.32,
+    };
+    let eye = |side: f32| HeadView {
+        pose: Pose {
+            position: Vec3::new(side * 0.0315, 0.0, 0.0),
+            orientation: Quat::IDENTITY,
+        },
+        fov: field(side),
+    };
+    let views = ViewsRecord {
+        time_ns: 5_030_000_000,
+        eyes: [eye(-1.0), eye(1.0)],
+    };
+    let trace: Vec<_> = (0..=10)
+        .map(|i| sample(5_000_000_000 + i * 10_000_000, Vec3::Y, 0.0))
+        .collect();
+    let config = NullConfig {
+        at_samples: true,
+        ..NullConfig::default()
+    };
+    let mut backend = NullBackend::new(trace, config)
+        .unwrap()
+        .with_views(vec![views])
+        .with_recorded_fields();
+    let frames = run(&mut backend);
+    assert_eq!(frames.len(), 11);
+    for f in &frames {
+        let want = if f.time_ns < views.time_ns {
+            [config.fov; 2]
+        } else {
+            [field(-1.0), field(1.0)]
+        };
+        assert_eq!([f.views[0].fov, f.views[1].fov], want, "{}", f.time_ns);
+    }
+}

@@ -97,6 +97,9 @@ pub struct InterruptionSummary {
     pub tracking_lost_orientation: u64,
     /// Frames drawn at the last tracked head position.
     pub frames_position_held: u64,
+    /// Frames whose head or eye pose the runtime marked valid but was not usable (not finite,
+    /// not a unit quaternion): taken as lost tracking.
+    pub frames_unusable_pose: u64,
     /// Times the reference space changed (recentred).
     pub recentres: u64,
     /// Swapchain image waits that timed out and were waited for again.
@@ -149,6 +152,7 @@ impl InterruptionSummary {
             tracking_lost_position: i.tracking_losses[TrackingLoss::Position as usize],
             tracking_lost_orientation: i.tracking_losses[TrackingLoss::Orientation as usize],
             frames_position_held: i.frames_position_held,
+            frames_unusable_pose: i.frames_unusable_pose,
             recentres: report.space_changes,
             image_wait_timeouts: i.image_wait_timeouts,
             failed_calls: i

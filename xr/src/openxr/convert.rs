@@ -19,6 +19,23 @@ pub(super) fn pose_of(p: &xr::Posef) -> Pose {
     }
 }
 
+/// Whether a pose's position is finite: a runtime may hand out anything where it marks a
+/// position valid by mistake (or leaves one it marks not valid undefined).
+pub(super) fn usable_position(p: &xr::Posef) -> bool {
+    [p.position.x, p.position.y, p.position.z]
+        .iter()
+        .all(|v| v.is_finite())
+}
+
+/// Whether a pose's orientation is a unit quaternion, within a tenth (OpenXR asks for unit
+/// length; runtimes have handed out all-zero ones marked valid at start-up): anything else
+/// cannot be normalised into a turn.
+pub(super) fn usable_orientation(p: &xr::Posef) -> bool {
+    let q = &p.orientation;
+    let norm = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w).sqrt();
+    (norm - 1.0).abs() < 0.1
+}
+
 /// OpenXR's pose of one of vitreous's.
 pub(super) fn posef_of(p: &Pose) -> xr::Posef {
     xr::Posef {
@@ -48,5 +65,43 @@ pub(super) fn ray_of(pose: &xr::Posef) -> GazeRay {
         origin: Vec3::new(pose.position.x, pose.position.y, pose.position.z),
         direction: (q * Vec3::NEG_Z).normalize_or(Vec3::NEG_Z),
         valid: true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn posef(position: [f32; 3], q: [f32; 4]) -> xr::Posef {
+        xr::Posef {
+            orientation: xr::Quaternionf {
+                x: q[0],
+                y: q[1],
+                z: q[2],
+                w: q[3],
+            },
+            position: xr::Vector3f {
+                x: position[0],
+                y: position[1],
+                z: position[2],
+            },
+        }
+    }
+
+    #[test]
+    fn a_pose_marked_valid_is_used_only_when_it_holds_a_place_and_a_turn() {
+        let turn = Quat::from_rotation_y(0.4).to_array();
+        let good = posef([0.1, 1.6, -0.2], turn);
+        assert!(usable_position(&good) && usable_orientation(&good));
+        // A runtime's rounding (a norm off by a few parts in a thousand) is still a turn.
+        let rounded = posef([0.0; 3], turn.map(|c| c * 1.004));
+        assert!(usable_orientation(&rounded));
+        for bad in [f32::NAN, f32::INFINITY] {
+            assert!(!usable_position(&posef([0.0, bad, 0.0], turn)));
+            assert!(!usable_orientation(&posef([0.0; 3], [0.0, bad, 0.0, 1.0])));
+        }
+        // All zero (handed out marked valid at start-up), or far from unit length.
+        assert!(!usable_orientation(&posef([0.0; 3], [0.0; 4])));
+        assert!(!usable_orientation(&posef([0.0; 3], [0.0, 0.0, 0.0, 0.5])));
     }
 }

@@ -1,8 +1,9 @@
 //! Lost head tracking ([`crate::faults`]): the frames whose head poses the fault schedule
-//! takes the position (then the orientation too) from, in `xrLocateViews` and in
-//! `xrLocateSpace` of the head (a VIEW reference space) against the world (LOCAL or STAGE).
-//! A pose whose flags say it is not valid holds nothing the app may use: its position is
-//! zeroed, its orientation made the identity, as a runtime leaves them undefined.
+//! takes the position (then the orientation too) from, or fills with numbers no pose can hold
+//! while marking them valid, in `xrLocateViews` and in `xrLocateSpace` of the head (a VIEW
+//! reference space) against the world (LOCAL or STAGE). What a pose's flags say is not valid
+//! the specification leaves undefined: the layer writes NaN there, so an app that reads it
+//! shows it.
 
 use openxr::sys::{self, Handle};
 
@@ -23,20 +24,48 @@ fn without_orientation(flags: sys::SpaceLocationFlags) -> sys::SpaceLocationFlag
             | sys::SpaceLocationFlags::ORIENTATION_TRACKED)
 }
 
-/// A pose as it is reported after `loss`: what is not valid is undefined.
+/// A pose as it is reported after `loss`: what is not valid is undefined (NaN); an unusable
+/// pose has a position that is not a number and an all-zero quaternion.
 fn lose(pose: &mut sys::Posef, loss: TrackingLoss) {
-    pose.position = sys::Vector3f::default();
-    if loss == TrackingLoss::Orientation {
-        pose.orientation = sys::Posef::IDENTITY.orientation;
+    let nan = sys::Vector3f {
+        x: f32::NAN,
+        y: f32::NAN,
+        z: f32::NAN,
+    };
+    pose.position = nan;
+    match loss {
+        TrackingLoss::Position => {}
+        TrackingLoss::Orientation => {
+            pose.orientation = sys::Quaternionf {
+                x: f32::NAN,
+                y: f32::NAN,
+                z: f32::NAN,
+                w: f32::NAN,
+            }
+        }
+        TrackingLoss::Unusable => {
+            pose.orientation = sys::Quaternionf {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+                w: 0.0,
+            }
+        }
+    }
+}
+
+/// The flags a located pose keeps after `loss` (an unusable pose keeps them all).
+fn kept_flags(flags: sys::SpaceLocationFlags, loss: TrackingLoss) -> sys::SpaceLocationFlags {
+    match loss {
+        TrackingLoss::Position => without_position(flags),
+        TrackingLoss::Orientation => without_orientation(flags),
+        TrackingLoss::Unusable => flags,
     }
 }
 
 /// Takes from a located space what this frame's head tracking lacks.
 pub fn lose_location(location: &mut sys::SpaceLocation, loss: TrackingLoss) {
-    location.location_flags = match loss {
-        TrackingLoss::Position => without_position(location.location_flags),
-        TrackingLoss::Orientation => without_orientation(location.location_flags),
-    };
+    location.location_flags = kept_flags(location.location_flags, loss);
     lose(&mut location.pose, loss);
 }
 
@@ -114,10 +143,7 @@ pub unsafe extern "system" fn locate_views(
         // SAFETY: on success the runtime filled the app's view state.
         let state = unsafe { &mut *state };
         let flags = sys::SpaceLocationFlags::from_raw(state.view_state_flags.into_raw());
-        let kept = match loss {
-            TrackingLoss::Position => without_position(flags),
-            TrackingLoss::Orientation => without_orientation(flags),
-        };
+        let kept = kept_flags(flags, loss);
         state.view_state_flags = sys::ViewStateFlags::from_raw(kept.into_raw());
         for i in 0..written {
             // SAFETY: the app's array of `capacity` views, `written` of them filled.
@@ -161,9 +187,14 @@ mod tests {
             F::ORIENTATION_VALID | F::ORIENTATION_TRACKED
         );
         assert_eq!(position_lost.pose.orientation.y, 0.6);
-        assert_eq!(position_lost.pose.position.y, 0.0);
+        assert!(position_lost.pose.position.y.is_nan());
+        let mut unusable = loc;
+        lose_location(&mut unusable, TrackingLoss::Unusable);
+        assert_eq!(unusable.location_flags, all, "still marked valid");
+        assert!(unusable.pose.position.x.is_nan());
+        assert_eq!(unusable.pose.orientation.w, 0.0);
         lose_location(&mut loc, TrackingLoss::Orientation);
         assert_eq!(loc.location_flags, F::EMPTY);
-        assert_eq!(loc.pose.orientation.w, 1.0);
+        assert!(loc.pose.orientation.w.is_nan());
     }
 }

@@ -12,6 +12,7 @@
 //! frame 560 image-timeout 2        # 2 swapchain image waits time out
 //! frame 580 runtime-failure xrLocateViews   # one call fails with XR_ERROR_RUNTIME_FAILURE
 //! frame 600 tracking-lost 20 10    # head position lost for 20 frames, then orientation for 10
+//! frame 650 unusable-pose 5        # 5 frames of head poses marked valid holding NaN and zeros
 //! frame 700 gaze-dropout 2 invalid # the eye tracker drops out for 2 s (none, invalid or low)
 //! frame 760 eyes 58 2              # the eyes from now on 58 mm apart, each turned 2 degrees out
 //! chaos 7 2000                     # a random schedule of every fault over 2000 frames (seed 7)
@@ -105,6 +106,9 @@ pub enum Fault {
     /// Head tracking lost: the position for this many frames, then the orientation too for
     /// that many.
     TrackingLost(u64, u64),
+    /// For this many frames the head's located poses are marked valid but hold nothing
+    /// usable: positions not a number, all-zero quaternions.
+    UnusablePose(u64),
     /// The eye tracker drops out for this many seconds of display time.
     GazeDropout(f64, Dropout),
     /// From now on `xrLocateViews` answers eyes this many millimetres apart, each view turned
@@ -127,6 +131,7 @@ impl Fault {
             Fault::ImageTimeout(_) => "image-timeout",
             Fault::RuntimeFailure(_) => "runtime-failure",
             Fault::TrackingLost(..) => "tracking-lost",
+            Fault::UnusablePose(_) => "unusable-pose",
             Fault::GazeDropout(..) => "gaze-dropout",
             Fault::Eyes(..) => "eyes",
         }
@@ -149,9 +154,11 @@ impl fmt::Display for Fault {
             Fault::HeadsetOff(s) | Fault::SessionLoss(s) | Fault::InstanceLoss(s) => {
                 write!(f, " {s}")
             }
-            Fault::Menu(n) | Fault::NoRender(n) | Fault::Late(n) | Fault::ImageTimeout(n) => {
-                write!(f, " {n}")
-            }
+            Fault::Menu(n)
+            | Fault::NoRender(n)
+            | Fault::Late(n)
+            | Fault::ImageTimeout(n)
+            | Fault::UnusablePose(n) => write!(f, " {n}"),
             Fault::RuntimeFailure(call) => write!(f, " {call}"),
             Fault::TrackingLost(p, o) => write!(f, " {p} {o}"),
             Fault::GazeDropout(s, kind) => write!(f, " {s} {}", kind.name()),
@@ -281,6 +288,7 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
         ["instance-loss", s] => Fault::InstanceLoss(secs(s, "instance-loss")?),
         ["recentre"] => Fault::Recentre,
         ["no-render", n] => Fault::NoRender(frames(n, "no-render")?),
+        ["unusable-pose", n] => Fault::UnusablePose(frames(n, "unusable-pose")?),
         ["late", n] => Fault::Late(whole(n, "late", 1, 100)?),
         ["image-timeout", n] => Fault::ImageTimeout(whole(n, "image-timeout", 1, 100)?),
         ["runtime-failure", call] => Fault::RuntimeFailure(
@@ -334,8 +342,8 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
             return Err(format!(
                 "`{name}`: not a fault with those arguments (headset-off S, menu N, session-loss S, \
                  instance-loss S, recentre, no-render N, late N, image-timeout N, \
-                 runtime-failure CALL, tracking-lost N N, gaze-dropout S none|invalid|low, \
-                 eyes MM [DEG])"
+                 runtime-failure CALL, tracking-lost N N, unusable-pose N, \
+                 gaze-dropout S none|invalid|low, eyes MM [DEG])"
             ));
         }
         [] => return Err("a trigger with no fault after it".into()),
@@ -345,11 +353,11 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
 /// A random schedule from `seed` over the app's first `frames` frames: every fault family at
 /// least once, in a shuffled order, then more drawn at random, each starting 60 to 160 frames
 /// after the one before ended (the app has time to recover and show frames in between).
-/// Outages last 0.5 to 3 s, a menu 10 to 60 frames, a dropout 0.3 to 3 s; new eyes are 54 to
-/// 72 mm apart and turned 0 to 3 degrees outwards.
+/// Outages last 0.5 to 3 s, a menu 10 to 60 frames, a dropout 0.3 to 3 s, unusable poses 1 to
+/// 10 frames; new eyes are 54 to 72 mm apart and turned 0 to 3 degrees outwards.
 pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
     let mut rng = SplitMix64(seed ^ 0x6368_616f_735f_7673);
-    let families = 12u64;
+    let families = 13u64;
     let mut order: Vec<u64> = (0..families).collect();
     rng.shuffle(&mut order);
     let mut out = Vec::new();
@@ -396,6 +404,10 @@ pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
                 let s = secs(&mut rng, 0.3, 3.0);
                 (Fault::GazeDropout(s, kind), (s * 20.0) as u64)
             }
+            11 => {
+                let n = 1 + rng.below(10);
+                (Fault::UnusablePose(n), n)
+            }
             _ => {
                 let ipd = 54.0 + 0.5 * rng.below(37) as f32;
                 let toe = 0.5 * rng.below(7) as f32;
@@ -428,18 +440,20 @@ mod tests {
             frame 560 image-timeout 2
             frame 580 runtime-failure xrLocateViews
             frame 600 tracking-lost 20 10
+            frame 650 unusable-pose 5
             frame 700 gaze-dropout 2 invalid
             frame 710 eyes 58.5 2
             frame 720 eyes 70
         ";
         let parsed = parse(text).unwrap();
-        assert_eq!(parsed.len(), 13);
+        assert_eq!(parsed.len(), 14);
         // Frame triggers first, in frame order; the time trigger after them.
         assert_eq!(parsed[0].to_string(), "frame 40 headset-off 3");
-        assert_eq!(parsed[9].to_string(), "frame 700 gaze-dropout 2 invalid");
-        assert_eq!(parsed[10].fault, Fault::Eyes(58.5, 2.0));
-        assert_eq!(parsed[11].to_string(), "frame 720 eyes 70 0");
-        assert_eq!(parsed[12].to_string(), "at 9.5 session-loss 2");
+        assert_eq!(parsed[9].to_string(), "frame 650 unusable-pose 5");
+        assert_eq!(parsed[10].to_string(), "frame 700 gaze-dropout 2 invalid");
+        assert_eq!(parsed[11].fault, Fault::Eyes(58.5, 2.0));
+        assert_eq!(parsed[12].to_string(), "frame 720 eyes 70 0");
+        assert_eq!(parsed[13].to_string(), "at 9.5 session-loss 2");
         for s in &parsed {
             assert_eq!(parse(&s.to_string()).unwrap(), vec![s.clone()]);
         }
@@ -502,6 +516,7 @@ mod tests {
             "image-timeout",
             "runtime-failure",
             "tracking-lost",
+            "unusable-pose",
             "gaze-dropout",
             "eyes",
         ] {

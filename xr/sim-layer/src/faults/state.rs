@@ -54,6 +54,9 @@ pub enum TrackingLoss {
     Position,
     /// Neither position nor orientation is valid.
     Orientation,
+    /// Both marked valid, but holding nothing usable: the position not a number, the
+    /// orientation an all-zero quaternion (as runtimes have handed out at start-up).
+    Unusable,
 }
 
 /// What the layer does with the app's `xrWaitFrame`.
@@ -166,6 +169,8 @@ pub struct Faults {
     failing: Vec<&'static str>,
     /// Frames still to lose the head's position, then its orientation.
     tracking_left: (u64, u64),
+    /// Frames still to hand out unusable head poses marked valid.
+    unusable_left: u64,
     /// What this frame's head poses lack.
     tracking_now: Option<TrackingLoss>,
     /// Eye tracker dropouts: from, until (runtime time), how.
@@ -200,6 +205,7 @@ impl Faults {
             timeouts_left: 0,
             failing: Vec::new(),
             tracking_left: (0, 0),
+            unusable_left: 0,
             tracking_now: None,
             dropouts: Vec::new(),
             eyes: None,
@@ -353,6 +359,10 @@ impl Faults {
         self.latest_display_ns = Some(display_ns);
         self.start_due(session, frame, display_ns, now);
         self.tracking_now = match self.tracking_left {
+            _ if self.unusable_left > 0 => {
+                self.unusable_left -= 1;
+                Some(TrackingLoss::Unusable)
+            }
             (p, _) if p > 0 => {
                 self.tracking_left.0 -= 1;
                 Some(TrackingLoss::Position)
@@ -447,6 +457,7 @@ impl Faults {
             Fault::ImageTimeout(n) => self.timeouts_left += n,
             Fault::RuntimeFailure(call) => self.failing.push(call),
             Fault::TrackingLost(p, o) => self.tracking_left = (p, o),
+            Fault::UnusablePose(n) => self.unusable_left = n,
             Fault::GazeDropout(s, kind) => {
                 let end = display_ns + (s * 1e9) as i64;
                 self.dropouts.push((display_ns, end, kind));

@@ -26,7 +26,7 @@ use openxr as xr;
 use vitreous_trace::session_event::{NotRendered, SessionEvent};
 use vitreous_trace::{EyeView, Fov, FrameInput};
 
-use super::super::convert::pose_of;
+use super::super::convert::{pose_of, usable_orientation, usable_position};
 use super::super::state::{self, EndReason};
 use super::super::{OpenXrError, Result, XrContext};
 use super::depth::{chain_depth, depth_info};
@@ -142,14 +142,32 @@ impl Session {
                 views.len()
             )));
         }
-        let position_valid = head
+        let said_position = head
             .location_flags
             .contains(xr::SpaceLocationFlags::POSITION_VALID)
             && flags.contains(xr::ViewStateFlags::POSITION_VALID);
-        let orientation_valid = head
+        let said_orientation = head
             .location_flags
             .contains(xr::SpaceLocationFlags::ORIENTATION_VALID)
             && flags.contains(xr::ViewStateFlags::ORIENTATION_VALID);
+        let located = [&head.pose, &views[0].pose, &views[1].pose];
+        let position_valid = said_position && located.iter().all(|p| usable_position(p));
+        let orientation_valid = said_orientation && located.iter().all(|p| usable_orientation(p));
+        if (said_position, said_orientation) != (position_valid, orientation_valid) {
+            if self.report.interruptions.frames_unusable_pose == 0 {
+                tracing::warn!(
+                    "frame {}: the runtime marked the head's pose valid but gave {}: taken as \
+                     lost tracking (counted in summary.json's interruptions)",
+                    self.next_index,
+                    if said_orientation && !orientation_valid {
+                        "an orientation that is not a unit quaternion"
+                    } else {
+                        "a position that is not a finite number"
+                    }
+                );
+            }
+            self.report.interruptions.frames_unusable_pose += 1;
+        }
         let poses = Poses {
             head: pose_of(&head.pose),
             eyes: [pose_of(&views[0].pose), pose_of(&views[1].pose)],

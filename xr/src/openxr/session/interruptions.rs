@@ -53,6 +53,9 @@ pub struct Interruptions {
     pub not_rendered_exiting: u64,
     /// Frames drawn at the last tracked head position (orientation tracked).
     pub frames_position_held: u64,
+    /// Frames whose located head or eye pose was marked valid but was not usable (a position
+    /// not finite, an orientation not a unit quaternion): taken as lost tracking.
+    pub frames_unusable_pose: u64,
     /// Times head tracking lost the position, and the orientation.
     pub tracking_losses: [u64; 2],
     /// Display periods the runtime moved past with no frame waited for (the app was late).
@@ -79,6 +82,7 @@ impl Interruptions {
         self.not_rendered_tracking += later.not_rendered_tracking;
         self.not_rendered_exiting += later.not_rendered_exiting;
         self.frames_position_held += later.frames_position_held;
+        self.frames_unusable_pose += later.frames_unusable_pose;
         self.tracking_losses[0] += later.tracking_losses[0];
         self.tracking_losses[1] += later.tracking_losses[1];
         self.late_periods += later.late_periods;

@@ -215,7 +215,8 @@ pub unsafe extern "system" fn get_system(
 
 /// `xrWaitFrame`: the frames a late app missed are waited for and ended first, then the app's
 /// is passed on; the first predicted display time starts the trace clock, and the frame is
-/// counted and told not to render where the faults say so.
+/// counted, told not to render and shown a bad display time where the faults say so (the
+/// layer keeps the true one).
 ///
 /// # Safety
 /// As `xrWaitFrame`.
@@ -260,10 +261,14 @@ pub unsafe extern "system" fn wait_frame(
             s.latest_display_ns = Some(display);
         }
         let asked = frame.should_render == sys::TRUE;
-        if let Some(render) =
-            faults::with(|f| f.after_wait(session.into_raw(), display, asked, Instant::now()))
-        {
+        if let Some((render, shown)) = faults::with(|f| {
+            let render = f.after_wait(session.into_raw(), display, asked, Instant::now());
+            (render, f.shown_display())
+        }) {
             frame.should_render = if render { sys::TRUE } else { sys::FALSE };
+            if let Some(shown) = shown {
+                frame.predicted_display_time = sys::Time::from_nanos(shown);
+            }
         }
         r
     })

@@ -9,6 +9,7 @@ use super::{SessionContext, chain};
 use crate::blend;
 use crate::config::Config;
 use crate::faults;
+use crate::faults::schedule::BadTime;
 use crate::guard::{guard, report};
 use crate::images::{AlphaLog, Reader, SessionImages, SharedImages, ViewImage, VulkanBinding};
 use crate::registry::{SessionState, registry};
@@ -311,8 +312,18 @@ pub unsafe extern "system" fn end_frame(
         let mut forwarded = *app;
         forwarded.environment_blend_mode = runtime_mode;
         forwarded.next = controls.rest;
+        // A frame shown a bad display time ends at its true one underneath; a negative one is
+        // refused as a runtime refuses it.
+        let bad = faults::with(|f| f.end_time(app.display_time.as_nanos())).flatten();
+        if let Some((truth, _)) = bad {
+            forwarded.display_time = sys::Time::from_nanos(truth);
+        }
         // SAFETY: a copy of the app's valid structure, pointing at the app's layers.
-        unsafe { (next.end_frame)(session, &forwarded) }
+        let r = unsafe { (next.end_frame)(session, &forwarded) };
+        match bad {
+            Some((_, BadTime::Negative)) if r.into_raw() >= 0 => sys::Result::ERROR_TIME_INVALID,
+            _ => r,
+        }
     })
 }
 

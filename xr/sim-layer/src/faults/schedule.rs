@@ -14,6 +14,7 @@
 //! frame 600 tracking-lost 20 10    # head position lost for 20 frames, then orientation for 10
 //! frame 650 unusable-pose 5        # 5 frames of head poses marked valid holding NaN and zeros
 //! frame 700 gaze-dropout 2 invalid # the eye tracker drops out for 2 s (none, invalid or low)
+//! frame 730 bad-time 3 negative    # 3 frames predicted at a negative display time (or repeat)
 //! frame 760 eyes 58 2              # the eyes from now on 58 mm apart, each turned 2 degrees out
 //! chaos 7 2000                     # a random schedule of every fault over 2000 frames (seed 7)
 //! ```
@@ -58,6 +59,26 @@ impl Dropout {
             Dropout::None => "none",
             Dropout::Invalid => "invalid",
             Dropout::Low => "low",
+        }
+    }
+}
+
+/// What a runtime's clock does wrong in a bad-time fault.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BadTime {
+    /// `xrWaitFrame` succeeds with a negative predicted display time, and `xrEndFrame` with it
+    /// fails with `XR_ERROR_TIME_INVALID` (as a SteamVR release did).
+    Negative,
+    /// `xrWaitFrame` predicts the same display time as the frame before.
+    Repeat,
+}
+
+impl BadTime {
+    /// The word the schedule uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            BadTime::Negative => "negative",
+            BadTime::Repeat => "repeat",
         }
     }
 }
@@ -111,6 +132,8 @@ pub enum Fault {
     UnusablePose(u64),
     /// The eye tracker drops out for this many seconds of display time.
     GazeDropout(f64, Dropout),
+    /// For this many frames `xrWaitFrame` predicts a display time no frame can have.
+    BadTime(u64, BadTime),
     /// From now on `xrLocateViews` answers eyes this many millimetres apart, each view turned
     /// this many degrees outwards (a wearer turning the headset's eye distance, or handing the
     /// headset to someone else): as `VITREOUS_SIM_VIEWS`, whose eyes it replaces.
@@ -133,6 +156,7 @@ impl Fault {
             Fault::TrackingLost(..) => "tracking-lost",
             Fault::UnusablePose(_) => "unusable-pose",
             Fault::GazeDropout(..) => "gaze-dropout",
+            Fault::BadTime(..) => "bad-time",
             Fault::Eyes(..) => "eyes",
         }
     }
@@ -162,6 +186,7 @@ impl fmt::Display for Fault {
             Fault::RuntimeFailure(call) => write!(f, " {call}"),
             Fault::TrackingLost(p, o) => write!(f, " {p} {o}"),
             Fault::GazeDropout(s, kind) => write!(f, " {s} {}", kind.name()),
+            Fault::BadTime(n, kind) => write!(f, " {n} {}", kind.name()),
             Fault::Eyes(ipd, toe) => write!(f, " {ipd} {toe}"),
             Fault::Recentre => Ok(()),
         }
@@ -324,6 +349,14 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
                 }
             },
         ),
+        ["bad-time", n, kind] => Fault::BadTime(
+            whole(n, "bad-time", 1, 1000)?,
+            match *kind {
+                "negative" => BadTime::Negative,
+                "repeat" => BadTime::Repeat,
+                other => return Err(format!("bad-time: `{other}` is not negative or repeat")),
+            },
+        ),
         ["eyes", ipd, toe @ ..] if toe.len() <= 1 => {
             let number = |w: &str| w.parse::<f32>().ok().filter(|v| v.is_finite());
             let (ipd_mm, toe_deg) = (number(ipd), toe.first().map_or(Some(0.0), |t| number(t)));
@@ -343,7 +376,7 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
                 "`{name}`: not a fault with those arguments (headset-off S, menu N, session-loss S, \
                  instance-loss S, recentre, no-render N, late N, image-timeout N, \
                  runtime-failure CALL, tracking-lost N N, unusable-pose N, \
-                 gaze-dropout S none|invalid|low, eyes MM [DEG])"
+                 gaze-dropout S none|invalid|low, bad-time N negative|repeat, eyes MM [DEG])"
             ));
         }
         [] => return Err("a trigger with no fault after it".into()),
@@ -354,10 +387,11 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
 /// least once, in a shuffled order, then more drawn at random, each starting 60 to 160 frames
 /// after the one before ended (the app has time to recover and show frames in between).
 /// Outages last 0.5 to 3 s, a menu 10 to 60 frames, a dropout 0.3 to 3 s, unusable poses 1 to
-/// 10 frames; new eyes are 54 to 72 mm apart and turned 0 to 3 degrees outwards.
+/// 10 frames, bad display times 1 to 5; new eyes are 54 to 72 mm apart and turned 0 to 3
+/// degrees outwards.
 pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
     let mut rng = SplitMix64(seed ^ 0x6368_616f_735f_7673);
-    let families = 13u64;
+    let families = 14u64;
     let mut order: Vec<u64> = (0..families).collect();
     rng.shuffle(&mut order);
     let mut out = Vec::new();
@@ -408,6 +442,11 @@ pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
                 let n = 1 + rng.below(10);
                 (Fault::UnusablePose(n), n)
             }
+            12 => {
+                let n = 1 + rng.below(5);
+                let kind = [BadTime::Negative, BadTime::Repeat][rng.below(2) as usize];
+                (Fault::BadTime(n, kind), n)
+            }
             _ => {
                 let ipd = 54.0 + 0.5 * rng.below(37) as f32;
                 let toe = 0.5 * rng.below(7) as f32;
@@ -442,18 +481,20 @@ mod tests {
             frame 600 tracking-lost 20 10
             frame 650 unusable-pose 5
             frame 700 gaze-dropout 2 invalid
+            frame 705 bad-time 3 negative
             frame 710 eyes 58.5 2
             frame 720 eyes 70
         ";
         let parsed = parse(text).unwrap();
-        assert_eq!(parsed.len(), 14);
+        assert_eq!(parsed.len(), 15);
         // Frame triggers first, in frame order; the time trigger after them.
         assert_eq!(parsed[0].to_string(), "frame 40 headset-off 3");
         assert_eq!(parsed[9].to_string(), "frame 650 unusable-pose 5");
         assert_eq!(parsed[10].to_string(), "frame 700 gaze-dropout 2 invalid");
-        assert_eq!(parsed[11].fault, Fault::Eyes(58.5, 2.0));
-        assert_eq!(parsed[12].to_string(), "frame 720 eyes 70 0");
-        assert_eq!(parsed[13].to_string(), "at 9.5 session-loss 2");
+        assert_eq!(parsed[11].to_string(), "frame 705 bad-time 3 negative");
+        assert_eq!(parsed[12].fault, Fault::Eyes(58.5, 2.0));
+        assert_eq!(parsed[13].to_string(), "frame 720 eyes 70 0");
+        assert_eq!(parsed[14].to_string(), "at 9.5 session-loss 2");
         for s in &parsed {
             assert_eq!(parse(&s.to_string()).unwrap(), vec![s.clone()]);
         }
@@ -484,6 +525,14 @@ mod tests {
             (
                 "frame 3 eyes 30",
                 "eyes: `30` is not a distance of 40 to 90",
+            ),
+            (
+                "frame 3 bad-time 2 late",
+                "`late` is not negative or repeat",
+            ),
+            (
+                "frame 3 bad-time 0 repeat",
+                "bad-time: `0` is not a whole number from 1",
             ),
             ("frame 3 eyes 60 12", "eyes: `60 12` is not"),
             ("frame 3 eyes 60 nan", "eyes: `60 nan` is not"),
@@ -518,6 +567,7 @@ mod tests {
             "tracking-lost",
             "unusable-pose",
             "gaze-dropout",
+            "bad-time",
             "eyes",
         ] {
             assert!(

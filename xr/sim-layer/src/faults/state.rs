@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 
 use openxr::sys;
 
-use super::schedule::{Dropout, Fault, Scheduled, Trigger};
+use super::schedule::{BadTime, Dropout, Fault, Scheduled, Trigger};
 use crate::config::SimViews;
 
 /// Something the layer hands the app through `xrPollEvent`.
@@ -171,6 +171,13 @@ pub struct Faults {
     tracking_left: (u64, u64),
     /// Frames still to hand out unusable head poses marked valid.
     unusable_left: u64,
+    /// Frames still to predict at a bad display time, and how.
+    bad_time_left: (u64, BadTime),
+    /// The display time the app was shown for its newest frame.
+    shown_ns: Option<i64>,
+    /// The newest frame's bad display time as shown, its true one and how it is bad, until the
+    /// app ends the frame.
+    falsified: Option<(i64, i64, BadTime)>,
     /// What this frame's head poses lack.
     tracking_now: Option<TrackingLoss>,
     /// Eye tracker dropouts: from, until (runtime time), how.
@@ -206,6 +213,9 @@ impl Faults {
             failing: Vec::new(),
             tracking_left: (0, 0),
             unusable_left: 0,
+            bad_time_left: (0, BadTime::Negative),
+            shown_ns: None,
+            falsified: None,
             tracking_now: None,
             dropouts: Vec::new(),
             eyes: None,
@@ -358,6 +368,7 @@ impl Faults {
         self.first_display_ns.get_or_insert(display_ns);
         self.latest_display_ns = Some(display_ns);
         self.start_due(session, frame, display_ns, now);
+        self.falsify_time(display_ns);
         self.tracking_now = match self.tracking_left {
             _ if self.unusable_left > 0 => {
                 self.unusable_left -= 1;
@@ -458,12 +469,52 @@ impl Faults {
             Fault::RuntimeFailure(call) => self.failing.push(call),
             Fault::TrackingLost(p, o) => self.tracking_left = (p, o),
             Fault::UnusablePose(n) => self.unusable_left = n,
+            Fault::BadTime(n, kind) => self.bad_time_left = (n, kind),
             Fault::GazeDropout(s, kind) => {
                 let end = display_ns + (s * 1e9) as i64;
                 self.dropouts.push((display_ns, end, kind));
                 self.log.push(("dropout", format!("{} {s}", kind.name())));
             }
             Fault::Eyes(ipd_mm, toe_out_deg) => self.eyes = SimViews::new(ipd_mm, toe_out_deg),
+        }
+    }
+
+    /// The display time the app is shown for the frame truly displayed at `display_ns`: a
+    /// bad one while a bad-time fault lasts (negative, or the frame before's again).
+    fn falsify_time(&mut self, display_ns: i64) {
+        let shown = match self.bad_time_left {
+            (n, kind) if n > 0 => {
+                self.bad_time_left.0 -= 1;
+                self.log.push(("bad-time", kind.name().to_owned()));
+                let shown = match kind {
+                    BadTime::Negative => -display_ns,
+                    BadTime::Repeat => self.shown_ns.unwrap_or(display_ns),
+                };
+                self.falsified = Some((shown, display_ns, kind));
+                shown
+            }
+            _ => {
+                self.falsified = None;
+                display_ns
+            }
+        };
+        self.shown_ns = Some(shown);
+    }
+
+    /// The bad display time the app is shown for its newest frame, if it is one.
+    pub fn shown_display(&self) -> Option<i64> {
+        self.falsified.map(|(shown, _, _)| shown)
+    }
+
+    /// For the app's `xrEndFrame` at `display_ns`: when that is the bad time it was shown, the
+    /// true one (which the runtime gets) and how it was bad.
+    pub fn end_time(&mut self, display_ns: i64) -> Option<(i64, BadTime)> {
+        match self.falsified {
+            Some((shown, truth, kind)) if shown == display_ns => {
+                self.falsified = None;
+                Some((truth, kind))
+            }
+            _ => None,
         }
     }
 

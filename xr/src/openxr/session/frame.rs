@@ -56,6 +56,13 @@ impl Session {
     fn begin_frame(&mut self) -> Result<Option<xr::FrameState>> {
         let frame = self.waiter.wait().xr("xrWaitFrame")?;
         self.report.interruptions.frames_waited += 1;
+        let display = frame.predicted_display_time.as_nanos();
+        if display <= 0 || self.last_display_ns.is_some_and(|last| display <= last) {
+            self.stream.begin().xr("xrBeginFrame")?;
+            self.leave_bad_time(&frame)?;
+            return Ok(None);
+        }
+        self.last_display_ns = Some(display);
         self.note_lateness(&frame);
         self.stream.begin().xr("xrBeginFrame")?;
         if !frame.should_render || self.exit_requested {
@@ -72,6 +79,56 @@ impl Session {
         }
         self.open = Some(OpenFrame::begun(frame.predicted_display_time));
         Ok(Some(frame))
+    }
+
+    /// A begun frame the runtime predicted at a display time no frame can have: not positive,
+    /// or not after the frame before's (runtimes have done both). Nothing of it is drawn,
+    /// recorded or timed by it (the clocks, the recording and the gaze filters need display
+    /// times that go forward): it is ended with no layers, where a runtime may refuse its own
+    /// time (`XR_ERROR_TIME_INVALID`, then no error of the session's), and counted as a failed
+    /// xrWaitFrame; more than [`MAX_FAILED_FRAMES_IN_A_ROW`] frames failing in a row end the run.
+    fn leave_bad_time(&mut self, frame: &xr::FrameState) -> Result<()> {
+        let time = frame.predicted_display_time;
+        match self.stream.end(time, self.blend, &[]) {
+            Ok(()) | Err(xr::sys::Result::ERROR_TIME_INVALID) => {}
+            Err(result) => return Err(result).xr("xrEndFrame"),
+        }
+        // The periods waited stay as they were: the next usable frame is not late for them.
+        let period = frame.predicted_display_period.as_nanos();
+        if period > 0 {
+            self.last_waited_ns = self.last_waited_ns.map(|last| last + period);
+        }
+        let failed = self
+            .report
+            .interruptions
+            .failed_calls
+            .entry("xrWaitFrame")
+            .or_default();
+        if *failed == 0 {
+            tracing::warn!(
+                "xrWaitFrame predicted display time {} ns, {}: the frame is left undrawn \
+                 (counted as a failed xrWaitFrame)",
+                time.as_nanos(),
+                match self.last_display_ns {
+                    Some(last) if time.as_nanos() > 0 => {
+                        format!("not after the frame before's {last} ns")
+                    }
+                    _ => "not a time a frame can have".to_owned(),
+                }
+            );
+        }
+        *failed += 1;
+        self.report.frames_abandoned += 1;
+        self.pending.not_rendered(NotRendered::Failed);
+        self.failed_in_a_row += 1;
+        if self.failed_in_a_row > MAX_FAILED_FRAMES_IN_A_ROW {
+            return Err(OpenXrError::Unsupported(format!(
+                "{MAX_FAILED_FRAMES_IN_A_ROW} frames in a row failed; the last: xrWaitFrame \
+                 predicted display time {} ns",
+                time.as_nanos()
+            )));
+        }
+        Ok(())
     }
 
     /// Counts the display periods the runtime moved past since the frame waited before (none

@@ -241,6 +241,9 @@ pub struct Session {
     pending: interruptions::Pending,
     /// The predicted display time of the frame waited for last (`None` after a stop).
     last_waited_ns: Option<i64>,
+    /// The newest display time a frame was predicted at that was usable (positive, after the
+    /// one before), in this session or the one it continues.
+    last_display_ns: Option<i64>,
     /// The last tracked head pose, and what tracking lacks now.
     tracking: tracking::HeadTracking,
     /// Since when the runtime has had the session stopped (the headset taken off), and when
@@ -351,6 +354,11 @@ impl Session {
     /// The predicted display time of the session's first frame, nanoseconds.
     pub fn first_display_ns(&self) -> Option<i64> {
         self.first_display.map(|t| t.as_nanos())
+    }
+
+    /// The newest usable display time a frame was predicted at, nanoseconds.
+    pub fn last_display_ns(&self) -> Option<i64> {
+        self.last_display_ns
     }
 
     /// The newest gaze sample a frame got.

@@ -283,6 +283,40 @@ fn new_eyes_hold_from_their_frame_and_the_newest_wins() {
 }
 
 #[test]
+fn a_bad_time_is_shown_to_the_app_and_the_true_one_ends_the_frame() {
+    let now = Instant::now();
+    let mut f = focused("frame 1 bad-time 2 negative\nframe 4 bad-time 1 repeat");
+    let mut shown = Vec::new();
+    for k in 0..6i64 {
+        frame(&mut f, now);
+        let truth = k * PERIOD_NS + 1;
+        let seen = f.shown_display();
+        if let Some(bad) = seen {
+            // The app ends the frame at the time it was shown: the runtime gets the true one.
+            assert_eq!(
+                f.end_time(bad),
+                Some((
+                    truth,
+                    if k < 4 {
+                        BadTime::Negative
+                    } else {
+                        BadTime::Repeat
+                    }
+                ))
+            );
+            assert_eq!(f.end_time(bad), None, "once");
+        }
+        shown.push(seen);
+    }
+    let t = |k: i64| k * PERIOD_NS + 1;
+    assert_eq!(
+        shown,
+        [None, Some(-t(1)), Some(-t(2)), None, Some(t(3)), None],
+        "negative twice from frame 1, then frame 3's time again at frame 4"
+    );
+}
+
+#[test]
 fn a_fault_that_walks_the_session_waits_for_the_one_before() {
     let now = Instant::now();
     let mut f = focused("frame 0 menu 5\nframe 1 headset-off 1");

@@ -401,14 +401,14 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             .map_or(scene.placement_at(0.0).light_position_m, |p| {
                 glam::Vec3::from_array(p.light_position_m)
             });
-        let (continued_from, next_index, first_display_ns, newest_gaze, last_display_ns) = {
+        let (continued_from, next_index, first_display_ns, newest_gaze, last_display) = {
             let s = xr.session();
             (
                 s.world_from_space(),
                 s.next_index(),
                 s.first_display_ns(),
                 s.newest_gaze(),
-                s.last_display_ns(),
+                s.last_display(),
             )
         };
         let closed = xr.close(|renderer| {
@@ -492,7 +492,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
                     world_from_space: continued_from,
                     waited_ms: waited.as_millis() as u64,
                     newest_gaze,
-                    last_display_ns,
+                    last_display,
                 }),
                 submitted,
             ),

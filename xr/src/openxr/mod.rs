@@ -412,9 +412,9 @@ pub struct Continued {
     /// The newest gaze sample a frame got: the new session's samples are held against it
     /// ([`GazeOrder`]).
     pub newest_gaze: Option<vitreous_trace::GazeSample>,
-    /// The newest usable display time a frame was predicted at: the new session's frames
-    /// must come after it.
-    pub last_display_ns: Option<i64>,
+    /// The newest usable display time a frame was predicted at, and when: the new session's
+    /// frames must come after it, and not further ahead than the world's time moved.
+    pub last_display: Option<(i64, std::time::Instant)>,
 }
 
 /// How depth is submitted (XR_KHR_composition_layer_depth).

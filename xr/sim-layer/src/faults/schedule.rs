@@ -14,7 +14,7 @@
 //! frame 600 tracking-lost 20 10    # head position lost for 20 frames, then orientation for 10
 //! frame 650 unusable-pose 5        # 5 frames of head poses marked valid holding NaN and zeros
 //! frame 700 gaze-dropout 2 invalid # the eye tracker drops out for 2 s (none, invalid or low)
-//! frame 730 bad-time 3 negative    # 3 frames predicted at a negative display time (or repeat)
+//! frame 730 bad-time 3 negative    # 3 frames at a negative display time (or repeat, or ahead)
 //! frame 760 eyes 58 2              # the eyes from now on 58 mm apart, each turned 2 degrees out
 //! chaos 7 2000                     # a random schedule of every fault over 2000 frames (seed 7)
 //! ```
@@ -71,6 +71,14 @@ pub enum BadTime {
     Negative,
     /// `xrWaitFrame` predicts the same display time as the frame before.
     Repeat,
+    /// `xrWaitFrame` predicts a display time 27.6 days ahead of the true one (as a streaming
+    /// runtime's pacer did after a refocus); `xrEndFrame` at it succeeds.
+    Ahead,
+}
+
+impl BadTime {
+    /// How far ahead an `Ahead` time is, nanoseconds: 27.6 days.
+    pub const AHEAD_NS: i64 = 2_384_640_000_000_000;
 }
 
 impl BadTime {
@@ -79,6 +87,7 @@ impl BadTime {
         match self {
             BadTime::Negative => "negative",
             BadTime::Repeat => "repeat",
+            BadTime::Ahead => "ahead",
         }
     }
 }
@@ -354,7 +363,12 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
             match *kind {
                 "negative" => BadTime::Negative,
                 "repeat" => BadTime::Repeat,
-                other => return Err(format!("bad-time: `{other}` is not negative or repeat")),
+                "ahead" => BadTime::Ahead,
+                other => {
+                    return Err(format!(
+                        "bad-time: `{other}` is not negative, repeat or ahead"
+                    ));
+                }
             },
         ),
         ["eyes", ipd, toe @ ..] if toe.len() <= 1 => {
@@ -376,7 +390,7 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
                 "`{name}`: not a fault with those arguments (headset-off S, menu N, session-loss S, \
                  instance-loss S, recentre, no-render N, late N, image-timeout N, \
                  runtime-failure CALL, tracking-lost N N, unusable-pose N, \
-                 gaze-dropout S none|invalid|low, bad-time N negative|repeat, eyes MM [DEG])"
+                 gaze-dropout S none|invalid|low, bad-time N negative|repeat|ahead, eyes MM [DEG])"
             ));
         }
         [] => return Err("a trigger with no fault after it".into()),
@@ -444,7 +458,8 @@ pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
             }
             12 => {
                 let n = 1 + rng.below(5);
-                let kind = [BadTime::Negative, BadTime::Repeat][rng.below(2) as usize];
+                let kind =
+                    [BadTime::Negative, BadTime::Repeat, BadTime::Ahead][rng.below(3) as usize];
                 (Fault::BadTime(n, kind), n)
             }
             _ => {
@@ -528,7 +543,7 @@ mod tests {
             ),
             (
                 "frame 3 bad-time 2 late",
-                "`late` is not negative or repeat",
+                "`late` is not negative, repeat or ahead",
             ),
             (
                 "frame 3 bad-time 0 repeat",

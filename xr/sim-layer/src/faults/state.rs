@@ -489,6 +489,7 @@ impl Faults {
                 let shown = match kind {
                     BadTime::Negative => -display_ns,
                     BadTime::Repeat => self.shown_ns.unwrap_or(display_ns),
+                    BadTime::Ahead => display_ns + BadTime::AHEAD_NS,
                 };
                 self.falsified = Some((shown, display_ns, kind));
                 shown

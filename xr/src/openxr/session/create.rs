@@ -296,7 +296,7 @@ pub(in crate::openxr) unsafe fn start(
                 pending
             },
             last_waited_ns: None,
-            last_display_ns: options.continued.and_then(|c| c.last_display_ns),
+            last_display: options.continued.and_then(|c| c.last_display),
             tracking: Default::default(),
             paused: None,
             failed_in_a_row: 0,

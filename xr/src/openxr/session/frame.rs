@@ -30,6 +30,7 @@ use super::super::convert::{pose_of, usable_orientation, usable_position};
 use super::super::state::{self, EndReason};
 use super::super::{OpenXrError, Result, XrContext};
 use super::depth::{chain_depth, depth_info};
+use super::display_time::{BadTime, bad_display_time};
 use super::frame_end::FrameEndChain;
 use super::images;
 use super::interruptions::{MAX_FAILED_FRAMES_IN_A_ROW, Pending, Severity, severity};
@@ -57,12 +58,13 @@ impl Session {
         let frame = self.waiter.wait().xr("xrWaitFrame")?;
         self.report.interruptions.frames_waited += 1;
         let display = frame.predicted_display_time.as_nanos();
-        if display <= 0 || self.last_display_ns.is_some_and(|last| display <= last) {
+        let now = Instant::now();
+        if let Some(bad) = bad_display_time(display, self.last_display, now) {
             self.stream.begin().xr("xrBeginFrame")?;
-            self.leave_bad_time(&frame)?;
+            self.leave_bad_time(&frame, bad)?;
             return Ok(None);
         }
-        self.last_display_ns = Some(display);
+        self.last_display = Some((display, now));
         self.note_lateness(&frame);
         self.stream.begin().xr("xrBeginFrame")?;
         if !frame.should_render || self.exit_requested {
@@ -81,13 +83,12 @@ impl Session {
         Ok(Some(frame))
     }
 
-    /// A begun frame the runtime predicted at a display time no frame can have: not positive,
-    /// or not after the frame before's (runtimes have done both). Nothing of it is drawn,
-    /// recorded or timed by it (the clocks, the recording and the gaze filters need display
-    /// times that go forward): it is ended with no layers, where a runtime may refuse its own
-    /// time (`XR_ERROR_TIME_INVALID`, then no error of the session's), and counted as a failed
-    /// xrWaitFrame; more than [`MAX_FAILED_FRAMES_IN_A_ROW`] frames failing in a row end the run.
-    fn leave_bad_time(&mut self, frame: &xr::FrameState) -> Result<()> {
+    /// A begun frame the runtime predicted at a display time no frame can have
+    /// ([`bad_display_time`]). Nothing of it is drawn, recorded or timed by it: it is ended
+    /// with no layers, where a runtime may refuse its own time (`XR_ERROR_TIME_INVALID`, then
+    /// no error of the session's), and counted as a failed xrWaitFrame; more than
+    /// [`MAX_FAILED_FRAMES_IN_A_ROW`] frames failing in a row end the run.
+    fn leave_bad_time(&mut self, frame: &xr::FrameState, bad: BadTime) -> Result<()> {
         let time = frame.predicted_display_time;
         match self.stream.end(time, self.blend, &[]) {
             Ok(()) | Err(xr::sys::Result::ERROR_TIME_INVALID) => {}
@@ -106,15 +107,9 @@ impl Session {
             .or_default();
         if *failed == 0 {
             tracing::warn!(
-                "xrWaitFrame predicted display time {} ns, {}: the frame is left undrawn \
+                "xrWaitFrame predicted display time {} ns, {bad}: the frame is left undrawn \
                  (counted as a failed xrWaitFrame)",
-                time.as_nanos(),
-                match self.last_display_ns {
-                    Some(last) if time.as_nanos() > 0 => {
-                        format!("not after the frame before's {last} ns")
-                    }
-                    _ => "not a time a frame can have".to_owned(),
-                }
+                time.as_nanos()
             );
         }
         *failed += 1;
@@ -124,7 +119,7 @@ impl Session {
         if self.failed_in_a_row > MAX_FAILED_FRAMES_IN_A_ROW {
             return Err(OpenXrError::Unsupported(format!(
                 "{MAX_FAILED_FRAMES_IN_A_ROW} frames in a row failed; the last: xrWaitFrame \
-                 predicted display time {} ns",
+                 predicted display time {} ns, {bad}",
                 time.as_nanos()
             )));
         }

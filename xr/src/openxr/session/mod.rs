@@ -8,6 +8,7 @@
 
 mod create;
 mod depth;
+mod display_time;
 mod frame;
 mod frame_end;
 mod images;
@@ -241,9 +242,10 @@ pub struct Session {
     pending: interruptions::Pending,
     /// The predicted display time of the frame waited for last (`None` after a stop).
     last_waited_ns: Option<i64>,
-    /// The newest display time a frame was predicted at that was usable (positive, after the
-    /// one before), in this session or the one it continues.
-    last_display_ns: Option<i64>,
+    /// The newest display time a frame was predicted at that was usable
+    /// ([`display_time::bad_display_time`]), in this session or the one it continues, and when
+    /// it was predicted.
+    last_display: Option<(i64, std::time::Instant)>,
     /// The last tracked head pose, and what tracking lacks now.
     tracking: tracking::HeadTracking,
     /// Since when the runtime has had the session stopped (the headset taken off), and when
@@ -356,9 +358,9 @@ impl Session {
         self.first_display.map(|t| t.as_nanos())
     }
 
-    /// The newest usable display time a frame was predicted at, nanoseconds.
-    pub fn last_display_ns(&self) -> Option<i64> {
-        self.last_display_ns
+    /// The newest usable display time a frame was predicted at (nanoseconds), and when.
+    pub fn last_display(&self) -> Option<(i64, std::time::Instant)> {
+        self.last_display
     }
 
     /// The newest gaze sample a frame got.

@@ -285,9 +285,10 @@ fn new_eyes_hold_from_their_frame_and_the_newest_wins() {
 #[test]
 fn a_bad_time_is_shown_to_the_app_and_the_true_one_ends_the_frame() {
     let now = Instant::now();
-    let mut f = focused("frame 1 bad-time 2 negative\nframe 4 bad-time 1 repeat");
+    let mut f =
+        focused("frame 1 bad-time 2 negative\nframe 4 bad-time 1 repeat\nframe 6 bad-time 1 ahead");
     let mut shown = Vec::new();
-    for k in 0..6i64 {
+    for k in 0..7i64 {
         frame(&mut f, now);
         let truth = k * PERIOD_NS + 1;
         let seen = f.shown_display();
@@ -297,10 +298,10 @@ fn a_bad_time_is_shown_to_the_app_and_the_true_one_ends_the_frame() {
                 f.end_time(bad),
                 Some((
                     truth,
-                    if k < 4 {
-                        BadTime::Negative
-                    } else {
-                        BadTime::Repeat
+                    match k {
+                        ..4 => BadTime::Negative,
+                        4 => BadTime::Repeat,
+                        _ => BadTime::Ahead,
                     }
                 ))
             );
@@ -311,8 +312,16 @@ fn a_bad_time_is_shown_to_the_app_and_the_true_one_ends_the_frame() {
     let t = |k: i64| k * PERIOD_NS + 1;
     assert_eq!(
         shown,
-        [None, Some(-t(1)), Some(-t(2)), None, Some(t(3)), None],
-        "negative twice from frame 1, then frame 3's time again at frame 4"
+        [
+            None,
+            Some(-t(1)),
+            Some(-t(2)),
+            None,
+            Some(t(3)),
+            None,
+            Some(t(6) + BadTime::AHEAD_NS)
+        ],
+        "negative twice from frame 1, frame 3's time again at frame 4, weeks ahead at frame 6"
     );
 }
 

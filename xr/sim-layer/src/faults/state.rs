@@ -10,6 +10,10 @@
 //! and FOCUSED on the next frames. Calls out of order for the state the app was shown get the
 //! result the specification gives (`XR_ERROR_SESSION_NOT_RUNNING`, `_NOT_READY`,
 //! `_NOT_STOPPING`), so an app that mishandles the walk fails the way it would on a headset.
+//!
+//! Just over 600 lines, one idea: the state every fault keeps and when each starts; the
+//! session's walk (`walk.rs`), the bad display times (`display_time.rs`) and the tests are
+//! apart.
 
 use std::collections::{HashMap, HashSet, VecDeque};
 use std::time::{Duration, Instant};
@@ -479,46 +483,6 @@ impl Faults {
         }
     }
 
-    /// The display time the app is shown for the frame truly displayed at `display_ns`: a
-    /// bad one while a bad-time fault lasts (negative, or the frame before's again).
-    fn falsify_time(&mut self, display_ns: i64) {
-        let shown = match self.bad_time_left {
-            (n, kind) if n > 0 => {
-                self.bad_time_left.0 -= 1;
-                self.log.push(("bad-time", kind.name().to_owned()));
-                let shown = match kind {
-                    BadTime::Negative => -display_ns,
-                    BadTime::Repeat => self.shown_ns.unwrap_or(display_ns),
-                    BadTime::Ahead => display_ns + BadTime::AHEAD_NS,
-                };
-                self.falsified = Some((shown, display_ns, kind));
-                shown
-            }
-            _ => {
-                self.falsified = None;
-                display_ns
-            }
-        };
-        self.shown_ns = Some(shown);
-    }
-
-    /// The bad display time the app is shown for its newest frame, if it is one.
-    pub fn shown_display(&self) -> Option<i64> {
-        self.falsified.map(|(shown, _, _)| shown)
-    }
-
-    /// For the app's `xrEndFrame` at `display_ns`: when that is the bad time it was shown, the
-    /// true one (which the runtime gets) and how it was bad.
-    pub fn end_time(&mut self, display_ns: i64) -> Option<(i64, BadTime)> {
-        match self.falsified {
-            Some((shown, truth, kind)) if shown == display_ns => {
-                self.falsified = None;
-                Some((truth, kind))
-            }
-            _ => None,
-        }
-    }
-
     /// The result `xrGetSystem` gets while the headset is gone, if it is.
     pub fn get_system(&mut self, now: Instant) -> Option<sys::Result> {
         self.refused_during(Outage::Headset, now, "xrGetSystem")
@@ -648,6 +612,7 @@ pub fn state_name(state: sys::SessionState) -> &'static str {
     }
 }
 
+mod display_time;
 #[cfg(test)]
 mod tests;
 mod walk;

@@ -3,10 +3,18 @@
 //! must go forward with the world's time; runtimes have answered times that do not: negative
 //! ones (a SteamVR release), the frame before's again, and a jump of weeks ahead after a
 //! refocus (a streaming runtime's pacer). A frame at such a time is left undrawn
-//! (`Session::leave_bad_time`).
+//! ([`Session::leave_bad_time`]); the periods between usable frames the app was late for are
+//! counted ([`Session::note_lateness`]).
 
 use std::fmt;
 use std::time::{Duration, Instant};
+
+use openxr as xr;
+use vitreous_trace::session_event::{NotRendered, SessionEvent};
+
+use super::Session;
+use super::interruptions::MAX_FAILED_FRAMES_IN_A_ROW;
+use crate::openxr::{OpenXrError, Result, XrContext};
 
 /// How far a display time may run ahead of the world's time since the newest usable frame:
 /// more is a clock that jumped (a frame is predicted a few periods ahead; a session resumed after
@@ -51,6 +59,68 @@ pub(super) fn bad_display_time(
     let moved = now.saturating_duration_since(at);
     let ahead_ns = display_ns - last_ns - moved.as_nanos().min(i64::MAX as u128) as i64;
     (ahead_ns > MAX_AHEAD.as_nanos() as i64).then_some(BadTime::Ahead(ahead_ns as f64 * 1e-9))
+}
+
+impl Session {
+    /// A begun frame the runtime predicted at a display time no frame can have
+    /// ([`bad_display_time`]). Nothing of it is drawn, recorded or timed by it: it is ended
+    /// with no layers, where a runtime may refuse its own time (`XR_ERROR_TIME_INVALID`, then
+    /// no error of the session's), and counted as a failed xrWaitFrame; more than
+    /// [`MAX_FAILED_FRAMES_IN_A_ROW`] frames failing in a row end the run.
+    pub(super) fn leave_bad_time(&mut self, frame: &xr::FrameState, bad: BadTime) -> Result<()> {
+        let time = frame.predicted_display_time;
+        match self.stream.end(time, self.blend, &[]) {
+            Ok(()) | Err(xr::sys::Result::ERROR_TIME_INVALID) => {}
+            Err(result) => return Err(result).xr("xrEndFrame"),
+        }
+        // The periods waited stay as they were: the next usable frame is not late for them.
+        let period = frame.predicted_display_period.as_nanos();
+        if period > 0 {
+            self.last_waited_ns = self.last_waited_ns.map(|last| last + period);
+        }
+        let failed = self
+            .report
+            .interruptions
+            .failed_calls
+            .entry("xrWaitFrame")
+            .or_default();
+        if *failed == 0 {
+            tracing::warn!(
+                "xrWaitFrame predicted display time {} ns, {bad}: the frame is left undrawn \
+                 (counted as a failed xrWaitFrame)",
+                time.as_nanos()
+            );
+        }
+        *failed += 1;
+        self.report.frames_abandoned += 1;
+        self.pending.not_rendered(NotRendered::Failed);
+        self.failed_in_a_row += 1;
+        if self.failed_in_a_row > MAX_FAILED_FRAMES_IN_A_ROW {
+            return Err(OpenXrError::Unsupported(format!(
+                "{MAX_FAILED_FRAMES_IN_A_ROW} frames in a row failed; the last: xrWaitFrame \
+                 predicted display time {} ns, {bad}",
+                time.as_nanos()
+            )));
+        }
+        Ok(())
+    }
+
+    /// Counts the display periods the runtime moved past since the frame waited before (none
+    /// across a stop of the session).
+    pub(super) fn note_lateness(&mut self, frame: &xr::FrameState) {
+        let display = frame.predicted_display_time.as_nanos();
+        let period = frame.predicted_display_period.as_nanos();
+        if let (Some(before), true) = (self.last_waited_ns, period > 0) {
+            let periods = ((display - before) as f64 / period as f64).round() as i64 - 1;
+            if periods > 0 {
+                self.report.interruptions.late_periods += periods as u64;
+                self.pending.push(SessionEvent::Late {
+                    periods: periods as u64,
+                });
+            }
+        }
+        self.last_waited_ns = Some(display);
+    }
 }
 
 #[cfg(test)]

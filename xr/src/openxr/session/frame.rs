@@ -30,7 +30,7 @@ use super::super::convert::{pose_of, usable_orientation, usable_position};
 use super::super::state::{self, EndReason};
 use super::super::{OpenXrError, Result, XrContext};
 use super::depth::{chain_depth, depth_info};
-use super::display_time::{BadTime, bad_display_time};
+use super::display_time::bad_display_time;
 use super::frame_end::FrameEndChain;
 use super::images;
 use super::interruptions::{MAX_FAILED_FRAMES_IN_A_ROW, Pending, Severity, severity};
@@ -81,66 +81,6 @@ impl Session {
         }
         self.open = Some(OpenFrame::begun(frame.predicted_display_time));
         Ok(Some(frame))
-    }
-
-    /// A begun frame the runtime predicted at a display time no frame can have
-    /// ([`bad_display_time`]). Nothing of it is drawn, recorded or timed by it: it is ended
-    /// with no layers, where a runtime may refuse its own time (`XR_ERROR_TIME_INVALID`, then
-    /// no error of the session's), and counted as a failed xrWaitFrame; more than
-    /// [`MAX_FAILED_FRAMES_IN_A_ROW`] frames failing in a row end the run.
-    fn leave_bad_time(&mut self, frame: &xr::FrameState, bad: BadTime) -> Result<()> {
-        let time = frame.predicted_display_time;
-        match self.stream.end(time, self.blend, &[]) {
-            Ok(()) | Err(xr::sys::Result::ERROR_TIME_INVALID) => {}
-            Err(result) => return Err(result).xr("xrEndFrame"),
-        }
-        // The periods waited stay as they were: the next usable frame is not late for them.
-        let period = frame.predicted_display_period.as_nanos();
-        if period > 0 {
-            self.last_waited_ns = self.last_waited_ns.map(|last| last + period);
-        }
-        let failed = self
-            .report
-            .interruptions
-            .failed_calls
-            .entry("xrWaitFrame")
-            .or_default();
-        if *failed == 0 {
-            tracing::warn!(
-                "xrWaitFrame predicted display time {} ns, {bad}: the frame is left undrawn \
-                 (counted as a failed xrWaitFrame)",
-                time.as_nanos()
-            );
-        }
-        *failed += 1;
-        self.report.frames_abandoned += 1;
-        self.pending.not_rendered(NotRendered::Failed);
-        self.failed_in_a_row += 1;
-        if self.failed_in_a_row > MAX_FAILED_FRAMES_IN_A_ROW {
-            return Err(OpenXrError::Unsupported(format!(
-                "{MAX_FAILED_FRAMES_IN_A_ROW} frames in a row failed; the last: xrWaitFrame \
-                 predicted display time {} ns, {bad}",
-                time.as_nanos()
-            )));
-        }
-        Ok(())
-    }
-
-    /// Counts the display periods the runtime moved past since the frame waited before (none
-    /// across a stop of the session).
-    fn note_lateness(&mut self, frame: &xr::FrameState) {
-        let display = frame.predicted_display_time.as_nanos();
-        let period = frame.predicted_display_period.as_nanos();
-        if let (Some(before), true) = (self.last_waited_ns, period > 0) {
-            let periods = ((display - before) as f64 / period as f64).round() as i64 - 1;
-            if periods > 0 {
-                self.report.interruptions.late_periods += periods as u64;
-                self.pending.push(SessionEvent::Late {
-                    periods: periods as u64,
-                });
-            }
-        }
-        self.last_waited_ns = Some(display);
     }
 
     /// The open frame, which every step after xrBeginFrame needs.

@@ -401,13 +401,13 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             .map_or(scene.placement_at(0.0).light_position_m, |p| {
                 glam::Vec3::from_array(p.light_position_m)
             });
-        let (continued_from, next_index, first_display_ns, newest_gaze, last_display) = {
+        let (continued_from, next_index, first_display_ns, gaze_order, last_display) = {
             let s = xr.session();
             (
                 s.world_from_space(),
                 s.next_index(),
                 s.first_display_ns(),
-                s.newest_gaze(),
+                s.gaze_order(),
                 s.last_display(),
             )
         };
@@ -491,7 +491,7 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
                     first_display_ns,
                     world_from_space: continued_from,
                     waited_ms: waited.as_millis() as u64,
-                    newest_gaze,
+                    gaze_order,
                     last_display,
                 }),
                 submitted,
@@ -572,6 +572,8 @@ fn run_with(options: &RunOptions, director: Option<&mut dyn Director>) -> Result
             received: report.gaze_samples.received,
             fresh_frames: report.gaze_samples.fresh,
             out_of_order: report.gaze_samples.out_of_order,
+            after_display: report.gaze_samples.after_display,
+            max_ahead_ms: report.gaze_samples.max_ahead_ns as f64 / 1e6,
         },
         space_changes: report.space_changes,
         frames_abandoned: report.frames_abandoned,

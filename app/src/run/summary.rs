@@ -288,4 +288,9 @@ pub struct GazeSamples {
     /// Frames whose sample was stamped before one already used: they got the newest one
     /// again (the recording's gaze times never go back).
     pub out_of_order: u64,
+    /// Frames whose new sample was stamped after the frame's display time (an eye tracker's
+    /// clock ahead of the runtime's): the frame used it, stamped at its display time.
+    pub after_display: u64,
+    /// The most a sample was stamped after its frame's display time, milliseconds.
+    pub max_ahead_ms: f64,
 }

@@ -51,6 +51,9 @@ use openxr::sys;
 
 /// Environment variable naming the trace file.
 pub const TRACE_VAR: &str = "VITREOUS_SIM_TRACE";
+/// Environment variable: `1` plays the trace's eye data over and over, `0` (the default) holds
+/// its last sample after its end.
+pub const TRACE_LOOP_VAR: &str = "VITREOUS_SIM_TRACE_LOOP";
 /// Environment variable choosing the eye-tracking extensions.
 pub const GAZE_VAR: &str = "VITREOUS_SIM_GAZE";
 /// Environment variable choosing the added blend modes.
@@ -184,6 +187,8 @@ pub struct Config {
     pub blend: Vec<sys::EnvironmentBlendMode>,
     /// The trace file.
     pub trace: Option<PathBuf>,
+    /// Whether the trace's eye data plays over and over.
+    pub trace_loop: bool,
     /// The submitted-frames CSV.
     pub submitted: Option<PathBuf>,
     /// The controller button script.
@@ -438,6 +443,11 @@ impl Config {
             gaze: parse_gaze(get(GAZE_VAR).as_deref())?,
             blend: parse_blend(get(BLEND_VAR).as_deref())?,
             trace: get(TRACE_VAR).map(PathBuf::from),
+            trace_loop: flag(
+                TRACE_LOOP_VAR,
+                get(TRACE_LOOP_VAR),
+                "1 (play the trace's eye data over and over) or 0",
+            )?,
             submitted: get(SUBMITTED_VAR).map(PathBuf::from),
             buttons: get(BUTTONS_VAR).map(PathBuf::from),
             eye_max: get(EYE_MAX_VAR).map(|v| parse_eye_max(&v)).transpose()?,
@@ -460,17 +470,11 @@ impl Config {
             views: get(VIEWS_VAR).map(|v| parse_views(&v)).transpose()?,
             faults: get(FAULTS_VAR).map(PathBuf::from),
             fault_log: get(FAULT_LOG_VAR).map(PathBuf::from),
-            ml_frame: match get(ML_FRAME_VAR).as_deref().map(str::trim) {
-                None | Some("0") => false,
-                Some("1") => true,
-                Some(other) => {
-                    return Err(ConfigError {
-                        var: ML_FRAME_VAR,
-                        value: other.to_owned(),
-                        expected: "1 (offer XR_ML_frame_end_info and XR_ML_global_dimmer) or 0",
-                    });
-                }
-            },
+            ml_frame: flag(
+                ML_FRAME_VAR,
+                get(ML_FRAME_VAR),
+                "1 (offer XR_ML_frame_end_info and XR_ML_global_dimmer) or 0",
+            )?,
         })
     }
 
@@ -588,6 +592,23 @@ pub fn parse_formats(value: &str) -> Result<Vec<i64>, ConfigError> {
     Ok(out)
 }
 
+/// A variable that is `1` or `0` (unset: `0`).
+fn flag(
+    var: &'static str,
+    value: Option<String>,
+    expected: &'static str,
+) -> Result<bool, ConfigError> {
+    match value.as_deref().map(str::trim) {
+        None | Some("0") => Ok(false),
+        Some("1") => Ok(true),
+        Some(other) => Err(ConfigError {
+            var,
+            value: other.to_owned(),
+            expected,
+        }),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -608,6 +629,18 @@ mod tests {
         assert_eq!(c.gaze, GazeExtension::ALL.to_vec());
         assert_eq!(c.blend, vec![M::ADDITIVE, M::ALPHA_BLEND]);
         assert_eq!((c.trace, c.submitted), (None, None));
+        assert!(!c.trace_loop && !c.ml_frame);
+    }
+
+    #[test]
+    fn flags_are_one_or_zero_and_a_bad_one_names_the_variable() {
+        assert!(config(&[(TRACE_LOOP_VAR, "1")]).unwrap().trace_loop);
+        assert!(!config(&[(TRACE_LOOP_VAR, " 0 ")]).unwrap().trace_loop);
+        assert!(config(&[(ML_FRAME_VAR, "1")]).unwrap().ml_frame);
+        for var in [TRACE_LOOP_VAR, ML_FRAME_VAR] {
+            let e = config(&[(var, "yes")]).unwrap_err();
+            assert_eq!((e.var, e.value.as_str()), (var, "yes"));
+        }
     }
 
     #[test]

@@ -102,10 +102,13 @@ fn prepare() -> Result<Prepared, String> {
         };
         let samples =
             vitreous_trace::read_trace(path).map_err(|e| format!("reading {TRACE_VAR}: {e}"))?;
-        Some(
-            GazeTimeline::new(&samples)
-                .ok_or_else(|| format!("{TRACE_VAR}: {} has no samples", path.display()))?,
-        )
+        let timeline = GazeTimeline::new(&samples)
+            .ok_or_else(|| format!("{TRACE_VAR}: {} has no samples", path.display()))?;
+        Some(if config.trace_loop {
+            timeline.looped()
+        } else {
+            timeline
+        })
     };
     let submitted = match &config.submitted {
         None => None,

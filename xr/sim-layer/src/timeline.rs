@@ -6,8 +6,12 @@
 //! pupil diameters linearly, ray directions by normalised linear interpolation; whether a ray
 //! is valid, and anything only one of the two samples has (the tracker's report too), comes
 //! from the nearer sample. Before the first sample the first is used, after the last the last,
-//! each with its own time. The gaze behaviour at a time is that of the nearer sample's episode
-//! ([`crate::behaviour`]), so a blink is answered exactly while the eye rays are invalid.
+//! each with its own time; or, looped (`VITREOUS_SIM_TRACE_LOOP=1`), the trace plays again from
+//! its first sample one sample interval after its last (the mean interval between samples),
+//! every time and stamp of a later pass a whole number of passes later, so a tracker replaying
+//! it never stalls and its stamps keep going forward. The gaze behaviour at a time is that of
+//! the nearer sample's episode ([`crate::behaviour`]), so a blink is answered exactly while the
+//! eye rays are invalid.
 
 use glam::Vec3;
 use vitreous_trace::format::TraceSample;
@@ -48,6 +52,9 @@ pub struct GazeTimeline {
     episodes: Vec<Episode>,
     /// The first trace line's `time_ns`: trace time zero of the time base.
     start_ns: i64,
+    /// One pass of a looped trace, nanoseconds (its samples' span and one mean interval);
+    /// `None` when the last sample holds after the end.
+    pass_ns: Option<i64>,
 }
 
 impl GazeTimeline {
@@ -67,7 +74,28 @@ impl GazeTimeline {
             samples,
             episodes,
             start_ns,
+            pass_ns: None,
         })
+    }
+
+    /// The timeline played over and over (a single sample simply holds).
+    pub fn looped(mut self) -> GazeTimeline {
+        let n = self.samples.len() as i64;
+        let span =
+            self.samples[self.samples.len() - 1].sample_time_ns - self.samples[0].sample_time_ns;
+        self.pass_ns = (n >= 2 && span > 0).then(|| span + span / (n - 1));
+        self
+    }
+
+    /// Trace time `t_ns` within the first pass, and how far later the pass it falls in is.
+    fn in_pass(&self, t_ns: i64) -> (i64, i64) {
+        match self.pass_ns {
+            Some(pass) if t_ns > self.samples[0].sample_time_ns => {
+                let shift = (t_ns - self.samples[0].sample_time_ns) / pass * pass;
+                (t_ns - shift, shift)
+            }
+            _ => (t_ns, 0),
+        }
     }
 
     /// The first trace line's `time_ns`.
@@ -88,6 +116,14 @@ impl GazeTimeline {
     /// The eye data at trace time `t_ns` (see the module doc); its `sample_time_ns` is `t_ns`
     /// between samples, else the time of the sample used.
     pub fn at(&self, t_ns: i64) -> GazeSample {
+        let (t_ns, shift) = self.in_pass(t_ns);
+        let mut s = self.at_once(t_ns);
+        s.sample_time_ns += shift;
+        s
+    }
+
+    /// [`GazeTimeline::at`] of one pass: the first sample before it, the last after it.
+    fn at_once(&self, t_ns: i64) -> GazeSample {
         let first = &self.samples[0];
         let last = &self.samples[self.samples.len() - 1];
         if t_ns <= first.sample_time_ns {
@@ -106,6 +142,14 @@ impl GazeTimeline {
     /// The gaze behaviour at trace time `t_ns`: the nearer sample's (the first before the
     /// trace, the last after it), its onset on the trace clock.
     pub fn behaviour_at(&self, t_ns: i64) -> Behaviour {
+        let (t_ns, shift) = self.in_pass(t_ns);
+        let mut b = self.behaviour_once(t_ns);
+        b.onset_ns += shift;
+        b
+    }
+
+    /// [`GazeTimeline::behaviour_at`] of one pass.
+    fn behaviour_once(&self, t_ns: i64) -> Behaviour {
         // The first sample later than t, 0..=len.
         let i = self.samples.partition_point(|s| s.sample_time_ns <= t_ns);
         let nearer = match i {
@@ -209,6 +253,40 @@ mod tests {
 
     fn close(a: Vec3, b: Vec3) -> bool {
         (a - b).length() < 1e-6
+    }
+
+    #[test]
+    fn a_looped_trace_plays_again_one_interval_after_its_end() {
+        // Samples at 0, 10, 20 ns: one pass is 20 + 10 ns.
+        let lines = [
+            line(0, 0, ray(0.0, Vec3::NEG_Z), None),
+            line(10, 10, ray(1.0, Vec3::NEG_Z), None),
+            line(20, 20, ray(2.0, Vec3::NEG_Z), None),
+        ];
+        let held = GazeTimeline::new(&lines).unwrap();
+        let looped = GazeTimeline::new(&lines).unwrap().looped();
+        // The first pass as without the loop; held after the end without it.
+        for t in [-5, 0, 5, 15, 20] {
+            assert_eq!(looped.at(t), held.at(t), "{t}");
+        }
+        assert_eq!(held.at(65).sample_time_ns, 20);
+        assert!(close(held.at(65).left.origin, Vec3::new(2.0, 0.0, 0.0)));
+        // Between the last sample and the next pass the last holds, its stamp its own.
+        assert_eq!(looped.at(25).sample_time_ns, 20);
+        // Two passes later (60 ns) the data of 5 ns, stamped at 65 ns.
+        let s = looped.at(65);
+        assert_eq!(s.sample_time_ns, 65);
+        assert!(close(s.left.origin, Vec3::new(0.5, 0.0, 0.0)));
+        // Stamps never go back across a pass.
+        let stamps: Vec<i64> = (0..200).map(|t| looped.at(t).sample_time_ns).collect();
+        assert!(stamps.windows(2).all(|w| w[1] >= w[0]), "{stamps:?}");
+        assert_eq!(
+            looped.behaviour_at(65).onset_ns,
+            held.behaviour_at(5).onset_ns + 60
+        );
+        // A single sample holds, looped or not.
+        let one = GazeTimeline::new(&lines[..1]).unwrap().looped();
+        assert_eq!(one.at(1000).sample_time_ns, 0);
     }
 
     #[test]

@@ -7,9 +7,11 @@
 //! rendered it. For each frame:
 //! - the head pose is interpolated between the samples around the frame time (position
 //!   linearly, orientation by slerp);
-//! - the gaze is the newest sample whose `sample_time_ns` is at or before the frame time, so a
-//!   30 Hz tracker seen by a 90 Hz loop gives the same sample (same `sample_time_ns`) to about
-//!   three frames: samples are never invented or interpolated;
+//! - the gaze is that of the newest sample (line) at or before the frame time, what was known
+//!   then: a 30 Hz tracker seen by a 90 Hz loop gives the same gaze sample (same
+//!   `sample_time_ns`) to about three frames, and a gaze sample stamped before the frame but
+//!   written on a later line (it reached the recorder later: a tracker's latency) is not yet
+//!   the frame's; samples are never invented or interpolated;
 //! - each eye's view is the one the recording's newest views line at or before the frame time
 //!   gives (version 1.5: the eyes the headset drew from, in the head's frame), with the
 //!   configured field of view (the replay's images are its own size) or, asked

@@ -67,14 +67,8 @@ impl NullBackend {
         index: u64,
         time_ns: i64,
     ) -> Result<Option<FrameInput>, NullError> {
-        // Gaze times never decrease, so once one is after the frame time no later sample can
-        // be this frame's gaze; and since gaze time <= time_ns, the head bracket is covered too.
-        while !self.exhausted
-            && self
-                .buffer
-                .back()
-                .is_none_or(|s| s.gaze.sample_time_ns <= time_ns)
-        {
+        // The samples up to the first after the frame time: the head bracket and the gaze.
+        while !self.exhausted && self.buffer.back().is_none_or(|s| s.time_ns <= time_ns) {
             self.pull()?;
         }
         let Some(last) = self.buffer.back() else {
@@ -99,10 +93,10 @@ impl NullBackend {
             }
             _ => self.buffer[a].head,
         };
-        let g = self
-            .buffer
-            .iter()
-            .rposition(|s| s.gaze.sample_time_ns <= time_ns);
+        // The gaze known at the frame time is the newest line's at or before it: a sample
+        // stamped before the frame but written on a later line reached the recorder later (an
+        // eye tracker's latency, or its clock behind the runtime's).
+        let g = (self.buffer[a].time_ns <= time_ns).then_some(a);
         let gaze = g.map(|g| self.buffer[g].gaze);
         if let Some(g) = g {
             self.count_gaze_up_to(self.buffer_base + g as u64);

@@ -122,6 +122,47 @@ fn fast_loop_repeats_tracker_samples_without_inventing_any() {
 }
 
 #[test]
+fn a_gaze_sample_written_later_is_not_known_before_its_line() {
+    // An eye tracker 25 ms late: the line at 40 ms holds the sample of 15 ms, and so on.
+    let mut samples: Vec<TraceSample> = (0..6i64)
+        .map(|i| sample(1_000_000_000 + i * 20_000_000, Vec3::ZERO, 0.0))
+        .collect();
+    for (i, s) in samples.iter_mut().enumerate() {
+        let stamp = s.time_ns - 25_000_000;
+        let mut g = GazeSample::none(stamp.max(1_000_000_000));
+        g.left = GazeRay {
+            origin: Vec3::new(-0.03, 0.0, 0.0),
+            direction: Vec3::new(i as f32 * 0.1, 0.0, -1.0).normalize(),
+            valid: true,
+        };
+        s.gaze = g;
+    }
+    for at_samples in [true, false] {
+        let config = NullConfig {
+            at_samples,
+            frame_rate_hz: 100.0,
+            ..NullConfig::default()
+        };
+        let frames = run(&mut NullBackend::new(samples.clone(), config).unwrap());
+        for f in &frames {
+            // The newest line at or before the frame, not the newest stamp at or before it
+            // (the line at 60 ms holds a sample stamped at 35 ms, which a frame at 40 ms did
+            // not have yet).
+            let line = samples
+                .iter()
+                .rposition(|s| s.time_ns <= f.time_ns)
+                .unwrap();
+            assert_eq!(
+                f.gaze,
+                Some(samples[line].gaze),
+                "frame at {} ns",
+                f.time_ns
+            );
+        }
+    }
+}
+
+#[test]
 fn views_are_an_ipd_apart_along_head_x() {
     let samples = vec![
         sample(0, Vec3::new(1.0, 1.6, 0.0), 0.7),

@@ -49,7 +49,7 @@ pub use choose::{ColorFormat, GazeChoice, GazeSource};
 pub use device_creator::XrDeviceCreator;
 pub(crate) use error::XrContext;
 pub use error::{OpenXrError, Result};
-pub use gaze::{GazeOrder, GazeTally};
+pub use gaze::{GazeOrder, GazeTally, Ordered};
 pub use session::{Interruptions, Session, SessionReport, interrupted};
 pub use state::{EndReason, State};
 
@@ -409,9 +409,9 @@ pub struct Continued {
     /// How long the app waited for the runtime to come back, milliseconds (the new session's
     /// first events say so: [`vitreous_trace::SessionEvent::Reconnected`]).
     pub waited_ms: u64,
-    /// The newest gaze sample a frame got: the new session's samples are held against it
-    /// ([`GazeOrder`]).
-    pub newest_gaze: Option<vitreous_trace::GazeSample>,
+    /// The frames' gaze order so far: the new session's samples are held against the newest
+    /// a frame got ([`GazeOrder`]).
+    pub gaze_order: GazeOrder,
     /// The newest usable display time a frame was predicted at, and when: the new session's
     /// frames must come after it, and not further ahead than the world's time moved.
     pub last_display: Option<(i64, std::time::Instant)>,

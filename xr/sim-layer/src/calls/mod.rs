@@ -114,14 +114,19 @@ impl SessionContext {
         })
     }
 
-    /// The eye data at runtime time `time_ns`, its `sample_time_ns` on the runtime clock.
-    /// Before the session's first frame there is no clock mapping yet: the trace's first
-    /// sample, stamped `time_ns`.
+    /// The eye data at runtime time `time_ns`, its `sample_time_ns` on the runtime clock (or
+    /// that far ahead of it while a `gaze-clock` fault lasts). Before the session's first frame
+    /// there is no clock mapping yet: the trace's first sample, stamped `time_ns`.
     pub fn gaze_at(&self, time_ns: i64) -> Option<GazeSample> {
-        match crate::faults::with(|f| f.dropout_at(time_ns)).flatten() {
+        let (dropout, lead_ns) =
+            crate::faults::with(|f| (f.dropout_at(time_ns), f.gaze_lead_at(time_ns)))
+                .unwrap_or((None, 0));
+        let mut sample = match dropout {
             None => self.trace_gaze_at(time_ns),
             Some((kind, from_ns)) => self.dropped_out(time_ns, kind, from_ns),
-        }
+        }?;
+        sample.sample_time_ns += lead_ns;
+        Some(sample)
     }
 
     /// The eye data while the tracker drops out (`kind`, since `from_ns`): the sample at the

@@ -1,7 +1,8 @@
 //! A headset that misbehaves: what real runtimes do to a session (the wearer taking the headset
 //! off, a system menu, a lost session or runtime, a recentre, frames not to render or late,
 //! swapchain timeouts, failing calls, lost tracking, poses marked valid that hold none, display
-//! times no frame can have, an eye tracker dropping out, eyes that change), injected from a
+//! times no frame can have, an eye tracker dropping out or its clock running ahead, eyes that
+//! change), injected from a
 //! schedule (`VITREOUS_SIM_FAULTS`, [`schedule`]) so a test can watch the app survive each.
 //!
 //! The schedule runs once per process, across every instance and session the app makes (an

@@ -14,6 +14,7 @@
 //! frame 600 tracking-lost 20 10    # head position lost for 20 frames, then orientation for 10
 //! frame 650 unusable-pose 5        # 5 frames of head poses marked valid holding NaN and zeros
 //! frame 700 gaze-dropout 2 invalid # the eye tracker drops out for 2 s (none, invalid or low)
+//! frame 715 gaze-clock 1 20        # for 1 s the eye tracker stamps its samples 20 ms ahead
 //! frame 730 bad-time 3 negative    # 3 frames at a negative display time (or repeat, or ahead)
 //! frame 760 eyes 58 2              # the eyes from now on 58 mm apart, each turned 2 degrees out
 //! chaos 7 2000                     # a random schedule of every fault over 2000 frames (seed 7)
@@ -141,6 +142,11 @@ pub enum Fault {
     UnusablePose(u64),
     /// The eye tracker drops out for this many seconds of display time.
     GazeDropout(f64, Dropout),
+    /// For this many seconds of display time the eye tracker's clock runs this many
+    /// milliseconds ahead of the runtime's (behind, when negative): every sample is stamped
+    /// that much after the time it holds (after the frame's display time, when asked at it;
+    /// behind, before samples already handed out).
+    GazeClock(f64, i64),
     /// For this many frames `xrWaitFrame` predicts a display time no frame can have.
     BadTime(u64, BadTime),
     /// From now on `xrLocateViews` answers eyes this many millimetres apart, each view turned
@@ -165,6 +171,7 @@ impl Fault {
             Fault::TrackingLost(..) => "tracking-lost",
             Fault::UnusablePose(_) => "unusable-pose",
             Fault::GazeDropout(..) => "gaze-dropout",
+            Fault::GazeClock(..) => "gaze-clock",
             Fault::BadTime(..) => "bad-time",
             Fault::Eyes(..) => "eyes",
         }
@@ -195,6 +202,7 @@ impl fmt::Display for Fault {
             Fault::RuntimeFailure(call) => write!(f, " {call}"),
             Fault::TrackingLost(p, o) => write!(f, " {p} {o}"),
             Fault::GazeDropout(s, kind) => write!(f, " {s} {}", kind.name()),
+            Fault::GazeClock(s, ms) => write!(f, " {s} {ms}"),
             Fault::BadTime(n, kind) => write!(f, " {n} {}", kind.name()),
             Fault::Eyes(ipd, toe) => write!(f, " {ipd} {toe}"),
             Fault::Recentre => Ok(()),
@@ -358,6 +366,18 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
                 }
             },
         ),
+        ["gaze-clock", s, ms] => Fault::GazeClock(
+            seconds(s, "gaze-clock", 0.001, MAX_SECONDS)?,
+            ms.parse::<i64>()
+                .ok()
+                .filter(|n| *n != 0 && n.abs() <= 1000)
+                .ok_or_else(|| {
+                    format!(
+                        "gaze-clock: `{ms}` is not a whole number of milliseconds ahead, -1000 \
+                         to 1000 and not 0"
+                    )
+                })?,
+        ),
         ["bad-time", n, kind] => Fault::BadTime(
             whole(n, "bad-time", 1, 1000)?,
             match *kind {
@@ -390,7 +410,8 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
                 "`{name}`: not a fault with those arguments (headset-off S, menu N, session-loss S, \
                  instance-loss S, recentre, no-render N, late N, image-timeout N, \
                  runtime-failure CALL, tracking-lost N N, unusable-pose N, \
-                 gaze-dropout S none|invalid|low, bad-time N negative|repeat|ahead, eyes MM [DEG])"
+                 gaze-dropout S none|invalid|low, gaze-clock S MS, \
+                 bad-time N negative|repeat|ahead, eyes MM [DEG])"
             ));
         }
         [] => return Err("a trigger with no fault after it".into()),
@@ -401,11 +422,11 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
 /// least once, in a shuffled order, then more drawn at random, each starting 60 to 160 frames
 /// after the one before ended (the app has time to recover and show frames in between).
 /// Outages last 0.5 to 3 s, a menu 10 to 60 frames, a dropout 0.3 to 3 s, unusable poses 1 to
-/// 10 frames, bad display times 1 to 5; new eyes are 54 to 72 mm apart and turned 0 to 3
-/// degrees outwards.
+/// 10 frames, bad display times 1 to 5, an eye tracker's clock 5 to 100 ms ahead (or, one
+/// time in four, 50 to 500 ms behind) for 0.3 to 3 s; new eyes are 54 to 72 mm apart and turned 0 to 3 degrees outwards.
 pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
     let mut rng = SplitMix64(seed ^ 0x6368_616f_735f_7673);
-    let families = 14u64;
+    let families = 15u64;
     let mut order: Vec<u64> = (0..families).collect();
     rng.shuffle(&mut order);
     let mut out = Vec::new();
@@ -461,6 +482,14 @@ pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
                 let kind =
                     [BadTime::Negative, BadTime::Repeat, BadTime::Ahead][rng.below(3) as usize];
                 (Fault::BadTime(n, kind), n)
+            }
+            13 => {
+                let s = secs(&mut rng, 0.3, 3.0);
+                let ms = match rng.below(4) {
+                    0 => -50 - rng.below(451) as i64,
+                    _ => 5 + rng.below(96) as i64,
+                };
+                (Fault::GazeClock(s, ms), (s * 20.0) as u64)
             }
             _ => {
                 let ipd = 54.0 + 0.5 * rng.below(37) as f32;

@@ -12,8 +12,8 @@
 //! `_NOT_STOPPING`), so an app that mishandles the walk fails the way it would on a headset.
 //!
 //! Just over 600 lines, one idea: the state every fault keeps and when each starts; the
-//! session's walk (`walk.rs`), the bad display times (`display_time.rs`) and the tests are
-//! apart.
+//! session's walk (`walk.rs`), the bad display times (`display_time.rs`), the eye tracker's
+//! faults (`gaze.rs`) and the tests are apart.
 
 use std::collections::{HashMap, HashSet, VecDeque};
 use std::time::{Duration, Instant};
@@ -22,6 +22,7 @@ use openxr::sys;
 
 use super::schedule::{BadTime, Dropout, Fault, Scheduled, Trigger};
 use crate::config::SimViews;
+use gaze::GazeFaults;
 
 /// Something the layer hands the app through `xrPollEvent`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -184,8 +185,8 @@ pub struct Faults {
     falsified: Option<(i64, i64, BadTime)>,
     /// What this frame's head poses lack.
     tracking_now: Option<TrackingLoss>,
-    /// Eye tracker dropouts: from, until (runtime time), how.
-    dropouts: Vec<(i64, i64, Dropout)>,
+    /// The eye tracker's dropouts and clocks ahead.
+    gaze: GazeFaults,
     /// The eyes the newest `eyes` fault gave the headset, if one has started.
     eyes: Option<SimViews>,
     /// Lines for the fault log, taken by the caller.
@@ -221,7 +222,7 @@ impl Faults {
             shown_ns: None,
             falsified: None,
             tracking_now: None,
-            dropouts: Vec::new(),
+            gaze: GazeFaults::default(),
             eyes: None,
             log,
         }
@@ -475,10 +476,10 @@ impl Faults {
             Fault::UnusablePose(n) => self.unusable_left = n,
             Fault::BadTime(n, kind) => self.bad_time_left = (n, kind),
             Fault::GazeDropout(s, kind) => {
-                let end = display_ns + (s * 1e9) as i64;
-                self.dropouts.push((display_ns, end, kind));
+                self.gaze.drop_out(display_ns, s, kind);
                 self.log.push(("dropout", format!("{} {s}", kind.name())));
             }
+            Fault::GazeClock(s, ms) => self.gaze.run_ahead(display_ns, s, ms),
             Fault::Eyes(ipd_mm, toe_out_deg) => self.eyes = SimViews::new(ipd_mm, toe_out_deg),
         }
     }
@@ -583,11 +584,13 @@ impl Faults {
 
     /// The eye tracker's dropout at runtime time `time_ns`, and when it started, if any.
     pub fn dropout_at(&self, time_ns: i64) -> Option<(Dropout, i64)> {
-        self.dropouts
-            .iter()
-            .rev()
-            .find(|(from, until, _)| (*from..*until).contains(&time_ns))
-            .map(|(from, _, kind)| (*kind, *from))
+        self.gaze.dropout_at(time_ns)
+    }
+
+    /// How far ahead of the runtime's the eye tracker's clock is at runtime time `time_ns`,
+    /// nanoseconds (behind: negative; 0 but during a `gaze-clock` fault).
+    pub fn gaze_lead_at(&self, time_ns: i64) -> i64 {
+        self.gaze.lead_at(time_ns)
     }
 }
 
@@ -613,6 +616,7 @@ pub fn state_name(state: sys::SessionState) -> &'static str {
 }
 
 mod display_time;
+mod gaze;
 #[cfg(test)]
 mod tests;
 mod walk;

@@ -10,7 +10,7 @@ use vitreous_trace::Blend;
 
 use super::super::actions::Controls;
 use super::super::choose::{self, GazeChoice, GazeOffer, GazeSource, SpaceChoice};
-use super::super::gaze::{ExtGaze, FbTracker, Gaze, GazeOrder, TraceGaze};
+use super::super::gaze::{ExtGaze, FbTracker, Gaze, TraceGaze};
 use super::super::ml_tracker::MlTracker;
 use super::super::state::State;
 use super::super::{
@@ -256,7 +256,7 @@ pub(in crate::openxr) unsafe fn start(
             injected_tx,
             injected_rx,
             gaze,
-            gaze_order: GazeOrder::after(options.continued.and_then(|c| c.newest_gaze)),
+            gaze_order: options.continued.map(|c| c.gaze_order).unwrap_or_default(),
             space,
             space_type,
             view_space,

@@ -234,17 +234,7 @@ impl Session {
             .gaze
             .sample(&self.session, &self.view_space, display, first_display);
         self.report.gaze_samples.count(&sampled);
-        let (gaze, out_of_order) = self.gaze_order.order(sampled.frame);
-        if out_of_order {
-            if self.report.gaze_samples.out_of_order == 0 {
-                tracing::warn!(
-                    "frame {}: the eye tracker's sample is stamped before one already used: \
-                     the newest is used again (counted in summary.json's gaze_samples)",
-                    self.next_index
-                );
-            }
-            self.report.gaze_samples.out_of_order += 1;
-        }
+        let gaze = self.order_gaze(&sampled, display.as_nanos());
         let eye = |i: usize| EyeView {
             pose: compose(&world_from_space, &eyes[i]),
             fov: Fov {

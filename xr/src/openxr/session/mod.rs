@@ -11,6 +11,7 @@ mod depth;
 mod display_time;
 mod frame;
 mod frame_end;
+mod gaze_time;
 mod images;
 mod interruptions;
 mod placement;
@@ -363,9 +364,9 @@ impl Session {
         self.last_display
     }
 
-    /// The newest gaze sample a frame got.
-    pub fn newest_gaze(&self) -> Option<vitreous_trace::GazeSample> {
-        self.gaze_order.newest()
+    /// The frames' gaze order so far (the newest sample a frame got).
+    pub fn gaze_order(&self) -> GazeOrder {
+        self.gaze_order
     }
 
     /// Where the application sends commands to be applied as if a live action gave them, at

@@ -18,19 +18,24 @@ fn every_fault_parses_and_prints_back() {
         frame 650 unusable-pose 5
         frame 700 gaze-dropout 2 invalid
         frame 705 bad-time 3 negative
+        frame 708 gaze-clock 1.5 20
+        frame 709 gaze-clock 0.5 -300
         frame 710 eyes 58.5 2
         frame 720 eyes 70
     ";
     let parsed = parse(text).unwrap();
-    assert_eq!(parsed.len(), 15);
+    assert_eq!(parsed.len(), 17);
     // Frame triggers first, in frame order; the time trigger after them.
     assert_eq!(parsed[0].to_string(), "frame 40 headset-off 3");
     assert_eq!(parsed[9].to_string(), "frame 650 unusable-pose 5");
     assert_eq!(parsed[10].to_string(), "frame 700 gaze-dropout 2 invalid");
     assert_eq!(parsed[11].to_string(), "frame 705 bad-time 3 negative");
-    assert_eq!(parsed[12].fault, Fault::Eyes(58.5, 2.0));
-    assert_eq!(parsed[13].to_string(), "frame 720 eyes 70 0");
-    assert_eq!(parsed[14].to_string(), "at 9.5 session-loss 2");
+    assert_eq!(parsed[12].fault, Fault::GazeClock(1.5, 20));
+    assert_eq!(parsed[12].to_string(), "frame 708 gaze-clock 1.5 20");
+    assert_eq!(parsed[13].fault, Fault::GazeClock(0.5, -300));
+    assert_eq!(parsed[14].fault, Fault::Eyes(58.5, 2.0));
+    assert_eq!(parsed[15].to_string(), "frame 720 eyes 70 0");
+    assert_eq!(parsed[16].to_string(), "at 9.5 session-loss 2");
     for s in &parsed {
         assert_eq!(parse(&s.to_string()).unwrap(), vec![s.clone()]);
     }
@@ -58,6 +63,13 @@ fn bad_lines_are_named_with_what_was_expected() {
             "`blink` is not none, invalid or low",
         ),
         ("frame 3 tracking-lost 0 0", "no frame lost"),
+        (
+            "frame 3 gaze-clock 1 0",
+            "gaze-clock: `0` is not a whole number of milliseconds ahead, -1000 to 1000",
+        ),
+        ("frame 3 gaze-clock 1 1001", "gaze-clock: `1001` is not"),
+        ("frame 3 gaze-clock 1 2.5", "gaze-clock: `2.5` is not"),
+        ("frame 3 gaze-clock 1", "`gaze-clock`: not a fault"),
         (
             "frame 3 eyes 30",
             "eyes: `30` is not a distance of 40 to 90",
@@ -103,6 +115,7 @@ fn chaos_is_reproducible_and_has_every_family_spaced_out() {
         "tracking-lost",
         "unusable-pose",
         "gaze-dropout",
+        "gaze-clock",
         "bad-time",
         "eyes",
     ] {

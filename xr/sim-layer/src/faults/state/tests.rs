@@ -266,6 +266,31 @@ fn a_dropout_covers_its_display_time_span() {
 }
 
 #[test]
+fn a_gaze_clock_runs_ahead_over_its_display_time_span() {
+    let now = Instant::now();
+    let mut f = focused("frame 1 gaze-clock 0.05 20");
+    for _ in 0..2 {
+        frame(&mut f, now);
+    }
+    let start = PERIOD_NS + 1;
+    assert_eq!(f.gaze_lead_at(start - 1), 0);
+    assert_eq!(f.gaze_lead_at(start), 20_000_000);
+    assert_eq!(f.gaze_lead_at(start + 49_999_999), 20_000_000);
+    assert_eq!(f.gaze_lead_at(start + 50_000_000), 0);
+    // Started like every fault, the eye tracker's own timing untouched otherwise.
+    assert!(
+        f.take_log()
+            .iter()
+            .any(|(e, d)| *e == "fault" && d == "gaze-clock 0.05 20")
+    );
+    assert_eq!(f.dropout_at(start), None);
+    // Behind: the stamps go back.
+    let mut f = focused("frame 0 gaze-clock 0.05 -300");
+    frame(&mut f, now);
+    assert_eq!(f.gaze_lead_at(1), -300_000_000);
+}
+
+#[test]
 fn new_eyes_hold_from_their_frame_and_the_newest_wins() {
     let now = Instant::now();
     let mut f = focused("frame 2 eyes 58 2\nframe 4 eyes 70");

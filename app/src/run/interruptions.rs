@@ -100,6 +100,9 @@ pub struct InterruptionSummary {
     /// Frames whose head or eye pose the runtime marked valid but was not usable (not finite,
     /// not a unit quaternion): taken as lost tracking.
     pub frames_unusable_pose: u64,
+    /// Frames whose views' field of view the runtime marked valid but was none (four zero
+    /// angles, not finite, not left of right and below up): not drawn.
+    pub frames_unusable_field: u64,
     /// Times the reference space changed (recentred).
     pub recentres: u64,
     /// Swapchain image waits that timed out and were waited for again.
@@ -153,6 +156,7 @@ impl InterruptionSummary {
             tracking_lost_orientation: i.tracking_losses[TrackingLoss::Orientation as usize],
             frames_position_held: i.frames_position_held,
             frames_unusable_pose: i.frames_unusable_pose,
+            frames_unusable_field: i.frames_unusable_field,
             recentres: report.space_changes,
             image_wait_timeouts: i.image_wait_timeouts,
             failed_calls: i

@@ -36,6 +36,15 @@ pub(super) fn usable_orientation(p: &xr::Posef) -> bool {
     (norm - 1.0).abs() < 0.1
 }
 
+/// Whether a view's field of view is one an image can be drawn with: every angle a finite
+/// number within a right angle of straight ahead, left of right and below up (runtimes have
+/// answered four zero angles when asked too early).
+pub(super) fn usable_field(f: &xr::Fovf) -> bool {
+    let angles = [f.angle_left, f.angle_right, f.angle_up, f.angle_down];
+    let within = |a: &f32| a.is_finite() && a.abs() < std::f32::consts::FRAC_PI_2;
+    angles.iter().all(within) && f.angle_left < f.angle_right && f.angle_down < f.angle_up
+}
+
 /// OpenXR's pose of one of vitreous's.
 pub(super) fn posef_of(p: &Pose) -> xr::Posef {
     xr::Posef {
@@ -103,5 +112,28 @@ mod tests {
         // All zero (handed out marked valid at start-up), or far from unit length.
         assert!(!usable_orientation(&posef([0.0; 3], [0.0; 4])));
         assert!(!usable_orientation(&posef([0.0; 3], [0.0, 0.0, 0.0, 0.5])));
+    }
+
+    #[test]
+    fn a_field_of_view_is_one_when_it_spans_left_to_right_and_down_to_up() {
+        let fov = |l: f32, r: f32, u: f32, d: f32| xr::Fovf {
+            angle_left: l,
+            angle_right: r,
+            angle_up: u,
+            angle_down: d,
+        };
+        // Magic Leap 2's left eye (about 44 by 53 degrees, off centre), and a narrow one.
+        assert!(usable_field(&fov(-0.42, 0.35, 0.48, -0.44)));
+        assert!(usable_field(&fov(0.01, 0.02, 0.02, 0.01)));
+        for bad in [
+            fov(0.0, 0.0, 0.0, 0.0),
+            fov(0.4, -0.4, 0.4, -0.4),
+            fov(-0.4, 0.4, -0.4, 0.4),
+            fov(-0.4, f32::NAN, 0.4, -0.4),
+            fov(-1.6, 0.4, 0.4, -0.4),
+            fov(-0.4, 0.4, f32::INFINITY, -0.4),
+        ] {
+            assert!(!usable_field(&bad), "{bad:?}");
+        }
     }
 }

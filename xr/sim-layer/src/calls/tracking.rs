@@ -1,7 +1,8 @@
 //! Lost head tracking ([`crate::faults`]): the frames whose head poses the fault schedule
 //! takes the position (then the orientation too) from, or fills with numbers no pose can hold
 //! while marking them valid, in `xrLocateViews` and in `xrLocateSpace` of the head (a VIEW
-//! reference space) against the world (LOCAL or STAGE). What a pose's flags say is not valid
+//! reference space) against the world (LOCAL or STAGE); and the frames whose views'
+//! fields of view `xrLocateViews` answers as four zero angles. What a pose's flags say is not valid
 //! the specification leaves undefined: the layer writes NaN there, so an app that reads it
 //! shows it.
 
@@ -32,9 +33,12 @@ fn lose(pose: &mut sys::Posef, loss: TrackingLoss) {
         y: f32::NAN,
         z: f32::NAN,
     };
+    if loss == TrackingLoss::ZeroFov {
+        return;
+    }
     pose.position = nan;
     match loss {
-        TrackingLoss::Position => {}
+        TrackingLoss::Position | TrackingLoss::ZeroFov => {}
         TrackingLoss::Orientation => {
             pose.orientation = sys::Quaternionf {
                 x: f32::NAN,
@@ -59,7 +63,7 @@ fn kept_flags(flags: sys::SpaceLocationFlags, loss: TrackingLoss) -> sys::SpaceL
     match loss {
         TrackingLoss::Position => without_position(flags),
         TrackingLoss::Orientation => without_orientation(flags),
-        TrackingLoss::Unusable => flags,
+        TrackingLoss::Unusable | TrackingLoss::ZeroFov => flags,
     }
 }
 
@@ -147,7 +151,16 @@ pub unsafe extern "system" fn locate_views(
         state.view_state_flags = sys::ViewStateFlags::from_raw(kept.into_raw());
         for i in 0..written {
             // SAFETY: the app's array of `capacity` views, `written` of them filled.
-            lose(unsafe { &mut (*views.add(i)).pose }, loss);
+            let view = unsafe { &mut *views.add(i) };
+            lose(&mut view.pose, loss);
+            if loss == TrackingLoss::ZeroFov {
+                view.fov = sys::Fovf {
+                    angle_left: 0.0,
+                    angle_right: 0.0,
+                    angle_up: 0.0,
+                    angle_down: 0.0,
+                };
+            }
         }
         r
     })

@@ -23,7 +23,8 @@
 //! failed with `XR_ERROR_RUNTIME_FAILURE`, detail the call), `lost-call` (a call refused as
 //! lost, detail the call and result), `unavailable` (`xrGetSystem` or `xrCreateInstance`
 //! refused during an outage), `tracking` (a frame's head poses reported without position, or
-//! without orientation), `dropout` (the eye tracker drops out, detail the kind and seconds),
+//! without orientation, or unusable; or its views' fields of view zero: detail `position`,
+//! `orientation`, `unusable` or `zerofov`), `dropout` (the eye tracker drops out, detail the kind and seconds),
 //! `unfocused-sync` (an `xrSyncActions` while the session was not focused) and `refused` (a
 //! call out of order for the state the app was shown, detail the call and the result).
 

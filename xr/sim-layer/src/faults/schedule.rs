@@ -13,6 +13,7 @@
 //! frame 580 runtime-failure xrLocateViews   # one call fails with XR_ERROR_RUNTIME_FAILURE
 //! frame 600 tracking-lost 20 10    # head position lost for 20 frames, then orientation for 10
 //! frame 650 unusable-pose 5        # 5 frames of head poses marked valid holding NaN and zeros
+//! frame 670 zero-fov 2             # 2 frames whose views' fields of view are four zeros
 //! frame 700 gaze-dropout 2 invalid # the eye tracker drops out for 2 s (none, invalid or low)
 //! frame 715 gaze-clock 1 20        # for 1 s the eye tracker stamps its samples 20 ms ahead
 //! frame 730 bad-time 3 negative    # 3 frames at a negative display time (or repeat, or ahead)
@@ -140,6 +141,9 @@ pub enum Fault {
     /// For this many frames the head's located poses are marked valid but hold nothing
     /// usable: positions not a number, all-zero quaternions.
     UnusablePose(u64),
+    /// For this many frames `xrLocateViews` answers every view's field of view as four zero
+    /// angles, its poses and flags as they are (a runtime asked before it knows its views).
+    ZeroFov(u64),
     /// The eye tracker drops out for this many seconds of display time.
     GazeDropout(f64, Dropout),
     /// For this many seconds of display time the eye tracker's clock runs this many
@@ -170,6 +174,7 @@ impl Fault {
             Fault::RuntimeFailure(_) => "runtime-failure",
             Fault::TrackingLost(..) => "tracking-lost",
             Fault::UnusablePose(_) => "unusable-pose",
+            Fault::ZeroFov(_) => "zero-fov",
             Fault::GazeDropout(..) => "gaze-dropout",
             Fault::GazeClock(..) => "gaze-clock",
             Fault::BadTime(..) => "bad-time",
@@ -198,7 +203,8 @@ impl fmt::Display for Fault {
             | Fault::NoRender(n)
             | Fault::Late(n)
             | Fault::ImageTimeout(n)
-            | Fault::UnusablePose(n) => write!(f, " {n}"),
+            | Fault::UnusablePose(n)
+            | Fault::ZeroFov(n) => write!(f, " {n}"),
             Fault::RuntimeFailure(call) => write!(f, " {call}"),
             Fault::TrackingLost(p, o) => write!(f, " {p} {o}"),
             Fault::GazeDropout(s, kind) => write!(f, " {s} {}", kind.name()),
@@ -331,6 +337,7 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
         ["recentre"] => Fault::Recentre,
         ["no-render", n] => Fault::NoRender(frames(n, "no-render")?),
         ["unusable-pose", n] => Fault::UnusablePose(frames(n, "unusable-pose")?),
+        ["zero-fov", n] => Fault::ZeroFov(frames(n, "zero-fov")?),
         ["late", n] => Fault::Late(whole(n, "late", 1, 100)?),
         ["image-timeout", n] => Fault::ImageTimeout(whole(n, "image-timeout", 1, 100)?),
         ["runtime-failure", call] => Fault::RuntimeFailure(
@@ -409,7 +416,7 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
             return Err(format!(
                 "`{name}`: not a fault with those arguments (headset-off S, menu N, session-loss S, \
                  instance-loss S, recentre, no-render N, late N, image-timeout N, \
-                 runtime-failure CALL, tracking-lost N N, unusable-pose N, \
+                 runtime-failure CALL, tracking-lost N N, unusable-pose N, zero-fov N, \
                  gaze-dropout S none|invalid|low, gaze-clock S MS, \
                  bad-time N negative|repeat|ahead, eyes MM [DEG])"
             ));
@@ -419,14 +426,14 @@ fn fault_of(words: &[&str]) -> Result<Fault, String> {
 }
 
 /// A random schedule from `seed` over the app's first `frames` frames: every fault family at
-/// least once, in a shuffled order, then more drawn at random, each starting 60 to 160 frames
+/// least once, in a shuffled order, then more drawn at random, each starting 50 to 130 frames
 /// after the one before ended (the app has time to recover and show frames in between).
 /// Outages last 0.5 to 3 s, a menu 10 to 60 frames, a dropout 0.3 to 3 s, unusable poses 1 to
-/// 10 frames, bad display times 1 to 5, an eye tracker's clock 5 to 100 ms ahead (or, one
-/// time in four, 50 to 500 ms behind) for 0.3 to 3 s; new eyes are 54 to 72 mm apart and turned 0 to 3 degrees outwards.
+/// 10 frames, zero fields of view 1 to 5, bad display times 1 to 5, an eye tracker's clock 5
+/// to 100 ms ahead (or, one time in four, 50 to 500 ms behind) for 0.3 to 3 s; new eyes are 54 to 72 mm apart and turned 0 to 3 degrees outwards.
 pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
     let mut rng = SplitMix64(seed ^ 0x6368_616f_735f_7673);
-    let families = 15u64;
+    let families = 16u64;
     let mut order: Vec<u64> = (0..families).collect();
     rng.shuffle(&mut order);
     let mut out = Vec::new();
@@ -483,6 +490,10 @@ pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
                     [BadTime::Negative, BadTime::Repeat, BadTime::Ahead][rng.below(3) as usize];
                 (Fault::BadTime(n, kind), n)
             }
+            14 => {
+                let n = 1 + rng.below(5);
+                (Fault::ZeroFov(n), n)
+            }
             13 => {
                 let s = secs(&mut rng, 0.3, 3.0);
                 let ms = match rng.below(4) {
@@ -501,7 +512,7 @@ pub fn chaos(seed: u64, frames: u64) -> Vec<Scheduled> {
             trigger: Trigger::Frame(at),
             fault,
         });
-        at += length + 60 + rng.below(101);
+        at += length + 50 + rng.below(81);
     }
     out
 }

@@ -62,6 +62,9 @@ pub enum TrackingLoss {
     /// Both marked valid, but holding nothing usable: the position not a number, the
     /// orientation an all-zero quaternion (as runtimes have handed out at start-up).
     Unusable,
+    /// The poses as they are, but every view's field of view four zero angles (as a runtime
+    /// asked for its views too early answers).
+    ZeroFov,
 }
 
 /// What the layer does with the app's `xrWaitFrame`.
@@ -176,6 +179,8 @@ pub struct Faults {
     tracking_left: (u64, u64),
     /// Frames still to hand out unusable head poses marked valid.
     unusable_left: u64,
+    /// Frames left whose views have a zero field of view.
+    zero_fov_left: u64,
     /// Frames still to predict at a bad display time, and how.
     bad_time_left: (u64, BadTime),
     /// The display time the app was shown for its newest frame.
@@ -218,6 +223,7 @@ impl Faults {
             failing: Vec::new(),
             tracking_left: (0, 0),
             unusable_left: 0,
+            zero_fov_left: 0,
             bad_time_left: (0, BadTime::Negative),
             shown_ns: None,
             falsified: None,
@@ -375,6 +381,10 @@ impl Faults {
         self.start_due(session, frame, display_ns, now);
         self.falsify_time(display_ns);
         self.tracking_now = match self.tracking_left {
+            _ if self.zero_fov_left > 0 => {
+                self.zero_fov_left -= 1;
+                Some(TrackingLoss::ZeroFov)
+            }
             _ if self.unusable_left > 0 => {
                 self.unusable_left -= 1;
                 Some(TrackingLoss::Unusable)
@@ -474,6 +484,7 @@ impl Faults {
             Fault::RuntimeFailure(call) => self.failing.push(call),
             Fault::TrackingLost(p, o) => self.tracking_left = (p, o),
             Fault::UnusablePose(n) => self.unusable_left = n,
+            Fault::ZeroFov(n) => self.zero_fov_left = n,
             Fault::BadTime(n, kind) => self.bad_time_left = (n, kind),
             Fault::GazeDropout(s, kind) => {
                 self.gaze.drop_out(display_ns, s, kind);

@@ -14,10 +14,10 @@
 //! app may start a new one); a runtime that stops the session (the headset taken off) is waited
 //! for, without a time limit, until it makes the session ready again.
 //!
-//! Just over 600 lines: every step of the scope (wait, begin, acquire, locate, submit, leave)
-//! reads and writes the same open frame and the session's counts of what a misbehaving headset
-//! did; the pure parts are already apart (`scope.rs`, `tracking.rs`, `interruptions.rs`,
-//! `images.rs`, `depth.rs`).
+//! Every step of the scope (wait, begin, acquire, submit, leave) reads and writes the same open
+//! frame and the session's counts of what a misbehaving headset did; what can stand apart does
+//! (`scope.rs`, `locate.rs`, `tracking.rs`, `interruptions.rs`, `images.rs`, `depth.rs`,
+//! `gaze_time.rs`, `display_time.rs`).
 
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -26,7 +26,6 @@ use openxr as xr;
 use vitreous_trace::session_event::{NotRendered, SessionEvent};
 use vitreous_trace::{EyeView, Fov, FrameInput};
 
-use super::super::convert::{pose_of, usable_orientation, usable_position};
 use super::super::state::{self, EndReason};
 use super::super::{OpenXrError, Result, XrContext};
 use super::depth::{chain_depth, depth_info};
@@ -36,7 +35,7 @@ use super::images;
 use super::interruptions::{MAX_FAILED_FRAMES_IN_A_ROW, Pending, Severity, severity};
 use super::placement::{compose, place_scene};
 use super::scope::{Handed, Hold, OpenFrame, Unwind};
-use super::tracking::{Located, Poses};
+use super::tracking::Located;
 use super::{INTERRUPTED, STATE_TIMEOUT, Session};
 use crate::{Backend, FrameTarget};
 
@@ -112,61 +111,6 @@ impl Session {
         }
         self.open_frame()?.depth = Hold::Waited;
         Ok((image, Some(depth)))
-    }
-
-    /// Locates the head and eyes for a frame displayed at `display`, in app space.
-    fn locate(&mut self, display: xr::Time) -> Result<(Poses, Vec<xr::View>)> {
-        let head = self
-            .view_space
-            .locate(&self.space, display)
-            .xr("xrLocateSpace")?;
-        let (flags, views) = self
-            .session
-            .locate_views(
-                xr::ViewConfigurationType::PRIMARY_STEREO,
-                display,
-                &self.space,
-            )
-            .xr("xrLocateViews")?;
-        if views.len() < 2 {
-            return Err(OpenXrError::Unsupported(format!(
-                "xrLocateViews gave {} views; expected 2",
-                views.len()
-            )));
-        }
-        let said_position = head
-            .location_flags
-            .contains(xr::SpaceLocationFlags::POSITION_VALID)
-            && flags.contains(xr::ViewStateFlags::POSITION_VALID);
-        let said_orientation = head
-            .location_flags
-            .contains(xr::SpaceLocationFlags::ORIENTATION_VALID)
-            && flags.contains(xr::ViewStateFlags::ORIENTATION_VALID);
-        let located = [&head.pose, &views[0].pose, &views[1].pose];
-        let position_valid = said_position && located.iter().all(|p| usable_position(p));
-        let orientation_valid = said_orientation && located.iter().all(|p| usable_orientation(p));
-        if (said_position, said_orientation) != (position_valid, orientation_valid) {
-            if self.report.interruptions.frames_unusable_pose == 0 {
-                tracing::warn!(
-                    "frame {}: the runtime marked the head's pose valid but gave {}: taken as \
-                     lost tracking (counted in summary.json's interruptions)",
-                    self.next_index,
-                    if said_orientation && !orientation_valid {
-                        "an orientation that is not a unit quaternion"
-                    } else {
-                        "a position that is not a finite number"
-                    }
-                );
-            }
-            self.report.interruptions.frames_unusable_pose += 1;
-        }
-        let poses = Poses {
-            head: pose_of(&head.pose),
-            eyes: [pose_of(&views[0].pose), pose_of(&views[1].pose)],
-            position_valid,
-            orientation_valid,
-        };
-        Ok((poses, views))
     }
 
     /// Everything between xrBeginFrame and handing the frame out: images, views, placement,

@@ -56,6 +56,9 @@ pub struct Interruptions {
     /// Frames whose located head or eye pose was marked valid but was not usable (a position
     /// not finite, an orientation not a unit quaternion): taken as lost tracking.
     pub frames_unusable_pose: u64,
+    /// Frames whose views' field of view was marked valid but was none (not finite, not left
+    /// of right and below up, or a right angle or more from straight ahead): not drawn.
+    pub frames_unusable_field: u64,
     /// Times head tracking lost the position, and the orientation.
     pub tracking_losses: [u64; 2],
     /// Display periods the runtime moved past with no frame waited for (the app was late).
@@ -83,6 +86,7 @@ impl Interruptions {
         self.not_rendered_exiting += later.not_rendered_exiting;
         self.frames_position_held += later.frames_position_held;
         self.frames_unusable_pose += later.frames_unusable_pose;
+        self.frames_unusable_field += later.frames_unusable_field;
         self.tracking_losses[0] += later.tracking_losses[0];
         self.tracking_losses[1] += later.tracking_losses[1];
         self.late_periods += later.late_periods;

@@ -14,6 +14,7 @@ mod frame_end;
 mod gaze_time;
 mod images;
 mod interruptions;
+mod locate;
 mod placement;
 mod scope;
 mod state_machine;

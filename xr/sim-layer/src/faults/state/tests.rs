@@ -266,6 +266,25 @@ fn a_dropout_covers_its_display_time_span() {
 }
 
 #[test]
+fn zero_fields_of_view_last_their_frames_and_are_logged() {
+    let now = Instant::now();
+    let mut f = focused("frame 1 zero-fov 2");
+    let seen: Vec<_> = (0..4)
+        .map(|_| {
+            frame(&mut f, now);
+            f.tracking()
+        })
+        .collect();
+    let zero = Some(TrackingLoss::ZeroFov);
+    assert_eq!(seen, [None, zero, zero, None]);
+    let logged = f.take_log();
+    let zeros = logged
+        .iter()
+        .filter(|(e, d)| *e == "tracking" && d == "zerofov");
+    assert_eq!(zeros.count(), 2);
+}
+
+#[test]
 fn a_gaze_clock_runs_ahead_over_its_display_time_span() {
     let now = Instant::now();
     let mut f = focused("frame 1 gaze-clock 0.05 20");

@@ -30,6 +30,7 @@ mod convert;
 mod device_creator;
 mod error;
 mod gaze;
+mod gaze_order;
 mod light_estimator;
 pub mod ml_eye_tracker;
 pub mod ml_light_estimation;
@@ -49,7 +50,8 @@ pub use choose::{ColorFormat, GazeChoice, GazeSource};
 pub use device_creator::XrDeviceCreator;
 pub(crate) use error::XrContext;
 pub use error::{OpenXrError, Result};
-pub use gaze::{GazeOrder, GazeTally, Ordered};
+pub use gaze::GazeTally;
+pub use gaze_order::{GazeOrder, Ordered};
 pub use session::{Interruptions, Session, SessionReport, interrupted};
 pub use state::{EndReason, State};
 

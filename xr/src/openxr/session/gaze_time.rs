@@ -1,6 +1,7 @@
-//! The frame's gaze sample in time order ([`crate::openxr::GazeOrder`]): a sample stamped before one a frame
-//! already got is not new, one stamped after the frame's display time is used at that time;
-//! both counted in the session's report and warned of once a session.
+//! The frame's gaze sample in time order ([`GazeOrder`](crate::openxr::GazeOrder)): a sample
+//! stamped before one a frame already got is not new, one stamped after the frame's display
+//! time is used at that time; both counted in the session's report and warned of once a
+//! session.
 
 use vitreous_trace::GazeSample;
 

@@ -33,7 +33,8 @@ use super::DepthOptions;
 use super::SessionOptions;
 use super::actions::Controls;
 use super::choose::{GazeSource, SpaceChoice};
-use super::gaze::{Gaze, GazeOrder, GazeTally};
+use super::gaze::{Gaze, GazeTally};
+use super::gaze_order::GazeOrder;
 use super::state::{EndReason, State};
 
 pub(super) use create::start;

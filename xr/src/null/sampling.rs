@@ -125,9 +125,9 @@ impl NullBackend {
             }),
         };
 
-        // Frame times increase: samples before both the head bracket and the gaze are done.
-        let keep_from = g.map_or(0, |g| g.min(a));
-        for _ in 0..keep_from {
+        // Frame times increase: samples before the head bracket, whose first holds the gaze,
+        // are done.
+        for _ in 0..a {
             self.buffer.pop_front();
             self.buffer_base += 1;
         }

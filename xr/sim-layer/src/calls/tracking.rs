@@ -1,10 +1,10 @@
 //! Lost head tracking ([`crate::faults`]): the frames whose head poses the fault schedule
 //! takes the position (then the orientation too) from, or fills with numbers no pose can hold
 //! while marking them valid, in `xrLocateViews` and in `xrLocateSpace` of the head (a VIEW
-//! reference space) against the world (LOCAL or STAGE); and the frames whose views'
-//! fields of view `xrLocateViews` answers as four zero angles. What a pose's flags say is not valid
-//! the specification leaves undefined: the layer writes NaN there, so an app that reads it
-//! shows it.
+//! reference space) against the world (LOCAL or STAGE); and the frames whose views' fields of
+//! view `xrLocateViews` answers as four zero angles. What a pose's flags say is not valid the
+//! specification leaves undefined: the layer writes NaN there, so an app that reads it shows
+//! it.
 
 use openxr::sys::{self, Handle};
 

@@ -3,27 +3,35 @@
 //! not numbers, all-zero quaternions and fields of four zero angles (asked for their views too
 //! early), all marked valid. Such a frame's poses are taken as lost tracking: its position held
 //! or the frame not drawn ([`super::tracking`]), warned once a session and counted.
+//!
+//! The views are located in the head's own frame (the VIEW space) and placed with the one head
+//! pose the frame has: each eye sits in the head exactly where the runtime says, whatever the
+//! two calls' predictions did apart (a runtime asked twice for one display time can answer two
+//! poses a little apart, and the eyes' place in the head, which a recording keeps in its views
+//! lines, would be their difference).
 
 use openxr as xr;
 
-use super::super::convert::{pose_of, usable_field, usable_orientation, usable_position};
+use super::super::convert::{pose_of, posef_of, usable_field, usable_orientation, usable_position};
 use super::super::{OpenXrError, Result, XrContext};
 use super::Session;
+use super::placement::compose;
 use super::tracking::Poses;
 
 impl Session {
-    /// Locates the head and eyes for a frame displayed at `display`, in app space.
+    /// Locates the head and eyes for a frame displayed at `display`, in app space (the views'
+    /// poses too).
     pub(super) fn locate(&mut self, display: xr::Time) -> Result<(Poses, Vec<xr::View>)> {
         let head = self
             .view_space
             .locate(&self.space, display)
             .xr("xrLocateSpace")?;
-        let (flags, views) = self
+        let (flags, mut views) = self
             .session
             .locate_views(
                 xr::ViewConfigurationType::PRIMARY_STEREO,
                 display,
-                &self.space,
+                &self.view_space,
             )
             .xr("xrLocateViews")?;
         if views.len() < 2 {
@@ -77,8 +85,12 @@ impl Session {
             }
             self.report.interruptions.frames_unusable_field += 1;
         }
+        let head_pose = pose_of(&head.pose);
+        for view in views.iter_mut() {
+            view.pose = posef_of(&compose(&head_pose, &pose_of(&view.pose)));
+        }
         let poses = Poses {
-            head: pose_of(&head.pose),
+            head: head_pose,
             eyes: [pose_of(&views[0].pose), pose_of(&views[1].pose)],
             position_valid,
             orientation_valid: orientation_usable && fields_usable,
